@@ -1,0 +1,121 @@
+"""Plain descriptions of what goes into an impact simulation (SI units, named frames).
+
+These dataclasses are the interface between the case files (``riskassess.case``) and the
+Exudyn builders; tests build them directly for analytic set-ups.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import trimesh
+
+from multibody.net import NetTopology
+
+
+@dataclass
+class RigidBodySpec:
+    """One debris rigid body.
+
+    Attributes
+    ----------
+    name : str
+    mass : float                      (kg)
+    inertia_body : (3, 3) float       Inertia about the CoM, body frame (kg m^2).
+    com_lvlh : (3,) float             Initial CoM position, LVLH (m).
+    body_to_lvlh : (3, 3) float       Initial attitude (rotation matrix body->LVLH).
+    velocity_lvlh : (3,) float        Initial CoM velocity (m/s), LVLH.
+    omega_body : (3,) float           Initial angular velocity (rad/s), body frame.
+    meshes_body : list of trimesh.Trimesh   Contact shapes, body frame (origin at CoM) (m).
+    """
+
+    name: str
+    mass: float
+    inertia_body: np.ndarray
+    com_lvlh: np.ndarray
+    body_to_lvlh: np.ndarray = field(default_factory=lambda: np.eye(3))
+    velocity_lvlh: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    omega_body: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    meshes_body: list[trimesh.Trimesh] = field(default_factory=list)
+
+
+@dataclass
+class JointSpec:
+    """A joint between two bodies, realised as a stiff penalty spring-damper in 6 DOF.
+
+    The joint frame (columns h1, h2, h3) follows the seed paper's hinge frame (Sec. 2.4.1):
+    h2 is the hinge axis, h1 points from the child's CoM towards the hinge (anti-parallel
+    to the appendage CoM), h3 completes the right-handed set.
+
+    Attributes
+    ----------
+    kind : {"revolute", "clamped"}
+    parent, child : int               Body indices.
+    point_lvlh : (3,) float           Joint point at t = 0, LVLH (m).
+    hinge_to_lvlh : (3, 3) float      Joint frame at t = 0 (columns h1, h2, h3 in LVLH), before
+                                      any initial hinge angle is applied to the child.
+    torsional_stiffness : float       About h2 for revolute joints (N m/rad).
+    torsional_damping : float         About h2 (N m s/rad).
+    penalty_translational : float     Penalty stiffness on the joint point offset (N/m).
+    penalty_rotational : float        Penalty stiffness on locked rotations (N m/rad).
+    penalty_damping_ratio : float     Damping of the penalty springs, fraction of critical (-).
+    """
+
+    name: str
+    kind: str
+    parent: int
+    child: int
+    point_lvlh: np.ndarray
+    hinge_to_lvlh: np.ndarray
+    torsional_stiffness: float = 0.0
+    torsional_damping: float = 0.0
+    penalty_translational: float = 1e9
+    penalty_rotational: float = 1e8
+    penalty_damping_ratio: float = 0.05
+
+
+@dataclass
+class ContactLaw:
+    """Hertz / Hunt-Crossley / Hollar contact parameters (seed paper Table 2)."""
+
+    stiffness: float          # k_n (N/m^exponent)
+    exponent: float = 1.5     # n (-)
+    hunt_crossley_alpha: float = 0.05  # alpha (s/m); d_n = 1.5 alpha k_n
+    mu_static: float = 0.19
+    mu_kinetic: float = 0.152
+    transition_speed: float = 0.01    # V_t0 (m/s)
+
+    @property
+    def damping(self) -> float:
+        """Hunt-Crossley damping coefficient d_n (N s/m^(n+1))."""
+        return 1.5 * self.hunt_crossley_alpha * self.stiffness
+
+
+@dataclass
+class SolverSpec:
+    """Time integration and output settings."""
+
+    end_time: float                 # (s)
+    step: float                     # fixed step (s)
+    integrator: str = "VelocityVerlet"
+    output_rate: float = 1000.0     # time-series samples per second (Hz)
+    net_output_rate: float = 50.0   # net snapshots per second (Hz)
+    contact_substep: float = 2e-6   # largest contact sub-step (s)
+    threads: int = 1
+
+    @property
+    def n_steps(self) -> int:
+        return int(round(self.end_time / self.step))
+
+
+@dataclass
+class ImpactAssembly:
+    """Everything one coupled net-impact simulation needs."""
+
+    net: NetTopology
+    net_velocity: np.ndarray        # (n, 3) initial node velocities, LVLH (m/s)
+    bodies: list[RigidBodySpec]
+    joints: list[JointSpec]
+    contact: ContactLaw
+    solver: SolverSpec
+    mean_motion: float = 0.0        # (rad/s), 0 without orbit

@@ -1,0 +1,119 @@
+"""Debris geometry: triangle meshes of primitives and mesh files (built with trimesh).
+
+Every shape is placed in the *target frame* (the debris reference frame of the case
+file); :func:`contact_shapes_body_frame` moves the triangles into a body frame
+(origin at the body CoM, axes parallel to the target frame).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import trimesh
+from scipy.spatial.transform import Rotation
+
+
+def shape_mesh(kind: str, *, size=None, radius=None, length=None, axis=None, center=(0, 0, 0),
+               rotation_vector=(0, 0, 0), file=None, scale=1.0, sections=32) -> trimesh.Trimesh:
+    """Closed triangle mesh of one shape, target frame (m).
+
+    Parameters
+    ----------
+    kind : {"box", "cylinder", "sphere", "mesh"}
+    size : (3,) float       Box edge lengths (m), box frame.
+    radius, length : float  Cylinder or sphere radius (m); cylinder length (m).
+    axis : (3,) float       Cylinder axis, target frame.
+    center : (3,) float     Shape centre, target frame (m).
+    rotation_vector : (3,) float  Shape->target rotation for boxes and meshes (rad).
+    file : path             Mesh file (any format trimesh reads), vertices in m before ``scale``.
+    """
+    if kind == "box":
+        mesh = trimesh.creation.box(extents=size)
+    elif kind == "cylinder":
+        mesh = trimesh.creation.cylinder(radius=radius, height=length, sections=sections)
+        mesh.apply_transform(_align_z_to(axis))
+    elif kind == "sphere":
+        mesh = trimesh.creation.icosphere(subdivisions=2, radius=radius)
+    elif kind == "mesh":
+        mesh = trimesh.load_mesh(Path(file), force="mesh")
+        mesh.apply_scale(scale)
+    else:
+        raise ValueError(f"unknown shape kind {kind!r}")
+    if kind in ("box", "mesh"):
+        transform = np.eye(4)
+        transform[:3, :3] = Rotation.from_rotvec(rotation_vector).as_matrix()
+        mesh.apply_transform(transform)
+    mesh.apply_translation(center)
+    return mesh
+
+
+def _align_z_to(axis) -> np.ndarray:
+    """4x4 rotation taking the z axis onto ``axis``."""
+    return trimesh.geometry.align_vectors([0, 0, 1], np.asarray(axis, float) / np.linalg.norm(axis))
+
+
+def uniform_density_inertia(meshes, mass, com):
+    """Inertia tensor (kg m^2) about ``com`` of ``mass`` spread evenly over the meshes' volume.
+
+    Overlapping shapes count twice; keep the shapes of one body disjoint when the
+    inertia is to come from geometry.
+    """
+    volume = sum(m.volume for m in meshes)
+    inertia = np.zeros((3, 3))
+    for m in meshes:
+        share = mass * m.volume / volume
+        j_own = m.moment_inertia * share / m.volume  # trimesh uses unit density
+        d = np.asarray(m.center_mass) - np.asarray(com)
+        inertia += j_own + share * (d @ d * np.eye(3) - np.outer(d, d))
+    return inertia
+
+
+def geometric_center_of_mass(meshes):
+    """Volume-weighted centroid of the meshes, target frame (m)."""
+    volumes = np.array([m.volume for m in meshes])
+    centers = np.array([m.center_mass for m in meshes])
+    return volumes @ centers / volumes.sum()
+
+
+@dataclass(frozen=True)
+class ContactShapes:
+    """Triangle soup of all contact shapes of all bodies, in body frames (see kernel)."""
+
+    triangles: np.ndarray       # (T, 3, 3) m
+    normals: np.ndarray         # (T, 3)
+    shape_body: np.ndarray      # (ns,) int
+    triangle_range: np.ndarray  # (ns, 2) int
+    box_min: np.ndarray         # (ns, 3) m
+    box_max: np.ndarray         # (ns, 3) m
+
+
+def contact_shapes_body_frame(meshes_per_body, com_per_body) -> ContactShapes:
+    """Collect the shapes of every body into kernel arrays, each moved into its body frame.
+
+    Parameters
+    ----------
+    meshes_per_body : list of list of trimesh.Trimesh
+        Shapes of each body, target frame.
+    com_per_body : (nb, 3) float
+        Body CoM, target frame (m). Body axes are parallel to the target frame.
+    """
+    triangles, normals, owner, ranges, lo, hi = [], [], [], [], [], []
+    start = 0
+    for b, meshes in enumerate(meshes_per_body):
+        for mesh in meshes:
+            tri = np.asarray(mesh.triangles) - np.asarray(com_per_body[b])
+            triangles.append(tri)
+            normals.append(np.asarray(mesh.face_normals))
+            owner.append(b)
+            ranges.append((start, start + len(tri)))
+            lo.append(tri.reshape(-1, 3).min(axis=0))
+            hi.append(tri.reshape(-1, 3).max(axis=0))
+            start += len(tri)
+    return ContactShapes(
+        triangles=np.ascontiguousarray(np.concatenate(triangles)),
+        normals=np.ascontiguousarray(np.concatenate(normals)),
+        shape_body=np.asarray(owner, np.int64),
+        triangle_range=np.asarray(ranges, np.int64),
+        box_min=np.asarray(lo), box_max=np.asarray(hi),
+    )

@@ -1,0 +1,245 @@
+"""The compiled force kernel that couples the net with the debris bodies in one Exudyn system.
+
+Exudyn integrates every coordinate: the net nodes (one ``NodeGenericODE2``), the
+debris rigid bodies (``NodeRigidBodyRotVecLG`` with Lie-group integration) and their
+joints (penalty connectors). The forces that act between net and bodies, the thread
+forces and the Clohessy-Wiltshire terms are computed here, in one numba function called
+by an ``ObjectGenericODE2`` that spans the net node and all rigid-body nodes. Because
+the contact force on a node and its reaction on the body are computed in the same call,
+linear and angular momentum exchange is exact (the reaction acts on the body at the
+node centre, on the same line of action).
+
+Coordinate layout of the generic object (Exudyn ``q`` / ``q_t``):
+
+* ``3 n`` net coordinates: node displacement from its reference position (m), LVLH;
+  velocities (m/s), LVLH.
+* 6 per rigid body: CoM displacement (m) and rotation vector body->LVLH (rad);
+  velocities: CoM velocity (m/s), LVLH, and angular velocity (rad/s), body frame.
+  The generalized force on the rotational part is the torque in the body frame
+  (checked in ``tests/multibody/test_kernel.py``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+
+from multibody.contact import contact_over_step, signed_distance_to_mesh
+from multibody.net import add_bending_forces, add_thread_forces
+from multibody.orbit import clohessy_wiltshire_acceleration
+
+#: Indices into the kernel's scalar output buffer.
+THREAD_ELASTIC, BENDING_ELASTIC, CONTACT_ELASTIC, THREAD_DISSIPATED, CONTACT_DISSIPATED, N_CONTACTS = range(6)
+N_SCALARS = 6
+
+
+@njit(cache=True)
+def rotation_matrix_from_rotation_vector(rv):
+    """Body->LVLH rotation matrix from a rotation vector (rad); Rodrigues' formula."""
+    angle = math.sqrt(rv @ rv)
+    k = np.zeros((3, 3))
+    k[0, 1] = -rv[2]
+    k[0, 2] = rv[1]
+    k[1, 0] = rv[2]
+    k[1, 2] = -rv[0]
+    k[2, 0] = -rv[1]
+    k[2, 1] = rv[0]
+    if angle < 1e-8:
+        return np.eye(3) + k + 0.5 * (k @ k)
+    return np.eye(3) + (math.sin(angle) / angle) * k + ((1.0 - math.cos(angle)) / angle**2) * (k @ k)
+
+
+@dataclass
+class KernelData:
+    """Everything the kernel needs, as contiguous arrays (SI units).
+
+    Body geometry is a list of closed contact shapes (one per primitive or mesh file),
+    each a slice of the triangle arrays in its body's frame (origin at the body CoM).
+    Signed distances are taken per shape, so shapes of one body may overlap.
+    """
+
+    net_reference: np.ndarray        # (n, 3) reference node positions, LVLH (m)
+    net_mass: np.ndarray             # (n,) (kg)
+    net_radius: np.ndarray           # (n,) (m)
+    threads: np.ndarray              # (m, 2) int
+    rest_lengths: np.ndarray         # (m,) (m)
+    thread_stiffness: np.ndarray     # (m,) (N/m)
+    thread_damping: np.ndarray       # (m,) (N s/m)
+    bending_triples: np.ndarray      # (b, 3) int
+    bending_stiffness: np.ndarray    # (b,) (N m/rad)
+    body_reference: np.ndarray       # (nb, 3) reference CoM positions, LVLH (m)
+    body_mass: np.ndarray            # (nb,) (kg)
+    triangles: np.ndarray            # (T, 3, 3) corners, body frame of the owning body (m)
+    triangle_normals: np.ndarray     # (T, 3) outward normals, body frame
+    shape_body: np.ndarray           # (ns,) int, body owning each contact shape
+    shape_triangle_range: np.ndarray # (ns, 2) int, triangle slice of each shape
+    shape_box_min: np.ndarray        # (ns, 3) body-frame bounding box of each shape (m)
+    shape_box_max: np.ndarray        # (ns, 3)
+    contact_stiffness: float         # k_n (N/m^n)
+    contact_exponent: float          # n (-)
+    contact_damping: float           # d_n = 1.5 alpha k_n
+    mu_static: float
+    mu_kinetic: float
+    transition_speed: float          # (m/s)
+    mean_motion: float               # (rad/s); 0 without orbit
+    step: float                      # integrator step (s)
+    contact_substep: float           # largest contact sub-step (s); >= step disables sub-cycling
+    stage_weight: float = 1.0        # 1 / force evaluations per integrator step
+    force: np.ndarray = field(init=False)
+    body_impulse: np.ndarray = field(init=False)   # (nb, 6) accumulated contact impulse and angular impulse about CoM, LVLH
+    velocity_lag: np.ndarray = field(init=False)   # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s)
+    lag_body: np.ndarray = field(init=False)       # (n,) body of the node's last contact, -1 for none
+    scalars: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        n = len(self.net_mass)
+        nb = len(self.body_mass)
+        self.force = np.zeros(3 * n + 6 * nb)
+        self.body_impulse = np.zeros((nb, 6))
+        self.scalars = np.zeros(N_SCALARS)
+        self.velocity_lag = np.zeros((n, 3))
+        self.lag_body = np.full(n, -1, dtype=np.int64)
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.net_mass)
+
+    @property
+    def n_bodies(self) -> int:
+        return len(self.body_mass)
+
+    def evaluate(self, q, qt):
+        """Generalized forces for coordinates ``q`` and velocities ``qt`` ((3n + 6nb,) each)."""
+        n_sub = max(1, int(math.ceil(self.step / self.contact_substep - 1e-9)))
+        coupled_generalized_forces(
+            q, qt, self.net_reference, self.net_mass, self.net_radius,
+            self.threads, self.rest_lengths, self.thread_stiffness, self.thread_damping,
+            self.bending_triples, self.bending_stiffness,
+            self.body_reference, self.body_mass, self.triangles, self.triangle_normals,
+            self.shape_body, self.shape_triangle_range, self.shape_box_min, self.shape_box_max,
+            self.contact_stiffness, self.contact_exponent, self.contact_damping,
+            self.mu_static, self.mu_kinetic, self.transition_speed,
+            self.mean_motion, self.step, n_sub, self.stage_weight, self.velocity_lag, self.lag_body,
+            self.force, self.body_impulse, self.scalars)
+        return self.force
+
+
+@njit(cache=True)
+def _apply_contact_pair(i, b, force, arm, weight, f_net, f_body, torque_lvlh, out_body_impulse):
+    """Force on node ``i`` and its reaction on body ``b`` on the same line of action."""
+    f_net[i] += force
+    f_body[b] -= force
+    moment = np.cross(arm, -force)
+    torque_lvlh[b] += moment
+    out_body_impulse[b, :3] -= force * weight
+    out_body_impulse[b, 3:] += moment * weight
+
+
+@njit(cache=True)
+def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
+                               threads, rest_lengths, thread_stiffness, thread_damping,
+                               bending_triples, bending_stiffness,
+                               body_reference, body_mass, triangles, triangle_normals,
+                               shape_body, shape_triangle_range, shape_box_min, shape_box_max,
+                               k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
+                               n_orbit, step, n_substeps, stage_weight, velocity_lag, lag_body,
+                               out_force, out_body_impulse, out_scalars):
+    """Fill ``out_force`` with the generalized forces of the coupled system (see module doc).
+
+    Also accumulates, per body, the contact impulse (N s) and angular impulse about the
+    CoM (N m s) in LVLH into ``out_body_impulse``, the dissipated energies into
+    ``out_scalars`` and sets the current elastic energies there. Accumulations are
+    weighted by ``stage_weight`` (1 / force evaluations per step: exact for
+    VelocityVerlet's single evaluation, an average for Runge-Kutta stages).
+    """
+    n = net_mass.shape[0]
+    nb = body_mass.shape[0]
+    x = net_reference + q[: 3 * n].reshape(n, 3)
+    v = qt[: 3 * n].reshape(n, 3)
+    f_net = np.zeros((n, 3))
+
+    elastic, power = add_thread_forces(x, v, threads, rest_lengths, thread_stiffness, thread_damping, f_net)
+    out_scalars[0] = elastic
+    out_scalars[1] = add_bending_forces(x, bending_triples, bending_stiffness, f_net)
+    out_scalars[3] += power * step * stage_weight
+
+    if n_orbit != 0.0:
+        for i in range(n):
+            f_net[i] += net_mass[i] * clohessy_wiltshire_acceleration(x[i], v[i], n_orbit)
+
+    rots = np.empty((nb, 3, 3))
+    coms = np.empty((nb, 3))
+    vels = np.empty((nb, 3))
+    omegas = np.empty((nb, 3))
+    f_body = np.zeros((nb, 3))
+    for b in range(nb):
+        base = 3 * n + 6 * b
+        coms[b] = body_reference[b] + q[base:base + 3]
+        vels[b] = qt[base:base + 3]
+        rots[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6].copy())
+        omegas[b] = rots[b] @ qt[base + 3:base + 6]
+        if n_orbit != 0.0:
+            f_body[b] += body_mass[b] * clohessy_wiltshire_acceleration(coms[b], vels[b], n_orbit)
+
+    torque_lvlh = np.zeros((nb, 3))
+    contact_energy = 0.0
+    n_contacts = 0
+    f_non_contact = f_net.copy()
+    v_true = v + velocity_lag
+    new_lag = np.zeros((n, 3))
+    touched = np.zeros(n, dtype=np.bool_)
+    for s in range(shape_body.shape[0]):
+        b = shape_body[s]
+        rot = rots[b]
+        for i in range(n):
+            arm = x[i] - coms[b]
+            p_body = rot.T @ arm
+            surface_velocity = vels[b] + np.cross(omegas[b], arm)
+            relative = v_true[i] - surface_velocity
+            margin = net_radius[i] + step * math.sqrt(relative @ relative)
+            outside = False
+            for k in range(3):
+                if p_body[k] < shape_box_min[s, k] - margin or p_body[k] > shape_box_max[s, k] + margin:
+                    outside = True
+            if outside:
+                continue
+            distance, normal_body = signed_distance_to_mesh(
+                p_body, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
+            normal = rot @ normal_body
+            penetration = net_radius[i] - distance
+            if penetration <= 0.0 and penetration - (relative @ normal) * step <= 0.0:
+                continue
+            impulse, mean_rel, end_rel, dissipated = contact_over_step(
+                penetration, relative, normal, f_non_contact[i], net_mass[i], step, n_substeps,
+                k_contact, exponent, d_contact, mu_s, mu_k, v_transition)
+            # Kick that makes the integrator's next drift follow the sub-cycled path; the
+            # difference between true end velocity and mean velocity is carried as a lag.
+            force = net_mass[i] * (mean_rel - relative) / step - f_non_contact[i]
+            new_lag[i] += end_rel - mean_rel
+            touched[i] = True
+            lag_body[i] = b
+            _apply_contact_pair(i, b, force, arm, step * stage_weight, f_net, f_body, torque_lvlh, out_body_impulse)
+            out_scalars[4] += dissipated * stage_weight
+            if penetration > 0.0:
+                contact_energy += k_contact * penetration ** (exponent + 1.0) / (exponent + 1.0)
+                n_contacts += 1
+    for i in range(n):
+        b = lag_body[i]
+        if b >= 0:
+            # Release the lag carried from the previous step (zero without sub-cycling).
+            force = net_mass[i] * velocity_lag[i] / step
+            _apply_contact_pair(i, b, force, x[i] - coms[b], step * stage_weight, f_net, f_body, torque_lvlh,
+                                out_body_impulse)
+            if not touched[i]:
+                lag_body[i] = -1
+        velocity_lag[i] = new_lag[i]
+    for b in range(nb):
+        base = 3 * n + 6 * b
+        out_force[base:base + 3] = f_body[b]
+        out_force[base + 3:base + 6] = rots[b].T @ torque_lvlh[b]
+    out_scalars[2] = contact_energy
+    out_scalars[5] = n_contacts
+    out_force[: 3 * n] = f_net.reshape(3 * n)
+    return out_force

@@ -1,0 +1,211 @@
+"""Lumped-mass (multi-spring-damper) net: topology, thread properties and thread forces.
+
+Cuadrat-Grzybowski & Gill 2024, Section 2.2: the square net of side :math:`L` has
+:math:`N\\times N` nodes carrying the thread mass evenly, joined by massless
+Kelvin-Voigt threads that only pull (eq. 1); four bullets hang on the corners.
+Optional bending stiffness (the paper's recommendation 2) adds a rotational spring
+between consecutive collinear threads.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+
+@dataclass(frozen=True)
+class NetTopology:
+    """Arrays describing a net; every position is in the LVLH frame (m).
+
+    Attributes
+    ----------
+    positions : (n, 3) float   Initial node positions (m), net nodes first, bullets last.
+    masses : (n,) float         Node masses (kg).
+    radii : (n,) float          Contact radii (m).
+    threads : (m, 2) int        Node pairs joined by a thread.
+    rest_lengths : (m,) float   Unstretched thread lengths (m).
+    stiffness : (m,) float      Axial stiffness EA/l0 (N/m).
+    damping : (m,) float        Axial damping (N s/m).
+    bending_triples : (b, 3) int  Node triples (a, b, c) along one thread line, b in the middle.
+    bending_stiffness : (b,) float  Rotational stiffness at b (N m/rad), zero when off.
+    nodes_per_side : int
+    n_bullets : int
+    """
+
+    positions: np.ndarray
+    masses: np.ndarray
+    radii: np.ndarray
+    threads: np.ndarray
+    rest_lengths: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    bending_triples: np.ndarray
+    bending_stiffness: np.ndarray
+    nodes_per_side: int
+    n_bullets: int
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.masses)
+
+
+def square_grid_threads(nodes_per_side: int) -> np.ndarray:
+    """Thread node pairs of a square mesh, row-major node numbering: (2 N (N-1), 2) int."""
+    idx = np.arange(nodes_per_side**2).reshape(nodes_per_side, nodes_per_side)
+    along_first = np.c_[idx[:-1, :].ravel(), idx[1:, :].ravel()]
+    along_second = np.c_[idx[:, :-1].ravel(), idx[:, 1:].ravel()]
+    return np.vstack([along_first, along_second])
+
+
+def square_grid_bending_triples(nodes_per_side: int) -> np.ndarray:
+    """Triples of consecutive nodes along each thread line: (2 N (N-2), 3) int."""
+    idx = np.arange(nodes_per_side**2).reshape(nodes_per_side, nodes_per_side)
+    first = np.c_[idx[:-2, :].ravel(), idx[1:-1, :].ravel(), idx[2:, :].ravel()]
+    second = np.c_[idx[:, :-2].ravel(), idx[:, 1:-1].ravel(), idx[:, 2:].ravel()]
+    return np.vstack([first, second])
+
+
+def thread_node_mass(side_length, nodes_per_side, diameter, density):
+    """Net node mass (kg): total thread mass spread evenly over the nodes (paper Sec. 2.2.2)."""
+    mesh = side_length / (nodes_per_side - 1)
+    n_threads = 2 * nodes_per_side * (nodes_per_side - 1)
+    area = np.pi * diameter**2 / 4.0
+    return n_threads * mesh * area * density / nodes_per_side**2
+
+
+def in_plane_axes(direction):
+    """Two unit vectors spanning the net plane, normal to the launch ``direction`` (LVLH).
+
+    The first axis is LVLH x (radial) projected on the plane, or LVLH z when the
+    launch is radial.
+    """
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    seed = np.array([1.0, 0.0, 0.0]) if abs(d[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
+    e1 = seed - (seed @ d) * d
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(d, e1)
+
+
+def flat_square_net(center, direction, side_length, nodes_per_side, node_mass, node_radius,
+                    thread_axial_rigidity, thread_damping, bullet_mass, bullet_radius,
+                    bullet_tether_length, bending_rigidity=0.0) -> NetTopology:
+    """A fully spread square net, normal to ``direction``, with a bullet on each corner.
+
+    Parameters
+    ----------
+    center, direction : (3,) float
+        Net centre (m) and launch direction, LVLH.
+    thread_axial_rigidity : float
+        EA of a thread (N); a thread of rest length l gets stiffness EA / l.
+    thread_damping : float
+        Axial damping of every thread (N s/m).
+    bullet_tether_length : float
+        Length of the thread from a corner node to its bullet, along the net diagonal (m).
+    bending_rigidity : float
+        EI of a thread (N m^2); 0 leaves the net without bending stiffness.
+    """
+    e1, e2 = in_plane_axes(direction)
+    mesh = side_length / (nodes_per_side - 1)
+    s = np.linspace(-side_length / 2, side_length / 2, nodes_per_side)
+    a, b = np.meshgrid(s, s, indexing="ij")
+    grid = np.asarray(center, float) + a.reshape(-1, 1) * e1 + b.reshape(-1, 1) * e2
+    threads = square_grid_threads(nodes_per_side)
+    rest = np.full(len(threads), mesh)
+
+    n = nodes_per_side
+    corners = np.array([0, n - 1, n * (n - 1), n * n - 1])
+    outward = grid[corners] - np.asarray(center, float)
+    outward /= np.linalg.norm(outward, axis=1, keepdims=True)
+    bullets = grid[corners] + bullet_tether_length * outward
+    bullet_ids = n * n + np.arange(4)
+    threads = np.vstack([threads, np.c_[corners, bullet_ids]])
+    rest = np.r_[rest, np.full(4, bullet_tether_length)]
+
+    positions = np.vstack([grid, bullets])
+    masses = np.r_[np.full(n * n, node_mass), np.full(4, bullet_mass)]
+    radii = np.r_[np.full(n * n, node_radius), np.full(4, bullet_radius)]
+    triples = square_grid_bending_triples(n)
+    return NetTopology(
+        positions=positions, masses=masses, radii=radii,
+        threads=threads.astype(np.int64), rest_lengths=rest,
+        stiffness=thread_axial_rigidity / rest,
+        damping=np.full(len(rest), float(thread_damping)),
+        bending_triples=triples.astype(np.int64),
+        bending_stiffness=np.full(len(triples), bending_rigidity / mesh),
+        nodes_per_side=n, n_bullets=4,
+    )
+
+
+@njit(cache=True)
+def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
+    """Add tension-only Kelvin-Voigt thread forces to ``force``; return (elastic J, damping W).
+
+    .. math:: T = \\max(0,\\; k (l - l_0) + c \\dot l) \\quad \\text{for } l > l_0
+
+    Parameters
+    ----------
+    x, v : (n, 3) float
+        Node positions (m) and velocities (m/s), LVLH.
+    force : (n, 3) float
+        Accumulator (N), LVLH.
+
+    Returns
+    -------
+    elastic_energy : float
+        :math:`\\sum \\tfrac12 k (l-l_0)^2` over stretched threads (J), paper eq. (17).
+    damping_power : float
+        Power dissipated by the thread dampers (W).
+    """
+    elastic = 0.0
+    power = 0.0
+    for t in range(threads.shape[0]):
+        a = threads[t, 0]
+        b = threads[t, 1]
+        d = x[b] - x[a]
+        length = np.sqrt(d @ d)
+        stretch = length - rest_lengths[t]
+        if stretch <= 0.0:
+            continue
+        e = d / length
+        rate = (v[b] - v[a]) @ e
+        elastic += 0.5 * stiffness[t] * stretch * stretch
+        tension = stiffness[t] * stretch + damping[t] * rate
+        if tension <= 0.0:
+            continue
+        power += damping[t] * rate * rate
+        force[a] += tension * e
+        force[b] -= tension * e
+    return elastic, power
+
+
+@njit(cache=True)
+def add_bending_forces(x, triples, bending_stiffness, force):
+    """Add forces of rotational springs between consecutive threads; return their energy (J).
+
+    Energy :math:`E = k_b (1 - \\hat e_1\\cdot\\hat e_2)`, which is :math:`\\tfrac12 k_b\\theta^2`
+    for small kink angles :math:`\\theta`; the forces are its exact negative gradient,
+    so they conserve momentum and energy.
+    """
+    energy = 0.0
+    for t in range(triples.shape[0]):
+        kb = bending_stiffness[t]
+        if kb == 0.0:
+            continue
+        a = triples[t, 0]
+        b = triples[t, 1]
+        c = triples[t, 2]
+        d1 = x[b] - x[a]
+        d2 = x[c] - x[b]
+        l1 = np.sqrt(d1 @ d1)
+        l2 = np.sqrt(d2 @ d2)
+        e1 = d1 / l1
+        e2 = d2 / l2
+        cosine = e1 @ e2
+        energy += kb * (1.0 - cosine)
+        fa = -kb * (e2 - cosine * e1) / l1
+        fc = kb * (e1 - cosine * e2) / l2
+        force[a] += fa
+        force[c] += fc
+        force[b] -= fa + fc
+    return energy

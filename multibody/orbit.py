@@ -1,0 +1,50 @@
+"""Relative orbital motion about a circular reference orbit (Clohessy-Wiltshire).
+
+Frame: LVLH centred on the chaser, x radial (outward), y along-track (flight
+direction), z cross-track (orbit normal); Cuadrat-Grzybowski & Gill 2024, Sec. 2.2.1.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+#: Earth's gravitational parameter (m^3/s^2), IERS 2010 / EGM2008 value.
+MU_EARTH = 3.986004418e14
+#: Earth's equatorial radius (m), WGS-84.
+R_EARTH = 6378137.0
+
+
+def mean_motion(altitude):
+    """Mean motion of a circular orbit (rad/s) at ``altitude`` above the equatorial radius (m)."""
+    return math.sqrt(MU_EARTH / (R_EARTH + altitude) ** 3)
+
+
+@njit(cache=True)
+def clohessy_wiltshire_acceleration(r_lvlh, v_lvlh, n):
+    """Apparent acceleration in LVLH (m/s^2) of a free body; seed paper eq. (9) without contact.
+
+    .. math:: \\ddot{\\mathbf r} = n^2 (3x, 0, -z) + 2n(\\dot y, -\\dot x, 0)
+
+    Parameters
+    ----------
+    r_lvlh, v_lvlh : (3,) float
+        Position (m) and velocity (m/s) relative to the chaser, LVLH.
+    n : float
+        Mean motion (rad/s); 0 turns the orbit off.
+    """
+    a = np.empty(3)
+    a[0] = n * n * 3.0 * r_lvlh[0] + 2.0 * n * v_lvlh[1]
+    a[1] = -2.0 * n * v_lvlh[0]
+    a[2] = -n * n * r_lvlh[2]
+    return a
+
+
+def clohessy_wiltshire_potential(r_lvlh, n):
+    """Potential energy per unit mass of the CW field (J/kg); with the Jacobi integral it is conserved.
+
+    The Coriolis term does no work, so :math:`\\tfrac12|v|^2 + \\tfrac12 n^2 (z^2 - 3x^2)` is constant.
+    """
+    r = np.atleast_2d(r_lvlh)
+    return 0.5 * n * n * (r[:, 2] ** 2 - 3.0 * r[:, 0] ** 2)

@@ -1,0 +1,208 @@
+"""What a coupled impact run records, sampled at the case's output rates.
+
+Time series (``Recorder.series``, all SI, frames in the names):
+
+======================================  =========================================================
+key                                     meaning
+======================================  =========================================================
+time                                    (k,) s
+contact_force_lvlh / _body              (k, nb, 3) net contact force on each body (N), averaged
+                                        over the output interval (impulse / interval)
+contact_moment_lvlh / _body             (k, nb, 3) contact moment about the body CoM (N m)
+body_com_lvlh, body_velocity_lvlh       (k, nb, 3) m, m/s
+body_omega_body                         (k, nb, 3) rad/s, body frame
+body_to_lvlh                            (k, nb, 3, 3) attitude
+debris_com_lvlh, debris_velocity_lvlh   (k, 3) CoM of all debris bodies together
+joint_rotation_joint                    (k, nj, 3) relative rotation vector (rad), joint frame;
+                                        component 1 is the hinge angle about h2
+joint_rate_joint                        (k, nj, 3) relative angular velocity (rad/s), joint frame
+joint_force_joint, joint_moment_joint   (k, nj, 3) connector reaction (N, N m), joint frame:
+                                        the load the parent exerts on the child at the joint
+energy_*                                (k,) J: net_kinetic, net_elastic (threads), net_bending,
+                                        contact_elastic, debris_translational, debris_rotational,
+                                        joint_elastic, orbital_potential (CW), dissipated_threads,
+                                        dissipated_contact, total (mechanical + dissipated)
+momentum_linear_lvlh                    (k, 3) total of net and debris (kg m/s)
+momentum_angular_lvlh                   (k, 3) about the LVLH origin (kg m^2/s)
+======================================  =========================================================
+
+Net snapshots (``Recorder.net``): ``time`` (s), ``positions_lvlh`` and ``velocities_lvlh``
+(k, n, 3) float32.
+"""
+from __future__ import annotations
+
+import numpy as np
+import exudyn as exu
+from scipy.spatial.transform import Rotation
+
+from multibody.hinge import relative_rotation_vector_joint_frame
+from multibody.kernel import (BENDING_ELASTIC, CONTACT_DISSIPATED, CONTACT_ELASTIC, THREAD_DISSIPATED,
+                              THREAD_ELASTIC)
+from multibody.orbit import clohessy_wiltshire_potential
+
+
+class Recorder:
+    """Samples the running system from Exudyn's post-step hook."""
+
+    def __init__(self, assembly, system, progress=None):
+        self.assembly = assembly
+        self.system = system
+        self.progress = progress
+        solver = assembly.solver
+        self.step = solver.step
+        self.output_interval = 1.0 / solver.output_rate
+        self.net_interval = 1.0 / solver.net_output_rate
+        self._next_output = self.output_interval
+        self._next_net = self.net_interval
+        self._last_output_time = 0.0
+        mbs = system.mbs
+        self._net_index = mbs.GetNodeODE2Index(system.net_node) if system.net_node is not None else 0
+        self._body_index = [mbs.GetNodeODE2Index(nd) for nd in system.body_nodes]
+        self._rows: dict[str, list] = {}
+        self._net_rows: dict[str, list] = {"time": [], "positions_lvlh": [], "velocities_lvlh": []}
+        self.series: dict[str, np.ndarray] = {}
+        self.net: dict[str, np.ndarray] = {}
+        self.wall_time = None
+        self.stopped_early = False
+
+    # -- Exudyn hook -----------------------------------------------------------------
+    def post_step(self, mbs, t):
+        half = 0.5 * self.step
+        if t >= self._next_output - half:
+            self.sample(t)
+            self._next_output += self.output_interval
+        return True
+
+    # -- sampling --------------------------------------------------------------------
+    def sample(self, t):
+        mbs = self.system.mbs
+        q = mbs.systemData.GetODE2Coordinates()
+        qt = mbs.systemData.GetODE2Coordinates_t()
+        row = {"time": t}
+        x, v = self._net_state(q, qt)
+        self._body_rows(row, q, qt, t)
+        self._joint_rows(row)
+        self._energy_rows(row, x, v)
+        self._momentum_rows(row, x, v)
+        for key, value in row.items():
+            self._rows.setdefault(key, []).append(np.asarray(value, float))
+        if t == 0.0 or t >= self._next_net - 0.5 * self.step:
+            self._net_rows["time"].append(t)
+            self._net_rows["positions_lvlh"].append(x.astype(np.float32))
+            self._net_rows["velocities_lvlh"].append(v.astype(np.float32))
+            if t > 0.0:
+                self._next_net += self.net_interval
+        if self.progress is not None:
+            self.progress(t)
+
+    def _net_state(self, q, qt):
+        net = self.assembly.net
+        n = net.n_nodes
+        i = self._net_index
+        x = net.positions + np.asarray(q[i:i + 3 * n]).reshape(n, 3)
+        v = np.asarray(qt[i:i + 3 * n]).reshape(n, 3)
+        return x, v
+
+    def body_states(self, q, qt):
+        """Per body: CoM (m), velocity (m/s), body->LVLH matrix, omega (rad/s, body frame)."""
+        com, vel, rot, omega = [], [], [], []
+        for body, i in zip(self.assembly.bodies, self._body_index):
+            com.append(body.com_lvlh + q[i:i + 3])
+            vel.append(np.array(qt[i:i + 3]))
+            rot.append(Rotation.from_rotvec(q[i + 3:i + 6]).as_matrix())
+            omega.append(np.array(qt[i + 3:i + 6]))
+        return np.array(com), np.array(vel), np.array(rot), np.array(omega)
+
+    def _body_rows(self, row, q, qt, t):
+        com, vel, rot, omega = self.body_states(q, qt)
+        self._bodies_now = (com, vel, rot, omega)
+        interval = t - self._last_output_time
+        impulse = self.system.kernel.body_impulse
+        if interval > 0.0:
+            force = impulse[:, :3] / interval
+            moment = impulse[:, 3:] / interval
+        else:
+            force = np.zeros_like(impulse[:, :3])
+            moment = np.zeros_like(force)
+        impulse[:] = 0.0
+        self._last_output_time = t
+        masses = np.array([b.mass for b in self.assembly.bodies])
+        row["contact_force_lvlh"] = force
+        row["contact_moment_lvlh"] = moment
+        row["contact_force_body"] = np.einsum("bji,bj->bi", rot, force)
+        row["contact_moment_body"] = np.einsum("bji,bj->bi", rot, moment)
+        row["body_com_lvlh"] = com
+        row["body_velocity_lvlh"] = vel
+        row["body_omega_body"] = omega
+        row["body_to_lvlh"] = rot
+        row["debris_com_lvlh"] = masses @ com / masses.sum() if len(masses) else np.zeros(3)
+        row["debris_velocity_lvlh"] = masses @ vel / masses.sum() if len(masses) else np.zeros(3)
+
+    def _joint_rows(self, row):
+        mbs = self.system.mbs
+        com, vel, rot, omega = self._bodies_now
+        rotations, rates, forces, moments, energy = [], [], [], [], 0.0
+        for j, joint in enumerate(self.assembly.joints):
+            obj = self.system.joint_objects[j]
+            rv = relative_rotation_vector_joint_frame(rot[joint.parent], rot[joint.child],
+                                                      self.system.joint_to_parent[j], self.system.joint_to_child[j])
+            frame = rot[joint.parent] @ self.system.joint_to_parent[j]
+            omega_rel = rot[joint.child] @ omega[joint.child] - rot[joint.parent] @ omega[joint.parent]
+            rotations.append(rv)
+            rates.append(frame.T @ omega_rel)
+            # Exudyn's connector force is the spring force acting on marker 1 (child) with
+            # reversed sign; the parent's load on the child is its negative.
+            forces.append(-np.asarray(mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)))
+            moments.append(-np.asarray(mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)))
+            offset = (rot[joint.child] @ self.system.joint_point_child[j] + com[joint.child]
+                      - rot[joint.parent] @ self.system.joint_point_parent[j] - com[joint.parent])
+            offset_joint = frame.T @ offset
+            k = np.diag(mbs.GetObjectParameter(obj, "stiffness"))
+            energy += 0.5 * (k[:3] @ offset_joint**2 + k[3:] @ rv**2)
+        nj = len(self.assembly.joints)
+        row["joint_rotation_joint"] = np.reshape(rotations, (nj, 3))
+        row["joint_rate_joint"] = np.reshape(rates, (nj, 3))
+        row["joint_force_joint"] = np.reshape(forces, (nj, 3))
+        row["joint_moment_joint"] = np.reshape(moments, (nj, 3))
+        self._joint_energy = energy
+
+    def _energy_rows(self, row, x, v):
+        scalars = self.system.kernel.scalars
+        net = self.assembly.net
+        com, vel, rot, omega = self._bodies_now
+        bodies = self.assembly.bodies
+        n_orbit = self.assembly.mean_motion
+        e = {
+            "net_kinetic": 0.5 * np.sum(net.masses * np.sum(v * v, axis=1)),
+            "net_elastic": scalars[THREAD_ELASTIC],
+            "net_bending": scalars[BENDING_ELASTIC],
+            "contact_elastic": scalars[CONTACT_ELASTIC],
+            "debris_translational": sum(0.5 * b.mass * vel[k] @ vel[k] for k, b in enumerate(bodies)),
+            "debris_rotational": sum(0.5 * omega[k] @ b.inertia_body @ omega[k] for k, b in enumerate(bodies)),
+            "joint_elastic": self._joint_energy,
+            "orbital_potential": (np.sum(net.masses * clohessy_wiltshire_potential(x, n_orbit))
+                                  + sum(b.mass * clohessy_wiltshire_potential(com[k], n_orbit)[0]
+                                        for k, b in enumerate(bodies))) if n_orbit else 0.0,
+            "dissipated_threads": scalars[THREAD_DISSIPATED],
+            "dissipated_contact": scalars[CONTACT_DISSIPATED],
+        }
+        e["total"] = sum(e.values())
+        for key, value in e.items():
+            row["energy_" + key] = value
+
+    def _momentum_rows(self, row, x, v):
+        net = self.assembly.net
+        com, vel, rot, omega = self._bodies_now
+        p_net = net.masses[:, None] * v
+        linear = p_net.sum(axis=0)
+        angular = np.cross(x, p_net).sum(axis=0)
+        for k, b in enumerate(self.assembly.bodies):
+            linear = linear + b.mass * vel[k]
+            angular = angular + b.mass * np.cross(com[k], vel[k]) + rot[k] @ (b.inertia_body @ omega[k])
+        row["momentum_linear_lvlh"] = linear
+        row["momentum_angular_lvlh"] = angular
+
+    def finish(self, wall_time):
+        self.wall_time = wall_time
+        self.series = {k: np.array(v) for k, v in self._rows.items()}
+        self.net = {k: np.array(v) for k, v in self._net_rows.items()}
