@@ -56,8 +56,9 @@ class JointSpec:
                                       any initial hinge angle is applied to the child.
     torsional_stiffness : float       About h2 for revolute joints (N m/rad).
     torsional_damping : float         About h2 (N m s/rad).
-    penalty_translational : float     Penalty stiffness on the joint point offset (N/m).
-    penalty_rotational : float        Penalty stiffness on locked rotations (N m/rad).
+    penalty_translational : float or None   Penalty stiffness on the joint point offset (N/m);
+                                      None: automatic, tuned to the step (multibody.hinge).
+    penalty_rotational : float or None      Penalty stiffness on locked rotations (N m/rad).
     penalty_damping_ratio : float     Damping of the penalty springs, fraction of critical (-).
     """
 
@@ -69,8 +70,8 @@ class JointSpec:
     hinge_to_lvlh: np.ndarray
     torsional_stiffness: float = 0.0
     torsional_damping: float = 0.0
-    penalty_translational: float = 1e9
-    penalty_rotational: float = 1e8
+    penalty_translational: float | None = None
+    penalty_rotational: float | None = None
     penalty_damping_ratio: float = 0.05
 
 

@@ -63,86 +63,95 @@ def hollar_friction_coefficient(slip_speed, mu_static, mu_kinetic, transition_sp
     return mu
 
 
-@njit(cache=True)
-def closest_point_on_triangle(p, a, b, c):
-    """Closest point to ``p`` on triangle ``(a, b, c)``; all (3,) arrays in one frame (m).
+@njit(cache=True, inline="always")
+def _dot(ax, ay, az, bx, by, bz):
+    return ax * bx + ay * by + az * bz
 
-    Region tests of Ericson, *Real-Time Collision Detection* (2005), section 5.1.5.
+
+@njit(cache=True)
+def closest_point_on_triangle(px, py, pz, tri):
+    """Closest point to ``p`` on triangle ``tri`` ((3, 3) corners), same frame (m); returns a tuple.
+
+    Region tests of Ericson, *Real-Time Collision Detection* (2005), section 5.1.5, in scalar
+    arithmetic (numba would send small-array products to BLAS).
     """
-    ab = b - a
-    ac = c - a
-    ap = p - a
-    d1 = ab @ ap
-    d2 = ac @ ap
+    ax, ay, az = tri[0, 0], tri[0, 1], tri[0, 2]
+    abx, aby, abz = tri[1, 0] - ax, tri[1, 1] - ay, tri[1, 2] - az
+    acx, acy, acz = tri[2, 0] - ax, tri[2, 1] - ay, tri[2, 2] - az
+    apx, apy, apz = px - ax, py - ay, pz - az
+    d1 = _dot(abx, aby, abz, apx, apy, apz)
+    d2 = _dot(acx, acy, acz, apx, apy, apz)
     if d1 <= 0.0 and d2 <= 0.0:
-        return a.copy()
-    bp = p - b
-    d3 = ab @ bp
-    d4 = ac @ bp
+        return ax, ay, az
+    bpx, bpy, bpz = px - tri[1, 0], py - tri[1, 1], pz - tri[1, 2]
+    d3 = _dot(abx, aby, abz, bpx, bpy, bpz)
+    d4 = _dot(acx, acy, acz, bpx, bpy, bpz)
     if d3 >= 0.0 and d4 <= d3:
-        return b.copy()
+        return tri[1, 0], tri[1, 1], tri[1, 2]
     vc = d1 * d4 - d3 * d2
     if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
-        return a + (d1 / (d1 - d3)) * ab
-    cp = p - c
-    d5 = ab @ cp
-    d6 = ac @ cp
+        t = d1 / (d1 - d3)
+        return ax + t * abx, ay + t * aby, az + t * abz
+    cpx, cpy, cpz = px - tri[2, 0], py - tri[2, 1], pz - tri[2, 2]
+    d5 = _dot(abx, aby, abz, cpx, cpy, cpz)
+    d6 = _dot(acx, acy, acz, cpx, cpy, cpz)
     if d6 >= 0.0 and d5 <= d6:
-        return c.copy()
+        return tri[2, 0], tri[2, 1], tri[2, 2]
     vb = d5 * d2 - d1 * d6
     if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
-        return a + (d2 / (d2 - d6)) * ac
+        t = d2 / (d2 - d6)
+        return ax + t * acx, ay + t * acy, az + t * acz
     va = d3 * d6 - d5 * d4
     if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
-        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
-        return b + w * (c - b)
+        t = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        return (tri[1, 0] + t * (tri[2, 0] - tri[1, 0]), tri[1, 1] + t * (tri[2, 1] - tri[1, 1]),
+                tri[1, 2] + t * (tri[2, 2] - tri[1, 2]))
     denom = 1.0 / (va + vb + vc)
     v = vb * denom
     w = vc * denom
-    return a + ab * v + ac * w
+    return ax + abx * v + acx * w, ay + aby * v + acy * w, az + abz * v + acz * w
 
 
 @njit(cache=True)
-def signed_distance_to_mesh(p_body, vertices, normals, first, last):
-    """Signed distance (m) and outward normal of point ``p_body`` to a closed triangle mesh.
+def signed_distance_to_mesh(px, py, pz, vertices, normals, first, last):
+    """Signed distance (m) and outward normal of point ``p`` to a closed convex triangle shape.
 
     Parameters
     ----------
-    p_body : (3,) float
+    px, py, pz : float
         Query point, body frame (m).
     vertices : (T, 3, 3) float
         Triangle corners, body frame (m).
     normals : (T, 3) float
         Outward unit normals, body frame.
     first, last : int
-        Triangle index range of this body.
+        Triangle index range of this shape.
 
     Returns
     -------
     distance : float
-        Distance to the closest surface point, negative inside the mesh (m).
-    normal : (3,) float
-        Unit vector from the surface to the point (outward where the point is inside).
+        Distance to the closest surface point, negative inside (m).
+    nx, ny, nz : float
+        Unit vector from the surface to the point (the face normal where the point is inside).
     """
     best = 1e300
     best_k = first
-    best_cp = np.zeros(3)
+    cx = cy = cz = 0.0
     for k in range(first, last):
-        cp = closest_point_on_triangle(p_body, vertices[k, 0], vertices[k, 1], vertices[k, 2])
-        d = p_body - cp
-        d2 = d @ d
+        qx, qy, qz = closest_point_on_triangle(px, py, pz, vertices[k])
+        d2 = (px - qx) ** 2 + (py - qy) ** 2 + (pz - qz) ** 2
         if d2 < best:
             best = d2
             best_k = k
-            best_cp = cp
+            cx, cy, cz = qx, qy, qz
     distance = math.sqrt(best)
-    offset = p_body - best_cp
-    if offset @ normals[best_k] < 0.0:
-        # Inside: push out along the face normal of the nearest face.
-        return -distance, normals[best_k].copy()
+    ox, oy, oz = px - cx, py - cy, pz - cz
+    fx, fy, fz = normals[best_k, 0], normals[best_k, 1], normals[best_k, 2]
+    if _dot(ox, oy, oz, fx, fy, fz) < 0.0:
+        return -distance, fx, fy, fz
     if distance > 1e-12:
-        return distance, offset / distance
-    return 0.0, normals[best_k].copy()
+        return distance, ox / distance, oy / distance, oz / distance
+    return 0.0, fx, fy, fz
 
 
 @njit(cache=True)
@@ -185,33 +194,45 @@ def contact_over_step(penetration, relative_velocity, normal, external_force, no
         Energy removed by contact damping and friction over the step (J).
     """
     dt = step / n_substeps
+    nx, ny, nz = normal[0], normal[1], normal[2]
+    ex, ey, ez = external_force[0], external_force[1], external_force[2]
+    wx, wy, wz = relative_velocity[0], relative_velocity[1], relative_velocity[2]
     delta = penetration
-    w = relative_velocity.copy()
-    impulse = np.zeros(3)
-    displacement = np.zeros(3)
+    jx = jy = jz = 0.0
+    sx = sy = sz = 0.0
     dissipated = 0.0
     for _ in range(n_substeps):
-        rate = -(w @ normal)
+        rate = -_dot(wx, wy, wz, nx, ny, nz)
         fn = hertz_hunt_crossley_normal_force(delta, rate, stiffness, exponent, damping)
-        slip = w + rate * normal
-        speed = math.sqrt(slip @ slip)
-        ft = np.zeros(3)
+        gx, gy, gz = wx + rate * nx, wy + rate * ny, wz + rate * nz  # slip velocity
+        speed = math.sqrt(gx * gx + gy * gy + gz * gz)
+        fx, fy, fz = fn * nx, fn * ny, fn * nz
         if fn > 0.0 and speed > 0.0:
             mu = hollar_friction_coefficient(speed, mu_static, mu_kinetic, transition_speed)
             # Friction may stop the slip within a sub-step but never reverse it.
             magnitude = min(mu * fn, node_mass * speed / dt)
-            ft = -magnitude / speed * slip
+            fx -= magnitude * gx / speed
+            fy -= magnitude * gy / speed
+            fz -= magnitude * gz / speed
             dissipated += magnitude * speed * dt
         if delta > 0.0:
             # Work of the non-elastic part: damping, or the stored energy lost when a
             # fast separation clips the force to zero (no adhesion).
             dissipated += (fn - stiffness * delta ** exponent) * rate * dt
-        contact = fn * normal + ft
-        w += dt * (contact + external_force) / node_mass
-        delta -= dt * (w @ normal)
-        displacement += dt * w
-        impulse += dt * contact
-    return impulse, displacement / step, w, dissipated
+        wx += dt * (fx + ex) / node_mass
+        wy += dt * (fy + ey) / node_mass
+        wz += dt * (fz + ez) / node_mass
+        delta -= dt * _dot(wx, wy, wz, nx, ny, nz)
+        sx += dt * wx
+        sy += dt * wy
+        sz += dt * wz
+        jx += dt * fx
+        jy += dt * fy
+        jz += dt * fz
+    impulse = np.array([jx, jy, jz])
+    mean_velocity = np.array([sx, sy, sz]) / step
+    end_velocity = np.array([wx, wy, wz])
+    return impulse, mean_velocity, end_velocity, dissipated
 
 
 def hertz_elastic_energy(penetration, stiffness, exponent):

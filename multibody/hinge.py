@@ -32,31 +32,73 @@ def hinge_frame_lvlh(axis_lvlh, point_lvlh, child_com_lvlh) -> np.ndarray:
     return np.column_stack([h1, h2, np.cross(h1, h2)])
 
 
-def joint_stiffness_joint_frame(joint: JointSpec) -> np.ndarray:
-    """Diagonal 6x6 stiffness (N/m, N m/rad) in the joint frame: [x, y, z, rot h1, rot h2, rot h3]."""
-    k_rot_h2 = joint.torsional_stiffness if joint.kind == "revolute" else joint.penalty_rotational
-    return np.diag([joint.penalty_translational] * 3
-                   + [joint.penalty_rotational, k_rot_h2, joint.penalty_rotational])
+#: Penalty joints are tuned to a frequency of PENALTY_STEP_FACTOR / step (rad/s): well under
+#: Verlet's stability limit 2 / step, with room for bodies held by two joints (x sqrt(2)).
+PENALTY_STEP_FACTOR = 0.5
+#: Upper bounds of automatic penalty stiffness; EXUDYN-NOTES: 1e9 N/m and 1e8 N m/rad give
+#: joint loads within 0.4 % of an ideal implicit joint.
+PENALTY_TRANSLATIONAL_CAP = 1e9
+PENALTY_ROTATIONAL_CAP = 1e8
 
 
-def joint_damping_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec) -> np.ndarray:
-    """Diagonal 6x6 damping: the penalty springs get a fraction of their critical damping.
+def effective_mass_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec) -> np.ndarray:
+    """Reduced mass (kg) and reduced inertias about the joint axes h1, h2, h3 (kg m^2).
 
-    The effective mass is the reduced mass of the two bodies; the effective inertia is
-    the child's mean inertia about the joint point (child usually lighter).
+    Each body's inertia is taken about the joint point; the pair acts like two
+    inertias on one spring, so the reduced value sets the penalty mode's frequency.
     """
-    reduced_mass = parent.mass * child.mass / (parent.mass + child.mass)
-    arm = child.com_lvlh - joint.point_lvlh
-    inertia_at_joint = np.trace(child.inertia_body) / 3.0 + child.mass * (arm @ arm)
-    zeta = joint.penalty_damping_ratio
-    c_trans = 2.0 * zeta * np.sqrt(joint.penalty_translational * reduced_mass)
-    c_rot = 2.0 * zeta * np.sqrt(joint.penalty_rotational * inertia_at_joint)
-    c_h2 = joint.torsional_damping if joint.kind == "revolute" else c_rot
-    return np.diag([c_trans] * 3 + [c_rot, c_h2, c_rot])
+    reduced = [parent.mass * child.mass / (parent.mass + child.mass)] * 3
+    for axis in joint.hinge_to_lvlh.T:
+        j = [axis @ _inertia_about_point_lvlh(b, joint.point_lvlh) @ axis for b in (parent, child)]
+        reduced.append(j[0] * j[1] / (j[0] + j[1]))
+    return np.array(reduced)
+
+
+def _inertia_about_point_lvlh(body: RigidBodySpec, point) -> np.ndarray:
+    r = body.com_lvlh - np.asarray(point)
+    j = body.body_to_lvlh @ body.inertia_body @ body.body_to_lvlh.T
+    return j + body.mass * ((r @ r) * np.eye(3) - np.outer(r, r))
+
+
+def joint_stiffness_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec,
+                                step: float) -> np.ndarray:
+    """Diagonal stiffness [x, y, z, rot h1, rot h2, rot h3] (N/m, N m/rad), joint frame.
+
+    Penalty values not given in the joint are set so that each penalty mode sits at
+    ``PENALTY_STEP_FACTOR / step`` rad/s (capped); given values must stay below the
+    explicit stability limit, otherwise a ``ValueError`` names the joint.
+    """
+    inertia = effective_mass_joint_frame(joint, parent, child)
+    auto = inertia * (PENALTY_STEP_FACTOR / step) ** 2
+    k = np.minimum(auto, [PENALTY_TRANSLATIONAL_CAP] * 3 + [PENALTY_ROTATIONAL_CAP] * 3)
+    if joint.penalty_translational is not None:
+        k[:3] = joint.penalty_translational
+    if joint.penalty_rotational is not None:
+        k[3:] = joint.penalty_rotational
+    if joint.kind == "revolute":
+        k[4] = joint.torsional_stiffness
+    omega_step = np.sqrt(k / inertia) * step
+    if omega_step.max() > 1.0:
+        axis = ["x", "y", "z", "rot h1", "rot h2", "rot h3"][int(omega_step.argmax())]
+        raise ValueError(
+            f"joint '{joint.name}': stiffness {k[omega_step.argmax()]:.3g} on {axis} gives a mode at "
+            f"{omega_step.max() / step:.3g} rad/s, too fast for the step {step:g} s (limit 1/step); "
+            f"lower the penalty stiffness (or omit it for the automatic value) or reduce simulation.step")
+    return k
+
+
+def joint_damping_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec,
+                              stiffness: np.ndarray) -> np.ndarray:
+    """Diagonal damping: each penalty spring gets ``penalty_damping_ratio`` of critical damping."""
+    inertia = effective_mass_joint_frame(joint, parent, child)
+    c = 2.0 * joint.penalty_damping_ratio * np.sqrt(stiffness * inertia)
+    if joint.kind == "revolute":
+        c[4] = joint.torsional_damping
+    return c
 
 
 def add_penalty_joint(mbs, joint: JointSpec, bodies: list[RigidBodySpec], body_objects,
-                      child_body_to_lvlh_unrotated: np.ndarray, child_com_unrotated: np.ndarray):
+                      child_body_to_lvlh_unrotated: np.ndarray, child_com_unrotated: np.ndarray, step: float):
     """Add the joint's connector to ``mbs``; return its object index.
 
     The joint frame is attached to the child as it was before any initial hinge angle, so
@@ -67,15 +109,27 @@ def add_penalty_joint(mbs, joint: JointSpec, bodies: list[RigidBodySpec], body_o
     joint_to_child = child_body_to_lvlh_unrotated.T @ joint.hinge_to_lvlh
     point_parent = parent.body_to_lvlh.T @ (joint.point_lvlh - parent.com_lvlh)
     point_child = child_body_to_lvlh_unrotated.T @ (joint.point_lvlh - child_com_unrotated)
+    stiffness = joint_stiffness_joint_frame(joint, parent, child, step)
     m0 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body_objects[joint.parent],
                                        localHT=exu.HT(rotation=joint_to_parent, translation=point_parent)))
     m1 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body_objects[joint.child],
                                        localHT=exu.HT(rotation=joint_to_child, translation=point_child)))
     return mbs.AddObject(ObjectConnectorRigidBodySpringDamper(
         name=joint.name, markerNumbers=[m0, m1],
-        stiffness=joint_stiffness_joint_frame(joint),
-        damping=joint_damping_joint_frame(joint, parent, child),
+        stiffness=np.diag(stiffness), damping=np.diag(joint_damping_joint_frame(joint, parent, child, stiffness)),
         useIntrinsicFormulation=True))
+
+
+def rotation_vector_from_matrix(rot) -> np.ndarray:
+    """Rotation vector (rad) of a rotation matrix (log map); accurate away from 180 degrees."""
+    cos_angle = np.clip((np.trace(rot) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(cos_angle)
+    axis_sin = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])
+    if angle < 1e-6:
+        return axis_sin
+    if np.pi - angle < 1e-6:
+        return Rotation.from_matrix(rot).as_rotvec()
+    return axis_sin * angle / np.sin(angle)
 
 
 def relative_rotation_vector_joint_frame(parent_to_lvlh, child_to_lvlh, joint_to_parent, joint_to_child):
@@ -84,4 +138,4 @@ def relative_rotation_vector_joint_frame(parent_to_lvlh, child_to_lvlh, joint_to
     Component 1 is the hinge angle about h2 for a revolute joint.
     """
     relative = (parent_to_lvlh @ joint_to_parent).T @ (child_to_lvlh @ joint_to_child)
-    return Rotation.from_matrix(relative).as_rotvec()
+    return rotation_vector_from_matrix(relative)

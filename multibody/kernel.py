@@ -166,8 +166,12 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     out_scalars[3] += power * step * stage_weight
 
     if n_orbit != 0.0:
+        # clohessy_wiltshire_acceleration written out in scalars (no per-node allocation).
         for i in range(n):
-            f_net[i] += net_mass[i] * clohessy_wiltshire_acceleration(x[i], v[i], n_orbit)
+            m = net_mass[i]
+            f_net[i, 0] += m * (3.0 * n_orbit * n_orbit * x[i, 0] + 2.0 * n_orbit * v[i, 1])
+            f_net[i, 1] -= m * 2.0 * n_orbit * v[i, 0]
+            f_net[i, 2] -= m * n_orbit * n_orbit * x[i, 2]
 
     rots = np.empty((nb, 3, 3))
     coms = np.empty((nb, 3))
@@ -190,24 +194,31 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     v_true = v + velocity_lag
     new_lag = np.zeros((n, 3))
     touched = np.zeros(n, dtype=np.bool_)
+    speed = np.sqrt(np.sum(v_true * v_true, axis=1))
     for s in range(shape_body.shape[0]):
         b = shape_body[s]
         rot = rots[b]
+        reach = max(np.sqrt(np.sum(shape_box_min[s] ** 2)), np.sqrt(np.sum(shape_box_max[s] ** 2)))
+        body_speed = np.sqrt(np.sum(vels[b] ** 2)) + np.sqrt(np.sum(omegas[b] ** 2)) * reach
         for i in range(n):
-            arm = x[i] - coms[b]
-            p_body = rot.T @ arm
-            surface_velocity = vels[b] + np.cross(omegas[b], arm)
-            relative = v_true[i] - surface_velocity
-            margin = net_radius[i] + step * math.sqrt(relative @ relative)
-            outside = False
-            for k in range(3):
-                if p_body[k] < shape_box_min[s, k] - margin or p_body[k] > shape_box_max[s, k] + margin:
-                    outside = True
-            if outside:
+            # Broad phase in scalars: node in the body frame against the shape's box, grown by
+            # the node radius and the distance the pair can close within one step.
+            ax = x[i, 0] - coms[b, 0]
+            ay = x[i, 1] - coms[b, 1]
+            az = x[i, 2] - coms[b, 2]
+            px = rot[0, 0] * ax + rot[1, 0] * ay + rot[2, 0] * az
+            py = rot[0, 1] * ax + rot[1, 1] * ay + rot[2, 1] * az
+            pz = rot[0, 2] * ax + rot[1, 2] * ay + rot[2, 2] * az
+            margin = net_radius[i] + step * (speed[i] + body_speed)
+            if (px < shape_box_min[s, 0] - margin or px > shape_box_max[s, 0] + margin
+                    or py < shape_box_min[s, 1] - margin or py > shape_box_max[s, 1] + margin
+                    or pz < shape_box_min[s, 2] - margin or pz > shape_box_max[s, 2] + margin):
                 continue
-            distance, normal_body = signed_distance_to_mesh(
-                p_body, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
-            normal = rot @ normal_body
+            distance, nbx, nby, nbz = signed_distance_to_mesh(
+                px, py, pz, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
+            arm = x[i] - coms[b]
+            normal = rot @ np.array([nbx, nby, nbz])
+            relative = v_true[i] - vels[b] - np.cross(omegas[b], arm)
             penetration = net_radius[i] - distance
             if penetration <= 0.0 and penetration - (relative @ normal) * step <= 0.0:
                 continue

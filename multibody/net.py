@@ -162,20 +162,29 @@ def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
     for t in range(threads.shape[0]):
         a = threads[t, 0]
         b = threads[t, 1]
-        d = x[b] - x[a]
-        length = np.sqrt(d @ d)
+        # Scalar arithmetic on purpose: numba sends small-array products to BLAS.
+        dx = x[b, 0] - x[a, 0]
+        dy = x[b, 1] - x[a, 1]
+        dz = x[b, 2] - x[a, 2]
+        length = np.sqrt(dx * dx + dy * dy + dz * dz)
         stretch = length - rest_lengths[t]
         if stretch <= 0.0:
             continue
-        e = d / length
-        rate = (v[b] - v[a]) @ e
+        ex = dx / length
+        ey = dy / length
+        ez = dz / length
+        rate = (v[b, 0] - v[a, 0]) * ex + (v[b, 1] - v[a, 1]) * ey + (v[b, 2] - v[a, 2]) * ez
         elastic += 0.5 * stiffness[t] * stretch * stretch
         tension = stiffness[t] * stretch + damping[t] * rate
         if tension <= 0.0:
             continue
         power += damping[t] * rate * rate
-        force[a] += tension * e
-        force[b] -= tension * e
+        force[a, 0] += tension * ex
+        force[a, 1] += tension * ey
+        force[a, 2] += tension * ez
+        force[b, 0] -= tension * ex
+        force[b, 1] -= tension * ey
+        force[b, 2] -= tension * ez
     return elastic, power
 
 

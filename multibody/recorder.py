@@ -33,10 +33,9 @@ from __future__ import annotations
 
 import numpy as np
 import exudyn as exu
-from scipy.spatial.transform import Rotation
 
 from multibody.hinge import relative_rotation_vector_joint_frame
-from multibody.kernel import (BENDING_ELASTIC, CONTACT_DISSIPATED, CONTACT_ELASTIC, THREAD_DISSIPATED,
+from multibody.kernel import (BENDING_ELASTIC, rotation_matrix_from_rotation_vector, CONTACT_DISSIPATED, CONTACT_ELASTIC, THREAD_DISSIPATED,
                               THREAD_ELASTIC)
 from multibody.orbit import clohessy_wiltshire_potential
 
@@ -109,7 +108,7 @@ class Recorder:
         for body, i in zip(self.assembly.bodies, self._body_index):
             com.append(body.com_lvlh + q[i:i + 3])
             vel.append(np.array(qt[i:i + 3]))
-            rot.append(Rotation.from_rotvec(q[i + 3:i + 6]).as_matrix())
+            rot.append(rotation_matrix_from_rotation_vector(np.array(q[i + 3:i + 6])))
             omega.append(np.array(qt[i + 3:i + 6]))
         return np.array(com), np.array(vel), np.array(rot), np.array(omega)
 

@@ -1,0 +1,5 @@
+import sys
+
+from riskassess.cli import main
+
+sys.exit(main())

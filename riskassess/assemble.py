@@ -1,0 +1,167 @@
+"""Turn a validated :class:`~riskassess.case.Case` into the multibody model's inputs.
+
+Frames: shapes, centres of mass, inertia and joints come in the target frame; each body
+frame has its origin at the body CoM and axes parallel to the target frame, so a body's
+attitude at t = 0 is the target attitude (times the initial hinge rotation for a child).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from multibody.assembly import ContactLaw, ImpactAssembly, JointSpec, RigidBodySpec, SolverSpec
+from multibody.geometry import geometric_center_of_mass, shape_mesh, uniform_density_inertia
+from multibody.hinge import hinge_frame_lvlh
+from multibody.net import flat_square_net, thread_node_mass
+from multibody.orbit import mean_motion
+from riskassess.case import Case, CircularOrbit
+
+
+@dataclass
+class ModelInputs:
+    """An assembly plus the joint rest states (child attitude and CoM before initial hinge angles)."""
+
+    assembly: ImpactAssembly
+    rest_attitudes: list
+    rest_coms: list
+
+
+def body_meshes_target_frame(case: Case, base: Path):
+    """Per body, its shapes as trimesh meshes in the target frame (m)."""
+    meshes = []
+    for body in case.target.bodies:
+        meshes.append([shape_mesh(**_shape_kwargs(s, base)) for s in body.shapes])
+    return meshes
+
+
+def _shape_kwargs(shape, base: Path) -> dict:
+    kwargs = shape.model_dump()
+    if shape.kind == "mesh":
+        kwargs["file"] = base / shape.file
+    return kwargs
+
+
+def mass_properties_target_frame(case: Case, meshes):
+    """Per body: (CoM (m), inertia about CoM (kg m^2)), target frame; defaults from geometry."""
+    props = []
+    for body, body_meshes in zip(case.target.bodies, meshes):
+        com = (np.asarray(body.center_of_mass, float) if body.center_of_mass is not None
+               else geometric_center_of_mass(body_meshes))
+        inertia = (np.asarray(body.inertia, float) if body.inertia is not None
+                   else uniform_density_inertia(body_meshes, body.mass, com))
+        props.append((com, inertia))
+    return props
+
+
+def target_vertices_lvlh(case: Case, base: Path = Path(".")) -> np.ndarray:
+    """Vertices of every target shape at t = 0, LVLH (m)."""
+    points = np.vstack([m.vertices for body in body_meshes_target_frame(case, base) for m in body])
+    rot = Rotation.from_rotvec(case.target.attitude_rotation_vector).as_matrix()
+    return np.asarray(case.target.position_lvlh, float) + points @ rot.T
+
+
+def build_net(case: Case):
+    """Net topology (LVLH) and initial node velocities for the case's launch."""
+    net, launch, bullets = case.net, case.launch, case.bullets
+    thread = net.thread
+    mesh = net.mesh_size
+    area = np.pi * thread.diameter**2 / 4.0
+    axial_rigidity = thread.stiffness * mesh if thread.stiffness is not None else thread.modulus * area
+    bending_rigidity = 0.0
+    if thread.bending:
+        bending_rigidity = (thread.bending_rigidity if thread.bending_rigidity is not None
+                            else thread.modulus * np.pi * thread.diameter**4 / 64.0)
+    node_mass = (net.node_mass if net.node_mass is not None
+                 else thread_node_mass(net.side_length, net.nodes_per_side, thread.diameter, thread.density))
+    direction = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
+    rot = Rotation.from_rotvec(case.target.attitude_rotation_vector).as_matrix()
+    aim = np.asarray(case.target.position_lvlh, float) + rot @ np.asarray(launch.aim_point, float)
+    topology = flat_square_net(
+        center=aim - launch.distance * direction, direction=direction,
+        side_length=net.side_length, nodes_per_side=net.nodes_per_side,
+        node_mass=node_mass, node_radius=thread.diameter / 2.0,
+        thread_axial_rigidity=axial_rigidity, thread_damping=thread.damping,
+        bullet_mass=bullets.mass, bullet_radius=bullets.radius,
+        bullet_tether_length=bullets.tether_length or mesh, bending_rigidity=bending_rigidity)
+    velocity = np.tile(launch.velocity * direction, (topology.n_nodes, 1))
+    return topology, velocity
+
+
+def build_bodies_and_joints(case: Case, base: Path):
+    """Rigid-body and joint specs in LVLH at t = 0, and the joints' rest states."""
+    target = case.target
+    meshes = body_meshes_target_frame(case, base)
+    props = mass_properties_target_frame(case, meshes)
+    target_to_lvlh = Rotation.from_rotvec(target.attitude_rotation_vector).as_matrix()
+    origin = np.asarray(target.position_lvlh, float)
+    omega_lvlh = target_to_lvlh @ np.asarray(target.angular_velocity, float)
+    names = [b.name for b in target.bodies]
+
+    bodies = []
+    for body, body_meshes, (com_t, inertia) in zip(target.bodies, meshes, props):
+        com = origin + target_to_lvlh @ com_t
+        shifted = [m.copy().apply_translation(-com_t) for m in body_meshes]
+        bodies.append(RigidBodySpec(
+            name=body.name, mass=body.mass, inertia_body=inertia, com_lvlh=com,
+            body_to_lvlh=target_to_lvlh.copy(),
+            velocity_lvlh=np.asarray(target.velocity_lvlh, float) + np.cross(omega_lvlh, com - origin),
+            omega_body=np.asarray(target.angular_velocity, float), meshes_body=shifted))
+    rest_attitudes = [b.body_to_lvlh.copy() for b in bodies]
+    rest_coms = [b.com_lvlh.copy() for b in bodies]
+
+    joints = []
+    for j in target.joints:
+        parent, child = names.index(j.parent), names.index(j.child)
+        point = origin + target_to_lvlh @ np.asarray(j.position, float)
+        frame = hinge_frame_lvlh(target_to_lvlh @ np.asarray(j.axis, float), point, bodies[child].com_lvlh)
+        joints.append(JointSpec(
+            name=j.name, kind=j.kind, parent=parent, child=child, point_lvlh=point, hinge_to_lvlh=frame,
+            torsional_stiffness=j.torsional_stiffness, torsional_damping=j.torsional_damping,
+            penalty_translational=j.penalty_translational, penalty_rotational=j.penalty_rotational,
+            penalty_damping_ratio=j.penalty_damping_ratio))
+        if j.initial_angle or j.initial_rate:
+            _apply_initial_hinge_state(bodies, joints, len(joints) - 1, j.initial_angle, j.initial_rate)
+    return bodies, joints, rest_attitudes, rest_coms
+
+
+def _descendants(joints, body):
+    out = [body]
+    for j in joints:
+        if j.parent == body:
+            out += _descendants(joints, j.child)
+    return out
+
+
+def _apply_initial_hinge_state(bodies, joints, index, angle, rate):
+    """Rotate the child subtree about the hinge axis by ``angle`` and give it ``rate`` (LVLH)."""
+    joint = joints[index]
+    axis = joint.hinge_to_lvlh[:, 1]
+    turn = Rotation.from_rotvec(angle * axis).as_matrix()
+    for k in _descendants(joints, joint.child):
+        b = bodies[k]
+        arm = turn @ (b.com_lvlh - joint.point_lvlh)
+        b.com_lvlh = joint.point_lvlh + arm
+        b.body_to_lvlh = turn @ b.body_to_lvlh
+        b.velocity_lvlh = turn @ b.velocity_lvlh + rate * np.cross(axis, arm)
+        b.omega_body = b.omega_body + rate * (b.body_to_lvlh.T @ axis)
+
+
+def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
+    """Everything :class:`multibody.impact.ImpactSimulation` needs for this case."""
+    net, velocity = build_net(case)
+    bodies, joints, rest_att, rest_com = build_bodies_and_joints(case, base)
+    law = case.contact
+    sim = case.simulation
+    assembly = ImpactAssembly(
+        net=net, net_velocity=velocity, bodies=bodies, joints=joints,
+        contact=ContactLaw(stiffness=law.stiffness, exponent=law.exponent,
+                           hunt_crossley_alpha=law.hunt_crossley_alpha, mu_static=law.mu_static,
+                           mu_kinetic=law.mu_kinetic, transition_speed=law.transition_speed),
+        solver=SolverSpec(end_time=sim.end_time, step=sim.step, integrator=sim.integrator,
+                          output_rate=sim.output_rate, net_output_rate=sim.net_output_rate,
+                          contact_substep=sim.contact_substep),
+        mean_motion=mean_motion(case.orbit.altitude) if isinstance(case.orbit, CircularOrbit) else 0.0)
+    return ModelInputs(assembly, rest_att, rest_com)

@@ -1,0 +1,364 @@
+"""Case files: TOML, validated once on load into typed objects.
+
+Every quantity is SI (m, kg, s, N, rad); the field descriptions below state the unit and
+are the schema documentation (``riskassess schema`` prints them). Frames:
+
+* **LVLH**: chaser-centred, x radial, y along-track (flight direction), z cross-track.
+* **target frame**: the debris reference frame in which body geometry, centres of
+  mass, inertia and joints are given; its pose in LVLH at t = 0 is ``target.position_lvlh``
+  and ``target.attitude_rotation_vector`` (target->LVLH).
+
+:func:`load_case` raises :class:`CaseError` listing every problem as
+``file: key.path: message`` before any simulation starts.
+"""
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Annotated, Literal, Union
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+Positive = Annotated[float, Field(gt=0)]
+NonNegative = Annotated[float, Field(ge=0)]
+
+
+class CaseError(ValueError):
+    """A case file that cannot be used; the message names the file, the key and what is allowed."""
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+# ---------------------------------------------------------------------------- simulation
+class Simulation(Strict):
+    end_time: Positive = Field(description="Simulated time (s).")
+    step: Annotated[float, Field(gt=0, le=1e-2)] = Field(
+        1e-4, description="Fixed integrator step (s); see docs/model.md for the convergence study.")
+    integrator: Literal["VelocityVerlet", "RK44", "ExplicitMidpoint"] = Field(
+        "VelocityVerlet", description="Exudyn explicit integrator.")
+    output_rate: Positive = Field(1000.0, description="Time-series samples per second (Hz).")
+    net_output_rate: Positive = Field(50.0, description="Net snapshots per second (Hz), for VTK export.")
+    contact_substep: Positive = Field(
+        2e-6, description="Largest sub-step of the contact impulse integration (s); >= step turns sub-cycling off.")
+
+    @model_validator(mode="after")
+    def _rates_fit_step(self):
+        if self.output_rate * self.step > 1.0 + 1e-9:
+            raise ValueError(f"output_rate must be <= 1/step = {1 / self.step:g} Hz. Got {self.output_rate:g} instead")
+        if self.end_time < self.step:
+            raise ValueError(f"end_time must be >= step ({self.step:g} s). Got {self.end_time:g} instead")
+        return self
+
+
+# ---------------------------------------------------------------------------- orbit
+class CircularOrbit(Strict):
+    kind: Literal["circular"]
+    altitude: Annotated[float, Field(ge=100e3, le=1e8)] = Field(
+        description="Altitude of the circular reference orbit above the equatorial radius (m); "
+                    "sets the Clohessy-Wiltshire mean motion.")
+
+
+class NoOrbit(Strict):
+    kind: Literal["none"]
+
+
+# ---------------------------------------------------------------------------- net
+class Thread(Strict):
+    diameter: Annotated[float, Field(gt=0, le=0.05)] = Field(
+        description="Thread diameter (m); node contact radius is half of it.")
+    density: Annotated[float, Field(gt=0, le=25000)] | None = Field(
+        None, description="Thread material density (kg/m^3); gives the node mass.")
+    modulus: Annotated[float, Field(gt=0, le=1e13)] | None = Field(
+        None, description="Young's modulus (Pa); stiffness = E A / l0.")
+    stiffness: Positive | None = Field(
+        None, description="Axial stiffness of one mesh-length thread (N/m), instead of modulus.")
+    damping: NonNegative = Field(description="Axial damping of a thread (N s/m).")
+    bending: bool = Field(False, description="Add thread bending stiffness (EI from modulus or bending_rigidity).")
+    bending_rigidity: Positive | None = Field(None, description="Thread bending rigidity EI (N m^2).")
+
+    @model_validator(mode="after")
+    def _one_stiffness(self):
+        if (self.modulus is None) == (self.stiffness is None):
+            raise ValueError("give exactly one of 'modulus' (Pa) or 'stiffness' (N/m)")
+        if self.bending and self.modulus is None and self.bending_rigidity is None:
+            raise ValueError("'bending = true' needs 'modulus' or 'bending_rigidity'")
+        return self
+
+
+class Net(Strict):
+    side_length: Positive = Field(description="Side of the square net (m).")
+    nodes_per_side: Annotated[int, Field(ge=2, le=200)] = Field(description="Nodes along one side (-).")
+    thread: Thread
+    node_mass: Positive | None = Field(
+        None, description="Mass of one net node (kg); default: thread mass spread evenly over the nodes.")
+
+    @model_validator(mode="after")
+    def _mass_source(self):
+        if self.node_mass is None and self.thread.density is None:
+            raise ValueError("give 'node_mass' (kg) or 'thread.density' (kg/m^3)")
+        return self
+
+    @property
+    def mesh_size(self) -> float:
+        return self.side_length / (self.nodes_per_side - 1)
+
+
+class Bullets(Strict):
+    mass: Positive = Field(description="Mass of each of the four corner bullets (kg).")
+    radius: Annotated[float, Field(gt=0, le=1.0)] = Field(description="Bullet contact radius (m).")
+    tether_length: Positive | None = Field(
+        None, description="Thread from corner node to bullet (m); default one mesh size.")
+
+
+class Launch(Strict):
+    distance: Positive = Field(description="Distance from the net centre to the aim point along 'direction' (m).")
+    velocity: Annotated[float, Field(gt=0, le=500)] = Field(description="Net speed along 'direction' (m/s).")
+    direction: Vector3 = Field(description="Launch direction, LVLH (-), normalised on load.")
+    aim_point: Vector3 = Field([0.0, 0.0, 0.0], description="Aim point, target frame (m).")
+
+    @field_validator("direction")
+    @classmethod
+    def _nonzero(cls, v):
+        if np.linalg.norm(v) == 0:
+            raise ValueError("direction must be a non-zero vector")
+        return v
+
+
+class Contact(Strict):
+    stiffness: Positive = Field(description="Hertz stiffness k_n (N/m^exponent).")
+    exponent: Annotated[float, Field(ge=1.0, le=3.0)] = Field(1.5, description="Hertz exponent n (-).")
+    hunt_crossley_alpha: NonNegative = Field(
+        description="Hunt-Crossley factor alpha (s/m): d_n = 1.5 alpha k_n.")
+    mu_static: NonNegative = Field(description="Static friction coefficient (-).")
+    mu_kinetic: NonNegative = Field(description="Kinetic friction coefficient (-).")
+    transition_speed: Positive = Field(description="Static-to-kinetic transition slip speed V_t0 (m/s).")
+
+    @model_validator(mode="after")
+    def _friction_order(self):
+        if self.mu_kinetic > self.mu_static:
+            raise ValueError(f"mu_kinetic must be <= mu_static ({self.mu_static}). Got {self.mu_kinetic} instead")
+        return self
+
+
+# ---------------------------------------------------------------------------- target
+class Box(Strict):
+    kind: Literal["box"]
+    size: Annotated[list[Positive], Field(min_length=3, max_length=3)] = Field(description="Edge lengths (m).")
+    center: Vector3 = Field(description="Centre, target frame (m).")
+    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Box->target rotation (rad).")
+
+
+class Cylinder(Strict):
+    kind: Literal["cylinder"]
+    radius: Positive = Field(description="(m)")
+    length: Positive = Field(description="(m)")
+    axis: Vector3 = Field(description="Axis direction, target frame (-).")
+    center: Vector3 = Field(description="Centre, target frame (m).")
+
+
+class Sphere(Strict):
+    kind: Literal["sphere"]
+    radius: Positive = Field(description="(m)")
+    center: Vector3 = Field(description="Centre, target frame (m).")
+
+
+class MeshFile(Strict):
+    kind: Literal["mesh"]
+    file: str = Field(description="Closed triangle mesh (STL, OBJ, PLY...), path relative to the case file.")
+    scale: Positive = Field(1.0, description="Factor taking file units to metres (-).")
+    center: Vector3 = Field([0.0, 0.0, 0.0], description="Translation of the mesh, target frame (m).")
+    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Mesh->target rotation (rad).")
+
+
+Shape = Annotated[Union[Box, Cylinder, Sphere, MeshFile], Field(discriminator="kind")]
+
+
+class Body(Strict):
+    name: str
+    mass: Positive = Field(description="(kg)")
+    center_of_mass: Vector3 | None = Field(None, description="CoM, target frame (m); default: shapes' centroid.")
+    inertia: Annotated[list[Vector3], Field(min_length=3, max_length=3)] | None = Field(
+        None, description="Inertia about the CoM, target-frame axes (kg m^2); default: uniform density over the shapes.")
+    shapes: Annotated[list[Shape], Field(min_length=1)]
+
+    @field_validator("inertia")
+    @classmethod
+    def _physical_inertia(cls, j):
+        if j is None:
+            return j
+        m = np.asarray(j, float)
+        if not np.allclose(m, m.T, rtol=1e-9, atol=1e-9 * np.abs(m).max()):
+            raise ValueError("inertia must be symmetric")
+        eig = np.linalg.eigvalsh(m)
+        if eig.min() <= 0:
+            raise ValueError(f"inertia must be positive definite (principal moments {eig.round(6).tolist()})")
+        if eig[0] + eig[1] < eig[2] * (1 - 1e-9):
+            raise ValueError(f"principal moments {eig.round(6).tolist()} violate the triangle inequality")
+        return j
+
+
+class Joint(Strict):
+    name: str
+    kind: Literal["revolute", "clamped"] = Field(description="Hinge with torsional spring-damper, or clamped.")
+    parent: str = Field(description="Name of the parent body.")
+    child: str = Field(description="Name of the child (appendage) body.")
+    position: Vector3 = Field(description="Joint point, target frame (m).")
+    axis: Vector3 = Field([0.0, 0.0, 1.0], description="Hinge axis h2, target frame (-).")
+    torsional_stiffness: NonNegative = Field(0.0, description="About the hinge axis (N m/rad).")
+    torsional_damping: NonNegative = Field(0.0, description="About the hinge axis (N m s/rad).")
+    initial_angle: float = Field(0.0, description="Initial hinge angle about h2 (rad).")
+    initial_rate: float = Field(0.0, description="Initial hinge rate about h2 (rad/s).")
+    penalty_translational: Positive | None = Field(
+        None, description="Penalty stiffness locking the joint point (N/m); default: tuned to the step.")
+    penalty_rotational: Positive | None = Field(
+        None, description="Penalty stiffness locking rotations (N m/rad); default: tuned to the step.")
+    penalty_damping_ratio: Annotated[float, Field(ge=0, le=1)] = Field(
+        0.05, description="Penalty damping, fraction of critical (-).")
+
+    @model_validator(mode="after")
+    def _revolute_fields(self):
+        if np.linalg.norm(self.axis) == 0:
+            raise ValueError("axis must be a non-zero vector")
+        if self.kind == "clamped" and (self.torsional_stiffness or self.initial_angle or self.initial_rate):
+            raise ValueError("a clamped joint takes no torsional_stiffness, initial_angle or initial_rate")
+        return self
+
+
+class Target(Strict):
+    position_lvlh: Vector3 = Field(description="Target-frame origin at t = 0, LVLH (m).")
+    attitude_rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Target->LVLH rotation at t = 0 (rad).")
+    velocity_lvlh: Vector3 = Field([0.0, 0.0, 0.0], description="Velocity of the target-frame origin, LVLH (m/s).")
+    angular_velocity: Vector3 = Field([0.0, 0.0, 0.0], description="Rigid tumble of the whole target, target frame (rad/s).")
+    bodies: Annotated[list[Body], Field(min_length=1)]
+    joints: list[Joint] = []
+
+    @model_validator(mode="after")
+    def _joint_tree(self):
+        names = [b.name for b in self.bodies]
+        if len(set(names)) != len(names):
+            raise ValueError(f"body names must be unique. Got {names}")
+        children = []
+        for j in self.joints:
+            for role in ("parent", "child"):
+                if getattr(j, role) not in names:
+                    raise ValueError(f"joint '{j.name}': {role} '{getattr(j, role)}' is not a body; bodies are {names}")
+            if j.parent == j.child:
+                raise ValueError(f"joint '{j.name}' joins body '{j.parent}' to itself")
+            children.append(j.child)
+        if len(set(children)) != len(children):
+            raise ValueError("each body can be the child of at most one joint")
+        roots = [n for n in names if n not in children]
+        if len(roots) != 1:
+            raise ValueError(f"the joints must form one tree with a single root body. Roots found: {roots}")
+        return self
+
+
+class Case(Strict):
+    name: str
+    description: str = ""
+    simulation: Simulation
+    orbit: Annotated[Union[CircularOrbit, NoOrbit], Field(discriminator="kind")]
+    net: Net
+    bullets: Bullets
+    launch: Launch
+    contact: Contact
+    target: Target
+
+
+# ---------------------------------------------------------------------------- loading
+def _format_location(loc) -> str:
+    parts = []
+    for item in loc:
+        if isinstance(item, int):
+            parts[-1] = f"{parts[-1]}[{item}]" if parts else f"[{item}]"
+        elif item in ("circular", "none", "box", "cylinder", "sphere", "mesh"):
+            continue  # discriminator tags add nothing for the user
+        else:
+            parts.append(str(item))
+    return ".".join(parts) or "(top level)"
+
+
+def format_validation_error(path: Path, error: ValidationError) -> str:
+    """scikit-learn-style messages, one per problem: ``file: key.path: message. Got X instead.``"""
+    lines = []
+    for e in error.errors():
+        where = _format_location(e["loc"])
+        msg = e["msg"].removeprefix("Value error, ")
+        if e["type"] == "extra_forbidden":
+            msg = "unknown key (check spelling; see 'riskassess schema')"
+        elif "input" in e and e["type"] not in ("missing",) and not isinstance(e["input"], dict):
+            msg = f"{msg}. Got {e['input']!r} instead"
+        lines.append(f"{path}: {where}: {msg}")
+    return "\n".join(lines)
+
+
+def load_case(path: str | Path) -> Case:
+    """Read and validate a case file; raise :class:`CaseError` naming every problem."""
+    path = Path(path)
+    try:
+        raw = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise CaseError(f"{path}: no such case file") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise CaseError(f"{path}: not valid TOML: {exc}") from None
+    try:
+        case = Case.model_validate(raw)
+    except ValidationError as exc:
+        raise CaseError(format_validation_error(path, exc)) from None
+    problems = _check_files(case, path.parent)
+    if not problems:
+        problems = _check_reach(case, path.parent)
+    if problems:
+        raise CaseError("\n".join(f"{path}: {p}" for p in problems))
+    return case
+
+
+def _check_files(case: Case, base: Path) -> list[str]:
+    problems = []
+    for i, body in enumerate(case.target.bodies):
+        for k, shape in enumerate(body.shapes):
+            if isinstance(shape, MeshFile) and not (base / shape.file).is_file():
+                problems.append(f"target.bodies[{i}].shapes[{k}].file: mesh file '{shape.file}' not found "
+                                f"(paths are relative to the case file)")
+    return problems
+
+
+def _check_reach(case: Case, base: Path) -> list[str]:
+    """Reject a net that cannot reach the target before any simulation starts."""
+    from riskassess.assemble import target_vertices_lvlh  # geometry needs the mesh loader
+
+    points = target_vertices_lvlh(case, base)
+    launch = case.launch
+    d = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
+    net_center = _target_point_lvlh(case, launch.aim_point) - launch.distance * d
+    relative = points - net_center
+    along = relative @ d
+    lateral = np.linalg.norm(relative - np.outer(along, d), axis=1)
+    half_diagonal = case.net.side_length / np.sqrt(2.0)
+    problems = []
+    ahead = along > 0
+    if not ahead.any():
+        return ["launch.direction: the whole target is behind the net; the net flies away from it"]
+    if lateral[ahead].min() > half_diagonal:
+        problems.append(f"launch.direction: the net's path misses the target by "
+                        f"{lateral[ahead].min() - half_diagonal:.2f} m beyond its half-diagonal "
+                        f"{half_diagonal:.2f} m; it cannot reach")
+    gap = along.min()
+    if gap <= 0:
+        problems.append(f"launch.distance: the net plane starts {-gap:.2f} m inside the target; "
+                        f"increase distance to more than {launch.distance - gap:.2f} m")
+    elif gap > launch.velocity * case.simulation.end_time:
+        problems.append(f"launch.distance: the net needs {gap / launch.velocity:.2f} s to reach the target but "
+                        f"simulation.end_time is {case.simulation.end_time:g} s")
+    return problems
+
+
+def _target_point_lvlh(case: Case, point_target) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    rot = Rotation.from_rotvec(case.target.attitude_rotation_vector).as_matrix()
+    return np.asarray(case.target.position_lvlh, float) + rot @ np.asarray(point_target, float)

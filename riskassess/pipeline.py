@@ -1,0 +1,88 @@
+"""The risk pipeline: case file -> coupled simulation -> run folder.
+
+Later stages (structures, reports, VTK) read the run folder; nothing here re-runs them.
+"""
+from __future__ import annotations
+
+import datetime
+import platform
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from multibody.impact import ImpactSimulation
+from riskassess import results
+from riskassess.assemble import model_inputs
+from riskassess.case import Case, load_case
+from riskassess.summary import run_summary
+
+
+@dataclass
+class RunOutput:
+    run_dir: Path
+    summary: dict
+
+
+def software_versions() -> dict:
+    import exudyn
+    import numba
+    import trimesh
+
+    return {"python": platform.python_version(), "exudyn": exudyn.__version__, "numpy": np.__version__,
+            "numba": numba.__version__, "trimesh": trimesh.__version__}
+
+
+def prepare_simulation(case: Case, case_path: Path) -> ImpactSimulation:
+    """Build the Exudyn model; raises ``ValueError`` for model-level problems before running."""
+    inputs = model_inputs(case, case_path.parent)
+    return ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
+
+
+def run_case(case_path: str | Path, out_dir: str | Path, progress=None) -> RunOutput:
+    """Load, simulate and write the run folder; returns the summary."""
+    case_path = Path(case_path)
+    case = load_case(case_path)
+    simulation = prepare_simulation(case, case_path)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    manifest = {"format": results.FORMAT, "version": results.VERSION, "case": case.name,
+                "created": datetime.datetime.now(datetime.timezone.utc).isoformat(),
+                "status": "running", "files": ["case.toml", "case.json"], "software": software_versions()}
+    shutil.copyfile(case_path, out / "case.toml")
+    results.atomic_write_json(out / "case.json", case.model_dump())
+    recorder = simulation.run(progress=progress)
+    summary = run_summary(recorder, simulation.assembly, case.name)
+    write_simulation_results(out, recorder, simulation)
+    results.atomic_write_json(out / "summary.json", summary)
+    manifest.update(status="complete", files=manifest["files"] + ["summary.json", "timeseries.npz", "net.npz",
+                                                                  "bodies.npz"])
+    results.atomic_write_json(out / "manifest.json", manifest)
+    return RunOutput(out, summary)
+
+
+def write_simulation_results(out: Path, recorder, simulation: ImpactSimulation) -> None:
+    assembly = simulation.assembly
+    series = dict(recorder.series)
+    series["body_names"] = np.array([b.name for b in assembly.bodies])
+    series["body_masses"] = np.array([b.mass for b in assembly.bodies])
+    series["joint_names"] = np.array([j.name for j in assembly.joints])
+    series["joint_kinds"] = np.array([j.kind for j in assembly.joints])
+    results.atomic_write_npz(out / "timeseries.npz", series)
+    net = assembly.net
+    results.atomic_write_npz(out / "net.npz", dict(
+        recorder.net, threads=net.threads, rest_lengths=net.rest_lengths, stiffness=net.stiffness,
+        damping=net.damping, masses=net.masses, radii=net.radii, n_bullets=net.n_bullets))
+    meshes = {}
+    for k, body in enumerate(assembly.bodies):
+        merged = body.meshes_body[0] if len(body.meshes_body) == 1 else _concatenate(body.meshes_body)
+        meshes[f"vertices_{k}"] = np.asarray(merged.vertices)
+        meshes[f"faces_{k}"] = np.asarray(merged.faces)
+    results.atomic_write_npz(out / "bodies.npz", meshes)
+
+
+def _concatenate(meshes):
+    import trimesh
+
+    return trimesh.util.concatenate(meshes)
