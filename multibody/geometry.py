@@ -110,6 +110,9 @@ def contact_shapes_body_frame(meshes_per_body, com_per_body) -> ContactShapes:
             lo.append(tri.reshape(-1, 3).min(axis=0))
             hi.append(tri.reshape(-1, 3).max(axis=0))
             start += len(tri)
+    if not triangles:  # bodies without contact shapes
+        return ContactShapes(np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros(0, np.int64),
+                             np.zeros((0, 2), np.int64), np.zeros((0, 3)), np.zeros((0, 3)))
     return ContactShapes(
         triangles=np.ascontiguousarray(np.concatenate(triangles)),
         normals=np.ascontiguousarray(np.concatenate(normals)),

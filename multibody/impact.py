@@ -131,7 +131,7 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
 
     def coupled_forces(mbs_, t, item, q, q_t):
         # Exudyn hands lists over; fromiter is the cheapest conversion measured (bench/).
-        return kernel.evaluate(np.fromiter(q, float, size), np.fromiter(q_t, float, size)).tolist()
+        return kernel.evaluate(np.fromiter(q, float, size), np.fromiter(q_t, float, size), t).tolist()
 
     mbs.AddObject(ObjectGenericODE2(nodeNumbers=generic_nodes, massMatrix=mass,
                                     forceUserFunction=coupled_forces))

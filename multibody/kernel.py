@@ -110,9 +110,13 @@ class KernelData:
     def n_bodies(self) -> int:
         return len(self.body_mass)
 
-    def evaluate(self, q, qt):
-        """Generalized forces for coordinates ``q`` and velocities ``qt`` ((3n + 6nb,) each)."""
-        n_sub = max(1, int(math.ceil(self.step / self.contact_substep - 1e-9)))
+    def evaluate(self, q, qt, time=1.0):
+        """Generalized forces for coordinates ``q`` and velocities ``qt`` ((3n + 6nb,) each).
+
+        At ``time`` 0 (the solver's initial-acceleration evaluation, which Verlet applies as
+        a half kick only) the contact is evaluated without sub-cycling.
+        """
+        n_sub = max(1, int(math.ceil(self.step / self.contact_substep - 1e-9))) if time > 0.0 else 1
         coupled_generalized_forces(
             q, qt, self.net_reference, self.net_mass, self.net_radius,
             self.threads, self.rest_lengths, self.thread_stiffness, self.thread_damping,
