@@ -1,0 +1,65 @@
+"""Case files are rejected with a message naming the file, the key and what is allowed."""
+from pathlib import Path
+
+import pytest
+
+from riskassess.case import CaseError, load_case
+
+CASES = Path(__file__).resolve().parents[2] / "cases"
+REFERENCE = (CASES / "envisat_net_impact.toml").read_text()
+
+
+def _load_modified(tmp_path, old, new):
+    assert old in REFERENCE, old
+    path = tmp_path / "bad.toml"
+    path.write_text(REFERENCE.replace(old, new, 1))
+    with pytest.raises(CaseError) as info:
+        load_case(path)
+    return str(info.value)
+
+
+def test_shipped_cases_are_valid():
+    for path in CASES.glob("*.toml"):
+        assert load_case(path).name
+
+
+def test_reference_case_matches_paper_tables():
+    case = load_case(CASES / "envisat_net_impact.toml")
+    # seed paper Table 1 / Table 2
+    assert case.net.side_length == 30.0 and case.net.nodes_per_side == 35
+    assert case.net.thread.stiffness == 62308.25 and case.net.thread.damping == 1.58
+    assert case.bullets.mass == 1.786 and case.launch.velocity == 20.0
+    assert case.contact.stiffness == 1.622e8 and case.contact.exponent == 1.5
+    assert (case.contact.mu_static, case.contact.mu_kinetic) == (0.19, 0.152)
+
+
+@pytest.mark.parametrize("old, new, expected", [
+    ('mass = 350.0', 'mass = -350.0', "target.bodies[1].mass: Input should be greater than 0. Got -350.0"),
+    ('stiffness = 62308.25', 'stiffness = 0.0', "net.thread.stiffness: Input should be greater than 0"),
+    ('velocity = 20.0', 'velocity = "20 m/s"', "launch.velocity: Input should be a valid number"),
+    ('side_length = 30.0', 'side_length = 30.0\nsidelength = 3', "net.sidelength: unknown key"),
+    ('diameter = 0.002', 'diameter = 2.0', "net.thread.diameter: Input should be less than or equal to 0.05"),
+    ('altitude = 770e3', 'altitude = 770', "orbit.altitude: Input should be greater than or equal to 100000"),
+    ('child = "solar_array"', 'child = "solar_panel"', "joint 'solar_array_hinge': child 'solar_panel' is not a body"),
+    ('torsional_stiffness = 5.0e4', 'torsional_stiffness = -1.0', "torsional_stiffness: Input should be greater than or equal to 0"),
+    ('stiffness = 1.622e8', 'stiffness = -1.622e8', "contact.stiffness: Input should be greater than 0"),
+])
+def test_bad_values_name_file_key_and_allowed_range(tmp_path, old, new, expected):
+    message = _load_modified(tmp_path, old, new)
+    assert str(tmp_path / "bad.toml") in message
+    assert expected in message
+
+
+def test_net_that_cannot_reach_is_rejected(tmp_path):
+    message = _load_modified(tmp_path, "aim_point = [0.0, 0.0, 7.0]", "aim_point = [40.0, 0.0, 7.0]")
+    assert "launch.direction" in message and "misses the target" in message
+    message = _load_modified(tmp_path, "distance = 3.0 ", "distance = 1000.0 ")
+    assert "launch.distance" in message and "end_time" in message
+    message = _load_modified(tmp_path, "distance = 3.0 ", "distance = 1.0 ")
+    assert "launch.distance" in message and "inside the target" in message
+
+
+def test_missing_mesh_file_is_named(tmp_path):
+    message = _load_modified(tmp_path, 'kind = "box"\nsize = [3.375, 3.75, 7.875]',
+                             'kind = "mesh"\nfile = "envisat_body.stl"')
+    assert "target.bodies[0].shapes[0]" in message
