@@ -59,6 +59,7 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
         bending_triples=net.bending_triples, bending_stiffness=net.bending_stiffness,
         body_reference=np.array([b.com_lvlh for b in assembly.bodies], float).reshape(-1, 3),
         body_mass=np.array([b.mass for b in assembly.bodies], float),
+        body_inverse_inertia=np.array([np.linalg.inv(b.inertia_body) for b in assembly.bodies]).reshape(-1, 3, 3),
         triangles=shapes.triangles, triangle_normals=shapes.normals,
         shape_body=shapes.shape_body, shape_triangle_range=shapes.triangle_range,
         shape_box_min=shapes.box_min, shape_box_max=shapes.box_max,

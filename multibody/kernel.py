@@ -71,6 +71,7 @@ class KernelData:
     bending_stiffness: np.ndarray    # (b,) (N m/rad)
     body_reference: np.ndarray       # (nb, 3) reference CoM positions, LVLH (m)
     body_mass: np.ndarray            # (nb,) (kg)
+    body_inverse_inertia: np.ndarray # (nb, 3, 3) inverse inertia about the CoM, body frame (1/(kg m^2))
     triangles: np.ndarray            # (T, 3, 3) corners, body frame of the owning body (m)
     triangle_normals: np.ndarray     # (T, 3) outward normals, body frame
     shape_body: np.ndarray           # (ns,) int, body owning each contact shape
@@ -121,7 +122,7 @@ class KernelData:
             q, qt, self.net_reference, self.net_mass, self.net_radius,
             self.threads, self.rest_lengths, self.thread_stiffness, self.thread_damping,
             self.bending_triples, self.bending_stiffness,
-            self.body_reference, self.body_mass, self.triangles, self.triangle_normals,
+            self.body_reference, self.body_mass, self.body_inverse_inertia, self.triangles, self.triangle_normals,
             self.shape_body, self.shape_triangle_range, self.shape_box_min, self.shape_box_max,
             self.contact_stiffness, self.contact_exponent, self.contact_damping,
             self.mu_static, self.mu_kinetic, self.transition_speed,
@@ -145,7 +146,7 @@ def _apply_contact_pair(i, b, force, arm, weight, f_net, f_body, torque_lvlh, ou
 def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
                                threads, rest_lengths, thread_stiffness, thread_damping,
                                bending_triples, bending_stiffness,
-                               body_reference, body_mass, triangles, triangle_normals,
+                               body_reference, body_mass_all, inverse_inertia, triangles, triangle_normals,
                                shape_body, shape_triangle_range, shape_box_min, shape_box_max,
                                k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
                                n_orbit, step, n_substeps, stage_weight, velocity_lag, lag_body,
@@ -159,7 +160,7 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     VelocityVerlet's single evaluation, an average for Runge-Kutta stages).
     """
     n = net_mass.shape[0]
-    nb = body_mass.shape[0]
+    nb = body_mass_all.shape[0]
     x = net_reference + q[: 3 * n].reshape(n, 3)
     v = qt[: 3 * n].reshape(n, 3)
     f_net = np.zeros((n, 3))
@@ -189,7 +190,7 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
         rots[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6].copy())
         omegas[b] = rots[b] @ qt[base + 3:base + 6]
         if n_orbit != 0.0:
-            f_body[b] += body_mass[b] * clohessy_wiltshire_acceleration(coms[b], vels[b], n_orbit)
+            f_body[b] += body_mass_all[b] * clohessy_wiltshire_acceleration(coms[b], vels[b], n_orbit)
 
     torque_lvlh = np.zeros((nb, 3))
     contact_energy = 0.0
@@ -226,13 +227,16 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
             penetration = net_radius[i] - distance
             if penetration <= 0.0 and penetration - (relative @ normal) * step <= 0.0:
                 continue
-            impulse, mean_rel, end_rel, dissipated = contact_over_step(
-                penetration, relative, normal, f_non_contact[i], net_mass[i], step, n_substeps,
+            lever = np.cross(arm, normal)
+            body_mass = 1.0 / (1.0 / body_mass_all[b] + lever @ (rot @ (inverse_inertia[b] @ (rot.T @ lever))))
+            impulse, mean_change, end_change, dissipated = contact_over_step(
+                penetration, relative, normal, f_non_contact[i], net_mass[i], body_mass, step, n_substeps,
                 k_contact, exponent, d_contact, mu_s, mu_k, v_transition)
             # Kick that makes the integrator's next drift follow the sub-cycled path; the
             # difference between true end velocity and mean velocity is carried as a lag.
-            force = net_mass[i] * (mean_rel - relative) / step - f_non_contact[i]
-            new_lag[i] += end_rel - mean_rel
+            # (The lag carried from the previous step is released in the loop below.)
+            force = net_mass[i] * mean_change / step - f_non_contact[i]
+            new_lag[i] += end_change - mean_change
             touched[i] = True
             lag_body[i] = b
             _apply_contact_pair(i, b, force, arm, step * stage_weight, f_net, f_body, torque_lvlh, out_body_impulse)
