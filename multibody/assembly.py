@@ -102,7 +102,7 @@ class SolverSpec:
     output_rate: float = 1000.0     # time-series samples per second (Hz)
     net_output_rate: float = 50.0   # net snapshots per second (Hz)
     contact_substep: float = 2e-6   # largest contact sub-step (s)
-    threads: int = 1
+    joint_tuning_step: float | None = None  # step the automatic penalty joints are tuned to (s); None: step
 
     @property
     def n_steps(self) -> int:

@@ -141,7 +141,7 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
     for joint in assembly.joints:
         joint_objects.append(add_penalty_joint(mbs, joint, assembly.bodies, body_objects,
                                                rest_attitudes[joint.child], rest_coms[joint.child],
-                                               assembly.solver.step))
+                                               assembly.solver.joint_tuning_step or assembly.solver.step))
         parent = assembly.bodies[joint.parent]
         to_parent.append(parent.body_to_lvlh.T @ joint.hinge_to_lvlh)
         to_child.append(rest_attitudes[joint.child].T @ joint.hinge_to_lvlh)
