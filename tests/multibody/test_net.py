@@ -1,0 +1,50 @@
+"""Net building blocks against closed forms."""
+import numpy as np
+import pytest
+
+from multibody.net import add_bending_forces, add_thread_forces, square_grid_threads, thread_node_mass
+
+
+def test_node_mass_of_the_reference_net():
+    # paper Sec. 3.1 net: 2380 threads of 0.8824 m, 2 mm Kevlar (1440 kg/m^3) over 1225 nodes
+    expected = 2 * 35 * 34 * (30 / 34) * np.pi * 1e-6 * 1440 / 35**2
+    assert thread_node_mass(30.0, 35, 0.002, 1440.0) == pytest.approx(expected, rel=1e-12)
+    assert expected == pytest.approx(0.00776, rel=1e-3)
+    assert len(square_grid_threads(35)) == 2380
+
+
+def test_thread_is_tension_only_kelvin_voigt():
+    x = np.array([[0.0, 0.0, 0.0], [1.1, 0.0, 0.0]])
+    v = np.array([[0.0, 0.0, 0.0], [0.5, 0.0, 0.0]])
+    args = (np.array([[0, 1]]), np.array([1.0]), np.array([1000.0]), np.array([2.0]))
+    f = np.zeros((2, 3))
+    elastic, power = add_thread_forces(x, v, *args, f)
+    # T = k (l - l0) + c l' = 1000 * 0.1 + 2 * 0.5 = 101 N pulling the nodes together
+    assert f[0, 0] == pytest.approx(101.0) and f[1, 0] == pytest.approx(-101.0)
+    assert elastic == pytest.approx(0.5 * 1000 * 0.01) and power == pytest.approx(2 * 0.25)
+    f[:] = 0.0
+    add_thread_forces(np.array([[0.0, 0, 0], [0.9, 0, 0]]), v, *args, f)
+    assert np.all(f == 0.0), "a slack thread pushes nothing"
+
+
+def test_bending_forces_are_the_energy_gradient_and_free_of_net_force_and_moment():
+    rng = np.random.default_rng(7)
+    x = np.array([[0.0, 0.0, 0.0], [1.0, 0.1, 0.0], [2.0, -0.2, 0.3]]) + 0.01 * rng.standard_normal((3, 3))
+    triples, kb = np.array([[0, 1, 2]]), np.array([0.5])
+    f = np.zeros((3, 3))
+    energy = add_bending_forces(x, triples, kb, f)
+    e1 = (x[1] - x[0]) / np.linalg.norm(x[1] - x[0])
+    e2 = (x[2] - x[1]) / np.linalg.norm(x[2] - x[1])
+    assert energy == pytest.approx(0.5 * (1 - e1 @ e2))
+    h = 1e-7
+    for node in range(3):
+        for axis in range(3):
+            xp, xm = x.copy(), x.copy()
+            xp[node, axis] += h
+            xm[node, axis] -= h
+            grad = (add_bending_forces(xp, triples, kb, np.zeros((3, 3)))
+                    - add_bending_forces(xm, triples, kb, np.zeros((3, 3)))) / (2 * h)
+            # central difference error ~ h^2 * third derivative: 1e-6 relative is ample
+            assert f[node, axis] == pytest.approx(-grad, rel=1e-5, abs=1e-8)
+    assert np.abs(f.sum(axis=0)).max() < 1e-12
+    assert np.abs(np.cross(x, f).sum(axis=0)).max() < 1e-12
