@@ -1,0 +1,1 @@
+"""Exudyn models of the net capture: net, contact, joints, orbit and the coupled impact system."""

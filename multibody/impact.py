@@ -7,6 +7,9 @@ records the time series through :mod:`multibody.recorder`.
 """
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
 import time
 from dataclasses import dataclass
 
@@ -169,6 +172,21 @@ def simulation_settings(assembly: ImpactAssembly) -> exu.SimulationSettings:
     return s
 
 
+@contextlib.contextmanager
+def solver_chatter_to_stderr():
+    """Send what Exudyn's C++ core prints (e.g. its VelocityVerlet notice) to stderr, so that
+    standard output carries only the tool's own results (``riskassess run --json``)."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 class ImpactSimulation:
     """Build and run one coupled impact; ``run()`` returns the recorder with all time series."""
 
@@ -185,7 +203,8 @@ class ImpactSimulation:
         settings = simulation_settings(self.assembly)
         recorder.sample(0.0)
         start = time.perf_counter()
-        exu.SolveDynamic(mbs, settings, solverType=INTEGRATORS[self.assembly.solver.integrator][0])
+        with solver_chatter_to_stderr():
+            exu.SolveDynamic(mbs, settings, solverType=INTEGRATORS[self.assembly.solver.integrator][0])
         self.wall_time = time.perf_counter() - start
         recorder.finish(self.wall_time)
         return recorder

@@ -1,0 +1,1 @@
+"""Case files, the risk pipeline, run folders and the ``riskassess`` command line."""

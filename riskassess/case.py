@@ -348,6 +348,10 @@ def _check_reach(case: Case, base: Path) -> list[str]:
                         f"{lateral[ahead].min() - half_diagonal:.2f} m beyond its half-diagonal "
                         f"{half_diagonal:.2f} m; it cannot reach")
     gap = along.min()
+    first_step = launch.velocity * case.simulation.step
+    if 0 < gap <= first_step:
+        problems.append(f"launch.distance: the net would touch the target within the first step "
+                        f"({first_step:.2g} m of travel); start it farther than {launch.distance - gap + first_step:.3f} m")
     if gap <= 0:
         problems.append(f"launch.distance: the net plane starts {-gap:.2f} m inside the target; "
                         f"increase distance to more than {launch.distance - gap:.2f} m")
