@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from multibody.contact import contact_over_step, signed_distance_to_mesh
+from multibody.contact import contact_over_step, contact_substeps, signed_distance_to_mesh
 from multibody.net import add_bending_forces, add_thread_forces
 from multibody.orbit import clohessy_wiltshire_acceleration
 
@@ -132,6 +132,22 @@ class KernelData:
 
 
 @njit(cache=True)
+def _effective_mass_along_normal(rot, inverse_inertia_body, mass, ax, ay, az, nx, ny, nz):
+    """Mass (kg) a body shows to a push along n at arm a from its CoM: 1 / (1/m + (a x n)^T J^-1 (a x n))."""
+    lx = ay * nz - az * ny
+    ly = az * nx - ax * nz
+    lz = ax * ny - ay * nx
+    # lever in the body frame
+    bx = rot[0, 0] * lx + rot[1, 0] * ly + rot[2, 0] * lz
+    by = rot[0, 1] * lx + rot[1, 1] * ly + rot[2, 1] * lz
+    bz = rot[0, 2] * lx + rot[1, 2] * ly + rot[2, 2] * lz
+    j = inverse_inertia_body
+    quad = (bx * (j[0, 0] * bx + j[0, 1] * by + j[0, 2] * bz) + by * (j[1, 0] * bx + j[1, 1] * by + j[1, 2] * bz)
+            + bz * (j[2, 0] * bx + j[2, 1] * by + j[2, 2] * bz))
+    return 1.0 / (1.0 / mass + quad)
+
+
+@njit(cache=True)
 def _apply_contact_pair(i, b, force, arm, weight, f_net, f_body, torque_lvlh, out_body_impulse):
     """Force on node ``i`` and its reaction on body ``b`` on the same line of action."""
     f_net[i] += force
@@ -221,16 +237,27 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
                 continue
             distance, nbx, nby, nbz = signed_distance_to_mesh(
                 px, py, pz, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
-            arm = x[i] - coms[b]
-            normal = rot @ np.array([nbx, nby, nbz])
-            relative = v_true[i] - vels[b] - np.cross(omegas[b], arm)
+            # Scalars again until the node is known to touch within the step.
             penetration = net_radius[i] - distance
-            if penetration <= 0.0 and penetration - (relative @ normal) * step <= 0.0:
+            nx = rot[0, 0] * nbx + rot[0, 1] * nby + rot[0, 2] * nbz
+            ny = rot[1, 0] * nbx + rot[1, 1] * nby + rot[1, 2] * nbz
+            nz = rot[2, 0] * nbx + rot[2, 1] * nby + rot[2, 2] * nbz
+            w = omegas[b]
+            rx = v_true[i, 0] - vels[b, 0] - (w[1] * az - w[2] * ay)
+            ry = v_true[i, 1] - vels[b, 1] - (w[2] * ax - w[0] * az)
+            rz = v_true[i, 2] - vels[b, 2] - (w[0] * ay - w[1] * ax)
+            if penetration <= 0.0 and penetration - (rx * nx + ry * ny + rz * nz) * step <= 0.0:
                 continue
-            lever = np.cross(arm, normal)
-            body_mass = 1.0 / (1.0 / body_mass_all[b] + lever @ (rot @ (inverse_inertia[b] @ (rot.T @ lever))))
+            arm = np.array([ax, ay, az])
+            normal = np.array([nx, ny, nz])
+            relative = np.array([rx, ry, rz])
+            body_mass = _effective_mass_along_normal(rot, inverse_inertia[b], body_mass_all[b], ax, ay, az, nx, ny, nz)
+            subs = n_substeps
+            if subs > 1:
+                subs = contact_substeps(penetration, -(relative @ normal), f_non_contact[i] @ normal,
+                                        net_mass[i], body_mass, step, subs, k_contact, exponent)
             impulse, mean_change, end_change, dissipated = contact_over_step(
-                penetration, relative, normal, f_non_contact[i], net_mass[i], body_mass, step, n_substeps,
+                penetration, relative, normal, f_non_contact[i], net_mass[i], body_mass, step, subs,
                 k_contact, exponent, d_contact, mu_s, mu_k, v_transition)
             # Kick that makes the integrator's next drift follow the sub-cycled path; the
             # difference between true end velocity and mean velocity is carried as a lag.
