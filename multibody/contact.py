@@ -254,38 +254,6 @@ def contact_over_step(penetration, relative_velocity, normal, external_force, no
     return impulse, mean_change, end_change, dissipated
 
 
-#: Sub-step as a fraction of the contact's period scale 1/omega; 0.1 keeps the symplectic-Euler
-#: error of the Hertz pulse well under 1 % (tests/multibody/test_contact.py).
-CONTACT_PHASE_PER_SUBSTEP = 0.1
-
-
-@njit(cache=True)
-def contact_substeps(penetration, approach_speed, external_normal_force, node_mass, body_mass, step,
-                     max_substeps, stiffness, exponent):
-    """Sub-steps needed over ``step`` for this contact, at most ``max_substeps``.
-
-    The deepest penetration reachable in the step is bounded from energy: the approach
-    kinetic energy (reduced mass), the stored Hertz energy and the work of the pressing
-    non-contact force over the distance the node can travel. The Hertz stiffness there,
-    :math:`n k \\delta^{n-1}`, sets the contact frequency :math:`\\omega`, and the sub-step is
-    ``CONTACT_PHASE_PER_SUBSTEP / omega``. Resting contacts (small penetration, slow) thus
-    take a few sub-steps and 20 m/s impacts the full count.
-    """
-    reduced_mass = node_mass * body_mass / (node_mass + body_mass)
-    delta0 = max(penetration, 0.0)
-    speed = max(approach_speed, 0.0)
-    push = max(-external_normal_force, 0.0)
-    travel = step * (speed + push * step / node_mass) + delta0
-    energy = (0.5 * reduced_mass * speed * speed + stiffness * delta0 ** (exponent + 1.0) / (exponent + 1.0)
-              + push * travel)
-    delta_max = max((energy * (exponent + 1.0) / stiffness) ** (1.0 / (exponent + 1.0)), delta0)
-    if delta_max <= 0.0:
-        return 1
-    omega = math.sqrt(exponent * stiffness * delta_max ** (exponent - 1.0) / reduced_mass)
-    needed = int(math.ceil(step * omega / CONTACT_PHASE_PER_SUBSTEP))
-    return max(1, min(needed, max_substeps))
-
-
 def hertz_elastic_energy(penetration, stiffness, exponent):
     """Elastic energy stored in a Hertz contact (J): :math:`k\\delta^{n+1}/(n+1)`."""
     penetration = np.maximum(penetration, 0.0)

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from multibody.contact import contact_over_step, contact_substeps, signed_distance_to_mesh
+from multibody.contact import contact_over_step, signed_distance_to_mesh
 from multibody.net import add_bending_forces, add_thread_forces
 from multibody.orbit import clohessy_wiltshire_acceleration
 
@@ -252,12 +252,8 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
             normal = np.array([nx, ny, nz])
             relative = np.array([rx, ry, rz])
             body_mass = _effective_mass_along_normal(rot, inverse_inertia[b], body_mass_all[b], ax, ay, az, nx, ny, nz)
-            subs = n_substeps
-            if subs > 1:
-                subs = contact_substeps(penetration, -(relative @ normal), f_non_contact[i] @ normal,
-                                        net_mass[i], body_mass, step, subs, k_contact, exponent)
             impulse, mean_change, end_change, dissipated = contact_over_step(
-                penetration, relative, normal, f_non_contact[i], net_mass[i], body_mass, step, subs,
+                penetration, relative, normal, f_non_contact[i], net_mass[i], body_mass, step, n_substeps,
                 k_contact, exponent, d_contact, mu_s, mu_k, v_transition)
             # Kick that makes the integrator's next drift follow the sub-cycled path; the
             # difference between true end velocity and mean velocity is carried as a lag.
