@@ -214,14 +214,24 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     f_non_contact = f_net.copy()
     v_true = v + velocity_lag
     new_lag = np.zeros((n, 3))
-    touched = np.zeros(n, dtype=np.bool_)
     speed = np.sqrt(np.sum(v_true * v_true, axis=1))
-    for s in range(shape_body.shape[0]):
+    n_shapes = shape_body.shape[0]
+    shape_speed = np.empty(n_shapes)
+    for s in range(n_shapes):
         b = shape_body[s]
-        rot = rots[b]
         reach = max(np.sqrt(np.sum(shape_box_min[s] ** 2)), np.sqrt(np.sum(shape_box_max[s] ** 2)))
-        body_speed = np.sqrt(np.sum(vels[b] ** 2)) + np.sqrt(np.sum(omegas[b] ** 2)) * reach
-        for i in range(n):
+        shape_speed[s] = np.sqrt(np.sum(vels[b] ** 2)) + np.sqrt(np.sum(omegas[b] ** 2)) * reach
+    # per-node contact lists, reused
+    c_body = np.empty(n_shapes, np.int64)
+    c_pen = np.empty(n_shapes)
+    c_normal = np.empty((n_shapes, 3))
+    c_rel = np.empty((n_shapes, 3))
+    c_mass = np.empty(n_shapes)
+    for i in range(n):
+        k = 0
+        for s in range(n_shapes):
+            b = shape_body[s]
+            rot = rots[b]
             # Broad phase in scalars: node in the body frame against the shape's box, grown by
             # the node radius and the distance the pair can close within one step.
             ax = x[i, 0] - coms[b, 0]
@@ -230,14 +240,13 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
             px = rot[0, 0] * ax + rot[1, 0] * ay + rot[2, 0] * az
             py = rot[0, 1] * ax + rot[1, 1] * ay + rot[2, 1] * az
             pz = rot[0, 2] * ax + rot[1, 2] * ay + rot[2, 2] * az
-            margin = net_radius[i] + step * (speed[i] + body_speed)
+            margin = net_radius[i] + step * (speed[i] + shape_speed[s])
             if (px < shape_box_min[s, 0] - margin or px > shape_box_max[s, 0] + margin
                     or py < shape_box_min[s, 1] - margin or py > shape_box_max[s, 1] + margin
                     or pz < shape_box_min[s, 2] - margin or pz > shape_box_max[s, 2] + margin):
                 continue
             distance, nbx, nby, nbz = signed_distance_to_mesh(
                 px, py, pz, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
-            # Scalars again until the node is known to touch within the step.
             penetration = net_radius[i] - distance
             nx = rot[0, 0] * nbx + rot[0, 1] * nby + rot[0, 2] * nbz
             ny = rot[1, 0] * nbx + rot[1, 1] * nby + rot[1, 2] * nbz
@@ -248,34 +257,42 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
             rz = v_true[i, 2] - vels[b, 2] - (w[0] * ay - w[1] * ax)
             if penetration <= 0.0 and penetration - (rx * nx + ry * ny + rz * nz) * step <= 0.0:
                 continue
-            arm = np.array([ax, ay, az])
-            normal = np.array([nx, ny, nz])
-            relative = np.array([rx, ry, rz])
-            body_mass = _effective_mass_along_normal(rot, inverse_inertia[b], body_mass_all[b], ax, ay, az, nx, ny, nz)
-            impulse, mean_change, end_change, dissipated = contact_over_step(
-                penetration, relative, normal, f_non_contact[i], net_mass[i], body_mass, step, n_substeps,
-                k_contact, exponent, d_contact, mu_s, mu_k, v_transition)
-            # Kick that makes the integrator's next drift follow the sub-cycled path; the
-            # difference between true end velocity and mean velocity is carried as a lag.
-            # (The lag carried from the previous step is released in the loop below.)
-            force = net_mass[i] * mean_change / step - f_non_contact[i]
-            new_lag[i] += end_change - mean_change
-            touched[i] = True
-            lag_body[i] = b
-            _apply_contact_pair(i, b, force, arm, step * stage_weight, f_net, f_body, torque_lvlh, out_body_impulse)
-            out_scalars[4] += dissipated * stage_weight
+            c_body[k] = b
+            c_pen[k] = penetration
+            c_normal[k, 0], c_normal[k, 1], c_normal[k, 2] = nx, ny, nz
+            c_rel[k, 0], c_rel[k, 1], c_rel[k, 2] = rx, ry, rz
+            c_mass[k] = _effective_mass_along_normal(rot, inverse_inertia[b], body_mass_all[b], ax, ay, az, nx, ny, nz)
+            k += 1
             if penetration > 0.0:
                 contact_energy += k_contact * penetration ** (exponent + 1.0) / (exponent + 1.0)
                 n_contacts += 1
-    for i in range(n):
+        if k > 0:
+            # All of this node's contacts in one sub-cycle (a node pinched between two bodies
+            # must feel both), then the kick that makes the integrator's next drift follow the
+            # sub-cycled path; true end velocity minus mean velocity is carried as a lag.
+            impulses, mean_change, end_change, dissipated = contact_over_step(
+                c_pen[:k], c_rel[:k], c_normal[:k], f_non_contact[i], net_mass[i], c_mass[:k], step, n_substeps,
+                k_contact, exponent, d_contact, mu_s, mu_k, v_transition)
+            force = net_mass[i] * mean_change / step - f_non_contact[i]
+            # The reaction goes to the bodies in proportion to their impulses (weights sum to 1,
+            # so momentum exchange stays exact).
+            norms = np.sqrt(np.sum(impulses * impulses, axis=1))
+            total = norms.sum()
+            strongest = 0
+            for c in range(k):
+                weight = norms[c] / total if total > 0.0 else 1.0 / k
+                _apply_contact_pair(i, c_body[c], weight * force, x[i] - coms[c_body[c]], step * stage_weight,
+                                    f_net, f_body, torque_lvlh, out_body_impulse)
+                if norms[c] > norms[strongest]:
+                    strongest = c
+            new_lag[i] = end_change - mean_change
+            out_scalars[4] += dissipated * stage_weight
+        # Release the lag carried from the previous step (zero without sub-cycling).
         b = lag_body[i]
         if b >= 0:
-            # Release the lag carried from the previous step (zero without sub-cycling).
-            force = net_mass[i] * velocity_lag[i] / step
-            _apply_contact_pair(i, b, force, x[i] - coms[b], step * stage_weight, f_net, f_body, torque_lvlh,
-                                out_body_impulse)
-            if not touched[i]:
-                lag_body[i] = -1
+            _apply_contact_pair(i, b, net_mass[i] * velocity_lag[i] / step, x[i] - coms[b], step * stage_weight,
+                                f_net, f_body, torque_lvlh, out_body_impulse)
+        lag_body[i] = c_body[strongest] if k > 0 else -1
         velocity_lag[i] = new_lag[i]
     for b in range(nb):
         base = 3 * n + 6 * b
