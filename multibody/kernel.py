@@ -194,21 +194,55 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
             f_net[i, 1] -= m * 2.0 * n_orbit * v[i, 0]
             f_net[i, 2] -= m * n_orbit * n_orbit * x[i, 2]
 
+    rots, coms, vels, omegas = body_states(q, qt, n, body_reference)
+    f_body = np.zeros((nb, 3))
+    if n_orbit != 0.0:
+        for b in range(nb):
+            f_body[b] += body_mass_all[b] * clohessy_wiltshire_acceleration(coms[b], vels[b], n_orbit)
+    torque_lvlh = np.zeros((nb, 3))
+    contact_energy, n_contacts = add_contact_forces(
+        x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
+        triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
+        k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight,
+        velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_scalars)
+    for b in range(nb):
+        base = 3 * n + 6 * b
+        out_force[base:base + 3] = f_body[b]
+        out_force[base + 3:base + 6] = rots[b].T @ torque_lvlh[b]
+    out_scalars[2] = contact_energy
+    out_scalars[5] = n_contacts
+    out_force[: 3 * n] = f_net.reshape(3 * n)
+    return out_force
+
+
+@njit(cache=True)
+def body_states(q, qt, n_nodes, body_reference):
+    """Per body: attitude body->LVLH, CoM (m), CoM velocity (m/s), angular velocity (rad/s), LVLH."""
+    nb = body_reference.shape[0]
     rots = np.empty((nb, 3, 3))
     coms = np.empty((nb, 3))
     vels = np.empty((nb, 3))
     omegas = np.empty((nb, 3))
-    f_body = np.zeros((nb, 3))
     for b in range(nb):
-        base = 3 * n + 6 * b
+        base = 3 * n_nodes + 6 * b
         coms[b] = body_reference[b] + q[base:base + 3]
         vels[b] = qt[base:base + 3]
         rots[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6].copy())
         omegas[b] = rots[b] @ qt[base + 3:base + 6]
-        if n_orbit != 0.0:
-            f_body[b] += body_mass_all[b] * clohessy_wiltshire_acceleration(coms[b], vels[b], n_orbit)
+    return rots, coms, vels, omegas
 
-    torque_lvlh = np.zeros((nb, 3))
+
+@njit(cache=True)
+def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
+                       triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
+                       k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight,
+                       velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_scalars):
+    """Add node-body contact kicks to ``f_net`` and their reactions to ``f_body``/``torque_lvlh``.
+
+    ``f_net`` enters holding every non-contact force on the nodes. Returns the elastic
+    contact energy (J) and the number of penetrating contacts at this evaluation.
+    """
+    n = net_mass.shape[0]
     contact_energy = 0.0
     n_contacts = 0
     f_non_contact = f_net.copy()
@@ -229,6 +263,7 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     c_mass = np.empty(n_shapes)
     for i in range(n):
         k = 0
+        strongest = 0
         for s in range(n_shapes):
             b = shape_body[s]
             rot = rots[b]
@@ -278,7 +313,6 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
             # so momentum exchange stays exact).
             norms = np.sqrt(np.sum(impulses * impulses, axis=1))
             total = norms.sum()
-            strongest = 0
             for c in range(k):
                 weight = norms[c] / total if total > 0.0 else 1.0 / k
                 _apply_contact_pair(i, c_body[c], weight * force, x[i] - coms[c_body[c]], step * stage_weight,
@@ -294,11 +328,4 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
                                 f_net, f_body, torque_lvlh, out_body_impulse)
         lag_body[i] = c_body[strongest] if k > 0 else -1
         velocity_lag[i] = new_lag[i]
-    for b in range(nb):
-        base = 3 * n + 6 * b
-        out_force[base:base + 3] = f_body[b]
-        out_force[base + 3:base + 6] = rots[b].T @ torque_lvlh[b]
-    out_scalars[2] = contact_energy
-    out_scalars[5] = n_contacts
-    out_force[: 3 * n] = f_net.reshape(3 * n)
-    return out_force
+    return contact_energy, n_contacts
