@@ -63,3 +63,15 @@ def test_missing_mesh_file_is_named(tmp_path):
     message = _load_modified(tmp_path, 'kind = "box"\nsize = [3.375, 3.75, 7.875]',
                              'kind = "mesh"\nfile = "envisat_body.stl"')
     assert "target.bodies[0].shapes[0]" in message
+
+
+def test_cli_reports_a_bad_case_before_running(tmp_path, capsys):
+    from riskassess.cli import main
+
+    path = tmp_path / "bad.toml"
+    path.write_text(REFERENCE.replace("mass = 1.786", "mass = -1.786", 1))
+    out = tmp_path / "run"
+    assert main(["run", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "bullets.mass: Input should be greater than 0. Got -1.786" in err
+    assert not out.exists(), "nothing is written for a case that does not validate"
