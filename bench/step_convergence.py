@@ -34,7 +34,7 @@ def figures(case_path, step, end_time, joint_tuning_step):
     rec = sim.run()
     wall = time.perf_counter() - t0
     s = rec.series
-    force, moment = contact_totals_debris(s, None)
+    force, moment = contact_totals_debris(s)
     hinge = np.abs(s["joint_moment_joint"]).max(axis=0)  # (nj, 3)
     return {
         "peak force (N)": np.linalg.norm(force, axis=1).max(),

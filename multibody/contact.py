@@ -269,7 +269,9 @@ def contact_over_step(penetrations, relative_velocities, normals, external_force
     return impulses, mean_change, end_change, dissipated
 
 
+@njit(cache=True)
 def hertz_elastic_energy(penetration, stiffness, exponent):
-    """Elastic energy stored in a Hertz contact (J): :math:`k\\delta^{n+1}/(n+1)`."""
-    penetration = np.maximum(penetration, 0.0)
+    """Elastic energy stored in a Hertz contact (J): :math:`k\\delta^{n+1}/(n+1)`, zero without contact."""
+    if penetration <= 0.0:
+        return 0.0
     return stiffness * penetration ** (exponent + 1.0) / (exponent + 1.0)

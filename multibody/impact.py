@@ -82,13 +82,6 @@ def _inertia6(inertia):
     return [j[0, 0], j[1, 1], j[2, 2], j[1, 2], j[0, 2], j[0, 1]]
 
 
-def _unrotated_child_states(assembly: ImpactAssembly):
-    """Child attitude and CoM before the initial hinge angle, per body (joint rest state)."""
-    attitude = [b.body_to_lvlh for b in assembly.bodies]
-    com = [b.com_lvlh for b in assembly.bodies]
-    return attitude, com
-
-
 def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms=None) -> BuiltSystem:
     """Assemble the coupled system in Exudyn.
 
@@ -100,7 +93,8 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
         unrotated child state here.
     """
     if rest_attitudes is None:
-        rest_attitudes, rest_coms = _unrotated_child_states(assembly)
+        rest_attitudes = [b.body_to_lvlh for b in assembly.bodies]
+        rest_coms = [b.com_lvlh for b in assembly.bodies]
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     net = assembly.net

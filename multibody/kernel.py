@@ -26,9 +26,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from multibody.contact import contact_over_step, signed_distance_to_mesh
+from multibody.contact import contact_over_step, hertz_elastic_energy, signed_distance_to_mesh
 from multibody.net import add_bending_forces, add_thread_forces
-from multibody.orbit import clohessy_wiltshire_acceleration
+from multibody.orbit import clohessy_wiltshire_acceleration, clohessy_wiltshire_acceleration_xyz
 
 #: Indices into the kernel's scalar output buffer.
 THREAD_ELASTIC, BENDING_ELASTIC, CONTACT_ELASTIC, THREAD_DISSIPATED, CONTACT_DISSIPATED, N_CONTACTS = range(6)
@@ -187,12 +187,11 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     out_scalars[3] += power * step * stage_weight
 
     if n_orbit != 0.0:
-        # clohessy_wiltshire_acceleration written out in scalars (no per-node allocation).
         for i in range(n):
-            m = net_mass[i]
-            f_net[i, 0] += m * (3.0 * n_orbit * n_orbit * x[i, 0] + 2.0 * n_orbit * v[i, 1])
-            f_net[i, 1] -= m * 2.0 * n_orbit * v[i, 0]
-            f_net[i, 2] -= m * n_orbit * n_orbit * x[i, 2]
+            ax, ay, az = clohessy_wiltshire_acceleration_xyz(x[i, 0], x[i, 2], v[i, 0], v[i, 1], n_orbit)
+            f_net[i, 0] += net_mass[i] * ax
+            f_net[i, 1] += net_mass[i] * ay
+            f_net[i, 2] += net_mass[i] * az
 
     rots, coms, vels, omegas = body_states(q, qt, n, body_reference)
     f_body = np.zeros((nb, 3))
@@ -247,7 +246,6 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
     n_contacts = 0
     f_non_contact = f_net.copy()
     v_true = v + velocity_lag
-    new_lag = np.zeros((n, 3))
     speed = np.sqrt(np.sum(v_true * v_true, axis=1))
     push = np.sqrt(np.sum(f_non_contact * f_non_contact, axis=1)) / net_mass  # acceleration bound (m/s^2)
     n_shapes = shape_body.shape[0]
@@ -304,8 +302,9 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
             c_mass[k] = _effective_mass_along_normal(rot, inverse_inertia[b], body_mass_all[b], ax, ay, az, nx, ny, nz)
             k += 1
             if penetration > 0.0:
-                contact_energy += k_contact * penetration ** (exponent + 1.0) / (exponent + 1.0)
+                contact_energy += hertz_elastic_energy(penetration, k_contact, exponent)
                 n_contacts += 1
+        new_lag = np.zeros(3)
         if k > 0:
             # All of this node's contacts in one sub-cycle (a node pinched between two bodies
             # must feel both), then the kick that makes the integrator's next drift follow the
@@ -324,7 +323,7 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
                                     f_net, f_body, torque_lvlh, out_body_impulse)
                 if norms[c] > norms[strongest]:
                     strongest = c
-            new_lag[i] = end_change - mean_change
+            new_lag = end_change - mean_change
             out_scalars[4] += dissipated * stage_weight
         # Release the lag carried from the previous step (zero without sub-cycling).
         b = lag_body[i]
@@ -332,5 +331,5 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
             _apply_contact_pair(i, b, net_mass[i] * velocity_lag[i] / step, x[i] - coms[b], step * stage_weight,
                                 f_net, f_body, torque_lvlh, out_body_impulse)
         lag_body[i] = c_body[strongest] if k > 0 else -1
-        velocity_lag[i] = new_lag[i]
+        velocity_lag[i] = new_lag
     return contact_energy, n_contacts

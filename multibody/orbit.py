@@ -21,6 +21,12 @@ def mean_motion(altitude):
     return math.sqrt(MU_EARTH / (R_EARTH + altitude) ** 3)
 
 
+@njit(cache=True, inline="always")
+def clohessy_wiltshire_acceleration_xyz(x, z, vx, vy, n):
+    """Components (m/s^2) of :func:`clohessy_wiltshire_acceleration`, in scalars (no allocation)."""
+    return n * n * 3.0 * x + 2.0 * n * vy, -2.0 * n * vx, -n * n * z
+
+
 @njit(cache=True)
 def clohessy_wiltshire_acceleration(r_lvlh, v_lvlh, n):
     """Apparent acceleration in LVLH (m/s^2) of a free body; seed paper eq. (9) without contact.
@@ -34,11 +40,8 @@ def clohessy_wiltshire_acceleration(r_lvlh, v_lvlh, n):
     n : float
         Mean motion (rad/s); 0 turns the orbit off.
     """
-    a = np.empty(3)
-    a[0] = n * n * 3.0 * r_lvlh[0] + 2.0 * n * v_lvlh[1]
-    a[1] = -2.0 * n * v_lvlh[0]
-    a[2] = -n * n * r_lvlh[2]
-    return a
+    ax, ay, az = clohessy_wiltshire_acceleration_xyz(r_lvlh[0], r_lvlh[2], v_lvlh[0], v_lvlh[1], n)
+    return np.array([ax, ay, az])
 
 
 def clohessy_wiltshire_potential(r_lvlh, n):

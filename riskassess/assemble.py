@@ -56,11 +56,22 @@ def mass_properties_target_frame(case: Case, meshes):
     return props
 
 
+def target_pose_lvlh(case: Case):
+    """Target-frame origin (m) and target->LVLH rotation matrix at t = 0."""
+    rot = Rotation.from_rotvec(case.target.attitude_rotation_vector).as_matrix()
+    return np.asarray(case.target.position_lvlh, float), rot
+
+
+def target_points_lvlh(case: Case, points_target) -> np.ndarray:
+    """Points given in the target frame ((3,) or (k, 3), m) at t = 0, in LVLH (m)."""
+    origin, rot = target_pose_lvlh(case)
+    return origin + np.asarray(points_target, float) @ rot.T
+
+
 def target_vertices_lvlh(case: Case, base: Path = Path(".")) -> np.ndarray:
     """Vertices of every target shape at t = 0, LVLH (m)."""
-    points = np.vstack([m.vertices for body in body_meshes_target_frame(case, base) for m in body])
-    rot = Rotation.from_rotvec(case.target.attitude_rotation_vector).as_matrix()
-    return np.asarray(case.target.position_lvlh, float) + points @ rot.T
+    return target_points_lvlh(case, np.vstack([m.vertices for body in body_meshes_target_frame(case, base)
+                                                for m in body]))
 
 
 def build_net(case: Case):
@@ -77,8 +88,7 @@ def build_net(case: Case):
     node_mass = (net.node_mass if net.node_mass is not None
                  else thread_node_mass(net.side_length, net.nodes_per_side, thread.diameter, thread.density))
     direction = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
-    rot = Rotation.from_rotvec(case.target.attitude_rotation_vector).as_matrix()
-    aim = np.asarray(case.target.position_lvlh, float) + rot @ np.asarray(launch.aim_point, float)
+    aim = target_points_lvlh(case, launch.aim_point)
     topology = flat_square_net(
         center=aim - launch.distance * direction, direction=direction,
         side_length=net.side_length, nodes_per_side=net.nodes_per_side,
@@ -95,8 +105,7 @@ def build_bodies_and_joints(case: Case, base: Path):
     target = case.target
     meshes = body_meshes_target_frame(case, base)
     props = mass_properties_target_frame(case, meshes)
-    target_to_lvlh = Rotation.from_rotvec(target.attitude_rotation_vector).as_matrix()
-    origin = np.asarray(target.position_lvlh, float)
+    origin, target_to_lvlh = target_pose_lvlh(case)
     omega_lvlh = target_to_lvlh @ np.asarray(target.angular_velocity, float)
     names = [b.name for b in target.bodies]
 

@@ -329,12 +329,12 @@ def _check_files(case: Case, base: Path) -> list[str]:
 
 def _check_reach(case: Case, base: Path) -> list[str]:
     """Reject a net that cannot reach the target before any simulation starts."""
-    from riskassess.assemble import target_vertices_lvlh  # geometry needs the mesh loader
+    from riskassess.assemble import target_points_lvlh, target_vertices_lvlh  # geometry needs the mesh loader
 
     points = target_vertices_lvlh(case, base)
     launch = case.launch
     d = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
-    net_center = _target_point_lvlh(case, launch.aim_point) - launch.distance * d
+    net_center = target_points_lvlh(case, launch.aim_point) - launch.distance * d
     relative = points - net_center
     along = relative @ d
     lateral = np.linalg.norm(relative - np.outer(along, d), axis=1)
@@ -359,10 +359,3 @@ def _check_reach(case: Case, base: Path) -> list[str]:
         problems.append(f"launch.distance: the net needs {gap / launch.velocity:.2f} s to reach the target but "
                         f"simulation.end_time is {case.simulation.end_time:g} s")
     return problems
-
-
-def _target_point_lvlh(case: Case, point_target) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
-
-    rot = Rotation.from_rotvec(case.target.attitude_rotation_vector).as_matrix()
-    return np.asarray(case.target.position_lvlh, float) + rot @ np.asarray(point_target, float)

@@ -21,7 +21,7 @@ def _cmd_run(args) -> int:
                TimeElapsedColumn(), TimeRemainingColumn()]
     with Progress(*columns, disable=args.json or not sys.stderr.isatty(), transient=True) as bar:
         task = bar.add_task("run", total=end, t=0.0)
-        result = run_case(args.case, out, progress=lambda t: bar.update(task, completed=t, t=t))
+        result = run_case(args.case, out, progress=lambda t: bar.update(task, completed=t, t=t), case=case)
     if args.json:
         print(json.dumps(result.summary, indent=2))
     else:

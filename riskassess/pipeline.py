@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import trimesh
 
 from multibody.impact import ImpactSimulation
 from riskassess import results
@@ -40,10 +41,10 @@ def prepare_simulation(case: Case, case_path: Path) -> ImpactSimulation:
     return ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
 
 
-def run_case(case_path: str | Path, out_dir: str | Path, progress=None) -> RunOutput:
-    """Load, simulate and write the run folder; returns the summary."""
+def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Case | None = None) -> RunOutput:
+    """Load (unless ``case`` is the already validated file), simulate and write the run folder."""
     case_path = Path(case_path)
-    case = load_case(case_path)
+    case = case or load_case(case_path)
     simulation = prepare_simulation(case, case_path)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -76,13 +77,8 @@ def write_simulation_results(out: Path, recorder, simulation: ImpactSimulation) 
         damping=net.damping, masses=net.masses, radii=net.radii, n_bullets=net.n_bullets))
     meshes = {}
     for k, body in enumerate(assembly.bodies):
-        merged = body.meshes_body[0] if len(body.meshes_body) == 1 else _concatenate(body.meshes_body)
+        merged = trimesh.util.concatenate(body.meshes_body)
         meshes[f"vertices_{k}"] = np.asarray(merged.vertices)
         meshes[f"faces_{k}"] = np.asarray(merged.faces)
     results.atomic_write_npz(out / "bodies.npz", meshes)
 
-
-def _concatenate(meshes):
-    import trimesh
-
-    return trimesh.util.concatenate(meshes)

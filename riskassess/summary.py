@@ -21,7 +21,7 @@ PAPER_REFERENCE = {
 TRANSIENT_SKIP_S = 0.25
 
 
-def contact_totals_debris(series, masses):
+def contact_totals_debris(series):
     """Total contact force (N) and moment about the debris CoM (N m), LVLH, over time."""
     force = series["contact_force_lvlh"].sum(axis=1)
     com = series["debris_com_lvlh"]
@@ -87,8 +87,7 @@ def run_summary(recorder, assembly, case_name: str) -> dict:
     """
     s = recorder.series
     t = s["time"]
-    masses = np.array([b.mass for b in assembly.bodies])
-    force, moment = contact_totals_debris(s, masses)
+    force, moment = contact_totals_debris(s)
     dv = s["debris_velocity_lvlh"][-1] - s["debris_velocity_lvlh"][0]
     estimate = momentum_exchange_velocity(assembly) - s["debris_velocity_lvlh"][0]
     solver = assembly.solver
