@@ -148,14 +148,30 @@ def _effective_mass_along_normal(rot, inverse_inertia_body, mass, ax, ay, az, nx
 
 
 @njit(cache=True)
-def _apply_contact_pair(i, b, force, arm, weight, f_net, f_body, torque_lvlh, out_body_impulse):
-    """Force on node ``i`` and its reaction on body ``b`` on the same line of action."""
-    f_net[i] += force
-    f_body[b] -= force
-    moment = np.cross(arm, -force)
-    torque_lvlh[b] += moment
-    out_body_impulse[b, :3] -= force * weight
-    out_body_impulse[b, 3:] += moment * weight
+def _apply_contact_pair(i, b, fx, fy, fz, coms, weight, x, f_net, f_body, torque_lvlh, out_body_impulse):
+    """Force (fx, fy, fz) on node ``i`` and its reaction on body ``b`` on the same line of action."""
+    f_net[i, 0] += fx
+    f_net[i, 1] += fy
+    f_net[i, 2] += fz
+    f_body[b, 0] -= fx
+    f_body[b, 1] -= fy
+    f_body[b, 2] -= fz
+    ax = x[i, 0] - coms[b, 0]
+    ay = x[i, 1] - coms[b, 1]
+    az = x[i, 2] - coms[b, 2]
+    # moment of the reaction -f about the body CoM: a x (-f)
+    mx = -(ay * fz - az * fy)
+    my = -(az * fx - ax * fz)
+    mz = -(ax * fy - ay * fx)
+    torque_lvlh[b, 0] += mx
+    torque_lvlh[b, 1] += my
+    torque_lvlh[b, 2] += mz
+    out_body_impulse[b, 0] -= fx * weight
+    out_body_impulse[b, 1] -= fy * weight
+    out_body_impulse[b, 2] -= fz * weight
+    out_body_impulse[b, 3] += mx * weight
+    out_body_impulse[b, 4] += my * weight
+    out_body_impulse[b, 5] += mz * weight
 
 
 @njit(cache=True)
@@ -240,40 +256,56 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
 
     ``f_net`` enters holding every non-contact force on the nodes. Returns the elastic
     contact energy (J) and the number of penetrating contacts at this evaluation.
+
+    With sub-cycling (Verlet only), the node's state at the evaluation time is the
+    solver's position and its mid-step velocity ``v`` (Verlet evaluates the force before
+    its second half kick) plus the half kick of the non-contact force and the lag carried
+    from the previous step. Starting the sub-cycle from ``v`` alone would apply half of
+    every thread force one step late inside contact: a delayed restoring force, which
+    acts as a negative damping of about ``k step / 2`` per thread (3 N s/m at 1e-4 s
+    against the threads' own 1.6 N s/m) and pumped energy into nodes held on a surface.
     """
     n = net_mass.shape[0]
     contact_energy = 0.0
     n_contacts = 0
     f_non_contact = f_net.copy()
-    v_true = v + velocity_lag
-    speed = np.sqrt(np.sum(v_true * v_true, axis=1))
-    push = np.sqrt(np.sum(f_non_contact * f_non_contact, axis=1)) / net_mass  # acceleration bound (m/s^2)
+    half_kick = 0.5 * step if n_substeps > 1 else 0.0
+    v_start = np.empty((n, 3))
+    speed = np.empty(n)
+    push = np.empty(n)  # acceleration bound (m/s^2)
+    for i in range(n):
+        for d in range(3):
+            v_start[i, d] = v[i, d] + velocity_lag[i, d] + half_kick * f_non_contact[i, d] / net_mass[i]
+        speed[i] = math.sqrt(v_start[i, 0] ** 2 + v_start[i, 1] ** 2 + v_start[i, 2] ** 2)
+        push[i] = math.sqrt(f_non_contact[i, 0] ** 2 + f_non_contact[i, 1] ** 2 + f_non_contact[i, 2] ** 2) / net_mass[i]
     n_shapes = shape_body.shape[0]
     shape_speed = np.empty(n_shapes)
     for s in range(n_shapes):
         b = shape_body[s]
         reach = max(np.sqrt(np.sum(shape_box_min[s] ** 2)), np.sqrt(np.sum(shape_box_max[s] ** 2)))
         shape_speed[s] = np.sqrt(np.sum(vels[b] ** 2)) + np.sqrt(np.sum(omegas[b] ** 2)) * reach
-    # per-node contact lists, reused
+    # per-node contact lists and sub-cycle work space, reused
     c_body = np.empty(n_shapes, np.int64)
     c_pen = np.empty(n_shapes)
     c_normal = np.empty((n_shapes, 3))
     c_rel = np.empty((n_shapes, 3))
     c_mass = np.empty(n_shapes)
+    impulses = np.empty((n_shapes, 3))
+    work_delta = np.empty(n_shapes)
+    work_recoil = np.empty((n_shapes, 3))
+    work_forces = np.empty((n_shapes, 3))
     for i in range(n):
         k = 0
-        strongest = 0
         for s in range(n_shapes):
             b = shape_body[s]
-            rot = rots[b]
             # Broad phase in scalars: node in the body frame against the shape's box, grown by
             # the node radius and the distance the pair can close within one step.
             ax = x[i, 0] - coms[b, 0]
             ay = x[i, 1] - coms[b, 1]
             az = x[i, 2] - coms[b, 2]
-            px = rot[0, 0] * ax + rot[1, 0] * ay + rot[2, 0] * az
-            py = rot[0, 1] * ax + rot[1, 1] * ay + rot[2, 1] * az
-            pz = rot[0, 2] * ax + rot[1, 2] * ay + rot[2, 2] * az
+            px = rots[b, 0, 0] * ax + rots[b, 1, 0] * ay + rots[b, 2, 0] * az
+            py = rots[b, 0, 1] * ax + rots[b, 1, 1] * ay + rots[b, 2, 1] * az
+            pz = rots[b, 0, 2] * ax + rots[b, 1, 2] * ay + rots[b, 2, 2] * az
             margin = net_radius[i] + step * (speed[i] + shape_speed[s]) + 0.5 * step * step * push[i]
             if (px < shape_box_min[s, 0] - margin or px > shape_box_max[s, 0] + margin
                     or py < shape_box_min[s, 1] - margin or py > shape_box_max[s, 1] + margin
@@ -282,13 +314,13 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
             distance, nbx, nby, nbz = signed_distance_to_mesh(
                 px, py, pz, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
             penetration = net_radius[i] - distance
-            nx = rot[0, 0] * nbx + rot[0, 1] * nby + rot[0, 2] * nbz
-            ny = rot[1, 0] * nbx + rot[1, 1] * nby + rot[1, 2] * nbz
-            nz = rot[2, 0] * nbx + rot[2, 1] * nby + rot[2, 2] * nbz
-            w = omegas[b]
-            rx = v_true[i, 0] - vels[b, 0] - (w[1] * az - w[2] * ay)
-            ry = v_true[i, 1] - vels[b, 1] - (w[2] * ax - w[0] * az)
-            rz = v_true[i, 2] - vels[b, 2] - (w[0] * ay - w[1] * ax)
+            nx = rots[b, 0, 0] * nbx + rots[b, 0, 1] * nby + rots[b, 0, 2] * nbz
+            ny = rots[b, 1, 0] * nbx + rots[b, 1, 1] * nby + rots[b, 1, 2] * nbz
+            nz = rots[b, 2, 0] * nbx + rots[b, 2, 1] * nby + rots[b, 2, 2] * nbz
+            wx, wy, wz = omegas[b, 0], omegas[b, 1], omegas[b, 2]
+            rx = v_start[i, 0] - vels[b, 0] - (wy * az - wz * ay)
+            ry = v_start[i, 1] - vels[b, 1] - (wz * ax - wx * az)
+            rz = v_start[i, 2] - vels[b, 2] - (wx * ay - wy * ax)
             # Touches within the step if the gap closes under the current velocity and the
             # non-contact force (a taut thread can pull a node 0.6 mm in 1e-4 s; missing that
             # lets it sink unresisted for a step and come back out with the Hertz energy).
@@ -299,37 +331,50 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
             c_pen[k] = penetration
             c_normal[k, 0], c_normal[k, 1], c_normal[k, 2] = nx, ny, nz
             c_rel[k, 0], c_rel[k, 1], c_rel[k, 2] = rx, ry, rz
-            c_mass[k] = _effective_mass_along_normal(rot, inverse_inertia[b], body_mass_all[b], ax, ay, az, nx, ny, nz)
+            c_mass[k] = _effective_mass_along_normal(rots[b], inverse_inertia[b], body_mass_all[b],
+                                                     ax, ay, az, nx, ny, nz)
             k += 1
             if penetration > 0.0:
                 contact_energy += hertz_elastic_energy(penetration, k_contact, exponent)
                 n_contacts += 1
-        new_lag = np.zeros(3)
+        lag_x = lag_y = lag_z = 0.0
+        strongest = -1
         if k > 0:
             # All of this node's contacts in one sub-cycle (a node pinched between two bodies
-            # must feel both), then the kick that makes the integrator's next drift follow the
-            # sub-cycled path; true end velocity minus mean velocity is carried as a lag.
-            impulses, mean_change, end_change, dissipated = contact_over_step(
+            # must feel both). The contact force is the kick that makes the integrator's next
+            # drift follow the sub-cycled path; the true end velocity minus the mean velocity
+            # is carried as a lag and released at the next evaluation.
+            mx, my, mz, ex, ey, ez, dissipated = contact_over_step(
                 c_pen[:k], c_rel[:k], c_normal[:k], f_non_contact[i], net_mass[i], c_mass[:k], step, n_substeps,
-                k_contact, exponent, d_contact, mu_s, mu_k, v_transition)
-            force = net_mass[i] * mean_change / step - f_non_contact[i]
+                k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
+                impulses, work_delta, work_recoil, work_forces)
+            scale = net_mass[i] / step
             # The reaction goes to the bodies in proportion to their impulses (weights sum to 1,
             # so momentum exchange stays exact).
-            norms = np.sqrt(np.sum(impulses * impulses, axis=1))
-            total = norms.sum()
+            total = 0.0
+            largest = -1.0
             for c in range(k):
-                weight = norms[c] / total if total > 0.0 else 1.0 / k
-                _apply_contact_pair(i, c_body[c], weight * force, x[i] - coms[c_body[c]], step * stage_weight,
-                                    f_net, f_body, torque_lvlh, out_body_impulse)
-                if norms[c] > norms[strongest]:
+                norm = math.sqrt(impulses[c, 0] ** 2 + impulses[c, 1] ** 2 + impulses[c, 2] ** 2)
+                total += norm
+                if norm > largest:
+                    largest = norm
                     strongest = c
-            new_lag = end_change - mean_change
+            for c in range(k):
+                norm = math.sqrt(impulses[c, 0] ** 2 + impulses[c, 1] ** 2 + impulses[c, 2] ** 2)
+                weight = norm / total if total > 0.0 else 1.0 / k
+                _apply_contact_pair(i, c_body[c], weight * scale * mx, weight * scale * my, weight * scale * mz,
+                                    coms, step * stage_weight, x, f_net, f_body, torque_lvlh, out_body_impulse)
+            lag_x, lag_y, lag_z = ex - mx, ey - my, ez - mz
             out_scalars[4] += dissipated * stage_weight
         # Release the lag carried from the previous step (zero without sub-cycling).
         b = lag_body[i]
         if b >= 0:
-            _apply_contact_pair(i, b, net_mass[i] * velocity_lag[i] / step, x[i] - coms[b], step * stage_weight,
+            scale = net_mass[i] / step
+            _apply_contact_pair(i, b, scale * velocity_lag[i, 0], scale * velocity_lag[i, 1],
+                                scale * velocity_lag[i, 2], coms, step * stage_weight, x,
                                 f_net, f_body, torque_lvlh, out_body_impulse)
         lag_body[i] = c_body[strongest] if k > 0 else -1
-        velocity_lag[i] = new_lag
+        velocity_lag[i, 0] = lag_x
+        velocity_lag[i, 1] = lag_y
+        velocity_lag[i, 2] = lag_z
     return contact_energy, n_contacts
