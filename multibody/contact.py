@@ -180,20 +180,21 @@ def _free_flight_substeps(delta, relative_velocities, normals, recoil, n_contact
                  + (relative_velocities[c, 1] + uy + ay * t - recoil[c, 1]) * ny
                  + (relative_velocities[c, 2] + uz + az * t - recoil[c, 2]) * nz)
         accel = -(ax * nx + ay * ny + az * nz)
-        # earliest tau > 0 with delta + rate tau + accel tau^2 / 2 = 0
-        if accel == 0.0:
-            touch = -delta[c] / rate if rate > 0.0 else np.inf
-        else:
-            disc = rate * rate - 2.0 * accel * delta[c]
-            if disc < 0.0:
-                touch = np.inf
-            else:
-                root = math.sqrt(disc)
-                lo = (-rate - root) / accel
-                hi = (-rate + root) / accel
-                if lo > hi:
-                    lo, hi = hi, lo
-                touch = lo if lo > 0.0 else (hi if hi > 0.0 else np.inf)
+        # earliest tau > 0 with delta + rate tau + accel tau^2 / 2 = 0; the roots in the
+        # cancellation-free form (q / (accel/2) and delta / q), as accel is often tiny
+        disc = rate * rate - 2.0 * accel * delta[c]
+        if disc < 0.0:
+            continue
+        q = -0.5 * (rate + math.copysign(math.sqrt(disc), rate))
+        touch = np.inf
+        if q != 0.0:
+            root = delta[c] / q
+            if root > 0.0:
+                touch = root
+            if accel != 0.0:
+                root = q / (0.5 * accel)
+                if 0.0 < root < touch:
+                    touch = root
         earliest = min(earliest, touch)
     return min(remaining, int(earliest / dt))
 

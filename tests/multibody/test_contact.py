@@ -87,3 +87,27 @@ def test_sub_cycled_contact_keeps_the_rebound_at_large_steps(node_strikes_plane,
     _, _, rebound = _hunt_crossley_reference(speed, alpha)
     # 0.5 %: the 2 us sub-step resolves the ~150 us contact with ~75 sub-steps.
     assert -rec.net["velocities_lvlh"][-1, 0, 1] == pytest.approx(rebound, rel=0.005)
+
+
+@pytest.mark.parametrize("gap", [1e-9, 1.2e-5])
+@pytest.mark.parametrize("push", [0.0, 1e-9, -1e-9, 1e-3, -1e-3])
+def test_sub_cycle_rebound_from_a_gap_under_a_constant_push(push, gap):
+    """A node one sub-step's travel short of the surface, closing at 20 m/s, under a small
+    constant non-contact force along the normal (a nearly slack thread): the closed-form
+    free-flight part of the sub-cycle must hand over to contact at the right sub-step.
+    Expected: the analytic Hunt-Crossley rebound speed, corrected by the push's impulse over
+    the step (its effect is exact, it acts in closed form); 0.5 % as in the test above. A
+    tiny push once made the touching time a 0/0 and skipped the whole contact."""
+    from multibody.contact import contact_over_step
+
+    speed, alpha, step, n_sub = 20.0, 0.05, 4e-4, 200  # 2 us sub-steps; the ~150 us contact ends within the step
+    normal = np.array([[0.0, 0.0, 1.0]])           # from the body to the node
+    # gap (m): touches within the first sub-step (1.2e-5 m is 0.3 of a sub-step's travel)
+    force = np.array([0.0, 0.0, -push])             # pushes the node towards the body
+    impulses = np.zeros((1, 3))
+    _, _, _, _, _, end_z, _ = contact_over_step(
+        np.array([-gap]), np.array([[0.0, 0.0, -speed]]), normal, force, M, np.array([1e12]), step, n_sub,
+        K, 1.5, 1.5 * alpha * K, 0.0, 0.0, 0.1, impulses, np.zeros(1), np.zeros((1, 3)), np.zeros((1, 3)))
+    _, _, rebound = _hunt_crossley_reference(speed, alpha)
+    # end_z is the velocity change by contact alone: rebound + speed (the push acts separately).
+    assert end_z - speed == pytest.approx(rebound, rel=0.005)
