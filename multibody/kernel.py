@@ -296,7 +296,7 @@ def body_states(q, qt, n_nodes, body_reference):
 #: Phase of a contact's linearized oscillation (rad) per contact sub-step. 0.06 is the
 #: 2 us sub-step of the seed paper's 7.7 g node striking at 20 m/s, which reproduces the
 #: analytic Hunt-Crossley rebound within 0.5 % (tests/multibody/test_contact.py).
-CONTACT_PHASE_PER_SUBSTEP = 0.06
+CONTACT_PHASE_PER_SUBSTEP = 0.02
 
 
 @njit(cache=True)
