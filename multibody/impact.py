@@ -253,9 +253,10 @@ class ImpactSimulation:
         self.system = build_impact_system(assembly, rest_attitudes, rest_coms)
         self.wall_time = None
 
-    def run(self, progress=None) -> Recorder:
-        """Integrate to the end time; ``progress(t)`` is called at every output sample."""
-        recorder = Recorder(self.assembly, self.system, progress=progress)
+    def run(self, progress=None, monitor=None) -> Recorder:
+        """Integrate to the end time; ``progress(t)`` is called at every output sample, and
+        ``monitor.check(...)`` after it (see :class:`~multibody.recorder.Recorder`)."""
+        recorder = Recorder(self.assembly, self.system, progress=progress, monitor=monitor)
         mbs = self.system.mbs
         mbs.SetPostStepUserFunction(recorder.post_step)
         settings = simulation_settings(self.assembly)

@@ -21,7 +21,9 @@ joint_force_joint, joint_moment_joint   (k, nj, 3) connector reaction (N, N m), 
 energy_*                                (k,) J: net_kinetic, net_elastic (threads), net_bending,
                                         contact_elastic, debris_translational, debris_rotational,
                                         joint_elastic, orbital_potential (CW), dissipated_threads,
-                                        dissipated_contact, total (mechanical + dissipated)
+                                        dissipated_contact, released_joints (penalty energy held
+                                        by joints when a failure released them), total
+                                        (mechanical + dissipated + released)
 momentum_linear_lvlh                    (k, 3) total of net and debris (kg m/s)
 momentum_angular_lvlh                   (k, 3) about the LVLH origin (kg m^2/s)
 ======================================  =========================================================
@@ -50,10 +52,15 @@ def _sum_of_cross_products(a, b):
 class Recorder:
     """Samples the running system from Exudyn's post-step hook."""
 
-    def __init__(self, assembly, system, progress=None):
+    def __init__(self, assembly, system, progress=None, monitor=None):
         self.assembly = assembly
         self.system = system
         self.progress = progress
+        #: optional ``check(t, force_joint, moment_joint, joint_energies)`` called after each
+        #: sample (structures.release.ReleaseMonitor switches failed joints off there)
+        self.monitor = monitor
+        self.joint_active = np.ones(len(assembly.joints), bool)
+        self._released_energy = 0.0
         solver = assembly.solver
         self.step = solver.step
         self.output_interval = 1.0 / solver.output_rate
@@ -93,6 +100,8 @@ class Recorder:
         self._momentum_rows(row, x, v)
         for key, value in row.items():
             self._rows.setdefault(key, []).append(np.asarray(value, float))
+        if self.monitor is not None:
+            self._check_monitor(t, row)
         if t == 0.0 or t >= self._next_net - 0.5 * self.step:
             self._net_rows["time"].append(t)
             self._net_rows["positions_lvlh"].append(x.astype(np.float32))
@@ -101,6 +110,15 @@ class Recorder:
                 self._next_net += self.net_interval
         if self.progress is not None:
             self.progress(t)
+
+    def _check_monitor(self, t, row):
+        before = len(self.monitor.events)
+        self.monitor.check(t, row["joint_force_joint"], row["joint_moment_joint"], self._joint_energies)
+        for event in self.monitor.events[before:]:
+            # The connector is off from the next step on: its loads read zero and the elastic
+            # energy it held leaves the balance as "released" energy, so the total stays closed.
+            self.joint_active[event.joint] = False
+            self._released_energy += event.stored_energy
 
     def _net_state(self, q, qt):
         net = self.assembly.net
@@ -148,7 +166,7 @@ class Recorder:
     def _joint_rows(self, row):
         mbs = self.system.mbs
         com, vel, rot, omega = self._bodies_now
-        rotations, rates, forces, moments, energy = [], [], [], [], 0.0
+        rotations, rates, forces, moments, energies = [], [], [], [], []
         for j, joint in enumerate(self.assembly.joints):
             obj = self.system.joint_objects[j]
             rv = relative_rotation_vector_joint_frame(rot[joint.parent], rot[joint.child],
@@ -159,19 +177,20 @@ class Recorder:
             rates.append(frame.T @ omega_rel)
             # Exudyn's connector force is the spring force acting on marker 1 (child) with
             # reversed sign; the parent's load on the child is its negative.
-            forces.append(-np.asarray(mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)))
-            moments.append(-np.asarray(mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)))
+            active = self.joint_active[j]
+            forces.append(-np.asarray(mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)) * active)
+            moments.append(-np.asarray(mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)) * active)
             offset = (rot[joint.child] @ self.system.joint_point_child[j] + com[joint.child]
                       - rot[joint.parent] @ self.system.joint_point_parent[j] - com[joint.parent])
             offset_joint = frame.T @ offset
             k = self._joint_stiffness[j]
-            energy += 0.5 * (k[:3] @ offset_joint**2 + k[3:] @ rv**2)
+            energies.append(0.5 * (k[:3] @ offset_joint**2 + k[3:] @ rv**2) * active)
         nj = len(self.assembly.joints)
         row["joint_rotation_joint"] = np.reshape(rotations, (nj, 3))
         row["joint_rate_joint"] = np.reshape(rates, (nj, 3))
         row["joint_force_joint"] = np.reshape(forces, (nj, 3))
         row["joint_moment_joint"] = np.reshape(moments, (nj, 3))
-        self._joint_energy = energy
+        self._joint_energies = np.array(energies, float)
 
     def _energy_rows(self, row, x, v):
         scalars = self.system.kernel.scalars
@@ -186,7 +205,8 @@ class Recorder:
             "contact_elastic": scalars[CONTACT_ELASTIC],
             "debris_translational": sum(0.5 * b.mass * vel[k] @ vel[k] for k, b in enumerate(bodies)),
             "debris_rotational": sum(0.5 * omega[k] @ b.inertia_body @ omega[k] for k, b in enumerate(bodies)),
-            "joint_elastic": self._joint_energy,
+            "joint_elastic": float(self._joint_energies.sum()),
+            "released_joints": self._released_energy,
             "orbital_potential": (np.sum(net.masses * clohessy_wiltshire_potential(x, n_orbit))
                                   + sum(b.mass * clohessy_wiltshire_potential(com[k], n_orbit)[0]
                                         for k, b in enumerate(bodies))) if n_orbit else 0.0,

@@ -174,3 +174,48 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
                           contact_substep=sim.contact_substep),
         mean_motion=mean_motion(case.orbit.altitude) if isinstance(case.orbit, CircularOrbit) else 0.0)
     return ModelInputs(assembly, rest_att, rest_com)
+
+
+def section_properties(spec):
+    """Section properties from a case section (raises ValueError for impossible dimensions)."""
+    from structures.sections import SECTIONS
+
+    params = spec.model_dump()
+    return SECTIONS[params.pop("kind")](**params)
+
+
+def weak_locations(case: Case, assembly) -> list:
+    """The case's weak locations with axes and offsets in their joint frames (t = 0)."""
+    from structures.criteria import Allowable
+    from structures.weak_location import WeakLocation
+
+    if case.structures is None:
+        return []
+    _, target_to_lvlh = target_pose_lvlh(case)
+    names = [j.name for j in assembly.joints]
+    out = []
+    for spec in case.structures.weak_locations:
+        k = names.index(spec.joint)
+        joint = assembly.joints[k]
+        target_to_joint = joint.hinge_to_lvlh.T @ target_to_lvlh
+        beam = np.asarray(spec.beam_axis, float)
+        beam /= np.linalg.norm(beam)
+        width = np.asarray(spec.width_axis, float)
+        width = width - (width @ beam) * beam
+        width /= np.linalg.norm(width)
+        section_to_target = np.column_stack([beam, width, np.cross(beam, width)])
+        if spec.moment_axes is not None:
+            axes = tuple(sorted({"h1": 0, "h2": 1, "h3": 2}[a] for a in spec.moment_axes))
+        else:
+            axes = (0, 2) if joint.kind == "revolute" else (0, 1, 2)
+        material = spec.material
+        out.append(WeakLocation(
+            name=spec.name, joint=k, section_to_joint=target_to_joint @ section_to_target,
+            offset_joint=target_to_joint @ np.asarray(spec.offset, float),
+            section=section_properties(spec.section) if spec.section is not None else None,
+            ultimate_normal=Allowable.of(material.ultimate_normal) if material else None,
+            ultimate_shear=Allowable.of(material.ultimate_shear) if material else None,
+            allowable_moment=Allowable.of(spec.allowable_moment) if spec.allowable_moment is not None else None,
+            allowable_force=Allowable.of(spec.allowable_force) if spec.allowable_force is not None else None,
+            moment_axes=axes))
+    return out

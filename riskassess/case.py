@@ -257,6 +257,99 @@ class Target(Strict):
         return self
 
 
+# ---------------------------------------------------------------------------- structures
+ValueOrRange = Union[Positive, Annotated[list[Positive], Field(min_length=2, max_length=2)]]
+
+
+class SolidRectangle(Strict):
+    kind: Literal["solid_rectangle"]
+    width: Positive = Field(description="Extent along section axis 2 (m).")
+    height: Positive = Field(description="Extent along section axis 3 (m).")
+
+
+class HollowRectangle(Strict):
+    kind: Literal["hollow_rectangle"]
+    width: Positive = Field(description="Outer extent along section axis 2 (m).")
+    height: Positive = Field(description="Outer extent along section axis 3 (m).")
+    wall: Positive = Field(description="Uniform wall thickness (m).")
+
+
+class ThinWalledBox(Strict):
+    kind: Literal["thin_walled_box"]
+    width: Positive = Field(description="Midline extent along section axis 2 (m).")
+    height: Positive = Field(description="Midline extent along section axis 3 (m).")
+    flange_thickness: Positive = Field(description="Thickness of the two walls along axis 2 (m).")
+    web_thickness: Positive = Field(description="Thickness of the two walls along axis 3 (m).")
+
+
+class CircularTube(Strict):
+    kind: Literal["circular_tube"]
+    outer_diameter: Positive = Field(description="(m)")
+    wall: Positive = Field(description="Wall thickness (m); outer_diameter / 2 for a solid shaft.")
+
+
+class ISection(Strict):
+    kind: Literal["i_section"]
+    height: Positive = Field(description="Overall depth along section axis 3, the web direction (m).")
+    flange_width: Positive = Field(description="Flange extent along section axis 2 (m).")
+    flange_thickness: Positive = Field(description="(m)")
+    web_thickness: Positive = Field(description="(m)")
+
+
+Section = Annotated[Union[SolidRectangle, HollowRectangle, ThinWalledBox, CircularTube, ISection],
+                    Field(discriminator="kind")]
+
+
+class Material(Strict):
+    modulus: Positive | None = Field(None, description="Young's modulus (Pa); informational, stresses do not need it.")
+    ultimate_normal: ValueOrRange = Field(description="Ultimate normal stress (Pa), a value or [low, high].")
+    ultimate_shear: ValueOrRange = Field(description="Ultimate shear stress (Pa), a value or [low, high].")
+
+
+class WeakLocationSpec(Strict):
+    name: str
+    joint: str = Field(description="Joint whose reaction loads this location (its name in target.joints).")
+    offset: Vector3 = Field([0.0, 0.0, 0.0], description="Cut point minus joint point, target frame (m), on the child side.")
+    beam_axis: Vector3 = Field([1.0, 0.0, 0.0], description="Section axis 1 (along the member, normal to the cut), target frame (-).")
+    width_axis: Vector3 = Field([0.0, 1.0, 0.0], description="Section axis 2, target frame (-); made normal to beam_axis.")
+    section: Section | None = Field(None, description="Cross-section at the cut; needs 'material'.")
+    material: Material | None = None
+    allowable_moment: ValueOrRange | None = Field(
+        None, description="Allowable moment (N m), a value or [low, high], against the resultant of 'moment_axes'.")
+    moment_axes: list[Literal["h1", "h2", "h3"]] | None = Field(
+        None, description="Joint-frame moment components judged by allowable_moment; default: all but the hinge "
+                          "axis h2 of a revolute joint (carried by its spring), all three for a clamped joint.")
+    allowable_force: ValueOrRange | None = Field(None, description="Allowable resultant joint force (N), value or [low, high].")
+
+    @field_validator("allowable_moment", "allowable_force")
+    @classmethod
+    def _ordered_range(cls, v):
+        if isinstance(v, list) and v[0] > v[1]:
+            raise ValueError(f"a range is [low, high] with low <= high. Got {v} instead")
+        return v
+
+    @model_validator(mode="after")
+    def _criteria(self):
+        if (self.section is None) != (self.material is None):
+            raise ValueError("'section' and 'material' come together (stresses need both)")
+        if self.section is None and self.allowable_moment is None and self.allowable_force is None:
+            raise ValueError("give at least one criterion: section + material, allowable_moment or allowable_force")
+        b, w = np.asarray(self.beam_axis, float), np.asarray(self.width_axis, float)
+        if np.linalg.norm(b) == 0 or np.linalg.norm(np.cross(b, w)) < 1e-6 * np.linalg.norm(b) * np.linalg.norm(w):
+            raise ValueError("beam_axis must be non-zero and width_axis not parallel to it")
+        return self
+
+
+class Structures(Strict):
+    skip_initial: NonNegative = Field(
+        0.0, description="Loads before this time are not judged (s); the seed paper omits about 0.25 s of "
+                         "initial impact loads that have no time to propagate.")
+    release: Literal["low", "nominal", "high", "never"] = Field(
+        "low", description="Which value of a range allowable releases a failed joint during the run "
+                           "('low': conservative, most debris), or 'never' to judge without releasing.")
+    weak_locations: Annotated[list[WeakLocationSpec], Field(min_length=1)]
+
+
 class Case(Strict):
     name: str
     description: str = ""
@@ -267,6 +360,21 @@ class Case(Strict):
     launch: Launch
     contact: Contact
     target: Target
+    structures: Structures | None = None
+
+    @model_validator(mode="after")
+    def _weak_location_joints(self):
+        if self.structures is None:
+            return self
+        joints = [j.name for j in self.target.joints]
+        for loc in self.structures.weak_locations:
+            if loc.joint not in joints:
+                raise ValueError(f"structures: weak location '{loc.name}': joint '{loc.joint}' is not in "
+                                 f"target.joints {joints}")
+        names = [loc.name for loc in self.structures.weak_locations]
+        if len(set(names)) != len(names):
+            raise ValueError(f"structures: weak location names must be unique. Got {names}")
+        return self
 
 
 # ---------------------------------------------------------------------------- loading
@@ -275,7 +383,8 @@ def _format_location(loc) -> str:
     for item in loc:
         if isinstance(item, int):
             parts[-1] = f"{parts[-1]}[{item}]" if parts else f"[{item}]"
-        elif item in ("circular", "none", "box", "cylinder", "sphere", "mesh"):
+        elif item in ("circular", "none", "box", "cylinder", "sphere", "mesh", "solid_rectangle",
+                      "hollow_rectangle", "thin_walled_box", "circular_tube", "i_section"):
             continue  # discriminator tags add nothing for the user
         else:
             parts.append(str(item))
@@ -309,7 +418,7 @@ def load_case(path: str | Path) -> Case:
         case = Case.model_validate(raw)
     except ValidationError as exc:
         raise CaseError(format_validation_error(path, exc)) from None
-    problems = _check_files(case, path.parent)
+    problems = _check_files(case, path.parent) + _check_sections(case)
     if not problems:
         problems = _check_reach(case, path.parent)
     if problems:
@@ -324,6 +433,19 @@ def _check_files(case: Case, base: Path) -> list[str]:
             if isinstance(shape, MeshFile) and not (base / shape.file).is_file():
                 problems.append(f"target.bodies[{i}].shapes[{k}].file: mesh file '{shape.file}' not found "
                                 f"(paths are relative to the case file)")
+    return problems
+
+
+def _check_sections(case: Case) -> list[str]:
+    from riskassess.assemble import section_properties
+
+    problems = []
+    for i, loc in enumerate(case.structures.weak_locations if case.structures else []):
+        if loc.section is not None:
+            try:
+                section_properties(loc.section)
+            except ValueError as exc:
+                problems.append(f"structures.weak_locations[{i}].section: {exc}")
     return problems
 
 

@@ -26,14 +26,68 @@ def _cmd_run(args) -> int:
         print(json.dumps(result.summary, indent=2))
     else:
         print_summary(result.summary, result.run_dir)
+        if "structures" in result.summary:
+            print_verdict(result.summary["structures"])
     return 0
+
+
+def _cmd_assess(args) -> int:
+    case = load_case(args.case)
+    if case.structures is None:
+        raise CaseError(f"{args.case}: structures: missing; 'assess' needs [[structures.weak_locations]] "
+                        f"(see docs/case-format.md)")
+    return _cmd_run(args)
+
+
+def _format_value(value, unit):
+    scale, prefix = (1e-6, "MPa") if unit == "Pa" else (1.0, unit)
+    return f"{value * scale:.4g} {prefix}"
+
+
+def _format_allowable(low, high, unit):
+    return _format_value(low, unit) if low == high else f"{_format_value(low, unit)} - {_format_value(high, unit)}"
+
+
+def print_verdict(verdict: dict) -> None:
+    """The verdict table: location, criterion, peak demand, allowable, margin, fails?, released piece."""
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console(width=None if sys.stdout.isatty() else 150)
+    table = Table(title=f"structural verdict (loads after {verdict['skip_initial_s']:g} s; "
+                        f"range allowables decide at their '{verdict['release_policy']}' value)")
+    for column, justify in (("location", "left"), ("criterion", "left"), ("max demand", "right"),
+                            ("allowable", "right"), ("margin", "right"), ("fails?", "center"),
+                            ("likelihood", "right"), ("released piece", "left")):
+        table.add_column(column, justify=justify)
+    pieces = {p["location"]: p for p in verdict["released_pieces"]}
+    for loc in verdict["locations"]:
+        piece = pieces.get(loc["name"])
+        piece_text = (f"{'+'.join(piece['bodies'])}, {piece['mass_kg']:.4g} kg, "
+                      f"{' x '.join(f'{e:.3g}' for e in piece['size_m'][:2])} m, at {piece['release_time_s']:.3f} s"
+                      if piece else "-")
+        for k, (name, c) in enumerate(loc["criteria"].items()):
+            table.add_row(loc["name"] if k == 0 else "", f"{name} ({c['mode']})", _format_value(c["peak"], c["unit"]),
+                          _format_allowable(*c["allowable"], c["unit"]), f"{c['margin_of_safety']:+.2f}",
+                          "[red]FAIL[/red]" if c["fails"] else "pass",
+                          (">= " if loc["released_at_s"] is not None else "") + f"{c['likelihood']:.0%}",
+                          piece_text if k == 0 else "")
+    console.print(table)
+    for p in verdict["released_pieces"]:
+        v = p["velocity_relative_to_chaser_lvlh_m_s"]
+        console.print(f"released {'+'.join(p['bodies'])}: at end {'inside' if p['inside_net_at_end'] else 'OUTSIDE'} "
+                      f"the net, velocity rel. chaser [{v[0]:.3f}, {v[1]:.3f}, {v[2]:.3f}] m/s LVLH, "
+                      f"spin {p['spin_rate_rad_s']:.3f} rad/s")
+    if verdict["released_pieces"]:
+        console.print("likelihoods of released locations are lower bounds: their loads after release are not known")
+    console.print("secondary debris: " + ("[red]YES[/red]" if verdict["secondary_debris"] else "none"))
 
 
 def print_summary(summary: dict, run_dir: Path) -> None:
     from rich.console import Console
     from rich.table import Table
 
-    console = Console()
+    console = Console(width=None if sys.stdout.isatty() else 150)
     ref = summary["paper_reference"]
     table = Table(title=f"{summary['case']}: coupled net impact", show_lines=False)
     table.add_column("quantity")
@@ -81,6 +135,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", help="output folder (default runs/<case name>)")
     run.add_argument("--json", action="store_true", help="print the run summary as JSON")
     run.set_defaults(func=_cmd_run)
+    assess = sub.add_parser("assess", help="simulate a case with weak locations and print the structural verdict")
+    assess.add_argument("case", help="case file (TOML) with [[structures.weak_locations]]")
+    assess.add_argument("--out", help="output folder (default runs/<case name>)")
+    assess.add_argument("--json", action="store_true", help="print the run summary (with the verdict) as JSON")
+    assess.set_defaults(func=_cmd_assess)
     val = sub.add_parser("validate", help="check a case file and exit")
     val.add_argument("case")
     val.set_defaults(func=_cmd_validate)

@@ -15,9 +15,11 @@ import trimesh
 
 from multibody.impact import ImpactSimulation
 from riskassess import results
-from riskassess.assemble import model_inputs
+from riskassess.assemble import model_inputs, weak_locations
 from riskassess.case import Case, load_case
 from riskassess.summary import run_summary
+from structures.release import ReleaseMonitor
+from structures.verdict import demand_series, structures_verdict
 
 
 @dataclass
@@ -53,13 +55,31 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
                 "status": "running", "files": ["case.toml", "case.json"], "software": software_versions()}
     shutil.copyfile(case_path, out / "case.toml")
     results.atomic_write_json(out / "case.json", case.model_dump())
-    recorder = simulation.run(progress=progress)
+    locations = weak_locations(case, simulation.assembly)
+    monitor = None
+    if locations and case.structures.release != "never":
+        monitor = ReleaseMonitor(locations, simulation.system, case.structures.skip_initial, case.structures.release)
+    recorder = simulation.run(progress=progress, monitor=monitor)
     summary = run_summary(recorder, simulation.assembly, case.name)
     write_simulation_results(out, recorder, simulation)
     results.atomic_write_json(out / "summary.json", summary)
     manifest.update(status="complete", files=manifest["files"] + ["summary.json", "timeseries.npz", "net.npz",
                                                                   "bodies.npz"])
     results.atomic_write_json(out / "manifest.json", manifest)
+    if locations:
+        # A later stage that fails leaves the finished simulation results and says so.
+        try:
+            summary["structures"] = structures_verdict(
+                locations, recorder.series, simulation.assembly, monitor.events if monitor else [],
+                recorder.net["positions_lvlh"][-1], case.structures.skip_initial, case.structures.release)
+            results.atomic_write_npz(out / "structures.npz", demand_series(locations, recorder.series))
+            results.atomic_write_json(out / "structures.json", summary["structures"])
+        except Exception as exc:
+            manifest.update(status="structures_failed", error=f"{type(exc).__name__}: {exc}")
+            results.atomic_write_json(out / "manifest.json", manifest)
+            raise
+        manifest["files"] += ["structures.json", "structures.npz"]
+        results.atomic_write_json(out / "manifest.json", manifest)
     return RunOutput(out, summary)
 
 

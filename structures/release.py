@@ -1,0 +1,127 @@
+"""Secondary debris, simulated: a failed weak location releases its joint during the run.
+
+:class:`ReleaseMonitor` is called by the recorder at every output sample with the joint
+loads just recorded. When a weak location's demand reaches its decisive allowable (after
+the skipped initial transient), the joint's connector is switched off in the Exudyn system
+(``activeConnector = False``) and the simulation continues: the released piece (the child
+body and everything still attached to it) flies on under the net's contact and the orbit.
+
+:func:`released_pieces` reports each piece after the run: bodies, mass, size (oriented
+bounding box of its shapes), release time, and at the end of the run its position,
+velocity and spin relative to the chaser (the LVLH origin), and whether it is still held
+inside the net (its centre of mass inside the convex hull of the net nodes).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import trimesh
+
+from structures.weak_location import WeakLocation, exceeds_now
+
+
+@dataclass
+class ReleaseEvent:
+    location: str
+    joint: int
+    time: float          # s
+    criterion: str
+    demand: float        # SI unit of the criterion
+    stored_energy: float # J, penalty-joint elastic energy let go at release
+
+
+class ReleaseMonitor:
+    """Releases joints whose weak location fails; see the module docstring."""
+
+    def __init__(self, locations: list[WeakLocation], system, skip_until=0.0, policy="low"):
+        self.locations = locations
+        self.system = system
+        self.skip_until = skip_until
+        self.policy = policy
+        self.events: list[ReleaseEvent] = []
+
+    def released_joints(self) -> set:
+        return {e.joint for e in self.events}
+
+    def check(self, t, force_joint, moment_joint, joint_energies):
+        """One output sample: (nj, 3) joint loads (joint frame) and (nj,) joint elastic energies (J)."""
+        if t < self.skip_until:
+            return
+        released = self.released_joints()
+        for loc in self.locations:
+            if loc.joint in released:
+                continue
+            hit = exceeds_now(loc, force_joint[loc.joint], moment_joint[loc.joint], self.policy)
+            if hit is not None:
+                self.release(loc, t, *hit, stored_energy=float(joint_energies[loc.joint]))
+                released.add(loc.joint)
+
+    def release(self, location: WeakLocation, t, criterion, demand, stored_energy=0.0):
+        mbs = self.system.mbs
+        mbs.SetObjectParameter(self.system.joint_objects[location.joint], "activeConnector", False)
+        self.events.append(ReleaseEvent(location.name, location.joint, float(t), criterion, demand, stored_energy))
+
+
+def piece_bodies(joints, joint_index: int, released_before: set) -> list[int]:
+    """Bodies that leave with ``joint_index``: its child and all bodies still attached below it."""
+    out = [joints[joint_index].child]
+    for k, j in enumerate(joints):
+        if j.parent in out and k not in released_before and k != joint_index:
+            out += piece_bodies(joints, k, released_before)
+    return out
+
+
+def piece_size(bodies, members, attitudes, coms) -> list[float]:
+    """Oriented bounding-box extents (m) of the piece's shapes, sorted large to small."""
+    meshes = []
+    for k in members:
+        for mesh in bodies[k].meshes_body:
+            m = mesh.copy()
+            transform = np.eye(4)
+            transform[:3, :3] = attitudes[k]
+            transform[:3, 3] = coms[k]
+            meshes.append(m.apply_transform(transform))
+    merged = trimesh.util.concatenate(meshes)
+    return sorted(np.asarray(merged.bounding_box_oriented.primitive.extents, float).tolist(), reverse=True)
+
+
+def inside_net(point_lvlh, net_positions_lvlh) -> bool:
+    """True if the point lies inside the convex hull of the net nodes (the net wraps it)."""
+    try:
+        hull = trimesh.convex.convex_hull(np.asarray(net_positions_lvlh, float))
+    except Exception:  # flat or degenerate node cloud: nothing is enclosed
+        return False
+    return bool(hull.contains(np.atleast_2d(point_lvlh))[0])
+
+
+def released_pieces(events: list[ReleaseEvent], assembly, series, net_positions_final) -> list[dict]:
+    """Report per release event (see module doc); states are the last recorded sample."""
+    bodies, joints = assembly.bodies, assembly.joints
+    masses = np.array([b.mass for b in bodies])
+    attitudes0 = [b.body_to_lvlh for b in bodies]
+    coms0 = [b.com_lvlh for b in bodies]
+    com_end = series["body_com_lvlh"][-1]
+    vel_end = series["body_velocity_lvlh"][-1]
+    omega_end = series["body_omega_body"][-1]
+    rot_end = series["body_to_lvlh"][-1]
+    out, before = [], set()
+    for e in sorted(events, key=lambda e: e.time):
+        members = piece_bodies(joints, e.joint, before)
+        before.add(e.joint)
+        m = masses[members]
+        com = m @ com_end[members] / m.sum()
+        vel = m @ vel_end[members] / m.sum()
+        root = members[0]
+        spin_lvlh = rot_end[root] @ omega_end[root]
+        out.append({
+            "location": e.location, "joint": joints[e.joint].name, "release_time_s": e.time,
+            "criterion": e.criterion, "demand_at_release": e.demand,
+            "bodies": [bodies[k].name for k in members], "mass_kg": float(m.sum()),
+            "size_m": piece_size(bodies, members, attitudes0, coms0),
+            "position_relative_to_chaser_lvlh_m": com.tolist(),
+            "velocity_relative_to_chaser_lvlh_m_s": vel.tolist(),
+            "spin_lvlh_rad_s": spin_lvlh.tolist(), "spin_rate_rad_s": float(np.linalg.norm(spin_lvlh)),
+            "inside_net_at_end": inside_net(com, net_positions_final),
+        })
+    return out

@@ -1,0 +1,126 @@
+"""A weak location (a joint, or a cut near it) and its checks against the co-simulated loads.
+
+Loads come from the joint reactions the run records (``joint_force_joint``,
+``joint_moment_joint``: the load the parent exerts on the child at the joint point, joint
+frame h1, h2, h3). A cut at ``offset`` from the joint point, on the child side, carries the
+same force and the moment transported to it, M_cut = M_joint - r x F: the inertia and the
+contact load of the short segment between joint and cut are neglected (keep cuts close to
+the joint, or put a joint at the cut).
+
+Each location has one or more criteria, each a demand time series against an
+:class:`~structures.criteria.Allowable`, and a failure mode:
+
+* ``normal_stress`` (Pa, mode "normal"): axial + bending, Euler-Bernoulli, at the section;
+* ``shear_stress`` (Pa, mode "shear"): torsion + transverse shear at the section;
+* ``moment`` (N m, mode "normal"): resultant of the joint-frame moment components in
+  ``moment_axes`` (the seed paper judges the hinge-panel interface by M_h1 and M_h3
+  against 200-1000 N m, Sec. 3.3.3);
+* ``force`` (N, mode "shear"): resultant joint force.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from structures.criteria import Allowable, combined_likelihood, first_exceedance_time
+from structures.sections import SectionProperties, section_stresses
+
+CRITERION_MODE = {"normal_stress": "normal", "shear_stress": "shear", "moment": "normal", "force": "shear"}
+CRITERION_UNIT = {"normal_stress": "Pa", "shear_stress": "Pa", "moment": "N m", "force": "N"}
+
+
+@dataclass(frozen=True)
+class WeakLocation:
+    """One weak location, with everything in the joint frame (SI)."""
+
+    name: str
+    joint: int                            # index of the joint whose reaction loads it
+    section_to_joint: np.ndarray          # (3, 3): columns are section axes 1 (beam), 2, 3 in the joint frame
+    offset_joint: np.ndarray              # (3,) cut point minus joint point, joint frame (m)
+    section: SectionProperties | None = None
+    ultimate_normal: Allowable | None = None
+    ultimate_shear: Allowable | None = None
+    allowable_moment: Allowable | None = None
+    allowable_force: Allowable | None = None
+    moment_axes: tuple = (0, 1, 2)       # joint-frame components judged by allowable_moment
+
+    def criteria(self) -> dict:
+        """Criterion name -> allowable, for the criteria this location has."""
+        out = {"normal_stress": self.ultimate_normal if self.section is not None else None,
+               "shear_stress": self.ultimate_shear if self.section is not None else None,
+               "moment": self.allowable_moment, "force": self.allowable_force}
+        return {k: v for k, v in out.items() if v is not None}
+
+
+def internal_loads_section_frame(location: WeakLocation, force_joint, moment_joint):
+    """Internal force (N, V2, V3) and moment (T, M2, M3) at the cut, section frame; (k, 3) each."""
+    f = np.atleast_2d(np.asarray(force_joint, float))
+    m = np.atleast_2d(np.asarray(moment_joint, float)) - np.cross(location.offset_joint, f)
+    rot = location.section_to_joint
+    return f @ rot, m @ rot
+
+
+def demands(location: WeakLocation, force_joint, moment_joint) -> dict:
+    """Demand time series per criterion ((k,) arrays, SI), plus the section's stress breakdown."""
+    out = {}
+    f = np.atleast_2d(np.asarray(force_joint, float))
+    m = np.atleast_2d(np.asarray(moment_joint, float))
+    if location.section is not None:
+        f_sec, m_sec = internal_loads_section_frame(location, f, m)
+        stresses = section_stresses(location.section, f_sec, m_sec)
+        out.update({"normal_stress": stresses["normal"], "shear_stress": stresses["shear"],
+                    "von_mises_stress": stresses["von_mises"], "bending_stress": stresses["bending"],
+                    "axial_stress": stresses["axial"], "torsion_stress": stresses["torsion"],
+                    "transverse_shear_stress": stresses["transverse_shear"]})
+    out["moment"] = np.linalg.norm(m[:, list(location.moment_axes)], axis=1)
+    out["force"] = np.linalg.norm(f, axis=1)
+    return out
+
+
+def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0.0, policy="low") -> dict:
+    """Verdict of one location over a load history.
+
+    Loads before ``skip_until`` (s) are not judged (the seed paper omits about 0.25 s of
+    initial impact loads that have no time to propagate). ``policy`` picks the value of a
+    range allowable that decides pass/fail and the margin ("low", "nominal", "high");
+    the likelihood always uses the whole range.
+    """
+    time = np.asarray(time, float)
+    series = demands(location, force_joint, moment_joint)
+    judged = time >= skip_until
+    result = {"name": location.name, "criteria": {}}
+    for name, allowable in location.criteria().items():
+        demand = series[name]
+        k = int(np.argmax(np.where(judged, demand, -np.inf))) if judged.any() else 0
+        peak = float(demand[k]) if judged.any() else 0.0
+        threshold = allowable.threshold(policy)
+        result["criteria"][name] = {
+            "mode": CRITERION_MODE[name], "unit": CRITERION_UNIT[name],
+            "peak": peak, "peak_time_s": float(time[k]) if judged.any() else None,
+            "allowable": [allowable.low, allowable.high], "decisive_allowable": threshold,
+            "margin_of_safety": allowable.margin_of_safety(peak, policy),
+            "fails": bool(peak >= threshold), "likelihood": allowable.likelihood_of_failure(peak),
+            "first_exceedance_s": first_exceedance_time(time, demand, threshold, skip_until),
+        }
+    crit = result["criteria"].values()
+    result["fails_normal"] = any(c["fails"] for c in crit if c["mode"] == "normal")
+    result["fails_shear"] = any(c["fails"] for c in crit if c["mode"] == "shear")
+    result["fails"] = result["fails_normal"] or result["fails_shear"]
+    result["likelihood"] = combined_likelihood([c["likelihood"] for c in crit])
+    times = [c["first_exceedance_s"] for c in crit if c["first_exceedance_s"] is not None]
+    result["first_exceedance_s"] = min(times) if times else None
+    if "von_mises_stress" in series:
+        vm = np.where(judged, series["von_mises_stress"], 0.0)
+        result["peak_von_mises_stress_Pa"] = float(vm.max()) if judged.any() else 0.0
+    return result
+
+
+def exceeds_now(location: WeakLocation, force_joint, moment_joint, policy="low"):
+    """The first criterion (name, demand) whose demand reaches its decisive allowable for one
+    sample of joint loads ((3,) each), or None: what a run checks to release a joint."""
+    series = demands(location, np.reshape(force_joint, (1, 3)), np.reshape(moment_joint, (1, 3)))
+    for name, allowable in location.criteria().items():
+        if series[name][0] >= allowable.threshold(policy):
+            return name, float(series[name][0])
+    return None
