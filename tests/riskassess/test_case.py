@@ -75,3 +75,19 @@ def test_cli_reports_a_bad_case_before_running(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "bullets.mass: Input should be greater than 0. Got -1.786" in err
     assert not out.exists(), "nothing is written for a case that does not validate"
+
+
+@pytest.mark.parametrize("old, new, expected", [
+    ('joint = "ka_band_hinge"', 'joint = "ka_hinge"',
+     "weak location 'ka_band_hinge': joint 'ka_hinge' is not in target.joints"),
+    ('outer_diameter = 0.1, wall = 0.002', 'outer_diameter = 0.1, wall = 0.2',
+     "structures.weak_locations[2].section: circular_tube: wall must be in (0, outer_diameter/2 = 0.05 m]"),
+    ('allowable_moment = [200.0, 1000.0]', 'allowable_moment = [1000.0, 200.0]',
+     "structures.weak_locations[0].allowable_moment: a range is [low, high] with low <= high"),
+    ('release = "low"', 'release = "sometimes"', "structures.release: Input should be 'low', 'nominal', 'high' or 'never'"),
+    ('material = { ultimate_normal = 570e6, ultimate_shear = 330e6 }', '',
+     "structures.weak_locations[1]: 'section' and 'material' come together"),
+])
+def test_bad_weak_locations_are_named(tmp_path, old, new, expected):
+    message = _load_modified(tmp_path, old, new)
+    assert expected in message
