@@ -101,7 +101,7 @@ class SolverSpec:
     integrator: str = "VelocityVerlet"
     output_rate: float = 1000.0     # time-series samples per second (Hz)
     net_output_rate: float = 50.0   # net snapshots per second (Hz)
-    contact_substep: float = 2e-6   # largest contact sub-step (s)
+    contact_substep: float = 2e-6   # shortest contact sub-step (s); multibody.kernel sizes each node's
     joint_tuning_step: float | None = None  # step the automatic penalty joints are tuned to (s); None: step
 
     @property

@@ -132,7 +132,7 @@ class KernelData:
     transition_speed: float          # (m/s)
     mean_motion: float               # (rad/s); 0 without orbit
     step: float                      # integrator step (s)
-    contact_substep: float           # largest contact sub-step (s); >= step disables sub-cycling
+    contact_substep: float           # shortest contact sub-step (s); >= step disables sub-cycling
     stage_weight: float = 1.0        # 1 / force evaluations per integrator step
     force: np.ndarray = field(init=False)
     body_impulse: np.ndarray = field(init=False)   # (nb, 6) accumulated contact impulse and angular impulse about CoM, LVLH

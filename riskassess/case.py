@@ -43,7 +43,9 @@ class Simulation(Strict):
     output_rate: Positive = Field(1000.0, description="Time-series samples per second (Hz).")
     net_output_rate: Positive = Field(50.0, description="Net snapshots per second (Hz), for VTK export.")
     contact_substep: Positive = Field(
-        2e-6, description="Largest sub-step of the contact impulse integration (s); >= step turns sub-cycling off.")
+        2e-6, description="Shortest sub-step of the contact impulse integration (s); each node's sub-step resolves "
+                          "its contact's period (0.02 rad per sub-step) and is never shorter; >= step turns "
+                          "sub-cycling off.")
 
     @model_validator(mode="after")
     def _rates_fit_step(self):

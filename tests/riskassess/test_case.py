@@ -91,3 +91,10 @@ def test_cli_reports_a_bad_case_before_running(tmp_path, capsys):
 def test_bad_weak_locations_are_named(tmp_path, old, new, expected):
     message = _load_modified(tmp_path, old, new)
     assert expected in message
+
+
+def test_case_format_doc_is_current():
+    """docs/case-format.md is generated from the models; regenerate with python -m riskassess.casedoc."""
+    from riskassess.casedoc import render
+
+    assert (CASES.parent / "docs" / "case-format.md").read_text() == render()
