@@ -75,6 +75,15 @@ class JointSpec:
     penalty_damping_ratio: float = 0.05
 
 
+def subtree_bodies(joints: list[JointSpec], root: int, cut_joints=()) -> list[int]:
+    """``root`` and every body attached below it through joints not in ``cut_joints`` (indices)."""
+    out = [root]
+    for k, joint in enumerate(joints):
+        if joint.parent == root and k not in cut_joints:
+            out += subtree_bodies(joints, joint.child, cut_joints)
+    return out
+
+
 @dataclass
 class ContactLaw:
     """Hertz / Hunt-Crossley / Hollar contact parameters (seed paper Table 2)."""

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from multibody.assembly import ContactLaw, ImpactAssembly, JointSpec, RigidBodySpec, SolverSpec
+from multibody.assembly import ContactLaw, ImpactAssembly, JointSpec, RigidBodySpec, SolverSpec, subtree_bodies
 from multibody.geometry import geometric_center_of_mass, shape_mesh, uniform_density_inertia
 from multibody.hinge import hinge_frame_lvlh
 from multibody.net import flat_square_net, thread_node_mass
@@ -136,20 +136,12 @@ def build_bodies_and_joints(case: Case, base: Path):
     return bodies, joints, rest_attitudes, rest_coms
 
 
-def _descendants(joints, body):
-    out = [body]
-    for j in joints:
-        if j.parent == body:
-            out += _descendants(joints, j.child)
-    return out
-
-
 def _apply_initial_hinge_state(bodies, joints, index, angle, rate):
     """Rotate the child subtree about the hinge axis by ``angle`` and give it ``rate`` (LVLH)."""
     joint = joints[index]
     axis = joint.hinge_to_lvlh[:, 1]
     turn = Rotation.from_rotvec(angle * axis).as_matrix()
-    for k in _descendants(joints, joint.child):
+    for k in subtree_bodies(joints, joint.child):
         b = bodies[k]
         arm = turn @ (b.com_lvlh - joint.point_lvlh)
         b.com_lvlh = joint.point_lvlh + arm

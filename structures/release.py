@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
+from multibody.assembly import subtree_bodies
 from structures.weak_location import WeakLocation, exceeds_now
 
 
@@ -63,15 +64,6 @@ class ReleaseMonitor:
         self.events.append(ReleaseEvent(location.name, location.joint, float(t), criterion, demand, stored_energy))
 
 
-def piece_bodies(joints, joint_index: int, released_before: set) -> list[int]:
-    """Bodies that leave with ``joint_index``: its child and all bodies still attached below it."""
-    out = [joints[joint_index].child]
-    for k, j in enumerate(joints):
-        if j.parent in out and k not in released_before and k != joint_index:
-            out += piece_bodies(joints, k, released_before)
-    return out
-
-
 def piece_size(bodies, members, attitudes, coms) -> list[float]:
     """Oriented bounding-box extents (m) of the piece's shapes, sorted large to small."""
     meshes = []
@@ -107,7 +99,8 @@ def released_pieces(events: list[ReleaseEvent], assembly, series, net_positions_
     rot_end = series["body_to_lvlh"][-1]
     out, before = [], set()
     for e in sorted(events, key=lambda e: e.time):
-        members = piece_bodies(joints, e.joint, before)
+        # the child and everything still attached below it (earlier releases cut their joints)
+        members = subtree_bodies(joints, joints[e.joint].child, before)
         before.add(e.joint)
         m = masses[members]
         com = m @ com_end[members] / m.sum()

@@ -79,3 +79,14 @@ def test_centripetal_joint_load_then_release_and_free_flight():
     assert piece["size_m"] == pytest.approx([2.0, 0.2, 0.2], rel=1e-9)
     assert piece["spin_rate_rad_s"] == pytest.approx(OMEGA, rel=1e-3)
     assert piece["inside_net_at_end"] is False
+
+
+def test_piece_is_the_subtree_below_the_released_joint():
+    """Chain 0-1-2-3 (joints 0, 1, 2): releasing joint 0 frees bodies 1, 2, 3 once each; after
+    joint 1 was released earlier, only body 1 leaves with joint 0."""
+    from multibody.assembly import subtree_bodies
+
+    joints = [JointSpec(name=f"j{k}", kind="clamped", parent=k, child=k + 1, point_lvlh=np.zeros(3),
+                        hinge_to_lvlh=np.eye(3)) for k in range(3)]
+    assert subtree_bodies(joints, 1) == [1, 2, 3]
+    assert subtree_bodies(joints, 1, cut_joints={1}) == [1]
