@@ -135,15 +135,13 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
                                                   forceVector=[0.0] * size))
     else:
         # Runge-Kutta stages need the force at every stage state: a force user function,
-        # which receives the state as Python lists (about 0.3 ms a call for the reference net).
-        state_index = None  # decided after Assemble(), below
+        # which receives the state as Python lists (about 0.3 ms a call for the reference net);
+        # it reads Exudyn's system vectors instead once the layout is known (after Assemble).
+        layout = {}
 
         def coupled_forces(mbs_, t, item, q, q_t):
-            if state_index is None:
-                x, v = np.fromiter(q, float, size), np.fromiter(q_t, float, size)
-            else:
-                x = mbs_.systemData.GetODE2Coordinates()[state_index]
-                v = mbs_.systemData.GetODE2Coordinates_t()[state_index]
+            data = mbs_.systemData
+            x, v = _object_state(layout["index"], data.GetODE2Coordinates(), data.GetODE2Coordinates_t())
             return kernel.evaluate(x, v, t)
 
         coupled = mbs.AddObject(ObjectGenericODE2(nodeNumbers=generic_nodes, massMatrix=mass,
@@ -160,15 +158,31 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
         p_parent.append(parent.body_to_lvlh.T @ (joint.point_lvlh - parent.com_lvlh))
         p_child.append(rest_attitudes[joint.child].T @ (joint.point_lvlh - rest_coms[joint.child]))
     mbs.Assemble()
-    # Where the generic object's coordinates sit in Exudyn's system vectors.
-    sizes = [3 * n] * bool(n) + [6] * len(body_nodes)
-    state_index = np.concatenate([np.arange(mbs.GetNodeODE2Index(nd), mbs.GetNodeODE2Index(nd) + k)
-                                  for nd, k in zip(generic_nodes, sizes)]).astype(np.int64)
+    state_index = _object_state_index(mbs, generic_nodes, [3 * n] * bool(n) + [6] * len(body_nodes))
     if verlet:
         mbs.SetPreStepUserFunction(VerletForces(mbs, coupled, kernel, assembly.solver.step, 3 * n,
                                                 len(body_nodes), state_index))
+    else:
+        layout["index"] = state_index
     return BuiltSystem(sc, mbs, kernel, net_node, body_nodes, body_objects, joint_objects,
                        to_parent, to_child, p_parent, p_child)
+
+
+def _object_state_index(mbs, nodes, sizes):
+    """Where the generic object's coordinates sit in Exudyn's system vectors: an index array,
+    or None when they are the whole system vector in order (the usual case)."""
+    index = np.concatenate([np.arange(mbs.GetNodeODE2Index(nd), mbs.GetNodeODE2Index(nd) + k)
+                            for nd, k in zip(nodes, sizes)]).astype(np.int64)
+    if mbs.systemData.ODE2Size() == len(index) and np.array_equal(index, np.arange(len(index))):
+        return None
+    return index
+
+
+def _object_state(index, *system_vectors):
+    """The generic object's part of each system vector (see _object_state_index)."""
+    if index is None:
+        return system_vectors
+    return tuple(vector[index] for vector in system_vectors)
 
 
 class VerletForces:
@@ -191,23 +205,18 @@ class VerletForces:
         self.step = step
         self.n_net_coordinates = n_net_coordinates
         self.n_bodies = n_bodies
-        identity = np.array_equal(state_index, np.arange(len(state_index)))
-        self.state_index = None if identity and mbs.systemData.ODE2Size() == len(state_index) else state_index
+        self.state_index = state_index  # see _object_state_index
         # The solver's initial acceleration uses the force at the initial state.
-        q, v = self._state(mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t())
+        q, v = _object_state(state_index, mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t())
         self._set_force(kernel.evaluate(q, v, 0.0))
-
-    def _state(self, *vectors):
-        if self.state_index is None:
-            return vectors
-        return tuple(vector[self.state_index] for vector in vectors)
 
     def _set_force(self, force):
         self.mbs.SetObjectParameter(self.coupled_object, "forceVector", force)
 
     def __call__(self, mbs, t):
         data = mbs.systemData
-        q, v, a = self._state(data.GetODE2Coordinates(), data.GetODE2Coordinates_t(), data.GetODE2Coordinates_tt())
+        q, v, a = _object_state(self.state_index, data.GetODE2Coordinates(), data.GetODE2Coordinates_t(),
+                                data.GetODE2Coordinates_tt())
         q_next, v_half = verlet_evaluation_state(q, v, a, self.step, self.n_net_coordinates, self.n_bodies)
         self._set_force(self.kernel.evaluate(q_next, v_half, t + self.step))
         return True
