@@ -16,7 +16,7 @@ Coordinate layout of the generic object (Exudyn ``q`` / ``q_t``):
 * 6 per rigid body: CoM displacement (m) and rotation vector body->LVLH (rad);
   velocities: CoM velocity (m/s), LVLH, and angular velocity (rad/s), body frame.
   The generalized force on the rotational part is the torque in the body frame
-  (checked in ``tests/multibody/test_kernel.py``).
+  (angular momentum conservation in ``tests/multibody/test_conservation.py`` depends on it).
 """
 from __future__ import annotations
 
@@ -244,9 +244,9 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     f_net = np.zeros((n, 3))
 
     elastic, power = add_thread_forces(x, v, threads, rest_lengths, thread_stiffness, thread_damping, f_net)
-    out_scalars[0] = elastic
-    out_scalars[1] = add_bending_forces(x, bending_triples, bending_stiffness, f_net)
-    out_scalars[3] += power * step * stage_weight
+    out_scalars[THREAD_ELASTIC] = elastic
+    out_scalars[BENDING_ELASTIC] = add_bending_forces(x, bending_triples, bending_stiffness, f_net)
+    out_scalars[THREAD_DISSIPATED] += power * step * stage_weight
 
     if n_orbit != 0.0:
         for i in range(n):
@@ -270,8 +270,8 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
         base = 3 * n + 6 * b
         out_force[base:base + 3] = f_body[b]
         out_force[base + 3:base + 6] = rots[b].T @ torque_lvlh[b]
-    out_scalars[2] = contact_energy
-    out_scalars[5] = n_contacts
+    out_scalars[CONTACT_ELASTIC] = contact_energy
+    out_scalars[N_CONTACTS] = n_contacts
     out_force[: 3 * n] = f_net.reshape(3 * n)
     return out_force
 
@@ -374,6 +374,7 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
     c_rel = np.empty((n_shapes, 3))
     c_mass = np.empty(n_shapes)
     impulses = np.empty((n_shapes, 3))
+    impulse_norm = np.empty(n_shapes)
     work_delta = np.empty(n_shapes)
     work_recoil = np.empty((n_shapes, 3))
     work_forces = np.empty((n_shapes, 3))
@@ -439,21 +440,16 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
             scale = net_mass[i] / step
             # The reaction goes to the bodies in proportion to their impulses (weights sum to 1,
             # so momentum exchange stays exact).
-            total = 0.0
-            largest = -1.0
             for c in range(k):
-                norm = math.sqrt(impulses[c, 0] ** 2 + impulses[c, 1] ** 2 + impulses[c, 2] ** 2)
-                total += norm
-                if norm > largest:
-                    largest = norm
-                    strongest = c
+                impulse_norm[c] = math.sqrt(impulses[c, 0] ** 2 + impulses[c, 1] ** 2 + impulses[c, 2] ** 2)
+            total = impulse_norm[:k].sum()
+            strongest = int(np.argmax(impulse_norm[:k]))
             for c in range(k):
-                norm = math.sqrt(impulses[c, 0] ** 2 + impulses[c, 1] ** 2 + impulses[c, 2] ** 2)
-                weight = norm / total if total > 0.0 else 1.0 / k
+                weight = impulse_norm[c] / total if total > 0.0 else 1.0 / k
                 _apply_contact_pair(i, c_body[c], weight * scale * mx, weight * scale * my, weight * scale * mz,
                                     coms, step * stage_weight, x, f_net, f_body, torque_lvlh, out_body_impulse)
             lag_x, lag_y, lag_z = ex - mx, ey - my, ez - mz
-            out_scalars[4] += dissipated * stage_weight
+            out_scalars[CONTACT_DISSIPATED] += dissipated * stage_weight
         # Release the lag carried from the previous step (zero without sub-cycling).
         b = lag_body[i]
         if b >= 0:
