@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import tomllib
 from pathlib import Path
-from typing import Annotated, Literal, Union
+from typing import Annotated, Literal, Union, get_args
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -380,13 +380,20 @@ class Case(Strict):
 
 
 # ---------------------------------------------------------------------------- loading
+def _discriminator_tags() -> set:
+    """The ``kind`` values that tag the members of a discriminated union (orbit, shape and
+    section kinds): models whose ``kind`` admits exactly one value."""
+    kinds = [get_args(model.model_fields["kind"].annotation)
+             for model in Strict.__subclasses__() if "kind" in model.model_fields]
+    return {values[0] for values in kinds if len(values) == 1}
+
+
 def _format_location(loc) -> str:
     parts = []
     for item in loc:
         if isinstance(item, int):
             parts[-1] = f"{parts[-1]}[{item}]" if parts else f"[{item}]"
-        elif item in ("circular", "none", "box", "cylinder", "sphere", "mesh", "solid_rectangle",
-                      "hollow_rectangle", "thin_walled_box", "circular_tube", "i_section"):
+        elif item in _discriminator_tags():
             continue  # discriminator tags add nothing for the user
         else:
             parts.append(str(item))

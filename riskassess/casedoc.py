@@ -1,8 +1,6 @@
 """Generate docs/case-format.md from the case models: ``python -m riskassess.casedoc > docs/case-format.md``."""
 from __future__ import annotations
 
-import typing
-
 from pydantic import BaseModel
 
 from riskassess import case as c

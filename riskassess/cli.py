@@ -23,11 +23,12 @@ def _cmd_run(args) -> int:
         task = bar.add_task("run", total=end, t=0.0)
         result = run_case(args.case, out, progress=lambda t: bar.update(task, completed=t, t=t), case=case)
     if args.json:
-        print(json.dumps(result.summary, indent=2))
+        extra = {"structures": result.structures} if result.structures is not None else {}
+        print(json.dumps({**result.summary, **extra}, indent=2))
     else:
         print_summary(result.summary, result.run_dir)
-        if "structures" in result.summary:
-            print_verdict(result.summary["structures"])
+        if result.structures is not None:
+            print_verdict(result.structures)
     return 0
 
 

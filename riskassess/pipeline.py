@@ -25,7 +25,8 @@ from structures.verdict import demand_series, structures_verdict
 @dataclass
 class RunOutput:
     run_dir: Path
-    summary: dict
+    summary: dict                  # as in summary.json
+    structures: dict | None = None  # as in structures.json, for a case with weak locations
 
 
 def software_versions() -> dict:
@@ -66,21 +67,22 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
     manifest.update(status="complete", files=manifest["files"] + ["summary.json", "timeseries.npz", "net.npz",
                                                                   "bodies.npz"])
     results.atomic_write_json(out / "manifest.json", manifest)
+    verdict = None
     if locations:
         # A later stage that fails leaves the finished simulation results and says so.
         try:
-            summary["structures"] = structures_verdict(
+            verdict = structures_verdict(
                 locations, recorder.series, simulation.assembly, monitor.events if monitor else [],
                 recorder.net["positions_lvlh"][-1], case.structures.skip_initial, case.structures.release)
             results.atomic_write_npz(out / "structures.npz", demand_series(locations, recorder.series))
-            results.atomic_write_json(out / "structures.json", summary["structures"])
+            results.atomic_write_json(out / "structures.json", verdict)
         except Exception as exc:
             manifest.update(status="structures_failed", error=f"{type(exc).__name__}: {exc}")
             results.atomic_write_json(out / "manifest.json", manifest)
             raise
         manifest["files"] += ["structures.json", "structures.npz"]
         results.atomic_write_json(out / "manifest.json", manifest)
-    return RunOutput(out, summary)
+    return RunOutput(out, summary, verdict)
 
 
 def write_simulation_results(out: Path, recorder, simulation: ImpactSimulation) -> None:
