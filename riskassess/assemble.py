@@ -18,6 +18,9 @@ from multibody.hinge import hinge_frame_lvlh
 from multibody.net import flat_square_net, thread_node_mass
 from multibody.orbit import mean_motion
 from riskassess.case import Case, CircularOrbit
+from structures.criteria import Allowable
+from structures.sections import SECTIONS
+from structures.weak_location import WeakLocation
 
 
 @dataclass
@@ -170,17 +173,12 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
 
 def section_properties(spec):
     """Section properties from a case section (raises ValueError for impossible dimensions)."""
-    from structures.sections import SECTIONS
-
     params = spec.model_dump()
     return SECTIONS[params.pop("kind")](**params)
 
 
 def weak_locations(case: Case, assembly) -> list:
     """The case's weak locations with axes and offsets in their joint frames (t = 0)."""
-    from structures.criteria import Allowable
-    from structures.weak_location import WeakLocation
-
     if case.structures is None:
         return []
     _, target_to_lvlh = target_pose_lvlh(case)
