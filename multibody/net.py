@@ -188,6 +188,33 @@ def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
     return elastic, power
 
 
+def thread_tension_strain(x, v, threads, rest_lengths, stiffness, damping):
+    """Tension (N) and engineering strain (-) of every thread, the law of :func:`add_thread_forces`.
+
+    Vectorised over snapshots for exports and reports (the simulation uses the kernel).
+
+    Parameters
+    ----------
+    x, v : (..., n, 3) float
+        Node positions (m) and velocities (m/s), LVLH.
+
+    Returns
+    -------
+    tension : (..., m) float
+        :math:`\max(0, k(l-l_0) + c\dot l)` on stretched threads, 0 on slack ones (N).
+    strain : (..., m) float
+        :math:`(l - l_0)/l_0`; negative on slack threads (-).
+    """
+    x = np.asarray(x, float)
+    v = np.asarray(v, float)
+    d = x[..., threads[:, 1], :] - x[..., threads[:, 0], :]
+    length = np.linalg.norm(d, axis=-1)
+    stretch = length - rest_lengths
+    rate = np.einsum("...i,...i->...", v[..., threads[:, 1], :] - v[..., threads[:, 0], :], d) / length
+    tension = np.where(stretch > 0.0, np.maximum(stiffness * stretch + damping * rate, 0.0), 0.0)
+    return tension, stretch / rest_lengths
+
+
 @njit(cache=True)
 def add_bending_forces(x, triples, bending_stiffness, force):
     """Add forces of rotational springs between consecutive threads; return their energy (J).

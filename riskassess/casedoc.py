@@ -1,5 +1,10 @@
-"""Generate docs/case-format.md from the case models: ``python -m riskassess.casedoc > docs/case-format.md``."""
+"""The case models described for people: docs/case-format.md and the report's input tables.
+
+``python -m riskassess.casedoc > docs/case-format.md`` regenerates the format page.
+"""
 from __future__ import annotations
+
+import re
 
 from pydantic import BaseModel
 
@@ -28,6 +33,77 @@ SECTIONS = [
     ('section: kind = "thin_walled_box"', c.ThinWalledBox), ('section: kind = "circular_tube"', c.CircularTube),
     ('section: kind = "i_section"', c.ISection),
 ]
+
+
+#: Symbols a unit in a field description may be built from (SI only, see the header).
+UNIT_SYMBOLS = {"m", "kg", "s", "N", "Pa", "rad", "Hz", "-"}
+
+
+def _is_unit(text: str) -> bool:
+    tokens = [t.split("^")[0] for t in re.split(r"[ /]", text.strip()) if t]
+    return bool(tokens) and all(t in UNIT_SYMBOLS for t in tokens)
+
+
+def field_unit(field) -> str:
+    """The SI unit a field's description states in parentheses, e.g. 'N m/rad'; '' if none."""
+    for group in re.findall(r"\(([^()]*)\)", field.description or ""):
+        if _is_unit(group):
+            return group
+    return ""
+
+
+def _format_leaf(value) -> str:
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, list) and value and all(isinstance(v, (int, float)) for v in value):
+        return "[" + ", ".join(_format_leaf(float(v)) for v in value) + "]"
+    if isinstance(value, list) and value and all(isinstance(v, list) for v in value):
+        return "[" + ", ".join(_format_leaf(v) for v in value) + "]"
+    return str(value)
+
+
+def _compact_model(model: BaseModel) -> str:
+    """One-line description of a small nested model (a shape, a section, a material)."""
+    parts = []
+    for name, field in type(model).model_fields.items():
+        value = getattr(model, name)
+        if value is None or name == "kind":
+            continue
+        unit = field_unit(field)
+        parts.append(f"{name} {_format_leaf(value)}{' ' + unit if unit and unit != '-' else ''}")
+    kind = getattr(model, "kind", None)
+    return (f"{kind}: " if kind else "") + ", ".join(parts)
+
+
+#: Nested models shown as one line each in input tables (they are details of their parent).
+COMPACT = (c.Box, c.Cylinder, c.Sphere, c.MeshFile, c.SolidRectangle, c.HollowRectangle, c.ThinWalledBox,
+           c.CircularTube, c.ISection, c.Material)
+
+
+def input_rows(model: BaseModel, prefix: str = "") -> list[tuple[str, str, str, str]]:
+    """Every input of a validated case as rows (key path, value, unit, meaning), in file order.
+
+    List items are keyed by their ``name`` where they have one (``target.bodies[solar_array]``);
+    shapes, sections and materials are one row each.
+    """
+    rows = []
+    for name, field in type(model).model_fields.items():
+        value = getattr(model, name)
+        key = f"{prefix}{name}"
+        if value is None or (name == "name" and prefix.endswith("].")):  # the key already names the item
+            continue
+        if isinstance(value, COMPACT):
+            rows.append((key, _compact_model(value), "", field.description or ""))
+        elif isinstance(value, BaseModel):
+            rows += input_rows(value, key + ".")
+        elif isinstance(value, list) and value and isinstance(value[0], BaseModel):
+            for k, item in enumerate(value):
+                label = f"{key}[{getattr(item, 'name', k)}]"
+                rows += ([(label, _compact_model(item), "", field.description or "")] if isinstance(item, COMPACT)
+                         else input_rows(item, label + "."))
+        else:
+            rows.append((key, _format_leaf(value), field_unit(field), field.description or ""))
+    return rows
 
 
 def model_table(model: type[BaseModel]) -> str:

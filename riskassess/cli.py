@@ -40,80 +40,47 @@ def _cmd_assess(args) -> int:
     return _cmd_run(args)
 
 
-def _format_value(value, unit):
-    scale, prefix = (1e-6, "MPa") if unit == "Pa" else (1.0, unit)
-    return f"{value * scale:.4g} {prefix}"
+def _table(title: str, columns, rows, justify=None):
+    from rich.table import Table
+
+    table = Table(title=title)
+    for k, column in enumerate(columns):
+        table.add_column(column, justify=(justify or {}).get(column, "left"))
+    for row in rows:
+        table.add_row(*row)
+    return table
 
 
-def _format_allowable(low, high, unit):
-    return _format_value(low, unit) if low == high else f"{_format_value(low, unit)} - {_format_value(high, unit)}"
+def _console():
+    from rich.console import Console
+
+    return Console(width=None if sys.stdout.isatty() else 150)
 
 
 def print_verdict(verdict: dict) -> None:
     """The verdict table: location, criterion, peak demand, allowable, margin, fails?, released piece."""
-    from rich.console import Console
-    from rich.table import Table
+    from riskassess.tables import VERDICT_COLUMNS, piece_fate, verdict_rows
 
-    console = Console(width=None if sys.stdout.isatty() else 150)
-    table = Table(title=f"structural verdict (loads after {verdict['skip_initial_s']:g} s; "
-                        f"range allowables decide at their '{verdict['release_policy']}' value)")
-    for column, justify in (("location", "left"), ("criterion", "left"), ("max demand", "right"),
-                            ("allowable", "right"), ("margin", "right"), ("fails?", "center"),
-                            ("likelihood", "right"), ("released piece", "left")):
-        table.add_column(column, justify=justify)
-    pieces = {p["location"]: p for p in verdict["released_pieces"]}
-    for loc in verdict["locations"]:
-        piece = pieces.get(loc["name"])
-        piece_text = (f"{'+'.join(piece['bodies'])}, {piece['mass_kg']:.4g} kg, "
-                      f"{' x '.join(f'{e:.3g}' for e in piece['size_m'][:2])} m, at {piece['release_time_s']:.3f} s"
-                      if piece else "-")
-        for k, (name, c) in enumerate(loc["criteria"].items()):
-            table.add_row(loc["name"] if k == 0 else "", f"{name} ({c['mode']})", _format_value(c["peak"], c["unit"]),
-                          _format_allowable(*c["allowable"], c["unit"]), f"{c['margin_of_safety']:+.2f}",
-                          "[red]FAIL[/red]" if c["fails"] else "pass",
-                          (">= " if loc["released_at_s"] is not None else "") + f"{c['likelihood']:.0%}",
-                          piece_text if k == 0 else "")
-    console.print(table)
+    console = _console()
+    rows = [[("[red]FAIL[/red]" if r["fails"] else "pass") if c == "fails?" else r[c] for c in VERDICT_COLUMNS]
+            for r in verdict_rows(verdict)]
+    right = {c: "right" for c in ("max demand", "at", "allowable", "margin", "likelihood")}
+    console.print(_table(f"structural verdict (loads after {verdict['skip_initial_s']:g} s; range allowables "
+                         f"decide at their '{verdict['release_policy']}' value)", VERDICT_COLUMNS, rows,
+                         {**right, "fails?": "center"}))
     for p in verdict["released_pieces"]:
-        v = p["velocity_relative_to_chaser_lvlh_m_s"]
-        console.print(f"released {'+'.join(p['bodies'])}: at end {'inside' if p['inside_net_at_end'] else 'OUTSIDE'} "
-                      f"the net, velocity rel. chaser [{v[0]:.3f}, {v[1]:.3f}, {v[2]:.3f}] m/s LVLH, "
-                      f"spin {p['spin_rate_rad_s']:.3f} rad/s")
+        console.print(f"released {'+'.join(p['bodies'])}: {piece_fate(p)}")
     if verdict["released_pieces"]:
         console.print("likelihoods of released locations are lower bounds: their loads after release are not known")
     console.print("secondary debris: " + ("[red]YES[/red]" if verdict["secondary_debris"] else "none"))
 
 
 def print_summary(summary: dict, run_dir: Path) -> None:
-    from rich.console import Console
-    from rich.table import Table
+    from riskassess.tables import summary_rows
 
-    console = Console(width=None if sys.stdout.isatty() else 150)
-    ref = summary["paper_reference"]
-    table = Table(title=f"{summary['case']}: coupled net impact", show_lines=False)
-    table.add_column("quantity")
-    table.add_column("this run", justify="right")
-    table.add_column("paper (decoupled)", justify="right")
-    f = summary["peak_contact_force_N"]
-    m = summary["peak_contact_moment_about_debris_com_Nm"]
-    table.add_row("peak contact force (N)", f"{f['value']:.4g} at {f['time_s']:.3f} s", f"{ref['peak_contact_force_N']:.3g}")
-    table.add_row("peak contact moment (N m)", f"{m['value']:.4g} at {m['time_s']:.3f} s",
-                  f"{ref['peak_contact_moment_Nm']:.3g}")
-    dv = summary["debris_velocity_change_final_third_mean_lvlh_m_s"]
-    est = summary["momentum_exchange_estimate_lvlh_m_s"]
-    table.add_row("debris along-track velocity change, mean of last third (m/s)", f"{dv[1]:.4f} (estimate {est[1]:.4f})",
-                  f"{ref['debris_along_track_velocity_simulated_m_s']}")
-    for name, j in summary["joints"].items():
-        mom = j["max_abs_moment_after_transient_Nm"] or j["max_abs_moment_joint_Nm"]
-        text = "/".join(f"{v:.3g}" for v in mom)
-        if j["kind"] == "revolute":
-            text += f"; angle {j['max_abs_angle_rad']:.4f} rad"
-        table.add_row(f"{name}: |M| h1/h2/h3 after 0.25 s (N m)", text,
-                      f"{ref['hinge_moment_h1_Nm']:.0f}/-/{ref['hinge_moment_h3_Nm']:.0f}" if j["kind"] == "revolute" else "")
-    checks = summary["checks"]
-    table.add_row("energy balance drift (rel.)", f"{checks['energy_balance_relative_drift']:.2e}", "")
-    table.add_row("wall time (s), steps/s", f"{summary['wall_time_s']:.1f}, {summary['steps_per_second']:.0f}", "")
-    console.print(table)
+    console = _console()
+    console.print(_table(f"{summary['case']}: coupled net impact", ("quantity", "this run", "paper (decoupled)"),
+                         summary_rows(summary), {"this run": "right", "paper (decoupled)": "right"}))
     console.print(f"results: {run_dir}")
 
 

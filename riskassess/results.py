@@ -15,7 +15,12 @@ net.npz            net snapshots (``time``, ``positions_lvlh``, ``velocities_lvl
                    topology (``threads``, ``rest_lengths``, ``stiffness``, ``damping``,
                    ``masses``, ``radii``, ``n_bullets``)
 bodies.npz         per body ``k``: ``vertices_k`` (m, body frame) and ``faces_k``
+structures.json    the structural verdict (cases with weak locations)
+structures.npz     demand time series per weak location, ``<location>/<demand>``
 =================  ==============================================================
+
+Products made later from the folder (``report.html``, ``report.pdf``, ``vtk/impact.pvd``)
+are listed under ``products`` in the manifest; deleting one does not spoil the folder.
 
 Every file is written to a temporary name and renamed, so a folder never holds a
 half-written file; the manifest is written last and lists what is complete.
@@ -33,6 +38,14 @@ FORMAT = "riskassess-run"
 VERSION = 1
 
 
+def _default_mode() -> int:
+    """File mode of a normally created file (0o666 less the umask); mkstemp's 0o600 would hide
+    results from the user's group."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder."""
     path = Path(path)
@@ -40,6 +53,7 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)
+        os.chmod(tmp, _default_mode())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -56,6 +70,7 @@ def atomic_write_npz(path: Path, arrays: dict) -> None:
     os.close(fd)
     try:
         np.savez_compressed(tmp, **arrays)
+        os.chmod(tmp, _default_mode())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -84,6 +99,102 @@ def read_manifest(run_dir: Path) -> dict:
     if missing:
         raise ValueError(f"{run_dir}: files listed in the manifest are missing: {missing}")
     return manifest
+
+
+#: Files every complete version-1 run folder holds; structures.* only for cases with weak locations.
+CORE_FILES = ("case.toml", "case.json", "summary.json", "timeseries.npz", "net.npz", "bodies.npz")
+
+
+class MissingData(LookupError):
+    """A run folder lacks a file or key a later stage needs; the message says which and why."""
+
+
+class RunFolder:
+    """Read access to a run folder for the stages after the simulation (report, VTK export).
+
+    Opening checks only the manifest; each accessor raises :class:`MissingData` naming the
+    missing file (or key) so a report of an incomplete or older folder can say what is
+    missing section by section instead of failing as a whole.
+    """
+
+    def __init__(self, run_dir: str | Path):
+        self.path = Path(run_dir)
+        self.manifest = read_manifest(self.path)
+        self._cache: dict = {}
+
+    @property
+    def complete(self) -> bool:
+        return self.manifest.get("status") == "complete"
+
+    def missing_core_files(self) -> list[str]:
+        return [f for f in CORE_FILES if not (self.path / f).is_file()]
+
+    def has(self, name: str) -> bool:
+        return (self.path / name).is_file() and (name in self.manifest.get("files", []) or name == "manifest.json")
+
+    def _require(self, name: str) -> Path:
+        if not self.has(name):
+            why = (f"the run stopped with status '{self.manifest.get('status')}'" if not self.complete
+                   else "not written by this run")
+            raise MissingData(f"{self.path / name} is missing ({why})")
+        return self.path / name
+
+    def json(self, name: str) -> dict:
+        if name not in self._cache:
+            self._cache[name] = json.loads(self._require(name).read_text())
+        return self._cache[name]
+
+    def arrays(self, name: str) -> dict[str, np.ndarray]:
+        if name not in self._cache:
+            with np.load(self._require(name)) as data:
+                self._cache[name] = {k: data[k] for k in data.files}
+        return self._cache[name]
+
+    @property
+    def summary(self) -> dict:
+        return self.json("summary.json")
+
+    @property
+    def case(self) -> dict:
+        return self.json("case.json")
+
+    @property
+    def timeseries(self) -> dict[str, np.ndarray]:
+        return self.arrays("timeseries.npz")
+
+    @property
+    def net(self) -> dict[str, np.ndarray]:
+        return self.arrays("net.npz")
+
+    @property
+    def bodies(self) -> dict[str, np.ndarray]:
+        return self.arrays("bodies.npz")
+
+    @property
+    def structures(self) -> dict:
+        return self.json("structures.json")
+
+    @property
+    def structures_series(self) -> dict[str, np.ndarray]:
+        return self.arrays("structures.npz")
+
+    def key(self, data: dict, *path):
+        """``data[path[0]][path[1]]...``; :class:`MissingData` naming the key for older folders."""
+        value = data
+        for k in path:
+            try:
+                value = value[k]
+            except (KeyError, IndexError, TypeError):
+                raise MissingData(f"{self.path}: key {'/'.join(map(str, path))} is missing "
+                                  f"(a run folder from an older version of the tool?)") from None
+        return value
+
+    def add_product(self, relative_path: str) -> None:
+        """Record a file made from this folder (report, export) in the manifest's ``products``."""
+        products = self.manifest.setdefault("products", [])
+        if relative_path not in products:
+            products.append(relative_path)
+            atomic_write_json(self.path / "manifest.json", self.manifest)
 
 
 def load_timeseries(run_dir: Path) -> dict[str, np.ndarray]:

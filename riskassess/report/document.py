@@ -1,0 +1,138 @@
+"""Build the report of a run folder and write it as one self-contained HTML file and as PDF.
+
+Both come from one Jinja2 template (``templates/report.html.j2``); the PDF is that HTML
+rendered by WeasyPrint with the print rules of ``templates/report.css``.
+
+A section is a function ``section(run: RunFolder) -> Section | None``, listed in
+:data:`SECTIONS` in reading order. It returns ``None`` when its stage did not run (a
+perception, towing, diagnosis or sweep section when the run folder holds none of its
+results), and raises :class:`~riskassess.results.MissingData` when the folder lacks what
+it needs: the report then shows the section with what is missing instead of failing.
+Adding a stage's section is adding one module and one line here.
+"""
+from __future__ import annotations
+
+import datetime
+from dataclasses import dataclass
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+
+import jinja2
+
+from riskassess import results
+from riskassess.report.blocks import Figure, Note, Section, Table
+from riskassess.report.impact import contact_section, debris_motion_section, energy_section, hinge_section
+from riskassess.report.inputs import case_section, run_facts_section
+from riskassess.report.plotting import STYLE
+from riskassess.report.structures import joint_loads_section, stresses_section, verdict_section
+from riskassess.results import MissingData, RunFolder
+
+#: (section id, title, builder) in reading order: the verdict first.
+SECTIONS = (
+    ("verdict", "Verdict: secondary debris", verdict_section),
+    ("case", "Case summary: inputs", case_section),
+    ("contact", "Contact forces and moments", contact_section),
+    ("debris-motion", "Debris velocity and angular velocity", debris_motion_section),
+    ("hinges", "Hinge angles", hinge_section),
+    ("joint-loads", "Hinge and joint loads against allowables", joint_loads_section),
+    ("stresses", "Stresses against strengths", stresses_section),
+    ("energy", "Net and debris energy", energy_section),
+    ("run-facts", "Run facts", run_facts_section),
+)
+TEMPLATES = Path(__file__).parent / "templates"
+
+
+@dataclass
+class ReportOutput:
+    html: Path
+    pdf: Path | None
+    pdf_pages: int | None
+    section_pages: dict          # section id -> PDF page number (1-based) where it starts
+    sections: list[Section]
+
+
+def tool_version() -> str:
+    try:
+        return version("adr-riskassess")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def build_sections(run: RunFolder, progress=None) -> list[Section]:
+    """Every applicable section; a section whose data is missing says what is missing."""
+    import matplotlib.pyplot as plt
+
+    sections = []
+    for k, (section_id, title, build) in enumerate(SECTIONS):
+        if progress:
+            progress(k, len(SECTIONS), title)
+        try:
+            with plt.rc_context(STYLE):
+                section = build(run)
+        except MissingData as exc:
+            section = Section(section_id, title, missing=str(exc))
+        if section is not None:
+            sections.append(section)
+    if progress:
+        progress(len(SECTIONS), len(SECTIONS), "done")
+    return sections
+
+
+def folder_problems(run: RunFolder) -> list[str]:
+    problems = []
+    if not run.complete:
+        problems.append(f"the run's status is '{run.manifest.get('status')}'"
+                        + (f" ({run.manifest['error']})" if run.manifest.get("error") else "")
+                        + "; sections without their data say what is missing.")
+    missing = run.missing_core_files()
+    if missing:
+        problems.append(f"missing files: {', '.join(missing)}.")
+    return problems
+
+
+def render_html(run: RunFolder, sections: list[Section]) -> str:
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True,
+                             undefined=jinja2.StrictUndefined)
+    env.tests.update(table=lambda b: isinstance(b, Table), figure=lambda b: isinstance(b, Figure),
+                     note=lambda b: isinstance(b, Note))
+    case_name = run.manifest.get("case", run.path.name)
+    try:
+        description = run.case.get("description") or ""
+    except MissingData:
+        description = ""
+    return env.get_template("report.html.j2").render(
+        title=f"Net-capture risk report: {case_name}", subtitle=description, run_dir=str(run.path),
+        created=run.manifest.get("created", "-"),
+        generated=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        tool_version=tool_version(), problems=folder_problems(run), sections=sections,
+        css=(TEMPLATES / "report.css").read_text())
+
+
+def render_pdf(html: str, base_url: Path):
+    """WeasyPrint document of the HTML: (pdf bytes, page count, section id -> first page)."""
+    import weasyprint
+
+    document = weasyprint.HTML(string=html, base_url=str(base_url)).render()
+    section_pages = {}
+    for number, page in enumerate(document.pages, start=1):
+        for anchor in page.anchors:
+            section_pages.setdefault(anchor, number)
+    return document.write_pdf(), len(document.pages), section_pages
+
+
+def write_report(run_dir: str | Path, pdf: bool = True, progress=None) -> ReportOutput:
+    """Write ``report.html`` (and ``report.pdf``) into the run folder, each atomically."""
+    run = RunFolder(run_dir)
+    sections = build_sections(run, progress)
+    html = render_html(run, sections)
+    html_path = run.path / "report.html"
+    results.atomic_write_bytes(html_path, html.encode("utf-8"))
+    run.add_product("report.html")
+    pdf_path, pages, section_pages = None, None, {}
+    if pdf:
+        data, pages, anchors = render_pdf(html, run.path)
+        section_pages = {s.id: anchors[s.id] for s in sections if s.id in anchors}
+        pdf_path = run.path / "report.pdf"
+        results.atomic_write_bytes(pdf_path, data)
+        run.add_product("report.pdf")
+    return ReportOutput(html_path, pdf_path, pages, section_pages, sections)

@@ -1,0 +1,128 @@
+"""Report sections of the structures stage: the verdict, loads against allowables, stresses
+against strengths (from structures.json and structures.npz of the run folder)."""
+from __future__ import annotations
+
+import numpy as np
+
+from riskassess.report.blocks import Figure, Note, Section, Table
+from riskassess.report.plotting import allowable_band, legend, mark_release, panels, shade_not_judged
+from riskassess.results import RunFolder
+from riskassess.tables import VERDICT_COLUMNS, format_vector, verdict_rows
+
+NOT_ASSESSED = ("Not assessed: the case declares no weak locations. Add [[structures.weak_locations]] to the case "
+                "(docs/case-format.md) and run it again to get failure verdicts and released pieces.")
+
+
+def verdict_section(run: RunFolder) -> Section:
+    if not run.has("structures.json"):
+        if "structures.json" not in run.manifest.get("files", []) and run.case.get("structures") is None:
+            return Section("verdict", "Verdict: secondary debris", [Note(NOT_ASSESSED, "warning")])
+        run.structures  # raises MissingData naming the file
+    verdict = run.structures
+    pieces = verdict["released_pieces"]
+    failing = [loc["name"] for loc in verdict["locations"] if loc["fails"]]
+    if verdict["secondary_debris"]:
+        headline = Note(f"SECONDARY DEBRIS: {len(pieces)} piece(s) released"
+                        + (f"; failing locations: {', '.join(failing)}" if failing else ""), "alarm")
+    else:
+        headline = Note("No secondary debris: every weak location holds with its decisive allowable.", "info")
+    blocks = [headline]
+    if pieces:
+        blocks.append(Table(
+            ["piece (bodies)", "released at (s)", "by", "mass (kg)", "size (m)", "at end", "velocity rel. chaser "
+             "(m/s, LVLH)", "spin (rad/s)"],
+            [["+".join(p["bodies"]), f"{p['release_time_s']:.3f}", f"{p['location']} ({p['criterion']})",
+              f"{p['mass_kg']:.4g}", " x ".join(f"{e:.3g}" for e in p["size_m"]),
+              "inside the net" if p["inside_net_at_end"] else "OUTSIDE the net",
+              format_vector(p["velocity_relative_to_chaser_lvlh_m_s"]), f"{p['spin_rate_rad_s']:.3g}"]
+             for p in pieces], "Released pieces (size: oriented bounding box of the piece's shapes)"))
+    rows = verdict_rows(verdict)
+    columns = [c for c in VERDICT_COLUMNS if c != "released piece"]
+    blocks.append(Table(columns, [[("FAIL" if r["fails"] else "pass") if c == "fails?" else r[c] for c in columns]
+                                  for r in rows],
+                        f"Weak locations: peak demand after {verdict['skip_initial_s']:g} s against the allowable; "
+                        f"range allowables decide at their '{verdict['release_policy']}' value. Margin of safety = "
+                        f"allowable / demand - 1.",
+                        alarm_rows={k for k, r in enumerate(rows) if r["fails"]}))
+    blocks.append(Note("Likelihood: probability of failure with the allowable uniformly distributed over its "
+                       "range. For a released location it is a lower bound ('>='), because the joint carries "
+                       "nothing after its release."))
+    return Section("verdict", "Verdict: secondary debris", blocks)
+
+
+def _locations_with(verdict: dict, criteria: set) -> list[dict]:
+    return [loc for loc in verdict["locations"] if criteria & set(loc["criteria"])]
+
+
+def _decorate(ax, verdict: dict, loc: dict, time_end: float) -> None:
+    shade_not_judged(ax, verdict["skip_initial_s"])
+    if loc["released_at_s"] is not None:
+        mark_release(ax, loc["released_at_s"])
+    ax.set_xlim(0.0, time_end)
+
+
+def joint_loads_section(run: RunFolder) -> Section:
+    """Moment and force demands of every weak location that has a moment or force allowable."""
+    title = "Hinge and joint loads against allowables"
+    if not run.has("structures.json") and run.case.get("structures") is None:
+        return Section("joint-loads", title, [Note(NOT_ASSESSED, "warning")])
+    verdict, series = run.structures, run.structures_series
+    t = series["time"]
+    units = {"moment": "N m", "force": "N"}
+    judged = [(loc, name) for loc in verdict["locations"] for name in units if name in loc["criteria"]]
+    if not judged:
+        return Section("joint-loads", title, [Note("No weak location has a moment or force allowable.")])
+    fig, axes = panels(len(judged), 1.9)
+    for ax, (loc, name) in zip(axes, judged):
+        c = loc["criteria"][name]
+        ax.plot(t, run.key(series, f"{loc['name']}/{name}"), color="k", label=f"{name} demand")
+        allowable_band(ax, *c["allowable"], c["decisive_allowable"], 1.0, units[name])
+        _decorate(ax, verdict, loc, t[-1])
+        ax.set_ylabel(f"{name} ({units[name]})")
+        ax.set_title(f"{loc['name']} (joint {loc['joint']})")
+        legend(ax, loc="upper right", ncols=2)
+    return Section("joint-loads", title, [Figure.from_matplotlib(
+        "fig-joint-loads", "Demand of each location with a moment or force allowable (the resultant of the "
+        "judged joint-frame components) against its allowable range; grey: initial transient not judged.", fig)])
+
+
+def stresses_section(run: RunFolder) -> Section:
+    title = "Stresses against strengths"
+    if not run.has("structures.json") and run.case.get("structures") is None:
+        return Section("stresses", title, [Note(NOT_ASSESSED, "warning")])
+    verdict, series = run.structures, run.structures_series
+    t = series["time"]
+    locations = _locations_with(verdict, {"normal_stress", "shear_stress"})
+    if not locations:
+        return Section("stresses", title, [Note("No weak location has a cross-section and material.")])
+    fig, axes = panels(len(locations), 1.9)
+    colors = {"normal_stress": "tab:blue", "shear_stress": "tab:purple"}
+    rows = []
+    for ax, loc in zip(axes, locations):
+        floor = np.inf
+        for name, color in colors.items():
+            c = loc["criteria"][name]
+            demand = np.asarray(run.key(series, f"{loc['name']}/{name}")) / 1e6
+            ax.plot(t, np.maximum(demand, 1e-9), color=color, label=f"{name.replace('_', ' ')}")
+            ax.axhspan(c["allowable"][0] / 1e6, c["allowable"][1] / 1e6, color=color, alpha=0.12, lw=0)
+            ax.axhline(c["decisive_allowable"] / 1e6, color=color, ls="--", lw=1.0,
+                       label=f"{c['mode']} strength {c['decisive_allowable'] / 1e6:.4g} MPa")
+            floor = min(floor, c["allowable"][0] / 1e6 * 1e-4)
+        ax.set_yscale("log")
+        ax.set_ylim(bottom=floor)
+        _decorate(ax, verdict, loc, t[-1])
+        ax.set_ylabel("stress (MPa)")
+        ax.set_title(f"{loc['name']} (joint {loc['joint']})")
+        legend(ax, loc="lower right", ncols=2)
+        rows.append([loc["name"], f"{loc['criteria']['normal_stress']['peak'] / 1e6:.4g}",
+                     f"{loc['criteria']['shear_stress']['peak'] / 1e6:.4g}",
+                     f"{loc.get('peak_von_mises_stress_Pa', float('nan')) / 1e6:.4g}",
+                     f"{loc['criteria']['normal_stress']['margin_of_safety']:+.2f} / "
+                     f"{loc['criteria']['shear_stress']['margin_of_safety']:+.2f}"])
+    return Section("stresses", title, [
+        Figure.from_matplotlib("fig-stresses", "Peak normal (axial + bending) and shear (torsion + transverse) "
+                               "stress at each section, log axis, against the material's ultimate strength "
+                               "(shaded: the given range; dashed: the decisive value).", fig),
+        Table(["location", "peak normal (MPa)", "peak shear (MPa)", "peak von Mises (MPa)",
+               "margin normal / shear"], rows, "Peak stresses after the initial transient"),
+    ])

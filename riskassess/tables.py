@@ -1,0 +1,83 @@
+"""Rows of the tables people read, as plain strings: the CLI prints them with rich, the
+report renders them as HTML. One place decides what a verdict or a summary row says."""
+from __future__ import annotations
+
+VERDICT_COLUMNS = ("location", "criterion", "max demand", "at", "allowable", "margin", "fails?", "likelihood",
+                   "released piece")
+
+
+def format_value(value: float, unit: str) -> str:
+    """A value with its unit; stresses in MPa."""
+    scale, shown = (1e-6, "MPa") if unit == "Pa" else (1.0, unit)
+    return f"{value * scale:.4g} {shown}"
+
+
+def format_allowable(low: float, high: float, unit: str) -> str:
+    return format_value(low, unit) if low == high else f"{format_value(low, unit)} - {format_value(high, unit)}"
+
+
+def format_vector(values, digits: int = 3) -> str:
+    return "[" + ", ".join(f"{v:.{digits}g}" for v in values) + "]"
+
+
+def piece_text(piece: dict) -> str:
+    """'solar_array, 350 kg, 14.3 x 5 m, at 0.744 s'."""
+    size = " x ".join(f"{e:.3g}" for e in piece["size_m"][:2])
+    return f"{'+'.join(piece['bodies'])}, {piece['mass_kg']:.4g} kg, {size} m, at {piece['release_time_s']:.3f} s"
+
+
+def verdict_rows(verdict: dict) -> list[dict]:
+    """One row per location and criterion, keyed by :data:`VERDICT_COLUMNS`; ``fails`` stays a bool.
+
+    Likelihoods of released locations read '>= x': their loads after the release are not
+    known, so the value is a lower bound.
+    """
+    pieces = {p["location"]: p for p in verdict["released_pieces"]}
+    rows = []
+    for loc in verdict["locations"]:
+        piece = pieces.get(loc["name"])
+        for k, (name, c) in enumerate(loc["criteria"].items()):
+            rows.append({
+                "location": loc["name"] if k == 0 else "",
+                "criterion": f"{name} ({c['mode']})",
+                "max demand": format_value(c["peak"], c["unit"]),
+                "at": f"{c['peak_time_s']:.3f} s" if c.get("peak_time_s") is not None else "-",
+                "allowable": format_allowable(*c["allowable"], c["unit"]),
+                "margin": f"{c['margin_of_safety']:+.2f}",
+                "fails": bool(c["fails"]),
+                "likelihood": (">= " if loc["released_at_s"] is not None else "") + f"{c['likelihood']:.0%}",
+                "released piece": (piece_text(piece) if piece else "-") if k == 0 else "",
+            })
+    return rows
+
+
+def piece_fate(piece: dict) -> str:
+    """Where a released piece is at the end of the run, relative to the chaser (LVLH)."""
+    v = piece["velocity_relative_to_chaser_lvlh_m_s"]
+    return (f"at end {'inside' if piece['inside_net_at_end'] else 'OUTSIDE'} the net, velocity rel. chaser "
+            f"{format_vector(v)} m/s LVLH, spin {piece['spin_rate_rad_s']:.3f} rad/s")
+
+
+def summary_rows(summary: dict) -> list[tuple[str, str, str]]:
+    """(quantity, this run, paper reference) rows of a run summary."""
+    ref = summary["paper_reference"]
+    f = summary["peak_contact_force_N"]
+    m = summary["peak_contact_moment_about_debris_com_Nm"]
+    dv = summary["debris_velocity_change_final_third_mean_lvlh_m_s"]
+    est = summary["momentum_exchange_estimate_lvlh_m_s"]
+    rows = [
+        ("peak contact force (N)", f"{f['value']:.4g} at {f['time_s']:.3f} s", f"{ref['peak_contact_force_N']:.3g}"),
+        ("peak contact moment (N m)", f"{m['value']:.4g} at {m['time_s']:.3f} s", f"{ref['peak_contact_moment_Nm']:.3g}"),
+        ("debris along-track velocity change, mean of last third (m/s)", f"{dv[1]:.4f} (estimate {est[1]:.4f})",
+         f"{ref['debris_along_track_velocity_simulated_m_s']}"),
+    ]
+    for name, j in summary["joints"].items():
+        mom = j["max_abs_moment_after_transient_Nm"] or j["max_abs_moment_joint_Nm"]
+        text = "/".join(f"{v:.3g}" for v in mom)
+        if j["kind"] == "revolute":
+            text += f"; angle {j['max_abs_angle_rad']:.4f} rad"
+        paper = f"{ref['hinge_moment_h1_Nm']:.0f}/-/{ref['hinge_moment_h3_Nm']:.0f}" if j["kind"] == "revolute" else ""
+        rows.append((f"{name}: |M| h1/h2/h3 after 0.25 s (N m)", text, paper))
+    rows.append(("energy balance drift (rel.)", f"{summary['checks']['energy_balance_relative_drift']:.2e}", ""))
+    rows.append(("wall time (s), steps/s", f"{summary['wall_time_s']:.1f}, {summary['steps_per_second']:.0f}", ""))
+    return rows
