@@ -5,7 +5,8 @@
 #   ./install.sh --test   run-time set-up plus the test tools
 set -euo pipefail
 cd "$(dirname "$0")"
-DEBIAN_PACKAGES="libusb-1.0-0 libgl1 libgomp1 libxrender1 libx11-6"
+# libusb/libgl/libgomp/libx*: open3d, vtk (pyvista), numba; pango/harfbuzz/fonts: WeasyPrint's PDF reports
+DEBIAN_PACKAGES="libusb-1.0-0 libgl1 libgomp1 libxrender1 libx11-6 libpango-1.0-0 libpangoft2-1.0-0 libharfbuzz-subset0 fonts-dejavu-core"
 missing=""
 for p in $DEBIAN_PACKAGES; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
 if [ -n "$missing" ]; then

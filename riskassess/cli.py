@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from riskassess.case import Case, CaseError, load_case
+from riskassess.results import MissingData
 
 
 def _cmd_run(args) -> int:
@@ -29,6 +30,65 @@ def _cmd_run(args) -> int:
         print_summary(result.summary, result.run_dir)
         if result.structures is not None:
             print_verdict(result.structures)
+    return _products(result.run_dir, args.report, args.vtk, quiet=args.json)
+
+
+def _products(run_dir: Path, report: bool, vtk: bool, quiet: bool = False) -> int:
+    """Report and VTK export after a run; a failure here keeps the finished run folder."""
+    status = 0
+    for wanted, make in ((report, _make_report), (vtk, _make_vtk)):
+        if not wanted:
+            continue
+        try:
+            make(run_dir, quiet=quiet)
+        except (ValueError, OSError, MissingData) as exc:
+            print(f"error: {exc}\n(the run folder {run_dir} is complete; retry this step alone with "
+                  f"'riskassess {'report' if make is _make_report else 'export-vtk'} {run_dir}')", file=sys.stderr)
+            status = 1
+    return status
+
+
+def _progress_bar(label: str, quiet: bool):
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    return Progress(TextColumn(f"[bold]{label}[/bold] {{task.description}}"), BarColumn(), MofNCompleteColumn(),
+                    TimeRemainingColumn(), disable=quiet or not sys.stderr.isatty(), transient=True)
+
+
+def _make_report(run_dir: Path, pdf: bool = True, quiet: bool = False):
+    from riskassess.report import write_report
+
+    with _progress_bar("report", quiet) as bar:
+        task = bar.add_task("", total=None)
+        out = write_report(run_dir, pdf=pdf,
+                           progress=lambda k, n, title: bar.update(task, completed=k, total=n, description=title))
+    if not quiet:
+        missing = [s.title for s in out.sections if s.missing]
+        print(f"report: {out.html}" + (f" and {out.pdf} ({out.pdf_pages} pages)" if out.pdf else ""))
+        if missing:
+            print(f"sections without their data (the report says what is missing): {', '.join(missing)}")
+    return out
+
+
+def _make_vtk(run_dir: Path, out=None, every: int = 1, quiet: bool = False):
+    from riskassess.vtk_export import export_vtk
+
+    with _progress_bar("VTK export", quiet) as bar:
+        task = bar.add_task("frames", total=None)
+        result = export_vtk(run_dir, out, every, progress=lambda k, n: bar.update(task, completed=k, total=n))
+    if not quiet:
+        print(f"VTK: {result.pvd} ({result.n_frames} frames, {result.times[0]:g}-{result.times[-1]:g} s); "
+              f"open it in ParaView")
+    return result
+
+
+def _cmd_report(args) -> int:
+    _make_report(Path(args.run_dir), pdf=not args.no_pdf)
+    return 0
+
+
+def _cmd_export_vtk(args) -> int:
+    _make_vtk(Path(args.run_dir), args.out, args.every)
     return 0
 
 
@@ -102,18 +162,34 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("case", help="case file (TOML)")
     run.add_argument("--out", help="output folder (default runs/<case name>)")
     run.add_argument("--json", action="store_true", help="print the run summary as JSON")
+    _product_flags(run)
     run.set_defaults(func=_cmd_run)
     assess = sub.add_parser("assess", help="simulate a case with weak locations and print the structural verdict")
     assess.add_argument("case", help="case file (TOML) with [[structures.weak_locations]]")
     assess.add_argument("--out", help="output folder (default runs/<case name>)")
     assess.add_argument("--json", action="store_true", help="print the run summary (with the verdict) as JSON")
+    _product_flags(assess)
     assess.set_defaults(func=_cmd_assess)
+    report = sub.add_parser("report", help="write report.html (self-contained) and report.pdf into a run folder")
+    report.add_argument("run_dir", help="run folder written by 'riskassess run'")
+    report.add_argument("--no-pdf", action="store_true", help="HTML only")
+    report.set_defaults(func=_cmd_report)
+    vtk = sub.add_parser("export-vtk", help="write the impact as VTK files and a ParaView collection (impact.pvd)")
+    vtk.add_argument("run_dir", help="run folder written by 'riskassess run'")
+    vtk.add_argument("--out", help="output folder (default RUN_DIR/vtk)")
+    vtk.add_argument("--every", type=int, default=1, help="export every N-th net snapshot (default 1: all)")
+    vtk.set_defaults(func=_cmd_export_vtk)
     val = sub.add_parser("validate", help="check a case file and exit")
     val.add_argument("case")
     val.set_defaults(func=_cmd_validate)
     schema = sub.add_parser("schema", help="print the case-file JSON schema (keys, units, limits)")
     schema.set_defaults(func=_cmd_schema)
     return parser
+
+
+def _product_flags(parser) -> None:
+    parser.add_argument("--report", action="store_true", help="also write report.html and report.pdf")
+    parser.add_argument("--vtk", action="store_true", help="also export VTK files (RUN_DIR/vtk/impact.pvd)")
 
 
 def main(argv=None) -> int:
@@ -123,7 +199,7 @@ def main(argv=None) -> int:
     except CaseError as exc:
         print(f"error: invalid case\n{exc}", file=sys.stderr)
         return 2
-    except ValueError as exc:
+    except (ValueError, MissingData) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 

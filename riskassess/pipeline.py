@@ -56,6 +56,8 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
                 "status": "running", "files": ["case.toml", "case.json"], "software": software_versions()}
     shutil.copyfile(case_path, out / "case.toml")
     results.atomic_write_json(out / "case.json", case.model_dump())
+    # Written now so an interrupted run is recognisable (status 'running') by later stages.
+    results.atomic_write_json(out / "manifest.json", manifest)
     locations = weak_locations(case, simulation.assembly)
     monitor = None
     if locations and case.structures.release != "never":

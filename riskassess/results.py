@@ -85,8 +85,12 @@ def _json_default(obj):
     raise TypeError(f"cannot write {type(obj).__name__} to JSON")
 
 
-def read_manifest(run_dir: Path) -> dict:
-    """The run's manifest; ``ValueError`` saying what is missing for an incomplete or foreign folder."""
+def read_manifest(run_dir: Path, strict: bool = True) -> dict:
+    """The run's manifest; ``ValueError`` saying what is missing for an incomplete or foreign folder.
+
+    ``strict=False`` accepts a folder whose listed files are not all there (readers that
+    say per item what is missing, like the report).
+    """
     path = Path(run_dir) / "manifest.json"
     if not path.is_file():
         raise ValueError(f"{run_dir}: no manifest.json; not a riskassess run folder, or the run did not finish")
@@ -96,7 +100,7 @@ def read_manifest(run_dir: Path) -> dict:
     if manifest.get("version", 0) > VERSION:
         raise ValueError(f"{path}: version {manifest['version']} is newer than this tool reads ({VERSION})")
     missing = [f for f in manifest.get("files", []) if not (Path(run_dir) / f).is_file()]
-    if missing:
+    if missing and strict:
         raise ValueError(f"{run_dir}: files listed in the manifest are missing: {missing}")
     return manifest
 
@@ -119,7 +123,7 @@ class RunFolder:
 
     def __init__(self, run_dir: str | Path):
         self.path = Path(run_dir)
-        self.manifest = read_manifest(self.path)
+        self.manifest = read_manifest(self.path, strict=False)
         self._cache: dict = {}
 
     @property
@@ -130,12 +134,17 @@ class RunFolder:
         return [f for f in CORE_FILES if not (self.path / f).is_file()]
 
     def has(self, name: str) -> bool:
-        return (self.path / name).is_file() and (name in self.manifest.get("files", []) or name == "manifest.json")
+        """The run wrote ``name`` completely (listed in the manifest) and it is still there."""
+        return (self.path / name).is_file() and name in self.manifest.get("files", [])
 
     def _require(self, name: str) -> Path:
         if not self.has(name):
-            why = (f"the run stopped with status '{self.manifest.get('status')}'" if not self.complete
-                   else "not written by this run")
+            if name in self.manifest.get("files", []):
+                why = "listed in the manifest, but deleted or moved since"
+            elif not self.complete:
+                why = f"the run stopped with status '{self.manifest.get('status')}'"
+            else:
+                why = "not written by this run"
             raise MissingData(f"{self.path / name} is missing ({why})")
         return self.path / name
 

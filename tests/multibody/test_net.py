@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from multibody.net import add_bending_forces, add_thread_forces, square_grid_threads, thread_node_mass
+from multibody.net import (add_bending_forces, add_thread_forces, square_grid_threads, thread_node_mass,
+                          thread_tension_strain)
 
 
 def test_node_mass_of_the_reference_net():
@@ -48,3 +49,30 @@ def test_bending_forces_are_the_energy_gradient_and_free_of_net_force_and_moment
             assert f[node, axis] == pytest.approx(-grad, rel=1e-5, abs=1e-8)
     assert np.abs(f.sum(axis=0)).max() < 1e-12
     assert np.abs(np.cross(x, f).sum(axis=0)).max() < 1e-12
+
+
+def test_exported_thread_tensions_are_the_kernel_forces():
+    """The vectorised tension of the exports gives, summed at the nodes, exactly the force
+    the simulation kernel applies (same tension-only Kelvin-Voigt law, paper eq. 1)."""
+    rng = np.random.default_rng(3)
+    threads = square_grid_threads(5)
+    n = 25
+    grid = np.stack(np.meshgrid(np.arange(5.0), np.arange(5.0)), -1).reshape(-1, 2)
+    x = np.c_[grid, np.zeros(n)] + rng.normal(0, 0.08, (n, 3))   # some threads slack, some taut
+    v = rng.normal(0, 2.0, (n, 3))
+    rest = np.full(len(threads), 1.0)
+    k, c = np.full(len(threads), 6.2e4), np.full(len(threads), 1.58)
+    kernel_force = np.zeros((n, 3))
+    add_thread_forces(x, v, threads, rest, k, c, kernel_force)
+    tension, strain = thread_tension_strain(x, v, threads, rest, k, c)
+    d = x[threads[:, 1]] - x[threads[:, 0]]
+    unit = d / np.linalg.norm(d, axis=1, keepdims=True)
+    force = np.zeros((n, 3))
+    np.add.at(force, threads[:, 0], tension[:, None] * unit)
+    np.add.at(force, threads[:, 1], -tension[:, None] * unit)
+    assert np.allclose(force, kernel_force, rtol=1e-12, atol=1e-9)
+    assert np.allclose(strain, np.linalg.norm(d, axis=1) - 1.0, rtol=0, atol=1e-15)  # rest length 1 m
+    assert (tension[strain <= 0] == 0).all() and (tension > 0).any() and (strain < 0).any()
+    # snapshots stack: (frames, nodes, 3) in, (frames, threads) out
+    tension2, _ = thread_tension_strain(np.stack([x, x]), np.stack([v, v]), threads, rest, k, c)
+    assert np.array_equal(tension2[1], tension)

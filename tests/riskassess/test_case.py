@@ -98,3 +98,36 @@ def test_case_format_doc_is_current():
     from riskassess.casedoc import render
 
     assert (CASES.parent / "docs" / "case-format.md").read_text() == render()
+
+
+def test_every_numeric_input_states_its_unit():
+    """The report lists every input with its unit, read from the field descriptions: a numeric
+    field without a recognisable SI unit in its description would show a blank unit."""
+    import typing
+
+    from pydantic import BaseModel
+
+    from riskassess import case as c
+    from riskassess.casedoc import field_unit
+
+    def numeric(annotation) -> bool:
+        if annotation in (int, float):
+            return True
+        return any(numeric(a) for a in typing.get_args(annotation) if a is not type(None))
+
+    models = [m for m in vars(c).values() if isinstance(m, type) and issubclass(m, BaseModel)
+              and m.__module__ == c.__name__]
+    unitless = [f"{m.__name__}.{name}" for m in models for name, field in m.model_fields.items()
+                if numeric(field.annotation) and name != "kind" and not field_unit(field)]
+    assert unitless == []
+
+
+def test_input_rows_of_the_reference_case_carry_units():
+    from riskassess.casedoc import input_rows
+
+    rows = {key: (value, unit) for key, value, unit, _ in input_rows(load_case(CASES / "envisat_net_impact.toml"))}
+    assert rows["launch.velocity"] == ("20", "m/s")                  # [paper T1]
+    assert rows["contact.stiffness"] == ("1.622e+08", "N/m^exponent")  # [paper T2]
+    assert rows["target.bodies[solar_array].mass"] == ("350", "kg")
+    assert rows["target.joints[solar_array_hinge].torsional_stiffness"][1] == "N m/rad"
+    assert rows["target.bodies[main_body].shapes[0]"][0].startswith("box: size [")

@@ -1,0 +1,122 @@
+"""`riskassess report`: one self-contained HTML and its PDF, every section, and clear words
+for incomplete or older run folders."""
+import base64
+import json
+import re
+import shutil
+
+import numpy as np
+import pytest
+from pypdf import PdfReader
+
+from riskassess.cli import main
+from riskassess.report import SECTIONS, write_report
+from riskassess.report.plotting import WIDTH_IN
+from riskassess.report.blocks import FIGURE_DPI
+
+FIGURES = {"contact": ["fig-contact"], "debris-motion": ["fig-debris-motion"], "hinges": ["fig-hinge-angle"],
+           "joint-loads": ["fig-joint-loads"], "stresses": ["fig-stresses"], "energy": ["fig-energy"]}
+
+
+@pytest.fixture(scope="module")
+def report(assessed, tmp_path_factory):
+    run = tmp_path_factory.mktemp("report") / "run"
+    shutil.copytree(assessed, run)
+    return write_report(run)
+
+
+def _html_section(html: str, section_id: str) -> str:
+    start = html.index(f'<section id="{section_id}"')
+    return html[start:html.index("</section>", start)]
+
+
+def test_html_has_every_section_in_order_with_its_figures(report):
+    html = report.html.read_text()
+    positions = [html.index(f'<section id="{sid}"') for sid, _, _ in SECTIONS]
+    assert positions == sorted(positions) and SECTIONS[0][0] == "verdict"   # the verdict first
+    for sid, figure_ids in FIGURES.items():
+        section = _html_section(html, sid)
+        assert "Not available" not in section
+        for fid in figure_ids:
+            png = re.search(rf'<figure id="{fid}">\s*<img src="data:image/png;base64,([^"]+)"', section)
+            assert png, f"figure {fid} missing from section {sid}"
+            data = base64.b64decode(png.group(1))
+            assert data[:8] == b"\x89PNG\r\n\x1a\n"
+            width = int.from_bytes(data[16:20], "big")
+            assert width == round(WIDTH_IN * FIGURE_DPI)  # the figure width set for an A4 page
+    # self-contained: nothing loaded from elsewhere
+    assert not re.search(r'(src|href)="(https?:|file:|/)', html)
+
+
+def test_html_states_the_runs_numbers_with_units(report, assessed):
+    html = report.html.read_text()
+    verdict = json.loads((assessed / "structures.json").read_text())
+    piece = verdict["released_pieces"][0]
+    assert "SECONDARY DEBRIS: 1 piece(s) released" in html
+    assert f"<td>{piece['release_time_s']:.3f}</td>" in _html_section(html, "verdict")
+    peak = verdict["locations"][0]["criteria"]["moment"]["peak"]
+    assert f"<td>{peak:.4g} N m</td>" in html
+    inputs = _html_section(html, "case")
+    # launch speed of cases/envisat_small.toml, with its unit
+    assert re.search(r"<td>velocity</td><td>20</td><td>m/s</td>", inputs)
+    assert re.search(r"<td>mass</td><td>6621</td><td>kg</td>", inputs)  # main body [paper T2]
+    facts = _html_section(html, "run-facts")
+    assert "VelocityVerlet" in facts and "version of exudyn" in facts
+
+
+def test_pdf_pages_hold_the_sections(report):
+    reader = PdfReader(report.pdf)
+    assert len(reader.pages) == report.pdf_pages >= len(SECTIONS)
+    # each section after the verdict starts a page (print CSS); its title is on that page
+    for number, (sid, title, _) in enumerate(SECTIONS, start=1):
+        page = report.section_pages[sid]
+        text = " ".join(reader.pages[page - 1].extract_text().split())
+        assert f"{number}. {title}" in text, (sid, page)
+    assert report.section_pages["verdict"] == 1
+    pages = [report.section_pages[sid] for sid, _, _ in SECTIONS]
+    assert pages == sorted(set(pages))
+    assert "page 1 of" in reader.pages[0].extract_text()
+
+
+def test_report_of_an_older_folder_says_what_is_missing(assessed, tmp_path, capsys):
+    run = tmp_path / "old"
+    shutil.copytree(assessed, run)
+    for name in ("structures.json", "structures.npz", "report.html", "report.pdf"):
+        (run / name).unlink(missing_ok=True)
+    summary = json.loads((run / "summary.json").read_text())
+    del summary["peak_contact_force_per_body_N"]    # a key older versions did not write
+    (run / "summary.json").write_text(json.dumps(summary))
+    assert main(["report", str(run), "--no-pdf"]) == 0
+    html = (run / "report.html").read_text()
+    contact = _html_section(html, "contact")
+    assert "Not available" in contact and "peak_contact_force_per_body_N" in contact
+    assert "structures.json is missing" in _html_section(html, "verdict")
+    assert "Not available" not in _html_section(html, "energy")  # unaffected sections are whole
+    assert "contact" in capsys.readouterr().out.lower()
+
+
+def test_report_of_an_interrupted_run_and_of_no_run(assessed, tmp_path, capsys):
+    run = tmp_path / "interrupted"
+    run.mkdir()
+    for name in ("case.toml", "case.json"):
+        shutil.copy(assessed / name, run / name)
+    manifest = json.loads((assessed / "manifest.json").read_text())
+    manifest.update(status="running", files=["case.toml", "case.json"])
+    (run / "manifest.json").write_text(json.dumps(manifest))
+    assert main(["report", str(run), "--no-pdf"]) == 0
+    html = (run / "report.html").read_text()
+    assert "Incomplete run folder" in html and "status is &#39;running&#39;" in html
+    assert "summary.json is missing (the run stopped with status &#39;running&#39;)" in html
+    assert main(["report", str(tmp_path / "nowhere")]) == 2
+    assert "no manifest.json" in capsys.readouterr().err
+
+
+def test_release_marked_in_the_hinge_figure_data(report, assessed):
+    """The hinge section lists the release time the structures stage recorded."""
+    verdict = json.loads((assessed / "structures.json").read_text())
+    t = verdict["released_pieces"][0]["release_time_s"]
+    hinges = _html_section(report.html.read_text(), "hinges")
+    assert f"<td>{t:.3f}</td>" in hinges
+    series = np.load(assessed / "timeseries.npz")
+    max_angle = np.degrees(np.abs(series["joint_rotation_joint"][:, 0, 1]).max())
+    assert f"<td>{max_angle:.3f}</td>" in hinges
