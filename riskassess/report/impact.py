@@ -58,12 +58,12 @@ def debris_motion_section(run: RunFolder) -> Section:
     estimate = np.asarray(run.key(summary, "momentum_exchange_estimate_lvlh_m_s")) * 1e3
     omega = np.degrees(s["body_omega_body"][:, 0])
     fig, (ax_v, ax_w) = panels(2, 2.0)
-    for i, axis in enumerate("xyz"):
-        ax_v.plot(t, dv[:, i], color=COMPONENT_COLORS[i], label=f"dv{axis}")
-        ax_w.plot(t, omega[:, i], color=COMPONENT_COLORS[i], label=f"omega{axis}")
-    ax_v.axhline(estimate[1], color=COMPONENT_COLORS[1], ls="--", lw=0.9, label="momentum-exchange estimate (y)")
+    for i, (axis, name) in enumerate(zip("xyz", ("radial", "along-track", "cross-track"))):
+        ax_v.plot(t, dv[:, i], color=COMPONENT_COLORS[i], label=f"dv{axis} ({name})")
+        ax_w.plot(t, omega[:, i], color=COMPONENT_COLORS[i], label=f"omega {axis}")
+    ax_v.axhline(estimate[1], color=COMPONENT_COLORS[1], ls="--", lw=0.9, label="momentum-exchange\nestimate (y)")
     ax_v.set_ylabel("velocity change (mm/s)")
-    ax_v.set_title("debris centre-of-mass velocity change, LVLH (x radial, y along-track, z cross-track)")
+    ax_v.set_title("debris centre-of-mass velocity change, LVLH")
     legend(ax_v, ncols=4, loc="lower right")
     ax_w.set_ylabel("angular velocity (deg/s)")
     ax_w.set_title(f"angular velocity of {s['body_names'][0]}, its body frame")
@@ -85,6 +85,8 @@ def _vec(values) -> str:
 
 
 def hinge_section(run: RunFolder) -> Section:
+    """Angle and rate of every revolute joint; after a release the curves continue in grey
+    (the relative rotation of two bodies no longer joined is not a hinge angle)."""
     s = run.timeseries
     t = s["time"]
     kinds = [str(k) for k in s["joint_kinds"]]
@@ -94,27 +96,28 @@ def hinge_section(run: RunFolder) -> Section:
         return Section("hinges", "Hinge angles", [Note("The target has no revolute joint.")])
     released = _release_times(run)
     fig, (ax_a, ax_r) = panels(2, 1.8)
+    rows = []
     for j in hinges:
-        line, = ax_a.plot(t, np.degrees(s["joint_rotation_joint"][:, j, 1]), label=names[j])
-        ax_r.plot(t, np.degrees(s["joint_rate_joint"][:, j, 1]), color=line.get_color(), label=names[j])
-        if names[j] in released:
-            for ax in (ax_a, ax_r):
+        joined = t < released.get(names[j], np.inf)
+        angle = np.degrees(s["joint_rotation_joint"][:, j, 1])
+        rate = np.degrees(s["joint_rate_joint"][:, j, 1])
+        for ax, values in ((ax_a, angle), (ax_r, rate)):
+            line, = ax.plot(t[joined], values[joined], label=names[j])
+            if not joined.all():
+                ax.plot(t[~joined], values[~joined], color="0.6", ls="--", lw=0.8, label="after release")
                 mark_release(ax, released[names[j]], f"{names[j]} released")
+        rows.append([names[j], f"{np.abs(angle[joined]).max():.3f}", f"{np.abs(rate[joined]).max():.3f}",
+                     f"{released[names[j]]:.3f}" if names[j] in released else "-"])
     ax_a.set_ylabel("hinge angle (deg)")
     ax_a.set_title("rotation about the hinge axis h2, child relative to parent")
-    legend(ax_a, loc="upper left")
+    legend(ax_a)
     ax_r.set_ylabel("hinge rate (deg/s)")
-    legend(ax_r, loc="upper left")
-    summary_joints = run.key(run.summary, "joints")
-    rows = [[names[j], f"{np.degrees(summary_joints[names[j]]['max_abs_angle_rad']):.3f}",
-             f"{np.degrees(summary_joints[names[j]]['max_abs_rate_rad_s']):.3f}",
-             f"{released[names[j]]:.3f}" if names[j] in released else "-"] for j in hinges]
-    blocks = [Figure.from_matplotlib("fig-hinge-angle", "Hinge angle and rate of every revolute joint.", fig),
-              Table(["hinge", "max |angle| (deg)", "max |rate| (deg/s)", "released at (s)"], rows)]
-    if released:
-        blocks.append(Note("After a release the 'angle' is the relative rotation of two bodies no longer joined; "
-                           "it is shown to the end of the run but is no longer a hinge angle.", "warning"))
-    return Section("hinges", "Hinge angles", blocks)
+    legend(ax_r)
+    return Section("hinges", "Hinge angles", [
+        Figure.from_matplotlib("fig-hinge-angle", "Hinge angle and rate of every revolute joint; grey dashed: "
+                               "relative rotation after the joint was released (no longer a hinge angle).", fig),
+        Table(["hinge", "max |angle| while joined (deg)", "max |rate| while joined (deg/s)", "released at (s)"],
+              rows)])
 
 
 #: Energy terms of the recorder, with their legend labels; the total is their balance.

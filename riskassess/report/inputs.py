@@ -33,7 +33,7 @@ def _at_a_glance(run: RunFolder, case: dict) -> Table:
 
 def case_section(run: RunFolder) -> Section:
     case = run.case
-    blocks = [Note(case.get("description") or "(no description)"), _at_a_glance(run, case)]
+    blocks = [_at_a_glance(run, case)]
     try:
         rows = input_rows(Case.model_validate(case))
     except ValidationError as exc:
@@ -41,11 +41,17 @@ def case_section(run: RunFolder) -> Section:
                            f"differences); inputs are listed without units.", "warning"))
         rows = [(k, str(v), "", "") for k, v in _flatten(case)]
     for group, items in groupby(rows, key=lambda r: r[0].rpartition(".")[0]):
-        items = [[key.rpartition(".")[2], *rest] for key, *rest in items]
+        items = [[key.rpartition(".")[2], value, unit, _meaning_without_unit(meaning, unit)]
+                 for key, value, unit, meaning in items]
         if not group:  # name and description, shown above
             continue
         blocks.append(Table(["key", "value", "unit", "meaning"], items, f"[{group}]", css_class="inputs"))
     return Section("case", "Case summary: inputs", blocks)
+
+
+def _meaning_without_unit(meaning: str, unit: str) -> str:
+    """The description without its '(unit)', which has its own column."""
+    return meaning.replace(f" ({unit})", "").replace(f"({unit})", "").strip() if unit else meaning
 
 
 def _flatten(data, prefix=""):

@@ -43,7 +43,7 @@ def verdict_section(run: RunFolder) -> Section:
                         f"Weak locations: peak demand after {verdict['skip_initial_s']:g} s against the allowable; "
                         f"range allowables decide at their '{verdict['release_policy']}' value. Margin of safety = "
                         f"allowable / demand - 1.",
-                        alarm_rows={k for k, r in enumerate(rows) if r["fails"]}))
+                        alarm_rows={k for k, r in enumerate(rows) if r["fails"]}, css_class="verdict"))
     blocks.append(Note("Likelihood: probability of failure with the allowable uniformly distributed over its "
                        "range. For a released location it is a lower bound ('>='), because the joint carries "
                        "nothing after its release."))
