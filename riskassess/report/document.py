@@ -22,7 +22,7 @@ import jinja2
 from riskassess import results
 from riskassess.report.blocks import Figure, Note, Section, Table
 from riskassess.report.impact import contact_section, debris_motion_section, energy_section, hinge_section
-from riskassess.report.inputs import case_section, run_facts_section
+from riskassess.report.inputs import appendix_inputs_section, case_section, run_facts_section
 from riskassess.report.plotting import STYLE
 from riskassess.report.structures import joint_loads_section, stresses_section, verdict_section
 from riskassess.results import MissingData, RunFolder
@@ -38,6 +38,7 @@ SECTIONS = (
     ("stresses", "Stresses against strengths", stresses_section),
     ("energy", "Net and debris energy", energy_section),
     ("run-facts", "Run facts", run_facts_section),
+    ("appendix-inputs", "Appendix: every case input", appendix_inputs_section),
 )
 TEMPLATES = Path(__file__).parent / "templates"
 

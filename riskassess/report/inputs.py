@@ -31,22 +31,68 @@ def _at_a_glance(run: RunFolder, case: dict) -> Table:
     return Table(["quantity", "value", "unit"], rows, "At a glance")
 
 
-def case_section(run: RunFolder) -> Section:
-    case = run.case
-    blocks = [_at_a_glance(run, case)]
+def _validated_rows(case: dict):
+    """Input rows with units, or raw rows and a warning for a case.json of another format version."""
     try:
-        rows = input_rows(Case.model_validate(case))
+        return input_rows(Case.model_validate(case)), None
     except ValidationError as exc:
-        blocks.append(Note(f"case.json does not match this version's case format ({exc.error_count()} "
-                           f"differences); inputs are listed without units.", "warning"))
-        rows = [(k, str(v), "", "") for k, v in _flatten(case)]
+        return [(k, str(v), "", "") for k, v in _flatten(case)], Note(
+            f"case.json does not match this version's case format ({exc.error_count()} differences); inputs are "
+            f"listed without units.", "warning")
+
+
+def _bodies_table(case: dict) -> Table:
+    rows = []
+    for body in case["target"]["bodies"]:
+        inertia = body.get("inertia")
+        rows.append([body["name"], f"{body['mass']:.6g}", _vector(body.get("center_of_mass")),
+                     _vector([inertia[i][i] for i in range(3)]) if inertia else "from the shapes",
+                     ", ".join(shape["kind"] for shape in body["shapes"])])
+    return Table(["body", "mass (kg)", "CoM, target frame (m)", "inertia diagonal (kg m^2)", "shapes"], rows,
+                 "Debris bodies")
+
+
+def _joints_table(case: dict) -> Table:
+    rows = [[j["name"], j["kind"], f"{j['parent']} -> {j['child']}", _vector(j["position"]), _vector(j["axis"]),
+             f"{j['torsional_stiffness']:.4g}", f"{j['torsional_damping']:.4g}", f"{j['initial_angle']:.4g}"]
+            for j in case["target"].get("joints", [])]
+    return Table(["joint", "kind", "parent -> child", "point, target frame (m)", "axis h2", "k (N m/rad)",
+                  "c (N m s/rad)", "initial angle (rad)"], rows, "Joints")
+
+
+def _vector(values) -> str:
+    return "-" if values is None else "[" + ", ".join(f"{v:.4g}" for v in values) + "]"
+
+
+def case_section(run: RunFolder) -> Section:
+    """At a glance, the scalar inputs with units, the bodies and the joints; every input is in the appendix."""
+    case = run.case
+    rows, warning = _validated_rows(case)
+    scalar = [[key, value, unit] for key, value, unit, _ in rows
+              if "." in key and not key.startswith(("target.", "structures."))]
+    blocks = [_at_a_glance(run, case)] + ([warning] if warning else [])
+    blocks.append(Table(["input", "value", "unit"], scalar, "Simulation, orbit, net, bullets, launch and contact",
+                        css_class="inputs-short"))
+    try:
+        blocks += [_bodies_table(case), _joints_table(case)]
+    except (KeyError, TypeError):
+        blocks.append(Note("The bodies and joints of this case.json could not be read (another format version); "
+                           "see the appendix.", "warning"))
+    blocks.append(Note("Every input of the case, with its meaning, is listed in the appendix; weak locations are "
+                       "in the verdict and the appendix."))
+    return Section("case", "Case summary: inputs", blocks)
+
+
+def appendix_inputs_section(run: RunFolder) -> Section:
+    rows, warning = _validated_rows(run.case)
+    blocks = [warning] if warning else []
     for group, items in groupby(rows, key=lambda r: r[0].rpartition(".")[0]):
         items = [[key.rpartition(".")[2], value, unit, _meaning_without_unit(meaning, unit)]
                  for key, value, unit, meaning in items]
-        if not group:  # name and description, shown above
+        if not group:  # name and description, shown in the title
             continue
         blocks.append(Table(["key", "value", "unit", "meaning"], items, f"[{group}]", css_class="inputs"))
-    return Section("case", "Case summary: inputs", blocks)
+    return Section("appendix-inputs", "Appendix: every case input", blocks)
 
 
 def _meaning_without_unit(meaning: str, unit: str) -> str:

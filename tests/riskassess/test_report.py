@@ -58,8 +58,12 @@ def test_html_states_the_runs_numbers_with_units(report, assessed):
     assert f"<td>{peak:.4g} N m</td>" in html
     inputs = _html_section(html, "case")
     # launch speed of cases/envisat_small.toml, with its unit
-    assert re.search(r"<td>velocity</td><td>20</td><td>m/s</td>", inputs)
-    assert re.search(r"<td>mass</td><td>6621</td><td>kg</td>", inputs)  # main body [paper T2]
+    assert "<td>launch.velocity</td><td>20</td><td>m/s</td>" in inputs
+    assert "<td>main_body</td><td>6621</td>" in inputs  # main body mass (kg) [paper T2]
+    appendix = _html_section(html, "appendix-inputs")
+    assert "<td>velocity</td><td>20</td><td>m/s</td>" in appendix
+    assert "<td>mass</td><td>6621</td><td>kg</td>" in appendix
+    assert "<td>allowable_moment</td><td>[200, 1000]</td><td>N m</td>" in appendix  # the weak location
     facts = _html_section(html, "run-facts")
     assert "VelocityVerlet" in facts and "version of exudyn" in facts
 
@@ -121,3 +125,21 @@ def test_release_marked_in_the_hinge_figure_data(report, assessed):
     joined = series["time"] < t  # after the release the relative rotation is no hinge angle
     max_angle = np.degrees(np.abs(series["joint_rotation_joint"][joined, 0, 1]).max())
     assert f"<td>{max_angle:.3f}</td>" in hinges
+
+
+def test_run_writes_report_and_vtk_when_asked(tmp_path):
+    """`riskassess run --report --vtk`: both products land in the run folder and its manifest."""
+    from tests.riskassess.conftest import CASES
+
+    text = (CASES / "envisat_small.toml").read_text().replace("end_time = 7.5", "end_time = 0.1", 1)
+    case = tmp_path / "short.toml"
+    case.write_text(text)
+    out = tmp_path / "run"
+    assert main(["run", str(case), "--out", str(out), "--json", "--report", "--vtk"]) == 0
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["products"] == ["report.html", "report.pdf", "vtk/impact.pvd"]
+    assert (out / "report.pdf").stat().st_size > 0
+    # 0.1 s at 50 Hz net snapshots: t = 0, 0.02, ..., 0.1
+    assert len(list((out / "vtk").glob("net_*.vtu"))) == 6
+    html = (out / "report.html").read_text()
+    assert "Not assessed: the case declares no weak locations" in _html_section(html, "verdict")
