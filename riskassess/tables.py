@@ -16,6 +16,11 @@ def format_allowable(low: float, high: float, unit: str) -> str:
     return format_value(low, unit) if low == high else f"{format_value(low, unit)} - {format_value(high, unit)}"
 
 
+def format_margin(margin: float) -> str:
+    """Margin of safety: two decimals near failure, three significant digits when it is large."""
+    return f"{margin:+.2f}" if abs(margin) < 100 else f"{margin:+.3g}"
+
+
 def format_vector(values, digits: int = 3) -> str:
     return "[" + ", ".join(f"{v:.{digits}g}" for v in values) + "]"
 
@@ -43,7 +48,7 @@ def verdict_rows(verdict: dict) -> list[dict]:
                 "max demand": format_value(c["peak"], c["unit"]),
                 "at": f"{c['peak_time_s']:.3f} s" if c.get("peak_time_s") is not None else "-",
                 "allowable": format_allowable(*c["allowable"], c["unit"]),
-                "margin": f"{c['margin_of_safety']:+.2f}",
+                "margin": format_margin(c["margin_of_safety"]),
                 "fails": bool(c["fails"]),
                 "likelihood": (">= " if loc["released_at_s"] is not None else "") + f"{c['likelihood']:.0%}",
                 "released piece": (piece_text(piece) if piece else "-") if k == 0 else "",

@@ -7,7 +7,7 @@ import numpy as np
 from riskassess.report.blocks import Figure, Note, Section, Table
 from riskassess.report.plotting import allowable_band, legend, mark_release, panels, shade_not_judged
 from riskassess.results import RunFolder
-from riskassess.tables import VERDICT_COLUMNS, format_vector, verdict_rows
+from riskassess.tables import VERDICT_COLUMNS, format_margin, format_vector, verdict_rows
 
 NOT_ASSESSED = ("Not assessed: the case declares no weak locations. Add [[structures.weak_locations]] to the case "
                 "(docs/case-format.md) and run it again to get failure verdicts and released pieces.")
@@ -117,8 +117,8 @@ def stresses_section(run: RunFolder) -> Section:
         rows.append([loc["name"], f"{loc['criteria']['normal_stress']['peak'] / 1e6:.4g}",
                      f"{loc['criteria']['shear_stress']['peak'] / 1e6:.4g}",
                      f"{loc.get('peak_von_mises_stress_Pa', float('nan')) / 1e6:.4g}",
-                     f"{loc['criteria']['normal_stress']['margin_of_safety']:+.2f} / "
-                     f"{loc['criteria']['shear_stress']['margin_of_safety']:+.2f}"])
+                     f"{format_margin(loc['criteria']['normal_stress']['margin_of_safety'])} / "
+                     f"{format_margin(loc['criteria']['shear_stress']['margin_of_safety'])}"])
     return Section("stresses", title, [
         Figure.from_matplotlib("fig-stresses", "Peak normal (axial + bending) and shear (torsion + transverse) "
                                "stress at each section, log axis, against the material's ultimate strength "
