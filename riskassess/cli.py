@@ -105,7 +105,8 @@ def _table(title: str, columns, rows, justify=None):
 
     table = Table(title=title)
     for k, column in enumerate(columns):
-        table.add_column(column, justify=(justify or {}).get(column, "left"))
+        # the first column names the row: never cut it
+        table.add_column(column, justify=(justify or {}).get(column, "left"), no_wrap=k == 0)
     for row in rows:
         table.add_row(*row)
     return table
