@@ -423,6 +423,13 @@ def load_case(path: str | Path) -> Case:
         raise CaseError(f"{path}: no such case file") from None
     except tomllib.TOMLDecodeError as exc:
         raise CaseError(f"{path}: not valid TOML: {exc}") from None
+    return validate_case(raw, path)
+
+
+def validate_case(raw: dict, path: str | Path) -> Case:
+    """Validate the parsed content of the case file ``path`` (mesh paths are relative to it);
+    raise :class:`CaseError` naming every problem. Sweeps call it for every varied case."""
+    path = Path(path)
     try:
         case = Case.model_validate(raw)
     except ValidationError as exc:

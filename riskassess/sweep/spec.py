@@ -1,0 +1,166 @@
+"""What a sweep runs: a grid of varied case keys times Monte Carlo samples of uncertain keys.
+
+Keys address the case file as dotted paths; list items are picked by their ``name``
+or by index: ``launch.velocity``, ``contact.mu_kinetic``,
+``target.joints[solar_array_hinge].torsional_damping``, ``target.angular_velocity[2]``.
+
+``--vary launch.velocity=10:30:5`` gives 10, 15, 20, 25, 30 (N values, ends included);
+``--uncertain contact.mu_kinetic=uniform(0.1,0.2)`` draws from a distribution
+(:data:`DISTRIBUTIONS`). Every run's overrides are validated into a case before anything
+runs, and every run gets an id from its overrides, so a re-run of the same sweep finds
+the runs it already finished.
+"""
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+#: name -> (parameter names, sampler(rng, n, *params)); all parameters in the key's SI unit.
+DISTRIBUTIONS = {
+    "uniform": (("low", "high"), lambda rng, n, a, b: rng.uniform(a, b, n)),
+    "normal": (("mean", "std"), lambda rng, n, m, s: rng.normal(m, s, n)),
+    "lognormal": (("median", "sigma_log"), lambda rng, n, med, s: med * np.exp(rng.normal(0.0, s, n))),
+    "triangular": (("low", "mode", "high"), lambda rng, n, a, c, b: rng.triangular(a, c, b, n)),
+}
+_TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[[^\]]+\])*)")
+
+
+class SweepSpecError(ValueError):
+    """A --vary or --uncertain argument that cannot be used; the message says what is allowed."""
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    run_id: str
+    overrides: dict      # case key -> value (SI)
+    grid_index: int      # which grid point (same varied values)
+    sample: int          # Monte Carlo sample number at that grid point (0 without Monte Carlo)
+
+
+def parse_vary(text: str) -> tuple[str, np.ndarray]:
+    """'KEY=START:STOP:N' -> (key, N evenly spaced values, ends included)."""
+    key, _, spec = text.partition("=")
+    parts = spec.split(":")
+    try:
+        if len(parts) != 3:
+            raise ValueError
+        start, stop, n = float(parts[0]), float(parts[1]), int(parts[2])
+        if n < 1:
+            raise ValueError
+    except ValueError:
+        raise SweepSpecError(f"--vary {text!r}: expected KEY=START:STOP:N with numbers and N >= 1, "
+                             f"e.g. launch.velocity=10:30:5") from None
+    _check_key(key, "--vary", text)
+    return key, np.linspace(start, stop, n)
+
+
+def parse_uncertain(text: str) -> tuple[str, str, tuple]:
+    """'KEY=DIST(a,b)' -> (key, distribution name, parameters)."""
+    key, _, spec = text.partition("=")
+    match = re.fullmatch(r"\s*([a-z]+)\s*\(([^)]*)\)\s*", spec)
+    allowed = ", ".join(f"{name}({', '.join(p)})" for name, (p, _) in DISTRIBUTIONS.items())
+    if not match or match.group(1) not in DISTRIBUTIONS:
+        raise SweepSpecError(f"--uncertain {text!r}: expected KEY=DIST(...) with DIST one of {allowed}")
+    name = match.group(1)
+    try:
+        params = tuple(float(v) for v in match.group(2).split(","))
+    except ValueError:
+        raise SweepSpecError(f"--uncertain {text!r}: parameters must be numbers") from None
+    if len(params) != len(DISTRIBUTIONS[name][0]):
+        raise SweepSpecError(f"--uncertain {text!r}: {name} takes {len(DISTRIBUTIONS[name][0])} parameters "
+                             f"({', '.join(DISTRIBUTIONS[name][0])}); got {len(params)}")
+    _check_key(key, "--uncertain", text)
+    return key, name, params
+
+
+def _check_key(key: str, option: str, text: str) -> None:
+    if not key or not all(_TOKEN.fullmatch(part) for part in _split_key(key)):
+        raise SweepSpecError(f"{option} {text!r}: '{key}' is not a case key like launch.velocity or "
+                             f"target.joints[solar_array_hinge].torsional_damping")
+
+
+def _split_key(key: str) -> list[str]:
+    return re.findall(r"[^.\[]+(?:\[[^\]]+\])*", key)
+
+
+def set_key(raw: dict, key: str, value) -> None:
+    """Set ``key`` in the parsed case file ``raw`` (in place); ``KeyError`` naming what is missing."""
+    node = raw
+    parts = _split_key(key)
+    for depth, part in enumerate(parts):
+        name, selectors = _TOKEN.fullmatch(part).groups()
+        selectors = re.findall(r"\[([^\]]+)\]", selectors)
+        last = depth == len(parts) - 1
+        if not isinstance(node, dict) or name not in node:
+            raise KeyError(f"'{key}': no key '{name}' at '{'.'.join(parts[:depth]) or 'top level'}'")
+        if last and not selectors:
+            node[name] = value
+            return
+        container, node = node, node[name]
+        for k, selector in enumerate(selectors):
+            item = _select(node, selector, key)
+            if last and k == len(selectors) - 1:
+                index = node.index(item) if isinstance(item, dict) else int(selector)
+                node[index] = value
+                return
+            node = item
+        del container
+
+
+def _select(items, selector: str, key: str):
+    if not isinstance(items, list):
+        raise KeyError(f"'{key}': [{selector}] needs a list")
+    if selector.lstrip("-").isdigit():
+        try:
+            return items[int(selector)]
+        except IndexError:
+            raise KeyError(f"'{key}': index {selector} out of range ({len(items)} items)") from None
+    for item in items:
+        if isinstance(item, dict) and item.get("name") == selector:
+            return item
+    names = [item.get("name") for item in items if isinstance(item, dict)]
+    raise KeyError(f"'{key}': no item named '{selector}' (names: {names})")
+
+
+def run_id(overrides: dict) -> str:
+    """Stable id of a run from its overrides (values to 12 significant digits)."""
+    canonical = json.dumps({k: float(f"{v:.12g}") for k, v in sorted(overrides.items())}, sort_keys=True)
+    return hashlib.sha1(canonical.encode()).hexdigest()[:12]
+
+
+def run_specs(vary: list[tuple[str, np.ndarray]], uncertain: list[tuple[str, str, tuple]] = (),
+              monte_carlo: int = 0, seed: int = 0) -> list[RunSpec]:
+    """The cartesian grid of ``vary``; at each grid point ``monte_carlo`` samples of ``uncertain``.
+
+    The same samples are used at every grid point (common random numbers), so differences
+    along the grid come from the varied keys, not from the draw.
+    """
+    if uncertain and monte_carlo < 1:
+        raise SweepSpecError("--uncertain needs --monte-carlo N (samples per grid point, N >= 1)")
+    rng = np.random.default_rng(seed)
+    samples = [{} for _ in range(max(monte_carlo, 1))]
+    for key, name, params in uncertain:
+        values = DISTRIBUTIONS[name][1](rng, len(samples), *params)
+        for sample, value in zip(samples, values):
+            sample[key] = float(value)
+    keys = [key for key, _ in vary]
+    specs = []
+    for g, values in enumerate(itertools.product(*(v for _, v in vary))):
+        for m, sample in enumerate(samples):
+            overrides = {**dict(zip(keys, map(float, values))), **sample}
+            specs.append(RunSpec(run_id(overrides), overrides, g, m))
+    return specs
+
+
+def case_with(raw: dict, overrides: dict) -> dict:
+    """A copy of the parsed case file with the overrides applied."""
+    out = copy.deepcopy(raw)
+    for key, value in overrides.items():
+        set_key(out, key, value)
+    return out
