@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import re
+from typing import get_args
 
 from pydantic import BaseModel
 
@@ -50,6 +51,24 @@ def field_unit(field) -> str:
         if _is_unit(group):
             return group
     return ""
+
+
+def _models_in(annotation) -> list[type[BaseModel]]:
+    """The case models an annotation can hold (through lists, unions and Annotated)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    return [m for arg in get_args(annotation) for m in _models_in(arg)]
+
+
+def key_unit(key: str) -> str:
+    """The unit of a case key such as 'launch.velocity' or 'target.joints[hinge].torsional_damping'."""
+    models, field = [c.Case], None
+    for part in re.sub(r"\[[^\]]*\]", "", key).split("."):
+        field = next((m.model_fields[part] for m in models if part in m.model_fields), None)
+        if field is None:
+            return ""
+        models = _models_in(field.annotation)
+    return field_unit(field) if field is not None else ""
 
 
 def _format_leaf(value) -> str:

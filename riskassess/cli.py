@@ -145,6 +145,69 @@ def print_summary(summary: dict, run_dir: Path) -> None:
     console.print(f"results: {run_dir}")
 
 
+def _cmd_sweep(args) -> int:
+    from riskassess.sweep.runner import run_sweep, validate_runs, write_sweep_products
+    from riskassess.sweep.spec import parse_uncertain, parse_vary, run_specs
+    from riskassess.sweep.store import ResultStore
+
+    case = load_case(args.case)  # a bad base case fails before any worker starts
+    specs = run_specs([parse_vary(v) for v in args.vary], [parse_uncertain(u) for u in args.uncertain],
+                      args.monte_carlo, args.seed)
+    validate_runs(args.case, Path(args.case).read_text(), specs)  # every run's case, before the store exists
+    store = ResultStore(Path(args.store) if args.store else Path("sweeps") / case.name / "results.sqlite")
+    arguments = [f"--vary {v}" for v in args.vary] + [f"--uncertain {u}" for u in args.uncertain] + (
+        [f"--monte-carlo {args.monte_carlo}", f"--seed {args.seed}"] if args.uncertain else [])
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+    columns = [TextColumn("[bold]sweep[/bold] done {task.fields[done]}, failed {task.fields[failed]}, "
+                          "remaining {task.fields[remaining]}"), BarColumn(), TimeElapsedColumn(), TextColumn("ETA"),
+               TimeRemainingColumn()]
+    with Progress(*columns, disable=args.json or not sys.stderr.isatty()) as bar:
+        task = bar.add_task("sweep", total=None, done=0, failed=0, remaining="?")
+
+        def progress(done, failed, remaining):
+            bar.update(task, completed=done + failed, total=done + failed + remaining, done=done, failed=failed,
+                       remaining=remaining)
+
+        outcome = run_sweep(args.case, specs, store, {"arguments": arguments, "created": _now()},
+                            scheduler=args.scheduler, n_workers=args.workers, retry_failed=args.retry_failed,
+                            keep_runs=args.keep_runs, progress=progress, validate=False)
+    env = write_sweep_products(store, args.confidence, args.reliability, pdf=not args.no_pdf)
+    from riskassess.sweep.envelope import envelope_statement
+
+    if args.json:
+        print(json.dumps({"store": str(store.path), "total": outcome.total, "skipped": outcome.skipped,
+                          "done": outcome.done, "failed": outcome.failed, "wall_s": outcome.wall_s,
+                          "envelope": env, "statement": envelope_statement(env)}, indent=2))
+    else:
+        print(f"sweep: {outcome.total} runs ({outcome.skipped} already in the store, {outcome.done} done now, "
+              f"{outcome.failed} failed) in {outcome.wall_s:.1f} s; store {store.path}")
+        print(envelope_statement(env))
+        print(f"report: {store.path.parent / 'report.html'}")
+    return 0
+
+
+def _now() -> str:
+    import datetime
+
+    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+
+
+def _cmd_sweep_status(args) -> int:
+    from riskassess.sweep.store import ResultStore
+
+    store = ResultStore.open_existing(args.store)
+    for r in store.rows():
+        values = " ".join(f"{k}={v:.6g}" for k, v in r["overrides"].items())
+        line = f"{r['run_id']} {r['state']} {values}"
+        if r["state"] == "done" and r["result"]["secondary_debris"] is not None:
+            line += f" secondary_debris={'yes' if r['result']['secondary_debris'] else 'no'}"
+        if r["state"] == "failed":
+            line += f" error={r['error_kind']}: {r['error'].splitlines()[0] if r['error'] else ''}"
+        print(line)
+    return 0
+
+
 def _cmd_validate(args) -> int:
     case = load_case(args.case)
     print(f"{args.case}: valid case '{case.name}'")
@@ -180,6 +243,30 @@ def build_parser() -> argparse.ArgumentParser:
     vtk.add_argument("--out", help="output folder (default RUN_DIR/vtk)")
     vtk.add_argument("--every", type=int, default=1, help="export every N-th net snapshot (default 1: all)")
     vtk.set_defaults(func=_cmd_export_vtk)
+    sweep = sub.add_parser("sweep", help="run a grid / Monte Carlo of cases on Dask; results survive interruption")
+    sweep.add_argument("case", help="base case file (TOML)")
+    sweep.add_argument("--vary", action="append", default=[], metavar="KEY=START:STOP:N",
+                       help="grid of a case key, N values with both ends (repeat for a cartesian grid)")
+    sweep.add_argument("--monte-carlo", type=int, default=0, metavar="N", help="samples of the uncertain keys "
+                       "at every grid point")
+    sweep.add_argument("--uncertain", action="append", default=[], metavar="KEY=DIST(...)",
+                       help="uniform(low,high), normal(mean,std), lognormal(median,sigma_log), "
+                            "triangular(low,mode,high)")
+    sweep.add_argument("--seed", type=int, default=0, help="random seed of the Monte Carlo draws (default 0)")
+    sweep.add_argument("--scheduler", help="address of a running Dask scheduler (default: a LocalCluster here)")
+    sweep.add_argument("--workers", type=int, default=2, help="LocalCluster worker processes (default 2)")
+    sweep.add_argument("--store", help="results store (SQLite; default sweeps/<case name>/results.sqlite)")
+    sweep.add_argument("--retry-failed", action="store_true", help="also re-run runs that failed in the run itself")
+    sweep.add_argument("--keep-runs", metavar="DIR", help="keep every run folder under DIR/<run id>")
+    sweep.add_argument("--confidence", type=float, default=0.95, help="confidence of the safe limit (default 0.95)")
+    sweep.add_argument("--reliability", type=float, default=0.9,
+                       help="required P(no secondary debris) of the safe limit (default 0.9)")
+    sweep.add_argument("--no-pdf", action="store_true", help="HTML report only")
+    sweep.add_argument("--json", action="store_true", help="print outcome and envelope as JSON")
+    sweep.set_defaults(func=_cmd_sweep)
+    status = sub.add_parser("sweep-status", help="list every run of a results store: id, state, inputs")
+    status.add_argument("store", help="results store written by 'riskassess sweep'")
+    status.set_defaults(func=_cmd_sweep_status)
     val = sub.add_parser("validate", help="check a case file and exit")
     val.add_argument("case")
     val.set_defaults(func=_cmd_validate)

@@ -92,20 +92,26 @@ def folder_problems(run: RunFolder) -> list[str]:
 
 
 def render_html(run: RunFolder, sections: list[Section]) -> str:
-    env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True,
-                             undefined=jinja2.StrictUndefined)
-    env.tests.update(table=lambda b: isinstance(b, Table), figure=lambda b: isinstance(b, Figure),
-                     note=lambda b: isinstance(b, Note))
     case_name = run.manifest.get("case", run.path.name)
     try:
         description = run.case.get("description") or ""
     except MissingData:
         description = ""
+    return render_document(f"Net-capture risk report: {case_name}", description, run.path,
+                           run.manifest.get("created", "-"), folder_problems(run), sections)
+
+
+def render_document(title: str, subtitle: str, folder: Path, created: str, problems: list[str],
+                    sections: list[Section]) -> str:
+    """The report template filled with any list of sections (runs, sweeps, later stages)."""
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True,
+                             undefined=jinja2.StrictUndefined)
+    env.tests.update(table=lambda b: isinstance(b, Table), figure=lambda b: isinstance(b, Figure),
+                     note=lambda b: isinstance(b, Note))
     return env.get_template("report.html.j2").render(
-        title=f"Net-capture risk report: {case_name}", subtitle=description, run_dir=str(run.path),
-        created=run.manifest.get("created", "-"),
+        title=title, subtitle=subtitle, run_dir=str(folder), created=created,
         generated=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
-        tool_version=tool_version(), problems=folder_problems(run), sections=sections,
+        tool_version=tool_version(), problems=problems, sections=sections,
         css=(TEMPLATES / "report.css").read_text())
 
 

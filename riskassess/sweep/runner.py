@@ -115,13 +115,17 @@ def _client(scheduler: str | None, n_workers: int):
 
 def run_sweep(case_path: str | Path, specs: list[RunSpec], store: ResultStore, definition: dict,
               scheduler: str | None = None, n_workers: int = 2, retry_failed: bool = False,
-              keep_runs: str | Path | None = None, progress=None) -> SweepOutcome:
-    """Run every spec not finished in ``store``; ``progress(done, failed, remaining)`` after each."""
+              keep_runs: str | Path | None = None, progress=None, validate: bool = True) -> SweepOutcome:
+    """Run every spec not finished in ``store``; ``progress(done, failed, remaining)`` after each.
+
+    ``validate=False`` when the caller already ran :func:`validate_runs`.
+    """
     from dask.distributed import as_completed
 
     case_path = str(case_path)
     case_text = Path(case_path).read_text()
-    validate_runs(case_path, case_text, specs)
+    if validate:
+        validate_runs(case_path, case_text, specs)
     store.declare(case_path, case_text, definition, specs)
     todo = store.to_run([s.run_id for s in specs], retry_failed)
     by_id = {s.run_id: s for s in specs}
@@ -151,3 +155,30 @@ def run_sweep(case_path: str | Path, specs: list[RunSpec], store: ResultStore, d
             if cluster is not None:
                 cluster.close()
     return SweepOutcome(len(specs), len(specs) - len(todo), done, failed, time.perf_counter() - start)
+
+
+def write_sweep_products(store: ResultStore, confidence: float = 0.95, reliability: float = 0.9,
+                         pdf: bool = True) -> dict:
+    """envelope.json and report.html (+ .pdf) beside the store; returns the envelope."""
+    from riskassess import results
+    from riskassess.report.document import render_document, render_pdf
+    from riskassess.report.plotting import STYLE
+    from riskassess.report.sweep import envelope_section, runs_section
+    from riskassess.sweep.envelope import envelope
+
+    import matplotlib.pyplot as plt
+
+    rows = store.rows()
+    info = store.info()
+    env = envelope(rows, confidence=confidence, reliability=reliability)
+    folder = store.path.parent
+    results.atomic_write_json(folder / "envelope.json", env)
+    with plt.rc_context(STYLE):
+        sections = [envelope_section(rows, env), runs_section(rows)]
+    problems = [f"{env['pending_runs']} runs pending"] if env["pending_runs"] else []
+    html = render_document(f"Sweep: {Path(info.get('case_path', '?')).name}",
+                           " ".join(info.get("arguments", [])), folder, info.get("created", "-"), problems, sections)
+    results.atomic_write_bytes(folder / "report.html", html.encode("utf-8"))
+    if pdf:
+        results.atomic_write_bytes(folder / "report.pdf", render_pdf(html, folder)[0])
+    return env

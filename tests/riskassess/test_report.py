@@ -109,7 +109,7 @@ def test_report_of_an_interrupted_run_and_of_no_run(assessed, tmp_path, capsys):
     (run / "manifest.json").write_text(json.dumps(manifest))
     assert main(["report", str(run), "--no-pdf"]) == 0
     html = (run / "report.html").read_text()
-    assert "Incomplete run folder" in html and "status is &#39;running&#39;" in html
+    assert "Incomplete:" in html and "status is &#39;running&#39;" in html
     assert "summary.json is missing (the run stopped with status &#39;running&#39;)" in html
     assert main(["report", str(tmp_path / "nowhere")]) == 2
     assert "no manifest.json" in capsys.readouterr().err

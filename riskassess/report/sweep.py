@@ -1,0 +1,98 @@
+"""Report sections of a sweep: the safe envelope (statement, plots) and the table of runs."""
+from __future__ import annotations
+
+from collections import defaultdict
+
+import numpy as np
+
+from riskassess.casedoc import key_unit
+from riskassess.report.blocks import Figure, Note, Section, Table
+from riskassess.report.plotting import legend, panels
+from riskassess.sweep.envelope import envelope_statement, is_probabilistic
+
+
+def _by_value(rows: list[dict], key: str) -> dict[float, list[dict]]:
+    groups = defaultdict(list)
+    for r in rows:
+        if r["state"] == "done" and r["result"]["secondary_debris"] is not None:
+            groups[r["overrides"][key]].append(r["result"])
+    return dict(sorted(groups.items()))
+
+
+def _band(ax, x, values_per_x, label, color=None, scale=1.0):
+    """Max over the runs at each x (line) and the min-max band over Monte Carlo samples."""
+    high = np.array([max(v) for v in values_per_x]) * scale
+    low = np.array([min(v) for v in values_per_x]) * scale
+    line, = ax.plot(x, high, marker="o", ms=3, color=color, label=label)
+    if (high > low).any():
+        ax.fill_between(x, low, high, color=line.get_color(), alpha=0.15, lw=0)
+
+
+def envelope_figure(rows: list[dict], env: dict) -> Figure:
+    key = env["key"]
+    groups = _by_value(rows, key)
+    x = np.array(list(groups))
+    locations = sorted({name for results in groups.values() for r in results for name in r["locations"]})
+    stressed = [n for n in locations if any("normal_stress" in r["locations"][n]["peaks"]
+                                            for results in groups.values() for r in results)]
+    fig, (ax_u, ax_s, ax_b) = panels(3, 1.9)
+    for name in locations:
+        _band(ax_u, x, [[r["locations"][name]["utilization"] for r in results] for results in groups.values()], name)
+    ax_u.axhline(1.0, color="tab:red", ls="--", lw=1.0, label="decisive allowable")
+    ax_u.set_ylabel("demand / allowable (-)")
+    ax_u.set_title("utilization: peak demand over decisive allowable (largest criterion)")
+    legend(ax_u)
+    for name in stressed:
+        for crit, style in (("normal_stress", "-"), ("shear_stress", ":")):
+            values = [[r["locations"][name]["peaks"][crit] for r in results] for results in groups.values()]
+            _band(ax_s, x, values, f"{name} {crit.split('_')[0]}", scale=1e-6)
+    if stressed:
+        ax_s.set_yscale("log")
+    ax_s.set_ylabel("peak stress (MPa)")
+    ax_s.set_title("peak normal and shear stress at the sections")
+    legend(ax_s) if stressed else ax_s.text(0.5, 0.5, "no section with a material", ha="center",
+                                            transform=ax_s.transAxes)
+    _band(ax_b, x, [[r["breakup_likelihood"] for r in results] for results in groups.values()],
+          "breakup likelihood (range allowables)")
+    ax_b.plot(x, [np.mean([r["secondary_debris"] for r in results]) for results in groups.values()], "s--",
+              ms=3, color="tab:red", label="fraction of runs with secondary debris")
+    ax_b.set_ylim(-0.03, 1.03)
+    ax_b.set_ylabel("probability (-)")
+    ax_b.set_title("breakup")
+    legend(ax_b)
+    unit = key_unit(key)
+    ax_b.set_xlabel(f"{key} ({unit})" if unit else key)
+    return Figure.from_matplotlib("fig-envelope", f"Envelope against {key}: lines are the largest value over "
+                                  f"the runs at each {key}, bands the spread over Monte Carlo samples.", fig)
+
+
+def envelope_section(rows: list[dict], env: dict) -> Section:
+    blocks = [Note(envelope_statement(env), "info" if env["deterministic_safe_limit"] is not None else "alarm")]
+    if env["points"]:
+        blocks.append(envelope_figure(rows, env))
+        blocks.append(Table(
+            [env["key"], "runs", "with debris", f"P(no debris) lower bound ({env['confidence']:.0%})",
+             "safe", "max utilization", "max breakup likelihood"],
+            [[f"{p['value']:.4g}", str(p["runs"]), str(p["with_debris"]), f"{p['no_debris_lower_bound']:.3f}",
+              "yes" if (p["safe"] if is_probabilistic(env) else p["deterministic_safe"]) else "NO",
+              f"{p['max_utilization']:.3f}", f"{p['max_breakup_likelihood']:.3f}"] for p in env["points"]],
+            "Envelope points", alarm_rows={k for k, p in enumerate(env["points"]) if p["with_debris"]}))
+    if env["failed_runs"] or env["pending_runs"]:
+        blocks.append(Note(f"{env['failed_runs']} failed and {env['pending_runs']} pending runs are not in the "
+                           f"envelope (see the runs table; re-run the sweep to finish them).", "warning"))
+    return Section("envelope", "Safe impact envelope", blocks)
+
+
+def runs_section(rows: list[dict]) -> Section:
+    keys = list(rows[0]["overrides"]) if rows else []
+    table_rows = []
+    for r in rows:
+        result = r["result"] or {}
+        debris = result.get("secondary_debris")
+        table_rows.append([r["run_id"], *(f"{r['overrides'][k]:.5g}" for k in keys), r["state"],
+                           "-" if debris is None else ("YES" if debris else "no"),
+                           f"{result['peak_contact_force_N']:.4g}" if result else "-",
+                           f"{result['wall_time_s']:.1f}" if result else "-", (r["error"] or "")[:120]])
+    return Section("sweep-runs", "Runs", [Table(["run", *keys, "state", "secondary debris", "peak contact force (N)",
+                                                  "wall time (s)", "error"], table_rows,
+                                                 alarm_rows={k for k, r in enumerate(rows) if r["state"] == "failed"})])
