@@ -1,0 +1,91 @@
+"""`riskassess sweep` on a Dask LocalCluster: same results as one by one, failures recorded,
+and a sweep killed part-way resumes with every run exactly once in the store."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from riskassess.cli import main
+from riskassess.sweep.runner import run_sweep, simulate_run
+from riskassess.sweep.spec import RunSpec, parse_vary, run_id, run_specs
+from riskassess.sweep.store import ResultStore
+from tests.riskassess.conftest import shortened_case
+
+#: 0.4 s of the reduced case: the net (3 m away) hits at 12-20 m/s and loads the joints.
+END_TIME = 0.4
+#: Results that depend on the machine's speed, not on the physics.
+TIMING_KEYS = {"wall_time_s", "steps_per_second"}
+
+
+@pytest.fixture(scope="module")
+def short_case(tmp_path_factory):
+    path = tmp_path_factory.mktemp("sweep_case") / "small_short.toml"
+    path.write_text(shortened_case(END_TIME))
+    return path
+
+
+def _physics(record: dict) -> dict:
+    return {k: v for k, v in record.items() if k not in TIMING_KEYS}
+
+
+def test_sweep_on_two_workers_equals_runs_one_by_one(short_case, tmp_path):
+    specs = run_specs([parse_vary("launch.velocity=12:20:3")])
+    bad = RunSpec(run_id({"launch.velocity": -1.0}), {"launch.velocity": -1.0}, 3, 0)  # fails inside its run
+    store = ResultStore(tmp_path / "results.sqlite")
+    outcome = run_sweep(short_case, specs + [bad], store, {"arguments": []}, n_workers=2, validate=False)
+    assert (outcome.done, outcome.failed, outcome.skipped) == (3, 1, 0)
+    rows = {r["run_id"]: r for r in store.rows()}
+    case_text = short_case.read_text()
+    for spec in specs:
+        alone = simulate_run(str(short_case), case_text, spec.overrides)
+        # the same deterministic simulation in another process: identical numbers
+        assert _physics(rows[spec.run_id]["result"]) == _physics(json.loads(json.dumps(alone)))
+        assert rows[spec.run_id]["state"] == "done" and rows[spec.run_id]["attempts"] == 1
+    failed = rows[bad.run_id]
+    assert failed["state"] == "failed" and failed["error_kind"] == "simulation"
+    assert "launch.velocity" in failed["error"] and "greater than 0" in failed["error"]
+    # a second sweep with the same store has nothing left to run (the simulation failure is not retried)
+    again = run_sweep(short_case, specs + [bad], store, {"arguments": []}, n_workers=2, validate=False)
+    assert (again.done, again.failed, again.skipped) == (0, 0, 4)
+
+
+def _done(store_path) -> dict:
+    if not store_path.exists():
+        return {}
+    store = ResultStore(store_path)
+    try:
+        return {r["run_id"]: r["finished"] for r in store.rows() if r["state"] == "done"}
+    finally:
+        store.close()
+
+
+def test_killed_sweep_resumes_with_every_run_once(short_case, tmp_path, capsys):
+    store_path = tmp_path / "sweep" / "results.sqlite"
+    args = [str(short_case), "--vary", "launch.velocity=12:20:5", "--store", str(store_path), "--no-pdf"]
+    sweep = subprocess.Popen([sys.executable, "-m", "riskassess", "sweep", *args, "--workers", "1"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 240
+        while not _done(store_path) and time.monotonic() < deadline and sweep.poll() is None:
+            time.sleep(0.2)
+        before = _done(store_path)
+        os.killpg(sweep.pid, signal.SIGKILL)   # the client and its cluster, mid-sweep
+    finally:
+        sweep.wait()
+    assert 1 <= len(before) < 5, "the sweep should be killed part-way"
+    assert main(["sweep", *args]) == 0
+    rows = ResultStore(store_path).rows()
+    assert len(rows) == 5 and len({r["run_id"] for r in rows}) == 5
+    assert all(r["state"] == "done" and r["attempts"] == 1 for r in rows)   # each run finished exactly once
+    assert {rid: _done(store_path)[rid] for rid in before} == before         # finished runs were not redone
+    capsys.readouterr()
+    assert main(["sweep-status", str(store_path)]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert len(lines) == 5 and all(" done launch.velocity=" in line for line in lines)
+    envelope = json.loads((store_path.parent / "envelope.json").read_text())
+    assert [p["value"] for p in envelope["points"]] == [12.0, 14.0, 16.0, 18.0, 20.0]
+    assert (store_path.parent / "report.html").is_file()
