@@ -89,3 +89,27 @@ def test_killed_sweep_resumes_with_every_run_once(short_case, tmp_path, capsys):
     envelope = json.loads((store_path.parent / "envelope.json").read_text())
     assert [p["value"] for p in envelope["points"]] == [12.0, 14.0, 16.0, 18.0, 20.0]
     assert (store_path.parent / "report.html").is_file()
+
+
+def test_killing_a_worker_loses_no_run(short_case, tmp_path):
+    """A worker process killed mid-sweep: Dask reschedules its run on the other worker."""
+    import threading
+
+    from dask.distributed import LocalCluster
+
+    specs = run_specs([parse_vary("launch.velocity=12:20:4")])
+    store_path = tmp_path / "results.sqlite"
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        outcome = {}
+        thread = threading.Thread(target=lambda: outcome.update(result=run_sweep(
+            short_case, specs, ResultStore(store_path), {"arguments": []}, scheduler=cluster.scheduler_address)))
+        thread.start()
+        deadline = time.monotonic() + 120
+        while not _done(store_path) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        victim = next(iter(cluster.workers.values()))
+        os.kill(victim.process.process.pid, signal.SIGKILL)   # a worker dies while runs are queued
+        thread.join(timeout=240)
+    assert not thread.is_alive()
+    rows = ResultStore(store_path).rows()
+    assert outcome["result"].done == 4 and all(r["state"] == "done" for r in rows) and len(rows) == 4
