@@ -8,7 +8,7 @@ import numpy as np
 from riskassess.casedoc import key_unit
 from riskassess.report.blocks import Figure, Note, Section, Table
 from riskassess.report.plotting import legend, panels
-from riskassess.sweep.envelope import envelope_statement, is_probabilistic
+from riskassess.sweep.envelope import envelope, envelope_statement, is_probabilistic
 
 
 def _by_value(rows: list[dict], key: str) -> dict[float, list[dict]]:
@@ -28,7 +28,7 @@ def _band(ax, x, values_per_x, label, color=None, scale=1.0):
         ax.fill_between(x, low, high, color=line.get_color(), alpha=0.15, lw=0)
 
 
-def envelope_figure(rows: list[dict], env: dict) -> Figure:
+def envelope_figure(rows: list[dict], env: dict, figure_id: str = "fig-envelope") -> Figure:
     key = env["key"]
     groups = _by_value(rows, key)
     x = np.array(list(groups))
@@ -62,14 +62,19 @@ def envelope_figure(rows: list[dict], env: dict) -> Figure:
     legend(ax_b)
     unit = key_unit(key)
     ax_b.set_xlabel(f"{key} ({unit})" if unit else key)
-    return Figure.from_matplotlib("fig-envelope", f"Envelope against {key}: lines are the largest value over "
-                                  f"the runs at each {key}, bands the spread over Monte Carlo samples.", fig)
+    return Figure.from_matplotlib(figure_id, f"Envelope against {key}: lines are the largest value over "
+                                  f"the runs at each {key}, bands the spread over those runs (Monte Carlo samples and the values "
+                                  f"of any other varied key).", fig)
 
 
-def envelope_section(rows: list[dict], env: dict) -> Section:
+def envelope_section(rows: list[dict], env: dict, other_keys=()) -> Section:
+    """The envelope against ``env['key']``, plus one figure against each other varied key."""
     blocks = [Note(envelope_statement(env), "info" if env["deterministic_safe_limit"] is not None else "alarm")]
     if env["points"]:
         blocks.append(envelope_figure(rows, env))
+        for k, key in enumerate(other_keys):
+            blocks.append(envelope_figure(rows, envelope(rows, key, env["confidence"], env["reliability"]),
+                                          f"fig-envelope-{k + 2}"))
         blocks.append(Table(
             [env["key"], "runs", "with debris", f"P(no debris) lower bound ({env['confidence']:.0%})",
              "safe", "max utilization", "max breakup likelihood"],

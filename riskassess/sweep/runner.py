@@ -173,8 +173,9 @@ def write_sweep_products(store: ResultStore, confidence: float = 0.95, reliabili
     env = envelope(rows, confidence=confidence, reliability=reliability)
     folder = store.path.parent
     results.atomic_write_json(folder / "envelope.json", env)
+    varied = [a.split(" ", 1)[1].split("=")[0] for a in info.get("arguments", []) if a.startswith("--vary ")]
     with plt.rc_context(STYLE):
-        sections = [envelope_section(rows, env), runs_section(rows)]
+        sections = [envelope_section(rows, env, [k for k in varied if k != env["key"]]), runs_section(rows)]
     problems = [f"{env['pending_runs']} runs pending"] if env["pending_runs"] else []
     html = render_document(f"Sweep: {Path(info.get('case_path', '?')).name}",
                            " ".join(info.get("arguments", [])), folder, info.get("created", "-"), problems, sections)

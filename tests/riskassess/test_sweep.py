@@ -88,7 +88,8 @@ def test_killed_sweep_resumes_with_every_run_once(short_case, tmp_path, capsys):
     assert len(lines) == 5 and all(" done launch.velocity=" in line for line in lines)
     envelope = json.loads((store_path.parent / "envelope.json").read_text())
     assert [p["value"] for p in envelope["points"]] == [12.0, 14.0, 16.0, 18.0, 20.0]
-    assert (store_path.parent / "report.html").is_file()
+    html = (store_path.parent / "report.html").read_text()
+    assert '<figure id="fig-envelope">' in html and html.count("<tr") == 1 + 5 + 1 + 5  # envelope and runs tables
 
 
 def test_killing_a_worker_loses_no_run(short_case, tmp_path):
