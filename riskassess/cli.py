@@ -222,18 +222,12 @@ def _cmd_schema(args) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="riskassess", description="Net-capture co-simulation and risk assessment.")
     sub = parser.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("run", help="simulate a case and write a run folder")
-    run.add_argument("case", help="case file (TOML)")
-    run.add_argument("--out", help="output folder (default runs/<case name>)")
-    run.add_argument("--json", action="store_true", help="print the run summary as JSON")
-    _product_flags(run)
-    run.set_defaults(func=_cmd_run)
-    assess = sub.add_parser("assess", help="simulate a case with weak locations and print the structural verdict")
-    assess.add_argument("case", help="case file (TOML) with [[structures.weak_locations]]")
-    assess.add_argument("--out", help="output folder (default runs/<case name>)")
-    assess.add_argument("--json", action="store_true", help="print the run summary (with the verdict) as JSON")
-    _product_flags(assess)
-    assess.set_defaults(func=_cmd_assess)
+    _simulation_command(sub, "run", _cmd_run, "simulate a case and write a run folder", "case file (TOML)",
+                        "print the run summary as JSON")
+    _simulation_command(sub, "assess", _cmd_assess,
+                        "simulate a case with weak locations and print the structural verdict",
+                        "case file (TOML) with [[structures.weak_locations]]",
+                        "print the run summary (with the verdict) as JSON")
     report = sub.add_parser("report", help="write report.html (self-contained) and report.pdf into a run folder")
     report.add_argument("run_dir", help="run folder written by 'riskassess run'")
     report.add_argument("--no-pdf", action="store_true", help="HTML only")
@@ -275,9 +269,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _product_flags(parser) -> None:
+def _simulation_command(sub, name, func, help_text, case_help, json_help) -> None:
+    """A command that simulates a case into a run folder (run, assess)."""
+    parser = sub.add_parser(name, help=help_text)
+    parser.add_argument("case", help=case_help)
+    parser.add_argument("--out", help="output folder (default runs/<case name>)")
+    parser.add_argument("--json", action="store_true", help=json_help)
     parser.add_argument("--report", action="store_true", help="also write report.html and report.pdf")
     parser.add_argument("--vtk", action="store_true", help="also export VTK files (RUN_DIR/vtk/impact.pvd)")
+    parser.set_defaults(func=func)
 
 
 def main(argv=None) -> int:

@@ -7,6 +7,7 @@ from riskassess.report.blocks import Figure, Note, Section, Table
 from riskassess.report.plotting import COMPONENT_COLORS, legend, mark_release, panels
 from riskassess.results import RunFolder
 from riskassess.summary import contact_totals_debris
+from riskassess.tables import format_vector
 
 
 def _release_times(run: RunFolder) -> dict[str, float]:
@@ -28,12 +29,12 @@ def contact_section(run: RunFolder) -> Section:
         ax_f.plot(t, np.linalg.norm(s["contact_force_lvlh"][:, k], axis=1) / 1e3, lw=0.8, label=name)
     ax_f.set_ylabel("|contact force| (kN)")
     ax_f.set_title("net contact force on the debris bodies")
-    legend(ax_f, ncols=3, loc="upper right")
+    legend(ax_f)
     for i, axis in enumerate("xyz"):
         ax_m.plot(t, moment[:, i] / 1e3, color=COMPONENT_COLORS[i], label=f"M{axis} (LVLH)")
     ax_m.set_ylabel("moment (kN m)")
     ax_m.set_title("contact moment about the debris centre of mass, LVLH")
-    legend(ax_m, ncols=3, loc="upper right")
+    legend(ax_m)
     ref = run.key(summary, "paper_reference")
     rows = [[name, f"{p['value']:.4g}", f"{p['time_s']:.3f}"]
             for name, p in run.key(summary, "peak_contact_force_per_body_N").items()]
@@ -64,24 +65,20 @@ def debris_motion_section(run: RunFolder) -> Section:
     ax_v.axhline(estimate[1], color=COMPONENT_COLORS[1], ls="--", lw=0.9, label="momentum-exchange\nestimate (y)")
     ax_v.set_ylabel("velocity change (mm/s)")
     ax_v.set_title("debris centre-of-mass velocity change, LVLH")
-    legend(ax_v, ncols=4, loc="lower right")
+    legend(ax_v)
     ax_w.set_ylabel("angular velocity (deg/s)")
     ax_w.set_title(f"angular velocity of {s['body_names'][0]}, its body frame")
-    legend(ax_w, ncols=3, loc="lower right")
+    legend(ax_w)
     mean = np.asarray(summary["debris_velocity_change_final_third_mean_lvlh_m_s"]) * 1e3
-    rows = [["final velocity change (mm/s, LVLH)", _vec(dv[-1])],
-            ["mean over the last third (mm/s, LVLH)", _vec(mean)],
-            ["momentum-exchange estimate (mm/s, LVLH)", _vec(estimate)],
-            [f"final angular velocity of {s['body_names'][0]} (deg/s, body frame)", _vec(omega[-1])]]
+    rows = [["final velocity change (mm/s, LVLH)", format_vector(dv[-1], 4)],
+            ["mean over the last third (mm/s, LVLH)", format_vector(mean, 4)],
+            ["momentum-exchange estimate (mm/s, LVLH)", format_vector(estimate, 4)],
+            [f"final angular velocity of {s['body_names'][0]} (deg/s, body frame)", format_vector(omega[-1], 4)]]
     return Section("debris-motion", "Debris velocity and angular velocity", [
         Figure.from_matplotlib("fig-debris-motion", "Velocity change of the debris centre of mass (all bodies) "
                                "and angular velocity of the main body.", fig),
         Table(["quantity", "value"], rows),
     ])
-
-
-def _vec(values) -> str:
-    return "[" + ", ".join(f"{v:.4g}" for v in values) + "]"
 
 
 def hinge_section(run: RunFolder) -> Section:
@@ -140,7 +137,7 @@ def energy_section(run: RunFolder) -> Section:
     ax_e.set_yscale("symlog", linthresh=1e-3)
     ax_e.set_ylabel("energy (kJ, symlog)")
     ax_e.set_title("energy of net and debris, relative to the LVLH frame")
-    legend(ax_e, ncols=2, loc="lower right")
+    legend(ax_e)
     e = s["energy_total"]
     drift = (e - e[0]) / e[0] * 100.0
     ax_d.plot(t, drift, color="k")

@@ -10,6 +10,7 @@ from riskassess.casedoc import input_rows
 from riskassess.case import Case
 from riskassess.report.blocks import Note, Section, Table
 from riskassess.results import MissingData, RunFolder
+from riskassess.tables import format_vector
 
 
 def _at_a_glance(run: RunFolder, case: dict) -> Table:
@@ -61,7 +62,7 @@ def _joints_table(case: dict) -> Table:
 
 
 def _vector(values) -> str:
-    return "-" if values is None else "[" + ", ".join(f"{v:.4g}" for v in values) + "]"
+    return "-" if values is None else format_vector(values, 4)
 
 
 def case_section(run: RunFolder) -> Section:

@@ -25,11 +25,9 @@ def panels(n: int, height_in: float = 2.0, sharex: bool = True):
     return fig, list(axes[:, 0])
 
 
-def legend(ax, **kwargs) -> None:
+def legend(ax) -> None:
     """Legend outside the axes, on the right, so it never hides a curve."""
-    kwargs.pop("loc", None)
-    kwargs.pop("ncols", None)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, **kwargs)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
 
 
 def shade_not_judged(ax, until: float) -> None:

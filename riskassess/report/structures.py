@@ -13,12 +13,15 @@ NOT_ASSESSED = ("Not assessed: the case declares no weak locations. Add [[struct
                 "(docs/case-format.md) and run it again to get failure verdicts and released pieces.")
 
 
+def _not_assessed(run: RunFolder) -> bool:
+    """The case declares no weak locations, so the run has no structures results to miss."""
+    return not run.has("structures.json") and run.case.get("structures") is None
+
+
 def verdict_section(run: RunFolder) -> Section:
-    if not run.has("structures.json"):
-        if "structures.json" not in run.manifest.get("files", []) and run.case.get("structures") is None:
-            return Section("verdict", "Verdict: secondary debris", [Note(NOT_ASSESSED, "warning")])
-        run.structures  # raises MissingData naming the file
-    verdict = run.structures
+    if _not_assessed(run):
+        return Section("verdict", "Verdict: secondary debris", [Note(NOT_ASSESSED, "warning")])
+    verdict = run.structures  # MissingData names the file when a case with weak locations lacks it
     pieces = verdict["released_pieces"]
     failing = [loc["name"] for loc in verdict["locations"] if loc["fails"]]
     if verdict["secondary_debris"]:
@@ -64,7 +67,7 @@ def _decorate(ax, verdict: dict, loc: dict, time_end: float) -> None:
 def joint_loads_section(run: RunFolder) -> Section:
     """Moment and force demands of every weak location that has a moment or force allowable."""
     title = "Hinge and joint loads against allowables"
-    if not run.has("structures.json") and run.case.get("structures") is None:
+    if _not_assessed(run):
         return Section("joint-loads", title, [Note(NOT_ASSESSED, "warning")])
     verdict, series = run.structures, run.structures_series
     t = series["time"]
@@ -80,7 +83,7 @@ def joint_loads_section(run: RunFolder) -> Section:
         _decorate(ax, verdict, loc, t[-1])
         ax.set_ylabel(f"{name} ({units[name]})")
         ax.set_title(f"{loc['name']} (joint {loc['joint']})")
-        legend(ax, loc="upper right", ncols=2)
+        legend(ax)
     return Section("joint-loads", title, [Figure.from_matplotlib(
         "fig-joint-loads", "Demand of each location with a moment or force allowable (the resultant of the "
         "judged joint-frame components) against its allowable range; grey: initial transient not judged.", fig)])
@@ -88,7 +91,7 @@ def joint_loads_section(run: RunFolder) -> Section:
 
 def stresses_section(run: RunFolder) -> Section:
     title = "Stresses against strengths"
-    if not run.has("structures.json") and run.case.get("structures") is None:
+    if _not_assessed(run):
         return Section("stresses", title, [Note(NOT_ASSESSED, "warning")])
     verdict, series = run.structures, run.structures_series
     t = series["time"]
@@ -113,7 +116,7 @@ def stresses_section(run: RunFolder) -> Section:
         _decorate(ax, verdict, loc, t[-1])
         ax.set_ylabel("stress (MPa)")
         ax.set_title(f"{loc['name']} (joint {loc['joint']})")
-        legend(ax, loc="lower right", ncols=2)
+        legend(ax)
         rows.append([loc["name"], f"{loc['criteria']['normal_stress']['peak'] / 1e6:.4g}",
                      f"{loc['criteria']['shear_stress']['peak'] / 1e6:.4g}",
                      f"{loc.get('peak_von_mises_stress_Pa', float('nan')) / 1e6:.4g}",

@@ -50,8 +50,10 @@ def envelope_figure(rows: list[dict], env: dict, figure_id: str = "fig-envelope"
         ax_s.set_yscale("log")
     ax_s.set_ylabel("peak stress (MPa)")
     ax_s.set_title("peak normal and shear stress at the sections")
-    legend(ax_s) if stressed else ax_s.text(0.5, 0.5, "no section with a material", ha="center",
-                                            transform=ax_s.transAxes)
+    if stressed:
+        legend(ax_s)
+    else:
+        ax_s.text(0.5, 0.5, "no section with a material", ha="center", transform=ax_s.transAxes)
     _band(ax_b, x, [[r["breakup_likelihood"] for r in results] for results in groups.values()],
           "breakup likelihood (range allowables)")
     ax_b.plot(x, [np.mean([r["secondary_debris"] for r in results]) for results in groups.values()], "s--",

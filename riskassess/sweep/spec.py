@@ -102,7 +102,7 @@ def set_key(raw: dict, key: str, value) -> None:
         if last and not selectors:
             node[name] = value
             return
-        container, node = node, node[name]
+        node = node[name]
         for k, selector in enumerate(selectors):
             item = _select(node, selector, key)
             if last and k == len(selectors) - 1:
@@ -110,7 +110,6 @@ def set_key(raw: dict, key: str, value) -> None:
                 node[index] = value
                 return
             node = item
-        del container
 
 
 def _select(items, selector: str, key: str):

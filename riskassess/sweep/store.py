@@ -86,10 +86,10 @@ class ResultStore:
 
     def to_run(self, run_ids, retry_failed: bool = False) -> list[str]:
         """Of ``run_ids``, those still to run: pending, infrastructure failures, and (if asked) all failures."""
-        rows = dict(self.db.execute("SELECT run_id, state || ':' || coalesce(error_kind, '') FROM runs"))
+        rows = {rid: (state, kind) for rid, state, kind in self.db.execute("SELECT run_id, state, error_kind FROM runs")}
         keep = []
         for rid in run_ids:
-            state, _, kind = rows.get(rid, "pending:").partition(":")
+            state, kind = rows.get(rid, ("pending", None))
             if state == "pending" or (state == "failed" and (retry_failed or kind == "infrastructure")):
                 keep.append(rid)
         return keep
