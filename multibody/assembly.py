@@ -119,8 +119,33 @@ class SolverSpec:
 
 
 @dataclass
+class NetMount:
+    """Net nodes held on a body by stiff rods (a chaser's net frame, Tang et al. 2023 Sec. 4.2.2).
+
+    Attributes
+    ----------
+    nodes : (k,) int            Mounted net nodes.
+    body : int                  Index of the carrying body (the chaser) in ``ImpactAssembly.bodies``.
+    points_body : (k, 3) float  Mount points, carrying body's frame, origin at its CoM (m).
+    stiffness : float           Rod stiffness per mount (N/m).
+    damping : float             Rod damping per mount (N s/m).
+    """
+
+    nodes: np.ndarray
+    body: int
+    points_body: np.ndarray
+    stiffness: float
+    damping: float
+
+
+@dataclass
 class ImpactAssembly:
-    """Everything one coupled net-impact simulation needs."""
+    """Everything one coupled net-impact simulation needs.
+
+    When a chaser body is simulated (``chaser`` is its index in ``bodies``; it carries the net
+    through ``mount``), it has no contact shapes and is not debris: the recorder keeps it out
+    of the debris totals.
+    """
 
     net: NetTopology
     net_velocity: np.ndarray        # (n, 3) initial node velocities, LVLH (m/s)
@@ -129,3 +154,10 @@ class ImpactAssembly:
     contact: ContactLaw
     solver: SolverSpec
     mean_motion: float = 0.0        # (rad/s), 0 without orbit
+    mount: NetMount | None = None
+    chaser: int | None = None
+
+    @property
+    def debris_indices(self) -> list[int]:
+        """Indices of the debris bodies (every body but the chaser)."""
+        return [k for k in range(len(self.bodies)) if k != self.chaser]

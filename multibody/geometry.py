@@ -15,17 +15,20 @@ from scipy.spatial.transform import Rotation
 
 
 def shape_mesh(kind: str, *, size=None, radius=None, length=None, axis=None, center=(0, 0, 0),
-               rotation_vector=(0, 0, 0), file=None, scale=1.0, sections=32) -> trimesh.Trimesh:
+               rotation_vector=(0, 0, 0), file=None, scale=1.0, sections=32, semi_axes=None,
+               subdivisions=3) -> trimesh.Trimesh:
     """Closed triangle mesh of one shape, target frame (m).
 
     Parameters
     ----------
-    kind : {"box", "cylinder", "sphere", "mesh"}
+    kind : {"box", "cylinder", "sphere", "ellipsoid", "mesh"}
     size : (3,) float       Box edge lengths (m), box frame.
     radius, length : float  Cylinder or sphere radius (m); cylinder length (m).
     axis : (3,) float       Cylinder axis, target frame.
+    semi_axes : (3,) float  Ellipsoid semi-axes along its own x, y, z (m) before ``rotation_vector``.
+    subdivisions : int      Icosphere refinement of the ellipsoid (3: 1280 triangles).
     center : (3,) float     Shape centre, target frame (m).
-    rotation_vector : (3,) float  Shape->target rotation for boxes and meshes (rad).
+    rotation_vector : (3,) float  Shape->target rotation for boxes, ellipsoids and meshes (rad).
     file : path             Mesh file (any format trimesh reads), vertices in m before ``scale``.
     """
     if kind == "box":
@@ -35,12 +38,15 @@ def shape_mesh(kind: str, *, size=None, radius=None, length=None, axis=None, cen
         mesh.apply_transform(_align_z_to(axis))
     elif kind == "sphere":
         mesh = trimesh.creation.icosphere(subdivisions=2, radius=radius)
+    elif kind == "ellipsoid":
+        mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
+        mesh.apply_scale(np.asarray(semi_axes, float))
     elif kind == "mesh":
         mesh = trimesh.load_mesh(Path(file), force="mesh")
         mesh.apply_scale(scale)
     else:
         raise ValueError(f"unknown shape kind {kind!r}")
-    if kind in ("box", "mesh"):
+    if kind in ("box", "ellipsoid", "mesh"):
         transform = np.eye(4)
         transform[:3, :3] = Rotation.from_rotvec(rotation_vector).as_matrix()
         mesh.apply_transform(transform)

@@ -73,13 +73,38 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
         contact_substep=(assembly.solver.contact_substep
                          if assembly.solver.integrator == "VelocityVerlet" else np.inf),
         stage_weight=1.0 / INTEGRATORS[assembly.solver.integrator][1],
+        **_mount_arrays(assembly.mount),
     )
+
+
+def _mount_arrays(mount) -> dict:
+    if mount is None:
+        return {}
+    return dict(mount_node=np.asarray(mount.nodes, np.int64),
+                mount_body=np.full(len(mount.nodes), mount.body, np.int64),
+                mount_point_body=np.ascontiguousarray(mount.points_body, float),
+                mount_stiffness=float(mount.stiffness), mount_damping=float(mount.damping))
 
 
 def _inertia6(inertia):
     """Exudyn's inertia 6-vector [Jxx, Jyy, Jzz, Jyz, Jxz, Jxy] from a 3x3 tensor."""
     j = np.asarray(inertia, float)
     return [j[0, 0], j[1, 1], j[2, 2], j[1, 2], j[0, 2], j[0, 1]]
+
+
+def add_rigid_bodies(mbs, bodies) -> tuple[list, list]:
+    """Add each body as a rotation-vector node (Lie-group integration) and a rigid body;
+    returns the node and object numbers."""
+    nodes, objects = [], []
+    for body in bodies:
+        node = mbs.AddNode(NodeRigidBodyRotVecLG(
+            referenceCoordinates=list(body.com_lvlh) + [0.0, 0.0, 0.0],
+            initialCoordinates=[0.0, 0.0, 0.0] + list(Rotation.from_matrix(body.body_to_lvlh).as_rotvec()),
+            initialVelocities=list(body.velocity_lvlh) + list(body.omega_body)))
+        nodes.append(node)
+        objects.append(mbs.AddObject(ObjectRigidBody(
+            name=body.name, nodeNumber=node, physicsMass=body.mass, physicsInertia=_inertia6(body.inertia_body))))
+    return nodes, objects
 
 
 def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms=None) -> BuiltSystem:
@@ -109,15 +134,7 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
             numberOfODE2Coordinates=3 * n))
         generic_nodes.append(net_node)
 
-    body_nodes, body_objects = [], []
-    for body in assembly.bodies:
-        node = mbs.AddNode(NodeRigidBodyRotVecLG(
-            referenceCoordinates=list(body.com_lvlh) + [0.0, 0.0, 0.0],
-            initialCoordinates=[0.0, 0.0, 0.0] + list(Rotation.from_matrix(body.body_to_lvlh).as_rotvec()),
-            initialVelocities=list(body.velocity_lvlh) + list(body.omega_body)))
-        body_nodes.append(node)
-        body_objects.append(mbs.AddObject(ObjectRigidBody(
-            name=body.name, nodeNumber=node, physicsMass=body.mass, physicsInertia=_inertia6(body.inertia_body))))
+    body_nodes, body_objects = add_rigid_bodies(mbs, assembly.bodies)
     generic_nodes += body_nodes
 
     kernel = kernel_data(assembly)

@@ -134,6 +134,12 @@ class KernelData:
     step: float                      # integrator step (s)
     contact_substep: float           # shortest contact sub-step (s); >= step disables sub-cycling
     stage_weight: float = 1.0        # 1 / force evaluations per integrator step
+    # Net nodes mounted on a body (a chaser's net frame): one stiff spring-damper per mount
+    mount_node: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # (k,) net node
+    mount_body: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # (k,) body
+    mount_point_body: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # (k, 3) body frame (m)
+    mount_stiffness: float = 0.0     # (N/m)
+    mount_damping: float = 0.0       # (N s/m)
     force: np.ndarray = field(init=False)
     body_impulse: np.ndarray = field(init=False)   # (nb, 6) accumulated contact impulse and angular impulse about CoM, LVLH
     velocity_lag: np.ndarray = field(init=False)   # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s)
@@ -173,6 +179,7 @@ class KernelData:
             self.contact_stiffness, self.contact_exponent, self.contact_damping,
             self.mu_static, self.mu_kinetic, self.transition_speed,
             self.mean_motion, self.step, n_sub, self.stage_weight, self.velocity_lag, self.lag_body,
+            self.mount_node, self.mount_body, self.mount_point_body, self.mount_stiffness, self.mount_damping,
             self.force, self.body_impulse, self.scalars)
         return self.force
 
@@ -228,6 +235,7 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
                                shape_body, shape_triangle_range, shape_box_min, shape_box_max,
                                k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
                                n_orbit, step, n_substeps, stage_weight, velocity_lag, lag_body,
+                               mount_node, mount_body, mount_point_body, k_mount, d_mount,
                                out_force, out_body_impulse, out_scalars):
     """Fill ``out_force`` with the generalized forces of the coupled system (see module doc).
 
@@ -261,6 +269,11 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
         for b in range(nb):
             f_body[b] += body_mass_all[b] * clohessy_wiltshire_acceleration(coms[b], vels[b], n_orbit)
     torque_lvlh = np.zeros((nb, 3))
+    mount_elastic, mount_power = add_mount_forces(x, v, coms, vels, rots, omegas, mount_node, mount_body,
+                                                  mount_point_body, k_mount, d_mount, f_net, f_body, torque_lvlh)
+    # Mounts are the rods that hold the net's rim on the chaser: booked with the threads.
+    out_scalars[THREAD_ELASTIC] += mount_elastic
+    out_scalars[THREAD_DISSIPATED] += mount_power * step * stage_weight
     contact_energy, n_contacts = add_contact_forces(
         x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
         triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
@@ -274,6 +287,32 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     out_scalars[N_CONTACTS] = n_contacts
     out_force[: 3 * n] = f_net.reshape(3 * n)
     return out_force
+
+
+@njit(cache=True)
+def add_mount_forces(x, v, coms, vels, rots, omegas, mount_node, mount_body, mount_point_body, k, d,
+                     f_net, f_body, torque_lvlh):
+    """Spring-dampers (k, d) from mounted net nodes to their points on a body, all LVLH.
+
+    The node's force and the body's reaction act on the same line, through the mount point,
+    so linear and angular momentum are exchanged exactly. Returns the elastic energy (J)
+    and the dissipated power (W).
+    """
+    elastic = 0.0
+    power = 0.0
+    for m in range(mount_node.shape[0]):
+        i = mount_node[m]
+        b = mount_body[m]
+        arm = rots[b] @ mount_point_body[m]
+        gap = x[i] - (coms[b] + arm)
+        rate = v[i] - (vels[b] + np.cross(omegas[b], arm))
+        f = -k * gap - d * rate
+        f_net[i] += f
+        f_body[b] -= f
+        torque_lvlh[b] -= np.cross(arm, f)
+        elastic += 0.5 * k * (gap @ gap)
+        power += d * (rate @ rate)
+    return elastic, power
 
 
 @njit(cache=True)

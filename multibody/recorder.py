@@ -153,7 +153,8 @@ class Recorder:
             moment = np.zeros_like(force)
         impulse[:] = 0.0
         self._last_output_time = t
-        masses = np.array([b.mass for b in self.assembly.bodies])
+        debris = self.assembly.debris_indices
+        masses = np.array([self.assembly.bodies[k].mass for k in debris])
         row["contact_force_lvlh"] = force
         row["contact_moment_lvlh"] = moment
         row["contact_force_body"] = np.einsum("bji,bj->bi", rot, force)
@@ -162,8 +163,8 @@ class Recorder:
         row["body_velocity_lvlh"] = vel
         row["body_omega_body"] = omega
         row["body_to_lvlh"] = rot
-        row["debris_com_lvlh"] = masses @ com / masses.sum() if len(masses) else np.zeros(3)
-        row["debris_velocity_lvlh"] = masses @ vel / masses.sum() if len(masses) else np.zeros(3)
+        row["debris_com_lvlh"] = masses @ com[debris] / masses.sum() if len(masses) else np.zeros(3)
+        row["debris_velocity_lvlh"] = masses @ vel[debris] / masses.sum() if len(masses) else np.zeros(3)
 
     def _joint_rows(self, row):
         mbs = self.system.mbs
@@ -200,13 +201,15 @@ class Recorder:
         com, vel, rot, omega = self._bodies_now
         bodies = self.assembly.bodies
         n_orbit = self.assembly.mean_motion
+        debris = self.assembly.debris_indices
+        chaser = self.assembly.chaser
         e = {
             "net_kinetic": 0.5 * np.sum(net.masses * np.sum(v * v, axis=1)),
             "net_elastic": scalars[THREAD_ELASTIC],
             "net_bending": scalars[BENDING_ELASTIC],
             "contact_elastic": scalars[CONTACT_ELASTIC],
-            "debris_translational": sum(0.5 * b.mass * vel[k] @ vel[k] for k, b in enumerate(bodies)),
-            "debris_rotational": sum(0.5 * omega[k] @ b.inertia_body @ omega[k] for k, b in enumerate(bodies)),
+            "debris_translational": sum(0.5 * bodies[k].mass * vel[k] @ vel[k] for k in debris),
+            "debris_rotational": sum(0.5 * omega[k] @ bodies[k].inertia_body @ omega[k] for k in debris),
             "joint_elastic": float(self._joint_energies.sum()),
             "released_joints": self._released_energy,
             "orbital_potential": (np.sum(net.masses * clohessy_wiltshire_potential(x, n_orbit))
@@ -215,6 +218,9 @@ class Recorder:
             "dissipated_threads": scalars[THREAD_DISSIPATED],
             "dissipated_contact": scalars[CONTACT_DISSIPATED],
         }
+        if chaser is not None:
+            b = bodies[chaser]
+            e["chaser_kinetic"] = 0.5 * b.mass * vel[chaser] @ vel[chaser] + 0.5 * omega[chaser] @ b.inertia_body @ omega[chaser]
         e["total"] = sum(e.values())
         for key, value in e.items():
             row["energy_" + key] = value

@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from multibody.assembly import ContactLaw, ImpactAssembly, JointSpec, RigidBodySpec, SolverSpec, subtree_bodies
+from multibody.assembly import (ContactLaw, ImpactAssembly, JointSpec, NetMount, RigidBodySpec, SolverSpec,
+                                subtree_bodies)
 from multibody.geometry import geometric_center_of_mass, shape_mesh, uniform_density_inertia
 from multibody.hinge import hinge_frame_lvlh
 from multibody.net import flat_square_net, thread_node_mass
@@ -153,10 +154,38 @@ def _apply_initial_hinge_state(bodies, joints, index, angle, rate):
         b.omega_body = b.omega_body + rate * (b.body_to_lvlh.T @ axis)
 
 
+def rim_nodes(nodes_per_side: int) -> np.ndarray:
+    """Indices of the square grid's perimeter nodes (row-major grid, see multibody.net)."""
+    i, j = np.divmod(np.arange(nodes_per_side**2), nodes_per_side)
+    return np.flatnonzero((i == 0) | (j == 0) | (i == nodes_per_side - 1) | (j == nodes_per_side - 1))
+
+
+def build_chaser(case: Case, net) -> tuple[RigidBodySpec, NetMount]:
+    """The chaser body behind the net plane, moving with the net, and the rods holding the rim."""
+    chaser, launch = case.chaser, case.launch
+    direction = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
+    n = case.net.nodes_per_side
+    net_center = net.positions[: n * n].mean(axis=0)
+    com = net_center - chaser.standoff * direction
+    body = RigidBodySpec(name="chaser", mass=chaser.mass, inertia_body=np.diag(chaser.principal_inertia),
+                         com_lvlh=com, velocity_lvlh=launch.velocity * direction)
+    rim = rim_nodes(n)
+    mount = NetMount(nodes=rim, body=-1, points_body=net.positions[rim] - com,
+                     stiffness=chaser.mount_stiffness, damping=chaser.mount_damping)
+    return body, mount
+
+
 def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
     """Everything :class:`multibody.impact.ImpactSimulation` needs for this case."""
     net, velocity = build_net(case)
     bodies, joints, rest_att, rest_com = build_bodies_and_joints(case, base)
+    mount = chaser_index = None
+    if case.chaser is not None:
+        chaser, mount = build_chaser(case, net)
+        chaser_index = mount.body = len(bodies)
+        bodies.append(chaser)
+        rest_att.append(chaser.body_to_lvlh.copy())
+        rest_com.append(chaser.com_lvlh.copy())
     law = case.contact
     sim = case.simulation
     assembly = ImpactAssembly(
@@ -167,7 +196,8 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
         solver=SolverSpec(end_time=sim.end_time, step=sim.step, integrator=sim.integrator,
                           output_rate=sim.output_rate, net_output_rate=sim.net_output_rate,
                           contact_substep=sim.contact_substep),
-        mean_motion=mean_motion(case.orbit.altitude) if isinstance(case.orbit, CircularOrbit) else 0.0)
+        mean_motion=mean_motion(case.orbit.altitude) if isinstance(case.orbit, CircularOrbit) else 0.0,
+        mount=mount, chaser=chaser_index)
     return ModelInputs(assembly, rest_att, rest_com)
 
 

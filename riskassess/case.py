@@ -168,6 +168,14 @@ class Sphere(Strict):
     center: Vector3 = Field(description="Centre, target frame (m).")
 
 
+class Ellipsoid(Strict):
+    kind: Literal["ellipsoid"]
+    semi_axes: Annotated[list[Positive], Field(min_length=3, max_length=3)] = Field(
+        description="Semi-axes along the ellipsoid's own x, y, z (m).")
+    center: Vector3 = Field(description="Centre, target frame (m).")
+    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Ellipsoid->target rotation (rad).")
+
+
 class MeshFile(Strict):
     kind: Literal["mesh"]
     file: str = Field(description="Closed triangle mesh (STL, OBJ, PLY...), path relative to the case file.")
@@ -176,7 +184,7 @@ class MeshFile(Strict):
     rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Mesh->target rotation (rad).")
 
 
-Shape = Annotated[Union[Box, Cylinder, Sphere, MeshFile], Field(discriminator="kind")]
+Shape = Annotated[Union[Box, Cylinder, Sphere, Ellipsoid, MeshFile], Field(discriminator="kind")]
 
 
 class Body(Strict):
@@ -257,6 +265,57 @@ class Target(Strict):
         if len(roots) != 1:
             raise ValueError(f"the joints must form one tree with a single root body. Roots found: {roots}")
         return self
+
+
+# ---------------------------------------------------------------------------- chaser
+class Chaser(Strict):
+    """The chaser simulated as a rigid body carrying the net on rods (a "netted pocket",
+    Tang et al. 2023 Sec. 4.2.2): the net's rim nodes are mounted on it and the whole
+    assembly flies at the target with the launch velocity."""
+    mass: Positive = Field(description="Chaser mass (kg).")
+    principal_inertia: Annotated[list[Positive], Field(min_length=3, max_length=3)] = Field(
+        description="Principal moments of inertia about its CoM, axes parallel to LVLH at t = 0 (kg m^2).")
+    standoff: Positive = Field(description="Distance from the chaser CoM back to the net plane along the launch direction (m).")
+    mount_stiffness: Positive = Field(description="Stiffness of each rod holding a rim node (N/m).")
+    mount_damping: NonNegative = Field(0.0, description="Damping of each rod (N s/m).")
+
+
+# ---------------------------------------------------------------------------- perception
+class Lidar(Strict):
+    position_chaser: Vector3 = Field([0.0, 0.0, 0.0], description="Sensor origin relative to the chaser CoM, LVLH axes at t = 0 (m).")
+    boresight_lvlh: Vector3 = Field(description="Sensor boresight (+x of the sensor frame), LVLH at t = 0 (-).")
+    up_lvlh: Vector3 = Field([0.0, 0.0, 1.0], description="Sensor +z (elevation up), LVLH; made orthogonal to the boresight (-).")
+    fov_azimuth: Annotated[float, Field(gt=0, le=2 * np.pi)] = Field(description="Full horizontal field of view (rad).")
+    fov_elevation: Annotated[float, Field(gt=0, le=np.pi)] = Field(description="Full vertical field of view (rad).")
+    resolution_azimuth: Positive = Field(description="Angle between rays, horizontal (rad).")
+    resolution_elevation: Positive = Field(description="Angle between rays, vertical (rad).")
+    range_noise: NonNegative = Field(description="Range noise 1 sigma (m), constant over range.")
+    rate: Annotated[float, Field(gt=0, le=100)] = Field(description="Frames per second (Hz).")
+    max_range: Positive = Field(200.0, description="Longest range returned (m).")
+
+    @model_validator(mode="after")
+    def _grid_size(self):
+        rays = (self.fov_azimuth / self.resolution_azimuth + 1) * (self.fov_elevation / self.resolution_elevation + 1)
+        if rays > 5e6:
+            raise ValueError(f"the ray grid has {rays:.3g} rays per frame; at most 5e6 are allowed "
+                             f"(coarsen the resolution or narrow the field of view)")
+        if abs(np.dot(self.boresight_lvlh, self.up_lvlh)) >= 0.999 * np.linalg.norm(self.boresight_lvlh) * np.linalg.norm(self.up_lvlh):
+            raise ValueError("up_lvlh must not be parallel to boresight_lvlh")
+        return self
+
+
+class Registration(Strict):
+    voxel: Positive = Field(0.03, description="Voxel size the scans are thinned to before ICP (m).")
+    model_frames: Annotated[int, Field(ge=1)] = Field(30, description="Frames merged into the debris model before it is frozen (-).")
+    max_correspondence: Positive = Field(0.1, description="ICP correspondence distance (m).")
+
+
+class Perception(Strict):
+    observation_time: Positive = Field(description="LiDAR tracking of the free tumble before the chaser moves in (s).")
+    hold_distance: Positive = Field(10.0, description="Chaser CoM to debris CoM while it observes, back along the launch direction (m).")
+    seed: int = Field(0, description="Seed of the range noise (-).")
+    lidar: Lidar
+    registration: Registration = Registration()
 
 
 # ---------------------------------------------------------------------------- structures
@@ -363,6 +422,8 @@ class Case(Strict):
     contact: Contact
     target: Target
     structures: Structures | None = None
+    chaser: Chaser | None = None
+    perception: Perception | None = None
 
     @model_validator(mode="after")
     def _weak_location_joints(self):
