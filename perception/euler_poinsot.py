@@ -1,0 +1,204 @@
+"""Torque-free rigid-body rotation (Euler-Poinsot) and its fit to a measured attitude sequence.
+
+Frames: **T** principal-axis body frame; **B** the body frame of the registration model
+(its axes are those of the world frame at the first scan); **W** the world frame the
+attitudes are measured in (inertial; LVLH without orbit).
+
+The paper (Tang et al. 2023, eq. 18) fits the normalized inertia to angular rates and
+accelerations obtained by central differences of registered poses. Here that linear fit
+(:func:`normalized_inertia_linear`) only gives the starting point; the estimate is the
+maximum-likelihood fit of the whole torque-free trajectory to the measured attitudes
+(:class:`TorqueFreeFit`), which needs no differentiation of noisy poses.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+
+@njit(cache=True)
+def _euler_rate(omega, j):
+    """dω/dt of a torque-free body, principal frame: J ω' = -ω x J ω (Euler's equations)."""
+    return np.array([(j[1] - j[2]) * omega[1] * omega[2] / j[0],
+                     (j[2] - j[0]) * omega[2] * omega[0] / j[1],
+                     (j[0] - j[1]) * omega[0] * omega[1] / j[2]])
+
+
+@njit(cache=True)
+def _quaternion_rate(q, omega):
+    """dq/dt = q ⊗ (0, ω)/2 for q = [w, x, y, z] (body->world), ω in the body frame."""
+    w, x, y, z = q
+    a, b, c = omega
+    return 0.5 * np.array([-x * a - y * b - z * c, w * a + y * c - z * b, w * b + z * a - x * c, w * c + x * b - y * a])
+
+
+@njit(cache=True)
+def propagate_torque_free(q0, omega0, principal_moments, times, max_step):
+    """Attitude quaternions (k, 4) [w, x, y, z] principal->world and rates (k, 3) (rad/s,
+    principal frame) at ``times`` (s, increasing, ``times[0]`` the initial time), by RK4
+    with steps no longer than ``max_step`` (s)."""
+    k = times.shape[0]
+    qs = np.empty((k, 4))
+    ws = np.empty((k, 3))
+    q = q0.copy()
+    w = omega0.copy()
+    qs[0] = q
+    ws[0] = w
+    for i in range(1, k):
+        span = times[i] - times[i - 1]
+        n = max(1, int(np.ceil(span / max_step)))
+        h = span / n
+        for _ in range(n):
+            k1q = _quaternion_rate(q, w)
+            k1w = _euler_rate(w, principal_moments)
+            k2q = _quaternion_rate(q + 0.5 * h * k1q, w + 0.5 * h * k1w)
+            k2w = _euler_rate(w + 0.5 * h * k1w, principal_moments)
+            k3q = _quaternion_rate(q + 0.5 * h * k2q, w + 0.5 * h * k2w)
+            k3w = _euler_rate(w + 0.5 * h * k2w, principal_moments)
+            k4q = _quaternion_rate(q + h * k3q, w + h * k3w)
+            k4w = _euler_rate(w + h * k3w, principal_moments)
+            q = q + h / 6.0 * (k1q + 2 * k2q + 2 * k3q + k4q)
+            w = w + h / 6.0 * (k1w + 2 * k2w + 2 * k3w + k4w)
+            q = q / np.sqrt(q @ q)
+        qs[i] = q
+        ws[i] = w
+    return qs, ws
+
+
+def rotations_from_wxyz(q) -> Rotation:
+    return Rotation.from_quat(np.asarray(q)[:, [1, 2, 3, 0]])
+
+
+def normalized_inertia_linear(omega_body, omega_dot_body) -> np.ndarray:
+    """Normalized inertia (3, 3) (largest eigenvalue... scaled so trace = 3), body frame, from
+    rates (k, 3) and accelerations (k, 3) through the torque-free Euler equation
+    J ω' + ω x J ω = 0, linear and homogeneous in the six entries of J (Tang et al. 2023,
+    eq. 18): the right singular vector of the smallest singular value."""
+    w = np.asarray(omega_body, float)
+    a = np.asarray(omega_dot_body, float)
+    rows = []
+    # J = [[j0, j3, j4], [j3, j1, j5], [j4, j5, j2]]
+    basis = [np.diag([1.0, 0, 0]), np.diag([0, 1.0, 0]), np.diag([0, 0, 1.0])]
+    for (r, c) in ((0, 1), (0, 2), (1, 2)):
+        e = np.zeros((3, 3))
+        e[r, c] = e[c, r] = 1.0
+        basis.append(e)
+    columns = [a @ e.T + np.cross(w, w @ e.T) for e in basis]   # (k, 3) each
+    matrix = np.stack([c.ravel() for c in columns], axis=1)
+    _, _, vt = np.linalg.svd(matrix, full_matrices=False)
+    j = sum(coef * e for coef, e in zip(vt[-1], basis))
+    if np.trace(j) < 0:
+        j = -j
+    return 3.0 * j / np.trace(j)
+
+
+def principal_frame(normalized_inertia) -> tuple[np.ndarray, np.ndarray]:
+    """Principal moments (3,) divided by the smallest, sorted so the last is 1 (the paper's
+    C axis is the minimum), and the rotation T->B (3, 3) whose columns are the principal axes."""
+    values, vectors = np.linalg.eigh(normalized_inertia)
+    order = np.argsort(values)[::-1]
+    values, vectors = values[order], vectors[:, order]
+    if np.linalg.det(vectors) < 0:
+        vectors[:, 2] *= -1
+    return values / values[-1], vectors
+
+
+class TorqueFreeFit:
+    """Maximum-likelihood torque-free motion through measured attitudes (scikit-learn style).
+
+    Parameters
+    ----------
+    moments : (3,) float or None   Known normalized principal moments [J1, J2, 1]; None: estimate.
+    principal_to_body : (3, 3) float or None  Known rotation T->B; None: estimate (needs ``moments`` None).
+    max_step : float               RK4 step limit of the propagation (s).
+
+    Attributes (after :meth:`fit`)
+    ------------------------------
+    moments_ : (3,) float           [A/C, B/C, 1], normalized principal moments (Tang et al. 2023, eq. 19).
+    principal_to_body_ : (3, 3)     T->B.
+    omega0_principal_ : (3,) float  Rate at ``times[0]`` (rad/s), principal frame.
+    principal_to_world0_ : (3, 3)   T->W at ``times[0]``.
+    residual_rms_ : float           Weighted RMS of the attitude residuals (-; 1 when the weights are right).
+    covariance_ : (p, p) float      Parameter covariance (J^T J)^-1 scaled by the residual variance.
+    """
+
+    def __init__(self, moments=None, principal_to_body=None, max_step=0.01):
+        self.moments = moments
+        self.principal_to_body = principal_to_body
+        self.max_step = max_step
+
+    # -- parameter vector ------------------------------------------------------------
+    def _unpack(self, p):
+        t2w = Rotation.from_rotvec(p[:3]) * self._t2w_ref
+        omega = p[3:6]
+        if self.moments is None:
+            moments = np.array([np.exp(p[6]), np.exp(p[7]), 1.0])
+            t2b = (Rotation.from_rotvec(p[8:11]) * self._t2b_ref).as_matrix()
+        else:
+            moments = np.asarray(self.moments, float)
+            t2b = np.asarray(self.principal_to_body, float)
+        return t2w, omega, moments, t2b
+
+    def predict_body_to_world(self, times) -> Rotation:
+        """Attitudes B->W at ``times`` (s) of the fitted motion."""
+        t2w, omega, moments, t2b = self._unpack(self._p)
+        return self._body_to_world(t2w, omega, moments, t2b, np.asarray(times, float))
+
+    def _body_to_world(self, t2w, omega, moments, t2b, times):
+        q0 = t2w.as_quat()[[3, 0, 1, 2]]
+        qs, _ = propagate_torque_free(q0, omega, moments, times, self.max_step)
+        return rotations_from_wxyz(qs) * Rotation.from_matrix(t2b.T)
+
+    def rates_principal(self, times) -> np.ndarray:
+        t2w, omega, moments, _ = self._unpack(self._p)
+        _, ws = propagate_torque_free(t2w.as_quat()[[3, 0, 1, 2]], omega, moments, np.asarray(times, float), self.max_step)
+        return ws
+
+    def _residuals(self, p, times, measured_inv, weights):
+        t2w, omega, moments, t2b = self._unpack(p)
+        predicted = self._body_to_world(t2w, omega, moments, t2b, times)
+        error = (measured_inv * predicted).as_rotvec()             # B frame, small
+        return np.einsum("kij,kj->ki", weights, error).ravel()
+
+    # -- fitting ---------------------------------------------------------------------
+    def fit(self, times, body_to_world: Rotation, weights, omega0_body, moments0=None, principal_to_body0=None):
+        """Fit the motion through the attitudes.
+
+        Parameters
+        ----------
+        times : (k,) float              (s)
+        body_to_world : Rotation (k,)   Measured attitudes B->W.
+        weights : (k, 3, 3) float       Square roots of the attitude information (1/rad), B frame.
+        omega0_body : (3,) float        Starting rate at ``times[0]`` (rad/s), B frame.
+        moments0, principal_to_body0 :  Starting inertia (ignored when known).
+        """
+        times = np.asarray(times, float)
+        if self.moments is None:
+            self._t2b_ref = Rotation.from_matrix(principal_to_body0)
+            t2b = principal_to_body0
+        else:
+            t2b = np.asarray(self.principal_to_body, float)
+        self._t2w_ref = body_to_world[0] * Rotation.from_matrix(t2b)
+        p0 = np.r_[np.zeros(3), t2b.T @ omega0_body]
+        if self.moments is None:
+            p0 = np.r_[p0, np.log(moments0[:2]), np.zeros(3)]
+        result = least_squares(self._residuals, p0, args=(times, body_to_world.inv(), weights),
+                               method="lm", x_scale="jac")
+        self._p = result.x
+        t2w, omega, moments, t2b = self._unpack(result.x)
+        self.moments_, self.principal_to_body_ = moments, t2b
+        self.omega0_principal_, self.principal_to_world0_ = omega, t2w.as_matrix()
+        dof = max(result.fun.size - result.x.size, 1)
+        self.residual_rms_ = float(np.sqrt(result.fun @ result.fun / dof))
+        jac = result.jac
+        self.covariance_ = np.linalg.pinv(jac.T @ jac) * self.residual_rms_**2
+        return self
+
+    @property
+    def moments_std_(self) -> np.ndarray:
+        """1-sigma of [A/C, B/C] (-), from the covariance (delta method on the log parameters)."""
+        if self.moments is not None:
+            return np.zeros(2)
+        return self.moments_[:2] * np.sqrt(np.diag(self.covariance_)[6:8])
