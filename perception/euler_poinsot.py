@@ -113,6 +113,7 @@ class TorqueFreeFit:
     moments : (3,) float or None   Known normalized principal moments [J1, J2, 1]; None: estimate.
     principal_to_body : (3, 3) float or None  Known rotation T->B; None: estimate (needs ``moments`` None).
     max_step : float               RK4 step limit of the propagation (s).
+    first_span : float             Length of the first fitted span (s); doubled until all data are in.
 
     Attributes (after :meth:`fit`)
     ------------------------------
@@ -124,10 +125,11 @@ class TorqueFreeFit:
     covariance_ : (p, p) float      Parameter covariance (J^T J)^-1 scaled by the residual variance.
     """
 
-    def __init__(self, moments=None, principal_to_body=None, max_step=0.01):
+    def __init__(self, moments=None, principal_to_body=None, max_step=0.01, first_span=5.0):
         self.moments = moments
         self.principal_to_body = principal_to_body
         self.max_step = max_step
+        self.first_span = first_span
 
     # -- parameter vector ------------------------------------------------------------
     def _unpack(self, p):
@@ -162,6 +164,15 @@ class TorqueFreeFit:
         error = (measured_inv * predicted).as_rotvec()             # B frame, small
         return np.einsum("kij,kj->ki", weights, error).ravel()
 
+    def _bounds(self, size):
+        """Moments ratios kept within [1/2, 2] of the smallest: a rigid body's principal moments
+        obey the triangle inequality (each at most the sum of the others), so no ratio between
+        them exceeds 2; the bound stops short spans from wandering into a degenerate top."""
+        lower, upper = np.full(size, -np.inf), np.full(size, np.inf)
+        if self.moments is None:
+            lower[6:8], upper[6:8] = np.log(0.5), np.log(2.0)
+        return lower, upper
+
     # -- fitting ---------------------------------------------------------------------
     def fit(self, times, body_to_world: Rotation, weights, omega0_body, moments0=None, principal_to_body0=None):
         """Fit the motion through the attitudes.
@@ -184,8 +195,18 @@ class TorqueFreeFit:
         p0 = np.r_[np.zeros(3), t2b.T @ omega0_body]
         if self.moments is None:
             p0 = np.r_[p0, np.log(moments0[:2]), np.zeros(3)]
-        result = least_squares(self._residuals, p0, args=(times, body_to_world.inv(), weights),
-                               method="lm", x_scale="jac")
+        measured_inv = body_to_world.inv()
+        # Continuation: the attitude error of a wrong inertia grows with time, so a long span
+        # seen at once has many local minima; fit a short span, then double it.
+        span = min(self.first_span, times[-1] - times[0])
+        while True:
+            use = times <= times[0] + span + 1e-9
+            result = least_squares(self._residuals, p0, args=(times[use], measured_inv[use], weights[use]),
+                                   bounds=self._bounds(p0.size), x_scale="jac")
+            p0 = result.x
+            if use.all():
+                break
+            span *= 2.0
         self._p = result.x
         t2w, omega, moments, t2b = self._unpack(result.x)
         self.moments_, self.principal_to_body_ = moments, t2b
