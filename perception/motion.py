@@ -1,0 +1,94 @@
+"""Rates and centre of mass from a registered pose sequence (Tang et al. 2023, Sec. 3.1).
+
+The paper takes rates and accelerations from central differences of the poses (its eqs. 9-10)
+and the CoM from intersecting spheres around feature points (eqs. 14-16). Here:
+
+* rates and accelerations come from local quadratic fits of the rotation over a sliding
+  window (a Savitzky-Golay filter on the rotation group), which smooths the ~1 deg frame-to-
+  frame registration noise instead of differencing it;
+* the CoM is the one body-fixed point that moves on a straight line: with body->world poses
+  (R_k, t_k), ``R_k c_B + t_k = p_0 + v (t_k - t_0)`` is linear in (c_B, p_0, v) and solved by
+  least squares over all frames. It is observable only if the body turns.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+
+class NotObservable(ValueError):
+    """The data cannot determine the quantity asked for (the message says why)."""
+
+
+def rates_from_attitudes(times, body_to_world: Rotation, half_window: int = 5):
+    """Angular velocity (k, 3) (rad/s) and acceleration (k, 3) (rad/s^2), body frame, from a
+    quadratic fit of log(R_k^-1 R_j) against (t_j - t_k) over the 2 half_window + 1 frames
+    around each frame (fewer at the ends)."""
+    times = np.asarray(times, float)
+    k = len(times)
+    omega = np.zeros((k, 3))
+    omega_dot = np.zeros((k, 3))
+    for i in range(k):
+        lo, hi = max(0, i - half_window), min(k, i + half_window + 1)
+        dt = times[lo:hi] - times[i]
+        local = (body_to_world[i].inv() * body_to_world[lo:hi]).as_rotvec()   # body frame at i
+        basis = np.vander(dt, 3, increasing=True)
+        coefficients, *_ = np.linalg.lstsq(basis, local, rcond=None)
+        omega[i] = coefficients[1]
+        omega_dot[i] = 2.0 * coefficients[2]
+    return omega, omega_dot
+
+
+@dataclass
+class CenterOfMassLine:
+    """CoM of a freely moving body from its poses.
+
+    Attributes: ``com_body`` (3,) CoM in the model frame B (m); ``position0_world`` (3,) at
+    ``time0`` (m); ``velocity_world`` (3,) (m/s); ``residual_rms`` (m); ``covariance`` (9, 9).
+    """
+
+    com_body: np.ndarray
+    position0_world: np.ndarray
+    velocity_world: np.ndarray
+    time0: float
+    residual_rms: float
+    covariance: np.ndarray
+
+    def position_world(self, times) -> np.ndarray:
+        return self.position0_world + np.outer(np.asarray(times) - self.time0, self.velocity_world)
+
+
+def center_of_mass_line(times, body_to_world, origin_world, com_body=None) -> CenterOfMassLine:
+    """Fit ``R_k c_B + t_k = p_0 + v (t_k - t_0)``; with ``com_body`` given, only p_0 and v.
+
+    Parameters
+    ----------
+    times : (k,) float             (s)
+    body_to_world : (k, 3, 3)      Attitudes B->world.
+    origin_world : (k, 3) float    Position of B's origin, world frame (m).
+    """
+    times = np.asarray(times, float)
+    rot = np.asarray(body_to_world, float)
+    origin = np.asarray(origin_world, float)
+    k = len(times)
+    eye = np.tile(np.eye(3), (k, 1, 1))
+    tau = (times - times[0])[:, None, None] * eye
+    if com_body is None:
+        turn = np.degrees(max(Rotation.from_matrix(rot[0].T @ r).magnitude() for r in rot))
+        if turn < 5.0:
+            raise NotObservable(f"the CoM needs the body to turn; it turned only {turn:.2f} deg over the frames")
+        design = np.concatenate([rot, -eye, -tau], axis=2).reshape(3 * k, 9)
+        rhs = -origin.reshape(-1)
+    else:
+        design = np.concatenate([-eye, -tau], axis=2).reshape(3 * k, 6)
+        rhs = -(origin + rot @ np.asarray(com_body, float)).reshape(-1)
+    solution, *_ = np.linalg.lstsq(design, rhs, rcond=None)
+    residual = design @ solution - rhs
+    dof = max(len(rhs) - len(solution), 1)
+    rms = float(np.sqrt(residual @ residual / dof))
+    covariance = np.linalg.pinv(design.T @ design) * rms**2
+    if com_body is None:
+        return CenterOfMassLine(solution[:3], solution[3:6], solution[6:9], times[0], rms, covariance)
+    return CenterOfMassLine(np.asarray(com_body, float), solution[:3], solution[3:6], times[0], rms, covariance)
