@@ -7,14 +7,12 @@ function, so the whole run stays in Exudyn's C++ core.
 """
 from __future__ import annotations
 
-import copy
-
 import exudyn as exu
 import numpy as np
 
 from multibody.assembly import RigidBodySpec
 from multibody.hinge import add_penalty_joint
-from multibody.impact import add_rigid_bodies, solver_chatter_to_stderr
+from multibody.impact import add_rigid_bodies, explicit_settings, solver_chatter_to_stderr
 from multibody.kernel import rotation_matrix_from_rotation_vector
 
 
@@ -60,29 +58,7 @@ def free_motion(bodies: list[RigidBodySpec], joints, sample_times, step: float =
 
     record(mbs, 0.0)
     mbs.SetPostStepUserFunction(record)
-    settings = exu.SimulationSettings()
-    n_steps = int(round(sample_times[-1] / step))
-    settings.timeIntegration.endTime = n_steps * step
-    settings.timeIntegration.numberOfSteps = n_steps
-    settings.timeIntegration.verboseMode = 0
-    settings.timeIntegration.explicit.useLieGroupIntegration = True
-    settings.timeIntegration.explicit.computeEndOfStepAccelerations = False
-    settings.solution.file.write = False
-    settings.solution.sensors.active = False
-    settings.parallel.numberOfThreads = 1
+    settings = explicit_settings(step, int(round(sample_times[-1] / step)))
     with solver_chatter_to_stderr():
         exu.SolveDynamic(mbs, settings, solverType=exu.DynamicSolverType.RK44)
     return {key: np.array(value, float) for key, value in states.items()}
-
-
-def bodies_at(bodies: list[RigidBodySpec], states: dict, k: int) -> list[RigidBodySpec]:
-    """Copies of ``bodies`` carrying the sampled state ``k`` (for the next phase's initial state)."""
-    out = []
-    for b, body in enumerate(bodies):
-        moved = copy.copy(body)
-        moved.com_lvlh = states["body_com_lvlh"][k, b].copy()
-        moved.velocity_lvlh = states["body_velocity_lvlh"][k, b].copy()
-        moved.body_to_lvlh = states["body_to_lvlh"][k, b].copy()
-        moved.omega_body = states["body_omega_body"][k, b].copy()
-        out.append(moved)
-    return out

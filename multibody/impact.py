@@ -239,20 +239,25 @@ class VerletForces:
         return True
 
 
-def simulation_settings(assembly: ImpactAssembly) -> exu.SimulationSettings:
-    """Explicit fixed-step settings: sparse mass matrix factorized once, no files written."""
+def explicit_settings(step: float, n_steps: int) -> exu.SimulationSettings:
+    """Explicit fixed-step settings with Lie-group rotation updates, no files written."""
     s = exu.SimulationSettings()
-    solver = assembly.solver
-    s.timeIntegration.endTime = solver.n_steps * solver.step
-    s.timeIntegration.numberOfSteps = solver.n_steps
+    s.timeIntegration.endTime = n_steps * step
+    s.timeIntegration.numberOfSteps = n_steps
     s.timeIntegration.verboseMode = 0
     s.timeIntegration.explicit.computeEndOfStepAccelerations = False
     s.timeIntegration.explicit.useLieGroupIntegration = True
-    s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     s.solution.file.write = False
     s.solution.sensors.active = False
     # Python user functions must stay on one thread (EXUDYN-NOTES: two threads can hang).
     s.parallel.numberOfThreads = 1
+    return s
+
+
+def simulation_settings(assembly: ImpactAssembly) -> exu.SimulationSettings:
+    """The impact's settings: explicit, sparse mass matrix factorized once."""
+    s = explicit_settings(assembly.solver.step, assembly.solver.n_steps)
+    s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     return s
 
 

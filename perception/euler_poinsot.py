@@ -72,7 +72,7 @@ def rotations_from_wxyz(q) -> Rotation:
 
 
 def normalized_inertia_linear(omega_body, omega_dot_body) -> np.ndarray:
-    """Normalized inertia (3, 3) (largest eigenvalue... scaled so trace = 3), body frame, from
+    """Normalized inertia (3, 3), scaled to trace 3, body frame, from
     rates (k, 3) and accelerations (k, 3) through the torque-free Euler equation
     J ω' + ω x J ω = 0, linear and homogeneous in the six entries of J (Tang et al. 2023,
     eq. 18): the right singular vector of the smallest singular value."""
@@ -152,11 +152,6 @@ class TorqueFreeFit:
         q0 = t2w.as_quat()[[3, 0, 1, 2]]
         qs, _ = propagate_torque_free(q0, omega, moments, times, self.max_step)
         return rotations_from_wxyz(qs) * Rotation.from_matrix(t2b.T)
-
-    def rates_principal(self, times) -> np.ndarray:
-        t2w, omega, moments, _ = self._unpack(self._p)
-        _, ws = propagate_torque_free(t2w.as_quat()[[3, 0, 1, 2]], omega, moments, np.asarray(times, float), self.max_step)
-        return ws
 
     def _residuals(self, p, times, measured_inv, weights):
         t2w, omega, moments, t2b = self._unpack(p)

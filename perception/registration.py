@@ -96,17 +96,15 @@ def _cloud(points, normals_radius=None) -> o3d.geometry.PointCloud:
     return cloud
 
 
-def point_to_plane_information(points_body, model_points, model_normals, tree, sigma) -> tuple[np.ndarray, np.ndarray]:
-    """Information (6, 6) of a point-to-plane alignment and the signed distances (n,) (m).
+def point_to_plane_information(points_body, normals, sigma) -> np.ndarray:
+    """Information (6, 6) of a point-to-plane alignment of scan points (n, 3) (B frame) on model
+    planes with normals (n, 3), residual scatter ``sigma`` (m).
 
-    Residual n.(q - m) for scan point q (B frame) and its nearest model point m with normal n;
-    its gradient with respect to a left rotation/translation of the pose is [(q x n), n].
+    Residual n.(q - m) for scan point q and its nearest model point m with normal n; its
+    gradient with respect to a left rotation/translation of the pose is [(q x n), n].
     """
-    _, index = tree.query(points_body)
-    n = model_normals[index]
-    distance = np.einsum("ij,ij->i", points_body - model_points[index], n)
-    jac = np.hstack([np.cross(points_body, n), n])
-    return jac.T @ jac / sigma**2, distance
+    jac = np.hstack([np.cross(points_body, normals), normals])
+    return jac.T @ jac / sigma**2
 
 
 def free_space_violation(points_world, model_world, sensor_world, bin_angle, margin) -> float:
@@ -121,11 +119,13 @@ def free_space_violation(points_world, model_world, sensor_world, bin_angle, mar
 
     scan_bin, scan_range = bins(points_world)
     model_bin, model_range = bins(model_world)
-    order = np.argsort(scan_range)[::-1]
-    nearest = dict(zip(scan_bin[order], scan_range[order]))   # last write wins: the nearest return
-    seen = np.array([nearest.get(b, np.inf) for b in model_bin])
+    order = np.lexsort((scan_range, scan_bin))             # by bin, nearest return first
+    first = np.r_[True, np.diff(scan_bin[order]) != 0]
+    seen_bin, nearest = scan_bin[order][first], scan_range[order][first]
+    slot = np.clip(np.searchsorted(seen_bin, model_bin), 0, len(seen_bin) - 1)
+    seen = np.where(seen_bin[slot] == model_bin, nearest[slot], np.inf)
     blocked = np.unique(model_bin[np.isfinite(seen) & (model_range < seen - margin)])
-    return len(blocked) / max(len(nearest), 1)
+    return len(blocked) / max(len(seen_bin), 1)
 
 
 def _transform(points, matrix) -> np.ndarray:
@@ -187,25 +187,22 @@ class DebrisTracker:
         start = time.perf_counter()
         scan = _cloud(points_world).voxel_down_sample(self.voxel)
         points = np.asarray(scan.points)
-        if not self.alignments and self._model is not None:
-            start_pose = np.eye(4)
-            start_pose[:3, 3] = -points.mean(axis=0)
-            alignment = self._search(time_s, scan, points, start_pose, sensor_world, _orientation_candidates())
-        elif self._model is None:
-            pose = np.eye(4)
-            pose[:3, 3] = -points.mean(axis=0)
-            self._set_model(_transform(points, pose))
-            self._frames_in_model = 1
-            alignment = Alignment(time_s, pose, np.zeros((6, 6)), 1.0, 0.0, 0.0, True, False,
-                                  time.perf_counter() - start, len(points))
-            self.alignments.append(alignment)
-            return alignment
+        if not self.alignments:
+            centroid_pose = np.eye(4)
+            centroid_pose[:3, 3] = -points.mean(axis=0)
+            if self._model is None:   # the first scan starts the model and defines the frame B
+                self._set_model(_transform(points, centroid_pose))
+                alignment = Alignment(time_s, centroid_pose, np.zeros((6, 6)), 1.0, 0.0, 0.0, True, False, 0.0,
+                                      len(points))
+            else:
+                alignment = self._search(time_s, scan, points, centroid_pose, sensor_world, _orientation_candidates())
         else:
             alignment = self._track(time_s, scan, points, sensor_world)
         alignment.seconds = time.perf_counter() - start
         self.alignments.append(alignment)
         if alignment.ok and self._frames_in_model < self.model_frames:
-            self._set_model(np.vstack([self._model_points, _transform(points, alignment.world_to_body)]))
+            if self._frames_in_model:
+                self._set_model(np.vstack([self._model_points, _transform(points, alignment.world_to_body)]))
             self._frames_in_model += 1
         return alignment
 
@@ -219,7 +216,7 @@ class DebrisTracker:
         if not alignment.ok:
             pose = self._icp(scan, self._global(scan, predicted))
             retry = self._judge(time_s, points, pose, predicted, sensor_world, has_motion, global_init=True)
-            if retry.ok or (not alignment.ok and retry.tight_fitness > alignment.tight_fitness):
+            if retry.ok or retry.tight_fitness > alignment.tight_fitness:
                 alignment = retry
         return alignment
 
@@ -236,10 +233,10 @@ class DebrisTracker:
         largest turn expected between frames, keeping the best-checked result: a smooth body
         (the paper's ellipsoid) gives ICP a basin of only a few degrees."""
         best = None
+        pivot = points.mean(axis=0)   # turn about the scan centroid (world), not the model origin
         for turn in _turn_candidates(SEARCH_TURN) if turns is None else turns:
             seed = start.copy()
             seed[:3, :3] = turn @ start[:3, :3]
-            pivot = points.mean(axis=0)   # turn about the scan centroid (world), not the model origin
             seed[:3, 3] = start[:3, 3] + start[:3, :3] @ pivot - seed[:3, :3] @ pivot
             pose = self._icp(scan, seed)
             candidate = self._judge(time_s, points, pose, start, sensor_world, False)
@@ -273,12 +270,13 @@ class DebrisTracker:
 
     def _judge(self, time_s, points_world, pose, predicted, sensor_world, has_motion, global_init=False) -> Alignment:
         points_body = _transform(points_world, pose)
-        first = point_to_plane_information(points_body, self._model_points, self._model_normals, self._tree, 1.0)[1]
-        inliers = np.abs(first) < self.max_correspondence / 3
-        sigma = max(float(np.sqrt(np.mean(first[inliers] ** 2))) if inliers.sum() > 6 else self.voxel, 1e-4)
-        information, _ = point_to_plane_information(points_body[inliers], self._model_points, self._model_normals,
-                                                    self._tree, sigma)
-        tight = float(np.mean(np.abs(first) < 3 * sigma))
+        _, nearest = self._tree.query(points_body)
+        normals = self._model_normals[nearest]
+        distance = np.einsum("ij,ij->i", points_body - self._model_points[nearest], normals)
+        inliers = np.abs(distance) < self.max_correspondence / 3
+        sigma = max(float(np.sqrt(np.mean(distance[inliers] ** 2))) if inliers.sum() > 6 else self.voxel, 1e-4)
+        information = point_to_plane_information(points_body[inliers], normals[inliers], sigma)
+        tight = float(np.mean(np.abs(distance) < 3 * sigma))
         body_to_world = np.linalg.inv(pose)
         model_world = _transform(self._model_points, body_to_world)
         range_scale = np.median(np.linalg.norm(points_world - sensor_world, axis=1))

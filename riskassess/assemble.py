@@ -160,8 +160,9 @@ def rim_nodes(nodes_per_side: int) -> np.ndarray:
     return np.flatnonzero((i == 0) | (j == 0) | (i == nodes_per_side - 1) | (j == nodes_per_side - 1))
 
 
-def build_chaser(case: Case, net) -> tuple[RigidBodySpec, NetMount]:
-    """The chaser body behind the net plane, moving with the net, and the rods holding the rim."""
+def build_chaser(case: Case, net, index: int) -> tuple[RigidBodySpec, NetMount]:
+    """The chaser body behind the net plane, moving with the net, and the rods holding the rim
+    on it; ``index`` is the chaser's place in the assembly's body list."""
     chaser, launch = case.chaser, case.launch
     direction = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
     n = case.net.nodes_per_side
@@ -170,7 +171,7 @@ def build_chaser(case: Case, net) -> tuple[RigidBodySpec, NetMount]:
     body = RigidBodySpec(name="chaser", mass=chaser.mass, inertia_body=np.diag(chaser.principal_inertia),
                          com_lvlh=com, velocity_lvlh=launch.velocity * direction)
     rim = rim_nodes(n)
-    mount = NetMount(nodes=rim, body=-1, points_body=net.positions[rim] - com,
+    mount = NetMount(nodes=rim, body=index, points_body=net.positions[rim] - com,
                      stiffness=chaser.mount_stiffness, damping=chaser.mount_damping)
     return body, mount
 
@@ -181,8 +182,8 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
     bodies, joints, rest_att, rest_com = build_bodies_and_joints(case, base)
     mount = chaser_index = None
     if case.chaser is not None:
-        chaser, mount = build_chaser(case, net)
-        chaser_index = mount.body = len(bodies)
+        chaser_index = len(bodies)
+        chaser, mount = build_chaser(case, net, chaser_index)
         bodies.append(chaser)
         rest_att.append(chaser.body_to_lvlh.copy())
         rest_com.append(chaser.com_lvlh.copy())
