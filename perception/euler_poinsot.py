@@ -78,7 +78,6 @@ def normalized_inertia_linear(omega_body, omega_dot_body) -> np.ndarray:
     eq. 18): the right singular vector of the smallest singular value."""
     w = np.asarray(omega_body, float)
     a = np.asarray(omega_dot_body, float)
-    rows = []
     # J = [[j0, j3, j4], [j3, j1, j5], [j4, j5, j2]]
     basis = [np.diag([1.0, 0, 0]), np.diag([0, 1.0, 0]), np.diag([0, 0, 1.0])]
     for (r, c) in ((0, 1), (0, 2), (1, 2)):
@@ -211,6 +210,23 @@ class TorqueFreeFit:
         jac = result.jac
         self.covariance_ = np.linalg.pinv(jac.T @ jac) * self.residual_rms_**2
         return self
+
+    def spin_momentum_per_c(self) -> tuple[np.ndarray, np.ndarray]:
+        """The fitted motion's spin angular momentum per unit C, h = R_T->W diag(J1, J2, 1) omega_T
+        (3,) (rad/s, world frame; constant in torque-free motion), and its covariance (3, 3)
+        propagated from the parameter covariance (finite-difference Jacobian)."""
+        def spin(p):
+            t2w, omega, moments, _ = self._unpack(p)
+            return t2w.as_matrix() @ (moments * omega)
+
+        h = spin(self._p)
+        jac = np.empty((3, self._p.size))
+        for i in range(self._p.size):
+            step = 1e-6 * max(1.0, abs(self._p[i]))
+            shifted = self._p.copy()
+            shifted[i] += step
+            jac[:, i] = (spin(shifted) - h) / step
+        return h, jac @ self.covariance_ @ jac.T
 
     @property
     def moments_std_(self) -> np.ndarray:

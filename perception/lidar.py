@@ -50,6 +50,15 @@ class LidarSpec:
                 -0.5 * self.fov_azimuth + self.resolution_azimuth * np.arange(cols))
 
 
+def sensor_to_platform(boresight, up) -> np.ndarray:
+    """Rotation sensor -> platform frame (3, 3) of a sensor whose boresight (+x) and up (+z,
+    made orthogonal to the boresight) are given in the platform frame."""
+    x = np.asarray(boresight, float) / np.linalg.norm(boresight)
+    z = np.asarray(up, float) - (np.asarray(up, float) @ x) * x
+    z /= np.linalg.norm(z)
+    return np.c_[x, np.cross(z, x), z]
+
+
 def direction_sensor(elevation, azimuth) -> np.ndarray:
     """Unit ray directions (..., 3), sensor frame, for broadcastable angle arrays (rad)."""
     el, az = np.broadcast_arrays(elevation, azimuth)

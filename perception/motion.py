@@ -92,3 +92,20 @@ def center_of_mass_line(times, body_to_world, origin_world, com_body=None) -> Ce
     if com_body is None:
         return CenterOfMassLine(solution[:3], solution[3:6], solution[6:9], times[0], rms, covariance)
     return CenterOfMassLine(np.asarray(com_body, float), solution[:3], solution[3:6], times[0], rms, covariance)
+
+
+def attitude_sqrt_information(informations) -> np.ndarray:
+    """Square roots W (k, 3, 3) (1/rad) of the attitude information of k registrations, from their
+    (6, 6) pose information (rotation first): the rotation block of the covariance, the
+    translation marginalized out, so that |W e|^2 is the attitude error's chi^2. A frame whose
+    information is singular (too few or degenerate points) gets the mean of the others."""
+    weights = np.full((len(informations), 3, 3), np.nan)
+    for k, information in enumerate(informations):
+        if np.linalg.matrix_rank(information) == 6:
+            attitude_covariance = np.linalg.inv(information)[:3, :3]
+            weights[k] = np.linalg.cholesky(np.linalg.inv(attitude_covariance)).T
+    bad = np.isnan(weights[:, 0, 0])
+    if bad.all():
+        raise NotObservable("no registration carried attitude information (all scans degenerate)")
+    weights[bad] = np.mean(weights[~bad], axis=0)
+    return weights

@@ -1,13 +1,24 @@
-"""Point-cloud registration of the tumbling debris with Open3D, and a check that an
-alignment really succeeded.
+"""Point-cloud registration of the tumbling debris, and a check that an alignment really succeeded.
 
 :class:`DebrisTracker` registers each scan to a model of the debris (frame-to-model): the
 model is the union of the first ``model_frames`` registered scans (frame-to-frame while it
 grows), in the body frame **B** (axes of the world frame at the first scan, origin at the
-first scan's centroid), then frozen, so later frames do not drift. Each frame is seeded with
-the pose predicted from the last two (constant rotation and translation rates) and refined
-by point-to-plane ICP, coarse to fine. When the check below fails, the frame is started again
-from a global FPFH + RANSAC alignment to the model.
+first scan's centroid), then frozen, so later frames do not drift. A known shape (catalogue,
+CAD) can be given instead; it is the model from the start.
+
+Each frame is seeded with the pose predicted from the last two (constant rotation and
+translation rates) and refined by point-to-plane ICP with Tukey weights, coarse to fine. The
+ICP is our own Gauss-Newton loop on one KD-tree of the model, built when the model changes
+(Open3D's ``registration_icp`` builds one per call), and it stops once a step no longer moves
+the scan across the surface: on the near-axisymmetric debris, steps keep wandering about the
+weakly seen long axis without improving the fit, so a test on the step size alone never stops.
+
+Without a motion prediction (first frame with a known shape, the frame after a single good one,
+or after the track was lost for frames) the frame is searched: seed attitudes (small turns of
+the last pose, or attitudes over all of SO(3) when the last good pose is older than one frame)
+are ranked by a coarse ICP on a heavily thinned scan, and only the best few distinct results are
+refined and checked. When the check below fails, the frame is started again from a global
+FPFH + RANSAC alignment to the model.
 
 Why a check of its own: Open3D's ``fitness`` and ``inlier_rmse`` are computed inside the
 correspondence distance that ICP itself used, so an ICP that slid into a wrong pose (users
@@ -21,6 +32,9 @@ three figures that a wrong pose cannot all pass:
   so the pose contradicts the measurement;
 * **innovation**: rotation between the registered and the predicted pose; a jump larger than
   the motion allows (a symmetric flip of a near-symmetric body) fails even when the surface fits.
+
+The surface figures (tight fitness, sigma, information) are taken on about ``CHECKED_POINTS``
+evenly spread scan points: shares to ~1 %, the information scaled to the whole scan.
 """
 from __future__ import annotations
 
@@ -40,6 +54,15 @@ MAX_FREE_SPACE_VIOLATION = 0.05  # share of viewing directions where the model b
 MAX_INNOVATION = np.radians(10.0)  # rad; the constant-rate prediction is good to ~0.2 deg for 2.3 rad/s tumbles at 10 Hz
 SEARCH_TURN = np.radians(30.0)     # rad; largest turn between frames searched without a prediction (3 rad/s at 10 Hz, paper Sec. 2)
 
+#: Effort of the ICP and of the search.
+ICP_ITERATIONS = 15     # per level, at most; a level from a good prediction settles in 1-3
+ICP_SETTLED = 3e-4      # m; rms motion of the matched points along their normals below which a level has settled
+SEARCH_SETTLED = 3e-3   # m; the same for ranking search seeds: only their order matters
+CHECKED_POINTS = 1000   # scan points in the coarse ICP level and in the check (shares to ~1 %)
+SEARCH_VOXELS = 4       # the search ranks its seeds on the scan thinned to this many voxels (~200 points)
+SEARCH_REFINED = 6      # best-ranked distinct seeds refined and checked (the 4 symmetric poses of an ellipsoid and spares)
+DISTINCT_TURN = np.radians(5.0)  # rad; ranked poses closer than this in attitude are one result
+
 
 def _turn_candidates(largest) -> list[np.ndarray]:
     """Identity and turns of largest/3, 2 largest/3 and largest about the 13 axes of a cube's
@@ -55,8 +78,38 @@ def _turn_candidates(largest) -> list[np.ndarray]:
 
 
 def _orientation_candidates(count=240) -> list[np.ndarray]:
-    """Rotations spread over SO(3) (fixed seed: reproducible) for the first frame against a known model."""
-    return list(Rotation.random(count, random_state=12345).as_matrix())
+    """Identity and rotations spread over SO(3) (fixed seed: reproducible), for a frame without
+    a usable last pose (first frame against a known model, track lost for frames)."""
+    return [np.eye(3)] + list(Rotation.random(count, random_state=12345).as_matrix())
+
+
+def _seeds(start, pivot, turns) -> list[np.ndarray]:
+    """world_to_body poses: ``start`` turned by each of ``turns`` (body frame) about the world
+    point ``pivot``, which keeps its place in B (turning about the model origin would swing the
+    scan off the model)."""
+    seeds = []
+    for turn in turns:
+        seed = start.copy()
+        seed[:3, :3] = turn @ start[:3, :3]
+        seed[:3, 3] = start[:3, 3] + start[:3, :3] @ pivot - seed[:3, :3] @ pivot
+        seeds.append(seed)
+    return seeds
+
+
+def _turn_angle(rotation, other) -> float:
+    """Angle (rad) of the rotation between two rotation matrices."""
+    return float(np.arccos(np.clip((np.trace(rotation @ other.T) - 1) / 2, -1.0, 1.0)))
+
+
+def _distinct(poses, count) -> list[np.ndarray]:
+    """The first ``count`` poses whose attitudes differ by more than DISTINCT_TURN from all kept before."""
+    kept = []
+    for pose in poses:
+        if all(_turn_angle(pose[:3, :3], other[:3, :3]) > DISTINCT_TURN for other in kept):
+            kept.append(pose)
+            if len(kept) == count:
+                break
+    return kept
 
 
 def _score(alignment) -> float:
@@ -71,6 +124,7 @@ class Alignment:
     world_to_body : (4, 4) float   Transform taking world points into the model frame B.
     information : (6, 6) float     Point-to-plane information of (rotation, translation), B frame,
                                    left perturbation of ``world_to_body`` (1/rad^2, 1/m^2).
+    n_points : int                 Scan points registered (after thinning and gating).
     """
 
     time: float
@@ -96,6 +150,12 @@ def _cloud(points, normals_radius=None) -> o3d.geometry.PointCloud:
     return cloud
 
 
+def _thinned(points, count) -> np.ndarray:
+    """Every k-th point, k the largest keeping at least ``count`` (all when fewer). Open3D's voxel
+    output is in hash order and ray-cast scans in scan-line order, so the stride spreads over the surface."""
+    return points[::max(1, len(points) // count)]
+
+
 def point_to_plane_information(points_body, normals, sigma) -> np.ndarray:
     """Information (6, 6) of a point-to-plane alignment of scan points (n, 3) (B frame) on model
     planes with normals (n, 3), residual scatter ``sigma`` (m).
@@ -103,8 +163,12 @@ def point_to_plane_information(points_body, normals, sigma) -> np.ndarray:
     Residual n.(q - m) for scan point q and its nearest model point m with normal n; its
     gradient with respect to a left rotation/translation of the pose is [(q x n), n].
     """
-    jac = np.hstack([np.cross(points_body, normals), normals])
+    jac = _plane_jacobian(points_body, normals)
     return jac.T @ jac / sigma**2
+
+
+def _plane_jacobian(points_body, normals) -> np.ndarray:
+    return np.hstack([np.cross(points_body, normals), normals])
 
 
 def free_space_violation(points_world, model_world, sensor_world, bin_angle, margin) -> float:
@@ -112,7 +176,7 @@ def free_space_violation(points_world, model_world, sensor_world, bin_angle, mar
     scan returns where a model point lies more than ``margin`` (m) in front of the nearest return."""
     def bins(points):
         d = points - sensor_world
-        r = np.linalg.norm(d, axis=1)
+        r = np.sqrt(np.einsum("ij,ij->i", d, d))
         el = np.arcsin(np.clip(d[:, 2] / r, -1, 1))
         az = np.arctan2(d[:, 1], d[:, 0])
         return np.floor(el / bin_angle).astype(np.int64) * 1_000_003 + np.floor(az / bin_angle).astype(np.int64), r
@@ -132,6 +196,21 @@ def _transform(points, matrix) -> np.ndarray:
     return points @ matrix[:3, :3].T + matrix[:3, 3]
 
 
+def _rigid_inverse(matrix) -> np.ndarray:
+    inverse = np.eye(4)
+    inverse[:3, :3] = matrix[:3, :3].T
+    inverse[:3, 3] = -matrix[:3, :3].T @ matrix[:3, 3]
+    return inverse
+
+
+def _twist(step) -> np.ndarray:
+    """Transform of a small (rotation vector, translation) step (6,) (rad, m)."""
+    matrix = np.eye(4)
+    matrix[:3, :3] = Rotation.from_rotvec(step[:3]).as_matrix()
+    matrix[:3, 3] = step[3:]
+    return matrix
+
+
 def predict_pose(previous, before) -> np.ndarray:
     """world_to_body at the next frame from the last two, at constant rotation and translation
     rates (equal frame spacing): T_next = (T_prev T_before^-1) T_prev."""
@@ -146,6 +225,7 @@ class DebrisTracker:
     voxel : float               Scan thinning (m); also the model's point spacing.
     max_correspondence : float  ICP correspondence distance at the coarse level (m).
     model_frames : int          Frames merged into the model before it is frozen.
+    model_points_body : (n, 3)  Known shape (m, frame B), optional: the model from the start.
     """
 
     def __init__(self, voxel=0.03, max_correspondence=0.1, model_frames=30, model_points_body=None):
@@ -181,80 +261,130 @@ class DebrisTracker:
                 self._model, o3d.geometry.KDTreeSearchParamHybrid(radius=5 * self.voxel, max_nn=100))
         return self._features
 
-    # -- one frame -------------------------------------------------------------------
-    def update(self, time_s, points_world, sensor_world) -> Alignment:
-        """Register one scan (n, 3) (m, world frame) taken from ``sensor_world`` (3,) (m)."""
-        start = time.perf_counter()
-        scan = _cloud(points_world).voxel_down_sample(self.voxel)
-        points = np.asarray(scan.points)
-        if not self.alignments:
-            centroid_pose = np.eye(4)
-            centroid_pose[:3, 3] = -points.mean(axis=0)
-            if self._model is None:   # the first scan starts the model and defines the frame B
-                self._set_model(_transform(points, centroid_pose))
-                alignment = Alignment(time_s, centroid_pose, np.zeros((6, 6)), 1.0, 0.0, 0.0, True, False, 0.0,
-                                      len(points))
-            else:
-                alignment = self._search(time_s, scan, points, centroid_pose, sensor_world, _orientation_candidates())
-        else:
-            alignment = self._track(time_s, scan, points, sensor_world)
-        alignment.seconds = time.perf_counter() - start
-        self.alignments.append(alignment)
+    def _start_model(self, time_s, points) -> Alignment:
+        """The first scan becomes the model; its centroid is the origin of B."""
+        pose = np.eye(4)
+        pose[:3, 3] = -points.mean(axis=0)
+        self._set_model(_transform(points, pose))
+        return Alignment(time_s, pose, np.zeros((6, 6)), 1.0, 0.0, 0.0, True, False, 0.0, len(points))
+
+    def _grow_model(self, alignment, points):
+        """Merges a good scan into the model until ``model_frames`` are in (the first scan is the model already)."""
         if alignment.ok and self._frames_in_model < self.model_frames:
             if self._frames_in_model:
                 self._set_model(np.vstack([self._model_points, _transform(points, alignment.world_to_body)]))
             self._frames_in_model += 1
+
+    # -- one frame -------------------------------------------------------------------
+    def update(self, time_s, points_world, sensor_world, gate=None) -> Alignment:
+        """Register one scan (n, 3) (m, world frame) taken from ``sensor_world`` (3,) (m).
+
+        gate : float, optional (m)  With a motion prediction, register only the scan points within
+            ``gate`` of the model at the predicted pose (to the nearest model point, ``voxel``
+            apart): returns of other objects, e.g. net threads in front of the debris, are dropped.
+        """
+        start = time.perf_counter()
+        scan = _cloud(points_world).voxel_down_sample(self.voxel)
+        if self._model is None:   # the first scan starts the model and defines the frame B
+            alignment = self._start_model(time_s, np.asarray(scan.points))
+        else:
+            predicted, has_motion = self._prediction()
+            if gate is not None and has_motion:
+                scan = self._gated(scan, predicted, gate)
+            alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
+        alignment.seconds = time.perf_counter() - start
+        self.alignments.append(alignment)
+        self._grow_model(alignment, np.asarray(scan.points))
         return alignment
 
-    def _track(self, time_s, scan, points, sensor_world) -> Alignment:
-        predicted, has_motion = self._prediction()
+    def _gated(self, scan, predicted, gate) -> o3d.geometry.PointCloud:
+        gap, _ = self._tree.query(_transform(np.asarray(scan.points), predicted), distance_upper_bound=gate)
+        return scan.select_by_index(np.flatnonzero(np.isfinite(gap)))
+
+    def _track(self, time_s, scan, predicted, has_motion, sensor_world) -> Alignment:
+        points = np.asarray(scan.points)
         if has_motion:
-            pose = self._icp(scan, predicted)
-            alignment = self._judge(time_s, points, pose, predicted, sensor_world, True)
+            alignment = self._judge(time_s, points, self._icp(scan, predicted), predicted, sensor_world, True)
+        elif self.alignments and self.alignments[-1].ok:
+            # One frame since the last good pose: the body turned by at most SEARCH_TURN.
+            alignment = self._search(time_s, scan, predicted, _turn_candidates(SEARCH_TURN), sensor_world)
         else:
-            alignment = self._search(time_s, scan, points, predicted, sensor_world)
+            # No pose yet, or the track was lost for frames (a collision may have changed the spin a lot).
+            alignment = self._search(time_s, scan, self._acquisition_start(points, predicted),
+                                     _orientation_candidates(), sensor_world)
         if not alignment.ok:
-            pose = self._icp(scan, self._global(scan, predicted))
-            retry = self._judge(time_s, points, pose, predicted, sensor_world, has_motion, global_init=True)
+            reference = alignment.world_to_body if predicted is None else predicted
+            pose = self._icp(scan, self._global(scan, reference))
+            retry = self._judge(time_s, points, pose, reference, sensor_world, has_motion, global_init=True)
             if retry.ok or retry.tight_fitness > alignment.tight_fitness:
                 alignment = retry
         return alignment
 
-    def _prediction(self) -> tuple[np.ndarray, bool]:
-        """Predicted pose and whether it carries the motion (two consecutive good frames)."""
+    def _prediction(self) -> tuple[np.ndarray | None, bool]:
+        """Predicted pose (None before any good frame) and whether it carries the motion (two
+        consecutive good frames); without the motion, the last good pose."""
         last = self.alignments[-2:]
         if len(last) == 2 and all(a.ok for a in last):
             return predict_pose(last[1].world_to_body, last[0].world_to_body), True
         good = [a for a in self.alignments if a.ok]
-        return good[-1].world_to_body, False
+        return (good[-1].world_to_body if good else None), False
 
-    def _search(self, time_s, scan, points, start, sensor_world, turns=None) -> Alignment:
-        """Without a motion prediction, ICP from rotations of the last pose spread over the
-        largest turn expected between frames, keeping the best-checked result: a smooth body
-        (the paper's ellipsoid) gives ICP a basin of only a few degrees."""
+    def _acquisition_start(self, points, last) -> np.ndarray:
+        """Pose putting the scan centroid on the model centroid, at the last good attitude if any."""
+        start = np.eye(4)
+        if last is not None:
+            start[:3, :3] = last[:3, :3]
+        start[:3, 3] = self._model_points.mean(axis=0) - start[:3, :3] @ points.mean(axis=0)
+        return start
+
+    def _search(self, time_s, scan, start, turns, sensor_world) -> Alignment:
+        """Without a motion prediction: ``start`` turned by each of ``turns`` about the scan
+        centroid (a smooth body, the paper's ellipsoid, gives ICP a basin of only a few tens of
+        degrees), each seed ranked by one coarse ICP level on a heavily thinned scan; the best
+        SEARCH_REFINED distinct results are refined and checked, the best-checked kept."""
+        points = np.asarray(scan.points)
+        thin = np.asarray(scan.voxel_down_sample(SEARCH_VOXELS * self.voxel).points)
+        fits = [self._icp_level(thin, seed, self.max_correspondence, SEARCH_SETTLED)
+                for seed in _seeds(start, points.mean(axis=0), turns)]
+        fits.sort(key=lambda fit: -fit[1])
         best = None
-        pivot = points.mean(axis=0)   # turn about the scan centroid (world), not the model origin
-        for turn in _turn_candidates(SEARCH_TURN) if turns is None else turns:
-            seed = start.copy()
-            seed[:3, :3] = turn @ start[:3, :3]
-            seed[:3, 3] = start[:3, 3] + start[:3, :3] @ pivot - seed[:3, :3] @ pivot
-            pose = self._icp(scan, seed)
-            candidate = self._judge(time_s, points, pose, start, sensor_world, False)
+        for pose in _distinct([pose for pose, _ in fits], SEARCH_REFINED):
+            candidate = self._judge(time_s, points, self._icp(scan, pose), start, sensor_world, False)
             if best is None or _score(candidate) > _score(best):
                 best = candidate
         return best
 
     def _icp(self, scan, initial) -> np.ndarray:
-        """Point-to-plane ICP, coarse (2x the correspondence distance) to fine, robust to outliers
-        (Tukey loss) such as net threads lying on the debris."""
-        pose = initial
-        for distance, iterations in ((self.max_correspondence, 15), (self.max_correspondence / 3, 15)):
-            result = reg.registration_icp(
-                scan, self._model, distance, pose,
-                reg.TransformationEstimationPointToPlane(reg.TukeyLoss(k=distance / 2)),
-                reg.ICPConvergenceCriteria(1e-7, 1e-7, max_iteration=iterations))
-            pose = result.transformation
+        """Point-to-plane ICP, robust to outliers (Tukey loss) such as net threads lying on the
+        debris: a coarse level on about CHECKED_POINTS scan points within ``max_correspondence``,
+        then a fine one on all points within a third of it."""
+        points = np.asarray(scan.points)
+        pose, _ = self._icp_level(_thinned(points, CHECKED_POINTS), initial, self.max_correspondence)
+        pose, _ = self._icp_level(points, pose, self.max_correspondence / 3)
         return pose
+
+    def _icp_level(self, points, pose, distance, settled=ICP_SETTLED) -> tuple[np.ndarray, float]:
+        """Gauss-Newton point-to-plane steps (Tukey weights, k = distance / 2) on the nearest model
+        points within ``distance``, until a step moves the matched points by less than ``settled``
+        (m, rms along the normals). Returns the pose and the fit: mean weight over all points."""
+        weight = np.zeros(0)
+        for _ in range(ICP_ITERATIONS):
+            body = _transform(points, pose)
+            gap, nearest = self._tree.query(body, distance_upper_bound=distance)
+            matched = np.isfinite(gap)
+            body, normals = body[matched], self._model_normals[nearest[matched]]
+            residual = np.einsum("ij,ij->i", body - self._model_points[nearest[matched]], normals)
+            weight = np.clip(1 - (2 * residual / distance) ** 2, 0.0, None) ** 2
+            if np.count_nonzero(weight) < 6:   # too few matches to fix 6 degrees of freedom
+                break
+            jac = _plane_jacobian(body, normals)
+            weighted = jac.T * weight
+            hessian = weighted @ jac
+            step = np.linalg.lstsq(hessian, -weighted @ residual, rcond=None)[0]
+            pose = _twist(step) @ pose
+            if step @ hessian @ step < settled**2 * weight.sum():
+                break
+        return pose, float(weight.sum() / max(len(points), 1))
 
     def _global(self, scan, fallback) -> np.ndarray:
         """FPFH + RANSAC alignment of the scan to the model (for large, unpredicted motion)."""
@@ -268,22 +398,29 @@ class DebrisTracker:
             reg.RANSACConvergenceCriteria(20000, 0.999))
         return result.transformation if result.fitness > 0 else fallback
 
+    # -- the check -------------------------------------------------------------------
     def _judge(self, time_s, points_world, pose, predicted, sensor_world, has_motion, global_init=False) -> Alignment:
-        points_body = _transform(points_world, pose)
+        tight, sigma, information = self._surface_fit(points_world, pose)
+        model_world = _transform(self._model_points, _rigid_inverse(pose))
+        range_scale = np.median(np.linalg.norm(points_world - sensor_world, axis=1))
+        violation = free_space_violation(points_world, model_world, sensor_world, 2 * self.voxel / range_scale,
+                                         3 * sigma + self.voxel)
+        innovation = _turn_angle(pose[:3, :3], predicted[:3, :3])
+        ok = (tight >= MIN_TIGHT_FITNESS and violation <= MAX_FREE_SPACE_VIOLATION
+              and (innovation <= MAX_INNOVATION or not has_motion))
+        return Alignment(time_s, pose, information, tight, violation, innovation, bool(ok), global_init, 0.0,
+                         len(points_world))
+
+    def _surface_fit(self, points_world, pose) -> tuple[float, float, np.ndarray]:
+        """Tight fitness, point-to-plane scatter sigma (m) and information of the posed scan, from
+        about CHECKED_POINTS of its points (information scaled to all of them)."""
+        checked = _thinned(points_world, CHECKED_POINTS)
+        points_body = _transform(checked, pose)
         _, nearest = self._tree.query(points_body)
         normals = self._model_normals[nearest]
         distance = np.einsum("ij,ij->i", points_body - self._model_points[nearest], normals)
         inliers = np.abs(distance) < self.max_correspondence / 3
         sigma = max(float(np.sqrt(np.mean(distance[inliers] ** 2))) if inliers.sum() > 6 else self.voxel, 1e-4)
-        information = point_to_plane_information(points_body[inliers], normals[inliers], sigma)
-        tight = float(np.mean(np.abs(distance) < 3 * sigma))
-        body_to_world = np.linalg.inv(pose)
-        model_world = _transform(self._model_points, body_to_world)
-        range_scale = np.median(np.linalg.norm(points_world - sensor_world, axis=1))
-        violation = free_space_violation(points_world, model_world, sensor_world, 2 * self.voxel / range_scale,
-                                         3 * sigma + self.voxel)
-        innovation = Rotation.from_matrix(pose[:3, :3] @ predicted[:3, :3].T).magnitude()
-        ok = (tight >= MIN_TIGHT_FITNESS and violation <= MAX_FREE_SPACE_VIOLATION
-              and (innovation <= MAX_INNOVATION or not has_motion))
-        return Alignment(time_s, pose, information, tight, violation, innovation, bool(ok), global_init, 0.0,
-                         len(points_world))
+        information = (point_to_plane_information(points_body[inliers], normals[inliers], sigma)
+                       * len(points_world) / max(len(checked), 1))
+        return float(np.mean(np.abs(distance) < 3 * sigma)), sigma, information

@@ -194,6 +194,9 @@ class Body(Strict):
     inertia: Annotated[list[Vector3], Field(min_length=3, max_length=3)] | None = Field(
         None, description="Inertia about the CoM, target-frame axes (kg m^2); default: uniform density over the shapes.")
     shapes: Annotated[list[Shape], Field(min_length=1)]
+    mass_properties_from: str | None = Field(
+        None, description="perception.json written by 'riskassess perceive' (path relative to the case file): mass, "
+                          "center_of_mass and inertia are taken from its estimates (then leave those three keys out).")
 
     @field_validator("inertia")
     @classmethod
@@ -292,6 +295,10 @@ class Lidar(Strict):
     range_noise: NonNegative = Field(description="Range noise 1 sigma (m), constant over range.")
     rate: Annotated[float, Field(gt=0, le=100)] = Field(description="Frames per second (Hz).")
     max_range: Positive = Field(200.0, description="Longest range returned (m).")
+    pointing: Literal["target", "body"] = Field(
+        "target", description="'target': a pan-tilt mount turns the boresight to the debris' last registered "
+                              "position each frame (the chaser may spin after the collision); 'body': fixed to the "
+                              "chaser along boresight_lvlh.")
 
     @model_validator(mode="after")
     def _grid_size(self):
@@ -491,6 +498,9 @@ def validate_case(raw: dict, path: str | Path) -> Case:
     """Validate the parsed content of the case file ``path`` (mesh paths are relative to it);
     raise :class:`CaseError` naming every problem. Sweeps call it for every varied case."""
     path = Path(path)
+    raw, problems = _with_perceived_mass_properties(raw, path.parent)
+    if problems:
+        raise CaseError("\n".join(f"{path}: {p}" for p in problems))
     try:
         case = Case.model_validate(raw)
     except ValidationError as exc:
@@ -501,6 +511,47 @@ def validate_case(raw: dict, path: str | Path) -> Case:
     if problems:
         raise CaseError("\n".join(f"{path}: {p}" for p in problems))
     return case
+
+
+#: perception.json keys -> body keys, for ``mass_properties_from``.
+PERCEIVED_KEYS = {"mass_kg": "mass", "center_of_mass_target_m": "center_of_mass", "inertia_target_kg_m2": "inertia"}
+
+
+def _with_perceived_mass_properties(raw: dict, base: Path) -> tuple[dict, list[str]]:
+    """Fill the mass properties of bodies that name a perception result; problems name the key."""
+    import copy
+    import json
+
+    bodies = raw.get("target", {}).get("bodies", []) if isinstance(raw.get("target"), dict) else []
+    if not any(isinstance(b, dict) and b.get("mass_properties_from") for b in bodies):
+        return raw, []
+    raw = copy.deepcopy(raw)
+    problems = []
+    for i, body in enumerate(raw["target"]["bodies"]):
+        source = body.get("mass_properties_from") if isinstance(body, dict) else None
+        if not source:
+            continue
+        key = f"target.bodies[{i}].mass_properties_from"
+        given = [k for k in PERCEIVED_KEYS.values() if k in body]
+        if given:
+            problems.append(f"{key}: the mass properties come from '{source}'; remove {given} from this body")
+            continue
+        try:
+            answer = json.loads((base / source).read_text())
+        except FileNotFoundError:
+            problems.append(f"{key}: perception result '{source}' not found (paths are relative to the case file)")
+            continue
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+            problems.append(f"{key}: '{source}' is not a perception.json ({exc})")
+            continue
+        missing = [k for k in PERCEIVED_KEYS if answer.get(k) is None]
+        if missing:
+            reason = answer.get("not_observable") or "keys missing"
+            problems.append(f"{key}: '{source}' has no estimate of {missing}: {reason}")
+            continue
+        for source_key, body_key in PERCEIVED_KEYS.items():
+            body[body_key] = answer[source_key]
+    return raw, problems
 
 
 def _check_files(case: Case, base: Path) -> list[str]:

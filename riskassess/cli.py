@@ -100,6 +100,38 @@ def _cmd_assess(args) -> int:
     return _cmd_run(args)
 
 
+def _cmd_perceive(args) -> int:
+    from riskassess.perceive import perceive_case
+
+    case = load_case(args.case)
+    out = Path(args.out) if args.out else Path("runs") / f"{case.name}"
+    with _progress_bar("perceive", args.json) as bar:
+        task = bar.add_task("", total=None)
+
+        def progress(stage, done, total):
+            bar.update(task, description=stage, completed=done, total=total)
+
+        answer = perceive_case(args.case, out, progress=progress, case=case)
+    if args.json:
+        print(json.dumps(answer, indent=2))
+    else:
+        print_perception(answer, out)
+    status = _products(out, args.report, args.vtk, quiet=args.json)
+    return 3 if answer["not_observable"] and status == 0 else status
+
+
+def print_perception(answer: dict, out: Path) -> None:
+    from riskassess.tables import perception_rows
+
+    console = _console()
+    console.print(_table(f"{answer['case']}: debris mass and inertia from LiDAR and the net collision",
+                         ("quantity", "estimate", "1 sigma", "error vs truth"), perception_rows(answer),
+                         {"estimate": "right", "1 sigma": "right", "error vs truth": "right"}))
+    if answer["not_observable"]:
+        console.print(f"[red]not observable[/red]: {answer['not_observable']}")
+    console.print(f"results: {out}")
+
+
 def _table(title: str, columns, rows, justify=None):
     from rich.table import Table
 
@@ -228,6 +260,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "simulate a case with weak locations and print the structural verdict",
                         "case file (TOML) with [[structures.weak_locations]]",
                         "print the run summary (with the verdict) as JSON")
+    _simulation_command(sub, "perceive", _cmd_perceive,
+                        "track the tumbling debris by LiDAR, simulate the net collision, estimate mass and inertia",
+                        "case file (TOML) with [perception] and [chaser]",
+                        "print the estimates (mass_estimate, inertia_estimate, errors, timings) as JSON")
     report = sub.add_parser("report", help="write report.html (self-contained) and report.pdf into a run folder")
     report.add_argument("run_dir", help="run folder written by 'riskassess run'")
     report.add_argument("--no-pdf", action="store_true", help="HTML only")

@@ -50,25 +50,13 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
     case = case or load_case(case_path)
     simulation = prepare_simulation(case, case_path)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    manifest = {"format": results.FORMAT, "version": results.VERSION, "case": case.name,
-                "created": datetime.datetime.now(datetime.timezone.utc).isoformat(),
-                "status": "running", "files": ["case.toml", "case.json"], "software": software_versions()}
-    shutil.copyfile(case_path, out / "case.toml")
-    results.atomic_write_json(out / "case.json", case.model_dump())
-    # Written now so an interrupted run is recognisable (status 'running') by later stages.
-    results.atomic_write_json(out / "manifest.json", manifest)
+    manifest = begin_run_folder(out, case_path, case)
     locations = weak_locations(case, simulation.assembly)
     monitor = None
     if locations and case.structures.release != "never":
         monitor = ReleaseMonitor(locations, simulation.system, case.structures.skip_initial, case.structures.release)
     recorder = simulation.run(progress=progress, monitor=monitor)
-    summary = run_summary(recorder, simulation.assembly, case.name)
-    write_simulation_results(out, recorder, simulation)
-    results.atomic_write_json(out / "summary.json", summary)
-    manifest.update(status="complete", files=manifest["files"] + ["summary.json", "timeseries.npz", "net.npz",
-                                                                  "bodies.npz"])
-    results.atomic_write_json(out / "manifest.json", manifest)
+    summary = finish_simulation(out, manifest, recorder, simulation, case)
     verdict = None
     if locations:
         # A later stage that fails leaves the finished simulation results and says so.
@@ -85,6 +73,30 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
         manifest["files"] += ["structures.json", "structures.npz"]
         results.atomic_write_json(out / "manifest.json", manifest)
     return RunOutput(out, summary, verdict)
+
+
+def begin_run_folder(out: Path, case_path: Path, case: Case) -> dict:
+    """Create the run folder with the case and a manifest saying 'running', so an interrupted
+    run is recognisable by later stages; returns the manifest to update."""
+    out.mkdir(parents=True, exist_ok=True)
+    manifest = {"format": results.FORMAT, "version": results.VERSION, "case": case.name,
+                "created": datetime.datetime.now(datetime.timezone.utc).isoformat(),
+                "status": "running", "files": ["case.toml", "case.json"], "software": software_versions()}
+    shutil.copyfile(case_path, out / "case.toml")
+    results.atomic_write_json(out / "case.json", case.model_dump())
+    results.atomic_write_json(out / "manifest.json", manifest)
+    return manifest
+
+
+def finish_simulation(out: Path, manifest: dict, recorder, simulation: ImpactSimulation, case: Case) -> dict:
+    """Write the simulation's results and summary; the manifest then says 'complete'."""
+    summary = run_summary(recorder, simulation.assembly, case.name)
+    write_simulation_results(out, recorder, simulation)
+    results.atomic_write_json(out / "summary.json", summary)
+    manifest.update(status="complete", files=manifest["files"] + ["summary.json", "timeseries.npz", "net.npz",
+                                                                  "bodies.npz"])
+    results.atomic_write_json(out / "manifest.json", manifest)
+    return summary
 
 
 def write_simulation_results(out: Path, recorder, simulation: ImpactSimulation) -> None:

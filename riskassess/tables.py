@@ -86,3 +86,39 @@ def summary_rows(summary: dict) -> list[tuple[str, str, str]]:
     rows.append(("energy balance drift (rel.)", f"{summary['checks']['energy_balance_relative_drift']:.2e}", ""))
     rows.append(("wall time (s), steps/s", f"{summary['wall_time_s']:.1f}, {summary['steps_per_second']:.0f}", ""))
     return rows
+
+
+def perception_rows(answer: dict) -> list[list[str]]:
+    """Rows (quantity, estimate, 1 sigma, error vs truth) of a perception answer; a quantity the
+    data could not determine reads 'not observable'."""
+    def row(name, value, sigma, error, fmt="{:.5g}", error_fmt="{:+.3f} %"):
+        if value is None:
+            return [name, "not observable", "", ""]
+        return [name, fmt.format(value), "" if sigma is None else fmt.format(sigma),
+                "" if error is None else error_fmt.format(error)]
+
+    rows = [row("mass (kg)", answer.get("mass_kg"), answer.get("mass_std_kg"), answer.get("mass_error_signed_percent"))]
+    for k, axis in enumerate("ABC"):
+        moments = answer.get("principal_moments_kg_m2")
+        rows.append(row(f"principal moment {axis} (kg m^2)", moments and moments[k],
+                        moments and answer["principal_moments_std_kg_m2"][k],
+                        moments and answer["principal_moments_error_percent"][k]))
+    for k, name in enumerate(("A/C", "B/C")):
+        ratios = answer.get("inertia_ratios")
+        rows.append(row(f"inertia ratio {name} (-)", ratios and ratios[k], ratios and answer["inertia_ratios_std"][k],
+                        ratios and answer["inertia_ratio_error_percent"][k]))
+    com = answer.get("center_of_mass_target_m")
+    rows.append(["centre of mass, target frame (m)", "not observable" if com is None else format_vector(com, 4),
+                 "" if com is None else format_vector(answer["center_of_mass_std_m"], 5),
+                 "" if com is None else f"{answer['center_of_mass_error_m'] * 1e3:.2f} mm"])
+    rows.append(row("normalized kinetic energy D = 2E/C (rad^2/s^2)", answer.get("normalized_kinetic_energy_D_rad2_s2"),
+                    None, answer.get("normalized_kinetic_energy_error_percent")))
+    rows.append(row("normalized angular momentum F = L^2/C^2 (rad^2/s^2)",
+                    answer.get("normalized_angular_momentum_F_rad2_s2"), None,
+                    answer.get("normalized_angular_momentum_error_percent")))
+    rows.append(row("angular momentum direction error (deg)", answer.get("angular_momentum_direction_error_deg"),
+                    None, None, "{:.3f}"))
+    rows.append(row("registration (ms/frame)", answer["registration_ms_per_frame"], None, None, "{:.1f}"))
+    rows.append(row("first frame global search (s)", answer["first_frame_search_s"], None, None, "{:.2f}"))
+    rows.append(row("observation time used (s)", answer["observation_time_s"], None, None, "{:.1f}"))
+    return rows

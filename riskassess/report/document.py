@@ -23,6 +23,7 @@ from riskassess import results
 from riskassess.report.blocks import Figure, Note, Section, Table
 from riskassess.report.impact import contact_section, debris_motion_section, energy_section, hinge_section
 from riskassess.report.inputs import appendix_inputs_section, case_section, run_facts_section
+from riskassess.report.perception import perception_section
 from riskassess.report.plotting import STYLE
 from riskassess.report.structures import joint_loads_section, stresses_section, verdict_section
 from riskassess.results import MissingData, RunFolder
@@ -37,6 +38,7 @@ SECTIONS = (
     ("joint-loads", "Hinge and joint loads against allowables", joint_loads_section),
     ("stresses", "Stresses against strengths", stresses_section),
     ("energy", "Net and debris energy", energy_section),
+    ("perception", "Perception: debris mass and inertia", perception_section),
     ("run-facts", "Run facts", run_facts_section),
     ("appendix-inputs", "Appendix: every case input", appendix_inputs_section),
 )

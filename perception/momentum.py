@@ -1,0 +1,140 @@
+"""True mass and principal moments of the debris from momentum conservation across the net
+collision (Tang et al. 2023, Sec. 3.2, eqs. 23-24).
+
+Chaser + net + debris form a closed system over the short collision, so with every momentum
+about one fixed point O of the inertial (world) frame W:
+
+* linear (eq. 23):  ``m_deb (v1 - v0) = -(Delta P_chaser + Delta P_net)``;
+* angular (eq. 24): ``m_deb Delta(p x v) + C (h1 - h0) = -(Delta L_chaser + Delta L_net)``,
+
+where ``v0, v1`` are the debris CoM velocities before and after, ``p`` its CoM, and
+``h = R_T->W diag(A/C, B/C, 1) omega_T`` its spin angular momentum per unit C: the torque-free
+fits before and after give ``h`` (the normalized inertia is known from before the collision),
+so each balance is linear in its one unknown (``m_deb``, then ``C``) and is solved by least
+squares over its three components. Uncertainties are first-order propagations of the inputs'
+covariances.
+
+Everything here is a pure function of SI arrays in the world frame W.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from perception.motion import NotObservable
+
+#: A momentum change smaller than this many standard deviations of its own uncertainty carries
+#: no information on the unknown: the answer is "not observable" rather than a noisy number.
+MIN_SIGNIFICANCE = 5.0
+
+
+def point_masses_momentum(masses, positions_world, velocities_world, origin_world=(0.0, 0.0, 0.0)):
+    """Linear (3,) (N s) and angular (3,) (N m s, about ``origin_world``) momentum of point masses
+    (n,) (kg) at positions (n, 3) (m) moving at velocities (n, 3) (m/s), world frame."""
+    masses = np.asarray(masses, float)
+    p = masses[:, None] * np.asarray(velocities_world, float)
+    arms = np.asarray(positions_world, float) - np.asarray(origin_world, float)
+    return p.sum(axis=0), np.cross(arms, p).sum(axis=0)
+
+
+def rigid_body_momentum(mass, inertia_body, com_world, velocity_world, body_to_world, omega_body,
+                        origin_world=(0.0, 0.0, 0.0)):
+    """Linear (3,) and angular (3,) momentum (about ``origin_world``) of a rigid body, world frame.
+
+    inertia_body : (3, 3) about the CoM, body frame (kg m^2); omega_body : (3,) (rad/s), body frame.
+    """
+    linear = mass * np.asarray(velocity_world, float)
+    spin = np.asarray(body_to_world, float) @ (np.asarray(inertia_body, float) @ np.asarray(omega_body, float))
+    return linear, np.cross(np.asarray(com_world, float) - np.asarray(origin_world, float), linear) + spin
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A scalar estimate with its 1-sigma uncertainty and the least-squares misfit of the
+    three-component balance it came from (same unit as the balance)."""
+
+    value: float
+    sigma: float
+    misfit: float
+
+
+def _scalar_least_squares(direction, target, cov_direction, cov_target, name, unit):
+    """x minimizing |target - x direction|, with first-order uncertainty.
+
+    dx/d target = d / |d|^2;  dx/d direction = (target - 2 x d) / |d|^2.
+    """
+    d = np.asarray(direction, float)
+    b = np.asarray(target, float)
+    norm2 = float(d @ d)
+    sigma_d = float(np.sqrt(max(np.trace(cov_direction), 0.0)))
+    sigma_b = float(np.sqrt(max(np.trace(cov_target), 0.0)))
+    if norm2 == 0.0 or np.sqrt(norm2) < MIN_SIGNIFICANCE * sigma_d:
+        raise NotObservable(f"the collision changed the debris {name} by {np.sqrt(norm2):.3g} {unit}, "
+                            f"not significant against its uncertainty {sigma_d:.3g} {unit}")
+    if np.linalg.norm(b) < MIN_SIGNIFICANCE * sigma_b or np.linalg.norm(b) == 0.0:
+        raise NotObservable(f"the collision transferred {np.linalg.norm(b):.3g} of momentum, not significant "
+                            f"against its uncertainty {sigma_b:.3g}")
+    x = float(d @ b) / norm2
+    g_b = d / norm2
+    g_d = (b - 2.0 * x * d) / norm2
+    variance = g_b @ cov_target @ g_b + g_d @ cov_direction @ g_d
+    misfit = float(np.linalg.norm(b - x * d))
+    return x, float(np.sqrt(max(variance, 0.0))), misfit
+
+
+def mass_from_linear_momentum(velocity_change_world, others_momentum_change_world,
+                              cov_velocity_change=None, cov_others_change=None) -> Estimate:
+    """Debris mass (kg) from ``m (v1 - v0) = -Delta P_others`` (Tang et al. 2023, eq. 23).
+
+    Parameters
+    ----------
+    velocity_change_world : (3,)      v1 - v0 of the debris CoM (m/s).
+    others_momentum_change_world : (3,)  Change of chaser + net linear momentum (N s).
+    cov_* : (3, 3)                    Their covariances (zero if omitted).
+    """
+    zero = np.zeros((3, 3))
+    mass, sigma, misfit = _scalar_least_squares(
+        velocity_change_world, -np.asarray(others_momentum_change_world, float),
+        zero if cov_velocity_change is None else cov_velocity_change,
+        zero if cov_others_change is None else cov_others_change, "velocity", "m/s")
+    if mass <= 0.0:
+        raise NotObservable(f"the linear momentum balance gives a non-positive mass ({mass:.3g} kg): "
+                            "the debris velocity change and the momentum the chaser and net lost disagree")
+    return Estimate(mass, sigma, misfit)
+
+
+def spin_momentum_per_c(normalized_moments, principal_to_world, omega_principal) -> np.ndarray:
+    """h = R_T->W diag(A/C, B/C, 1) omega_T (rad/s), world frame: the debris spin angular
+    momentum divided by its smallest principal moment C."""
+    return np.asarray(principal_to_world, float) @ (np.asarray(normalized_moments, float)
+                                                     * np.asarray(omega_principal, float))
+
+
+def smallest_moment_from_angular_momentum(spin_change_per_c, orbital_change_per_mass, mass,
+                                          others_angular_change, cov_spin_change=None,
+                                          cov_orbital_change_per_mass=None, mass_sigma=0.0,
+                                          cov_others_change=None) -> Estimate:
+    """C (kg m^2) from ``m Delta(p x v) + C Delta h = -Delta L_others`` (Tang et al. 2023, eq. 24).
+
+    Parameters
+    ----------
+    spin_change_per_c : (3,)       h1 - h0 (rad/s), see :func:`spin_momentum_per_c`.
+    orbital_change_per_mass : (3,)  Delta (p x v) of the debris CoM about O (m^2/s).
+    mass, mass_sigma : float       Debris mass and its 1 sigma (kg), from the linear balance.
+    others_angular_change : (3,)   Change of chaser + net angular momentum about O (N m s).
+    cov_* : (3, 3)                 Covariances (zero if omitted).
+    """
+    zero = np.zeros((3, 3))
+    orbital = np.asarray(orbital_change_per_mass, float)
+    target = -np.asarray(others_angular_change, float) - mass * orbital
+    cov_target = (zero if cov_others_change is None else np.asarray(cov_others_change))
+    cov_target = cov_target + mass**2 * (zero if cov_orbital_change_per_mass is None
+                                         else np.asarray(cov_orbital_change_per_mass))
+    cov_target = cov_target + mass_sigma**2 * np.outer(orbital, orbital)
+    c, sigma, misfit = _scalar_least_squares(spin_change_per_c, target,
+                                             zero if cov_spin_change is None else cov_spin_change,
+                                             cov_target, "spin", "rad/s")
+    if c <= 0.0:
+        raise NotObservable(f"the angular momentum balance gives a non-positive moment ({c:.3g} kg m^2)")
+    return Estimate(c, sigma, misfit)

@@ -1,0 +1,39 @@
+"""Rotational symmetries of a debris shape: the poses a surface-only measurement cannot tell
+apart (for scoring registrations against the truth; the estimators never use them)."""
+from __future__ import annotations
+
+import numpy as np
+import open3d as o3d
+import trimesh
+
+
+def half_turn_symmetries(mesh: trimesh.Trimesh, tolerance: float, samples: int = 4000) -> list[np.ndarray]:
+    """Rotations S (3, 3), mesh frame, that map the surface onto itself: the identity and those
+    half turns about the principal axes (through the centroid) after which every sampled surface
+    point lies within ``tolerance`` (m) of the surface. A uniform ellipsoid has all three; a
+    generic body only the identity."""
+    points = trimesh.sample.sample_surface(mesh, samples, seed=1)[0]
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.core.Tensor(np.asarray(mesh.vertices, np.float32)),
+                        o3d.core.Tensor(np.asarray(mesh.faces, np.uint32)))
+    center = mesh.center_mass if mesh.is_watertight else mesh.centroid
+    axes = mesh.principal_inertia_vectors.T if mesh.is_watertight else np.linalg.eigh(np.cov((points - center).T))[1]
+    found = [np.eye(3)]
+    for k in range(3):
+        flip = -np.ones(3)
+        flip[k] = 1.0
+        turn = axes @ np.diag(flip) @ axes.T
+        moved = (points - center) @ turn.T + center
+        if scene.compute_distance(o3d.core.Tensor(moved.astype(np.float32))).numpy().max() < tolerance:
+            found.append(turn)
+    return found
+
+
+def rotation_error(estimated_body_to_world, true_body_to_world, symmetries) -> float:
+    """Smallest rotation angle (rad) between an estimated attitude and the true one or any of its
+    indistinguishable variants ``R_true S``."""
+    angles = []
+    for s in symmetries:
+        relative = np.asarray(estimated_body_to_world) @ (np.asarray(true_body_to_world) @ s).T
+        angles.append(np.arccos(np.clip((np.trace(relative) - 1.0) / 2.0, -1.0, 1.0)))
+    return float(min(angles))
