@@ -269,7 +269,9 @@ def solver_chatter_to_stderr():
     saved = os.dup(1)
     try:
         os.dup2(2, 1)
-        yield
+        # pybind's print goes through sys.stdout, which need not be file descriptor 1
+        with contextlib.redirect_stdout(sys.stderr):
+            yield
     finally:
         sys.stdout.flush()
         os.dup2(saved, 1)

@@ -69,12 +69,12 @@ def _scalar_least_squares(direction, target, cov_direction, cov_target, name, un
     norm2 = float(d @ d)
     sigma_d = float(np.sqrt(max(np.trace(cov_direction), 0.0)))
     sigma_b = float(np.sqrt(max(np.trace(cov_target), 0.0)))
+    if np.linalg.norm(b) == 0.0 or np.linalg.norm(b) < MIN_SIGNIFICANCE * sigma_b:
+        raise NotObservable(f"the collision transferred {np.linalg.norm(b):.3g} of momentum, not significant "
+                            f"against its uncertainty {sigma_b:.3g}")
     if norm2 == 0.0 or np.sqrt(norm2) < MIN_SIGNIFICANCE * sigma_d:
         raise NotObservable(f"the collision changed the debris {name} by {np.sqrt(norm2):.3g} {unit}, "
                             f"not significant against its uncertainty {sigma_d:.3g} {unit}")
-    if np.linalg.norm(b) < MIN_SIGNIFICANCE * sigma_b or np.linalg.norm(b) == 0.0:
-        raise NotObservable(f"the collision transferred {np.linalg.norm(b):.3g} of momentum, not significant "
-                            f"against its uncertainty {sigma_b:.3g}")
     x = float(d @ b) / norm2
     g_b = d / norm2
     g_d = (b - 2.0 * x * d) / norm2

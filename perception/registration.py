@@ -9,16 +9,19 @@ CAD) can be given instead; it is the model from the start.
 Each frame is seeded with the pose predicted from the last two (constant rotation and
 translation rates) and refined by point-to-plane ICP with Tukey weights, coarse to fine. The
 ICP is our own Gauss-Newton loop on one KD-tree of the model, built when the model changes
-(Open3D's ``registration_icp`` builds one per call), and it stops once a step no longer moves
-the scan across the surface: on the near-axisymmetric debris, steps keep wandering about the
-weakly seen long axis without improving the fit, so a test on the step size alone never stops.
+(Open3D's ``registration_icp`` builds one per call), and a level stops once a step no longer
+moves the scan across the surface: on the near-axisymmetric debris, steps keep wandering about
+the weakly seen long axis without improving the fit, so a test on the step size alone never stops.
 
-Without a motion prediction (first frame with a known shape, the frame after a single good one,
-or after the track was lost for frames) the frame is searched: seed attitudes (small turns of
-the last pose, or attitudes over all of SO(3) when the last good pose is older than one frame)
-are ranked by a coarse ICP on a heavily thinned scan, and only the best few distinct results are
-refined and checked. When the check below fails, the frame is started again from a global
-FPFH + RANSAC alignment to the model.
+Without a motion prediction the frame is searched: seed attitudes are ranked by a coarse ICP on
+a heavily thinned scan, and only the best few distinct results are refined and checked. The
+seeds are small turns of the last pose when it is one frame old (a good frame after a failed or
+no frame), attitudes over all of SO(3) otherwise: the first frame against a known shape, and
+after the track was lost for frames (a collision may have changed the spin a lot). When the
+check below fails, the frame is started again from a global FPFH + RANSAC alignment to the model.
+
+``update(..., gate=...)`` registers, when a motion prediction exists, only the scan points near
+the predicted model: returns of other objects (net threads in front of the debris) are dropped.
 
 Why a check of its own: Open3D's ``fitness`` and ``inlier_rmse`` are computed inside the
 correspondence distance that ICP itself used, so an ICP that slid into a wrong pose (users
@@ -53,14 +56,18 @@ MIN_TIGHT_FITNESS = 0.8          # share of points within 3 sigma; a correct pos
 MAX_FREE_SPACE_VIOLATION = 0.05  # share of viewing directions where the model blocks a measured return
 MAX_INNOVATION = np.radians(10.0)  # rad; the constant-rate prediction is good to ~0.2 deg for 2.3 rad/s tumbles at 10 Hz
 SEARCH_TURN = np.radians(30.0)     # rad; largest turn between frames searched without a prediction (3 rad/s at 10 Hz, paper Sec. 2)
+MIN_POINTS = 50                    # thinned scan points below which a frame is not registered (too few for the check)
 
 #: Effort of the ICP and of the search.
-ICP_ITERATIONS = 15     # per level, at most; a level from a good prediction settles in 1-3
-ICP_SETTLED = 3e-4      # m; rms motion of the matched points along their normals below which a level has settled
-SEARCH_SETTLED = 3e-3   # m; the same for ranking search seeds: only their order matters
+ICP_ITERATIONS = 15     # per level, at most; from a good prediction a level settles in 1-4
+# A level has settled when a step moves the matched points by less than this (m, rms along their
+# normals). Tighter fine levels only wander longer about the weak axis (1e-4 m: no better, 30 % slower).
+COARSE_SETTLED = 1e-3   # m; the coarse level only has to reach the fine level's basin
+FINE_SETTLED = 1.5e-4   # m; <1 % of the case's 2 cm range noise
+SEARCH_SETTLED = 5e-3   # m; ranking search seeds: only their order matters (1e-2 ranks the truth low)
 CHECKED_POINTS = 1000   # scan points in the coarse ICP level and in the check (shares to ~1 %)
-SEARCH_VOXELS = 4       # the search ranks its seeds on the scan thinned to this many voxels (~200 points)
-SEARCH_REFINED = 6      # best-ranked distinct seeds refined and checked (the 4 symmetric poses of an ellipsoid and spares)
+SEARCH_VOXELS = 4       # the search ranks its seeds on the scan thinned to this many voxels (~300 points)
+SEARCH_REFINED = 6      # best-ranked distinct seeds refined and checked (an ellipsoid's 4 symmetric poses, spares)
 DISTINCT_TURN = np.radians(5.0)  # rad; ranked poses closer than this in attitude are one result
 
 
@@ -151,8 +158,9 @@ def _cloud(points, normals_radius=None) -> o3d.geometry.PointCloud:
 
 
 def _thinned(points, count) -> np.ndarray:
-    """Every k-th point, k the largest keeping at least ``count`` (all when fewer). Open3D's voxel
-    output is in hash order and ray-cast scans in scan-line order, so the stride spreads over the surface."""
+    """Every k-th point, k the largest keeping at least ``count`` (all when fewer): the stride runs
+    over the whole list (Open3D's voxel output in hash order, a ray-cast scan in scan-line order),
+    so the points kept spread over the whole surface."""
     return points[::max(1, len(points) // count)]
 
 
@@ -168,7 +176,10 @@ def point_to_plane_information(points_body, normals, sigma) -> np.ndarray:
 
 
 def _plane_jacobian(points_body, normals) -> np.ndarray:
-    return np.hstack([np.cross(points_body, normals), normals])
+    """Rows [(q x n), n]; the cross product written out (np.cross costs more than the product on small arrays)."""
+    q, n = points_body, normals
+    return np.column_stack([q[:, 1] * n[:, 2] - q[:, 2] * n[:, 1], q[:, 2] * n[:, 0] - q[:, 0] * n[:, 2],
+                            q[:, 0] * n[:, 1] - q[:, 1] * n[:, 0], n])
 
 
 def free_space_violation(points_world, model_world, sensor_world, bin_angle, margin) -> float:
@@ -204,9 +215,12 @@ def _rigid_inverse(matrix) -> np.ndarray:
 
 
 def _twist(step) -> np.ndarray:
-    """Transform of a small (rotation vector, translation) step (6,) (rad, m)."""
+    """Transform of a (rotation vector, translation) step (6,) (rad, m); Rodrigues' formula."""
+    angle = np.linalg.norm(step[:3])
+    k = np.array([[0.0, -step[2], step[1]], [step[2], 0.0, -step[0]], [-step[1], step[0], 0.0]])
     matrix = np.eye(4)
-    matrix[:3, :3] = Rotation.from_rotvec(step[:3]).as_matrix()
+    if angle > 0:
+        matrix[:3, :3] += np.sin(angle) / angle * k + (1 - np.cos(angle)) / angle**2 * (k @ k)
     matrix[:3, 3] = step[3:]
     return matrix
 
@@ -298,11 +312,15 @@ class DebrisTracker:
         return alignment
 
     def _gated(self, scan, predicted, gate) -> o3d.geometry.PointCloud:
+        """The scan points within ``gate`` (m) of a model point at the ``predicted`` pose."""
         gap, _ = self._tree.query(_transform(np.asarray(scan.points), predicted), distance_upper_bound=gate)
         return scan.select_by_index(np.flatnonzero(np.isfinite(gap)))
 
     def _track(self, time_s, scan, predicted, has_motion, sensor_world) -> Alignment:
         points = np.asarray(scan.points)
+        if len(points) < MIN_POINTS:   # e.g. everything gated away: record the frame as failed, do not guess
+            pose = predicted if predicted is not None else np.eye(4)
+            return Alignment(time_s, pose, np.zeros((6, 6)), 0.0, 1.0, np.inf, False, False, 0.0, len(points))
         if has_motion:
             alignment = self._judge(time_s, points, self._icp(scan, predicted), predicted, sensor_world, True)
         elif self.alignments and self.alignments[-1].ok:
@@ -313,12 +331,16 @@ class DebrisTracker:
             alignment = self._search(time_s, scan, self._acquisition_start(points, predicted),
                                      _orientation_candidates(), sensor_world)
         if not alignment.ok:
-            reference = alignment.world_to_body if predicted is None else predicted
-            pose = self._icp(scan, self._global(scan, reference))
-            retry = self._judge(time_s, points, pose, reference, sensor_world, has_motion, global_init=True)
-            if retry.ok or retry.tight_fitness > alignment.tight_fitness:
-                alignment = retry
+            alignment = self._retry_from_global(time_s, scan, alignment, predicted, has_motion, sensor_world)
         return alignment
+
+    def _retry_from_global(self, time_s, scan, failed, predicted, has_motion, sensor_world) -> Alignment:
+        """The frame again from FPFH + RANSAC; kept when it passes or fits tighter than ``failed``."""
+        reference = failed.world_to_body if predicted is None else predicted
+        pose = self._icp(scan, self._global(scan, reference))
+        points = np.asarray(scan.points)
+        retry = self._judge(time_s, points, pose, reference, sensor_world, has_motion, global_init=True)
+        return retry if retry.ok or retry.tight_fitness > failed.tight_fitness else failed
 
     def _prediction(self) -> tuple[np.ndarray | None, bool]:
         """Predicted pose (None before any good frame) and whether it carries the motion (two
@@ -339,9 +361,9 @@ class DebrisTracker:
 
     def _search(self, time_s, scan, start, turns, sensor_world) -> Alignment:
         """Without a motion prediction: ``start`` turned by each of ``turns`` about the scan
-        centroid (a smooth body, the paper's ellipsoid, gives ICP a basin of only a few tens of
-        degrees), each seed ranked by one coarse ICP level on a heavily thinned scan; the best
-        SEARCH_REFINED distinct results are refined and checked, the best-checked kept."""
+        centroid (a smooth body, the paper's ellipsoid, gives ICP a basin of only a few degrees),
+        each seed ranked by one coarse ICP level on a heavily thinned scan; the best SEARCH_REFINED
+        distinct results are refined and checked, the best-checked kept."""
         points = np.asarray(scan.points)
         thin = np.asarray(scan.voxel_down_sample(SEARCH_VOXELS * self.voxel).points)
         fits = [self._icp_level(thin, seed, self.max_correspondence, SEARCH_SETTLED)
@@ -359,11 +381,11 @@ class DebrisTracker:
         debris: a coarse level on about CHECKED_POINTS scan points within ``max_correspondence``,
         then a fine one on all points within a third of it."""
         points = np.asarray(scan.points)
-        pose, _ = self._icp_level(_thinned(points, CHECKED_POINTS), initial, self.max_correspondence)
-        pose, _ = self._icp_level(points, pose, self.max_correspondence / 3)
+        pose, _ = self._icp_level(_thinned(points, CHECKED_POINTS), initial, self.max_correspondence, COARSE_SETTLED)
+        pose, _ = self._icp_level(points, pose, self.max_correspondence / 3, FINE_SETTLED)
         return pose
 
-    def _icp_level(self, points, pose, distance, settled=ICP_SETTLED) -> tuple[np.ndarray, float]:
+    def _icp_level(self, points, pose, distance, settled) -> tuple[np.ndarray, float]:
         """Gauss-Newton point-to-plane steps (Tukey weights, k = distance / 2) on the nearest model
         points within ``distance``, until a step moves the matched points by less than ``settled``
         (m, rms along the normals). Returns the pose and the fit: mean weight over all points."""
@@ -374,13 +396,16 @@ class DebrisTracker:
             matched = np.isfinite(gap)
             body, normals = body[matched], self._model_normals[nearest[matched]]
             residual = np.einsum("ij,ij->i", body - self._model_points[nearest[matched]], normals)
-            weight = np.clip(1 - (2 * residual / distance) ** 2, 0.0, None) ** 2
+            weight = np.maximum(1 - (2 * residual / distance) ** 2, 0.0) ** 2
             if np.count_nonzero(weight) < 6:   # too few matches to fix 6 degrees of freedom
                 break
             jac = _plane_jacobian(body, normals)
             weighted = jac.T * weight
             hessian = weighted @ jac
-            step = np.linalg.lstsq(hessian, -weighted @ residual, rcond=None)[0]
+            try:
+                step = np.linalg.solve(hessian, -weighted @ residual)
+            except np.linalg.LinAlgError:   # degenerate matches (e.g. all on one plane)
+                break
             pose = _twist(step) @ pose
             if step @ hessian @ step < settled**2 * weight.sum():
                 break

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import open3d as o3d
 import trimesh
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
@@ -48,6 +49,8 @@ from riskassess.case import Case, CaseError
 #: Scan points farther than this from the predicted debris surface are not registered to it (m):
 #: a frame's motion is predicted to ~1 cm; net threads sit decimetres to metres in front.
 DEBRIS_GATE = 0.3
+#: Returns closer than this to a predicted net thread are taken as net, not debris (m).
+NET_GATE = 0.1
 #: The debris flies free once no tracked net thread comes closer to its surface than this (m).
 SEPARATION = 0.1
 #: Fewest registered free-flight frames after the collision for the momentum step.
@@ -149,6 +152,12 @@ def _aim_point(tracker: DebrisTracker):
     return body_to_world[:3, :3] @ tracker.model_points_body.mean(axis=0) + body_to_world[:3, 3]
 
 
+def _thinned(points_world, voxel) -> np.ndarray:
+    """One point per ``voxel`` (m) cell (Open3D voxel filter): keeps thin threads, bounds the work."""
+    cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points_world))
+    return np.asarray(cloud.voxel_down_sample(voxel).points)
+
+
 def _crop_to_predicted(tracker: DebrisTracker, points_world) -> np.ndarray:
     """Scan points near the debris surface predicted from the last two good frames (others
     belong to the net); all points when there is no prediction."""
@@ -222,14 +231,32 @@ class FreeMotion:
     spin_per_c_cov: np.ndarray
 
 
-def _good(tracker, frames, select) -> np.ndarray:
+def _good(tracker, select) -> np.ndarray:
     ok = np.array([a.ok for a in tracker.alignments])
     return np.flatnonzero(ok & select)
 
 
+#: A frame whose attitude residual's chi^2 (3 dof, scaled by the median frame's) exceeds this is
+#: dropped and the fit redone: 16.27 is the 0.1 % tail. It removes poses that passed the check but
+#: are wrong (during and right after the collision) and frames still touched by the net.
+OUTLIER_CHI2 = 16.27
+
+
 def fit_free_motion(tracker, indices, times, com_body=None, moments=None, principal_to_body=None) -> FreeMotion:
     """CoM line and torque-free fit through the registered frames ``indices``; inertia shape
-    estimated (before the collision) or known (after)."""
+    estimated (before the collision) or known (after). Frames the fitted motion does not explain
+    (chi^2 above :data:`OUTLIER_CHI2`) are dropped and the fit redone."""
+    indices = np.asarray(indices)
+    for _ in range(5):
+        motion, chi2 = _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_to_body)
+        keep = chi2 <= OUTLIER_CHI2 * np.median(chi2) / 2.366   # 2.366: median of chi^2 with 3 dof
+        if keep.all():
+            break
+        indices = indices[keep]
+    return motion
+
+
+def _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_to_body):
     if len(indices) < MIN_FRAMES_AFTER:
         raise NotObservable(f"only {len(indices)} registered frames of free flight; at least {MIN_FRAMES_AFTER} "
                             "are needed")
@@ -244,8 +271,10 @@ def fit_free_motion(tracker, indices, times, com_body=None, moments=None, princi
         fit = TorqueFreeFit().fit(t, attitudes, weights, omega[0], moments0, axes0)
     else:
         fit = TorqueFreeFit(moments, principal_to_body).fit(t, attitudes, weights, omega[0])
+    error = (attitudes.inv() * fit.predict_body_to_world(t)).as_rotvec()
+    chi2 = np.sum(np.einsum("kij,kj->ki", weights, error) ** 2, axis=1)
     h, h_cov = fit.spin_momentum_per_c()
-    return FreeMotion(t, line, fit, h, h_cov)
+    return FreeMotion(t, line, fit, h, h_cov), chi2
 
 
 # ------------------------------------------------------------------------------ phase 2
@@ -302,11 +331,16 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
                                         thread_mesh(true_net, net.threads, radius)],
                                 sensor_world, sensor_to_world, t, rng)
         frames.cast_seconds.append(time.perf_counter() - tic)
-        _register(tracker, frames, t, 1, _crop_to_predicted(tracker, points), sensor_world, rot, com, symmetries)
-        # The net: predicted by carrying the last estimate with the chaser, fitted to the returns
-        # the debris does not explain, its rim held at the rod tips.
+        points = _thinned(points, 0.5 * tracker.voxel)
+        # The net is predicted by carrying the last estimate with the chaser; returns on the
+        # predicted threads are not offered to the debris registration.
         start_pose = previous_chaser if previous_chaser is not None else _pose(np.eye(3), assembly.bodies[chaser].com_lvlh)
         predicted = carried_by_chaser(estimate, start_pose, chaser_pose)
+        on_net = nearest_segments(points, predicted, net.threads)[2] < NET_GATE if len(points) else np.zeros(0, bool)
+        _register(tracker, frames, t, 1, _crop_to_predicted(tracker, points[~on_net]), sensor_world, rot, com,
+                  symmetries)
+        # The net's nodes are fitted to the returns the debris does not explain, the rim held at
+        # the rod tips.
         alignment = tracker.alignments[-1]
         debris_world = model_sample @ alignment.body_to_world[:3, :3].T + alignment.body_to_world[:3, 3]
         near_debris = cKDTree(debris_world).query(points, distance_upper_bound=2 * tracker.voxel)[0]
@@ -336,7 +370,9 @@ def free_flight_start(track: NetTrack) -> int:
     touching = np.flatnonzero(~clear)
     if len(touching) == 0:
         raise NotObservable("the net never came near the debris: the collision transferred no momentum")
-    return int(touching[-1] + 1)
+    # The contact may end between frames and the gap is measured on an estimated net: the first
+    # clear frame is a margin, free flight is taken from the second.
+    return int(touching[-1] + 2)
 
 
 # ------------------------------------------------------------------------------ momentum step
@@ -526,13 +562,22 @@ def perceive_case(case_path, out_dir, progress=None, case: Case | None = None) -
     symmetries = half_turn_symmetries(scene.mesh_target, 0.5 * p.registration.voxel)
     frames = Frames()
     wall = time.perf_counter()
-    state_at_zero = observe_tumble(scene, tracker, frames, symmetries, rng, progress)
+    # Open3D's RANSAC warnings go to stdout, which --json keeps for the answer.
+    with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
+        state_at_zero = observe_tumble(scene, tracker, frames, symmetries, rng, progress)
     answer = {"case": case.name, "observation_time_s": p.observation_time, "not_observable": None}
     before = after = step = None
     try:
-        before = fit_free_motion(tracker, _good(tracker, frames, np.array(frames.phase) == 0), frames.time)
+        before = fit_free_motion(tracker, _good(tracker, np.array(frames.phase) == 0), frames.time)
     except NotObservable as exc:
+        # Nothing to scale by the collision: stop before simulating it.
         answer["not_observable"] = f"before the collision: {exc}"
+        answer.update(_timing(tracker, frames))
+        answer["tracking"] = _tracking_figures(tracker, frames)
+        answer["wall_s"] = time.perf_counter() - wall
+        manifest["status"] = "not_observable"
+        _write_perception(out, manifest, answer, tracker, frames, NetTrack())
+        return answer
 
     collision = collision_case(case, *state_at_zero, scene.spec.rate)
     inputs = model_inputs(collision, scene.base)
@@ -541,22 +586,21 @@ def perceive_case(case_path, out_dir, progress=None, case: Case | None = None) -
                               if progress else None)
     finish_simulation(out, manifest, recorder, simulation, collision)
     assembly = simulation.assembly
-    track = observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembly, progress)
+    with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
+        track = observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembly, progress)
     times = np.array(frames.time)
-    if before is not None:
-        try:
-            start_time = track.times[free_flight_start(track)]
-            after = fit_free_motion(tracker, _good(tracker, frames, times >= start_time - 1e-9), times,
-                                    before.line.com_body, before.fit.moments_, before.fit.principal_to_body_)
-            origin = before.line.position_world([0.0])[0]
-            others_after = others_momentum_after(scene, assembly, recorder, track, after.times, origin)
-            step = momentum_step(before, after, others_momentum_before(assembly, origin), others_after, origin)
-            answer["free_flight_after_s"] = [float(after.times[0]), float(after.times[-1])]
-            answer["observation_time_s"] = float(p.observation_time + after.times[-1])
-        except NotObservable as exc:
-            answer["not_observable"] = f"after the collision: {exc}"
-    if before is not None:
-        answer.update(estimates(scene, before, after, step, state_at_zero))
+    try:
+        start_time = track.times[free_flight_start(track)]
+        after = fit_free_motion(tracker, _good(tracker, times >= start_time - 1e-9), times,
+                                before.line.com_body, before.fit.moments_, before.fit.principal_to_body_)
+        origin = before.line.position_world([0.0])[0]
+        others_after = others_momentum_after(scene, assembly, recorder, track, after.times, origin)
+        step = momentum_step(before, after, others_momentum_before(assembly, origin), others_after, origin)
+        answer["free_flight_after_s"] = [float(after.times[0]), float(after.times[-1])]
+        answer["observation_time_s"] = float(p.observation_time + after.times[-1])
+    except NotObservable as exc:
+        answer["not_observable"] = f"after the collision: {exc}"
+    answer.update(estimates(scene, before, after, step, state_at_zero))
     answer.update(_timing(tracker, frames))
     answer["tracking"] = _tracking_figures(tracker, frames)
     answer["net"] = _net_figures(track, assembly)
@@ -571,7 +615,7 @@ def _net_figures(track: NetTrack, assembly) -> dict:
             "returns_per_frame_mean": float(np.mean(track.n_points)), "mass_kg": float(assembly.net.masses.sum())}
 
 
-def _write_perception(out, manifest, answer, tracker, frames, track) -> None:
+def _write_perception(out, manifest, answer, tracker, frames, track: NetTrack) -> None:
     from riskassess import results
 
     poses = np.array([a.body_to_world for a in tracker.alignments])

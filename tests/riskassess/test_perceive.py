@@ -1,0 +1,86 @@
+"""`riskassess perceive` end to end on a shortened Tang et al. (2023) scenario, and its
+"not observable" answers."""
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from riskassess.case import load_case
+from riskassess.cli import main
+
+CASE = Path(__file__).parents[2] / "cases" / "tang2023_debris_perception.toml"
+
+
+def _shortened(tmp_path, observation, end_time, **replace):
+    """The paper case with a shorter observation and collision run (and any key = value line
+    replaced), written next to the test's outputs."""
+    text = CASE.read_text()
+    text = re.sub(r"(?m)^observation_time = .*$", f"observation_time = {observation}", text)
+    text = re.sub(r"(?m)^end_time = .*$", f"end_time = {end_time}", text)
+    for key, value in replace.items():
+        text = re.sub(rf"(?m)^{key} = .*$", f"{key} = {value}", text)
+    path = tmp_path / "case.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def perceived(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("perceive")
+    case = _shortened(tmp, 15.0, 3.0)
+    return tmp, case
+
+
+def test_perceive_estimates_mass_and_inertia(perceived, capsys):
+    # 15 s of tumble and 3 s of collision run: the torque-free fit fixes the inertia ratios to
+    # ~0.1 %, the linear balance the mass to ~0.01 % (1 sigma ~0.2 kg: the CoM velocity from ~16
+    # free-flight frames). The angular balance has only 1.6 s of free flight after the contact
+    # ends (1.02 s) and the net's own angular momentum (~15 N m s of ~500 exchanged) from the
+    # partly seen net: measured C error -2.2 % here, -0.08 % with 2.5 s of free flight
+    # (bench/bench_perception.py). Bounds: mass 0.5 % (the issue's goal), moments 3 %.
+    tmp, case = perceived
+    assert main(["perceive", str(case), "--out", str(tmp / "run"), "--json"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    assert answer["not_observable"] is None
+    for key in ("mass_estimate", "inertia_estimate", "mass_error_percent", "inertia_error_percent",
+                "registration_ms_per_frame", "observation_time_s"):
+        assert answer[key] is not None, key
+    assert answer["mass_error_percent"] < 0.5
+    assert answer["inertia_error_percent"] < 3.0
+    # the stated 1-sigma uncertainties cover the errors (4 sigma)
+    assert abs(answer["mass_kg"] - answer["true_mass_kg"]) < 4 * answer["mass_std_kg"] + 1e-9
+    assert answer["center_of_mass_error_m"] < 0.005
+    assert 15.0 < answer["observation_time_s"] <= 18.0
+    manifest = json.loads((tmp / "run" / "manifest.json").read_text())
+    assert manifest["status"] == "complete" and "perception.json" in manifest["files"]
+
+
+def test_case_takes_mass_properties_from_a_perception_result(perceived):
+    tmp, case = perceived
+    answer = json.loads((tmp / "run" / "perception.json").read_text())
+    text = case.read_text()
+    text = re.sub(r"(?m)^mass = 1715.23.*$\n^center_of_mass = .*$\n^#.*$\n^inertia = .*$",
+                  'mass_properties_from = "run/perception.json"', text)
+    assert "mass_properties_from" in text
+    fed = tmp / "fed.toml"
+    fed.write_text(text)
+    body = load_case(fed).target.bodies[0]
+    assert body.mass == pytest.approx(answer["mass_kg"], rel=1e-12)
+    assert body.inertia == answer["inertia_target_kg_m2"]
+
+
+def test_a_debris_that_does_not_turn_is_not_observable(tmp_path, capsys):
+    case = _shortened(tmp_path, 3.0, 1.0, angular_velocity="[0.0, 0.0, 0.0]")
+    assert main(["perceive", str(case), "--out", str(tmp_path / "run"), "--json"]) == 3
+    answer = json.loads(capsys.readouterr().out)
+    assert "turn" in answer["not_observable"]
+    assert "mass_estimate" not in answer
+
+
+def test_an_empty_scan_is_not_observable(tmp_path, capsys):
+    # the debris sits 10 m away; a 5 m range returns nothing: no pose, no estimate
+    case = _shortened(tmp_path, 2.0, 1.0, rate="10.0\nmax_range = 5.0")
+    assert main(["perceive", str(case), "--out", str(tmp_path / "run"), "--json"]) == 3
+    answer = json.loads(capsys.readouterr().out)
+    assert "registered frames" in answer["not_observable"]
