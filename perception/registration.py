@@ -342,6 +342,11 @@ class DebrisTracker:
         retry = self._judge(time_s, points, pose, reference, sensor_world, has_motion, global_init=True)
         return retry if retry.ok or retry.tight_fitness > failed.tight_fitness else failed
 
+    def predicted_world_to_body(self) -> np.ndarray | None:
+        """The next frame's expected pose (world -> B): from the motion of the last two good
+        frames, else the last good pose; None before any good frame."""
+        return self._prediction()[0]
+
     def _prediction(self) -> tuple[np.ndarray | None, bool]:
         """Predicted pose (None before any good frame) and whether it carries the motion (two
         consecutive good frames); without the motion, the last good pose."""
