@@ -482,16 +482,30 @@ def format_validation_error(path: Path, error: ValidationError) -> str:
     return "\n".join(lines)
 
 
-def load_case(path: str | Path) -> Case:
-    """Read and validate a case file; raise :class:`CaseError` naming every problem."""
+def read_toml(path: str | Path) -> dict:
+    """The parsed TOML of a case file; :class:`CaseError` when it is missing or not TOML."""
     path = Path(path)
     try:
-        raw = tomllib.loads(path.read_text())
+        return tomllib.loads(path.read_text())
     except FileNotFoundError:
         raise CaseError(f"{path}: no such case file") from None
     except tomllib.TOMLDecodeError as exc:
         raise CaseError(f"{path}: not valid TOML: {exc}") from None
-    return validate_case(raw, path)
+
+
+def load_model(path: str | Path, model: type[BaseModel]):
+    """Read the TOML file ``path`` into the pydantic ``model`` (a stage's own case schema, e.g.
+    towing or approach); raise :class:`CaseError` naming the file, every bad key and what is allowed."""
+    path = Path(path)
+    try:
+        return model.model_validate(read_toml(path))
+    except ValidationError as exc:
+        raise CaseError(format_validation_error(path, exc)) from None
+
+
+def load_case(path: str | Path) -> Case:
+    """Read and validate a net-impact case file; raise :class:`CaseError` naming every problem."""
+    return validate_case(read_toml(path), path)
 
 
 def validate_case(raw: dict, path: str | Path) -> Case:
