@@ -1,0 +1,1 @@
+"""Controllers and guidance: MU approach optimal control, tether elongation MRAC, attitude control."""

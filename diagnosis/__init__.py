@@ -1,0 +1,1 @@
+"""Model diagnosis: residuals against measured data, a catalog of candidate effects, fit and selection."""
