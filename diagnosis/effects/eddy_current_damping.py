@@ -1,0 +1,64 @@
+"""``eddy_current_damping``: braking torque of eddy currents induced by the geomagnetic field.
+
+For a conductive body spinning in a field B (Gomez & Walker 2015, Ortiz Gomez & Walker,
+"Eddy currents applied to de-tumbling of space debris"), the torque opposes the spin
+component normal to the field:
+
+.. math:: \\boldsymbol\\tau = -c\\,(\\boldsymbol\\omega - (\\boldsymbol\\omega\\cdot\\hat b)\\hat b)
+
+with c = k_e |B|^2 (N m s) and the field direction b fixed in the inertial frame over the record
+(a few minutes of a LEO orbit); the angular momentum is not conserved (an external torque).
+Parameters: c and the field direction (azimuth, elevation in I = LVLH at t = 0). Main body only.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_Q, X_W, quaternion_matrix
+from diagnosis.effects.base import Effect, Parameter
+from diagnosis.plant import Plant
+
+
+@njit(cache=True)
+def field_direction(azimuth, elevation):
+    """Unit field direction in I from azimuth (about z, from x) and elevation (rad)."""
+    return np.array([np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)])
+
+
+@njit(cache=True)
+def eddy_torque(omega_body, field_body, coefficient):
+    """Eddy-current torque (N m, B) at ``omega_body`` (rad/s, B), unit field ``field_body`` (B)."""
+    return -coefficient * (omega_body - (omega_body @ field_body) * field_body)
+
+
+@njit(LAW_SIGNATURE, cache=True)
+def law(t, x, p, env, load):
+    rot = quaternion_matrix(x[X_Q:X_Q + 4])
+    load[L_TM:L_TM + 3] += eddy_torque(x[X_W:X_W + 3], rot.T @ field_direction(p[1], p[2]), p[0])
+
+
+class EddyCurrentDamping(Effect):
+    id = "eddy_current_damping"
+    title = "eddy-current braking in the geomagnetic field (spin normal to the field decays)"
+    channels = ("omega_x", "omega_y", "omega_z", "q_w")
+    law = staticmethod(law)
+
+    def parameter_specs(self, case, channels=None):
+        j_max = float(np.linalg.eigvalsh(Plant.from_case(case).inertia_main)[-1])
+        return [Parameter("coefficient", "N m s", "k_e |B|^2, torque per unit spin rate", j_max / 3000.0, 0.0,
+                          j_max / 10.0),
+                Parameter("field_azimuth", "rad", "field direction about I z, from I x", 0.0, -2 * np.pi, 2 * np.pi),
+                Parameter("field_elevation", "rad", "field direction above the I x-y plane", 0.0, -np.pi / 2, np.pi / 2)]
+
+    def starts(self, specs):
+        c = specs[0].typical
+        return [np.array([c, 0.0, 1.2]), np.array([c, 0.0, 0.0]), np.array([c, np.pi / 2, 0.0])]
+
+    def add_to_exudyn(self, builder, values, names):
+        b = field_direction(values[1], values[2])
+        builder.add_body_torque(lambda t, body, rot, omega: eddy_torque(omega, rot.T @ b, values[0]) if body == 0
+                                else np.zeros(3))
+
+
+EFFECT = EddyCurrentDamping()

@@ -1,0 +1,37 @@
+"""One prediction of the measured channels: plant + at most one effect, by the fast model."""
+from __future__ import annotations
+
+import numpy as np
+
+from diagnosis.dynamics import environment, initial_state, integrate, no_load
+from diagnosis.effects.base import Effect
+from diagnosis.observation import outputs
+from diagnosis.plant import Plant
+
+#: RK4 step as a fraction of the fastest motion's period / 2 pi (rad): 0.06 rad per step keeps the
+#: RK4 error of a 300 s record below 1e-6 of the signal (checked in tests/diagnosis/test_dynamics.py).
+ANGLE_PER_STEP = 0.06
+#: Longest RK4 step (s).
+MAX_STEP = 0.25
+
+
+def max_step(plant: Plant, stiffness_rate: float = 0.0) -> float:
+    """The RK4 step (s) for a plant and an effect's fastest decay rate (1/s)."""
+    step = min(MAX_STEP, ANGLE_PER_STEP / plant.rate_scale())
+    return min(step, 1.5 / stiffness_rate) if stiffness_rate > 0 else step
+
+
+def predict(plant: Plant, times, effect: Effect | None = None, values=(), names=(), step: float | None = None) -> dict:
+    """Channels (dict of (k,) arrays) at ``times`` (s) of ``plant`` with ``effect`` at ``values``."""
+    times = np.asarray(times, float)
+    values = np.asarray(values, float)
+    if effect is None:
+        law, p, sample_times = no_load, np.zeros(1), times
+    else:
+        plant = effect.modify_plant(plant, values)
+        law, p, sample_times = effect.law, effect.law_parameters(plant, values), effect.sample_times(times, values)
+    step = step or max_step(plant)
+    states = integrate(law, p if p.size else np.zeros(1), environment(plant), initial_state(plant),
+                       sample_times, step)
+    out = outputs(plant, sample_times, states)
+    return effect.measure(out, values, names) if effect is not None else out

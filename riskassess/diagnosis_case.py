@@ -1,0 +1,180 @@
+"""Case files of `riskassess diagnose`: a scenario the tool simulates and compares with measured data.
+
+One TOML file, validated on load (:func:`load_diagnosis_case`) into one of the scenario models
+picked by the top-level ``kind``:
+
+* ``"tumbling_rigid"``: one rigid debris body tumbling freely (torque-free nominal).
+* ``"hinged_appendage"``: a main body and an appendage on a revolute hinge with a torsional
+  spring-damper, released from an initial hinge angle and rate; no external load in the nominal.
+* ``"towing"`` is reserved for the tethered towing model (not yet available).
+
+Frames: **target frame** = the main body's reference frame; the main body frame has the same
+axes and its origin at the main body's CoM. **LVLH** is chaser-centred (x radial, y along-track,
+z orbit normal); it rotates at the orbit's mean motion about z. The inertial frame used by the
+dynamics is LVLH at t = 0. Time 0 is the epoch of the initial state; measured times use it.
+"""
+from __future__ import annotations
+
+from typing import Annotated, Literal, Union
+
+import numpy as np
+from pydantic import Field, RootModel, field_validator, model_validator
+
+from riskassess.case import NonNegative, Positive, Strict, Vector3, load_model
+
+Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3)]
+
+
+def _check_inertia(j):
+    m = np.asarray(j, float)
+    if not np.allclose(m, m.T, rtol=1e-9, atol=1e-9 * np.abs(m).max()):
+        raise ValueError("inertia must be symmetric")
+    eig = np.linalg.eigvalsh(m)
+    if eig.min() <= 0:
+        raise ValueError(f"inertia must be positive definite (principal moments {eig.round(6).tolist()})")
+    if eig[0] + eig[1] < eig[2] * (1 - 1e-9):
+        raise ValueError(f"principal moments {eig.round(6).tolist()} violate the triangle inequality")
+    return j
+
+
+class MainBody(Strict):
+    mass: Positive = Field(description="Mass of the (main) body (kg).")
+    center_of_mass: Vector3 = Field([0.0, 0.0, 0.0], description="CoM, target frame (m).")
+    inertia: Matrix3 = Field(description="Inertia about the CoM, target-frame axes (kg m^2).")
+
+    @field_validator("inertia")
+    @classmethod
+    def _physical(cls, j):
+        return _check_inertia(j)
+
+
+class Appendage(Strict):
+    mass: Positive = Field(description="Mass of the appendage (kg).")
+    com_offset_from_hinge: Vector3 = Field(
+        description="Appendage CoM minus hinge point at zero hinge angle, target frame (m).")
+    inertia: Matrix3 = Field(description="Inertia about the appendage CoM at zero hinge angle, target-frame axes (kg m^2).")
+
+    @field_validator("inertia")
+    @classmethod
+    def _physical(cls, j):
+        return _check_inertia(j)
+
+
+class Hinge(Strict):
+    position: Vector3 = Field(description="Hinge point, target frame (m).")
+    axis: Vector3 = Field(description="Hinge axis, target frame (-); normalised on load. The hinge angle is the "
+                                      "appendage's rotation about it relative to the main body.")
+    torsional_stiffness: NonNegative = Field(0.0, description="Linear torsional spring about the axis (N m/rad); "
+                                                              "rest at zero hinge angle.")
+    torsional_damping: NonNegative = Field(0.0, description="Viscous torsional damping about the axis (N m s/rad).")
+    initial_angle: float = Field(0.0, description="Hinge angle at t = 0 (rad).")
+    initial_rate: float = Field(0.0, description="Hinge rate at t = 0 (rad/s).")
+
+    @field_validator("axis")
+    @classmethod
+    def _nonzero(cls, v):
+        if np.linalg.norm(v) == 0:
+            raise ValueError("axis must be a non-zero vector")
+        return v
+
+
+class InitialState(Strict):
+    attitude_rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Target->LVLH rotation at t = 0 (rad).")
+    angular_velocity: Vector3 = Field(description="Inertial angular velocity of the main body at t = 0, target "
+                                                  "frame (rad/s).")
+    position_lvlh: Vector3 = Field([0.0, 0.0, 0.0], description="Target-frame origin relative to the chaser at "
+                                                                "t = 0, LVLH (m).")
+    velocity_lvlh: Vector3 = Field([0.0, 0.0, 0.0], description="Velocity of the debris' centre of mass (all "
+                                                                "bodies) relative to the chaser at t = 0, LVLH (m/s).")
+
+
+class CircularOrbit(Strict):
+    kind: Literal["circular"]
+    altitude: Annotated[float, Field(ge=100e3, le=1e8)] = Field(description="Circular orbit altitude above the "
+                                                                            "equatorial radius (m).")
+    inclination: Annotated[float, Field(ge=0, le=np.pi)] = Field(0.0, description="Orbit inclination (rad).")
+    argument_of_latitude: float = Field(0.0, description="Chaser's argument of latitude at t = 0 (rad), from the "
+                                                         "ascending node (right ascension of the node 0).")
+
+
+class NoOrbit(Strict):
+    kind: Literal["none"]
+
+
+Orbit = Annotated[Union[CircularOrbit, NoOrbit], Field(discriminator="kind")]
+
+
+class Uncertain(Strict):
+    """1-sigma prior uncertainties of nominal parameters; the fit estimates every parameter given
+    here (a Gaussian prior centred on the case value), 0 or absent = known exactly."""
+    attitude: NonNegative = Field(0.0, description="Initial attitude, per axis (rad).")
+    angular_velocity: NonNegative = Field(0.0, description="Initial angular velocity, per axis (rad/s).")
+    position: NonNegative = Field(0.0, description="Initial position, per axis (m).")
+    velocity: NonNegative = Field(0.0, description="Initial velocity, per axis (m/s).")
+    hinge_angle: NonNegative = Field(0.0, description="Initial hinge angle (rad).")
+    hinge_rate: NonNegative = Field(0.0, description="Initial hinge rate (rad/s).")
+    torsional_stiffness: NonNegative = Field(0.0, description="Hinge torsional stiffness (N m/rad).")
+    torsional_damping: NonNegative = Field(0.0, description="Hinge torsional damping (N m s/rad).")
+
+
+class EffectEntry(Strict):
+    id: str = Field(description="Effect id from the catalog (docs/diagnosis.md).")
+    parameters: dict[str, float] = Field(description="Physical parameters by name, SI units (see the catalog).")
+
+
+class Diagnosis(Strict):
+    holdout_fraction: Annotated[float, Field(gt=0.05, lt=0.8)] = Field(
+        0.3, description="Last fraction of the record kept out of the fit and used to score predictions (-).")
+    decisive_delta_bic: Positive = Field(
+        10.0, description="BIC difference that counts as decisive evidence (-); Kass & Raftery 1995: > 10 very strong.")
+    adequate_rms: Annotated[float, Field(gt=1.0)] = Field(
+        1.25, description="A model explains a channel when its residual RMS is below this multiple of the noise (-).")
+
+
+class _ScenarioBase(Strict):
+    name: str
+    description: str = ""
+    main_body: MainBody
+    initial: InitialState
+    orbit: Orbit = NoOrbit(kind="none")
+    uncertain: Uncertain = Uncertain()
+    diagnosis: Diagnosis = Diagnosis()
+    effects: list[EffectEntry] = Field([], description="Effects switched on in this model (an extended case).")
+
+    @model_validator(mode="after")
+    def _known_effects(self):
+        from diagnosis.effects import CATALOG
+
+        for k, entry in enumerate(self.effects):
+            if entry.id not in CATALOG:
+                raise ValueError(f"effects[{k}].id: '{entry.id}' is not in the catalog {sorted(CATALOG)}")
+            names = [p.name for p in CATALOG[entry.id].parameter_specs(self)]
+            unknown = sorted(set(entry.parameters) - set(names))
+            missing = [] if getattr(CATALOG[entry.id], "partial_parameters", False) else \
+                sorted(set(names) - set(entry.parameters))
+            if unknown or missing:
+                raise ValueError(f"effects[{k}] ({entry.id}).parameters: expected {names}; unknown {unknown}, "
+                                 f"missing {missing}")
+        return self
+
+
+class TumblingRigidCase(_ScenarioBase):
+    kind: Literal["tumbling_rigid"]
+
+
+class HingedAppendageCase(_ScenarioBase):
+    kind: Literal["hinged_appendage"]
+    appendage: Appendage
+    hinge: Hinge
+
+
+DiagnosisCase = Union[TumblingRigidCase, HingedAppendageCase]
+
+
+class DiagnosisCaseFile(RootModel):
+    root: Annotated[DiagnosisCase, Field(discriminator="kind")]
+
+
+def load_diagnosis_case(path) -> DiagnosisCase:
+    """Read and validate a diagnosis case; :class:`~riskassess.case.CaseError` names file and key."""
+    return load_model(path, DiagnosisCaseFile).root
