@@ -235,7 +235,9 @@ class VerletForces:
         q, v, a = _object_state(self.state_index, data.GetODE2Coordinates(), data.GetODE2Coordinates_t(),
                                 data.GetODE2Coordinates_tt())
         q_next, v_half = verlet_evaluation_state(q, v, a, self.step, self.n_net_coordinates, self.n_bodies)
-        self._set_force(self.kernel.evaluate(q_next, v_half, t + self.step))
+        # Exudyn calls the pre-step function with the step's end time already set: t is the time
+        # of the evaluation state (checked in tests/multibody/test_towing.py).
+        self._set_force(self.kernel.evaluate(q_next, v_half, t))
         return True
 
 

@@ -137,6 +137,30 @@ def flat_square_net(center, direction, side_length, nodes_per_side, node_mass, n
     )
 
 
+@njit(cache=True, inline="always")
+def tension_only_kelvin_voigt(stretch, rate, stiffness, damping):
+    """Tension (N) of a thread or tether that pulls only: a Kelvin-Voigt spring-damper while
+    stretched and pulling, zero when slack or when the damper would push.
+
+    .. math:: T = \\begin{cases} \\max(0,\\; k s + c \\dot s) & s > 0 \\\\ 0 & s \\le 0 \\end{cases}
+
+    Cuadrat-Grzybowski & Gill 2024 eq. (1); the same law is the main tether and sub-tethers
+    of Boonrath, Singh & Botta 2024, eqs. (5a) and (14a).
+
+    Parameters
+    ----------
+    stretch : float
+        Length minus natural length, :math:`l - l_0` (m).
+    rate : float
+        Rate of change of the length, :math:`\\dot l` (m/s).
+    stiffness, damping : float
+        :math:`k` (N/m) and :math:`c` (N s/m).
+    """
+    if stretch <= 0.0:
+        return 0.0
+    return max(0.0, stiffness * stretch + damping * rate)
+
+
 @njit(cache=True)
 def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
     """Add tension-only Kelvin-Voigt thread forces to ``force``; return (elastic J, damping W).
@@ -175,7 +199,7 @@ def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
         ez = dz / length
         rate = (v[b, 0] - v[a, 0]) * ex + (v[b, 1] - v[a, 1]) * ey + (v[b, 2] - v[a, 2]) * ez
         elastic += 0.5 * stiffness[t] * stretch * stretch
-        tension = stiffness[t] * stretch + damping[t] * rate
+        tension = tension_only_kelvin_voigt(stretch, rate, stiffness[t], damping[t])
         if tension <= 0.0:
             continue
         power += damping[t] * rate * rate

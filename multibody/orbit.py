@@ -51,3 +51,37 @@ def clohessy_wiltshire_potential(r_lvlh, n):
     """
     r = np.atleast_2d(r_lvlh)
     return 0.5 * n * n * (r[:, 2] ** 2 - 3.0 * r[:, 0] ** 2)
+
+
+@njit(cache=True, inline="always")
+def two_body_acceleration_xyz(x, y, z, mu):
+    """Components (m/s^2) of :func:`two_body_acceleration`, in scalars (no allocation)."""
+    r2 = x * x + y * y + z * z
+    scale = -mu / (r2 * math.sqrt(r2))
+    return scale * x, scale * y, scale * z
+
+
+@njit(cache=True)
+def two_body_acceleration(r_inertial, mu):
+    """Gravitational acceleration of a point at ``r_inertial`` (m/s^2), Earth-centred inertial frame.
+
+    Boonrath, Singh & Botta 2024, eq. (1) divided by the body's mass:
+
+    .. math:: \\mathbf a = -\\mu \\frac{\\mathbf r}{\\|\\mathbf r\\|^3}
+
+    Parameters
+    ----------
+    r_inertial : (3,) float
+        Position of the body's CoM from the Earth's centre (m), inertial frame.
+    mu : float
+        Gravitational parameter (m^3/s^2).
+    """
+    ax, ay, az = two_body_acceleration_xyz(r_inertial[0], r_inertial[1], r_inertial[2], mu)
+    return np.array([ax, ay, az])
+
+
+def two_body_specific_energy(r_inertial, v_inertial, mu):
+    """Specific orbital energy :math:`\\tfrac12 v^2 - \\mu/r` (J/kg) of states (..., 3) in the
+    inertial frame; constant on a Keplerian orbit."""
+    r = np.linalg.norm(r_inertial, axis=-1)
+    return 0.5 * np.sum(np.asarray(v_inertial) ** 2, axis=-1) - mu / r

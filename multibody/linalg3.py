@@ -1,0 +1,41 @@
+"""3-vector and 3x3-matrix products for compiled kernels, written out in scalars.
+
+numba hands ``@`` on small arrays to BLAS (about 1 us a call), which dominated the towing
+kernel; these loops cost a few ns. Arguments are float64 arrays of shape (3,) or (3, 3).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def dot3(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True, inline="always")
+def cross3(a, b):
+    out = np.empty(3)
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+    return out
+
+
+@njit(cache=True, inline="always")
+def matvec3(m, x):
+    """m x for a (3, 3) matrix."""
+    out = np.empty(3)
+    for i in range(3):
+        out[i] = m[i, 0] * x[0] + m[i, 1] * x[1] + m[i, 2] * x[2]
+    return out
+
+
+@njit(cache=True, inline="always")
+def mattvec3(m, x):
+    """m^T x for a (3, 3) matrix."""
+    out = np.empty(3)
+    for i in range(3):
+        out[i] = m[0, i] * x[0] + m[1, i] * x[1] + m[2, i] * x[2]
+    return out

@@ -1,0 +1,257 @@
+"""Lower-order towing model in Exudyn: chaser and debris rigid bodies, the connection point mass,
+the main tether and the sub-tethers (Boonrath, Singh & Botta 2024, Sec. 2.2, Fig. 2).
+
+The three bodies are Exudyn nodes (the point P a ``NodeGenericODE2`` of 3 coordinates, chaser and
+debris ``NodeRigidBodyRotVecLG`` with Lie-group integration); every force between them, gravity,
+thrust and the attitude control torque come from the compiled :func:`multibody.towing_kernel.towing_forces`
+through one ``ObjectGenericODE2`` whose force vector is set before each VelocityVerlet step
+(:class:`multibody.impact.VerletForces`, the impact model's coupling). Frame: Earth-centred
+inertial for every position and velocity; angular velocities in the body frames.
+
+:func:`run_twin` integrates the same forces with the same scheme in compiled code, without
+Exudyn (~50x faster: no per-step Python call); the identification uses it and
+``tests/multibody/test_towing.py`` checks that both agree.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import exudyn as exu
+import numpy as np
+from exudyn.itemInterface import NodeGenericODE2, NodeRigidBodyRotVecLG, ObjectGenericODE2, ObjectRigidBody
+from scipy.spatial.transform import Rotation
+
+from multibody.impact import _object_state_index, explicit_settings, solver_chatter_to_stderr
+from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.towing_kernel import (N_COORDINATES, ST_TENSION, pack, packed_forces, start_forces, step_forces,
+                                     twin_run)
+
+
+@dataclass
+class TowingModel:
+    """Everything one lower-order run needs (SI units; inertial frame unless ``_body``).
+
+    Attributes
+    ----------
+    masses : (3,) float             m_P, m_C, m_D (kg).
+    inertia_body : (2, 3, 3) float  J_C, J_D about the CoMs, body frames (kg m^2).
+    attach_chaser_body : (3,) float MT attachment r_A/C, chaser frame (m).
+    attach_debris_body : (n, 3) float  ST attachments r_i/D, debris frame (m).
+    tether : (6,) float             k_MT (N/m), c_MT (N s/m), l_MT0 (m), k_ST, c_ST, l_ST0.
+    mu : float                      Gravitational parameter (m^3/s^2).
+    attitude : (8,) float           Controller on (1/0), K (1/s), G (3,) (rad/s^2), epsilon (3,) (rad/s).
+    thrust_kind : int               :data:`control.thrust.KINDS` code.
+    thrust_along_body_z : bool      Thrust along the chaser's body z (MRAC) or against its velocity (ramp).
+    thrust_params, thrust_state : (k,) float   The thrust law's constants and initial states.
+    positions, velocities : (3, 3) float       P, chaser CoM, debris CoM at ``start_time`` (m, m/s).
+    body_to_inertial : (2, 3, 3) float         Chaser and debris attitude at ``start_time``.
+    omega_body : (2, 3) float                  Chaser and debris angular velocity, body frames (rad/s).
+    start_time, end_time, step, output_interval : float   (s)
+    """
+
+    masses: np.ndarray
+    inertia_body: np.ndarray
+    attach_chaser_body: np.ndarray
+    attach_debris_body: np.ndarray
+    tether: np.ndarray
+    mu: float
+    attitude: np.ndarray
+    thrust_kind: int
+    thrust_along_body_z: bool
+    thrust_params: np.ndarray
+    thrust_state: np.ndarray
+    positions: np.ndarray
+    velocities: np.ndarray
+    body_to_inertial: np.ndarray
+    omega_body: np.ndarray
+    start_time: float
+    end_time: float
+    step: float
+    output_interval: float
+    inverse_inertia: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        self.inverse_inertia = np.linalg.inv(self.inertia_body)
+
+    @property
+    def n_steps(self) -> int:
+        return int(round((self.end_time - self.start_time) / self.step))
+
+    @property
+    def every(self) -> int:
+        """Steps between output samples."""
+        return max(1, int(round(self.output_interval / self.step)))
+
+    def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """Coordinates and velocities (15,) each at ``start_time`` (layout of :mod:`multibody.towing_kernel`)."""
+        q, v = np.zeros(N_COORDINATES), np.zeros(N_COORDINATES)
+        v[0:3] = self.velocities[0]
+        for b, base in enumerate((3, 9)):
+            q[base + 3:base + 6] = Rotation.from_matrix(self.body_to_inertial[b]).as_rotvec()
+            v[base:base + 3] = self.velocities[b + 1]
+            v[base + 3:base + 6] = self.omega_body[b]
+        return q, v
+
+
+def packed(model: TowingModel) -> np.ndarray:
+    """The model as one float array for the compiled kernel (:func:`multibody.towing_kernel.pack`);
+    it also carries the thrust law's state, so each run needs its own."""
+    return pack(model.positions, model.masses, model.inertia_body, model.attach_chaser_body,
+                model.attach_debris_body, model.tether, model.mu, model.attitude, model.thrust_kind,
+                model.thrust_along_body_z, model.thrust_params, model.thrust_state, model.step)
+
+
+@dataclass
+class TowResult:
+    """Samples of one run: ``time`` (k,) (s), ``q``/``v`` (k, 15) in the kernel layout, ``diag``
+    (k, 10 + n) diagnostics of :func:`~multibody.towing_kernel.towing_forces`, wall time (s)."""
+
+    model: TowingModel
+    time: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    diag: np.ndarray
+    wall_time: float
+
+    def series(self) -> dict:
+        """Named time series (SI; frames in the names), see docs/towing.md."""
+        from multibody.towing_kernel import MT_ELONGATION, MT_ELONGATION_RATE, MT_TENSION, SLIDING, THRUST, TORQUE
+
+        m = self.model
+        rot = np.array([[rotation_matrix_from_rotation_vector(self.q[k, b + 3:b + 6]) for b in (3, 9)]
+                        for k in range(len(self.time))]).reshape(-1, 2, 3, 3)
+        return {
+            "time": self.time,
+            "connection_point_inertial": m.positions[0] + self.q[:, 0:3],
+            "chaser_com_inertial": m.positions[1] + self.q[:, 3:6],
+            "debris_com_inertial": m.positions[2] + self.q[:, 9:12],
+            "connection_point_velocity_inertial": self.v[:, 0:3],
+            "chaser_velocity_inertial": self.v[:, 3:6], "debris_velocity_inertial": self.v[:, 9:12],
+            "chaser_to_inertial": rot[:, 0], "debris_to_inertial": rot[:, 1],
+            "chaser_omega_body": self.v[:, 6:9], "debris_omega_body": self.v[:, 12:15],
+            "main_tether_tension": self.diag[:, MT_TENSION],
+            "main_tether_elongation": self.diag[:, MT_ELONGATION],
+            "main_tether_elongation_rate": self.diag[:, MT_ELONGATION_RATE],
+            "sub_tether_tension": self.diag[:, ST_TENSION:],
+            "thrust": self.diag[:, THRUST], "control_torque_body": self.diag[:, TORQUE:TORQUE + 3],
+            "sliding_variable": self.diag[:, SLIDING:SLIDING + 3],
+        }
+
+
+def _sample_buffers(model: TowingModel):
+    k = model.n_steps // model.every + 1
+    return np.zeros((k, N_COORDINATES)), np.zeros((k, N_COORDINATES)), np.zeros((k, ST_TENSION + len(model.attach_debris_body)))
+
+
+def run_twin(model: TowingModel) -> TowResult:
+    """Integrate ``model`` with the compiled twin of Exudyn's scheme (:func:`~multibody.towing_kernel.twin_run`)."""
+    q, v = model.initial_state()
+    out_q, out_v, out_diag = _sample_buffers(model)
+    start = time.perf_counter()
+    twin_run(q, v, model.start_time, model.n_steps, model.every, packed(model), out_q, out_v, out_diag)
+    wall = time.perf_counter() - start
+    times = model.start_time + model.step * model.every * np.arange(len(out_q))
+    return TowResult(model, times, out_q, out_v, out_diag, wall)
+
+
+def build_towing_system(model: TowingModel):
+    """The Exudyn system: P node, chaser and debris rigid bodies, one coupled generic object.
+    Returns (system container, main system, coupled object, node list)."""
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    q0, v0 = model.initial_state()
+    nodes = [mbs.AddNode(NodeGenericODE2(referenceCoordinates=list(model.positions[0]), initialCoordinates=[0.0] * 3,
+                                         initialCoordinates_t=list(v0[0:3]), numberOfODE2Coordinates=3))]
+    for b, base in enumerate((3, 9)):
+        node = mbs.AddNode(NodeRigidBodyRotVecLG(referenceCoordinates=list(model.positions[b + 1]) + [0.0] * 3,
+                                                 initialCoordinates=list(q0[base:base + 6]),
+                                                 initialVelocities=list(v0[base:base + 6])))
+        j = model.inertia_body[b]
+        mbs.AddObject(ObjectRigidBody(nodeNumber=node, physicsMass=float(model.masses[b + 1]),
+                                      physicsInertia=[j[0, 0], j[1, 1], j[2, 2], j[1, 2], j[0, 2], j[0, 1]]))
+        nodes.append(node)
+    mass = exu.MatrixContainer()
+    mass.SetWithSparseMatrixCSR(N_COORDINATES, N_COORDINATES, [[i, i, float(model.masses[0])] for i in range(3)],
+                                useDenseMatrix=False)
+    coupled = mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, massMatrix=mass, forceVector=[0.0] * N_COORDINATES))
+    mbs.Assemble()
+    return sc, mbs, coupled, nodes
+
+
+class _TowVerletStep:
+    """Exudyn pre-step function: records the state every ``model.every`` steps, then sets the force
+    vector of the coming VelocityVerlet step, evaluated at the state where the step evaluates it.
+
+    The scheme is :class:`multibody.impact.VerletForces`'; the differences are for speed in this
+    small system, where the Python side is most of a step: one compiled call per step
+    (:func:`~multibody.towing_kernel.step_forces` on the packed model), and the start-of-step
+    acceleration is the one that call computed in the previous step (Exudyn's own to round-off,
+    see the tests) instead of a third read of Exudyn's system vectors (~3 us each).
+    """
+
+    def __init__(self, mbs, coupled, model: TowingModel, index, buffers):
+        self.mbs, self.coupled, self.model, self.index = mbs, coupled, model, index
+        self.work = packed(model)
+        self.out_q, self.out_v, self.out_diag = buffers
+        self.step, self.every, self.count, self.sample = model.step, model.every, 0, 0
+        # Exudyn's initial accelerations use this force
+        self.set_force(start_forces(*self.state(), model.start_time, self.work))
+
+    def state(self):
+        data = self.mbs.systemData
+        q, v = data.GetODE2Coordinates(), data.GetODE2Coordinates_t()
+        return (q, v) if self.index is None else (q[self.index], v[self.index])
+
+    def set_force(self, force):
+        self.mbs.SetObjectParameter(self.coupled, "forceVector", force)
+
+    def record(self, q, v, t):
+        """Sample state (q, v) at Exudyn time t (diagnostics without advancing the thrust law)."""
+        self.out_q[self.sample], self.out_v[self.sample] = q, v
+        self.out_diag[self.sample] = packed_forces(q, v, self.model.start_time + t, self.work, False)[1]
+        self.sample += 1
+
+    def __call__(self, mbs, t):
+        # Exudyn calls the pre-step function with the step's end time t already set
+        q, v = self.state()
+        if self.count % self.every == 0 and self.sample < len(self.out_q):
+            self.record(q, v, t - self.step)
+        self.count += 1
+        self.set_force(step_forces(q, v, self.model.start_time + t, self.work)[0])
+        return True
+
+
+def run_exudyn(model: TowingModel) -> TowResult:
+    """Build and integrate ``model`` in Exudyn (VelocityVerlet, fixed step, Lie-group rotations)."""
+    sc, mbs, coupled, nodes = build_towing_system(model)
+    index = _object_state_index(mbs, nodes, [3, 6, 6])
+    buffers = _sample_buffers(model)
+    step_function = _TowVerletStep(mbs, coupled, model, index, buffers)
+    mbs.SetPreStepUserFunction(step_function)
+    settings = explicit_settings(model.step, model.n_steps)
+    start = time.perf_counter()
+    with solver_chatter_to_stderr():
+        exu.SolveDynamic(mbs, settings, solverType=exu.DynamicSolverType.VelocityVerlet)
+    wall = time.perf_counter() - start
+    if step_function.sample < len(buffers[0]):  # the last sample is the end state
+        step_function.record(*step_function.state(), model.n_steps * model.step)
+    times = model.start_time + model.step * model.every * np.arange(len(buffers[0]))
+    return TowResult(model, times, *buffers, wall)
+
+
+def stable_step(model: TowingModel, safety: float = 0.5) -> float:
+    """Largest VelocityVerlet step (s) the connection point allows, times ``safety``.
+
+    P (mass m_P) hangs on all tethers at once: :math:`\\ddot x = -\\omega^2 x - \\gamma\\dot x` with
+    :math:`\\omega^2 = k_\\Sigma/m_P`, :math:`\\gamma = c_\\Sigma/m_P` (summed tether stiffness and damping).
+    Verlet applies the damper with the half-step velocity; its one-step matrix has trace
+    :math:`2 - h^2\\omega^2 - h\\gamma` and determinant :math:`1 - h\\gamma`, and the Jury conditions give
+    stability for :math:`h^2\\omega^2 + 2h\\gamma < 4`, i.e.
+    :math:`h < (\\sqrt{\\gamma^2 + 4\\omega^2} - \\gamma)/\\omega^2`. With ``safety`` 0.5,
+    :math:`h\\gamma < 1`: the damped mode does not oscillate from step to step.
+    """
+    n = len(model.attach_debris_body)
+    omega2 = (model.tether[0] + n * model.tether[3]) / model.masses[0]
+    gamma = (model.tether[1] + n * model.tether[4]) / model.masses[0]
+    return safety * (np.sqrt(gamma * gamma + 4.0 * omega2) - gamma) / omega2

@@ -1,0 +1,269 @@
+"""Compiled forces of the lower-order towing model (Boonrath, Singh & Botta 2024, Sec. 2.2) and
+its compiled twin integrator.
+
+Bodies: the connection point P (point mass), the chaser C and the debris D (rigid bodies); the
+main tether (MT) joins P to the chaser's attachment point A, the sub-tethers (ST) join P to the
+debris' attachment points. Every vector is in the Earth-centred inertial frame unless named
+``_body``.
+
+Coordinate layout of the coupled Exudyn object and of the twin (``q`` / ``v``, 15 entries):
+
+* 0-2  P: displacement from its reference position (m); velocity (m/s), inertial.
+* 3-8  chaser: CoM displacement (m), rotation vector body->inertial (rad); CoM velocity (m/s),
+  inertial, and angular velocity (rad/s), body frame.
+* 9-14 debris: same as the chaser.
+
+The generalized force on a rotational part is the torque in the body frame; the rigid bodies'
+gyroscopic terms are Exudyn's own (the twin adds them as Exudyn does).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from control.attitude import desired_attitude, sliding_mode_torque
+from control.thrust import thrust_command
+from multibody.kernel import rotation_matrix_from_rotation_vector, verlet_evaluation_state
+from multibody.linalg3 import cross3, matvec3
+from multibody.net import tension_only_kelvin_voigt
+from multibody.orbit import two_body_acceleration_xyz
+
+N_COORDINATES = 15
+P, CHASER, DEBRIS = 0, 3, 9
+#: Diagnostic outputs of :func:`towing_forces`, then one sub-tether tension per attachment point.
+MT_TENSION, MT_ELONGATION, MT_ELONGATION_RATE, THRUST, TORQUE, SLIDING, ST_TENSION = 0, 1, 2, 3, 4, 7, 10
+#: Tether parameter indices.
+K_MT, C_MT, L_MT, K_ST, C_ST, L_ST = range(6)
+#: Attitude-controller parameter indices: on/off, K, G (3), boundary-layer width (3).
+ATT_ON, ATT_K, ATT_G, ATT_WIDTH = 0, 1, 2, 5
+
+
+@njit(cache=True, inline="always")
+def _rotate(r, x, y, z):
+    """r (x, y, z) for a (3, 3) matrix, as a tuple (no allocation)."""
+    return (r[0, 0] * x + r[0, 1] * y + r[0, 2] * z, r[1, 0] * x + r[1, 1] * y + r[1, 2] * z,
+            r[2, 0] * x + r[2, 1] * y + r[2, 2] * z)
+
+
+@njit(cache=True, inline="always")
+def _cross(ax, ay, az, bx, by, bz):
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+
+
+@njit(cache=True)
+def _tether_to_body(x, v, rot, base, com, point_body, k, c, rest, out_force):
+    """One tether from P (at ``x``, m) to a point of the body at ``base`` (eqs. 4-5, 13-14): adds its
+    pull on P and on the body to ``out_force``; returns tension (N), stretch (m), stretch rate (m/s)
+    and the unit vector point->P (inertial)."""
+    ax, ay, az = _rotate(rot, point_body[0], point_body[1], point_body[2])
+    wx, wy, wz = _cross(v[base + 3], v[base + 4], v[base + 5], point_body[0], point_body[1], point_body[2])
+    ux, uy, uz = _rotate(rot, wx, wy, wz)
+    dx = x[0] - com[0] - ax
+    dy = x[1] - com[1] - ay
+    dz = x[2] - com[2] - az
+    length = math.sqrt(dx * dx + dy * dy + dz * dz)
+    dx, dy, dz = dx / length, dy / length, dz / length
+    rate = (v[0] - v[base] - ux) * dx + (v[1] - v[base + 1] - uy) * dy + (v[2] - v[base + 2] - uz) * dz
+    tension = tension_only_kelvin_voigt(length - rest, rate, k, c)
+    fx, fy, fz = tension * dx, tension * dy, tension * dz
+    out_force[0] -= fx
+    out_force[1] -= fy
+    out_force[2] -= fz
+    out_force[base] += fx
+    out_force[base + 1] += fy
+    out_force[base + 2] += fz
+    bx = rot[0, 0] * fx + rot[1, 0] * fy + rot[2, 0] * fz  # pull in the body frame
+    by = rot[0, 1] * fx + rot[1, 1] * fy + rot[2, 1] * fz
+    bz = rot[0, 2] * fx + rot[1, 2] * fy + rot[2, 2] * fz
+    mx, my, mz = _cross(point_body[0], point_body[1], point_body[2], bx, by, bz)
+    out_force[base + 3] += mx
+    out_force[base + 4] += my
+    out_force[base + 5] += mz
+    return tension, length - rest, rate, dx, dy, dz
+
+
+@njit(cache=True, inline="always")
+def _add_gravity(out_force, x, y, z, mass, mu, base):
+    """Eq. (1) on the body at ``base``; ``mu`` = 0 turns gravity off (tests away from any orbit)."""
+    if mu == 0.0:
+        return
+    gx, gy, gz = two_body_acceleration_xyz(x, y, z, mu)
+    out_force[base] += mass * gx
+    out_force[base + 1] += mass * gy
+    out_force[base + 2] += mass * gz
+
+
+@njit(cache=True)
+def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, attach_debris, tether, mu,
+                  attitude, thrust_kind, thrust_along_body_z, thrust_params, thrust_state, step, advance,
+                  out_force, out_diag):
+    """Generalized forces (``out_force``, (15,)) of the lower-order model at time ``t`` (s).
+
+    MT and ST tensions (eqs. 4, 5, 13, 14), two-body gravity on P, chaser and debris (eq. 1),
+    thrust (the ramp after eq. 2 or a :mod:`control.thrust` law), sliding-mode torque (eqs. 7-10).
+    ``reference`` (3, 3) holds the reference positions of P, chaser and debris (m);
+    ``masses`` = [m_P, m_C, m_D] (kg); ``tether`` = [k_MT, c_MT, l_MT0, k_ST, c_ST, l_ST0];
+    ``attitude`` = [on, K, G (3), width (3)]. The thrust law's state advances by ``step`` when
+    ``advance``. ``out_diag`` receives MT tension, elongation and rate, thrust magnitude, control
+    torque (3, body), sliding variable (3) and the ST tensions.
+    """
+    out_force[:] = 0.0
+    x = np.empty(3)  # P, absolute (m)
+    com_c = np.empty(3)
+    com_d = np.empty(3)
+    for i in range(3):
+        x[i] = reference[0, i] + q[i]
+        com_c[i] = reference[1, i] + q[CHASER + i]
+        com_d[i] = reference[2, i] + q[DEBRIS + i]
+    rot_c = rotation_matrix_from_rotation_vector(q[CHASER + 3:CHASER + 6])
+    rot_d = rotation_matrix_from_rotation_vector(q[DEBRIS + 3:DEBRIS + 6])
+    tension, z, z_rate, ux, uy, uz = _tether_to_body(x, v, rot_c, CHASER, com_c, attach_chaser,
+                                                     tether[K_MT], tether[C_MT], tether[L_MT], out_force)
+    out_diag[MT_TENSION], out_diag[MT_ELONGATION], out_diag[MT_ELONGATION_RATE] = tension, z, z_rate
+    for i in range(attach_debris.shape[0]):
+        out_diag[ST_TENSION + i] = _tether_to_body(x, v, rot_d, DEBRIS, com_d, attach_debris[i],
+                                                   tether[K_ST], tether[C_ST], tether[L_ST], out_force)[0]
+    _add_gravity(out_force, x[0], x[1], x[2], masses[0], mu, 0)
+    _add_gravity(out_force, com_c[0], com_c[1], com_c[2], masses[1], mu, CHASER)
+    _add_gravity(out_force, com_d[0], com_d[1], com_d[2], masses[2], mu, DEBRIS)
+
+    magnitude = thrust_command(thrust_kind, t, z, z_rate, thrust_params, thrust_state, step, advance)
+    out_diag[THRUST] = magnitude
+    if magnitude != 0.0:
+        if thrust_along_body_z:
+            dx, dy, dz = rot_c[0, 2], rot_c[1, 2], rot_c[2, 2]
+        else:
+            speed = math.sqrt(v[CHASER] ** 2 + v[CHASER + 1] ** 2 + v[CHASER + 2] ** 2)
+            dx, dy, dz = -v[CHASER] / speed, -v[CHASER + 1] / speed, -v[CHASER + 2] / speed
+        out_force[CHASER] += magnitude * dx
+        out_force[CHASER + 1] += magnitude * dy
+        out_force[CHASER + 2] += magnitude * dz
+    if attitude[ATT_ON] > 0.0:
+        u = np.empty(3)
+        u[0], u[1], u[2] = ux, uy, uz
+        desired = desired_attitude(u, com_c)
+        torque, s = sliding_mode_torque(rot_c, v[CHASER + 3:CHASER + 6], desired, inertia_chaser,
+                                        attitude[ATT_K], attitude[ATT_G:ATT_G + 3], attitude[ATT_WIDTH:ATT_WIDTH + 3])
+        for i in range(3):
+            out_force[CHASER + 3 + i] += torque[i]
+            out_diag[TORQUE + i] = torque[i]
+            out_diag[SLIDING + i] = s[i]
+
+
+@njit(cache=True)
+def accelerations(v, force, masses, inertia, inverse_inertia):
+    """Accelerations as Exudyn forms them: M^-1 (f - gyroscopic terms), rotation-vector Lie-group nodes."""
+    a = np.empty(N_COORDINATES)
+    a[0:3] = force[0:3] / masses[0]
+    for b in range(2):
+        base = CHASER + 6 * b
+        omega = v[base + 3:base + 6]
+        a[base:base + 3] = force[base:base + 3] / masses[b + 1]
+        a[base + 3:base + 6] = matvec3(inverse_inertia[b], force[base + 3:base + 6] - cross3(omega, matvec3(inertia[b], omega)))
+    return a
+
+
+# ---------------------------------------------------------------------------- packed model
+# One float array holds the whole model, the thrust law's state and the work buffers, so that a
+# step costs one call from Python (numba's dispatch costs ~0.2 us per argument).
+(W_N_ATTACH, W_KIND, W_ALONG_Z, W_STEP, W_MU, W_THRUST_PARAMS, W_N_THRUST_PARAMS, W_THRUST_STATE, W_N_THRUST_STATE,
+ W_ATTACH, W_DIAG, W_FORCE, W_ACCEL) = range(13)
+W_REFERENCE, W_MASSES, W_INERTIA, W_INVERSE, W_ATTACH_CHASER, W_TETHER, W_ATTITUDE, W_END = (
+    16, 25, 28, 46, 64, 67, 73, 81)
+
+
+def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, attitude, thrust_kind,
+         thrust_along_body_z, thrust_params, thrust_state, step) -> np.ndarray:
+    """The packed model (see :func:`towing_forces` for the meaning of each part)."""
+    n = len(attach_debris)
+    sizes = [3 * n, len(thrust_params), len(thrust_state), ST_TENSION + n, N_COORDINATES, N_COORDINATES]
+    offsets = W_END + np.concatenate([[0], np.cumsum(sizes)])
+    work = np.zeros(offsets[-1])
+    work[:13] = [n, thrust_kind, float(thrust_along_body_z), step, mu, offsets[1], len(thrust_params), offsets[2],
+                 len(thrust_state), offsets[0], offsets[3], offsets[4], offsets[5]]
+    inertia = np.asarray(inertia, float)
+    work[W_REFERENCE:W_END] = np.concatenate([np.ravel(reference), masses, inertia.ravel(), np.linalg.inv(inertia).ravel(),
+                                              attach_chaser, tether, attitude])
+    for start, part in zip(offsets[:3], (np.ravel(attach_debris), thrust_params, thrust_state)):
+        work[start:start + len(part)] = part
+    return work
+
+
+@njit(cache=True, inline="always")
+def _section(work, index, size_index):
+    start = int(work[index])
+    return work[start:start + int(work[size_index])]
+
+
+@njit(cache=True)
+def packed_forces(q, v, t, work, advance):
+    """:func:`towing_forces` of the packed model; the force and diagnostics land in ``work``."""
+    n = int(work[W_N_ATTACH])
+    attach = work[int(work[W_ATTACH]):int(work[W_ATTACH]) + 3 * n].reshape((n, 3))
+    diag = work[int(work[W_DIAG]):int(work[W_DIAG]) + ST_TENSION + n]
+    force = work[int(work[W_FORCE]):int(work[W_FORCE]) + N_COORDINATES]
+    towing_forces(q, v, t, work[W_REFERENCE:W_MASSES].reshape((3, 3)), work[W_MASSES:W_INERTIA],
+                  work[W_INERTIA:W_INERTIA + 9].reshape((3, 3)), work[W_ATTACH_CHASER:W_TETHER], attach,
+                  work[W_TETHER:W_ATTITUDE], work[W_MU], work[W_ATTITUDE:W_END], int(work[W_KIND]),
+                  work[W_ALONG_Z] > 0.0, _section(work, W_THRUST_PARAMS, W_N_THRUST_PARAMS),
+                  _section(work, W_THRUST_STATE, W_N_THRUST_STATE), work[W_STEP], advance, force, diag)
+    return force, diag
+
+
+@njit(cache=True)
+def _store_accelerations(v, force, work):
+    a = accelerations(v, force, work[W_MASSES:W_INERTIA], work[W_INERTIA:W_INVERSE].reshape((2, 3, 3)),
+                      work[W_INVERSE:W_ATTACH_CHASER].reshape((2, 3, 3)))
+    start = int(work[W_ACCEL])
+    work[start:start + N_COORDINATES] = a
+
+
+@njit(cache=True)
+def start_forces(q, v, t, work):
+    """Force at the initial state (thrust law advanced, as at every step); stores the initial
+    accelerations in ``work``; returns the force (15,)."""
+    force, _ = packed_forces(q, v, t, work, True)
+    _store_accelerations(v, force, work)
+    return force
+
+
+@njit(cache=True)
+def step_forces(q, v, t, work):
+    """The force of the VelocityVerlet step that starts at (q, v) with the stored accelerations,
+    evaluated where Exudyn's VelocityVerlet evaluates it at time ``t`` (the step's end): half
+    kick, drift with the Lie-group update (:func:`multibody.kernel.verlet_evaluation_state`).
+    Stores the step's accelerations for the next call; returns the force (15,) and the
+    evaluation state (q, v)."""
+    start = int(work[W_ACCEL])
+    q_next, v_half = verlet_evaluation_state(q, v, work[start:start + N_COORDINATES], work[W_STEP], 3, 2)
+    force, _ = packed_forces(q_next, v_half, t, work, True)
+    _store_accelerations(v_half, force, work)
+    return force, q_next, v_half
+
+
+@njit(cache=True)
+def twin_run(q, v, t0, n_steps, every, work, out_q, out_v, out_diag):
+    """Integrate the lower-order model with exactly the scheme Exudyn's VelocityVerlet applies to the
+    coupled object: half kick, drift (Lie-group update of the rotation vectors), force at the new
+    state (:func:`step_forces`), half kick. Samples every ``every`` steps into ``out_q``/``out_v``
+    (k, 15) and ``out_diag`` (diagnostics at the sampled state, thrust law not advanced). ``q``,
+    ``v`` and ``work`` are updated in place; returns the final time (s)."""
+    step = work[W_STEP]
+    start_forces(q, v, t0, work)
+    acc = int(work[W_ACCEL])
+    sample = 0
+    for n in range(n_steps + 1):
+        t = t0 + n * step
+        if n % every == 0 and sample < out_q.shape[0]:
+            out_q[sample] = q
+            out_v[sample] = v
+            out_diag[sample] = packed_forces(q, v, t, work, False)[1]
+            sample += 1
+        if n == n_steps:
+            break
+        _, q_next, v_half = step_forces(q, v, t + step, work)
+        q[:] = q_next
+        v[:] = v_half + (0.5 * step) * work[acc:acc + N_COORDINATES]
+    return t0 + n_steps * step
