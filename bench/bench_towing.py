@@ -1,0 +1,72 @@
+"""Towing benchmark: the 275 s lower-order run of cases/zenit2_towing.toml (Boonrath et al. 2024:
+about 1 min in MATLAB) and the step-size study behind its default step.
+
+    python bench/bench_towing.py [--case cases/zenit2_towing.toml] [--repeat 3] [--no-convergence]
+
+Prints, for the Exudyn model and its compiled twin, the wall time, steps per second and the
+step; then the step study: RMSE against a 0.25 ms run of the quantities the identification
+compares (r_D/C, both angular velocities, main-tether tension). Goal: the Exudyn run < 2 s.
+Timings are upper bounds when other jobs share the machine.
+"""
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from multibody.towing import run_exudyn, run_twin, stable_step
+from riskassess.case import load_model
+from riskassess.tow import towing_model
+from riskassess.towing_case import TowingCase
+
+
+def _rmse(a, b):
+    """RMSE of the vector (or scalar) difference over the samples, as eq. (19)."""
+    diff = (np.asarray(a) - np.asarray(b)).reshape(len(a), -1)
+    return float(np.sqrt(np.mean(np.sum(diff**2, axis=1))))
+
+
+def compared(result) -> tuple:
+    s = result.series()
+    return (s["debris_com_inertial"] - s["chaser_com_inertial"], s["chaser_omega_body"], s["debris_omega_body"],
+            s["main_tether_tension"])
+
+
+def speed(case, repeat):
+    model = towing_model(case)
+    run_twin(model), run_exudyn(towing_model(case, end_time=case.simulation.start_time + 1.0))  # compile, warm up
+    print(f"275 s lower-order run, step {model.step * 1e3:.3f} ms ({model.n_steps} steps; stability limit of the "
+          f"connection point x 0.5: {stable_step(model) * 1e3:.3f} ms)")
+    for name, run in (("Exudyn", run_exudyn), ("twin", run_twin)):
+        walls = [run(model).wall_time for _ in range(repeat)]
+        best = min(walls)
+        print(f"  {name:6s} wall {best:6.3f} s (best of {repeat}; all {', '.join(f'{w:.3f}' for w in walls)}), "
+              f"{model.n_steps / best:9.0f} steps/s")
+
+
+def convergence(case):
+    interval = case.simulation.output_interval
+    steps = [interval / k for k in (400, 200, 100, 50, 27)]
+    reference = compared(run_twin(towing_model(case, step=steps[0])))
+    print("step study (twin = Exudyn's scheme), RMSE against 0.25 ms:")
+    print(f"  {'step ms':>8} {'r_D/C m':>10} {'w_C rad/s':>10} {'w_D rad/s':>10} {'T_MT N':>10}")
+    for h in steps[1:]:
+        values = compared(run_twin(towing_model(case, step=h)))
+        errors = [_rmse(a, b) for a, b in zip(values, reference)]
+        print(f"  {h * 1e3:8.3f} " + " ".join(f"{e:10.2e}" for e in errors))
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--case", default="cases/zenit2_towing.toml")
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--no-convergence", action="store_true")
+    args = parser.parse_args()
+    case = load_model(args.case, TowingCase)
+    speed(case, args.repeat)
+    if not args.no_convergence:
+        convergence(case)
+
+
+if __name__ == "__main__":
+    main()
