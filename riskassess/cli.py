@@ -120,6 +120,25 @@ def _cmd_perceive(args) -> int:
     return 3 if answer["not_observable"] and status == 0 else status
 
 
+def _cmd_tow(args) -> int:
+    from riskassess.case import load_model
+    from riskassess.tow import tow_case
+    from riskassess.towing_case import TowingCase
+
+    case = load_model(args.case, TowingCase)
+    out = Path(args.out) if args.out else Path("runs") / case.name
+    summary = tow_case(args.case, out, case=case)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(f"{case.name}: towed {summary['simulated_s']:g} s with thrust '{summary['thrust_kind']}', "
+              f"debris spin {summary['spin_rate_deg_s']:.2f} deg/s; main tether peak "
+              f"{summary['main_tether_peak_tension_N']:.1f} N, final {summary['main_tether_final_tension_N']:.1f} N, "
+              f"slack while thrusting {summary['main_tether_slack_time_while_thrusting_s']:.2f} s; "
+              f"{summary['wall_time_s']:.2f} s wall\nresults: {out}")
+    return 0
+
+
 def print_perception(answer: dict, out: Path) -> None:
     from riskassess.tables import perception_rows
 
@@ -264,6 +283,11 @@ def build_parser() -> argparse.ArgumentParser:
                         "track the tumbling debris by LiDAR, simulate the net collision, estimate mass and inertia",
                         "case file (TOML) with [perception] and [chaser]",
                         "print the estimates (mass_estimate, inertia_estimate, errors, timings) as JSON")
+    tow = sub.add_parser("tow", help="lower-order towing run of a towing case (chaser, tethers, net-wrapped debris)")
+    tow.add_argument("case", help="towing case file (TOML), e.g. cases/zenit2_towing.toml")
+    tow.add_argument("--out", help="output folder (default runs/<case name>)")
+    tow.add_argument("--json", action="store_true", help="print the summary as JSON")
+    tow.set_defaults(func=_cmd_tow)
     report = sub.add_parser("report", help="write report.html (self-contained) and report.pdf into a run folder")
     report.add_argument("run_dir", help="run folder written by 'riskassess run'")
     report.add_argument("--no-pdf", action="store_true", help="HTML only")
