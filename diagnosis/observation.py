@@ -41,7 +41,7 @@ def outputs(plant: Plant, times, states) -> dict[str, np.ndarray]:
     q = (to_lvlh * body_to_inertial).as_quat()[:, [3, 0, 1, 2]]
     share = plant.mass_appendage / plant.total_mass
     offset_b = plant.origin_main - share * plant.appendage_offset(states[:, X_TH]) if plant.hinged \
-        else np.broadcast_to(plant.origin_main, (len(times), 3))
+        else np.tile(plant.origin_main, (len(times), 1))
     rel = to_lvlh.apply(states[:, X_R:X_R + 3] + body_to_inertial.apply(offset_b))
     out = {c: states[:, X_W + k] for k, c in enumerate(OMEGA)}
     out.update({c: q[:, k] for k, c in enumerate(QUATERNION)})

@@ -1,0 +1,104 @@
+"""Model selection: which effect, if any, the data decisively call for.
+
+Each model (the nominal and nominal + one effect) is scored by the Bayesian information
+criterion with the Gaussian noise model on the training part,
+BIC = chi^2 + k ln n (Schwarz 1978; the common constants dropped), and by its prediction of the
+held-out part it was not fitted on. A cause is named only when all of these hold:
+
+1. decisive against the nominal: BIC_nominal - BIC_best > ``decisive_delta_bic`` (10: "very
+   strong" evidence, Kass & Raftery 1995, J. Am. Stat. Assoc. 90, 773, Sec. 3.2);
+2. decisive against the runner-up effect (same threshold), otherwise the data cannot tell them
+   apart and the answer is "unexplained" (ambiguous);
+3. adequate: the extended model's training residual RMS is within ``adequate_rms`` sigma in every
+   channel (what is left is noise), otherwise the effect only absorbs part of something else;
+4. material: it predicts the held-out data better by at least ``MIN_GAIN_PERCENT``.
+
+Otherwise the answer is "none" (no significant discrepancy: the nominal model is adequate) or
+"unexplained" (the nominal model is not, and no single catalog effect explains it).
+Confidence is the BIC posterior weight of the answer's model among all fitted models
+(equal prior odds): exp(-BIC/2) normalized.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from diagnosis.fit import FitResult, Problem
+from diagnosis.residuals import normalized_residuals
+
+#: Smallest held-out gain (aggregate normalized RMSE, %) for a named cause: an effect that explains
+#: decisively but predicts unseen data less than 5 % better is not the cause the user is after.
+MIN_GAIN_PERCENT = 5.0
+
+
+def posterior_weights(fits: dict[str, FitResult]) -> dict[str, float]:
+    bic = {k: f.bic for k, f in fits.items()}
+    low = min(bic.values())
+    w = {k: np.exp(-0.5 * (b - low)) for k, b in bic.items()}
+    total = sum(w.values())
+    return {k: float(v / total) for k, v in w.items()}
+
+
+def channel_rms(problem: Problem, model: dict, part: np.ndarray) -> dict:
+    """Per channel: normalized RMS residual and RMSE (channel units) over the samples ``part``."""
+    measured = {c: v[part] for c, v in problem.values.items()}
+    r = normalized_residuals({c: v[part] for c, v in model.items()}, measured, problem.noise)
+    out = {}
+    for c, res in r.items():
+        ok = np.isfinite(res)
+        rms = float(np.sqrt(np.mean(res[ok] ** 2)))
+        out[c] = {"rms_sigma": rms, "rmse": rms * problem.noise[c]}
+    return out
+
+
+def aggregate_rms(per_channel: dict) -> float:
+    """RMS over channels of their normalized RMS (sigma units)."""
+    return float(np.sqrt(np.mean([v["rms_sigma"] ** 2 for v in per_channel.values()])))
+
+
+def score(problem: Problem, predictions: dict[str, dict]) -> dict[str, dict]:
+    """Training and held-out figures of every model's prediction over the whole record."""
+    test = ~problem.train
+    out = {}
+    for key, model in predictions.items():
+        train, held = channel_rms(problem, model, problem.train), channel_rms(problem, model, test)
+        out[key] = {"train": train, "holdout": held, "train_rms_sigma": aggregate_rms(train),
+                    "holdout_rms_sigma": aggregate_rms(held)}
+    return out
+
+
+def gain_percent(before: float, after: float) -> float:
+    return float(100.0 * (before - after) / before) if before > 0 else 0.0
+
+
+def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float, adequate_rms: float) -> dict:
+    """The answer: cause (an effect id, "none" or "unexplained"), confidence, and why."""
+    weights = posterior_weights(fits)
+    nominal = fits["nominal"]
+    ranked = sorted((k for k in fits if k != "nominal"), key=lambda k: fits[k].bic)
+    adequate = {k: max(v["rms_sigma"] for v in s["train"].values()) <= adequate_rms for k, s in scores.items()}
+    answer = {"weights": weights, "ranked": ranked, "adequate": adequate}
+    if ranked:
+        best = ranked[0]
+        delta = nominal.bic - fits[best].bic
+        margin = fits[ranked[1]].bic - fits[best].bic if len(ranked) > 1 else np.inf
+        gain = gain_percent(scores["nominal"]["holdout_rms_sigma"], scores[best]["holdout_rms_sigma"])
+        if delta > decisive and adequate[best] and gain >= MIN_GAIN_PERCENT:
+            if margin > decisive:
+                return {**answer, "cause": best, "model": best, "confidence": weights[best],
+                        "reason": f"{best}: BIC lower by {delta:.1f} than the nominal model and by {margin:.1f} than "
+                                  f"the runner-up {ranked[1] if len(ranked) > 1 else '-'}; residual within "
+                                  f"{adequate_rms:g} sigma; held-out prediction {gain:.0f} % better"}
+            close = [k for k in ranked if fits[k].bic - fits[best].bic <= decisive]
+            return {**answer, "cause": "unexplained", "model": best, "confidence": None,
+                    "reason": f"ambiguous: {', '.join(close)} explain the data about equally (BIC within "
+                              f"{decisive:g}); no single cause is decisive"}
+    if adequate["nominal"]:
+        return {**answer, "cause": "none", "model": "nominal", "confidence": weights["nominal"],
+                "reason": f"no significant discrepancy: the nominal model's residual is within {adequate_rms:g} "
+                          f"sigma in every channel and no effect is decisively better"}
+    best = ranked[0] if ranked else "nominal"
+    why = "no candidate is decisively better" if not ranked or nominal.bic - fits[best].bic <= decisive else (
+        f"the best candidate ({best}) leaves a residual above {adequate_rms:g} sigma or does not predict the "
+        f"held-out data better")
+    return {**answer, "cause": "unexplained", "model": "nominal", "confidence": None,
+            "reason": f"the nominal model departs from the data and {why}"}
