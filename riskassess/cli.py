@@ -196,6 +196,35 @@ def print_summary(summary: dict, run_dir: Path) -> None:
     console.print(f"results: {run_dir}")
 
 
+def _cmd_diagnose(args) -> int:
+    from riskassess.diagnose import diagnose_case
+
+    noise = {}
+    for item in args.noise:
+        name, _, sigma = item.partition("=")
+        try:
+            noise[name.strip()] = float(sigma)
+        except ValueError:
+            raise ValueError(f"--noise {item}: expected CHANNEL=SIGMA with SIGMA a number (channel units)") from None
+    with _progress_bar("diagnose", args.json) as bar:
+        task = bar.add_task("", total=None)
+        answer = diagnose_case(args.case, args.measured, args.out, noise, progress=lambda stage, done, total:
+                               bar.update(task, description=stage, completed=done, total=total))
+    if args.json:
+        print(json.dumps(answer, indent=2, default=float))
+    else:
+        confidence = "" if answer["confidence"] is None else f" (confidence {answer['confidence']:.3f})"
+        print(f"{answer['case']}: cause = {answer['cause']}{confidence}\n{answer['statement']}")
+        for name, p in answer["parameters"].items():
+            print(f"  {name} = {p['value']:.4g} +- {p['std']:.2g} {p['unit']}")
+        print("held-out RMSE before -> after (gain %): " + ", ".join(
+            f"{c} {answer['rmse_before'][c]:.3g} -> {answer['rmse_after'][c]:.3g} ({answer['gain_percent'][c]:.0f})"
+            for c in answer["rmse_before"]))
+        if answer["extended_case"]:
+            print(f"extended case: {answer['extended_case']}")
+    return 0
+
+
 def _cmd_sweep(args) -> int:
     from riskassess.sweep.runner import run_sweep, validate_runs, write_sweep_products
     from riskassess.sweep.spec import parse_uncertain, parse_vary, run_specs
@@ -288,6 +317,16 @@ def build_parser() -> argparse.ArgumentParser:
     tow.add_argument("--out", help="output folder (default runs/<case name>)")
     tow.add_argument("--json", action="store_true", help="print the summary as JSON")
     tow.set_defaults(func=_cmd_tow)
+    diagnose = sub.add_parser("diagnose", help="compare a simulated scenario with measured data, name the missing "
+                                               "effect, fit it and report the prediction gain")
+    diagnose.add_argument("case", help="diagnosis case file (TOML, kind tumbling_rigid or hinged_appendage)")
+    diagnose.add_argument("--measured", required=True, help="measured data (CSV: time, then named channels, SI)")
+    diagnose.add_argument("--out", help="output folder (default runs/<case name>-diagnosis)")
+    diagnose.add_argument("--json", action="store_true", help="print the diagnosis (cause, confidence, parameters, "
+                                                              "rmse_before, rmse_after, gain_percent) as JSON")
+    diagnose.add_argument("--noise", action="append", default=[], metavar="CHANNEL=SIGMA",
+                          help="1-sigma noise of a channel (its SI unit) instead of the estimate from the data")
+    diagnose.set_defaults(func=_cmd_diagnose)
     report = sub.add_parser("report", help="write report.html (self-contained) and report.pdf into a run folder")
     report.add_argument("run_dir", help="run folder written by 'riskassess run'")
     report.add_argument("--no-pdf", action="store_true", help="HTML only")

@@ -178,3 +178,33 @@ class DiagnosisCaseFile(RootModel):
 def load_diagnosis_case(path) -> DiagnosisCase:
     """Read and validate a diagnosis case; :class:`~riskassess.case.CaseError` names file and key."""
     return load_model(path, DiagnosisCaseFile).root
+
+
+# ---------------------------------------------------------------------------- writing
+def _toml_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(float(value)) if isinstance(value, float) else str(value)
+    if isinstance(value, str):
+        import json
+
+        return json.dumps(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"cannot write {type(value).__name__} to TOML")
+
+
+def toml_text(data: dict, prefix: str = "") -> str:
+    """TOML text of a case dictionary (scalars and lists, tables, arrays of tables); enough for the
+    case files, which hold nothing else."""
+    lines = [f"{k} = {_toml_value(v)}" for k, v in data.items()
+             if not isinstance(v, dict) and not (isinstance(v, list) and v and isinstance(v[0], dict))]
+    for key, value in data.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            lines += ["", f"[{name}]", toml_text(value, f"{name}.")]
+        elif isinstance(value, list) and value and isinstance(value[0], dict):
+            for item in value:
+                lines += ["", f"[[{name}]]", toml_text(item, f"{name}.")]
+    return "\n".join(line for line in lines if line is not None).strip("\n")

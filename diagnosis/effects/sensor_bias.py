@@ -24,6 +24,8 @@ class SensorBias(Effect):
     channels = tuple(BIASED)
     #: the parameter set follows the measured channels; a case may give any subset
     partial_parameters = True
+    #: the measured channels are linear in the biases (the fit reuses their Jacobian columns)
+    linear = True
 
     def parameter_specs(self, case, channels=None):
         present = [c for c in BIASED if channels is None or c in channels]

@@ -21,6 +21,7 @@ import jinja2
 
 from riskassess import results
 from riskassess.report.blocks import Figure, Note, Section, Table
+from riskassess.report.diagnosis import diagnosis_section
 from riskassess.report.impact import contact_section, debris_motion_section, energy_section, hinge_section
 from riskassess.report.inputs import appendix_inputs_section, case_section, run_facts_section
 from riskassess.report.perception import perception_section
@@ -39,6 +40,7 @@ SECTIONS = (
     ("stresses", "Stresses against strengths", stresses_section),
     ("energy", "Net and debris energy", energy_section),
     ("perception", "Perception: debris mass and inertia", perception_section),
+    ("diagnosis", "Model diagnosis against measured data", diagnosis_section),
     ("run-facts", "Run facts", run_facts_section),
     ("appendix-inputs", "Appendix: every case input", appendix_inputs_section),
 )

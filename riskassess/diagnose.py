@@ -1,0 +1,205 @@
+"""`riskassess diagnose`: where the simulation departs from measured data, the missing effect, its gain.
+
+Steps: read the case (:mod:`riskassess.diagnosis_case`) and the measured CSV
+(:mod:`diagnosis.measured`); fit the nominal model and nominal + each applicable catalog effect
+on the training part (:mod:`diagnosis.fit`, two worker processes); score every model on the
+held-out part and select (:mod:`diagnosis.selection`); analyse the residuals before and after
+(:mod:`diagnosis.residuals`) and hint at the form of what is left (:mod:`diagnosis.hint`).
+
+Writes into the output folder (default ``runs/<case name>-diagnosis``), each file atomically:
+``diagnosis.json`` (the answer), ``diagnosis.npz`` (time series behind the plots), PNG plots,
+``case.toml`` (the input case) and, when a cause is named, the extended case, also written next
+to the input case as ``<case stem>.extended.toml``; ``manifest.json`` last.
+"""
+from __future__ import annotations
+
+import multiprocessing
+import time
+from pathlib import Path
+
+import numpy as np
+
+from diagnosis.effects import CATALOG
+from diagnosis.fit import CandidateFit, FitResult, Problem, prediction
+from diagnosis.hint import describe_terms, library, sparse_terms
+from diagnosis.measured import read_measured
+from diagnosis.observation import CHANNELS, scenario_channels
+from diagnosis.residuals import analyse, describe
+from diagnosis.selection import decide, gain_percent, score
+from riskassess import results
+from riskassess.case import read_toml
+from riskassess.diagnosis_case import load_diagnosis_case, toml_text
+
+#: Worker processes fitting candidates in parallel (the issue's 2-core machine).
+WORKERS = 2
+_PROBLEM: Problem | None = None    # the problem the forked workers fit (inherited, not pickled)
+
+
+def _fit_one(effect_id: str | None) -> FitResult:
+    return CandidateFit(_PROBLEM, CATALOG[effect_id] if effect_id else None).fit()
+
+
+def fit_candidates(problem: Problem, effect_ids: list[str], workers: int = WORKERS, progress=None) -> dict:
+    """Nominal and every effect fitted; returns id -> :class:`FitResult` (forked workers when > 1)."""
+    global _PROBLEM
+    _PROBLEM = problem
+    tasks = [None] + list(effect_ids)
+    fits = {}
+    if workers > 1 and "fork" in multiprocessing.get_all_start_methods():
+        with multiprocessing.get_context("fork").Pool(workers) as pool:
+            for k, fit in enumerate(pool.imap_unordered(_fit_one, tasks)):
+                fits[fit.id] = fit
+                if progress:
+                    progress("fitting", k + 1, len(tasks))
+    else:
+        for k, task in enumerate(tasks):
+            fit = _fit_one(task)
+            fits[fit.id] = fit
+            if progress:
+                progress("fitting", k + 1, len(tasks))
+    return fits
+
+
+def _parameters(fit: FitResult, nominal: bool) -> dict:
+    rows = zip(fit.names, fit.values, fit.std, fit.units)
+    picked = list(rows)[:fit.nominal_count] if nominal else list(rows)[fit.nominal_count:]
+    return {n: {"value": float(v), "std": float(s), "unit": u} for n, v, s, u in picked}
+
+
+def _candidate_rows(fits, scores, decision) -> list[dict]:
+    nominal = fits["nominal"]
+    return [{"id": k, "delta_bic": float(nominal.bic - fits[k].bic), "weight": decision["weights"][k],
+             "parameters": _parameters(fits[k], nominal=False), "train_rms_sigma": scores[k]["train_rms_sigma"],
+             "holdout_rms_sigma": scores[k]["holdout_rms_sigma"], "adequate": bool(decision["adequate"][k]),
+             "fit_seconds": fits[k].seconds, "evaluations": fits[k].evaluations} for k in decision["ranked"]]
+
+
+def _gain(scores, chosen: str) -> tuple[dict, dict, dict]:
+    before = {c: v["rmse"] for c, v in scores["nominal"]["holdout"].items()}
+    after = {c: v["rmse"] for c, v in scores[chosen]["holdout"].items()}
+    gain = {c: gain_percent(before[c], after[c]) for c in before}
+    gain["overall"] = gain_percent(scores["nominal"]["holdout_rms_sigma"], scores[chosen]["holdout_rms_sigma"])
+    return before, after, gain
+
+
+def _hint(problem: Problem, analysis: dict, nominal_prediction: dict) -> dict:
+    worst = max(analysis, key=lambda c: analysis[c]["rms"])
+    model = {c: v for c, v in nominal_prediction.items() if c in problem.values}
+    kept = sparse_terms(analysis[worst]["residual"], library(problem.time, analysis[worst]["dominant_hz"], model))
+    return {"channel": worst, "terms": kept, "statement": describe_terms(worst, kept)}
+
+
+def extended_case(case_path: Path, problem: Problem, fit: FitResult) -> str:
+    """The input case with the named effect and its fitted parameters (and the fitted nominal values)."""
+    from scipy.spatial.transform import Rotation
+
+    raw = read_toml(case_path)
+    nominal = _parameters(fit, nominal=True)
+    initial = raw.setdefault("initial", {})
+    value = {n: p["value"] for n, p in nominal.items()}
+    if "attitude_x" in value:
+        delta = Rotation.from_rotvec([value[f"attitude_{a}"] for a in "xyz"])
+        initial["attitude_rotation_vector"] = (Rotation.from_matrix(problem.plant.attitude0) * delta).as_rotvec().tolist()
+    for key, field in (("angular_velocity", "angular_velocity"), ("position", "position_lvlh"),
+                       ("velocity", "velocity_lvlh")):
+        if f"{key}_x" in value:
+            initial[field] = [value[f"{key}_{a}"] for a in "xyz"]
+    for key, field in (("hinge_angle", "initial_angle"), ("hinge_rate", "initial_rate"),
+                       ("torsional_stiffness", "torsional_stiffness"), ("torsional_damping", "torsional_damping")):
+        if key in value:
+            raw["hinge"][field] = value[key]
+    effect = {n: p["value"] for n, p in _parameters(fit, nominal=False).items()}
+    raw["effects"] = [e for e in raw.get("effects", []) if e.get("id") != fit.id] + [{"id": fit.id, "parameters": effect}]
+    header = (f"# Extended by 'riskassess diagnose' from {case_path.name}: effect '{fit.id}' added with its fitted\n"
+              f"# parameters; the initial state and hinge values are the fitted nominal ones.\n")
+    return header + toml_text(raw) + "\n"
+
+
+def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = None, workers: int = WORKERS,
+                  progress=None) -> dict:
+    """Run the diagnosis; returns the answer (also written to ``diagnosis.json``)."""
+    wall = time.perf_counter()
+    case_path = Path(case_path)
+    case = load_diagnosis_case(case_path)
+    measured = read_measured(measured_path, noise)
+    out = Path(out_dir) if out_dir else Path("runs") / f"{case.name}-diagnosis"
+    problem = Problem.build(case, measured, case.diagnosis.holdout_fraction)
+    if not problem.channels:
+        raise ValueError(f"{measured_path}: none of its channels ({', '.join(measured.channels)}) is predicted by the "
+                         f"'{case.kind}' scenario ({', '.join(scenario_channels(problem.plant))})")
+    not_applicable = {k: e.not_applicable(case, problem.channels) for k, e in CATALOG.items()}
+    not_applicable = {k: v for k, v in not_applicable.items() if v}
+    fits = fit_candidates(problem, [k for k in CATALOG if k not in not_applicable], workers, progress)
+    predictions = {k: prediction(problem, CATALOG.get(k), f, problem.time) for k, f in fits.items()}
+    scores = score(problem, predictions)
+    decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms)
+    chosen = decision["model"]
+    before = analyse(problem.time, predictions["nominal"], problem.values, problem.noise)
+    after = analyse(problem.time, predictions[chosen], problem.values, problem.noise)
+    rmse_before, rmse_after, gain = _gain(scores, chosen)
+    answer = {
+        "case": case.name, "scenario": case.kind, "measured": str(measured_path), "cause": decision["cause"],
+        "confidence": decision["confidence"], "statement": decision["reason"], "model": chosen,
+        "parameters": _parameters(fits[chosen], nominal=False) if chosen != "nominal" else {},
+        "nominal_parameters": _parameters(fits[chosen], nominal=True),
+        "rmse_before": rmse_before, "rmse_after": rmse_after, "gain_percent": gain,
+        "rmse_case_as_given": None, "candidates": _candidate_rows(fits, scores, decision),
+        "not_applicable": not_applicable,
+        "nominal": {"bic": fits["nominal"].bic, "train_rms_sigma": scores["nominal"]["train_rms_sigma"],
+                    "holdout_rms_sigma": scores["nominal"]["holdout_rms_sigma"], "fit_seconds": fits["nominal"].seconds},
+        "channels": {"used": problem.channels, "unknown": measured.unknown,
+                     "not_predicted": [c for c in measured.channels if c not in problem.channels]},
+        "noise": {c: {"sigma": measured.noise[c], "source": measured.noise_source[c]} for c in measured.channels},
+        "split_time_s": problem.split_time, "samples": int(len(problem.time)),
+        "residuals_before": {c: describe(c, r) for c, r in before.items()},
+        "residuals_after": {c: describe(c, r) for c, r in after.items()},
+        "residual_figures": {k: {c: {f: r[f] for f in ("rms", "mean", "white_p", "trend_p", "dominant_hz",
+                                                        "dominant_share", "window_rms")} for c, r in a.items()}
+                             for k, a in (("before", before), ("after", after))},
+        "hint": _hint(problem, before, predictions["nominal"]),
+        "decisive_delta_bic": case.diagnosis.decisive_delta_bic, "adequate_rms": case.diagnosis.adequate_rms,
+    }
+    case_as_given = prediction(problem, None, _unfitted(problem), problem.time)
+    answer["rmse_case_as_given"] = {c: v["rmse"] for c, v in score(problem, {"case": case_as_given})["case"]["holdout"].items()}
+    answer["extended_case"] = None
+    extended = extended_case(case_path, problem, fits[chosen]) if chosen != "nominal" and \
+        decision["cause"] == chosen else None
+    answer["wall_s"] = time.perf_counter() - wall
+    _write(out, case_path, answer, problem, predictions, chosen, before, after, extended)
+    return answer
+
+
+def _unfitted(problem: Problem) -> FitResult:
+    n = len(problem.nominal_center)
+    return FitResult("nominal", [], [], problem.nominal_center, np.zeros(n), n, 0.0, 0.0, 1, 0.0, 0, "")
+
+
+def _write(out: Path, case_path: Path, answer, problem, predictions, chosen, before, after, extended) -> None:
+    from riskassess.report.diagnosis import write_figures
+
+    out.mkdir(parents=True, exist_ok=True)
+    files = ["case.toml", "diagnosis.json", "diagnosis.npz"]
+    results.atomic_write_bytes(out / "case.toml", case_path.read_bytes())
+    if extended is not None:
+        target = case_path.with_name(f"{case_path.stem}.extended.toml")
+        results.atomic_write_bytes(target, extended.encode())
+        results.atomic_write_bytes(out / target.name, extended.encode())
+        answer["extended_case"] = str(target)
+        files.append(target.name)
+    arrays = {"time": problem.time, "train": problem.train, "channels": np.array(problem.channels)}
+    for c in problem.channels:
+        arrays[f"measured/{c}"] = problem.values[c]
+        arrays[f"nominal/{c}"] = predictions["nominal"][c]
+        arrays[f"chosen/{c}"] = predictions[chosen][c]
+        arrays[f"residual_before/{c}"] = before[c]["residual"]
+        arrays[f"residual_after/{c}"] = after[c]["residual"]
+    results.atomic_write_npz(out / "diagnosis.npz", arrays)
+    files += write_figures(out, answer, arrays)
+    results.atomic_write_json(out / "diagnosis.json", answer)
+    manifest = {"format": results.FORMAT, "version": results.VERSION, "case": answer["case"], "stage": "diagnose",
+                "status": "complete", "files": files,
+                "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+    results.atomic_write_json(out / "manifest.json", manifest)
+
+
+__all__ = ["diagnose_case", "fit_candidates", "extended_case", "CHANNELS"]
