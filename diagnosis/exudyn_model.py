@@ -246,3 +246,29 @@ def simulate_exudyn(plant: Plant, times, effect=None, values=(), names=(), step:
         effect.add_to_exudyn(scenario, values, names)
     out = scenario.simulate(sample_times)
     return effect.measure(out, values, names) if effect is not None else out
+
+
+def simulate_case(case, times, step: float | None = None) -> dict:
+    """Channels at ``times`` (s) of a case with every effect its ``[[effects]]`` lists (an extended
+    case written by `riskassess diagnose`), by Exudyn: plant changes, loads and sensor effects in
+    the order given."""
+    from diagnosis.effects import CATALOG
+
+    plant = Plant.from_case(case)
+    applied = []
+    for entry in case.effects:
+        effect = CATALOG[entry.id]
+        names = list(entry.parameters)
+        values = np.array([entry.parameters[n] for n in names], float)
+        plant = effect.modify_plant(plant, values)
+        applied.append((effect, values, names))
+    sample_times = np.asarray(times, float)
+    for effect, values, _ in applied:
+        sample_times = effect.sample_times(sample_times, values)
+    scenario = ExudynScenario(plant, step)
+    for effect, values, names in applied:
+        effect.add_to_exudyn(scenario, values, names)
+    out = scenario.simulate(sample_times)
+    for effect, values, names in applied:
+        out = effect.measure(out, values, names)
+    return out

@@ -1,0 +1,33 @@
+"""Diagnosis scenarios for the tests (SI), built from the sample case files in cases/."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from riskassess.diagnosis_case import DiagnosisCaseFile
+from riskassess.case import read_toml
+
+CASES = Path(__file__).parents[2] / "cases"
+TUMBLING_CASE = CASES / "diagnose_tumbling_rigid.toml"
+HINGED_CASE = CASES / "diagnose_hinged_appendage.toml"
+
+
+def case_with(path: Path, **changes):
+    """The case file's content with top-level tables updated (``initial={...}`` merges into [initial])."""
+    raw = read_toml(path)
+    for key, value in changes.items():
+        raw[key] = {**raw.get(key, {}), **value} if isinstance(value, dict) and key != "orbit" else value
+    return DiagnosisCaseFile.model_validate(raw).root
+
+
+@pytest.fixture
+def tumbling_rocket_body():
+    """cases/diagnose_tumbling_rigid.toml: 1500 kg body at ~0.2 rad/s, circular 780 km orbit."""
+    return case_with(TUMBLING_CASE)
+
+
+@pytest.fixture
+def panel_on_hinge():
+    """cases/diagnose_hinged_appendage.toml: 800 kg body, 60 kg panel released at 0.4 rad."""
+    return case_with(HINGED_CASE)
