@@ -176,13 +176,17 @@ class CandidateFit:
         return least_squares(self._fun, z0, jac=self.jacobian, args=(use,), bounds=(low, high), method="trf",
                              ftol=TOLERANCE, xtol=TOLERANCE, gtol=TOLERANCE, max_nfev=MAX_EVALUATIONS)
 
-    def fit(self) -> FitResult:
+    def fit(self, nominal_start: FitResult | None = None) -> FitResult:
+        """Fit from the case values, or from the nominal parameters of ``nominal_start`` (the nominal
+        model's fit: a candidate then starts where the nominal model ended)."""
         start = clock.perf_counter()
         p = self.problem
         t_train = p.time[p.train]
         first = p.train & (p.time <= t_train[0] + FIRST_SPAN * (t_train[-1] - t_train[0]))
         n_nominal = len(p.nominal_center)
-        starts = [np.r_[np.zeros(n_nominal), s / self.scale] for s in
+        z_nominal = np.zeros(n_nominal) if nominal_start is None else \
+            (nominal_start.values[:n_nominal] - p.nominal_center) / p.nominal_sigma
+        starts = [np.r_[z_nominal, s / self.scale] for s in
                   (self.effect.starts(self.specs) if self.effect else [np.zeros(0)])]
         stage1 = [self._solve(z0, first) for z0 in starts]
         best = min(stage1, key=lambda r: r.cost)

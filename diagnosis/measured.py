@@ -199,5 +199,5 @@ def write_measured(path, time, values: dict) -> None:
     names = list(values)
     lines = [",".join(["time"] + names)]
     for k, t in enumerate(time):
-        lines.append(",".join([f"{t:.6f}"] + [f"{values[c][k]:.10g}" for c in names]))
+        lines.append(",".join([f"{t:.6f}"] + [f"{values[c][k]:.9g}" for c in names]))
     atomic_write_bytes(Path(path), ("\n".join(lines) + "\n").encode())

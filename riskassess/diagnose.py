@@ -32,31 +32,35 @@ from riskassess.diagnosis_case import load_diagnosis_case, toml_text
 
 #: Worker processes fitting candidates in parallel (the issue's 2-core machine).
 WORKERS = 2
-_PROBLEM: Problem | None = None    # the problem the forked workers fit (inherited, not pickled)
+_PROBLEM: Problem | None = None    # what the forked workers fit (inherited, not pickled) ...
+_NOMINAL: FitResult | None = None   # ... starting from the nominal model's fit
 
 
-def _fit_one(effect_id: str | None) -> FitResult:
-    return CandidateFit(_PROBLEM, CATALOG[effect_id] if effect_id else None).fit()
+def _fit_one(effect_id: str) -> FitResult:
+    return CandidateFit(_PROBLEM, CATALOG[effect_id]).fit(_NOMINAL)
 
 
 def fit_candidates(problem: Problem, effect_ids: list[str], workers: int = WORKERS, progress=None) -> dict:
-    """Nominal and every effect fitted; returns id -> :class:`FitResult` (forked workers when > 1)."""
-    global _PROBLEM
+    """The nominal model, then every effect from the nominal fit (forked workers when > 1);
+    returns id -> :class:`FitResult`."""
+    global _PROBLEM, _NOMINAL
     _PROBLEM = problem
-    tasks = [None] + list(effect_ids)
-    fits = {}
+    _NOMINAL = CandidateFit(problem).fit()
+    fits = {"nominal": _NOMINAL}
+    total = len(effect_ids) + 1
+    if progress:
+        progress("fitting", 1, total)
     if workers > 1 and "fork" in multiprocessing.get_all_start_methods():
         with multiprocessing.get_context("fork").Pool(workers) as pool:
-            for k, fit in enumerate(pool.imap_unordered(_fit_one, tasks)):
+            for fit in pool.imap_unordered(_fit_one, effect_ids):
                 fits[fit.id] = fit
                 if progress:
-                    progress("fitting", k + 1, len(tasks))
+                    progress("fitting", len(fits), total)
     else:
-        for k, task in enumerate(tasks):
-            fit = _fit_one(task)
-            fits[fit.id] = fit
+        for effect_id in effect_ids:
+            fits[effect_id] = _fit_one(effect_id)
             if progress:
-                progress("fitting", k + 1, len(tasks))
+                progress("fitting", len(fits), total)
     return fits
 
 

@@ -8,7 +8,6 @@ decays towards b.
 """
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from diagnosis.dynamics import LAW_SIGNATURE, E_K, L_TH, X_TH

@@ -1,0 +1,42 @@
+"""Write the sample measured data of the diagnosis cases (run from the repository root):
+
+    python cases/data/make_diagnosis_samples.py
+
+* ``cases/data/tumbling_rigid_nutation.csv``: cases/diagnose_tumbling_rigid.toml with an internal
+  nutation damper (``internal_energy_dissipation``: J_d = 12 kg m^2, T_d = 40 s);
+* ``cases/data/hinged_appendage_friction.csv``: cases/diagnose_hinged_appendage.toml with hinge
+  Coulomb friction (``hinge_coulomb_friction``: 1.2 N m);
+
+each 300 s at 10 Hz from the Exudyn model (diagnosis.exudyn_model), with white Gaussian noise at the
+levels of ``diagnosis.synthetic.NOISE`` (seed 2024). Try them with
+``riskassess diagnose cases/diagnose_tumbling_rigid.toml --measured cases/data/tumbling_rigid_nutation.csv``.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from diagnosis.measured import write_measured
+from diagnosis.synthetic import noisy, sample_times, simulate_effect
+from riskassess.diagnosis_case import load_diagnosis_case
+
+ROOT = Path(__file__).resolve().parents[2]
+SAMPLES = (("diagnose_tumbling_rigid.toml", "tumbling_rigid_nutation.csv", "internal_energy_dissipation",
+            {"damper_inertia": 12.0, "time_constant": 40.0}),
+           ("diagnose_hinged_appendage.toml", "hinged_appendage_friction.csv", "hinge_coulomb_friction",
+            {"friction_torque": 1.2}))
+
+
+def main() -> None:
+    rng = np.random.default_rng(2024)
+    times = sample_times(300.0, 10.0)
+    for case_name, data_name, effect, values in SAMPLES:
+        case = load_diagnosis_case(ROOT / "cases" / case_name)
+        data, _ = noisy(simulate_effect(case, times, effect, values), rng)
+        write_measured(ROOT / "cases" / "data" / data_name, times, data)
+        print(f"cases/data/{data_name}: {case_name} + {effect} {values}")
+
+
+if __name__ == "__main__":
+    main()
