@@ -139,6 +139,28 @@ def _cmd_tow(args) -> int:
     return 0
 
 
+def _cmd_identify(args) -> int:
+    from riskassess.case import load_model
+    from riskassess.identify import benchmark_case
+    from riskassess.towing_case import TowingCase
+
+    case = load_model(args.case, TowingCase)
+    if not args.benchmark:
+        raise ValueError("identification against full-net runs needs the full-net towing model, which is not "
+                         "built yet; run the Sec. 4.3 benchmark with --benchmark")
+    out = Path(args.out) if args.out else Path("runs") / f"{case.name}_identify"
+    answer = benchmark_case(args.case, out, case=case)
+    if args.json:
+        print(json.dumps({k: v for k, v in answer.items()}, indent=2))
+    else:
+        for name, run in answer["runs"].items():
+            print(f"{name:8s} s = {', '.join(f'{x:.6f}' for x in run['s'])}  cost {run['cost']:.3e}  "
+                  f"max relative error {max(run['relative_error']):.2e}  {run['evaluations']} evaluations, "
+                  f"{run['wall_s']:.0f} s")
+        print(f"truth    s = {', '.join(f'{x:.6f}' for x in answer['truth'])}\nresults: {out}")
+    return 0
+
+
 def print_perception(answer: dict, out: Path) -> None:
     from riskassess.tables import perception_rows
 
@@ -327,6 +349,13 @@ def build_parser() -> argparse.ArgumentParser:
     diagnose.add_argument("--noise", action="append", default=[], metavar="CHANNEL=SIGMA",
                           help="1-sigma noise of a channel (its SI unit) instead of the estimate from the data")
     diagnose.set_defaults(func=_cmd_diagnose)
+    ident = sub.add_parser("identify", help="identify the sub-tether parameters of the lower-order towing model")
+    ident.add_argument("case", help="towing case file (TOML) with [identification]")
+    ident.add_argument("--benchmark", action="store_true", help="Sec. 4.3 benchmark: data from the model itself "
+                       "with identification.benchmark_truth at the training rates")
+    ident.add_argument("--out", help="output folder (default runs/<case name>_identify)")
+    ident.add_argument("--json", action="store_true", help="print s, cost, optimizer, wall_s and every run as JSON")
+    ident.set_defaults(func=_cmd_identify)
     report = sub.add_parser("report", help="write report.html (self-contained) and report.pdf into a run folder")
     report.add_argument("run_dir", help="run folder written by 'riskassess run'")
     report.add_argument("--no-pdf", action="store_true", help="HTML only")

@@ -1,0 +1,197 @@
+"""`riskassess identify`: sub-tether parameters of the lower-order towing model (Boonrath, Singh &
+Botta 2024, Sec. 3).
+
+Decision vector :math:`s = [\\log_{10} k_{ST}, l_{ST,0}, \\log_{10} c_{ST}, m_P/m_{net}]` (eq. 22) within
+the bounds of eq. (24). For each candidate, one lower-order run per spin rate of the data set
+(the compiled twin of the Exudyn model, :func:`multibody.towing.run_twin`) is compared with the
+data by
+
+* :func:`cost_f1`: :math:`\\sum_j w_1 RMSE_{r,j} + w_2 (RMSE_{\\omega_D,j} + RMSE_{\\omega_C,j})`, eqs. (17)-(19);
+* :func:`cost_f2`: :math:`\\sum_j RMSE_{T,j}` of the main-tether tension, eqs. (20)-(21).
+
+Two maintained optimizers of pymoo minimize it: particle swarm (:class:`pymoo.algorithms.soo.nonconvex.pso.PSO`,
+the paper's ``particleswarm``) and pattern search (:class:`pymoo.algorithms.soo.nonconvex.pattern.PatternSearch`,
+Hooke-Jeeves, in place of MATLAB's MADS ``patternsearch``). A population's runs are spread over
+worker processes (:class:`multiprocessing.Pool`; each worker holds the case and the data).
+
+The benchmark of Sec. 4.3 (:func:`benchmark`) takes as data the model's own runs with
+``identification.benchmark_truth`` at the training rates, so the minimum is known: cost 0 at s_true.
+"""
+from __future__ import annotations
+
+import multiprocessing
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from pymoo.algorithms.soo.nonconvex.pattern import PatternSearch
+from pymoo.algorithms.soo.nonconvex.pso import PSO
+from pymoo.core.problem import Problem
+from pymoo.optimize import minimize
+from pymoo.termination.default import DefaultSingleObjectiveTermination
+
+from multibody.towing import run_twin
+from riskassess.tow import towing_model
+from riskassess.towing_case import TowingCase
+
+#: The quantities the costs compare, from :meth:`multibody.towing.TowResult.series`.
+COMPARED = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
+
+
+def compared_series(result) -> dict:
+    """r_D/C (m, inertial), both angular velocities (rad/s, body frames) and the MT tension (N) of a run."""
+    s = result.series()
+    return {"relative_position": s["debris_com_inertial"] - s["chaser_com_inertial"],
+            "chaser_omega_body": s["chaser_omega_body"], "debris_omega_body": s["debris_omega_body"],
+            "main_tether_tension": s["main_tether_tension"]}
+
+
+def rmse(model, data) -> float:
+    """:math:`\\sqrt{\\sum_g \\|x^L_g - x^H_g\\|^2 / N_t}` over the samples, eqs. (19), (21)."""
+    diff = (np.asarray(model) - np.asarray(data)).reshape(len(data), -1)
+    return float(np.sqrt(np.mean(np.sum(diff**2, axis=1))))
+
+
+def cost_f1(model: dict, data: dict, weights) -> float:
+    """One run's term of eq. (18): :math:`w_1 RMSE_r + w_2 (RMSE_{\\omega_D} + RMSE_{\\omega_C})`."""
+    return weights[0] * rmse(model["relative_position"], data["relative_position"]) + weights[1] * (
+        rmse(model["debris_omega_body"], data["debris_omega_body"])
+        + rmse(model["chaser_omega_body"], data["chaser_omega_body"]))
+
+
+def cost_f2(model: dict, data: dict, weights=None) -> float:
+    """One run's term of eq. (20): the RMSE of the main-tether tension."""
+    return rmse(model["main_tether_tension"], data["main_tether_tension"])
+
+
+COSTS = {"f1": cost_f1, "f2": cost_f2}
+
+
+def simulate(case: TowingCase, rate_deg_s: float, s, end_time=None) -> dict:
+    """The compared series of one lower-order run (twin) at spin rate ``rate_deg_s`` with sub-tethers ``s``."""
+    return compared_series(run_twin(towing_model(case, rate_deg_s, s, end_time=end_time)))
+
+
+# ------------------------------------------------------------------ parallel evaluation
+_WORKER = {}
+
+
+def _init_worker(case, data, cost, weights, end_time):
+    _WORKER.update(case=case, data=data, cost=COSTS[cost], weights=weights, end_time=end_time)
+
+
+def _run_term(task) -> float:
+    """Cost term of one (candidate, rate index) pair, in a worker; a run that fails scores inf."""
+    s, j = task
+    w = _WORKER
+    rate = w["data"][j]["rate_deg_s"]
+    try:
+        return w["cost"](simulate(w["case"], rate, s, w["end_time"]), w["data"][j], w["weights"])
+    except (ValueError, ZeroDivisionError, FloatingPointError):
+        return np.inf
+
+
+class TowingFit(Problem):
+    """pymoo problem: minimize ``cost`` of the lower-order runs against ``data`` over s in the bounds;
+    each population is evaluated as (candidates x rates) runs on ``pool``."""
+
+    def __init__(self, pool, n_runs, lower, upper):
+        super().__init__(n_var=4, n_obj=1, xl=np.asarray(lower, float), xu=np.asarray(upper, float))
+        self.pool, self.n_runs = pool, n_runs
+        self.evaluations, self.best = [], []
+
+    def _evaluate(self, x, out, *args, **kwargs):
+        tasks = [(np.array(s), j) for s in x for j in range(self.n_runs)]
+        terms = np.array(self.pool.map(_run_term, tasks, chunksize=max(1, len(tasks) // (4 * self.pool._processes))))
+        costs = terms.reshape(len(x), self.n_runs).sum(axis=1)
+        out["F"] = costs
+        for c in costs:
+            self.evaluations.append(len(self.evaluations) + 1)
+            self.best.append(min(c, self.best[-1]) if self.best else c)
+
+
+@dataclass
+class Identified:
+    """Result of one optimizer run: s (4,), cost, optimizer name, evaluations, wall time (s) and
+    the best cost after each evaluation."""
+
+    s: np.ndarray
+    cost: float
+    optimizer: str
+    evaluations: int
+    wall_s: float
+    history: list
+
+
+def _optimizer(name, settings, initial_guess):
+    if name == "pso":
+        return PSO(pop_size=settings.swarm_size), DefaultSingleObjectiveTermination(
+            ftol=settings.pso_tolerance, period=settings.stall_generations, n_max_gen=settings.pso_generations)
+    return PatternSearch(x0=np.asarray(initial_guess, float)), DefaultSingleObjectiveTermination(
+        xtol=settings.pattern_tolerance, ftol=0.0, period=20, n_max_evals=settings.pattern_evaluations)
+
+
+def identify(case: TowingCase, data: list[dict], optimizer: str, end_time=None, workers=None,
+             initial_guess=None) -> Identified:
+    """Minimize the case's cost (``identification.cost``) against ``data`` (one dict per run: the
+    compared series and ``rate_deg_s``) with ``optimizer`` ('pso' or 'pattern')."""
+    ident = case.identification
+    settings = ident.optimizers
+    algorithm, termination = _optimizer(optimizer, settings, ident.initial_guess if initial_guess is None else initial_guess)
+    start = time.perf_counter()
+    with multiprocessing.get_context("fork").Pool(
+            workers or ident.workers, _init_worker, (case, data, ident.cost, ident.weights, end_time)) as pool:
+        problem = TowingFit(pool, len(data), ident.lower_bounds, ident.upper_bounds)
+        result = minimize(problem, algorithm, termination, seed=settings.seed, verbose=False)
+    return Identified(np.asarray(result.X, float).ravel(), float(np.atleast_1d(result.F)[0]), optimizer,
+                      len(problem.evaluations), time.perf_counter() - start, problem.best)
+
+
+def training_data(case: TowingCase, s, rates, end_time=None) -> list[dict]:
+    """Lower-order runs with sub-tethers ``s`` at ``rates`` (deg/s): the benchmark's data (Sec. 4.3)."""
+    return [{**simulate(case, rate, s, end_time), "rate_deg_s": rate} for rate in rates]
+
+
+def benchmark(case: TowingCase, optimizers=("pso", "pattern"), rates=None, end_time=None, workers=None) -> dict:
+    """Sec. 4.3: data from ``benchmark_truth`` at the training rates, identified by each optimizer.
+    Returns per optimizer s, cost, relative error against the truth, evaluations and wall time."""
+    truth = np.asarray(case.identification.benchmark_truth, float)
+    rates = case.rates.training_deg_s if rates is None else rates
+    start = time.perf_counter()
+    data = training_data(case, truth, rates, end_time)
+    out = {"truth": truth.tolist(), "cost_function": case.identification.cost, "rates_deg_s": list(rates),
+           "data_wall_s": time.perf_counter() - start, "runs": {}}
+    for name in optimizers:
+        found = identify(case, data, name, end_time, workers)
+        out["runs"][name] = {"s": found.s.tolist(), "cost": found.cost, "optimizer": name,
+                             "relative_error": (np.abs(found.s - truth) / np.abs(truth)).tolist(),
+                             "evaluations": found.evaluations, "wall_s": found.wall_s, "history": found.history}
+    return out
+
+
+def benchmark_case(case_path, out_dir, case: TowingCase | None = None, end_time=None) -> dict:
+    """`riskassess identify CASE --benchmark`: run :func:`benchmark` and write ``identification.json``
+    (every run, history included), ``convergence.png`` and a manifest to ``out_dir``; returns the
+    answer with the best run's ``s``, ``cost``, ``optimizer`` and ``wall_s`` on top."""
+    from pathlib import Path
+
+    from riskassess import results
+    from riskassess.case import load_model
+    from riskassess.towing_plots import plot_convergence
+
+    case = case or load_model(case_path, TowingCase)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    answer = benchmark(case, end_time=end_time)
+    best = min(answer["runs"].values(), key=lambda r: r["cost"])
+    answer = {"case": case.name, "s": best["s"], "cost": best["cost"], "optimizer": best["optimizer"],
+              "wall_s": time.perf_counter() - start, **answer}
+    results.atomic_write_json(out / "identification.json", answer)
+    plot_convergence({name: (np.arange(1, len(r["history"]) + 1), np.maximum(r["history"], 1e-12))
+                      for name, r in answer["runs"].items()}, out / "convergence.png",
+                     f"{case.name}: Sec. 4.3 benchmark, cost {answer['cost_function']}")
+    results.atomic_write_json(out / "manifest.json", {"format": "riskassess-identify", "version": 1, "case": case.name,
+                                                      "status": "complete",
+                                                      "files": ["identification.json", "convergence.png"]})
+    return answer
