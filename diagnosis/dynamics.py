@@ -72,16 +72,14 @@ def environment(plant: Plant) -> np.ndarray:
 
 def initial_state(plant: Plant) -> np.ndarray:
     """State at t = 0: the tracked point and the CoM velocity in LVLH give the system CoM in I."""
-    from scipy.spatial.transform import Rotation
-
     x = np.zeros(STATE_SIZE)
-    q = Rotation.from_matrix(plant.attitude0).as_quat()
-    x[X_Q:X_Q + 4] = q[[3, 0, 1, 2]]
+    x[X_Q:X_Q + 4] = quaternion_from_matrix(np.ascontiguousarray(plant.attitude0))
     x[X_W:X_W + 3] = plant.omega0
     x[X_TH], x[X_THD] = plant.hinge_angle0, plant.hinge_rate0
     share = plant.mass_appendage / plant.total_mass
     main_com = plant.position0 - plant.attitude0 @ plant.origin_main
-    rho = main_com + plant.attitude0 @ (share * plant.appendage_offset(plant.hinge_angle0))
+    offset = plant.hinge_main + axis_rotation(plant.axis, plant.hinge_angle0) @ plant.appendage_from_hinge
+    rho = main_com + plant.attitude0 @ (share * offset)
     x[X_R:X_R + 3] = rho
     x[X_V:X_V + 3] = plant.velocity0 + np.cross([0.0, 0.0, plant.mean_motion], rho)
     x[X_E:X_E + 3] = plant.omega0
@@ -101,6 +99,49 @@ def quaternion_matrix(q):
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                      [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+@njit(cache=True)
+def quaternion_from_matrix(m):
+    """Unit quaternion [w, x, y, z] (w >= 0) of a rotation matrix (Shepperd's method)."""
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    q = np.empty(4)
+    if trace > max(m[0, 0], m[1, 1], m[2, 2]):
+        r = np.sqrt(1.0 + trace)
+        q[0], q[1], q[2], q[3] = 0.5 * r, (m[2, 1] - m[1, 2]) / (2 * r), (m[0, 2] - m[2, 0]) / (2 * r), \
+            (m[1, 0] - m[0, 1]) / (2 * r)
+    else:
+        i = 0 if m[0, 0] >= m[1, 1] and m[0, 0] >= m[2, 2] else (1 if m[1, 1] >= m[2, 2] else 2)
+        j, k = (i + 1) % 3, (i + 2) % 3
+        r = np.sqrt(1.0 + m[i, i] - m[j, j] - m[k, k])
+        q[1 + i] = 0.5 * r
+        q[1 + j] = (m[j, i] + m[i, j]) / (2 * r)
+        q[1 + k] = (m[k, i] + m[i, k]) / (2 * r)
+        q[0] = (m[k, j] - m[j, k]) / (2 * r)
+    return q if q[0] >= 0 else -q
+
+
+@njit(cache=True)
+def observe(states, times, env, origin_main):
+    """Channels (k, 12) from states: omega_B (3), quaternion B->LVLH(t) (4), tracked point in LVLH
+    (3), hinge angle and rate; see :mod:`diagnosis.observation`."""
+    n = env[E_N]
+    share = env[E_MA] / (env[E_MM] + env[E_MA])
+    out = np.empty((states.shape[0], 12))
+    for k in range(states.shape[0]):
+        x = states[k]
+        c, s = np.cos(0.5 * n * times[k]), np.sin(0.5 * n * times[k])    # I -> LVLH: -n t about z
+        w, a, b, d = x[0], x[1], x[2], x[3]
+        out[k, 3:7] = (c * w + s * d, c * a + s * b, c * b - s * a, c * d - s * w)
+        offset = origin_main.copy()
+        if env[E_HINGED] != 0.0:
+            offset -= share * appendage_state(env, x[X_TH])[1]
+        p = x[X_R:X_R + 3] + quaternion_matrix(x[0:4]) @ offset
+        cn, sn = np.cos(n * times[k]), np.sin(n * times[k])
+        out[k, 7], out[k, 8], out[k, 9] = cn * p[0] + sn * p[1], -sn * p[0] + cn * p[1], p[2]
+        out[k, 0:3] = x[X_W:X_W + 3]
+        out[k, 10], out[k, 11] = x[X_TH], x[X_THD]
+    return out
 
 
 @njit(cache=True)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from diagnosis.dynamics import X_Q, X_R, X_TH, X_THD, X_W
+from diagnosis.dynamics import environment, observe
 from diagnosis.plant import Plant
 
 OMEGA = ("omega_x", "omega_y", "omega_z")
@@ -35,17 +35,7 @@ def lvlh_from_inertial(n: float, times) -> Rotation:
 
 def outputs(plant: Plant, times, states) -> dict[str, np.ndarray]:
     """Every channel of ``scenario_channels(plant)`` at ``times`` (s) from states (k, STATE_SIZE)."""
-    times = np.asarray(times, float)
-    to_lvlh = lvlh_from_inertial(plant.mean_motion, times)
-    body_to_inertial = Rotation.from_quat(states[:, [X_Q + 1, X_Q + 2, X_Q + 3, X_Q]])
-    q = (to_lvlh * body_to_inertial).as_quat()[:, [3, 0, 1, 2]]
-    share = plant.mass_appendage / plant.total_mass
-    offset_b = plant.origin_main - share * plant.appendage_offset(states[:, X_TH]) if plant.hinged \
-        else np.tile(plant.origin_main, (len(times), 1))
-    rel = to_lvlh.apply(states[:, X_R:X_R + 3] + body_to_inertial.apply(offset_b))
-    out = {c: states[:, X_W + k] for k, c in enumerate(OMEGA)}
-    out.update({c: q[:, k] for k, c in enumerate(QUATERNION)})
-    out.update({c: rel[:, k] for k, c in enumerate(REL)})
-    if plant.hinged:
-        out["hinge_angle"], out["hinge_rate"] = states[:, X_TH], states[:, X_THD]
-    return out
+    values = observe(np.ascontiguousarray(states), np.ascontiguousarray(times, float), environment(plant),
+                     np.ascontiguousarray(plant.origin_main, float))
+    names = OMEGA + QUATERNION + REL + (HINGE if plant.hinged else ())
+    return {c: values[:, k] for k, c in enumerate(names)}

@@ -26,6 +26,7 @@ from diagnosis.measured import read_measured
 from diagnosis.observation import CHANNELS, scenario_channels
 from diagnosis.residuals import analyse, describe
 from diagnosis.selection import decide, gain_percent, score
+from diagnosis.threads import single_threaded_blas
 from riskassess import results
 from riskassess.case import read_toml
 from riskassess.diagnosis_case import load_diagnosis_case, toml_text
@@ -37,6 +38,7 @@ _NOMINAL: FitResult | None = None   # ... starting from the nominal model's fit
 
 
 def _fit_one(effect_id: str) -> FitResult:
+    single_threaded_blas()
     return CandidateFit(_PROBLEM, CATALOG[effect_id]).fit(_NOMINAL)
 
 
@@ -44,6 +46,7 @@ def fit_candidates(problem: Problem, effect_ids: list[str], workers: int = WORKE
     """The nominal model, then every effect from the nominal fit (forked workers when > 1);
     returns id -> :class:`FitResult`."""
     global _PROBLEM, _NOMINAL
+    single_threaded_blas()
     _PROBLEM = problem
     _NOMINAL = CandidateFit(problem).fit()
     fits = {"nominal": _NOMINAL}
