@@ -116,11 +116,25 @@ class Plant:
         r = self.appendage_from_hinge - (self.appendage_from_hinge @ self.axis) * self.axis
         return float(self.axis @ self.inertia_appendage @ self.axis + self.mass_appendage * r @ r)
 
+    def effective_hinge_inertia(self) -> float:
+        """Inertia of the hinge mode with the main body free (kg m^2): the Schur complement
+        c - b^T A^-1 b of the Kane mass matrix at the initial angle (diagnosis.dynamics)."""
+        a = self.axis
+        s = Rotation.from_rotvec(self.hinge_angle0 * a).apply(self.appendage_from_hinge)
+        d = self.hinge_main + s
+        rot = Rotation.from_rotvec(self.hinge_angle0 * a).as_matrix()
+        ja = rot @ self.inertia_appendage @ rot.T
+        mr = self.mass_main * self.mass_appendage / self.total_mass
+        big = self.inertia_main + ja + mr * ((d @ d) * np.eye(3) - np.outer(d, d))
+        b = ja @ a + mr * np.cross(d, np.cross(a, s))
+        c = a @ ja @ a + mr * np.cross(a, s) @ np.cross(a, s)
+        return float(c - b @ np.linalg.solve(big, b))
+
     def rate_scale(self) -> float:
         """Fastest rate of the nominal motion (rad/s): tumble, hinge rate or hinge natural frequency."""
         rates = [np.linalg.norm(self.omega0), 0.01]
         if self.hinged:
-            rates += [abs(self.hinge_rate0), np.sqrt(self.stiffness / self.hinge_inertia())]
+            rates += [abs(self.hinge_rate0), np.sqrt(self.stiffness / self.effective_hinge_inertia())]
         return float(max(rates))
 
 

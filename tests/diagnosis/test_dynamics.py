@@ -46,10 +46,10 @@ def test_hinged_bodies_keep_momentum_and_energy_without_damping():
     assert np.ptp(states[:, 7]) > 0.7          # the panel swings through +-0.4 rad
     h = angular_momentum_inertial(plant, states)
     energy = np.array([_kinetic_energy(plant, x) for x in states])
-    # The step is 0.1 rad of the panel's uncoupled frequency; the coupled mode is faster, so the RK4
-    # drift is larger than the rigid body's: measured 4e-6 of |H| over 300 s; bound 1e-5.
-    assert np.abs(h - h[0]).max() < 1e-5 * np.linalg.norm(h[0])
-    assert np.abs(energy - energy[0]).max() < 1e-5 * energy[0]
+    # The step is 0.1 rad of the hinge mode (as for the tumble); RK4's energy error grows with the
+    # ~30 hinge periods: measured 1.2e-5 of the energy and 3e-7 of |H| over 300 s; bounds 3e-5, 1e-6.
+    assert np.abs(h - h[0]).max() < 1e-6 * np.linalg.norm(h[0])
+    assert np.abs(energy - energy[0]).max() < 3e-5 * energy[0]
 
 
 def test_step_halving_changes_the_channels_by_less_than_a_tenth_of_sensor_noise():
