@@ -1,14 +1,16 @@
 """Lower-order towing model in Exudyn: chaser and debris rigid bodies, the connection point mass,
 the main tether and the sub-tethers (Boonrath, Singh & Botta 2024, Sec. 2.2, Fig. 2).
 
-The three bodies are Exudyn nodes (the point P a ``NodeGenericODE2`` of 3 coordinates, chaser and
-debris ``NodeRigidBodyRotVecLG`` with Lie-group integration); every force between them, gravity,
-thrust and the attitude control torque come from the compiled :func:`multibody.towing_kernel.towing_forces`
-through the force user function of one ``ObjectGenericODE2`` spanning the three nodes. Frame: Earth-centred
-inertial for every position and velocity; angular velocities in the body frames.
+Chaser and debris are Exudyn nodes (``NodeRigidBodyRotVecLG``, Lie-group integration, explicit
+VelocityVerlet); every force on them, gravity, thrust and the attitude control torque come from the
+compiled :func:`multibody.towing_kernel.towing_forces` through the force user function of one
+``ObjectGenericODE2`` spanning both nodes. The light connection point P is stepped implicitly inside
+that user function, once per step (:mod:`multibody.connection_point`, BDF2): its stiff, damped
+tethers no longer limit the step, so a run costs the same for every s of eq. (24). Frame:
+Earth-centred inertial for every position and velocity; angular velocities in the body frames.
 
 :func:`run_twin` integrates the same forces with the same scheme in compiled code, without
-Exudyn (~50x faster: no per-step Python call); the identification uses it and
+Exudyn (2-3x faster: no per-step Python call); the identification uses it and
 ``tests/multibody/test_towing.py`` checks that both agree.
 """
 from __future__ import annotations
@@ -18,12 +20,12 @@ from dataclasses import dataclass, field
 
 import exudyn as exu
 import numpy as np
-from exudyn.itemInterface import NodeGenericODE2, NodeRigidBodyRotVecLG, ObjectGenericODE2, ObjectRigidBody
+from exudyn.itemInterface import NodeRigidBodyRotVecLG, ObjectGenericODE2, ObjectRigidBody
 from scipy.spatial.transform import Rotation
 
 from multibody.impact import _object_state_index, explicit_settings, solver_chatter_to_stderr
 from multibody.kernel import rotation_matrix_from_rotation_vector
-from multibody.towing_kernel import N_COORDINATES, ST_TENSION, pack, packed_forces, twin_run
+from multibody.towing_kernel import N_COORDINATES, ST_TENSION, body_forces, pack, sampled_state, twin_run
 
 
 @dataclass
@@ -97,7 +99,8 @@ def packed(model: TowingModel) -> np.ndarray:
     it also carries the thrust law's state, so each run needs its own."""
     return pack(model.positions, model.masses, model.inertia_body, model.attach_chaser_body,
                 model.attach_debris_body, model.tether, model.mu, model.attitude, model.thrust_kind,
-                model.thrust_along_body_z, model.thrust_params, model.thrust_state, model.step)
+                model.thrust_along_body_z, model.thrust_params, model.thrust_state, model.step, model.velocities[0],
+                model.start_time)
 
 
 @dataclass
@@ -156,11 +159,12 @@ def run_twin(model: TowingModel) -> TowResult:
 class _TowForces:
     """Force user function of the coupled object: Exudyn's VelocityVerlet calls it once per step, at
     the step's end time with the state where the step evaluates its force (new position, half-step
-    velocity), and once at the start. The thrust law's state advances once per new time.
+    velocity), and once at the start. The thrust law's state and the connection point P (implicit,
+    :mod:`multibody.connection_point`; not an Exudyn node) advance once per new time.
 
     (The impact model sets the force from a pre-step function instead, because converting its
     thousands of coordinates to and from Python costs more than predicting the evaluation state;
-    for these 15 coordinates the user function is the cheaper route: ~6 us per step against ~15.)
+    for these 12 coordinates the user function is the cheaper route: ~6 us per step against ~15.)
     """
 
     def __init__(self, model: TowingModel):
@@ -171,7 +175,7 @@ class _TowForces:
     def __call__(self, mbs, t, item, q, q_t):
         advance = t > self.last_time
         self.last_time = max(t, self.last_time)
-        return packed_forces(np.asarray(q), np.asarray(q_t), self.model.start_time + t, self.work, advance)[0]
+        return body_forces(np.asarray(q), np.asarray(q_t), self.model.start_time + t, self.work, advance)
 
 
 class _Sampler:
@@ -188,8 +192,8 @@ class _Sampler:
         q, v = data.GetODE2Coordinates(), data.GetODE2Coordinates_t()
         if self.index is not None:
             q, v = q[self.index], v[self.index]
-        self.out_q[sample], self.out_v[sample] = q, v
-        self.out_diag[sample] = packed_forces(q, v, self.forces.model.start_time + t, self.forces.work, False)[1]
+        self.out_q[sample], self.out_v[sample], self.out_diag[sample] = sampled_state(
+            np.asarray(q), np.asarray(v), self.forces.model.start_time + t, self.forces.work)
 
     def __call__(self, mbs, t):
         if self.count % self.every == 0 and self.sample < len(self.out_q):
@@ -200,13 +204,13 @@ class _Sampler:
 
 
 def build_towing_system(model: TowingModel, forces: _TowForces):
-    """The Exudyn system: P node, chaser and debris rigid bodies, one coupled generic object whose
-    force is ``forces``. Returns (system container, main system, node list)."""
+    """The Exudyn system: chaser and debris rigid bodies and one coupled generic object whose force
+    is ``forces`` (the connection point P is advanced inside it, implicitly). Returns (system
+    container, main system, node list)."""
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     q0, v0 = model.initial_state()
-    nodes = [mbs.AddNode(NodeGenericODE2(referenceCoordinates=list(model.positions[0]), initialCoordinates=[0.0] * 3,
-                                         initialCoordinates_t=list(v0[0:3]), numberOfODE2Coordinates=3))]
+    nodes = []
     for b, base in enumerate((3, 9)):
         node = mbs.AddNode(NodeRigidBodyRotVecLG(referenceCoordinates=list(model.positions[b + 1]) + [0.0] * 3,
                                                  initialCoordinates=list(q0[base:base + 6]),
@@ -215,10 +219,7 @@ def build_towing_system(model: TowingModel, forces: _TowForces):
         mbs.AddObject(ObjectRigidBody(nodeNumber=node, mass=float(model.masses[b + 1]),
                                       inertia=[j[0, 0], j[1, 1], j[2, 2], j[1, 2], j[0, 2], j[0, 1]]))
         nodes.append(node)
-    mass = exu.MatrixContainer()
-    mass.SetWithSparseMatrixCSR(N_COORDINATES, N_COORDINATES, [[i, i, float(model.masses[0])] for i in range(3)],
-                                useDenseMatrix=False)
-    mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, massMatrix=mass, forceUserFunction=forces))
+    mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=forces))
     mbs.Assemble()
     return sc, mbs, nodes
 
@@ -227,7 +228,7 @@ def run_exudyn(model: TowingModel) -> TowResult:
     """Build and integrate ``model`` in Exudyn (VelocityVerlet, fixed step, Lie-group rotations)."""
     forces = _TowForces(model)
     sc, mbs, nodes = build_towing_system(model, forces)
-    sampler = _Sampler(forces, _object_state_index(mbs, nodes, [3, 6, 6]), _sample_buffers(model))
+    sampler = _Sampler(forces, _object_state_index(mbs, nodes, [6, 6]), _sample_buffers(model))
     mbs.SetPostStepUserFunction(sampler)
     settings = explicit_settings(model.step, model.n_steps)
     start = time.perf_counter()
@@ -239,7 +240,8 @@ def run_exudyn(model: TowingModel) -> TowResult:
 
 
 def stable_step(model: TowingModel, safety: float = 0.5) -> float:
-    """Largest VelocityVerlet step (s) the connection point allows, times ``safety``.
+    """Largest VelocityVerlet step (s) an explicit connection point would allow, times ``safety``
+    (P is implicit now; kept to report what the implicit update saves, bench/bench_towing.py).
 
     P (mass m_P) hangs on all tethers at once: :math:`\\ddot x = -\\omega^2 x - \\gamma\\dot x` with
     :math:`\\omega^2 = k_\\Sigma/m_P`, :math:`\\gamma = c_\\Sigma/m_P` (summed tether stiffness and damping).

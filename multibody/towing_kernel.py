@@ -6,7 +6,9 @@ main tether (MT) joins P to the chaser's attachment point A, the sub-tethers (ST
 debris' attachment points. Every vector is in the Earth-centred inertial frame unless named
 ``_body``.
 
-Coordinate layout of the coupled Exudyn object and of the twin (``q`` / ``v``, 15 entries):
+Coordinate layout of the kernel and of the twin (``q`` / ``v``, 15 entries; the Exudyn object holds
+entries 3-14, P's state lives in the packed model and is advanced implicitly by
+:mod:`multibody.connection_point` once per step):
 
 * 0-2  P: displacement from its reference position (m); velocity (m/s), inertial.
 * 3-8  chaser: CoM displacement (m), rotation vector body->inertial (rad); CoM velocity (m/s),
@@ -25,6 +27,7 @@ from numba import njit
 
 from control.attitude import desired_attitude, sliding_mode_torque
 from control.thrust import thrust_command
+from multibody.connection_point import STATE_SIZE, TIME, V_N, X_N, advance_point, initial_point_state
 from multibody.kernel import rotation_matrix_from_rotation_vector, verlet_evaluation_state
 from multibody.linalg3 import cross3, matvec3
 from multibody.net import tension_only_kelvin_voigt
@@ -154,9 +157,10 @@ def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, att
 
 @njit(cache=True)
 def accelerations(v, force, masses, inertia, inverse_inertia):
-    """Accelerations as Exudyn forms them: M^-1 (f - gyroscopic terms), rotation-vector Lie-group nodes."""
+    """Accelerations of chaser and debris as Exudyn forms them: M^-1 (f - gyroscopic terms),
+    rotation-vector Lie-group nodes; zero for P (implicit, see the module doc)."""
     a = np.empty(N_COORDINATES)
-    a[0:3] = force[0:3] / masses[0]
+    a[0:3] = 0.0  # P is advanced implicitly (multibody.connection_point), not by the Verlet kicks
     for b in range(2):
         base = CHASER + 6 * b
         omega = v[base + 3:base + 6]
@@ -169,20 +173,22 @@ def accelerations(v, force, masses, inertia, inverse_inertia):
 # One float array holds the whole model, the thrust law's state and the work buffers, so that a
 # step costs one call from Python (numba's dispatch costs ~0.2 us per argument).
 (W_N_ATTACH, W_KIND, W_ALONG_Z, W_STEP, W_MU, W_THRUST_PARAMS, W_N_THRUST_PARAMS, W_THRUST_STATE, W_N_THRUST_STATE,
- W_ATTACH, W_DIAG, W_FORCE, W_ACCEL) = range(13)
+ W_ATTACH, W_DIAG, W_FORCE, W_ACCEL, W_POINT) = range(14)
 W_REFERENCE, W_MASSES, W_INERTIA, W_INVERSE, W_ATTACH_CHASER, W_TETHER, W_ATTITUDE, W_END = (
     16, 25, 28, 46, 64, 67, 73, 81)
 
 
 def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, attitude, thrust_kind,
-         thrust_along_body_z, thrust_params, thrust_state, step) -> np.ndarray:
-    """The packed model (see :func:`towing_forces` for the meaning of each part)."""
+         thrust_along_body_z, thrust_params, thrust_state, step, point_velocity, start_time) -> np.ndarray:
+    """The packed model (see :func:`towing_forces` for the meaning of each part) with P's integrator
+    state at ``start_time`` (s), P moving with ``point_velocity`` (m/s, inertial)."""
     n = len(attach_debris)
-    sizes = [3 * n, len(thrust_params), len(thrust_state), ST_TENSION + n, N_COORDINATES, N_COORDINATES]
+    sizes = [3 * n, len(thrust_params), len(thrust_state), ST_TENSION + n, N_COORDINATES, N_COORDINATES, STATE_SIZE]
     offsets = W_END + np.concatenate([[0], np.cumsum(sizes)])
     work = np.zeros(offsets[-1])
-    work[:13] = [n, thrust_kind, float(thrust_along_body_z), step, mu, offsets[1], len(thrust_params), offsets[2],
-                 len(thrust_state), offsets[0], offsets[3], offsets[4], offsets[5]]
+    work[:14] = [n, thrust_kind, float(thrust_along_body_z), step, mu, offsets[1], len(thrust_params), offsets[2],
+                 len(thrust_state), offsets[0], offsets[3], offsets[4], offsets[5], offsets[6]]
+    work[offsets[6]:offsets[7]] = initial_point_state(point_velocity, start_time)
     inertia = np.asarray(inertia, float)
     work[W_REFERENCE:W_END] = np.concatenate([np.ravel(reference), masses, inertia.ravel(), np.linalg.inv(inertia).ravel(),
                                               attach_chaser, tether, attitude])
@@ -198,18 +204,86 @@ def _section(work, index, size_index):
 
 
 @njit(cache=True)
+def _attachments(q, v, reference, attach_chaser, attach_debris):
+    """Main-tether end on the chaser, then the sub-tether ends on the debris: positions relative
+    to P's reference position (m) and velocities (m/s), inertial, (1 + n, 3) each."""
+    n = attach_debris.shape[0]
+    points, velocities = np.empty((n + 1, 3)), np.empty((n + 1, 3))
+    for b, base in ((1, CHASER), (2, DEBRIS)):
+        rot = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
+        for i in range(1 if b == 1 else n):
+            r = attach_chaser if b == 1 else attach_debris[i]
+            row = 0 if b == 1 else i + 1
+            points[row] = reference[b] - reference[0] + q[base:base + 3] + matvec3(rot, r)
+            velocities[row] = v[base:base + 3] + matvec3(rot, cross3(v[base + 3:base + 6], r))
+    return points, velocities
+
+
+@njit(cache=True)
+def _advance_connection_point(q, v, t, work, attach):
+    """If ``t`` is a new step time: the bodies' velocities at ``t`` predicted from the step's
+    evaluation (half-step) velocities ``v`` and the last stored accelerations, v + h/2 a (so the
+    implicit P and the tether dampers see chaser, debris and P at the same instant: with the
+    half-step velocities the damper force would be O(h) off); then P stepped implicitly to ``t``
+    (:func:`multibody.connection_point.advance_point`). Returns the velocities to evaluate the
+    forces with, P's entries (also in ``q``, ``v``) from its state at ``t``."""
+    n = attach.shape[0]
+    reference = work[W_REFERENCE:W_MASSES].reshape((3, 3))
+    tether = work[W_TETHER:W_ATTITUDE]
+    state = work[int(work[W_POINT]):int(work[W_POINT]) + STATE_SIZE]
+    step = work[W_STEP]
+    v_eval = v
+    if t > state[TIME] + 0.5 * step:
+        v_eval = v + (0.5 * (t - state[TIME])) * work[int(work[W_ACCEL]):int(work[W_ACCEL]) + N_COORDINATES]
+        points, velocities = _attachments(q, v_eval, reference, work[W_ATTACH_CHASER:W_TETHER], attach)
+        stiffness, damping, rest = np.full(n + 1, tether[K_ST]), np.full(n + 1, tether[C_ST]), np.full(n + 1, tether[L_ST])
+        stiffness[0], damping[0], rest[0] = tether[K_MT], tether[C_MT], tether[L_MT]
+        advance_point(state, t, step, work[W_MASSES], reference[0], work[W_MU], points, velocities,
+                      stiffness, damping, rest)
+    q[0:3] = state[X_N:X_N + 3]
+    v[0:3] = state[V_N:V_N + 3]
+    v_eval[0:3] = state[V_N:V_N + 3]
+    return v_eval
+
+
+@njit(cache=True)
 def packed_forces(q, v, t, work, advance):
-    """:func:`towing_forces` of the packed model; the force and diagnostics land in ``work``."""
+    """:func:`towing_forces` of the packed model; the force and diagnostics land in ``work``. P's
+    entries of ``q`` and ``v`` are overwritten with its implicit state at ``t`` (advanced first if
+    ``t`` is a new step time, the forces then taken at the bodies' predicted velocities at ``t``,
+    see :func:`_advance_connection_point`)."""
     n = int(work[W_N_ATTACH])
     attach = work[int(work[W_ATTACH]):int(work[W_ATTACH]) + 3 * n].reshape((n, 3))
+    v_eval = _advance_connection_point(q, v, t, work, attach)
     diag = work[int(work[W_DIAG]):int(work[W_DIAG]) + ST_TENSION + n]
     force = work[int(work[W_FORCE]):int(work[W_FORCE]) + N_COORDINATES]
-    towing_forces(q, v, t, work[W_REFERENCE:W_MASSES].reshape((3, 3)), work[W_MASSES:W_INERTIA],
+    towing_forces(q, v_eval, t, work[W_REFERENCE:W_MASSES].reshape((3, 3)), work[W_MASSES:W_INERTIA],
                   work[W_INERTIA:W_INERTIA + 9].reshape((3, 3)), work[W_ATTACH_CHASER:W_TETHER], attach,
                   work[W_TETHER:W_ATTITUDE], work[W_MU], work[W_ATTITUDE:W_END], int(work[W_KIND]),
                   work[W_ALONG_Z] > 0.0, _section(work, W_THRUST_PARAMS, W_N_THRUST_PARAMS),
                   _section(work, W_THRUST_STATE, W_N_THRUST_STATE), work[W_STEP], advance, force, diag)
     return force, diag
+
+
+@njit(cache=True)
+def body_forces(q_bodies, v_bodies, t, work, advance):
+    """The packed model's generalized forces on chaser and debris (12,) for Exudyn's object, which
+    holds only their coordinates (entries 3-14 of the kernel layout); P comes from ``work``; the
+    thrust law's state advances when ``advance``."""
+    q, v = np.zeros(N_COORDINATES), np.zeros(N_COORDINATES)
+    q[3:], v[3:] = q_bodies, v_bodies
+    force, _ = packed_forces(q, v, t, work, advance)
+    _store_accelerations(v, force, work)  # as the twin does, for the next step's velocity prediction
+    return force[3:].copy()
+
+
+@njit(cache=True)
+def sampled_state(q_bodies, v_bodies, t, work):
+    """Full state (15,) each and diagnostics at ``t`` from the bodies' state and P's stored state."""
+    q, v = np.zeros(N_COORDINATES), np.zeros(N_COORDINATES)
+    q[3:], v[3:] = q_bodies, v_bodies
+    diag = packed_forces(q, v, t, work, False)[1]
+    return q, v, diag.copy()
 
 
 @njit(cache=True)

@@ -27,7 +27,7 @@ from scipy.optimize import brentq, minimize_scalar
 from control.attitude import quaternion_to_matrix, sampled_boundary_layer
 from control.mrac import mrac_initial_state, mrac_params
 from control.thrust import KINDS
-from multibody.towing import TowingModel, run_exudyn, stable_step
+from multibody.towing import TowingModel, run_exudyn
 from riskassess import results
 from riskassess.case import load_model
 from riskassess.pipeline import software_versions
@@ -77,7 +77,8 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
                  end_time: float | None = None) -> TowingModel:
     """The lower-order model of ``case`` with the debris spinning at ``spin_rate_deg_s`` (default: the
     case's) and sub-tethers ``s`` (default: the case's). The step is the case's (or ``step``),
-    reduced to :func:`multibody.towing.stable_step` and to a divisor of the output interval."""
+    reduced to a divisor of the output interval. The connection point is implicit
+    (:mod:`multibody.connection_point`), so the step does not depend on ``s``."""
     s = case_decision_vector(case) if s is None else np.asarray(s, float)
     sim, ch, de = case.simulation, case.chaser, case.debris
     mt = case.main_tether
@@ -102,8 +103,7 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
         body_to_inertial=rot, omega_body=omega, start_time=sim.start_time,
         end_time=sim.end_time if end_time is None else end_time, step=sim.step if step is None else step,
         output_interval=sim.output_interval)
-    h = min(model.step, stable_step(model))
-    model.step = sim.output_interval / np.ceil(sim.output_interval / h - 1e-9)
+    model.step = sim.output_interval / np.ceil(sim.output_interval / model.step - 1e-9)
     ac = case.attitude_control
     model.attitude = np.r_[float(ac.enabled), ac.k_gain, ac.gain,
                            sampled_boundary_layer(ac.boundary_layer, np.asarray(ac.gain, float), model.step)]
