@@ -25,8 +25,9 @@ import numpy as np
 from diagnosis.fit import FitResult, Problem
 from diagnosis.residuals import normalized_residuals
 
-#: Smallest held-out gain (aggregate normalized RMSE, %) for a named cause: an effect that explains
-#: decisively but predicts unseen data less than 5 % better is not the cause the user is after.
+#: Smallest gain (aggregate normalized RMS, %, training or held-out) for a named cause: an effect that
+#: is decisive but improves the fit by less than 5 % absorbs a small model difference, it is not the
+#: cause the user is after.
 MIN_GAIN_PERCENT = 5.0
 
 
@@ -82,12 +83,14 @@ def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float,
         delta = nominal.bic - fits[best].bic
         margin = fits[ranked[1]].bic - fits[best].bic if len(ranked) > 1 else np.inf
         gain = gain_percent(scores["nominal"]["holdout_rms_sigma"], scores[best]["holdout_rms_sigma"])
-        if delta > decisive and adequate[best] and gain >= MIN_GAIN_PERCENT:
+        gain_train = gain_percent(scores["nominal"]["train_rms_sigma"], scores[best]["train_rms_sigma"])
+        if delta > decisive and adequate[best] and max(gain, gain_train) >= MIN_GAIN_PERCENT and gain >= 0:
             if margin > decisive:
                 return {**answer, "cause": best, "model": best, "confidence": weights[best],
                         "reason": f"{best}: BIC lower by {delta:.1f} than the nominal model and by {margin:.1f} than "
                                   f"the runner-up {ranked[1] if len(ranked) > 1 else '-'}; residual within "
-                                  f"{adequate_rms:g} sigma; held-out prediction {gain:.0f} % better"}
+                                  f"{adequate_rms:g} sigma; fit {gain_train:.0f} % and held-out prediction "
+                                  f"{gain:.0f} % better"}
             close = [k for k in ranked if fits[k].bic - fits[best].bic <= decisive]
             return {**answer, "cause": "unexplained", "model": best, "confidence": None,
                     "reason": f"ambiguous: {', '.join(close)} explain the data about equally (BIC within "

