@@ -56,6 +56,13 @@ def mrac_params(kind, t_on, u_max, chaser_mass, k_mt, c_mt, z_d, k_p, k_d, **gai
                             *p.ravel()], float)
 
 
+def reference_steady_elongation(k_mt, k_p, z_d) -> float:
+    """Elongation (m) the reference model of eq. (13) settles at while taut: its PD force balances the
+    tether, :math:`k_{MT} z_m = K_P (z_d - z_m)`, so :math:`z_m = K_P z_d / (k_{MT} + K_P)` (not
+    :math:`z_d` itself: eq. 13 has no integral action)."""
+    return k_p * z_d / (k_mt + k_p)
+
+
 def mrac_initial_state(kind, params, z0, z_rate0) -> np.ndarray:
     """Reference model started on the measured state; adaptive parameters at their ideal values
     for the abstracted model (MRAC-1: :math:`\\hat h = m_C`, :math:`\\hat a = [k, c]`; MRAC-2:

@@ -8,12 +8,14 @@ and writes the run folder:
 ============== ==============================================================
 file           content
 ============== ==============================================================
-manifest.json  format ``riskassess-tow``, case, status, files, software
+manifest.json  format of :mod:`riskassess.results`, stage ``tow``, case, status, files
 case.toml      the case file as given
-summary.json   tension peaks, slack time, separation, attitude errors, step, wall time
-timeseries.npz every series of :meth:`multibody.towing.TowResult.series`
+towing.json    tension peaks, tautness after engagement, separation, rates, step, wall time
+towing.npz     every series of :meth:`multibody.towing.TowResult.series`
 tow.png        main-tether tension, thrust, separation and angular rates
 ============== ==============================================================
+
+``riskassess report DIR`` shows it in its towing section (:mod:`riskassess.report.towing`).
 """
 from __future__ import annotations
 
@@ -25,7 +27,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from control.attitude import quaternion_to_matrix, sampled_boundary_layer
-from control.mrac import mrac_initial_state, mrac_params
+from control.mrac import mrac_initial_state, mrac_params, reference_steady_elongation
 from control.thrust import KINDS
 from multibody.towing import TowingModel, run_exudyn
 from riskassess import results
@@ -33,7 +35,9 @@ from riskassess.case import load_model
 from riskassess.pipeline import software_versions
 from riskassess.towing_case import TowingCase
 
-FORMAT = "riskassess-tow"
+#: Main-tether tension (N) from which the tether counts as engaged: before it the sub-tethers are still
+#: slack and only the connection point hangs on the main tether.
+ENGAGED_N = 1.0
 
 
 def case_decision_vector(case: TowingCase) -> np.ndarray:
@@ -110,6 +114,31 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
     return model
 
 
+def reference_elongation(case: TowingCase) -> float | None:
+    """Where the MRAC laws steer the elongation (m): the steady state of their reference model
+    (:func:`control.mrac.reference_steady_elongation`); None without an [mrac] section."""
+    if case.mrac is None:
+        return None
+    return reference_steady_elongation(case.main_tether.stiffness, case.mrac.k_p, case.mrac.desired_elongation)
+
+
+def tautness(series: dict, target_elongation: float | None) -> dict:
+    """Main-tether figures after engagement (first sample with tension > :data:`ENGAGED_N`): smallest
+    tension and slack time (taut: > 0 N and 0 s), peak tension, final elongation and its RMS error
+    against ``target_elongation`` over the last 100 s (None without a target) (SI)."""
+    t, tension, z = series["time"], series["main_tether_tension"], series["main_tether_elongation"]
+    engaged = np.nonzero(tension > ENGAGED_N)[0]
+    k = engaged[0] if len(engaged) else len(t) - 1
+    dt = np.diff(t, prepend=t[0])
+    late = t >= t[-1] - 100.0
+    return {"engaged_at_s": float(t[k]), "min_tension_after_engagement_N": float(tension[k:].min()),
+            "slack_after_engagement_s": float(np.sum(dt[k:][tension[k:] <= 0.0])),
+            "peak_tension_N": float(tension.max()), "final_elongation_m": float(z[-1]),
+            "target_elongation_m": target_elongation,
+            "rms_elongation_error_m": None if target_elongation is None else
+            float(np.sqrt(np.mean((z[late] - target_elongation) ** 2)))}
+
+
 def summarize(case: TowingCase, result, s) -> dict:
     """The numbers ``riskassess tow`` prints and writes to summary.json (SI)."""
     series = result.series()
@@ -126,6 +155,7 @@ def summarize(case: TowingCase, result, s) -> dict:
         "main_tether_peak_tension_N": float(tension.max()),
         "main_tether_final_tension_N": float(tension[-1]),
         "main_tether_slack_time_while_thrusting_s": float(np.sum(dt[thrusting & (tension <= 0.0)])),
+        "main_tether": tautness(series, reference_elongation(case)),
         "sub_tether_peak_tension_N": float(series["sub_tether_tension"].max()),
         "separation_m": {"initial": float(separation[0]), "min": float(separation.min()),
                          "max": float(separation.max()), "final": float(separation[-1])},
@@ -144,18 +174,19 @@ def tow_case(case_path: str | Path, out_dir: str | Path, case: TowingCase | None
     model = towing_model(case)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    manifest = {"format": FORMAT, "version": 1, "case": case.name, "status": "running",
+    manifest = {"format": results.FORMAT, "version": results.VERSION, "stage": "tow", "case": case.name,
+                "status": "running",
                 "created": datetime.datetime.now(datetime.timezone.utc).isoformat(),
                 "files": ["case.toml"], "software": software_versions()}
     shutil.copyfile(case_path, out / "case.toml")
     results.atomic_write_json(out / "manifest.json", manifest)
     result = run_exudyn(model)
     summary = summarize(case, result, case_decision_vector(case))
-    results.atomic_write_npz(out / "timeseries.npz", result.series())
-    results.atomic_write_json(out / "summary.json", summary)
+    results.atomic_write_npz(out / "towing.npz", result.series())
+    results.atomic_write_json(out / "towing.json", summary)
     from riskassess.towing_plots import plot_tow
 
     plot_tow(result.series(), out / "tow.png", case.name)
-    manifest.update(status="complete", files=manifest["files"] + ["summary.json", "timeseries.npz", "tow.png"])
+    manifest.update(status="complete", files=manifest["files"] + ["towing.json", "towing.npz", "tow.png"])
     results.atomic_write_json(out / "manifest.json", manifest)
     return summary

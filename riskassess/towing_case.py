@@ -131,6 +131,10 @@ class Optimizers(Strict):
     stall_generations: Annotated[int, Field(ge=1)] = Field(20, description="MaxStallIterations (-), Sec. 4.3.")
     pattern_evaluations: Annotated[int, Field(ge=1)] = Field(2000, description="Largest number of pattern-search evaluations (-).")
     pattern_tolerance: Positive = Field(1e-6, description="Pattern-search step tolerance, in units of each bound range (-).")
+    polish_evaluations: Annotated[int, Field(ge=0)] = Field(
+        0, description="Pattern-search evaluations polishing the PSO's best (0: none); reported as optimizer 'pso+pattern' (-).")
+    polish_delta: Annotated[float, Field(gt=0, le=0.5)] = Field(
+        0.02, description="Initial pattern-search step of the polish, in units of each bound range (-).")
     seed: int = Field(0, description="Seed of the PSO (-).")
 
 
@@ -145,6 +149,9 @@ class Identification(Strict):
     benchmark_truth: DecisionVector = Field(description="s of the benchmark's data, Sec. 4.3.")
     optimizers: Optimizers = Optimizers()
     workers: Annotated[int, Field(ge=1)] = Field(2, description="Processes evaluating simulations in parallel (-).")
+    step: Annotated[float, Field(gt=0, le=0.05)] = Field(
+        0.02, description="Step of the identification's lower-order runs (s); the connection point is implicit, so it "
+                          "does not depend on s (docs/towing.md: step study).")
 
     @model_validator(mode="after")
     def _inside_bounds(self):

@@ -28,21 +28,27 @@ def _tow_panels(axes, s, label, style="-"):
     axes[2].plot(t, np.degrees(np.linalg.norm(s["debris_omega_body"], axis=1)), style, label=f"{label} debris")
 
 
-def plot_tow(series: dict, path: Path, title: str, others: dict | None = None) -> None:
+def tow_figure(series: dict, title: str, others: dict | None = None):
     """Main-tether tension and thrust, chaser-debris distance, angular rates against time;
-    ``others`` (label -> series) are drawn dashed on the same axes (e.g. thrust laws compared)."""
+    ``others`` (label -> series) are drawn dashed on the same axes (e.g. thrust laws compared).
+    Call inside ``plt.rc_context(STYLE)``; returns the matplotlib figure."""
+    fig, axes = panels(3, 1.8)
+    _tow_panels(axes, series, "")
+    for label, other in (others or {}).items():
+        _tow_panels(axes, other, label, "--")
+    axes[0].set_ylabel("force (N)")
+    axes[0].set_title(f"{title}: main-tether tension and thrust")
+    axes[1].set_ylabel("|r_D/C| (m)")
+    axes[2].set_ylabel("|omega| (deg/s)")
+    for ax in axes:
+        legend(ax)
+    return fig
+
+
+def plot_tow(series: dict, path: Path, title: str, others: dict | None = None) -> None:
+    """:func:`tow_figure` written to ``path`` as PNG."""
     with plt.rc_context(STYLE):
-        fig, axes = panels(3, 1.8)
-        _tow_panels(axes, series, "")
-        for label, other in (others or {}).items():
-            _tow_panels(axes, other, label, "--")
-        axes[0].set_ylabel("force (N)")
-        axes[0].set_title(f"{title}: main-tether tension and thrust")
-        axes[1].set_ylabel("|r_D/C| (m)")
-        axes[2].set_ylabel("|omega| (deg/s)")
-        for ax in axes:
-            legend(ax)
-        _save(fig, path)
+        _save(tow_figure(series, title, others), path)
 
 
 def plot_convergence(histories: dict, path: Path, title: str) -> None:

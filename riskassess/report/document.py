@@ -27,6 +27,7 @@ from riskassess.report.inputs import appendix_inputs_section, case_section, run_
 from riskassess.report.perception import perception_section
 from riskassess.report.plotting import STYLE
 from riskassess.report.structures import joint_loads_section, stresses_section, verdict_section
+from riskassess.report.towing import towing_section
 from riskassess.results import MissingData, RunFolder
 
 #: (section id, title, builder) in reading order: the verdict first.
@@ -41,6 +42,7 @@ SECTIONS = (
     ("energy", "Net and debris energy", energy_section),
     ("perception", "Perception: debris mass and inertia", perception_section),
     ("diagnosis", "Model diagnosis against measured data", diagnosis_section),
+    ("towing", "Towing: main tether and tethered bodies", towing_section),
     ("run-facts", "Run facts", run_facts_section),
     ("appendix-inputs", "Appendix: every case input", appendix_inputs_section),
 )

@@ -1,0 +1,69 @@
+"""`riskassess tow` (riskassess/tow.py): the run folder, the tautness figures and the report section."""
+import json
+
+import numpy as np
+import pytest
+
+from control.mrac import reference_steady_elongation
+from multibody.net import tension_only_kelvin_voigt
+from riskassess.case import load_model
+from riskassess.report import write_report
+from riskassess.report.towing import towing_section
+from riskassess.results import RunFolder
+from riskassess.tow import tautness, tow_case
+from riskassess.towing_case import TowingCase
+
+CASE = "cases/zenit2_towing.toml"
+
+
+@pytest.fixture(scope="module")
+def tow_folder(tmp_path_factory):
+    """The case's tow with MRAC-1, shortened to 45 s of towing (engagement at ~32 s, Exudyn ~1 s)."""
+    case = load_model(CASE, TowingCase)
+    case = case.model_copy(update=dict(simulation=case.simulation.model_copy(update=dict(end_time=70.0)),
+                                       thrust=case.thrust.model_copy(update=dict(kind="mrac1"))))
+    out = tmp_path_factory.mktemp("tow")
+    tow_case(CASE, out, case=case)
+    return out, case
+
+
+def test_folder_is_complete_and_tension_follows_the_tether_law(tow_folder):
+    out, case = tow_folder
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["status"] == "complete" and manifest["stage"] == "tow"
+    assert all((out / f).is_file() for f in manifest["files"])
+    summary = json.loads((out / "towing.json").read_text())
+    assert summary["thrust_kind"] == "mrac1" and summary["simulated_s"] == pytest.approx(45.0)
+    series = dict(np.load(out / "towing.npz"))
+    mt = case.main_tether
+    # the sampled tension is eq. (5a) of the sampled stretch and stretch rate, to round-off
+    expected = [tension_only_kelvin_voigt(z, r, mt.stiffness, mt.damping)
+                for z, r in zip(series["main_tether_elongation"], series["main_tether_elongation_rate"])]
+    np.testing.assert_allclose(series["main_tether_tension"], expected, rtol=1e-12, atol=1e-9)
+    # the MRAC laws keep the main tether taut once the sub-tethers pull (bench/bench_tow_control.py over
+    # the Table 3 rates: smallest tension after engagement 0.03-5 N, never slack)
+    assert summary["main_tether"]["slack_after_engagement_s"] == 0.0
+    assert summary["main_tether"]["min_tension_after_engagement_N"] > 0.0
+
+
+def test_tautness_counts_slack_after_engagement_only():
+    # hand-made series at 0.5 s: slack before engagement (ignored), 2 samples slack after it
+    t = np.arange(0.0, 5.0, 0.5)
+    tension = np.array([0.0, 0.0, 0.5, 2.0, 3.0, 0.0, 0.0, 4.0, 5.0, 6.0])
+    s = tautness({"time": t, "main_tether_tension": tension, "main_tether_elongation": tension / 100.0}, 0.05)
+    assert s["engaged_at_s"] == 1.5 and s["min_tension_after_engagement_N"] == 0.0
+    assert s["slack_after_engagement_s"] == pytest.approx(1.0)
+    assert s["rms_elongation_error_m"] == pytest.approx(np.sqrt(np.mean((tension / 100.0 - 0.05) ** 2)), rel=1e-12)
+
+
+def test_reference_steady_elongation_balances_pd_and_tether():
+    # eq. (13) at rest and taut: k_MT z = K_P (z_d - z) -> z = K_P z_d / (k_MT + K_P); exact arithmetic
+    assert reference_steady_elongation(3000.0, 1000.0, 0.04) == pytest.approx(0.01, rel=1e-15)
+
+
+def test_report_of_a_tow_folder_has_the_towing_section(tow_folder):
+    out, _ = tow_folder
+    section = towing_section(RunFolder(out))
+    assert section is not None and section.id == "towing" and section.figures
+    html = write_report(out, pdf=False).html.read_text()
+    assert '<section id="towing"' in html and "fig-towing" in html
