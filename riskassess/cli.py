@@ -247,6 +247,26 @@ def _cmd_diagnose(args) -> int:
     return 0
 
 
+def _cmd_approach(args) -> int:
+    from riskassess.approach import approach_case
+    from riskassess.approach_case import ApproachCase
+    from riskassess.case import load_model
+
+    case = load_model(args.case, ApproachCase)
+    out = Path(args.out) if args.out else Path("runs") / case.name
+    answer = approach_case(args.case, out, replay=args.replay, case=case)
+    if args.json:
+        print(json.dumps(answer, indent=2))
+    else:
+        points = answer["constraints_resimulated"]
+        print(f"{answer['case']}: {answer['objective']} -> solver {answer['solver_status']}, t_f "
+              f"{answer['final_time']:.4f} s, fuel {answer['fuel_kg']:.4f} kg, solve {answer['solve_s']:.2f} s; "
+              f"keep-out margin {points['keep_out_margin_m']:.4f} m, end miss {points['final_mouth_miss_m']:.4f} m "
+              f"(re-simulated); constraints {'satisfied' if answer['constraints_satisfied'] else 'VIOLATED'}")
+        print(f"results: {out}")
+    return 0 if answer["constraints_satisfied"] else 4
+
+
 def _cmd_sweep(args) -> int:
     from riskassess.sweep.runner import run_sweep, validate_runs, write_sweep_products
     from riskassess.sweep.spec import parse_uncertain, parse_vary, run_specs
@@ -356,6 +376,14 @@ def build_parser() -> argparse.ArgumentParser:
     ident.add_argument("--out", help="output folder (default runs/<case name>_identify)")
     ident.add_argument("--json", action="store_true", help="print s, cost, optimizer, wall_s and every run as JSON")
     ident.set_defaults(func=_cmd_identify)
+    approach = sub.add_parser("approach", help="optimal approach of the net carried by two maneuverable units "
+                              "(direct collocation, IPOPT); exit code 4 when not solved or a constraint fails")
+    approach.add_argument("case", help="approach case file (TOML), e.g. cases/approach_mu_min_time.toml")
+    approach.add_argument("--out", help="output folder (default runs/<case name>)")
+    approach.add_argument("--json", action="store_true", help="print final_time, fuel_kg, constraints_satisfied, "
+                          "solve_s and the checks as JSON")
+    approach.add_argument("--replay", action="store_true", help="also replay the path with the 3-D Exudyn net")
+    approach.set_defaults(func=_cmd_approach)
     report = sub.add_parser("report", help="write report.html (self-contained) and report.pdf into a run folder")
     report.add_argument("run_dir", help="run folder written by 'riskassess run'")
     report.add_argument("--no-pdf", action="store_true", help="HTML only")

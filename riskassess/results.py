@@ -130,7 +130,16 @@ class RunFolder:
     def complete(self) -> bool:
         return self.manifest.get("status") == "complete"
 
+    @property
+    def stage(self) -> str:
+        """The stage that wrote the folder: 'impact' (run, assess, perceive: the files of
+        :data:`CORE_FILES`) or the manifest's ``stage`` (approach, tow, diagnose), whose folders hold
+        no impact results."""
+        return self.manifest.get("stage", "impact")
+
     def missing_core_files(self) -> list[str]:
+        if self.stage != "impact":
+            return []
         return [f for f in CORE_FILES if not (self.path / f).is_file()]
 
     def has(self, name: str) -> bool:

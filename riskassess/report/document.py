@@ -20,6 +20,7 @@ from pathlib import Path
 import jinja2
 
 from riskassess import results
+from riskassess.report.approach import approach_section
 from riskassess.report.blocks import Figure, Note, Section, Table
 from riskassess.report.diagnosis import diagnosis_section
 from riskassess.report.impact import contact_section, debris_motion_section, energy_section, hinge_section
@@ -43,6 +44,7 @@ SECTIONS = (
     ("perception", "Perception: debris mass and inertia", perception_section),
     ("diagnosis", "Model diagnosis against measured data", diagnosis_section),
     ("towing", "Towing: main tether and tethered bodies", towing_section),
+    ("approach", "Net approach with maneuverable units", approach_section),
     ("run-facts", "Run facts", run_facts_section),
     ("appendix-inputs", "Appendix: every case input", appendix_inputs_section),
 )
@@ -77,7 +79,8 @@ def build_sections(run: RunFolder, progress=None) -> list[Section]:
             with plt.rc_context(STYLE):
                 section = build(run)
         except MissingData as exc:
-            section = Section(section_id, title, missing=str(exc))
+            # a folder of another stage (approach, tow) has no impact results to miss
+            section = Section(section_id, title, missing=str(exc)) if run.stage == "impact" else None
         if section is not None:
             sections.append(section)
     if progress:

@@ -31,7 +31,7 @@ def _html_section(html: str, section_id: str) -> str:
 
 
 #: Sections of stages the impact run does not have (they return None and are left out).
-OTHER_STAGES = {"perception", "diagnosis", "towing"}
+OTHER_STAGES = {"perception", "diagnosis", "towing", "approach"}
 IMPACT_SECTIONS = [s for s in SECTIONS if s[0] not in OTHER_STAGES]
 
 
