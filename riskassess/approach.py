@@ -62,7 +62,8 @@ def build_problem(case: ApproachCase, source: str = "case") -> ApproachProblem:
         final_time=obj.final_time if obj.kind == "min_fuel" else None,
         time_weight=getattr(obj, "time_weight", 1.0), impulse_weight=getattr(obj, "impulse_weight", 1.0),
         width_bounds=widths, position_bounds=positions, min_unit_mass=min_mass,
-        final_at_rest=case.collocation.final_at_rest, keep_out_margin=case.collocation.keep_out_margin, **free)
+        final_at_rest=case.collocation.final_at_rest, keep_out_margin=case.collocation.keep_out_margin,
+        control_smoothing=case.collocation.control_smoothing, **free)
     _check_start(problem, source)
     return problem
 
@@ -111,7 +112,8 @@ def solve_case(case: ApproachCase, source: str = "case"):
               "solver_status": solution.status, "converged": solution.success,
               "final_time": solution.final_time, "fuel_kg": solution.fuel_kg, "impulse_Ns": solution.impulse_Ns,
               "objective_value": solution.objective_value, "iterations": solution.iterations,
-              "nlp_solves": solution.extras["nlp_solves"], "solve_s": solution.solve_s,
+              "nlp_solves": solution.extras["nlp_solves"], "smoothing_penalty": solution.extras["smoothing_penalty"],
+              "solve_s": solution.solve_s,
               "intervals": problem.intervals, "constraints_at_collocation_points": points,
               "constraints_resimulated": fine,
               "resimulation_final_state_difference": float(np.abs(resim.states[:, -1] - solution.states[:, -1]).max()),

@@ -104,6 +104,9 @@ class Collocation(Strict):
     keep_out_margin: NonNegative = Field(0.02, description="Added to r_o at the collocation points so that the "
                                                            "path between them keeps r_o too (m).")
     final_at_rest: bool = Field(False, description="Require zero velocities at the final time.")
+    control_smoothing: NonNegative = Field(1e-4, description="Weight of the tie-breaking penalty on control jumps "
+                                                             "between collocation points (-); picks a smooth one "
+                                                             "among equally optimal controls.")
 
 
 class Reference(Strict):
