@@ -84,12 +84,15 @@ def _diagnose(tmp_path, case_path, channels, times):
 def _check_named(answer, effect_id, values):
     assert answer["cause"] == effect_id, (effect_id, values, answer["statement"])
     assert answer["confidence"] > 0.99
-    # Substantial gain: the hidden effect stands >= 8 sigma out of the case model; the fitted nominal
-    # model absorbs part of it (a delay looks much like another initial state) and the held-out part
-    # may be quiet (a panel stopped by friction), so: the channel the effect shows most in is
-    # predicted at least 30 % better on the held-out part, and all channels together no worse.
-    channel_gains = [g for c, g in answer["gain_percent"].items() if c != "overall"]
-    assert max(channel_gains) > 30.0 and answer["gain_percent"]["overall"] > 0.0, answer["gain_percent"]
+    # Substantial gain on the held-out part: the extended model removes at least half of the nominal
+    # model's excess residual power over the noise (sigma^2 units; 0.05 for the noise estimate's few
+    # per cent). Not a fixed percentage: the fitted nominal model absorbs part of some effects (a
+    # sensor delay of a free tumble is nearly another initial state) and a held-out part can be quiet
+    # (a panel stopped by friction); the gain then is small because little is left to gain.
+    after = next(r for r in answer["candidates"] if r["id"] == effect_id)["holdout_rms_sigma"]
+    before = answer["nominal"]["holdout_rms_sigma"]
+    assert after ** 2 - 1.0 <= 0.5 * (before ** 2 - 1.0) + 0.05, (before, after, answer["gain_percent"])
+    assert answer["gain_percent"]["overall"] > 0.0
     for name, true in values.items():
         fitted = answer["parameters"][name]
         # the fitted value within 5 sigma of its own uncertainty, or 20 % (model differences
