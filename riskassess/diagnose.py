@@ -189,10 +189,14 @@ def _write(out: Path, case_path: Path, answer, problem, predictions, chosen, bef
     results.atomic_write_bytes(out / "case.toml", case_path.read_bytes())
     if extended is not None:
         target = case_path.with_name(f"{case_path.stem}.extended.toml")
-        results.atomic_write_bytes(target, extended.encode())
         results.atomic_write_bytes(out / target.name, extended.encode())
-        answer["extended_case"] = str(target)
         files.append(target.name)
+        try:
+            results.atomic_write_bytes(target, extended.encode())
+        except OSError as exc:   # a read-only case folder: the copy in the output folder is the result
+            answer["extended_case_note"] = f"not written next to the case ({exc}); see the output folder"
+            target = out / target.name
+        answer["extended_case"] = str(target)
     arrays = {"time": problem.time, "train": problem.train, "channels": np.array(problem.channels)}
     for c in problem.channels:
         arrays[f"measured/{c}"] = problem.values[c]
