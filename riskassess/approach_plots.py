@@ -10,7 +10,7 @@ from riskassess.report.plotting import legend, panels, plt
 
 def trajectory_figure(answer: dict, arrays: dict):
     """MU paths (nodes and re-simulation), mouth segments every few nodes, the keep-out circle."""
-    fig, ax = plt.subplots(figsize=(6.7, 5.2), layout="constrained")
+    fig, ax = plt.subplots(figsize=(6.7, 4.2), layout="constrained")
     paths, fine = arrays["unit_paths"], arrays["resim_unit_paths"]
     for k, color in enumerate(("tab:blue", "tab:orange")):
         ax.plot(fine[k, 0], fine[k, 1], color=color, lw=1.0, label=f"MU{k + 1} (re-simulated)")
