@@ -28,14 +28,17 @@ from tests.diagnosis.conftest import HINGED_CASE, TUMBLING_CASE, case_with
 SEED = int(os.environ.get("DIAGNOSIS_SEED", "0"))
 #: Record length of the fast tests (s) at 10 Hz: a few tumble and hinge periods.
 DURATION = 40.0
-#: Effects seen within 40 s at their physical size and the sample data's sensor noise. Gravity
-#: gradient and J2 need minutes (a 2.5e-3 N m torque, a 1e-4 m drift in 40 s): the slow test runs
-#: them on 300 s records.
+#: Effects drawn by the fast tests (40 s records). Gravity gradient and J2 need minutes (a 2.5e-3 N m
+#: torque, a 1e-4 m drift in 40 s), and the main-body torques (damper, eddy currents) move a hinged
+#: body's channels by less than the penalty hinge's compliance (6e-5 of their range) at the low noise
+#: they would need in 40 s: the slow test runs them all on 300 s records.
 FAST_EFFECTS = {"tumbling_rigid": ["internal_energy_dissipation", "eddy_current_damping", "com_offset",
                                    "sensor_time_delay", "sensor_bias"],
                 "hinged_appendage": ["hinge_coulomb_friction", "hinge_stiffness_hardening", "hinge_backlash",
-                                     "com_offset", "sensor_time_delay", "sensor_bias", "internal_energy_dissipation",
-                                     "eddy_current_damping"]}
+                                     "com_offset", "sensor_time_delay", "sensor_bias"]}
+SLOW_EFFECTS = {"tumbling_rigid": FAST_EFFECTS["tumbling_rigid"] + ["gravity_gradient_torque", "j2_perturbation"],
+                "hinged_appendage": FAST_EFFECTS["hinged_appendage"] + ["internal_energy_dissipation",
+                                                                        "eddy_current_damping"]}
 #: Signal of the hidden effect, in noise sigmas (largest RMS over the channels): at least this.
 VISIBLE = 8.0
 
@@ -58,18 +61,18 @@ def draw_effect(case, effect_id, rng):
 
 def hidden_effect_data(case, effect_id, rng, times):
     """(values, noise scale, measured channels): the effect drawn until its signal stands
-    ``VISIBLE`` sigmas out at a noise of 0.2-1 x the sample data's (the noise level is drawn too)."""
+    ``VISIBLE`` sigmas out at the noise level, drawn too (log-uniform, 0.05-1 x the sample data's)."""
     plant = Plant.from_case(case)
     nominal = predict(plant, times)
-    for _ in range(20):
+    for _ in range(50):
         values = draw_effect(case, effect_id, rng)
         signal = predict(plant, times, CATALOG[effect_id], list(values.values()), list(values))
         snr = max(np.sqrt(np.mean((signal[c] - nominal[c]) ** 2)) / channel_noise(c) for c in nominal)
-        scale = rng.uniform(0.2, 1.0)
+        scale = 10 ** rng.uniform(np.log10(0.05), 0.0)
         if snr / scale >= VISIBLE:
             clean = simulate_effect(case, times, effect_id, values)
             return values, scale, {c: v + rng.normal(0.0, channel_noise(c, scale), v.shape) for c, v in clean.items()}
-    raise AssertionError(f"{effect_id}: no visible draw in 20 tries")
+    raise AssertionError(f"{effect_id}: no visible draw in 50 tries")
 
 
 def _diagnose(tmp_path, case_path, channels, times):
@@ -125,7 +128,7 @@ def test_no_effect_gives_no_significant_discrepancy_through_the_cli(tmp_path, ca
     rng = np.random.default_rng(SEED + 2000)
     times = sample_times(DURATION, 10.0)
     clean = simulate_effect(tumbling_rocket_body, times)
-    scale = rng.uniform(0.2, 1.0)
+    scale = 10 ** rng.uniform(np.log10(0.05), 0.0)
     data = tmp_path / "measured.csv"
     write_measured(data, times, {c: v + rng.normal(0.0, channel_noise(c, scale), v.shape) for c, v in clean.items()})
     case = tmp_path / TUMBLING_CASE.name
@@ -157,9 +160,8 @@ def test_out_of_catalog_torque_is_not_pinned_on_a_catalog_cause(tmp_path, tumbli
 
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", range(10))
-@pytest.mark.parametrize("path, effects", [(TUMBLING_CASE, FAST_EFFECTS["tumbling_rigid"] + ["gravity_gradient_torque",
-                                                                                             "j2_perturbation"]),
-                                           (HINGED_CASE, FAST_EFFECTS["hinged_appendage"])])
+@pytest.mark.parametrize("path, effects", [(TUMBLING_CASE, SLOW_EFFECTS["tumbling_rigid"]),
+                                           (HINGED_CASE, SLOW_EFFECTS["hinged_appendage"])])
 def test_hidden_effect_any_seed_full_length(tmp_path, seed, path, effects):
     rng = np.random.default_rng(seed)
     case = case_with(path)
