@@ -244,6 +244,11 @@ def _cmd_diagnose(args) -> int:
             for c in answer["rmse_before"]))
         if answer["extended_case"]:
             print(f"extended case: {answer['extended_case']}")
+        for key, label in (("unknown", "unknown channels (not used)"), ("not_predicted", "channels the scenario "
+                                                                                           "does not predict")):
+            if answer["channels"][key]:
+                print(f"{label}: {', '.join(answer['channels'][key])}")
+        print(f"results: {args.out or 'runs/' + answer['case'] + '-diagnosis'}")
     return 0
 
 
