@@ -3,7 +3,8 @@ constraint margins on the re-simulation and the relative difference to the paper
 
     python3 bench/bench_approach.py [CASE ...]
 
-Timings are wall times of the IPOPT solve alone, on whatever else runs on the machine.
+Timings are the wall and CPU (process) times of the IPOPT solve alone; the wall time includes
+whatever else runs on the machine.
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ def _relative(reference, key):
 
 def main(paths) -> None:
     paths = paths or sorted(str(p) for p in (Path(__file__).parents[1] / "cases").glob("approach_*.toml"))
-    print(f"{'case':28s} {'status':26s} {'solve s':>7s} {'iter':>5s} {'t_f s':>8s} {'fuel kg':>8s} "
+    print(f"{'case':28s} {'status':26s} {'solve s':>7s} {'cpu s':>6s} {'iter':>5s} {'t_f s':>8s} {'fuel kg':>8s} "
           f"{'keep-out m':>10s} {'width m':>8s} {'miss m':>7s} {'ok':>3s} {'t_f vs paper':>12s} "
           f"{'fuel vs paper':>13s} {'paper solve s':>13s}")
     for path in paths:
@@ -33,7 +34,7 @@ def main(paths) -> None:
         answer, _, _ = solve_case(case, path)
         fine, ref = answer["constraints_resimulated"], answer["reference"]
         width = f"{fine['width_margin_m']:.4f}" if "width_margin_m" in fine else "-"
-        print(f"{case.name:28s} {answer['solver_status']:26s} {answer['solve_s']:7.2f} {answer['iterations']:5d} "
+        print(f"{case.name:28s} {answer['solver_status']:26s} {answer['solve_s']:7.2f} {answer['solve_cpu_s']:6.2f} {answer['iterations']:5d} "
               f"{answer['final_time']:8.4f} {answer['fuel_kg']:8.5f} {fine['keep_out_margin_m']:10.4f} {width:>8s} "
               f"{fine['final_mouth_miss_m']:7.4f} {'yes' if answer['constraints_satisfied'] else 'NO':>3s} "
               f"{_relative(ref, 'final_time'):>12s} {_relative(ref, 'fuel_kg'):>13s} "

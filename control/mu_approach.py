@@ -336,9 +336,10 @@ def _solve_nlp(problem: ApproachProblem, width: bool, start):
     nlp = {"x": tr.w, "f": tr.cost(), "g": ca.vertcat(*tr.g)}
     solver = ca.nlpsol("approach", "ipopt", nlp, IPOPT_OPTIONS)
     lbx, ubx = _variable_bounds(problem)
-    tic = time.perf_counter()
+    tic, cpu = time.perf_counter(), time.process_time()
     out = solver(x0=start, lbx=lbx, ubx=ubx, lbg=tr.lbg, ubg=tr.ubg)
-    return tr, out, solver.stats(), time.perf_counter() - tic
+    stats = dict(solver.stats(), cpu_s=time.process_time() - cpu)
+    return tr, out, stats, time.perf_counter() - tic
 
 
 def _widths_hold(problem: ApproachProblem, tr, out) -> bool:
@@ -368,10 +369,11 @@ def solve(problem: ApproachProblem) -> ApproachSolution:
     # 108 iterations): solve it with them at once.
     deferred = problem.width_bounds is not None and problem.objective != "min_fuel"
     tr, out, stats, solve_s = _solve_nlp(problem, not deferred, start)
-    iterations, solves = int(stats["iter_count"]), 1
+    iterations, solves, cpu_s = int(stats["iter_count"]), 1, stats["cpu_s"]
     if deferred and not _widths_hold(problem, tr, out):
         tr, out, stats, more_s = _solve_nlp(problem, True, np.array(out["x"], float).ravel())
         iterations, solves, solve_s = iterations + int(stats["iter_count"]), 2, solve_s + more_s
+        cpu_s += stats["cpu_s"]
     values = ca.Function("values", [tr.w], [tr.X, tr.Xm, tr.U, tr.Um, tr.tf, tr.impulse(), tr.objective(),
                                             tr.smoothing()])(out["x"])
     X, Xm, U, Um, tf, impulse, objective, penalty = (np.array(v, float) for v in values)
@@ -379,7 +381,7 @@ def solve(problem: ApproachProblem) -> ApproachSolution:
     return ApproachSolution(problem, stats["return_status"], stats["return_status"] in SUCCESS, iterations,
                             solve_s, tf, float(objective.squeeze()), float(impulse.squeeze()),
                             tf * np.linspace(0.0, 1.0, problem.intervals + 1), X, U, Xm, Um,
-                            {"nlp_solves": solves, "smoothing_penalty": float(penalty.squeeze())})
+                            {"nlp_solves": solves, "smoothing_penalty": float(penalty.squeeze()), "cpu_s": cpu_s})
 
 
 def _quadratic_controls(u_start, u_mid, u_end, tau, thrust_bounds):

@@ -113,7 +113,7 @@ def solve_case(case: ApproachCase, source: str = "case"):
               "final_time": solution.final_time, "fuel_kg": solution.fuel_kg, "impulse_Ns": solution.impulse_Ns,
               "objective_value": solution.objective_value, "iterations": solution.iterations,
               "nlp_solves": solution.extras["nlp_solves"], "smoothing_penalty": solution.extras["smoothing_penalty"],
-              "solve_s": solution.solve_s,
+              "solve_s": solution.solve_s, "solve_cpu_s": solution.extras["cpu_s"],
               "intervals": problem.intervals, "constraints_at_collocation_points": points,
               "constraints_resimulated": fine,
               "resimulation_final_state_difference": float(np.abs(resim.states[:, -1] - solution.states[:, -1]).max()),
