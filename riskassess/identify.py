@@ -125,33 +125,49 @@ class Identified:
     history: list
 
 
-def _optimizer(name, settings, initial_guess):
-    if name == "pso":
-        return PSO(pop_size=settings.swarm_size), DefaultSingleObjectiveTermination(
-            ftol=settings.pso_tolerance, period=settings.stall_generations, n_max_gen=settings.pso_generations)
-    if name == "polish":
-        return PatternSearch(x0=np.asarray(initial_guess, float), init_delta=settings.polish_delta), \
-            DefaultSingleObjectiveTermination(xtol=settings.pattern_tolerance, ftol=0.0, period=20,
-                                              n_max_evals=settings.polish_evaluations)
-    return PatternSearch(x0=np.asarray(initial_guess, float)), DefaultSingleObjectiveTermination(
-        xtol=settings.pattern_tolerance, ftol=0.0, period=20, n_max_evals=settings.pattern_evaluations)
+def _pattern_search(problem, x0, settings, first_delta, budget):
+    """Hooke-Jeeves (pymoo) from ``x0`` with restarts: each leg runs at most
+    ``settings.restart_evaluations`` evaluations and restarts from the best point with the step
+    ``settings.polish_delta`` (a fresh step: Hooke-Jeeves only shrinks it, and in the narrow k_ST-c_ST
+    valley it shrinks long before the flat m_P direction is resolved); a leg without improvement
+    shrinks the restart step tenfold; stops at ``budget`` evaluations or a step below
+    ``settings.pattern_tolerance``. Returns (best s, best cost)."""
+    x, f, delta = np.asarray(x0, float), np.inf, first_delta
+    while len(problem.evaluations) < budget and delta >= settings.pattern_tolerance:
+        n = min(settings.restart_evaluations, budget - len(problem.evaluations))
+        result = minimize(problem, PatternSearch(x0=x, init_delta=delta), DefaultSingleObjectiveTermination(
+            xtol=settings.pattern_tolerance, ftol=0.0, period=20, n_max_evals=n), verbose=False)
+        cost = float(np.atleast_1d(result.F)[0])
+        if cost < f:
+            x, f, delta = np.asarray(result.X, float).ravel(), cost, settings.polish_delta
+        else:
+            delta *= 0.1
+    return x, f
 
 
 def identify(case: TowingCase, data: list[dict], optimizer: str, end_time=None, workers=None,
              initial_guess=None) -> Identified:
     """Minimize the case's cost (``identification.cost``) against ``data`` (one dict per run: the
-    compared series and ``rate_deg_s``) with ``optimizer`` ('pso', 'pattern', or 'polish': a pattern
-    search with the small initial step ``optimizers.polish_delta`` from ``initial_guess``)."""
+    compared series and ``rate_deg_s``) with ``optimizer``: 'pso' (pymoo PSO), 'pattern' (pattern
+    search with restarts from ``initial_guess`` or the case's s0, :func:`_pattern_search`) or 'polish'
+    (the same, with ``optimizers.polish_delta`` as first step and ``polish_evaluations`` as budget)."""
     ident = case.identification
     settings = ident.optimizers
-    algorithm, termination = _optimizer(optimizer, settings, ident.initial_guess if initial_guess is None else initial_guess)
+    x0 = ident.initial_guess if initial_guess is None else initial_guess
     start = time.perf_counter()
     with multiprocessing.get_context("fork").Pool(
             workers or ident.workers, _init_worker, (case, data, ident.cost, ident.weights, end_time)) as pool:
         problem = TowingFit(pool, len(data), ident.lower_bounds, ident.upper_bounds)
-        result = minimize(problem, algorithm, termination, seed=settings.seed, verbose=False)
-    return Identified(np.asarray(result.X, float).ravel(), float(np.atleast_1d(result.F)[0]), optimizer,
-                      len(problem.evaluations), time.perf_counter() - start, problem.best)
+        if optimizer == "pso":
+            result = minimize(problem, PSO(pop_size=settings.swarm_size), DefaultSingleObjectiveTermination(
+                ftol=settings.pso_tolerance, period=settings.stall_generations, n_max_gen=settings.pso_generations),
+                seed=settings.seed, verbose=False)
+            s, cost = np.asarray(result.X, float).ravel(), float(np.atleast_1d(result.F)[0])
+        elif optimizer == "pattern":
+            s, cost = _pattern_search(problem, x0, settings, 0.25, settings.pattern_evaluations)
+        else:
+            s, cost = _pattern_search(problem, x0, settings, settings.polish_delta, settings.polish_evaluations)
+    return Identified(s, cost, optimizer, len(problem.evaluations), time.perf_counter() - start, problem.best)
 
 
 def training_data(case: TowingCase, s, rates, end_time=None) -> list[dict]:

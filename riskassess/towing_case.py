@@ -133,8 +133,10 @@ class Optimizers(Strict):
     pattern_tolerance: Positive = Field(1e-6, description="Pattern-search step tolerance, in units of each bound range (-).")
     polish_evaluations: Annotated[int, Field(ge=0)] = Field(
         0, description="Pattern-search evaluations polishing the PSO's best (0: none); reported as optimizer 'pso+pattern' (-).")
+    restart_evaluations: Annotated[int, Field(ge=10)] = Field(
+        1000, description="Evaluations of one pattern-search leg before it restarts from its best point (-).")
     polish_delta: Annotated[float, Field(gt=0, le=0.5)] = Field(
-        0.02, description="Initial pattern-search step of the polish, in units of each bound range (-).")
+        0.02, description="Pattern-search step of the polish and of every restart, in units of each bound range (-).")
     seed: int = Field(0, description="Seed of the PSO (-).")
 
 

@@ -32,6 +32,40 @@ def test_costs_vanish_on_the_data_and_grow_off_it(reduced_benchmark):
     assert cost_f1(other, data[0], weights) > 1e-3 and cost_f2(other, data[0]) > 1e-2
 
 
+@pytest.fixture(scope="module")
+def small_benchmark():
+    """Sec. 4.3 at unit-test size: one Table 3 rate (20.44 deg/s), the first 35 s of towing (the
+    sub-tethers engage at ~28 s and pull for the rest), a box around s_true (1/5 to 1/2 of eq. 24's
+    ranges), PSO with 12 particles x 10 generations polished by 150 pattern-search evaluations."""
+    case = load_model(CASE, TowingCase)
+    optimizers = case.identification.optimizers.model_copy(update=dict(
+        swarm_size=12, pso_generations=10, polish_evaluations=150, polish_delta=0.02))
+    ident = case.identification.model_copy(update=dict(
+        lower_bounds=[1.5, 6.0, 1.5, 0.6], upper_bounds=[2.5, 8.0, 2.5, 1.0], optimizers=optimizers))
+    case = case.model_copy(update=dict(identification=ident))
+    end = case.simulation.start_time + 35.0
+    return case, training_data(case, ident.benchmark_truth, [20.44], end), end
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_pso_and_pattern_search_recover_known_sub_tether_parameters(small_benchmark, seed):
+    case, data, end = small_benchmark
+    settings = case.identification.optimizers.model_copy(update=dict(seed=seed))
+    case = case.model_copy(update=dict(identification=case.identification.model_copy(update=dict(optimizers=settings))))
+    swarm = identify(case, data, "pso", end_time=end, workers=2)
+    found = identify(case, data, "polish", end_time=end, workers=2, initial_guess=swarm.s)
+    truth = np.asarray(case.identification.benchmark_truth)
+    assert found.cost <= swarm.cost
+    # The cost is an RMSE: it grows linearly with |s - s_true|. Measured (60 s of towing, one rate):
+    # 2e-3 on s1 costs 3.7e-3 and 2e-3 on s3 costs 3.7e-4, but 0.1 on s4 only 1.1e-3: m_P barely moves
+    # the bodies, less still in 35 s (the paper's MADS runs also ended at s4 = 0.48 and 0.83 for a truth
+    # of 1, Table 5). Measured here (seeds 0, 1): s1-s3 within 1 %, s4 anywhere in its box. Tolerances: 1 % on
+    # k_ST, l_ST0 and c_ST; s4 only inside its bounds. The full benchmark's figures: docs/towing.md.
+    np.testing.assert_allclose(found.s[:3], truth[:3], rtol=1e-2)
+    lower, upper = case.identification.lower_bounds[3], case.identification.upper_bounds[3]
+    assert lower <= found.s[3] <= upper
+
+
 @pytest.mark.slow  # not yet robust: one run in two ended in the k-c valley at the c bound (cost 0.145)
 def test_pattern_search_recovers_known_sub_tether_parameters(reduced_benchmark):
     case, data, end = reduced_benchmark
