@@ -76,6 +76,22 @@ def test_gravity_gradient_torque_of_a_tilted_body():
                                    abs=1e-15)
 
 
+def test_j2_acceleration_is_the_gradient_of_the_j2_potential():
+    """J2 term of the (positive) geopotential U = -mu J2 R^2 / (2 r^3) (3 z^2 / r^2 - 1) (Vallado
+    eq. 8-24, a = +grad U): gradient by central differences (step 1 m at 7e6 m: truncation ~1e-12
+    relative, rounding ~1e-9 of 1e-2 m/s^2)."""
+    from diagnosis.effects.j2_perturbation import J2_EARTH, j2_acceleration
+    from multibody.orbit import MU_EARTH, R_EARTH
+
+    def potential(r):
+        rn = np.linalg.norm(r)
+        return -MU_EARTH * J2_EARTH * R_EARTH ** 2 / (2 * rn ** 3) * (3 * r[2] ** 2 / rn ** 2 - 1)
+
+    r = np.array([4.1e6, -3.3e6, 4.6e6])
+    gradient = np.array([(potential(r + e) - potential(r - e)) / 2.0 for e in np.eye(3)])
+    assert j2_acceleration(r, J2_EARTH) == pytest.approx(gradient, rel=1e-6)
+
+
 def test_sensor_effects_transform_the_channels():
     times = np.array([0.0, 0.5, 1.0, 3.0])
     assert np.allclose(CATALOG["sensor_time_delay"].sample_times(times, [0.7]), [0.0, 0.0, 0.3, 2.3])
