@@ -153,9 +153,9 @@ def nominal_parameter_names(case, channels) -> list[str]:
     return names
 
 
-def nominal_vector(plant: Plant, names) -> tuple[np.ndarray, np.ndarray]:
-    """The case values (attitude as a zero perturbation) and prior 1-sigmas are set by the caller;
-    here: the values of ``names`` in ``plant``, flattened."""
+def nominal_vector(plant: Plant, names) -> np.ndarray:
+    """The case values of the nominal parameters ``names``, flattened (the attitude as a zero
+    perturbation, rad)."""
     values = {"attitude": np.zeros(3), "angular_velocity": plant.omega0, "position": plant.position0,
               "velocity": plant.velocity0, "hinge_angle": [plant.hinge_angle0], "hinge_rate": [plant.hinge_rate0],
               "torsional_stiffness": [plant.stiffness], "torsional_damping": [plant.damping]}
