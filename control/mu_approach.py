@@ -22,7 +22,7 @@ eq. 8 without a cut at 0 or the 2 pi ambiguity); results report them in [0, 2pi)
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import casadi as ca
 import numpy as np
@@ -37,6 +37,9 @@ NU = len(CONTROLS)
 #: answer here); measured 123 instead of 544 iterations on case study 2, minimum time.
 IPOPT_OPTIONS = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-9,
                  "ipopt.max_iter": 1000, "ipopt.bound_push": 1e-6, "ipopt.bound_frac": 1e-6}
+#: IPOPT settings added for a solve on a refined mesh, which starts at the previous answer: a small
+#: initial barrier parameter keeps IPOPT near it.
+WARM_OPTIONS = {"ipopt.mu_init": 1e-6}
 #: Solver statuses that count as a solution.
 SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
@@ -54,6 +57,11 @@ class ApproachProblem:
     keep_out_radius : float             r_o (m), eqs. 5-6.
     thrust_bounds : (2,) float          Thrust magnitude bounds per MU (N), eq. 7.
     intervals : int                     Collocation intervals N.
+    mesh : tuple or None                Interval widths in normalized time (N,), summing to 1; None: N
+                                        equal intervals. Set by the mesh refinement of :func:`solve`.
+    mesh_tolerance : float              Largest local error of an interval (-, :func:`local_errors`)
+                                        left unrefined.
+    mesh_rounds : int                   Most refinement solves after the first.
     final_time : float or None          Fixed t_f (s) (min_fuel); None: free in ``final_time_bounds``.
     final_time_bounds : (2,) float      (s).
     final_time_guess : float            (s).
@@ -87,6 +95,35 @@ class ApproachProblem:
     final_at_rest: bool = False
     keep_out_margin: float = 0.02
     control_smoothing: float = 1e-4
+    mesh: tuple | None = None
+    mesh_tolerance: float = 1e-4
+    mesh_rounds: int = 3
+
+
+def interval_widths(problem: ApproachProblem) -> np.ndarray:
+    """Interval widths (N,) in normalized time zeta = t / t_f (-)."""
+    if problem.mesh is None:
+        return np.full(problem.intervals, 1.0 / problem.intervals)
+    return np.asarray(problem.mesh, float)
+
+
+def node_fractions(problem: ApproachProblem) -> np.ndarray:
+    """Normalized node times (N+1,) (-), 0 to 1."""
+    if problem.mesh is None:
+        return np.linspace(0.0, 1.0, problem.intervals + 1)
+    return np.r_[0.0, np.cumsum(interval_widths(problem))]
+
+
+def point_fractions(problem: ApproachProblem) -> np.ndarray:
+    """Normalized times (2N+1,) (-) of the nodes and midpoints interleaved. (On the uniform mesh
+    exactly ``linspace``: the initial guess's thrust angles where the guessed force vanishes are
+    arctan2 of rounding noise, and their change by other roundings cost 93 -> 212 iterations.)"""
+    if problem.mesh is None:
+        return np.linspace(0.0, 1.0, 2 * problem.intervals + 1)
+    nodes = node_fractions(problem)
+    points = np.empty(2 * problem.intervals + 1)
+    points[::2], points[1::2] = nodes, (nodes[:-1] + nodes[1:]) / 2.0
+    return points
 
 
 @dataclass
@@ -162,10 +199,10 @@ class _Transcription:
 
     def dynamics(self):
         """Hermite-Simpson defects (Betts 2010 eqs. 4.103-4.104) in normalized time."""
-        n = self.problem.intervals
+        n, nx = self.problem.intervals, self.problem.model.n_states
         f = _symbolic_rhs(self.problem.model).map(n + 1)
         fm = _symbolic_rhs(self.problem.model).map(n)
-        h = 1.0 / n
+        h = ca.repmat(ca.DM(interval_widths(self.problem)).T, nx, 1)
         F = self.tf * f(self.X, self.U)
         Fm = self.tf * fm(self.Xm, self.Um)
         xk, xk1 = self.X[:, :-1], self.X[:, 1:]
@@ -197,9 +234,9 @@ class _Transcription:
 
     def impulse(self):
         """Both MUs' thrust impulse (N s), Simpson's rule on the nodes and midpoints."""
-        n = self.problem.intervals
+        h = ca.DM(interval_widths(self.problem)).T
         s, sm = self.U[0, :] + self.U[1, :], self.Um[0, :] + self.Um[1, :]
-        return self.tf / (6.0 * n) * (ca.sum2(s[:-1]) + 4.0 * ca.sum2(sm) + ca.sum2(s[1:]))
+        return self.tf / 6.0 * ca.sum2(h * (s[:, :-1] + 4.0 * sm + s[:, 1:]))
 
     def smoothing(self):
         """Tie-breaking penalty: sum of squared jumps of the controls between consecutive points
@@ -267,7 +304,7 @@ def straight_line_guess(problem: ApproachProblem):
     iterations from the answer.) Returns states (nx, 2N+1) and controls (4, 2N+1) on the nodes
     and midpoints interleaved, and t_f (s)."""
     tf = problem.final_time or problem.final_time_guess
-    t = tf * np.linspace(0.0, 1.0, 2 * problem.intervals + 1)
+    t = tf * point_fractions(problem)
     model, x0 = problem.model, np.asarray(problem.initial_state, float)
     x1, y1, x2, y2 = model.unit_positions(x0)
     center0 = np.array([x1 + x2, y1 + y2]) / 2.0
@@ -326,7 +363,7 @@ def _guess_vector(problem: ApproachProblem):
     return np.r_[vector, tf] if problem.final_time is None else vector
 
 
-def _solve_nlp(problem: ApproachProblem, width: bool, start):
+def _solve_nlp(problem: ApproachProblem, width: bool, start, options=None):
     """One IPOPT solve from the decision vector ``start``; returns (transcription, result, stats, s)."""
     tr = _Transcription(problem, width)
     tr.dynamics()
@@ -334,7 +371,7 @@ def _solve_nlp(problem: ApproachProblem, width: bool, start):
     tr.unit_directions()
     tr.boundary()
     nlp = {"x": tr.w, "f": tr.cost(), "g": ca.vertcat(*tr.g)}
-    solver = ca.nlpsol("approach", "ipopt", nlp, IPOPT_OPTIONS)
+    solver = ca.nlpsol("approach", "ipopt", nlp, {**IPOPT_OPTIONS, **(options or {})})
     lbx, ubx = _variable_bounds(problem)
     tic, cpu = time.perf_counter(), time.process_time()
     out = solver(x0=start, lbx=lbx, ubx=ubx, lbg=tr.lbg, ubg=tr.ubg)
@@ -352,8 +389,35 @@ def _widths_hold(problem: ApproachProblem, tr, out) -> bool:
     return bool(np.all(width >= low - 1e-9) and np.all(width <= high + 1e-9))
 
 
+def _solve_once(problem: ApproachProblem, start, deferred: bool, options=None):
+    """IPOPT on one mesh from ``start``, with the width constraints deferred as :func:`solve` says.
+    Returns (transcription, result, {iterations, solves, solve_s, cpu_s, status})."""
+    tr, out, stats, solve_s = _solve_nlp(problem, not deferred, start, options)
+    tally = {"iterations": int(stats["iter_count"]), "solves": 1, "solve_s": solve_s, "cpu_s": stats["cpu_s"]}
+    if deferred and not _widths_hold(problem, tr, out):
+        tr, out, stats, more_s = _solve_nlp(problem, True, np.array(out["x"], float).ravel(), options)
+        tally = {"iterations": tally["iterations"] + int(stats["iter_count"]), "solves": 2,
+                 "solve_s": tally["solve_s"] + more_s, "cpu_s": tally["cpu_s"] + stats["cpu_s"]}
+    tally["status"] = stats["return_status"]
+    return tr, out, tally
+
+
+def _solution(problem: ApproachProblem, tr, out, tally: dict) -> ApproachSolution:
+    values = ca.Function("values", [tr.w], [tr.X, tr.Xm, tr.U, tr.Um, tr.tf, tr.impulse(), tr.objective(),
+                                            tr.smoothing()])(out["x"])
+    X, Xm, U, Um, tf, impulse, objective, penalty = (np.array(v, float) for v in values)
+    tf = float(tf.squeeze())
+    return ApproachSolution(problem, tally["status"], tally["status"] in SUCCESS, tally["iterations"],
+                            tally["solve_s"], tf, float(objective.squeeze()), float(impulse.squeeze()),
+                            tf * node_fractions(problem), X, U, Xm, Um,
+                            {"nlp_solves": tally["solves"], "smoothing_penalty": float(penalty.squeeze()),
+                             "cpu_s": tally["cpu_s"], "mesh_refinements": 0})
+
+
 def solve(problem: ApproachProblem) -> ApproachSolution:
-    """Transcribe and solve the problem with IPOPT; the solution says whether IPOPT succeeded.
+    """Transcribe and solve the problem with IPOPT, refining the mesh where the controls, replayed
+    open loop, miss the collocated states (:func:`refine_mesh`); the solution says whether IPOPT
+    succeeded.
 
     The mouth-width constraints (eq. 15) are added only when needed: a first solve leaves them
     out, and when its widths are within bounds at every point it is the answer (a local optimum
@@ -363,35 +427,83 @@ def solve(problem: ApproachProblem) -> ApproachSolution:
     cost IPOPT 2-4 times the wall time (measured on case study 2: minimum time 0.75 s against
     3.6 s, combined 1.5 s against 3.9 s). Not for min_fuel (see below).
     """
-    start = _guess_vector(problem)
     # min_fuel: every direction profile at the lowest thrust is optimal, so the answer without the
     # width constraints is an arbitrary point of that set and a poor start (measured 435 against
     # 108 iterations): solve it with them at once.
     deferred = problem.width_bounds is not None and problem.objective != "min_fuel"
-    tr, out, stats, solve_s = _solve_nlp(problem, not deferred, start)
-    iterations, solves, cpu_s = int(stats["iter_count"]), 1, stats["cpu_s"]
-    if deferred and not _widths_hold(problem, tr, out):
-        tr, out, stats, more_s = _solve_nlp(problem, True, np.array(out["x"], float).ravel())
-        iterations, solves, solve_s = iterations + int(stats["iter_count"]), 2, solve_s + more_s
-        cpu_s += stats["cpu_s"]
-    values = ca.Function("values", [tr.w], [tr.X, tr.Xm, tr.U, tr.Um, tr.tf, tr.impulse(), tr.objective(),
-                                            tr.smoothing()])(out["x"])
-    X, Xm, U, Um, tf, impulse, objective, penalty = (np.array(v, float) for v in values)
-    tf = float(tf.squeeze())
-    return ApproachSolution(problem, stats["return_status"], stats["return_status"] in SUCCESS, iterations,
-                            solve_s, tf, float(objective.squeeze()), float(impulse.squeeze()),
-                            tf * np.linspace(0.0, 1.0, problem.intervals + 1), X, U, Xm, Um,
-                            {"nlp_solves": solves, "smoothing_penalty": float(penalty.squeeze()), "cpu_s": cpu_s})
+    solution = _solution(problem, *_solve_once(problem, _guess_vector(problem), deferred))
+    for _ in range(problem.mesh_rounds):
+        refined = refine_mesh(solution)
+        if refined is None or not solution.success:
+            break
+        tr, out, tally = _solve_once(refined, _interpolated_start(solution, refined), deferred, WARM_OPTIONS)
+        previous, solution = solution, _solution(refined, tr, out, tally)
+        solution.iterations += previous.iterations
+        solution.solve_s += previous.solve_s
+        for key in ("nlp_solves", "cpu_s", "mesh_refinements"):
+            solution.extras[key] += previous.extras[key]
+        solution.extras["mesh_refinements"] += 1
+    return solution
+
+
+def local_errors(solution: ApproachSolution, rtol: float = 1e-9) -> np.ndarray:
+    """Local error of each interval (N,) (-): the interval's interpolated controls
+    (:func:`_quadratic_controls`) integrated from its collocated start node, against the collocated
+    end node, :math:`\\max_i |\\Delta x_i| / (1 + \\max_t |x_i|)` (the relative error of Betts
+    2010, Sec. 4.7.1, with a DOP853 solution in place of his quadrature). All intervals are
+    integrated at once in their local time tau in [0, 1]. A thrust switch inside an interval,
+    which the quadratic control cannot follow, shows up here."""
+    nx, n = solution.states.shape[0], solution.problem.intervals
+    u0, um, u1 = solution.controls[:, :-1], solution.mid_controls, solution.controls[:, 1:]
+    h, model, bounds = np.diff(solution.t), solution.problem.model, solution.problem.thrust_bounds
+
+    def rhs(tau, y):
+        return (h * model.rhs(y.reshape(nx, n), _quadratic_controls(u0, um, u1, tau, bounds))).ravel()
+
+    end = solve_ivp(rhs, (0.0, 1.0), solution.states[:, :-1].ravel(), method="DOP853", rtol=rtol, atol=rtol)
+    scale = 1.0 + np.abs(np.c_[solution.states, solution.mid_states]).max(axis=1)
+    return np.max(np.abs(end.y[:, -1].reshape(nx, n) - solution.states[:, 1:]) / scale[:, None], axis=0)
+
+
+#: Sub-intervals an interval over :attr:`ApproachProblem.mesh_tolerance` is split into.
+SPLIT = 8
+
+
+def refine_mesh(solution: ApproachSolution) -> ApproachProblem | None:
+    """The problem on a mesh whose intervals with a local error (:func:`local_errors`) over
+    ``mesh_tolerance`` are split into :data:`SPLIT` equal ones; None when no interval is over it."""
+    problem = solution.problem
+    errors = local_errors(solution)
+    if errors.max() <= problem.mesh_tolerance:
+        return None
+    widths = interval_widths(problem)
+    counts = np.where(errors > problem.mesh_tolerance, SPLIT, 1)
+    mesh = np.repeat(widths / counts, counts)
+    return replace(problem, mesh=tuple(mesh), intervals=len(mesh))
+
+
+def _interpolated_start(solution: ApproachSolution, refined: ApproachProblem):
+    """Decision vector on ``refined``'s mesh, linear in time between the solution's nodes and
+    midpoints, direction cosines renormalized."""
+    t, states, controls = collocation_points(solution)
+    zeta = point_fractions(refined)
+    states = np.array([np.interp(zeta, t / solution.final_time, row) for row in states])
+    controls = np.array([np.interp(zeta, t / solution.final_time, row) for row in controls])
+    for i in (2, 4):
+        controls[i:i + 2] /= np.hypot(controls[i], controls[i + 1])
+    parts = [states[:, ::2], states[:, 1::2], controls[:, ::2], controls[:, 1::2]]
+    vector = np.concatenate([p.ravel(order="F") for p in parts])
+    return np.r_[vector, solution.final_time] if refined.final_time is None else vector
 
 
 def _quadratic_controls(u_start, u_mid, u_end, tau, thrust_bounds):
     """Controls on one interval at local times ``tau`` in [0, 1]: the quadratic through the node,
     midpoint and node values (the Hermite-Simpson control), thrust clipped to its bounds (the
     quadratic overshoots at a thrust switch), directions renormalized to unit vectors.
-    Returns (6, len(tau))."""
+    Values (6,) and ``tau`` (M,), or values (6, M) of M intervals and one ``tau``: returns (6, M)."""
     tau = np.atleast_1d(tau)
-    basis = np.array([2 * (tau - 0.5) * (tau - 1.0), -4 * tau * (tau - 1.0), 2 * tau * (tau - 0.5)])
-    u = np.c_[u_start, u_mid, u_end] @ basis
+    basis = (2 * (tau - 0.5) * (tau - 1.0), -4 * tau * (tau - 1.0), 2 * tau * (tau - 0.5))
+    u = sum(np.reshape(v, (NU, -1)) * b for v, b in zip((u_start, u_mid, u_end), basis))
     u[:2] = np.clip(u[:2], *thrust_bounds)
     for i in (2, 4):
         u[i:i + 2] /= np.hypot(u[i], u[i + 1])
@@ -408,35 +520,38 @@ class Resimulation:
     controls: np.ndarray
 
 
+def _interval_rhs(solution: ApproachSolution, k: int):
+    """dX/dt on interval k with its quadratic controls (:func:`_quadratic_controls`)."""
+    t0, h = solution.t[k], solution.t[k + 1] - solution.t[k]
+    u0, um, u1 = solution.controls[:, k], solution.mid_controls[:, k], solution.controls[:, k + 1]
+    model, bounds = solution.problem.model, solution.problem.thrust_bounds
+    return lambda t, state: model.rhs(state, _quadratic_controls(u0, um, u1, (t - t0) / h, bounds)[:, 0])
+
+
 def resimulate(solution: ApproachSolution, points_per_interval: int = 20, rtol: float = 1e-10) -> Resimulation:
     """Integrate the NumPy dynamics from the initial state with the interpolated controls
     (:func:`_quadratic_controls`), interval by interval (DOP853), sampled ``points_per_interval``
     times per interval: the fine check of the constraints between the collocation points."""
-    model, n = solution.problem.model, solution.problem.intervals
-    bounds = solution.problem.thrust_bounds
-    h = solution.final_time / n
+    n, bounds = solution.problem.intervals, solution.problem.thrust_bounds
     x = np.asarray(solution.problem.initial_state, float)
     ts, xs, us = [], [], []
     for k in range(n):
-        u0, um, u1 = solution.controls[:, k], solution.mid_controls[:, k], solution.controls[:, k + 1]
-
-        def rhs(t, state, t0=k * h, u0=u0, um=um, u1=u1):
-            return model.rhs(state, _quadratic_controls(u0, um, u1, (t - t0) / h, bounds)[:, 0])
-
-        span = (k * h, (k + 1) * h)
+        span = (solution.t[k], solution.t[k + 1])
         local = np.linspace(*span, points_per_interval + 1)[:points_per_interval + (k == n - 1)]
-        sol = solve_ivp(rhs, span, x, method="DOP853", t_eval=local, rtol=rtol, atol=rtol)
+        sol = solve_ivp(_interval_rhs(solution, k), span, x, method="DOP853", t_eval=local, rtol=rtol, atol=rtol,
+                        dense_output=True)
         ts.append(sol.t)
         xs.append(sol.y)
-        us.append(_quadratic_controls(u0, um, u1, (sol.t - k * h) / h, bounds))
-        x = solve_ivp(rhs, span, x, method="DOP853", rtol=rtol, atol=rtol).y[:, -1]
+        us.append(_quadratic_controls(solution.controls[:, k], solution.mid_controls[:, k],
+                                      solution.controls[:, k + 1], (sol.t - span[0]) / (span[1] - span[0]), bounds))
+        x = sol.sol(span[1])
     return Resimulation(np.concatenate(ts), np.hstack(xs), np.hstack(us))
 
 
 def collocation_points(solution: ApproachSolution):
     """Times (2N+1,) (s), states and controls at the nodes and midpoints in time order."""
     n = solution.problem.intervals
-    t = solution.final_time * np.linspace(0.0, 1.0, 2 * n + 1)
+    t = solution.final_time * point_fractions(solution.problem)
     states = np.empty((solution.states.shape[0], 2 * n + 1))
     controls = np.empty((solution.controls.shape[0], 2 * n + 1))
     states[:, ::2], states[:, 1::2] = solution.states, solution.mid_states

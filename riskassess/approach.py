@@ -114,7 +114,8 @@ def solve_case(case: ApproachCase, source: str = "case"):
               "objective_value": solution.objective_value, "iterations": solution.iterations,
               "nlp_solves": solution.extras["nlp_solves"], "smoothing_penalty": solution.extras["smoothing_penalty"],
               "solve_s": solution.solve_s, "solve_cpu_s": solution.extras["cpu_s"],
-              "intervals": problem.intervals, "constraints_at_collocation_points": points,
+              "intervals": solution.problem.intervals, "mesh_refinements": solution.extras["mesh_refinements"],
+              "constraints_at_collocation_points": points,
               "constraints_resimulated": fine,
               "resimulation_final_state_difference": float(np.abs(resim.states[:, -1] - solution.states[:, -1]).max()),
               "tolerances": {"width_m": WIDTH_TOLERANCE_M, "final_mouth_miss_m": MISS_TOLERANCE_M}}
