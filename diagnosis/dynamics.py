@@ -202,38 +202,39 @@ def solve_spd(m, f):
     return y
 
 
-# 3-vectors as tuples and 3 x 3 matrices as row-major 9-sequences: the hot path allocates nothing
-# but the load, the derivative and the 4 x 4 system (the allocating version cost ~2x more per step).
+# 3-vectors as tuples and 3 x 3 matrices as row-major 9-sequences (t-prefixed helpers, also used by the
+# effect laws): the hot path allocates nothing but the load, the derivative and the 4 x 4 system (the
+# allocating version cost 7x more per evaluation with the hinge).
 @njit(cache=True, inline="always")
-def _cr(a, b):
+def tcross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 @njit(cache=True, inline="always")
-def _dot(a, b):
+def tdot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 @njit(cache=True, inline="always")
-def _lin(ca, a, cb, b):
+def tlin(ca, a, cb, b):
     """ca a + cb b."""
     return (ca * a[0] + cb * b[0], ca * a[1] + cb * b[1], ca * a[2] + cb * b[2])
 
 
 @njit(cache=True, inline="always")
-def _mv(m, v):
+def tmv(m, v):
     return (m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
             m[6] * v[0] + m[7] * v[1] + m[8] * v[2])
 
 
 @njit(cache=True, inline="always")
-def _mtv(m, v):
+def tmtv(m, v):
     return (m[0] * v[0] + m[3] * v[1] + m[6] * v[2], m[1] * v[0] + m[4] * v[1] + m[7] * v[2],
             m[2] * v[0] + m[5] * v[1] + m[8] * v[2])
 
 
 @njit(cache=True, inline="always")
-def _quaternion_rows(q):
+def quaternion_rows(q):
     w, x, y, z = q[0], q[1], q[2], q[3]
     return (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
             2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
@@ -241,7 +242,7 @@ def _quaternion_rows(q):
 
 
 @njit(cache=True, inline="always")
-def _axis_rows(a, angle):
+def axis_rows(a, angle):
     c, s = np.cos(angle), np.sin(angle)
     k = 1.0 - c
     return (k * a[0] * a[0] + c, k * a[0] * a[1] - s * a[2], k * a[0] * a[2] + s * a[1],
@@ -250,9 +251,9 @@ def _axis_rows(a, angle):
 
 
 @njit(cache=True, inline="always")
-def _sandwich(rot, inertia, v):
+def sandwich(rot, inertia, v):
     """rot inertia rot^T v: the appendage's inertia (given at zero angle) applied in B."""
-    return _mv(rot, _mv(inertia, _mtv(rot, v)))
+    return tmv(rot, tmv(inertia, tmtv(rot, v)))
 
 
 @njit(cache=True)
@@ -261,7 +262,7 @@ def _rotation_rates(t, x, env, load, rot):
     ``rot`` is B -> I as a row-major 9-tuple."""
     w = (x[X_W], x[X_W + 1], x[X_W + 2])
     jm = env[E_JM:E_JM + 9]
-    rhs_w = _lin(1.0, (load[L_TM], load[L_TM + 1], load[L_TM + 2]), -1.0, _cr(w, _mv(jm, w)))
+    rhs_w = tlin(1.0, (load[L_TM], load[L_TM + 1], load[L_TM + 2]), -1.0, tcross(w, tmv(jm, w)))
     hinged = env[E_HINGED] != 0.0
     m = np.zeros((4, 4) if hinged else (3, 3))
     f = np.empty(4 if hinged else 3)
@@ -274,36 +275,36 @@ def _rotation_rates(t, x, env, load, rot):
         return (u[0], u[1], u[2]), 0.0
     a = (env[E_AXIS], env[E_AXIS + 1], env[E_AXIS + 2])
     theta, rate = x[X_TH], x[X_THD]
-    ra = _axis_rows(a, theta)
+    ra = axis_rows(a, theta)
     ja0 = env[E_JA:E_JA + 9]
-    s = _mv(ra, (env[E_S0], env[E_S0 + 1], env[E_S0 + 2]))
+    s = tmv(ra, (env[E_S0], env[E_S0 + 1], env[E_S0 + 2]))
     d = (env[E_HINGE] + s[0], env[E_HINGE + 1] + s[1], env[E_HINGE + 2] + s[2])
     mr = env[E_MM] * env[E_MA] / (env[E_MM] + env[E_MA])
     n = env[E_N]
-    axs = _cr(a, s)
-    r_b = _mtv(rot, (np.cos(n * t), np.sin(n * t), 0.0))
-    om = _lin(1.0, w, rate, a)
-    w_rel = _lin(1.0, _cr(w, d), rate, axs)
-    kappa_w = _lin(1.0, _lin(rate, _cr(w, axs), rate * rate, _cr(a, axs)), 1.0, _cr(w, w_rel))
-    f_rel = _lin(mr * n * n, _lin(3.0 * _dot(r_b, d), r_b, -1.0, d), -mr, kappa_w)
-    t_app = _lin(1.0, _lin(1.0, (load[L_TA], load[L_TA + 1], load[L_TA + 2]), -rate, _sandwich(ra, ja0, _cr(w, a))),
-                 -1.0, _cr(om, _sandwich(ra, ja0, om)))
+    axs = tcross(a, s)
+    r_b = tmtv(rot, (np.cos(n * t), np.sin(n * t), 0.0))
+    om = tlin(1.0, w, rate, a)
+    w_rel = tlin(1.0, tcross(w, d), rate, axs)
+    kappa_w = tlin(1.0, tlin(rate, tcross(w, axs), rate * rate, tcross(a, axs)), 1.0, tcross(w, w_rel))
+    f_rel = tlin(mr * n * n, tlin(3.0 * tdot(r_b, d), r_b, -1.0, d), -mr, kappa_w)
+    t_app = tlin(1.0, tlin(1.0, (load[L_TA], load[L_TA + 1], load[L_TA + 2]), -rate, sandwich(ra, ja0, tcross(w, a))),
+                 -1.0, tcross(om, sandwich(ra, ja0, om)))
     tau_h = -env[E_K] * theta - env[E_C] * rate + load[L_TH]
-    dd = _dot(d, d)
+    dd = tdot(d, d)
     for j in range(3):
         e = (1.0 if j == 0 else 0.0, 1.0 if j == 1 else 0.0, 1.0 if j == 2 else 0.0)
-        column = _sandwich(ra, ja0, e)
+        column = sandwich(ra, ja0, e)
         for i in range(3):
             m[i, j] += column[i] - mr * d[i] * d[j] + (mr * dd if i == j else 0.0)
-    ja_a = _sandwich(ra, ja0, a)
-    b = _lin(1.0, ja_a, mr, _cr(d, axs))
+    ja_a = sandwich(ra, ja0, a)
+    b = tlin(1.0, ja_a, mr, tcross(d, axs))
     for i in range(3):
         m[i, 3] = b[i]
         m[3, i] = b[i]
-    m[3, 3] = _dot(a, ja_a) + mr * _dot(axs, axs)
-    moment = _lin(1.0, _lin(1.0, rhs_w, 1.0, t_app), 1.0, _cr(d, f_rel))
+    m[3, 3] = tdot(a, ja_a) + mr * tdot(axs, axs)
+    moment = tlin(1.0, tlin(1.0, rhs_w, 1.0, t_app), 1.0, tcross(d, f_rel))
     f[0], f[1], f[2] = moment
-    f[3] = _dot(a, t_app) + tau_h + _dot(axs, f_rel)
+    f[3] = tdot(a, t_app) + tau_h + tdot(axs, f_rel)
     u = solve_spd(m, f)
     return (u[0], u[1], u[2]), u[3]
 
@@ -320,14 +321,14 @@ def derivative(t, x, law, p, env):
     dx[1] = 0.5 * (q[0] * w[0] + q[2] * w[2] - q[3] * w[1])
     dx[2] = 0.5 * (q[0] * w[1] + q[3] * w[0] - q[1] * w[2])
     dx[3] = 0.5 * (q[0] * w[2] + q[1] * w[1] - q[2] * w[0])
-    dw, dd = _rotation_rates(t, x, env, load, _quaternion_rows(q))
+    dw, dd = _rotation_rates(t, x, env, load, quaternion_rows(q))
     dx[X_W], dx[X_W + 1], dx[X_W + 2] = dw
     dx[X_TH] = x[X_THD]
     dx[X_THD] = dd
     n = env[E_N]
     r_hat = (np.cos(n * t), np.sin(n * t), 0.0)
     rho = (x[X_R], x[X_R + 1], x[X_R + 2])
-    tidal = _lin(3.0 * n * n * _dot(r_hat, rho), r_hat, -n * n, rho)
+    tidal = tlin(3.0 * n * n * tdot(r_hat, rho), r_hat, -n * n, rho)
     mass = env[E_MM] + env[E_MA]
     for i in range(3):
         dx[X_R + i] = x[X_V + i]

@@ -15,27 +15,31 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_Q, X_W, quaternion_matrix
+from diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_Q, X_W, quaternion_rows, tdot, tmtv
 from diagnosis.effects.base import Effect, Parameter
 from diagnosis.plant import Plant
 
 
 @njit(cache=True)
 def field_direction(azimuth, elevation):
-    """Unit field direction in I from azimuth (about z, from x) and elevation (rad)."""
-    return np.array([np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)])
+    """Unit field direction (3-tuple) in I from azimuth (about z, from x) and elevation (rad)."""
+    return (np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation))
 
 
 @njit(cache=True)
 def eddy_torque(omega_body, field_body, coefficient):
-    """Eddy-current torque (N m, B) at ``omega_body`` (rad/s, B), unit field ``field_body`` (B)."""
-    return -coefficient * (omega_body - (omega_body @ field_body) * field_body)
+    """Eddy-current torque (N m, B, 3-tuple) at ``omega_body`` (rad/s, B), unit field ``field_body`` (B)."""
+    along = tdot(omega_body, field_body)
+    return (-coefficient * (omega_body[0] - along * field_body[0]), -coefficient * (omega_body[1] - along * field_body[1]),
+            -coefficient * (omega_body[2] - along * field_body[2]))
 
 
 @njit(LAW_SIGNATURE, cache=True)
 def law(t, x, p, env, load):
-    rot = quaternion_matrix(x[X_Q:X_Q + 4])
-    load[L_TM:L_TM + 3] += eddy_torque(x[X_W:X_W + 3], rot.T @ field_direction(p[1], p[2]), p[0])
+    field = tmtv(quaternion_rows(x[X_Q:X_Q + 4]), field_direction(p[1], p[2]))
+    torque = eddy_torque((x[X_W], x[X_W + 1], x[X_W + 2]), field, p[0])
+    for i in range(3):
+        load[L_TM + i] += torque[i]
 
 
 class EddyCurrentDamping(Effect):
@@ -56,9 +60,9 @@ class EddyCurrentDamping(Effect):
         return [np.array([c, 0.0, 1.2]), np.array([c, 0.0, 0.0]), np.array([c, np.pi / 2, 0.0])]
 
     def add_to_exudyn(self, builder, values, names):
-        b = field_direction(values[1], values[2])
-        builder.add_body_torque(lambda t, body, rot, omega: eddy_torque(omega, rot.T @ b, values[0]) if body == 0
-                                else np.zeros(3))
+        b = np.array(field_direction(values[1], values[2]))
+        builder.add_body_torque(lambda t, body, rot, omega: np.array(eddy_torque(omega, rot.T @ b, values[0]))
+                                if body == 0 else np.zeros(3))
 
 
 EFFECT = EddyCurrentDamping()

@@ -12,26 +12,33 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from diagnosis.dynamics import LAW_SIGNATURE, E_HINGED, E_JM, E_N, L_TA, L_TM, X_Q, X_TH, appendage_state, cross, quaternion_matrix, \
-    radial_inertial
+from diagnosis.dynamics import (LAW_SIGNATURE, E_AXIS, E_HINGED, E_JA, E_JM, E_N, L_TA, L_TM, X_Q, X_TH, axis_rows,
+                                quaternion_rows, radial_inertial, sandwich, tcross, tmtv, tmv)
 from diagnosis.effects.base import Effect, Parameter
 from diagnosis.plant import Plant
 
 
 @njit(cache=True)
-def gravity_gradient(radial_body, inertia, mean_motion):
-    """Gravity-gradient torque (N m) in the frame of ``radial_body`` (unit, -) and ``inertia`` (kg m^2)."""
-    return 3.0 * mean_motion ** 2 * cross(radial_body, inertia @ radial_body)
+def gravity_gradient(radial_body, inertia_times_radial, mean_motion):
+    """Gravity-gradient torque (N m, 3-tuple) in the frame of ``radial_body`` (unit, -), given the
+    inertia times it, J r (kg m^2)."""
+    c = tcross(radial_body, inertia_times_radial)
+    k = 3.0 * mean_motion ** 2
+    return (k * c[0], k * c[1], k * c[2])
 
 
 @njit(LAW_SIGNATURE, cache=True)
 def law(t, x, p, env, load):
-    rot = quaternion_matrix(x[X_Q:X_Q + 4])
-    r_b = rot.T @ radial_inertial(env[E_N], t)
-    load[L_TM:L_TM + 3] += gravity_gradient(r_b, env[E_JM:E_JM + 9].reshape(3, 3), p[0])
+    n = env[E_N]
+    r_b = tmtv(quaternion_rows(x[X_Q:X_Q + 4]), (np.cos(n * t), np.sin(n * t), 0.0))
+    main = gravity_gradient(r_b, tmv(env[E_JM:E_JM + 9], r_b), p[0])
+    for i in range(3):
+        load[L_TM + i] += main[i]
     if env[E_HINGED] != 0.0:
-        _, _, ja = appendage_state(env, x[X_TH])
-        load[L_TA:L_TA + 3] += gravity_gradient(r_b, ja, p[0])
+        ra = axis_rows((env[E_AXIS], env[E_AXIS + 1], env[E_AXIS + 2]), x[X_TH])
+        appendage = gravity_gradient(r_b, sandwich(ra, env[E_JA:E_JA + 9], r_b), p[0])
+        for i in range(3):
+            load[L_TA + i] += appendage[i]
 
 
 class GravityGradientTorque(Effect):
@@ -55,8 +62,10 @@ class GravityGradientTorque(Effect):
 
     def add_to_exudyn(self, builder, values, names):
         n_orbit = builder.plant.mean_motion
-        builder.add_body_torque(lambda t, body, rot, omega: gravity_gradient(
-            rot.T @ radial_inertial(n_orbit, t), builder.inertia_body(body), values[0]))
+        def torque(t, body, rot, omega):
+            r_b = rot.T @ radial_inertial(n_orbit, t)
+            return np.array(gravity_gradient(r_b, builder.inertia_body(body) @ r_b, values[0]))
+        builder.add_body_torque(torque)
 
 
 EFFECT = GravityGradientTorque()
