@@ -1,5 +1,7 @@
 """Collocation guidance of the MU net approach: the discretized dynamics against an independent
 integrator, constraints on the re-simulated path, and the paper's case-study-2 figures."""
+from dataclasses import replace
+
 import casadi as ca
 import numpy as np
 import pytest
@@ -114,7 +116,7 @@ def test_mesh_refinement_splits_the_thrust_switches_until_the_replay_follows():
     refined = ma.refine_mesh(coarse)
     assert refined.intervals == problem.intervals + (ma.SPLIT - 1) * over.sum()
     assert sum(refined.mesh) == pytest.approx(1.0, abs=1e-12)
-    solution = ma.solve(ma.replace(problem, mesh_rounds=3))
+    solution = ma.solve(replace(problem, mesh_rounds=3))
     assert solution.success and solution.extras["mesh_refinements"] >= 1
     assert ma.local_errors(solution).max() <= problem.mesh_tolerance
     report = ma.constraint_report(problem, *_replayed(solution))
