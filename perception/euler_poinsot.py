@@ -17,6 +17,8 @@ from numba import njit
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
+from perception.motion import integrated_autocorrelation_time
+
 
 @njit(cache=True)
 def _euler_rate(omega, j):
@@ -121,7 +123,9 @@ class TorqueFreeFit:
     omega0_principal_ : (3,) float  Rate at ``times[0]`` (rad/s), principal frame.
     principal_to_world0_ : (3, 3)   T->W at ``times[0]``.
     residual_rms_ : float           Weighted RMS of the attitude residuals (-; 1 when the weights are right).
-    covariance_ : (p, p) float      Parameter covariance (J^T J)^-1 scaled by the residual variance.
+    covariance_ : (p, p) float      Parameter covariance (J^T J)^-1 scaled by the residual variance
+                                    and by the residuals' correlation time.
+    correlation_time_ : float       Integrated autocorrelation time of the residuals (frames).
     """
 
     def __init__(self, moments=None, principal_to_body=None, max_step=0.01, first_span=5.0):
@@ -208,7 +212,10 @@ class TorqueFreeFit:
         dof = max(result.fun.size - result.x.size, 1)
         self.residual_rms_ = float(np.sqrt(result.fun @ result.fun / dof))
         jac = result.jac
-        self.covariance_ = np.linalg.pinv(jac.T @ jac) * self.residual_rms_**2
+        # Scan-to-scan correlated registration errors: scale the white-noise covariance by the
+        # residuals' integrated autocorrelation time.
+        self.correlation_time_ = integrated_autocorrelation_time(result.fun.reshape(-1, 3))
+        self.covariance_ = np.linalg.pinv(jac.T @ jac) * self.residual_rms_**2 * self.correlation_time_
         return self
 
     def spin_momentum_per_c(self) -> tuple[np.ndarray, np.ndarray]:

@@ -91,10 +91,34 @@ def center_of_mass_line(times, body_to_world, origin_world, com_body=None) -> Ce
     residual = design @ solution - rhs
     dof = max(len(rhs) - len(solution), 1)
     rms = float(np.sqrt(residual @ residual / dof))
-    covariance = np.linalg.pinv(design.T @ design) * rms**2
+    correlation = integrated_autocorrelation_time(residual.reshape(k, 3))
+    covariance = np.linalg.pinv(design.T @ design) * rms**2 * correlation
     if com_body is None:
         return CenterOfMassLine(solution[:3], solution[3:6], solution[6:9], times[0], rms, covariance)
     return CenterOfMassLine(np.asarray(com_body, float), solution[:3], solution[3:6], times[0], rms, covariance)
+
+
+def integrated_autocorrelation_time(residuals) -> float:
+    """Integrated autocorrelation time tau (frames, >= 1) of a residual series (k, d), pooled
+    over its d components: tau = 1 + 2 sum_lag rho(lag), summed while rho stays positive
+    (Geyer's initial positive sequence, truncated at the first non-positive lag).
+
+    Registration errors of successive scans are correlated (the same view gives the same bias
+    for a while); a least-squares covariance that assumes white errors is then too small by
+    about tau, the number of frames that carry one independent error (variance of a mean of k
+    correlated samples = sigma^2 tau / k)."""
+    r = np.asarray(residuals, float)
+    r = (r - r.mean(axis=0)).reshape(len(r), -1)
+    variance = np.sum(r * r)
+    if variance == 0.0:
+        return 1.0
+    tau = 1.0
+    for lag in range(1, len(r) // 4):
+        rho = np.sum(r[:-lag] * r[lag:]) / variance
+        if rho <= 0.0:
+            break
+        tau += 2.0 * rho
+    return float(tau)
 
 
 def attitude_sqrt_information(informations) -> np.ndarray:
@@ -112,3 +136,19 @@ def attitude_sqrt_information(informations) -> np.ndarray:
         raise NotObservable("no registration carried attitude information (all scans degenerate)")
     weights[bad] = np.mean(weights[~bad], axis=0)
     return weights
+
+
+def isotropic_attitude_weights(sqrt_information) -> np.ndarray:
+    """Per-frame isotropic weights (k, 3, 3) s_k I (1/rad) from the attitude information square
+    roots W_k (k, 3, 3): s_k = |det W_k|^(1/3), the geometric mean of the frame's precisions.
+
+    The point-to-plane information only knows the range noise. It rates the rotations about the
+    long axes of a near-symmetric body as 5 times better known than the rotation about the
+    symmetry axis, but the registration's view-dependent errors are of a similar size on all
+    axes. Weighting by the anisotropic information then lets those errors bias the fitted motion:
+    on Tang et al.'s ellipsoid the angular momentum direction came out 0.27 deg off, against
+    0.03-0.1 deg with isotropic weights (60 s of 10 Hz scans, seeds 0 and 1). A frame's overall
+    quality (how many points, how much of the surface) is kept."""
+    w = np.asarray(sqrt_information, float)
+    scale = np.abs(np.linalg.det(w)) ** (1.0 / 3.0)
+    return scale[:, None, None] * np.eye(3)
