@@ -46,6 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import open3d as o3d
+import trimesh
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
@@ -223,6 +224,14 @@ def _twist(step) -> np.ndarray:
         matrix[:3, :3] += np.sin(angle) / angle * k + (1 - np.cos(angle)) / angle**2 * (k @ k)
     matrix[:3, 3] = step[3:]
     return matrix
+
+
+def known_shape_model(mesh, voxel, seed) -> tuple[np.ndarray, np.ndarray]:
+    """Registration model of a known debris mesh (frame B = target frame): surface samples (n, 3)
+    (m) about 0.4 voxel apart (denser than the thinned scan), with their faces' exact outward normals (n, 3)."""
+    count = int(np.ceil(mesh.area / (0.4 * voxel) ** 2))
+    points, faces = trimesh.sample.sample_surface(mesh, count, seed=seed)
+    return points, mesh.face_normals[faces]
 
 
 def predict_pose(previous, before) -> np.ndarray:

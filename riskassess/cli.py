@@ -336,8 +336,10 @@ def _cmd_sweep_status(args) -> int:
 
 
 def _cmd_validate(args) -> int:
-    case = load_case(args.case)
-    print(f"{args.case}: valid case '{case.name}'")
+    from riskassess.case_kinds import load_any_case
+
+    kind, case = load_any_case(args.case)
+    print(f"{args.case}: valid {kind} case '{case.name}'")
     return 0
 
 

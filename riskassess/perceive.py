@@ -42,7 +42,7 @@ from perception.momentum import (mass_from_linear_momentum, point_masses_momentu
 from perception.motion import (NotObservable, attitude_sqrt_information, center_of_mass_line, isotropic_attitude_weights,
                                rates_from_attitudes)
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
-from perception.registration import DebrisTracker, predict_pose
+from perception.registration import DebrisTracker, known_shape_model, predict_pose
 from perception.shape import half_turn_symmetries, rotation_error
 from riskassess import results
 from riskassess.assemble import body_meshes_target_frame, model_inputs
@@ -141,14 +141,6 @@ def _scan_world(scene, meshes_world, sensor_world, sensor_to_world, t, rng):
     meshes_sensor = [((v - sensor_world) @ sensor_to_world, f) for v, f in meshes_world]
     scan = cast(scene.spec, meshes_sensor, t, rng)
     return scan.points_sensor @ sensor_to_world.T + sensor_world, scan.label
-
-
-def known_shape_model(mesh, voxel, seed) -> tuple[np.ndarray, np.ndarray]:
-    """Registration model of a known debris mesh (frame B = target frame): surface samples (n, 3)
-    (m) about 0.4 voxel apart (denser than the thinned scan), with their faces' exact outward normals (n, 3)."""
-    count = int(np.ceil(mesh.area / (0.4 * voxel) ** 2))
-    points, faces = trimesh.sample.sample_surface(mesh, count, seed=seed)
-    return points, mesh.face_normals[faces]
 
 
 def _aim_point(tracker: DebrisTracker):
