@@ -25,6 +25,20 @@ Positive = Annotated[float, Field(gt=0)]
 NonNegative = Annotated[float, Field(ge=0)]
 
 
+def check_physical_inertia(j):
+    """The inertia tensor ``j`` (3, 3) (kg m^2) of a rigid body, or ValueError: it must be
+    symmetric, positive definite and obey the triangle inequality of principal moments."""
+    m = np.asarray(j, float)
+    if not np.allclose(m, m.T, rtol=1e-9, atol=1e-9 * np.abs(m).max()):
+        raise ValueError("inertia must be symmetric")
+    eig = np.linalg.eigvalsh(m)
+    if eig.min() <= 0:
+        raise ValueError(f"inertia must be positive definite (principal moments {eig.round(6).tolist()})")
+    if eig[0] + eig[1] < eig[2] * (1 - 1e-9):
+        raise ValueError(f"principal moments {eig.round(6).tolist()} violate the triangle inequality")
+    return j
+
+
 class CaseError(ValueError):
     """A case file that cannot be used; the message names the file, the key and what is allowed."""
 
@@ -201,17 +215,7 @@ class Body(Strict):
     @field_validator("inertia")
     @classmethod
     def _physical_inertia(cls, j):
-        if j is None:
-            return j
-        m = np.asarray(j, float)
-        if not np.allclose(m, m.T, rtol=1e-9, atol=1e-9 * np.abs(m).max()):
-            raise ValueError("inertia must be symmetric")
-        eig = np.linalg.eigvalsh(m)
-        if eig.min() <= 0:
-            raise ValueError(f"inertia must be positive definite (principal moments {eig.round(6).tolist()})")
-        if eig[0] + eig[1] < eig[2] * (1 - 1e-9):
-            raise ValueError(f"principal moments {eig.round(6).tolist()} violate the triangle inequality")
-        return j
+        return j if j is None else check_physical_inertia(j)
 
 
 class Joint(Strict):

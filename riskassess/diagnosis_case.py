@@ -20,21 +20,9 @@ from typing import Annotated, Literal, Union
 import numpy as np
 from pydantic import Field, RootModel, field_validator, model_validator
 
-from riskassess.case import NonNegative, Positive, Strict, Vector3, load_model
+from riskassess.case import NonNegative, Positive, Strict, Vector3, check_physical_inertia, load_model
 
 Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3)]
-
-
-def _check_inertia(j):
-    m = np.asarray(j, float)
-    if not np.allclose(m, m.T, rtol=1e-9, atol=1e-9 * np.abs(m).max()):
-        raise ValueError("inertia must be symmetric")
-    eig = np.linalg.eigvalsh(m)
-    if eig.min() <= 0:
-        raise ValueError(f"inertia must be positive definite (principal moments {eig.round(6).tolist()})")
-    if eig[0] + eig[1] < eig[2] * (1 - 1e-9):
-        raise ValueError(f"principal moments {eig.round(6).tolist()} violate the triangle inequality")
-    return j
 
 
 class MainBody(Strict):
@@ -45,7 +33,7 @@ class MainBody(Strict):
     @field_validator("inertia")
     @classmethod
     def _physical(cls, j):
-        return _check_inertia(j)
+        return check_physical_inertia(j)
 
 
 class Appendage(Strict):
@@ -57,7 +45,7 @@ class Appendage(Strict):
     @field_validator("inertia")
     @classmethod
     def _physical(cls, j):
-        return _check_inertia(j)
+        return check_physical_inertia(j)
 
 
 class Hinge(Strict):
