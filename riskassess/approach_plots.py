@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from riskassess import results
-from riskassess.report.plotting import legend, panels, plt
+from riskassess.report.plotting import legend, panels, plt, write_png
 
 
 def trajectory_figure(answer: dict, arrays: dict):
@@ -54,14 +53,8 @@ def controls_figure(answer: dict, arrays: dict):
 
 def write_plots(out, answer: dict, arrays: dict) -> list[str]:
     """approach_trajectory.png and approach_controls.png into ``out``; returns their names."""
-    import io
-
     names = []
     for name, make in (("approach_trajectory.png", trajectory_figure), ("approach_controls.png", controls_figure)):
-        fig = make(answer, arrays)
-        buffer = io.BytesIO()
-        fig.savefig(buffer, format="png", dpi=120)
-        plt.close(fig)
-        results.atomic_write_bytes(out / name, buffer.getvalue())
+        write_png(make(answer, arrays), out / name, dpi=120)
         names.append(name)
     return names

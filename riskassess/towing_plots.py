@@ -2,20 +2,15 @@
 identification's convergence and data-versus-fit comparison."""
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
 
-from riskassess.report.plotting import STYLE, legend, panels, plt
-from riskassess.results import atomic_write_bytes
+from riskassess.report.plotting import STYLE, legend, panels, plt, write_png
 
 
 def _save(fig, path: Path) -> None:
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=130)
-    plt.close(fig)
-    atomic_write_bytes(Path(path), buffer.getvalue())
+    write_png(fig, path, dpi=130)
 
 
 def _tow_panels(axes, s, label, style="-"):

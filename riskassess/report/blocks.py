@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import base64
-import io
 from dataclasses import dataclass, field
 
 #: Resolution of embedded figures (dots per inch): sharp on screen and in print at 17 cm width.
@@ -28,12 +27,9 @@ class Figure:
     @classmethod
     def from_matplotlib(cls, id: str, caption: str, fig) -> Figure:
         """Render and close a matplotlib figure."""
-        import matplotlib.pyplot as plt
+        from riskassess.report.plotting import png_bytes
 
-        buffer = io.BytesIO()
-        fig.savefig(buffer, format="png", dpi=FIGURE_DPI)
-        plt.close(fig)
-        return cls(id, caption, base64.b64encode(buffer.getvalue()).decode("ascii"))
+        return cls(id, caption, base64.b64encode(png_bytes(fig, FIGURE_DPI)).decode("ascii"))
 
 
 @dataclass

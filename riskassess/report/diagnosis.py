@@ -5,13 +5,11 @@ The same figure builders write the stage's PNG files and the report's embedded f
 """
 from __future__ import annotations
 
-import io
 
 import numpy as np
 
-from riskassess import results
 from riskassess.report.blocks import Figure, Note, Section, Table
-from riskassess.report.plotting import STYLE, legend, panels
+from riskassess.report.plotting import STYLE, legend, panels, write_png
 
 #: Channels shown in the time-series figures: the ones with the largest residual before.
 SHOWN_CHANNELS = 6
@@ -115,10 +113,7 @@ def write_figures(out, answer: dict, arrays: dict) -> list[str]:
     names = []
     with plt.rc_context(STYLE):
         for name, _, _, fig in _figures(answer, arrays):
-            buffer = io.BytesIO()
-            fig.savefig(buffer, format="png", dpi=150)
-            plt.close(fig)
-            results.atomic_write_bytes(out / name, buffer.getvalue())
+            write_png(fig, out / name, dpi=150)
             names.append(name)
     return names
 

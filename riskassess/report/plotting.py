@@ -4,10 +4,15 @@ Section builders run inside ``matplotlib.pyplot.rc_context(STYLE)`` (see :mod:`.
 """
 from __future__ import annotations
 
+import io
+from pathlib import Path
+
 import matplotlib
 
 matplotlib.use("Agg")  # reports are written headless
 import matplotlib.pyplot as plt  # noqa: E402
+
+from riskassess.results import atomic_write_bytes  # noqa: E402
 
 #: Figure width fits an A4 page with 2 cm margins (17 cm); fonts stay readable at that size.
 WIDTH_IN = 6.7
@@ -15,6 +20,19 @@ STYLE = {"font.size": 8.5, "axes.titlesize": 9, "axes.labelsize": 8.5, "legend.f
          "xtick.labelsize": 8, "ytick.labelsize": 8, "axes.grid": True, "grid.alpha": 0.3, "lines.linewidth": 1.0,
          "legend.framealpha": 0.85}
 COMPONENT_COLORS = ("tab:blue", "tab:orange", "tab:green")
+
+
+def png_bytes(fig, dpi: float) -> bytes:
+    """Render a matplotlib figure as PNG at ``dpi`` (dots per inch) and close it."""
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=dpi)
+    plt.close(fig)
+    return buffer.getvalue()
+
+
+def write_png(fig, path, dpi: float) -> None:
+    """Render a figure as PNG, close it, and write it to ``path`` atomically (a reader never sees half a file)."""
+    atomic_write_bytes(Path(path), png_bytes(fig, dpi))
 
 
 def panels(n: int, height_in: float = 2.0, sharex: bool = True):
