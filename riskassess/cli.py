@@ -361,11 +361,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "track the tumbling debris by LiDAR, simulate the net collision, estimate mass and inertia",
                         "case file (TOML) with [perception] and [chaser]",
                         "print the estimates (mass_estimate, inertia_estimate, errors, timings) as JSON")
-    tow = sub.add_parser("tow", help="lower-order towing run of a towing case (chaser, tethers, net-wrapped debris)")
-    tow.add_argument("case", help="towing case file (TOML), e.g. cases/zenit2_towing.toml")
-    tow.add_argument("--out", help="output folder (default runs/<case name>)")
-    tow.add_argument("--json", action="store_true", help="print the summary as JSON")
-    tow.set_defaults(func=_cmd_tow)
+    _case_command(sub, "tow", _cmd_tow, "lower-order towing run of a towing case (chaser, tethers, net-wrapped debris)",
+                  "towing case file (TOML), e.g. cases/zenit2_towing.toml", "print the summary as JSON")
     diagnose = sub.add_parser("diagnose", help="compare a simulated scenario with measured data, name the missing "
                                                "effect, fit it and report the prediction gain")
     diagnose.add_argument("case", help="diagnosis case file (TOML, kind tumbling_rigid or hinged_appendage)")
@@ -376,21 +373,18 @@ def build_parser() -> argparse.ArgumentParser:
     diagnose.add_argument("--noise", action="append", default=[], metavar="CHANNEL=SIGMA",
                           help="1-sigma noise of a channel (its SI unit) instead of the estimate from the data")
     diagnose.set_defaults(func=_cmd_diagnose)
-    ident = sub.add_parser("identify", help="identify the sub-tether parameters of the lower-order towing model")
-    ident.add_argument("case", help="towing case file (TOML) with [identification]")
+    ident = _case_command(sub, "identify", _cmd_identify,
+                          "identify the sub-tether parameters of the lower-order towing model",
+                          "towing case file (TOML) with [identification]",
+                          "print s, cost, optimizer, wall_s and every run as JSON", "runs/<case name>_identify")
     ident.add_argument("--benchmark", action="store_true", help="Sec. 4.3 benchmark: data from the model itself "
                        "with identification.benchmark_truth at the training rates")
-    ident.add_argument("--out", help="output folder (default runs/<case name>_identify)")
-    ident.add_argument("--json", action="store_true", help="print s, cost, optimizer, wall_s and every run as JSON")
-    ident.set_defaults(func=_cmd_identify)
-    approach = sub.add_parser("approach", help="optimal approach of the net carried by two maneuverable units "
-                              "(direct collocation, IPOPT); exit code 4 when not solved or a constraint fails")
-    approach.add_argument("case", help="approach case file (TOML), e.g. cases/approach_mu_min_time.toml")
-    approach.add_argument("--out", help="output folder (default runs/<case name>)")
-    approach.add_argument("--json", action="store_true", help="print final_time, fuel_kg, constraints_satisfied, "
-                          "solve_s and the checks as JSON")
+    approach = _case_command(sub, "approach", _cmd_approach,
+                             "optimal approach of the net carried by two maneuverable units (direct collocation, "
+                             "IPOPT); exit code 4 when not solved or a constraint fails",
+                             "approach case file (TOML), e.g. cases/approach_mu_min_time.toml",
+                             "print final_time, fuel_kg, constraints_satisfied, solve_s and the checks as JSON")
     approach.add_argument("--replay", action="store_true", help="also replay the path with the 3-D Exudyn net")
-    approach.set_defaults(func=_cmd_approach)
     report = sub.add_parser("report", help="write report.html (self-contained) and report.pdf into a run folder")
     report.add_argument("run_dir", help="run folder written by 'riskassess run'")
     report.add_argument("--no-pdf", action="store_true", help="HTML only")
@@ -432,15 +426,21 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _simulation_command(sub, name, func, help_text, case_help, json_help) -> None:
-    """A command that simulates a case into a run folder (run, assess)."""
+def _case_command(sub, name, func, help_text, case_help, json_help, out_default="runs/<case name>"):
+    """A command that runs a stage on one case file into an output folder; returns its parser."""
     parser = sub.add_parser(name, help=help_text)
     parser.add_argument("case", help=case_help)
-    parser.add_argument("--out", help="output folder (default runs/<case name>)")
+    parser.add_argument("--out", help=f"output folder (default {out_default})")
     parser.add_argument("--json", action="store_true", help=json_help)
+    parser.set_defaults(func=func)
+    return parser
+
+
+def _simulation_command(sub, name, func, help_text, case_help, json_help) -> None:
+    """A command that simulates a case into a run folder (run, assess, perceive)."""
+    parser = _case_command(sub, name, func, help_text, case_help, json_help)
     parser.add_argument("--report", action="store_true", help="also write report.html and report.pdf")
     parser.add_argument("--vtk", action="store_true", help="also export VTK files (RUN_DIR/vtk/impact.pvd)")
-    parser.set_defaults(func=func)
 
 
 def main(argv=None) -> int:
