@@ -36,10 +36,11 @@ def test_costs_vanish_on_the_data_and_grow_off_it(reduced_benchmark):
 def small_benchmark():
     """Sec. 4.3 at unit-test size: one Table 3 rate (20.44 deg/s), the first 35 s of towing (the
     sub-tethers engage at ~28 s and pull for the rest), a box around s_true (1/5 to 1/2 of eq. 24's
-    ranges), PSO with 12 particles x 10 generations polished by 150 pattern-search evaluations."""
+    ranges), PSO with 12 particles x 10 generations polished by 300 pattern-search evaluations (150 once
+    left c_ST 1.1 % off in CI)."""
     case = load_model(CASE, TowingCase)
     optimizers = case.identification.optimizers.model_copy(update=dict(
-        swarm_size=12, pso_generations=10, polish_evaluations=150, polish_delta=0.02))
+        swarm_size=12, pso_generations=10, polish_evaluations=300, polish_delta=0.02))
     ident = case.identification.model_copy(update=dict(
         lower_bounds=[1.5, 6.0, 1.5, 0.6], upper_bounds=[2.5, 8.0, 2.5, 1.0], optimizers=optimizers))
     case = case.model_copy(update=dict(identification=ident))
