@@ -66,7 +66,7 @@ def point_force(x, v, points, point_velocities, stiffness, damping, rest, force,
 
 @njit(cache=True)
 def implicit_point_step(x_hat, v_hat, beta, mass, reference, mu, points, point_velocities, stiffness, damping, rest,
-                        v_guess):
+                        v_guess, external):
     """Solve :math:`m(v - \\hat v) = \\beta (F(\\hat x + \\beta v, v) + m g(\\hat x + \\beta v))` for P's new
     velocity (Newton, the tether Jacobians of :func:`point_force`; the gravity gradient, 1e-6 1/s^2,
     is left out of the Newton matrix only). ``reference`` is P's reference position (absolute, m)
@@ -77,6 +77,8 @@ def implicit_point_step(x_hat, v_hat, beta, mass, reference, mu, points, point_v
     for _ in range(MAX_ITERATIONS):
         x = x_hat + beta * v
         point_force(x, v, points, point_velocities, stiffness, damping, rest, force, jac_x, jac_v)
+        for a in range(3):
+            force[a] += external[a]   # other loads on P, held over the step (e.g. a diagnosis effect)
         if mu != 0.0:
             gx, gy, gz = two_body_acceleration_xyz(reference[0] + x[0], reference[1] + x[1], reference[2] + x[2], mu)
             force[0] += mass * gx
@@ -106,9 +108,10 @@ def initial_point_state(velocity, time) -> np.ndarray:
 
 
 @njit(cache=True)
-def advance_point(state, t, step, mass, reference, mu, points, point_velocities, stiffness, damping, rest):
+def advance_point(state, t, step, mass, reference, mu, points, point_velocities, stiffness, damping, rest, external):
     """Advance P's ``state`` (:data:`STATE_SIZE`) to time ``t`` (s) if ``t`` is a new step: BDF2 when
-    the previous step had the same length ``step``, backward Euler otherwise (first step)."""
+    the previous step had the same length ``step``, backward Euler otherwise (first step). ``external``
+    (3,) is a further force on P (N, inertial) held over the step."""
     h = t - state[TIME]
     if h <= 0.5 * step:
         return
@@ -120,7 +123,7 @@ def advance_point(state, t, step, mass, reference, mu, points, point_velocities,
     else:
         beta, x_hat, v_hat = h, x_n, v_n
     x, v = implicit_point_step(x_hat, v_hat, beta, mass, reference, mu, points, point_velocities, stiffness, damping,
-                               rest, v_n)
+                               rest, v_n, external)
     state[X_PREVIOUS:X_PREVIOUS + 3], state[V_PREVIOUS:V_PREVIOUS + 3] = x_n, v_n
     state[X_N:X_N + 3], state[V_N:V_N + 3] = x, v
     state[TIME], state[HISTORY] = t, 1.0

@@ -173,7 +173,7 @@ def accelerations(v, force, masses, inertia, inverse_inertia):
 # One float array holds the whole model, the thrust law's state and the work buffers, so that a
 # step costs one call from Python (numba's dispatch costs ~0.2 us per argument).
 (W_N_ATTACH, W_KIND, W_ALONG_Z, W_STEP, W_MU, W_THRUST_PARAMS, W_N_THRUST_PARAMS, W_THRUST_STATE, W_N_THRUST_STATE,
- W_ATTACH, W_DIAG, W_FORCE, W_ACCEL, W_POINT) = range(14)
+ W_ATTACH, W_DIAG, W_FORCE, W_ACCEL, W_POINT, W_EXTRA) = range(15)
 W_REFERENCE, W_MASSES, W_INERTIA, W_INVERSE, W_ATTACH_CHASER, W_TETHER, W_ATTITUDE, W_END = (
     16, 25, 28, 46, 64, 67, 73, 81)
 
@@ -181,13 +181,17 @@ W_REFERENCE, W_MASSES, W_INERTIA, W_INVERSE, W_ATTACH_CHASER, W_TETHER, W_ATTITU
 def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, attitude, thrust_kind,
          thrust_along_body_z, thrust_params, thrust_state, step, point_velocity, start_time) -> np.ndarray:
     """The packed model (see :func:`towing_forces` for the meaning of each part) with P's integrator
-    state at ``start_time`` (s), P moving with ``point_velocity`` (m/s, inertial)."""
+    state at ``start_time`` (s), P moving with ``point_velocity`` (m/s, inertial). The last section
+    (:data:`W_EXTRA`, zero here) holds further generalized forces (15,) in the kernel layout that
+    other stages set between steps (:func:`extra_forces`; the diagnosis' effects): added to the
+    bodies' forces, and P's entries act inside its implicit step."""
     n = len(attach_debris)
-    sizes = [3 * n, len(thrust_params), len(thrust_state), ST_TENSION + n, N_COORDINATES, N_COORDINATES, STATE_SIZE]
+    sizes = [3 * n, len(thrust_params), len(thrust_state), ST_TENSION + n, N_COORDINATES, N_COORDINATES, STATE_SIZE,
+             N_COORDINATES]
     offsets = W_END + np.concatenate([[0], np.cumsum(sizes)])
     work = np.zeros(offsets[-1])
-    work[:14] = [n, thrust_kind, float(thrust_along_body_z), step, mu, offsets[1], len(thrust_params), offsets[2],
-                 len(thrust_state), offsets[0], offsets[3], offsets[4], offsets[5], offsets[6]]
+    work[:15] = [n, thrust_kind, float(thrust_along_body_z), step, mu, offsets[1], len(thrust_params), offsets[2],
+                 len(thrust_state), offsets[0], offsets[3], offsets[4], offsets[5], offsets[6], offsets[7]]
     work[offsets[6]:offsets[7]] = initial_point_state(point_velocity, start_time)
     inertia = np.asarray(inertia, float)
     work[W_REFERENCE:W_END] = np.concatenate([np.ravel(reference), masses, inertia.ravel(), np.linalg.inv(inertia).ravel(),
@@ -239,7 +243,7 @@ def _advance_connection_point(q, v, t, work, attach):
         stiffness, damping, rest = np.full(n + 1, tether[K_ST]), np.full(n + 1, tether[C_ST]), np.full(n + 1, tether[L_ST])
         stiffness[0], damping[0], rest[0] = tether[K_MT], tether[C_MT], tether[L_MT]
         advance_point(state, t, step, work[W_MASSES], reference[0], work[W_MU], points, velocities,
-                      stiffness, damping, rest)
+                      stiffness, damping, rest, extra_forces(work)[0:3])
     q[0:3] = state[X_N:X_N + 3]
     v[0:3] = state[V_N:V_N + 3]
     v_eval[0:3] = state[V_N:V_N + 3]
@@ -262,7 +266,17 @@ def packed_forces(q, v, t, work, advance):
                   work[W_TETHER:W_ATTITUDE], work[W_MU], work[W_ATTITUDE:W_END], int(work[W_KIND]),
                   work[W_ALONG_Z] > 0.0, _section(work, W_THRUST_PARAMS, W_N_THRUST_PARAMS),
                   _section(work, W_THRUST_STATE, W_N_THRUST_STATE), work[W_STEP], advance, force, diag)
+    extra = extra_forces(work)
+    for i in range(3, N_COORDINATES):
+        force[i] += extra[i]
     return force, diag
+
+
+@njit(cache=True, inline="always")
+def extra_forces(work):
+    """The packed model's further generalized forces (15,), kernel layout (a view: set them in place)."""
+    start = int(work[W_EXTRA])
+    return work[start:start + N_COORDINATES]
 
 
 @njit(cache=True)
