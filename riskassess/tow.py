@@ -65,7 +65,8 @@ def connection_point_start(debris_com, debris_to_inertial, attach_body, toward, 
     return debris_com + brentq(reach, nearest, span, xtol=1e-12) * axis
 
 
-def _thrust_law(case: TowingCase, tether, z0, z_rate0):
+def thrust_law(case: TowingCase, tether, z0, z_rate0):
+    """The case's thrust law: (kind code, parameters, initial state) for elongation z0 (m), rate z_rate0 (m/s)."""
     kind = KINDS[case.thrust.kind]
     th = case.thrust
     if kind == 0:
@@ -95,9 +96,11 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
     omega = np.array([ch.angular_velocity_body, rate * np.asarray(de.spin_axis_body) / np.linalg.norm(de.spin_axis_body)])
     a_point = com[0] + rot[0] @ np.asarray(ch.tether_attachment_body, float)
     p0 = connection_point_start(com[1], rot[1], attach_debris, a_point, s[1])
+    if case.sub_tethers.connection_point_start_inertial is not None:
+        p0 = np.asarray(case.sub_tethers.connection_point_start_inertial, float)
     v_p0 = np.asarray(de.velocity_inertial) + rot[1] @ np.cross(omega[1], rot[1].T @ (p0 - com[1]))
     z0 = np.linalg.norm(p0 - a_point) - mt.natural_length
-    kind, params, state = _thrust_law(case, tether, z0, 0.0)
+    kind, params, state = thrust_law(case, tether, z0, 0.0)
     model = TowingModel(
         masses=masses, inertia_body=np.array([np.diag(ch.principal_inertia), np.diag(de.principal_inertia)], float),
         attach_chaser_body=np.asarray(ch.tether_attachment_body, float), attach_debris_body=attach_debris,
@@ -167,8 +170,9 @@ def summarize(case: TowingCase, result, s) -> dict:
 
 
 def tow_case(case_path: str | Path, out_dir: str | Path, case: TowingCase | None = None) -> dict:
-    """Load the case (unless given), run the lower-order tow in Exudyn, write the run folder;
-    return the summary."""
+    """Load the case (unless given), run the lower-order tow in Exudyn (or the full-net tow when
+    ``simulation.model = "full-net"``, :mod:`riskassess.tow_fullnet`), write the run folder; return
+    the summary."""
     case_path = Path(case_path)
     case = case or load_model(case_path, TowingCase)
     model = towing_model(case)
@@ -180,13 +184,23 @@ def tow_case(case_path: str | Path, out_dir: str | Path, case: TowingCase | None
                 "files": ["case.toml"], "software": software_versions()}
     shutil.copyfile(case_path, out / "case.toml")
     results.atomic_write_json(out / "manifest.json", manifest)
+    if case.simulation.model == "full-net":
+        from riskassess.tow_fullnet import run_full_net
+
+        summary, series = run_full_net(case, out)
+        return _finish(case, out, manifest, series, summary, ["towing.json", "towing.npz", "net.npz", "tow.png"])
     result = run_exudyn(model)
     summary = summarize(case, result, case_decision_vector(case))
     results.atomic_write_npz(out / "towing.npz", result.series())
     results.atomic_write_json(out / "towing.json", summary)
+    return _finish(case, out, manifest, result.series(), summary, ["towing.json", "towing.npz", "tow.png"])
+
+
+def _finish(case, out, manifest, series, summary, files) -> dict:
+    """Plot, mark the run folder complete with ``files``, return ``summary``."""
     from riskassess.towing_plots import plot_tow
 
-    plot_tow(result.series(), out / "tow.png", case.name)
-    manifest.update(status="complete", files=manifest["files"] + ["towing.json", "towing.npz", "tow.png"])
+    plot_tow(series, out / "tow.png", case.name)
+    manifest.update(status="complete", files=manifest["files"] + files)
     results.atomic_write_json(out / "manifest.json", manifest)
     return summary

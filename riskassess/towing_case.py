@@ -65,6 +65,10 @@ class SubTethers(Strict):
     damping: NonNegative = Field(description="c_ST (N s/m); s3 = log10 c_ST.")
     connection_mass_fraction: Annotated[float, Field(gt=0, le=1)] = Field(
         description="m_P / m_net (-); s4. The rest of the net mass goes to the debris.")
+    connection_point_start_inertial: Vector3 | None = Field(
+        None, description="Initial position of P (m, inertial), moving with the debris; default: on the line from the "
+                          "debris CoM to the main tether's chaser end where the farthest sub-tether is at its natural "
+                          "length. The full-net identification sets it to the net's central node at 25 s (Sec. 4.1).")
 
 
 class Thrust(Strict):
@@ -108,6 +112,9 @@ class TowSimulation(Strict):
                                                                     "below the connection point's stability limit.")
     output_interval: Positive = Field(description="Time between samples, Delta t_save (s).")
     mu: Positive = Field(3.986e14, description="Earth's gravitational parameter (m^3/s^2), Sec. 2.1.")
+    model: Literal["lower-order", "full-net"] = Field(
+        "lower-order", description="Model 'riskassess tow' runs: the lower-order model (Sec. 2.2) or the full net "
+                                   "wrapped around the debris ([full_net], Sec. 2.1; docs/towing.md).")
 
     @model_validator(mode="after")
     def _times(self):
@@ -169,6 +176,57 @@ class Identification(Strict):
         return self
 
 
+class FullNetContact(Strict):
+    stiffness: Positive = Field(description="Hertz k_n of node-debris contact (N/m^exponent).")
+    exponent: Annotated[float, Field(ge=1, le=2)] = Field(1.5, description="Hertz exponent n (-).")
+    hunt_crossley_alpha: NonNegative = Field(description="Hunt-Crossley alpha (s/m); d_n = 1.5 alpha k_n.")
+    mu_static: NonNegative = Field(description="Static friction coefficient (-), Hollar's law.")
+    mu_kinetic: NonNegative = Field(description="Kinetic friction coefficient (-).")
+    transition_speed: Positive = Field(description="Slip speed V_t0 where friction reaches mu_static (m/s).")
+
+
+class FullNet(Strict):
+    """The wrapped net of the full-net towing model (multibody/net_towing.py; docs/towing.md)."""
+
+    start: Literal["wrapped", "capture"] = Field(
+        "wrapped", description="'wrapped': prepared wrapped state at simulation.start_time; 'capture': net ejected at "
+                               "t = 0 (not built: rejected with a message).")
+    side_length: Positive = Field(description="Side of the square net (m); (nodes_per_side - 1) sections of l_net,0.")
+    nodes_per_side: Annotated[int, Field(ge=5, le=41)] = Field(description="Nodes along a side (-), odd so that a central node exists.")
+    corner_mass: Positive = Field(description="Each of the four corner masses (kg), part of net_mass.")
+    node_radius: Positive = Field(description="Contact radius of a net node (m).")
+    corner_radius: Positive = Field(description="Contact radius of a corner mass (m).")
+    thread_axial_rigidity: Positive = Field(description="EA of a thread (N); a section of length l gets EA/l (N/m).")
+    thread_damping: NonNegative = Field(description="Axial damping of a thread section (N s/m).")
+    closing_axial_rigidity: Positive = Field(description="EA of the closing thread (N).")
+    closed_fraction: Annotated[float, Field(gt=0, le=1)] = Field(
+        description="Natural length of the closed loop over its open length (-).")
+    closing_time: NonNegative = Field(15.0, description="Closing-mechanism activation; the main tether gets its "
+                                                        "stiffness and damping from then on (s), Sec. 2.1, 4.1.")
+    main_tether_slack: NonNegative = Field(0.0, description="How much shorter than l_MT,0 the main tether starts in "
+                                                            "the wrapped state (m); 0: at its natural length.")
+    step: Annotated[float, Field(gt=0, le=0.02)] = Field(description="VelocityVerlet step of chaser and debris (s).")
+    substeps: Annotated[int, Field(ge=1, le=1000)] = Field(description="Net sub-steps per step (-); the net's step is "
+                                                                      "step/substeps (docs/towing.md: step study).")
+    net_output_interval: Positive = Field(1.0, description="Time between net snapshots in net.npz (s).")
+    contact: FullNetContact
+    identification_end_time: Positive | None = Field(
+        None, description="End of the full-net and lower-order runs of 'riskassess identify' (s); default simulation.end_time.")
+    identification_training_runs: Annotated[int, Field(ge=1)] | None = Field(
+        None, description="Use only the first k training rates (-); default all.")
+    identification_validation_runs: Annotated[int, Field(ge=1)] | None = Field(
+        None, description="Use only the first k validation rates (-); default all.")
+
+    @model_validator(mode="after")
+    def _odd(self):
+        if self.nodes_per_side % 2 == 0:
+            raise ValueError(f"nodes_per_side must be odd (the main tether needs a central node). Got {self.nodes_per_side}")
+        if self.start == "capture":
+            raise ValueError("start = 'capture' (net ejected from the chaser at t = 0) is not built; use 'wrapped' "
+                             "(docs/towing.md)")
+        return self
+
+
 class TowingCase(Strict):
     name: str
     description: str = ""
@@ -183,9 +241,15 @@ class TowingCase(Strict):
     attitude_control: AttitudeControl
     rates: Rates
     identification: Identification
+    full_net: FullNet | None = None
 
     @model_validator(mode="after")
     def _mrac_given(self):
         if self.thrust.kind != "ramp" and self.mrac is None:
             raise ValueError(f"thrust.kind = '{self.thrust.kind}' needs an [mrac] section")
+        if self.simulation.model == "full-net" and self.full_net is None:
+            raise ValueError("simulation.model = 'full-net' needs a [full_net] section")
+        if self.full_net is not None and 4 * self.full_net.corner_mass >= self.net_mass:
+            raise ValueError(f"full_net.corner_mass must be < net_mass / 4 ({self.net_mass / 4:g} kg). "
+                             f"Got {self.full_net.corner_mass:g} instead")
         return self

@@ -1,0 +1,336 @@
+"""Full-net towing model in Exudyn: the chaser and the Zenit-2 debris as rigid bodies, the wrapped
+net (lumped masses, tension-only threads, closing loop, contact with friction on the debris) and the
+main tether from the net's central node to the chaser (Boonrath, Singh & Botta 2024, Sec. 2.1).
+
+As in the lower-order model (:mod:`multibody.towing`), chaser and debris are Exudyn nodes
+(``NodeRigidBodyRotVecLG``, explicit VelocityVerlet, Lie-group rotations) and one
+``ObjectGenericODE2`` spanning both carries every force through its force user function; the light,
+stiff net is the sub-system advanced inside that function, sub-cycled over each step
+(:mod:`multibody.net_towing_kernel`: why and how, and the consistency argument). Thrust law and
+attitude control are the lower-order model's (:mod:`control.thrust`, :mod:`control.attitude`).
+Frame: Earth-centred inertial; angular velocities in the body frames.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import exudyn as exu
+import numpy as np
+from exudyn.itemInterface import NodeRigidBodyRotVecLG, ObjectGenericODE2, ObjectRigidBody
+from numba import njit
+from scipy.spatial.transform import Rotation
+
+from multibody.impact import explicit_settings, solver_chatter_to_stderr
+from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING, ACC_CONTACT_F, ACC_CONTACTS,
+                                         ACC_DEBRIS_F, ACC_DEBRIS_T, ACC_EXTERNAL, ACC_SIZE, ACC_TENSION, D_CLOSING,
+                                         D_CONTACT_F, D_CONTACTS, D_ELONGATION, D_RATE, D_SIZE, D_TENSION, advance_net,
+                                         body_gravity, chaser_actuation, net_forces)
+from multibody.net_wrap import TowingNet
+
+#: Layout of the run state ``clock``: net time (s), external impulse (3, N s) since the start.
+CLOCK_TIME, CLOCK_IMPULSE, CLOCK_SIZE = 0, 1, 4
+
+
+@dataclass
+class FullNetModel:
+    """Everything one full-net run needs (SI units; inertial frame unless ``_body``).
+
+    Attributes
+    ----------
+    net : TowingNet                    Topology, closing loop; its thread arrays are the state's (copied).
+    node_positions, node_velocities : (n, 3) float  Nodes at ``start_time`` (m, absolute; m/s).
+    masses : (2,) float                m_C, m_D (kg).
+    inertia_body : (2, 3, 3) float     J_C, J_D (kg m^2), body frames.
+    attach_chaser_body : (3,) float    r_A/C (m), chaser frame.
+    main_tether : (3,) float           k_MT (N/m), c_MT (N s/m), l_MT0 (m); zero stiffness before ``closing_time``.
+    geometry : (3,) float              Debris cylinder: radius (m), half length (m), axial centre z_body (m).
+    contact_law : (6,) float           k_n, n, d_n, mu_s, mu_k, V_t0 (:mod:`multibody.net_towing_kernel`).
+    mu : float                         (m^3/s^2).
+    attitude, thrust_kind, thrust_along_body_z, thrust_params, thrust_state : as :class:`multibody.towing.TowingModel`.
+    positions, velocities : (2, 3) float    Chaser and debris CoM (m) and velocity (m/s) at ``start_time``.
+    body_to_inertial : (2, 3, 3) float
+    omega_body : (2, 3) float          (rad/s), body frames.
+    start_time, end_time, step, output_interval, net_output_interval, closing_time : float (s)
+    substeps : int                     Net sub-steps per body step.
+    """
+
+    net: TowingNet
+    node_positions: np.ndarray
+    node_velocities: np.ndarray
+    masses: np.ndarray
+    inertia_body: np.ndarray
+    attach_chaser_body: np.ndarray
+    main_tether: np.ndarray
+    geometry: np.ndarray
+    contact_law: np.ndarray
+    mu: float
+    attitude: np.ndarray
+    thrust_kind: int
+    thrust_along_body_z: bool
+    thrust_params: np.ndarray
+    thrust_state: np.ndarray
+    positions: np.ndarray
+    velocities: np.ndarray
+    body_to_inertial: np.ndarray
+    omega_body: np.ndarray
+    start_time: float
+    end_time: float
+    step: float
+    substeps: int
+    output_interval: float
+    net_output_interval: float
+    closing_time: float = 15.0
+    inverse_inertia_debris: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        self.inverse_inertia_debris = np.linalg.inv(self.inertia_body[1])
+
+    @property
+    def n_steps(self) -> int:
+        return int(round((self.end_time - self.start_time) / self.step))
+
+    @property
+    def every(self) -> int:
+        return max(1, int(round(self.output_interval / self.step)))
+
+    @property
+    def net_every(self) -> int:
+        return max(1, int(round(self.net_output_interval / self.step)))
+
+    @property
+    def total_mass(self) -> float:
+        return float(self.masses.sum() + self.net.topology.masses.sum())
+
+
+@njit(cache=True)
+def _bodies(q, v, reference_c, reference_d):
+    """(2, 12): per body CoM (absolute), rotation vector, CoM velocity, angular velocity (body)."""
+    out = np.empty((2, 12))
+    for b, ref in ((0, reference_c), (1, reference_d)):
+        out[b, 0:3] = ref + q[6 * b:6 * b + 3]
+        out[b, 3:6] = q[6 * b + 3:6 * b + 6]
+        out[b, 6:12] = v[6 * b:6 * b + 6]
+    return out
+
+
+@njit(cache=True)
+def step_forces(q, v, t, advance, x, xv, clock, masses, radii, threads, rest, stiffness, damping, reference, mu, central,
+                main_tether, attach_c, body_masses, inertia, inverse_inertia_d, geometry, law, n_sub, step, attitude,
+                thrust_kind, along_z, thrust_params, thrust_state, body_reference, acc, diag, f, work):
+    """Generalized forces (12,) on chaser and debris at time ``t`` (s, absolute) for Exudyn's object.
+    If ``advance``, the net (``x`` relative to ``reference``, ``xv``) is first sub-cycled from
+    ``clock[CLOCK_TIME]`` to ``t`` (:func:`multibody.net_towing_kernel.advance_net`) and the bodies get
+    the step's mean reactions; otherwise (the solver's initial evaluation, output samples) the
+    reactions at the current state. Thrust, attitude torque and gravity are evaluated at ``t``."""
+    bodies = _bodies(q, v, body_reference[0], body_reference[1])
+    force = np.zeros(12)
+    if advance:
+        h_step = t - clock[CLOCK_TIME]
+        tension, z, rate = advance_net(x, xv, clock[CLOCK_TIME], t, n_sub, masses, radii, threads, rest, stiffness,
+                                       damping, reference, mu, central, main_tether, attach_c, bodies, body_masses[1],
+                                       inverse_inertia_d, geometry, law, f, acc, work)
+        clock[CLOCK_TIME] = t
+        clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3] += acc[ACC_EXTERNAL:ACC_EXTERNAL + 3]
+        scale = 1.0 / h_step
+    else:
+        h_step, scale = step, 1.0
+        rot_c = rotation_matrix_from_rotation_vector(bodies[0, 3:6])
+        rot_d = rotation_matrix_from_rotation_vector(bodies[1, 3:6])
+        arm = rot_c @ attach_c
+        a_point = bodies[0, 0:3] + arm
+        a_velocity = bodies[0, 6:9] + rot_c @ np.cross(bodies[0, 9:12], attach_c)
+        acc[:] = 0.0
+        tension, z, rate = net_forces(x, xv, masses, radii, threads, rest, stiffness, damping, reference, mu, central,
+                                      main_tether, a_point, a_velocity, bodies[0, 0:3], bodies[1, 0:3] - reference,
+                                      rot_d, bodies[1, 6:9], rot_d @ bodies[1, 9:12], body_masses[1], inverse_inertia_d,
+                                      geometry, law, 1.0, f, acc, work)
+    rot_c = rotation_matrix_from_rotation_vector(bodies[0, 3:6])
+    rot_d = rotation_matrix_from_rotation_vector(bodies[1, 3:6])
+    force[0:3] = scale * acc[ACC_CHASER_F:ACC_CHASER_F + 3]
+    force[3:6] = rot_c.T @ (scale * acc[ACC_CHASER_T:ACC_CHASER_T + 3])
+    force[6:9] = scale * acc[ACC_DEBRIS_F:ACC_DEBRIS_F + 3]
+    force[9:12] = rot_d.T @ (scale * acc[ACC_DEBRIS_T:ACC_DEBRIS_T + 3])
+    diag[D_TENSION] = scale * acc[ACC_TENSION] if advance else tension
+    diag[D_ELONGATION], diag[D_RATE] = z, rate
+    diag[D_CONTACTS] = scale * acc[ACC_CONTACTS]
+    diag[D_CONTACT_F] = scale * acc[ACC_CONTACT_F]
+    diag[D_CLOSING] = acc[ACC_CLOSING]
+    a_point = bodies[0, 0:3] + rot_c @ attach_c
+    u = reference + x[central] - a_point
+    u /= np.sqrt(u @ u)
+    chaser = force[0:6]
+    before = chaser[0:3].copy()
+    chaser_actuation(t, z, rate, u, rot_c, bodies[0, 0:3], bodies[0, 6:9], bodies[0, 9:12], inertia[0], attitude,
+                     thrust_kind, along_z, thrust_params, thrust_state, step, advance, chaser, diag)
+    debris = force[6:12]
+    body_gravity(bodies[0, 0:3], body_masses[0], mu, chaser)
+    body_gravity(bodies[1, 0:3], body_masses[1], mu, debris)
+    if advance:
+        clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3] += h_step * (chaser[0:3] - before) + h_step * (
+            debris[0:3] - scale * acc[ACC_DEBRIS_F:ACC_DEBRIS_F + 3])
+    return force
+
+
+class NetTowState:
+    """The net's state and work arrays of one run, and the call into :func:`step_forces`."""
+
+    def __init__(self, model: FullNetModel):
+        top = model.net.topology
+        self.model = model
+        self.reference = np.array(model.positions[1], float)
+        self.x = np.ascontiguousarray(model.node_positions - self.reference)
+        self.v = np.ascontiguousarray(model.node_velocities, float)
+        self.clock = np.zeros(CLOCK_SIZE)
+        self.clock[CLOCK_TIME] = model.start_time
+        self.rest = top.rest_lengths.copy()
+        self.stiffness = top.stiffness.copy()
+        self.thrust_state = np.array(model.thrust_state, float)
+        self.acc, self.diag = np.zeros(ACC_SIZE), np.zeros(D_SIZE)
+        self.f, self.work = np.zeros_like(self.x), np.zeros(21)
+        self.tether_on = np.array(model.main_tether, float)
+        self.tether_off = np.array([0.0, 0.0, model.main_tether[2]])
+
+    def forces(self, q, v, t, advance):
+        m, top = self.model, self.model.net.topology
+        tether = self.tether_on if t >= m.closing_time else self.tether_off
+        return step_forces(q, v, t, advance, self.x, self.v, self.clock, top.masses, top.radii, top.threads, self.rest,
+                           self.stiffness, top.damping, self.reference, m.mu, m.net.central, tether,
+                           m.attach_chaser_body, m.masses, m.inertia_body, m.inverse_inertia_debris, m.geometry,
+                           m.contact_law, m.substeps, m.step, m.attitude, m.thrust_kind, m.thrust_along_body_z,
+                           m.thrust_params, self.thrust_state, m.positions, self.acc, self.diag, self.f, self.work)
+
+    def momentum(self, v_bodies) -> np.ndarray:
+        """Total linear momentum (N s, inertial) of chaser, debris and net."""
+        m = self.model
+        return (m.masses[0] * v_bodies[0:3] + m.masses[1] * v_bodies[6:9]
+                + (m.net.topology.masses[:, None] * self.v).sum(axis=0))
+
+
+class _Forces:
+    """Force user function of the coupled object (see :class:`multibody.towing._TowForces`)."""
+
+    def __init__(self, state: NetTowState):
+        self.state = state
+        self.last_time = -np.inf
+
+    def __call__(self, mbs, t, item, q, q_t):
+        advance = t > self.last_time and t > 0.0
+        self.last_time = max(t, self.last_time)
+        return self.state.forces(np.asarray(q), np.asarray(q_t), self.state.model.start_time + t, advance)
+
+
+@dataclass
+class NetTowResult:
+    """Samples of one full-net run: body states (k, 12), central node (k, 6), diagnostics (k, D_SIZE),
+    momentum and external impulse (k, 3) each; net snapshots (j, n, 3) at ``net_time``; wall time (s)."""
+
+    model: FullNetModel
+    time: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    node: np.ndarray
+    diag: np.ndarray
+    momentum: np.ndarray
+    external_impulse: np.ndarray
+    net_time: np.ndarray
+    net_positions: np.ndarray
+    wall_time: float
+
+    def series(self) -> dict:
+        """The lower-order model's series names (:meth:`multibody.towing.TowResult.series`; the
+        connection point is the central node), plus the net's own (SI; frames in the names)."""
+        from multibody.net_towing_kernel import D_SLIDING, D_THRUST, D_TORQUE
+
+        m = self.model
+        rot = np.array([[rotation_matrix_from_rotation_vector(self.q[k, b + 3:b + 6]) for b in (0, 6)]
+                        for k in range(len(self.time))]).reshape(-1, 2, 3, 3)
+        return {
+            "time": self.time,
+            "connection_point_inertial": self.node[:, 0:3], "connection_point_velocity_inertial": self.node[:, 3:6],
+            "chaser_com_inertial": m.positions[0] + self.q[:, 0:3], "debris_com_inertial": m.positions[1] + self.q[:, 6:9],
+            "chaser_velocity_inertial": self.v[:, 0:3], "debris_velocity_inertial": self.v[:, 6:9],
+            "chaser_to_inertial": rot[:, 0], "debris_to_inertial": rot[:, 1],
+            "chaser_omega_body": self.v[:, 3:6], "debris_omega_body": self.v[:, 9:12],
+            "main_tether_tension": self.diag[:, D_TENSION], "main_tether_elongation": self.diag[:, D_ELONGATION],
+            "main_tether_elongation_rate": self.diag[:, D_RATE],
+            "thrust": self.diag[:, D_THRUST], "control_torque_body": self.diag[:, D_TORQUE:D_TORQUE + 3],
+            "sliding_variable": self.diag[:, D_SLIDING:D_SLIDING + 3],
+            "net_contacts": self.diag[:, D_CONTACTS], "net_contact_force": self.diag[:, D_CONTACT_F],
+            "closing_thread_peak_tension": self.diag[:, D_CLOSING],
+            "total_momentum_inertial": self.momentum, "external_impulse_inertial": self.external_impulse,
+            "net_time": self.net_time, "net_nodes_inertial": self.net_positions,
+        }
+
+
+class _Sampler:
+    """Post-step function: samples every ``model.every`` steps, net snapshots every ``model.net_every``."""
+
+    def __init__(self, state: NetTowState):
+        m = state.model
+        self.state, self.count = state, 0
+        k, j = m.n_steps // m.every + 1, m.n_steps // m.net_every + 1
+        self.time, self.q, self.v, self.node = np.zeros(k), np.zeros((k, 12)), np.zeros((k, 12)), np.zeros((k, 6))
+        self.diag, self.momentum, self.impulse = np.zeros((k, D_SIZE)), np.zeros((k, 3)), np.zeros((k, 3))
+        self.net_time, self.net = np.zeros(j), np.zeros((j, len(state.x), 3))
+        self.sample = self.net_sample = 0
+
+    def record(self, mbs, t):
+        s = self.state
+        m = s.model
+        data = mbs.systemData
+        q, v = np.asarray(data.GetODE2Coordinates()), np.asarray(data.GetODE2Coordinates_t())
+        k = self.sample
+        if self.count % m.every == 0 and k < len(self.time):
+            self.time[k], self.q[k], self.v[k] = m.start_time + t, q, v
+            self.diag[k] = s.diag  # of the last force evaluation: this step's (Exudyn's initial one at t = 0)
+            self.node[k] = np.r_[s.reference + s.x[m.net.central], s.v[m.net.central]]
+            self.momentum[k], self.impulse[k] = s.momentum(v), s.clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3]
+            self.sample += 1
+        if self.count % m.net_every == 0 and self.net_sample < len(self.net_time):
+            self.net_time[self.net_sample] = m.start_time + t
+            self.net[self.net_sample] = s.reference + s.x
+            self.net_sample += 1
+        self.count += 1
+        return True
+
+    def __call__(self, mbs, t):
+        return self.record(mbs, t)
+
+
+def build_system(model: FullNetModel, forces: _Forces):
+    """Exudyn system: chaser and debris rigid bodies, one generic object carrying all forces."""
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    nodes = []
+    for b in range(2):
+        node = mbs.AddNode(NodeRigidBodyRotVecLG(
+            referenceCoordinates=list(model.positions[b]) + [0.0] * 3,
+            initialCoordinates=[0.0] * 3 + list(Rotation.from_matrix(model.body_to_inertial[b]).as_rotvec()),
+            initialVelocities=list(model.velocities[b]) + list(model.omega_body[b])))
+        j = model.inertia_body[b]
+        mbs.AddObject(ObjectRigidBody(nodeNumber=node, mass=float(model.masses[b]),
+                                      inertia=[j[0, 0], j[1, 1], j[2, 2], j[1, 2], j[0, 2], j[0, 1]]))
+        nodes.append(node)
+    mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=forces))
+    mbs.Assemble()
+    return sc, mbs
+
+
+def run_exudyn(model: FullNetModel) -> NetTowResult:
+    """Build and integrate ``model`` (VelocityVerlet at ``model.step``, net sub-cycled)."""
+    state = NetTowState(model)
+    forces = _Forces(state)
+    sc, mbs = build_system(model, forces)
+    sampler = _Sampler(state)
+    mbs.SetPostStepUserFunction(sampler)
+    settings = explicit_settings(model.step, model.n_steps)
+    start = time.perf_counter()
+    with solver_chatter_to_stderr():
+        exu.SolveDynamic(mbs, settings, solverType=exu.DynamicSolverType.VelocityVerlet)
+    wall = time.perf_counter() - start
+    k = sampler.sample
+    return NetTowResult(model, sampler.time[:k], sampler.q[:k], sampler.v[:k], sampler.node[:k], sampler.diag[:k],
+                        sampler.momentum[:k], sampler.impulse[:k], sampler.net_time[:sampler.net_sample],
+                        sampler.net[:sampler.net_sample], wall)

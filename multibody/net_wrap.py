@@ -1,0 +1,160 @@
+"""The towing net: a square lumped-mass net with corner masses and a closing mechanism, and its
+prepared wrapped state around the Zenit-2 cylinder (Boonrath, Singh & Botta 2024, Sec. 2.1, 4.1).
+
+Topology from :func:`multibody.net.flat_square_net` (N x N nodes, corner masses on the corners);
+the closing mechanism is a loop of tension-only threads laced through the four corner masses and
+two perimeter nodes per side (twelve lacing points, Sec. 2.1), appended as the last
+:data:`N_CLOSING` threads; shortening their natural length closes the net.
+
+The wrapped state (:func:`drape_and_close`) is made by the model itself, in the debris frame with
+the debris held still: the net starts flat above the cylinder's side facing the chaser,
+falls onto it under a pseudo-gravity towards the axis and drapes over it, the closing loop is reeled in
+to ``closed_fraction`` of its length, then the pseudo-gravity is removed and the net settles under
+drag. Every node ends outside the cylinder, threads at or below their natural length except where
+the closed loop pulls. Positions in the debris frame (origin at the debris CoM, m).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from multibody.net import NetTopology, flat_square_net
+from multibody.net_towing_kernel import ACC_SIZE, CYL_HALF, CYL_RADIUS, CYL_Z, cylinder_distance, net_forces
+
+#: Threads of the closing loop (four corner masses and eight perimeter nodes, Sec. 2.1).
+N_CLOSING = 12
+
+
+@dataclass(frozen=True)
+class TowingNet:
+    """Net topology with its closing loop (SI; positions in the frame they were built in).
+
+    Attributes
+    ----------
+    topology : NetTopology           Net nodes, corner masses last; threads end with the closing loop.
+    central : int                    Node the main tether attaches to (the net's central node).
+    closing_rest_open : (12,) float  Natural lengths of the closing threads before closing (m).
+    closing_rest_closed : (12,) float  Their natural lengths once closed (m).
+    closing_axial_rigidity : float   EA of the closing thread (N).
+    """
+
+    topology: NetTopology
+    central: int
+    closing_rest_open: np.ndarray
+    closing_rest_closed: np.ndarray
+    closing_axial_rigidity: float
+
+    def closing_stiffness(self, rest):
+        """Stiffness EA/l0 (N/m) of each closing thread at natural lengths ``rest`` (m)."""
+        return self.closing_axial_rigidity / np.asarray(rest)
+
+
+def closing_loop(nodes_per_side: int) -> np.ndarray:
+    """The twelve lacing points in order around the perimeter (node indices; the corner masses are
+    :func:`~multibody.net.flat_square_net`'s bullets n^2 .. n^2+3 on grid corners 0, n-1, n(n-1), n^2-1)."""
+    n = nodes_per_side
+    j1 = int(round((n - 1) / 3))
+    j2 = n - 1 - j1
+    cm = n * n + np.arange(4)
+    return np.array([cm[0], j1, j2, cm[1], j1 * n + n - 1, j2 * n + n - 1, cm[3], (n - 1) * n + j2,
+                     (n - 1) * n + j1, cm[2], j2 * n, j1 * n])
+
+
+def towing_net(side_length, nodes_per_side, net_mass, corner_mass, node_radius, corner_radius, thread_axial_rigidity,
+               thread_damping, closing_axial_rigidity, closed_fraction, center_body, normal_body) -> TowingNet:
+    """A flat net of ``net_mass`` (kg, corner masses included) centred at ``center_body`` with its
+    normal ``normal_body`` (m, -), corner masses one mesh length out along the diagonals, closing loop
+    appended open (natural lengths = straight distances between lacing points)."""
+    n = nodes_per_side
+    node_mass = (net_mass - 4.0 * corner_mass) / (n * n)
+    if node_mass <= 0.0:
+        raise ValueError(f"corner masses 4 x {corner_mass} kg leave nothing of the net mass {net_mass} kg for the nodes")
+    mesh = side_length / (n - 1)
+    net = flat_square_net(center_body, normal_body, side_length, n, node_mass, node_radius, thread_axial_rigidity,
+                          thread_damping, corner_mass, corner_radius, mesh)
+    loop = closing_loop(n)
+    pairs = np.c_[loop, np.roll(loop, -1)]
+    rest_open = np.linalg.norm(net.positions[pairs[:, 1]] - net.positions[pairs[:, 0]], axis=1)
+    rest_closed = closed_fraction * rest_open
+    topology = NetTopology(
+        positions=net.positions, masses=net.masses, radii=net.radii,
+        threads=np.vstack([net.threads, pairs]).astype(np.int64), rest_lengths=np.r_[net.rest_lengths, rest_open],
+        stiffness=np.r_[net.stiffness, closing_axial_rigidity / rest_open],
+        damping=np.r_[net.damping, np.full(N_CLOSING, float(thread_damping))],
+        bending_triples=net.bending_triples, bending_stiffness=net.bending_stiffness,
+        nodes_per_side=n, n_bullets=4)
+    return TowingNet(topology, (n // 2) * n + n // 2, rest_open, rest_closed, float(closing_axial_rigidity))
+
+
+@dataclass(frozen=True)
+class DrapeSchedule:
+    """Pseudo-time schedule of the wrapping (s, m/s^2, 1/s): fall and drape, reel in, settle."""
+
+    fall: float = 4.0
+    reel: float = 6.0
+    settle: float = 6.0
+    pseudo_gravity: float = 2.0
+    drag: float = 3.0
+    step: float = 1e-4
+
+
+@njit(cache=True)
+def _drape(x, v, masses, radii, threads, rest, stiffness, damping, central, rest_open, rest_closed, ea, geometry, law,
+           up, fall, reel, settle, gravity, drag, h):
+    n_closing = rest_open.shape[0]
+    first = threads.shape[0] - n_closing
+    f = np.zeros_like(x)
+    acc, work = np.zeros(ACC_SIZE), np.zeros(21)
+    zeros3, big = np.zeros(3), 1e30
+    rot, tether = np.eye(3), np.zeros(3)
+    inverse = np.zeros((3, 3))
+    far = 1e9 * up  # the (force-free) main tether's other end
+    n_steps = int((fall + reel + settle) / h)
+    for k in range(n_steps):
+        t = k * h
+        ramp = min(1.0, max(0.0, (t - fall) / reel))
+        for c in range(n_closing):
+            rest[first + c] = rest_open[c] + ramp * (rest_closed[c] - rest_open[c])
+            stiffness[first + c] = ea / rest[first + c]
+        net_forces(x, v, masses, radii, threads, rest, stiffness, damping, zeros3, 0.0, central, tether, far, zeros3,
+                   zeros3, zeros3, rot, zeros3, zeros3, big, inverse, geometry, law, h, f, acc, work)
+        g = gravity if t < fall + reel else 0.0
+        for i in range(x.shape[0]):
+            for a in range(3):
+                f[i, a] -= masses[i] * g * up[a]
+                v[i, a] += h * (f[i, a] / masses[i] - drag * v[i, a])
+                x[i, a] += h * v[i, a]
+    v[:] = 0.0
+
+
+def drape_and_close(net: TowingNet, geometry, contact_law, up_body, schedule: DrapeSchedule = DrapeSchedule()) -> np.ndarray:
+    """The wrapped node positions (n, 3) (m, debris frame) after draping ``net`` (built flat on the
+    ``up_body`` side of the cylinder ``geometry`` = [radius, half length, axial centre z] (m), the
+    pseudo-gravity along -``up_body``) and closing it (module doc); ``contact_law`` is the kernel's
+    contact array. The net's threads end at the closed natural lengths."""
+    top = net.topology
+    x = np.array(top.positions, float)
+    v = np.zeros_like(x)
+    rest, stiffness = top.rest_lengths.copy(), top.stiffness.copy()
+    _drape(x, v, top.masses, top.radii, top.threads, rest, stiffness, top.damping, net.central, net.closing_rest_open,
+           net.closing_rest_closed, net.closing_axial_rigidity, np.asarray(geometry, float),
+           np.asarray(contact_law, float), np.asarray(up_body, float), schedule.fall, schedule.reel, schedule.settle, schedule.pseudo_gravity,
+           schedule.drag, schedule.step)
+    return x
+
+
+def wrap_summary(x_body, net: TowingNet, geometry) -> dict:
+    """Shape figures of a wrapped net (debris frame): smallest node clearance to the cylinder (m),
+    largest thread strain (-), how far the central node sits from the cylinder axis (m)."""
+    top = net.topology
+    clear = [cylinder_distance(p[0], p[1], p[2], np.asarray(geometry, float))[0] - r for p, r in zip(x_body, top.radii)]
+    length = np.linalg.norm(x_body[top.threads[:, 1]] - x_body[top.threads[:, 0]], axis=1)
+    rest = np.r_[top.rest_lengths[:-N_CLOSING], net.closing_rest_closed]
+    strain = length / rest - 1.0
+    return {"min_clearance_m": float(min(clear)), "max_net_strain": float(strain[:-N_CLOSING].max()),
+            "max_closing_strain": float(strain[-N_CLOSING:].max()),
+            "central_node_body": x_body[net.central].tolist(),
+            "geometry": {"radius": float(geometry[CYL_RADIUS]), "half_length": float(geometry[CYL_HALF]),
+                         "z_center": float(geometry[CYL_Z])}}
