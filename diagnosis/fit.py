@@ -20,7 +20,8 @@ from scipy.optimize import least_squares
 from diagnosis.effects.base import Effect, Parameter
 from diagnosis.model import max_step, predict
 from diagnosis.observation import QUATERNION, scenario_channels
-from diagnosis.plant import NOMINAL_PARAMETERS, Plant, nominal_parameter_names, nominal_vector, prior_sigmas, with_nominal
+from diagnosis.plant import (NOMINAL_PARAMETERS, Plant, is_towing, nominal_parameter_names, nominal_vector, plant_of,
+                             prior_sigmas, with_nominal)
 from diagnosis.residuals import aligned_quaternion
 
 #: Share of the training span fitted first (continuation).
@@ -55,7 +56,7 @@ class Problem:
 
     @classmethod
     def build(cls, case, measured, holdout_fraction: float) -> "Problem":
-        plant = Plant.from_case(case)
+        plant = plant_of(case)
         used = [c for c in measured.values if c in scenario_channels(plant)]
         time = measured.time
         split = time[0] + (1.0 - holdout_fraction) * (time[-1] - time[0])
@@ -109,7 +110,8 @@ class CandidateFit:
         self.specs: list[Parameter] = effect.parameter_specs(problem.case, problem.channels) if effect else []
         self.scale = np.array([max(abs(p.typical), (p.upper - p.lower) / 20.0) for p in self.specs])
         self.step = max_step(problem.plant, effect.stiffness_rate(problem.plant, self.specs) if effect else 0.0)
-        linear_nominal = [n in LINEAR_NOMINAL for n in _expanded(problem.nominal_names)]
+        # (towing: the tether couples the debris' position to everything, nothing is linear)
+        linear_nominal = [n in LINEAR_NOMINAL and not is_towing(problem.plant) for n in _expanded(problem.nominal_names)]
         self.linear = np.r_[np.array(linear_nominal, bool),
                             np.full(len(self.specs), bool(effect is not None and getattr(effect, "linear", False)))]
         self._cache = {}

@@ -25,6 +25,8 @@ UNITS = {**{c: "rad/s" for c in OMEGA}, **{c: "-" for c in QUATERNION}, "hinge_a
 
 def scenario_channels(plant: Plant) -> tuple[str, ...]:
     """Channels a scenario's model predicts."""
+    if getattr(plant, "kind", None) == "towing":
+        return OMEGA + QUATERNION + REL + TENSION
     return OMEGA + QUATERNION + (HINGE if plant.hinged else ()) + REL
 
 

@@ -138,12 +138,29 @@ class Plant:
         return float(max(rates))
 
 
+def plant_of(case):
+    """The plant of a diagnosis case: :class:`Plant`, or :class:`diagnosis.towing_plant.TowingPlant`
+    for the towing scenario."""
+    if case.kind == "towing":
+        from diagnosis.towing_plant import TowingPlant
+
+        return TowingPlant.from_case(case)
+    return Plant.from_case(case)
+
+
+def is_towing(plant) -> bool:
+    return getattr(plant, "kind", None) == "towing"
+
+
 def nominal_parameter_names(case, channels) -> list[str]:
     """Nominal parameters the fit estimates: those with a prior 1-sigma > 0 that the scenario has and
     the channels can see (position and velocity only with rel_x..z)."""
     names = []
     for name in NOMINAL_PARAMETERS:
-        if getattr(case.uncertain, name) <= 0:
+        if getattr(case.uncertain, name, 0.0) <= 0:
+            continue
+        if case.kind == "towing":     # the tether couples position and attitude: every channel sees them
+            names.append(name)
             continue
         if name in HINGE_PARAMETERS and case.kind != "hinged_appendage":
             continue
@@ -156,6 +173,8 @@ def nominal_parameter_names(case, channels) -> list[str]:
 def nominal_vector(plant: Plant, names) -> np.ndarray:
     """The case values of the nominal parameters ``names``, flattened (the attitude as a zero
     perturbation, rad)."""
+    if is_towing(plant):
+        return plant.nominal_vector(names)
     values = {"attitude": np.zeros(3), "angular_velocity": plant.omega0, "position": plant.position0,
               "velocity": plant.velocity0, "hinge_angle": [plant.hinge_angle0], "hinge_rate": [plant.hinge_rate0],
               "torsional_stiffness": [plant.stiffness], "torsional_damping": [plant.damping]}
@@ -165,6 +184,8 @@ def nominal_vector(plant: Plant, names) -> np.ndarray:
 def with_nominal(plant: Plant, names, vector) -> Plant:
     """``plant`` with the nominal parameters ``names`` set from ``vector`` (attitude: a rotation
     vector (rad), B frame, composed after the case attitude)."""
+    if is_towing(plant):
+        return plant.with_nominal(names, vector)
     changes, k = {}, 0
     for name in names:
         size = NOMINAL_PARAMETERS[name][0]

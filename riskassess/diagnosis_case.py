@@ -6,7 +6,9 @@ picked by the top-level ``kind``:
 * ``"tumbling_rigid"``: one rigid debris body tumbling freely (torque-free nominal).
 * ``"hinged_appendage"``: a main body and an appendage on a revolute hinge with a torsional
   spring-damper, released from an initial hinge angle and rate; no external load in the nominal.
-* ``"towing"`` is reserved for the tethered towing model (not yet available).
+* ``"towing"``: post-capture towing, the lower-order tethered model (:mod:`multibody.towing`) of a
+  towing case file that the diagnosis case names (``towing = "zenit2_towing.toml"``, relative to
+  the diagnosis case; its tethers, masses, thrust law and initial state are the nominal model).
 
 Frames: **target frame** = the main body's reference frame; the main body frame has the same
 axes and its origin at the main body's CoM. **LVLH** is chaser-centred (x radial, y along-track,
@@ -15,12 +17,14 @@ dynamics is LVLH at t = 0. Time 0 is the epoch of the initial state; measured ti
 """
 from __future__ import annotations
 
-from typing import Annotated, Literal, Union
+from pathlib import Path
+from typing import Annotated, Literal, Optional, Union
 
 import numpy as np
-from pydantic import Field, RootModel, field_validator, model_validator
+from pydantic import Field, PrivateAttr, RootModel, ValidationError, ValidationInfo, field_validator, model_validator
 
-from riskassess.case import NonNegative, Positive, Strict, Vector3, check_physical_inertia, load_model
+from riskassess.case import (CaseError, NonNegative, Positive, Strict, Vector3, check_physical_inertia,
+                             format_validation_error, load_model, read_toml)
 
 Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3)]
 
@@ -131,19 +135,26 @@ class _ScenarioBase(Strict):
 
     @model_validator(mode="after")
     def _known_effects(self):
-        from diagnosis.effects import CATALOG
+        return _check_effects(self)
 
-        for k, entry in enumerate(self.effects):
-            if entry.id not in CATALOG:
-                raise ValueError(f"effects[{k}].id: '{entry.id}' is not in the catalog {sorted(CATALOG)}")
-            names = [p.name for p in CATALOG[entry.id].parameter_specs(self)]
-            unknown = sorted(set(entry.parameters) - set(names))
-            missing = [] if getattr(CATALOG[entry.id], "partial_parameters", False) else \
-                sorted(set(names) - set(entry.parameters))
-            if unknown or missing:
-                raise ValueError(f"effects[{k}] ({entry.id}).parameters: expected {names}; unknown {unknown}, "
-                                 f"missing {missing}")
-        return self
+
+def _check_effects(case):
+    """Every ``[[effects]]`` entry names a catalog effect that applies and gives its parameters."""
+    from diagnosis.effects import CATALOG
+
+    for k, entry in enumerate(case.effects):
+        if entry.id not in CATALOG:
+            raise ValueError(f"effects[{k}].id: '{entry.id}' is not in the catalog {sorted(CATALOG)}")
+        if case.kind not in CATALOG[entry.id].scenarios:
+            raise ValueError(f"effects[{k}].id: '{entry.id}' does not apply to the '{case.kind}' scenario")
+        names = [p.name for p in CATALOG[entry.id].parameter_specs(case)]
+        unknown = sorted(set(entry.parameters) - set(names))
+        missing = [] if getattr(CATALOG[entry.id], "partial_parameters", False) else \
+            sorted(set(names) - set(entry.parameters))
+        if unknown or missing:
+            raise ValueError(f"effects[{k}] ({entry.id}).parameters: expected {names}; unknown {unknown}, "
+                             f"missing {missing}")
+    return case
 
 
 class TumblingRigidCase(_ScenarioBase):
@@ -156,16 +167,83 @@ class HingedAppendageCase(_ScenarioBase):
     hinge: Hinge
 
 
-DiagnosisCase = Union[TumblingRigidCase, HingedAppendageCase]
+class TowingUncertain(Strict):
+    """1-sigma priors of the towing scenario's nominal parameters (the debris' initial state); 0 or
+    absent = known exactly."""
+    attitude: NonNegative = Field(0.0, description="Initial debris attitude, per axis of the debris frame (rad).")
+    angular_velocity: NonNegative = Field(0.0, description="Initial debris angular velocity, per axis (rad/s).")
+    position: NonNegative = Field(0.0, description="Initial debris position relative to the chaser, per LVLH axis (m).")
+    velocity: NonNegative = Field(0.0, description="Initial debris velocity relative to the chaser, per LVLH axis (m/s).")
+
+
+class TowingInitial(Strict):
+    """The debris' state at the record's t = 0 where it differs from the towing case's (an extended
+    case written by the diagnosis carries the fitted values). LVLH: the chaser's, at t = 0."""
+    attitude_change: Vector3 = Field([0.0, 0.0, 0.0], description="Rotation vector composed after the towing case's "
+                                                                   "debris attitude, debris frame (rad).")
+    angular_velocity: Optional[Vector3] = Field(None, description="Debris inertial angular velocity, debris frame "
+                                                                  "(rad/s); default: the towing case's spin.")
+    position_lvlh: Optional[Vector3] = Field(None, description="Debris target-frame origin (its CoM in the towing "
+                                                               "case) minus the chaser CoM, LVLH axes (m).")
+    velocity_lvlh: Optional[Vector3] = Field(None, description="Debris CoM velocity minus the chaser's (inertial "
+                                                               "derivative), LVLH axes (m/s).")
+
+
+class TowingDiagnosisCase(Strict):
+    """Post-capture towing: the lower-order model of the towing case ``towing`` is the nominal."""
+    kind: Literal["towing"]
+    name: str
+    description: str = ""
+    towing: str = Field(description="Towing case file (riskassess/towing_case.py), relative to this file: tethers, "
+                                    "masses, thrust law, attitude control and the state at the record's t = 0.")
+    fit_step: Annotated[float, Field(gt=0, le=0.05)] = Field(
+        0.02, description="Step of the fit's towing runs (s); the identification's step (docs/towing.md: within 2 % "
+                          "of the paper's RMSE scales at 20 ms).")
+    initial: TowingInitial = TowingInitial()
+    uncertain: TowingUncertain = TowingUncertain()
+    diagnosis: Diagnosis = Diagnosis()
+    effects: list[EffectEntry] = Field([], description="Effects switched on in this model (an extended case).")
+    _towing_case: object = PrivateAttr(None)
+
+    @model_validator(mode="after")
+    def _load_towing(self, info: ValidationInfo):
+        from riskassess.case import CaseError
+        from riskassess.towing_case import TowingCase
+
+        path = Path(self.towing)
+        if not path.is_absolute():
+            path = Path((info.context or {}).get("case_dir", ".")) / path
+        try:
+            self._towing_case = load_model(path, TowingCase)
+        except (CaseError, OSError) as exc:
+            raise ValueError(f"towing: the towing case cannot be loaded: {exc}") from None
+        return _check_effects(self)
+
+    @property
+    def towing_case(self):
+        """The validated :class:`riskassess.towing_case.TowingCase`."""
+        return self._towing_case
+
+
+DiagnosisCase = Union[TumblingRigidCase, HingedAppendageCase, TowingDiagnosisCase]
 
 
 class DiagnosisCaseFile(RootModel):
     root: Annotated[DiagnosisCase, Field(discriminator="kind")]
 
 
+def diagnosis_case_from_dict(raw: dict, case_dir=".") -> DiagnosisCase:
+    """Validate parsed case content; file references (``towing``) are relative to ``case_dir``."""
+    return DiagnosisCaseFile.model_validate(raw, context={"case_dir": str(case_dir)}).root
+
+
 def load_diagnosis_case(path) -> DiagnosisCase:
     """Read and validate a diagnosis case; :class:`~riskassess.case.CaseError` names file and key."""
-    return load_model(path, DiagnosisCaseFile).root
+    path = Path(path)
+    try:
+        return diagnosis_case_from_dict(read_toml(path), path.parent)
+    except ValidationError as exc:
+        raise CaseError(format_validation_error(path, exc)) from None
 
 
 # ---------------------------------------------------------------------------- writing

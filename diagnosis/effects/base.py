@@ -8,7 +8,9 @@ the model in one or more of four ways, each a pure function:
 * ``modify_plant``: new mass properties or geometry (e.g. a CoM offset);
 * ``sample_times`` / ``measure``: a sensor effect (time shift, bias) on the simulated channels;
 * ``add_to_exudyn``: the same physics on the Exudyn builder (:mod:`diagnosis.exudyn_model`),
-  through user-function loads that call the same pure force law.
+  through user-function loads that call the same pure force law;
+* ``towing_law``: the same physics on the towing model (:mod:`diagnosis.towing_dynamics`; the fast
+  model and its Exudyn reference both call it), for effects that apply to the towing scenario.
 """
 from __future__ import annotations
 
@@ -18,6 +20,7 @@ import numpy as np
 
 from diagnosis.dynamics import no_load
 from diagnosis.plant import Plant
+from diagnosis.towing_dynamics import no_towing_load
 
 
 @dataclass(frozen=True)
@@ -46,6 +49,8 @@ class Effect:
     channels: tuple[str, ...] = ()
     #: numba load law of the fast model (``no_load``: none).
     law = staticmethod(no_load)
+    #: numba load law of the towing model (:mod:`diagnosis.towing_dynamics`; ``no_towing_load``: none).
+    towing_law = staticmethod(no_towing_load)
 
     def parameter_specs(self, case, channels=None) -> list[Parameter]:
         raise NotImplementedError
@@ -60,6 +65,10 @@ class Effect:
 
     def law_parameters(self, plant: Plant, values: np.ndarray) -> np.ndarray:
         """Parameters ``p`` of the numba law from the physical values (same order by default)."""
+        return np.asarray(values, float)
+
+    def towing_law_parameters(self, plant, values: np.ndarray) -> np.ndarray:
+        """Parameters ``p`` of the towing law from the physical values (same order by default)."""
         return np.asarray(values, float)
 
     def modify_plant(self, plant: Plant, values: np.ndarray) -> Plant:

@@ -8,16 +8,20 @@ component normal to the field:
 
 with c = k_e |B|^2 (N m s) and the field direction b fixed in the inertial frame over the record
 (a few minutes of a LEO orbit); the angular momentum is not conserved (an external torque).
-Parameters: c and the field direction (azimuth, elevation in I = LVLH at t = 0). Main body only.
+Parameters: c and the field direction (azimuth, elevation in I = LVLH at t = 0). Main body only
+(towing: the debris; I = the chaser's LVLH at the record's t = 0).
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
-from diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_Q, X_W, quaternion_rows, tdot, tmtv
+from diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_Q, X_W, quaternion_rows, tdot, tmtv, tmv
 from diagnosis.effects.base import Effect, Parameter
-from diagnosis.plant import Plant
+from diagnosis.plant import plant_of
+from diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
+from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.towing_kernel import DEBRIS
 
 
 @njit(cache=True)
@@ -42,14 +46,30 @@ def law(t, x, p, env, load):
         load[L_TM + i] += torque[i]
 
 
+@njit(TOWING_LAW_SIGNATURE, cache=True)
+def towing_law(t, q, v, p, work, xe, h, load):
+    """On the towed debris; ``p`` = [c, azimuth, elevation, I -> ECI (9, row-major)]."""
+    b_eci = tmv(p[3:12], field_direction(p[1], p[2]))
+    rot = rotation_matrix_from_rotation_vector(q[DEBRIS + 3:DEBRIS + 6])
+    field = rot.T @ np.array(b_eci)
+    torque = eddy_torque((v[DEBRIS + 3], v[DEBRIS + 4], v[DEBRIS + 5]), field, p[0])
+    for i in range(3):
+        load[DEBRIS + 3 + i] += torque[i]
+
+
 class EddyCurrentDamping(Effect):
     id = "eddy_current_damping"
     title = "eddy-current braking in the geomagnetic field (spin normal to the field decays)"
     channels = ("omega_x", "omega_y", "omega_z", "q_w")
+    scenarios = ("tumbling_rigid", "hinged_appendage", "towing")
     law = staticmethod(law)
+    towing_law = staticmethod(towing_law)
+
+    def towing_law_parameters(self, plant, values):
+        return np.r_[np.asarray(values, float), plant.lvlh0.ravel()]
 
     def parameter_specs(self, case, channels=None):
-        j_max = float(np.linalg.eigvalsh(Plant.from_case(case).inertia_main)[-1])
+        j_max = float(np.linalg.eigvalsh(plant_of(case).inertia_main)[-1])
         return [Parameter("coefficient", "N m s", "k_e |B|^2, torque per unit spin rate", j_max / 3000.0, 0.0,
                           j_max / 10.0),
                 Parameter("field_azimuth", "rad", "field direction about I z, from I x", 0.0, -2 * np.pi, 2 * np.pi),

@@ -6,6 +6,8 @@
 the body's frame and J its inertia about its CoM; applied to the main body and the appendage.
 The nominal model already moves every body's CoM in the orbit's tidal field (Clohessy-Wiltshire);
 this adds the bodies' own inertia. Parameter: the mean motion n, expected at the case orbit's.
+Towing: on the chaser and the debris, r their CoM's direction from the Earth's centre (the towing
+model's two-body gravity acts on the CoMs only); n expected at the chaser's initial orbit radius.
 """
 from __future__ import annotations
 
@@ -15,7 +17,10 @@ from numba import njit
 from diagnosis.dynamics import (LAW_SIGNATURE, E_AXIS, E_HINGED, E_JA, E_JM, E_N, L_TA, L_TM, X_Q, X_TH, axis_rows,
                                 quaternion_rows, radial_inertial, sandwich, tcross, tmtv, tmv)
 from diagnosis.effects.base import Effect, Parameter
-from diagnosis.plant import Plant
+from diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, W_INERTIA, body_position
+from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.towing_kernel import CHASER, DEBRIS
+from diagnosis.plant import plant_of
 
 
 @njit(cache=True)
@@ -41,19 +46,34 @@ def law(t, x, p, env, load):
             load[L_TA + i] += appendage[i]
 
 
+@njit(TOWING_LAW_SIGNATURE, cache=True)
+def towing_law(t, q, v, p, work, xe, h, load):
+    """On chaser and debris of the towing model: r from the Earth's centre to each CoM (ECI)."""
+    for b, base in enumerate((CHASER, DEBRIS)):
+        r = body_position(work, q, base)
+        rot = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
+        r_b = rot.T @ (r / np.sqrt(r @ r))
+        inertia = work[W_INERTIA + 9 * b:W_INERTIA + 9 * b + 9]
+        torque = gravity_gradient((r_b[0], r_b[1], r_b[2]), tmv(inertia, (r_b[0], r_b[1], r_b[2])), p[0])
+        for i in range(3):
+            load[base + 3 + i] += torque[i]
+
+
 class GravityGradientTorque(Effect):
     id = "gravity_gradient_torque"
     title = "gravity-gradient torque on the bodies' inertia"
     channels = ("omega_x", "omega_y", "omega_z", "q_w", "hinge_angle", "hinge_rate")
+    scenarios = ("tumbling_rigid", "hinged_appendage", "towing")
     law = staticmethod(law)
+    towing_law = staticmethod(towing_law)
 
     def not_applicable(self, case, channels):
-        if case.orbit.kind != "circular":
+        if case.kind != "towing" and case.orbit.kind != "circular":
             return "the case has no orbit ([orbit] kind = 'circular' with its altitude)"
         return super().not_applicable(case, channels)
 
     def parameter_specs(self, case, channels=None):
-        n = Plant.from_case(case).mean_motion
+        n = plant_of(case).mean_motion
         return [Parameter("mean_motion", "rad/s", "orbit mean motion seen by the torque (the case orbit's: "
                           f"{n:.4g})", n, 0.0, 10.0 * n)]
 

@@ -17,7 +17,9 @@ from numba import njit
 
 from diagnosis.dynamics import LAW_SIGNATURE, L_E, L_TM, X_E, X_W, cross
 from diagnosis.effects.base import Effect, Parameter
-from diagnosis.plant import Plant
+from diagnosis.plant import plant_of
+from diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, XE_DAMPER
+from multibody.towing_kernel import DEBRIS
 
 
 @njit(cache=True)
@@ -35,14 +37,28 @@ def law(t, x, p, env, load):
     load[L_E:L_E + 3] += -torque / p[0] - cross(w, wd) if p[0] > 0 else -cross(w, wd)
 
 
+@njit(TOWING_LAW_SIGNATURE, cache=True)
+def towing_law(t, q, v, p, work, xe, h, load):
+    """The damper in the towed debris; its rate (``XE_DAMPER``, debris frame) advanced by explicit
+    Euler over the step (h / T_d <= 0.05 at the fit's 50 ms limit and T_d >= 1 s)."""
+    w = v[DEBRIS + 3:DEBRIS + 6]
+    wd = xe[XE_DAMPER:XE_DAMPER + 3]
+    torque = damper_torque(w, wd, p[0], p[1])
+    load[DEBRIS + 3:DEBRIS + 6] += torque
+    if h > 0.0 and p[0] > 0.0:
+        xe[XE_DAMPER:XE_DAMPER + 3] += h * (-torque / p[0] - cross(w, wd))
+
+
 class InternalEnergyDissipation(Effect):
     id = "internal_energy_dissipation"
     title = "nutation damping by internal energy dissipation (spherical viscous damper)"
     channels = ("omega_x", "omega_y", "omega_z", "q_w")
+    scenarios = ("tumbling_rigid", "hinged_appendage", "towing")
     law = staticmethod(law)
+    towing_law = staticmethod(towing_law)
 
     def parameter_specs(self, case, channels=None):
-        j_min = float(np.linalg.eigvalsh(Plant.from_case(case).inertia_main)[0])
+        j_min = float(np.linalg.eigvalsh(plant_of(case).inertia_main)[0])
         return [Parameter("damper_inertia", "kg m^2", "inertia of the damper rotor", 0.01 * j_min, 0.0, 0.2 * j_min),
                 Parameter("time_constant", "s", "damper time constant J_d / c", 30.0, 1.0, 3000.0)]
 

@@ -8,7 +8,9 @@ relative to the chaser, which the nominal Clohessy-Wiltshire motion leaves out.
 (Vallado, *Fundamentals of Astrodynamics*, eq. 8-30, Earth-centred inertial), applied as
 :math:`\\mathbf a_{J2}(\\mathbf R_c + \\boldsymbol\\rho) - \\mathbf a_{J2}(\\mathbf R_c)` with the chaser on
 the case's circular orbit (inclination, argument of latitude; right ascension of the node 0).
-Parameter: J2 itself, expected at Earth's 1.08263e-3.
+Parameter: J2 itself, expected at Earth's 1.08263e-3. Towing: the towing model moves every body in
+Earth-centred inertial coordinates with two-body gravity (the towing case's frame, z the Earth's
+axis); the effect adds J2's acceleration to P, the chaser and the debris.
 """
 from __future__ import annotations
 
@@ -17,6 +19,8 @@ from numba import njit
 
 from diagnosis.dynamics import LAW_SIGNATURE, E_INC, E_MA, E_MM, E_N, E_RADIUS, E_U0, L_F, X_R
 from diagnosis.effects.base import Effect, Parameter
+from diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, W_MASSES, W_REFERENCE, body_position, point_position
+from multibody.towing_kernel import CHASER, DEBRIS
 from multibody.orbit import MU_EARTH, R_EARTH
 
 #: Earth's J2 (-), EGM2008.
@@ -58,14 +62,27 @@ def law(t, x, p, env, load):
     load[L_F:L_F + 3] += (env[E_MM] + env[E_MA]) * a
 
 
+@njit(TOWING_LAW_SIGNATURE, cache=True)
+def towing_law(t, q, v, p, work, xe, h, load):
+    """J2 on P, chaser and debris of the towing model (Earth-centred inertial, z the Earth's axis)."""
+    point, _ = point_position(work)
+    for b, base in enumerate((0, CHASER, DEBRIS)):
+        r = work[W_REFERENCE:W_REFERENCE + 3] + point if b == 0 else body_position(work, q, base)
+        a = j2_acceleration(r, p[0])
+        for i in range(3):
+            load[base + i] += work[W_MASSES + b] * a[i]
+
+
 class J2Perturbation(Effect):
     id = "j2_perturbation"
     title = "differential J2 acceleration of the debris relative to the chaser"
     channels = ("rel_x", "rel_y", "rel_z")
+    scenarios = ("tumbling_rigid", "hinged_appendage", "towing")
     law = staticmethod(law)
+    towing_law = staticmethod(towing_law)
 
     def not_applicable(self, case, channels):
-        if case.orbit.kind != "circular":
+        if case.kind != "towing" and case.orbit.kind != "circular":
             return "the case has no orbit ([orbit] kind = 'circular' with altitude and inclination)"
         return super().not_applicable(case, channels)
 

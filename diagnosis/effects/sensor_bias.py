@@ -21,6 +21,7 @@ BIASED = {**{c: 1e-3 for c in OMEGA}, "hinge_angle": 0.01, "hinge_rate": 1e-3, *
 class SensorBias(Effect):
     id = "sensor_bias"
     title = "constant sensor biases"
+    scenarios = ("tumbling_rigid", "hinged_appendage", "towing")
     channels = tuple(BIASED)
     #: the parameter set follows the measured channels; a case may give any subset
     partial_parameters = True
@@ -32,7 +33,7 @@ class SensorBias(Effect):
         if case.kind != "hinged_appendage":
             present = [c for c in present if not c.startswith("hinge")]
         return [Parameter(f"bias_{c}", UNITS[c], f"bias of {c}", BIASED[c], -1000 * BIASED[c], 1000 * BIASED[c])
-                for c in present if c != "tether_tension"]
+                for c in present if c != "tether_tension" or case.kind == "towing"]
 
     def starts(self, specs):
         return [np.zeros(len(specs))]

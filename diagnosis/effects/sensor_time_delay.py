@@ -19,6 +19,7 @@ def delayed_times(times, delay):
 class SensorTimeDelay(Effect):
     id = "sensor_time_delay"
     title = "constant time delay of the measurements"
+    scenarios = ("tumbling_rigid", "hinged_appendage", "towing")
 
     def parameter_specs(self, case, channels=None):
         return [Parameter("delay", "s", "measurement delay", 0.2, 0.0, 5.0)]

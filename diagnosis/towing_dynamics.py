@@ -1,0 +1,128 @@
+"""The towing scenario's fast model: the lower-order towing model's compiled twin with effect loads.
+
+The nominal model is :mod:`multibody.towing` (chaser, connection point P, main tether and
+sub-tethers, two-body gravity, thrust law, sliding-mode attitude control; Boonrath, Singh & Botta
+2024, Sec. 2.2). :func:`integrate` runs exactly the twin's scheme
+(:func:`multibody.towing_kernel.twin_run`: Verlet half kick, Lie-group drift, forces at the
+evaluation state with P stepped implicitly, half kick) and, before each force evaluation, calls an
+effect's *towing law*; the law's loads go into the packed model's further-forces section
+(:func:`multibody.towing_kernel.extra_forces`) and so act in that step, P's share inside its
+implicit step. ``tests/diagnosis/test_towing.py`` checks that with no effect it reproduces
+:func:`multibody.towing.run_twin` to round-off.
+
+A towing law has the signature ``law(t, q, v, p, work, xe, h, load)``:
+
+* ``t`` (s, the towing case's clock), ``q``, ``v`` (15,) the evaluation state in the kernel layout
+  (P's entries are stale: read P from :func:`point_position`);
+* ``p`` the effect's law parameters, ``work`` the packed model (geometry, masses, the last
+  evaluation's diagnostics: main-tether elongation and rate, thrust);
+* ``xe`` (``EXTRA_STATES``,) the effects' own states (``XE_MAXWELL``: Maxwell-branch tension (N);
+  ``XE_DAMPER``: a nutation damper's angular velocity, debris frame (rad/s)), advanced in place by
+  the law over ``h`` (s; 0: do not advance);
+* ``load`` (15,) the generalized forces it ADDS, kernel layout: force on P (N, inertial), chaser
+  and debris force (N, inertial) and torque (N m, body frame).
+
+Loads are evaluated once per step and held over it (as the thrust law and P's update are).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, types
+
+from multibody.connection_point import V_N, X_N
+from multibody.kernel import rotation_matrix_from_rotation_vector, verlet_evaluation_state
+from multibody.towing_kernel import (CHASER, DEBRIS, N_COORDINATES, ST_TENSION, W_ACCEL, W_ATTACH_CHASER, W_INERTIA,
+                                     W_DIAG, W_MASSES, W_POINT, W_REFERENCE, W_STEP, W_TETHER, extra_forces, packed_forces, start_forces)
+
+_VECTOR = types.float64[::1]
+#: numba signature of a towing law (see the module doc); laws are compiled eagerly with it so that one
+#: compiled integrator takes any of them as a first-class function.
+TOWING_LAW_SIGNATURE = types.void(types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64, _VECTOR)
+_LAW = types.FunctionType(TOWING_LAW_SIGNATURE)
+#: Effects' own states: Maxwell-branch tension (N), damper angular velocity (3, debris frame, rad/s).
+XE_MAXWELL, XE_DAMPER, EXTRA_STATES = 0, 1, 4
+
+
+@njit(TOWING_LAW_SIGNATURE, cache=True)
+def no_towing_load(t, q, v, p, work, xe, h, load):
+    """The nominal towing model: no effect."""
+    return
+
+
+@njit(cache=True, inline="always")
+def point_position(work):
+    """P's position displacement (m) and velocity (m/s), inertial, at the last completed step."""
+    start = int(work[W_POINT])
+    return work[start + X_N:start + X_N + 3], work[start + V_N:start + V_N + 3]
+
+
+@njit(cache=True, inline="always")
+def last_diagnostics(work):
+    """The last force evaluation's diagnostics (:data:`multibody.towing_kernel.MT_TENSION` ... layout)."""
+    start = int(work[W_DIAG])
+    return work[start:start + ST_TENSION]
+
+
+@njit(cache=True)
+def body_position(work, q, base):
+    """Absolute CoM position (m, Earth-centred inertial) of the body at ``base`` (CHASER or DEBRIS)."""
+    row = 1 if base == CHASER else 2
+    reference = work[W_REFERENCE + 3 * row:W_REFERENCE + 3 * row + 3]
+    return reference + q[base:base + 3]
+
+
+@njit(cache=True)
+def main_tether_direction(work, q):
+    """Unit vector from the main tether's chaser end A to P (inertial) and the chaser rotation
+    (body -> inertial) at the state ``q``."""
+    rot_c = rotation_matrix_from_rotation_vector(q[CHASER + 3:CHASER + 6])
+    attach = work[W_ATTACH_CHASER:W_TETHER]
+    point, _ = point_position(work)
+    d = work[W_REFERENCE:W_REFERENCE + 3] + point - body_position(work, q, CHASER) - rot_c @ attach
+    return d / np.sqrt(d @ d), rot_c
+
+
+@njit(cache=True)
+def _set_loads(law, t, q, v, p, work, xe, h, load):
+    load[:] = 0.0
+    law(t, q, v, p, work, xe, h, load)
+    extra = extra_forces(work)
+    extra[:] = load
+
+
+@njit(types.void(_LAW, _VECTOR, _VECTOR, _VECTOR, types.float64, types.int64, _VECTOR, _VECTOR, types.int64[::1],
+                 types.float64[:, ::1], types.float64[:, ::1], types.float64[:, ::1], types.float64[:, ::1]), cache=True)
+def integrate(law, p, q, v, t0, n_steps, work, xe, record, out_q, out_v, out_diag, out_xe):
+    """Integrate the packed towing model ``work`` from (``q``, ``v``) at ``t0`` (s) over ``n_steps``
+    steps with the effect ``law``; records state, diagnostics and effect states after the steps
+    listed in ``record`` (increasing step indices, 0 = the initial state) into the ``out_*`` rows."""
+    step = work[W_STEP]
+    load = np.zeros(N_COORDINATES)
+    _set_loads(law, t0, q, v, p, work, xe, 0.0, load)
+    start_forces(q, v, t0, work)
+    acc = work[int(work[W_ACCEL]):int(work[W_ACCEL]) + N_COORDINATES]     # the stored accelerations (a view)
+    k = 0
+    for n in range(n_steps + 1):
+        t = t0 + n * step
+        while k < record.shape[0] and record[k] == n:
+            out_q[k], out_v[k], out_xe[k] = q, v, xe
+            out_diag[k] = packed_forces(q.copy(), v.copy(), t, work, False)[1]
+            k += 1
+        if n == n_steps or k == record.shape[0]:
+            break
+        q_next, v_half = verlet_evaluation_state(q, v, acc, step, 3, 2)
+        _set_loads(law, t + step, q_next, v_half, p, work, xe, step, load)
+        start_forces(q_next, v_half, t + step, work)
+        q[:] = q_next
+        v[:] = v_half + (0.5 * step) * acc
+
+
+def diagnostics_size(work) -> int:
+    """Columns of the diagnostics rows of a packed model (main tether, thrust, torque, sliding, STs)."""
+    from multibody.towing_kernel import W_N_ATTACH
+
+    return ST_TENSION + int(work[W_N_ATTACH])
+
+
+__all__ = ["DEBRIS", "EXTRA_STATES", "TOWING_LAW_SIGNATURE", "W_INERTIA", "W_MASSES", "W_TETHER", "XE_DAMPER",
+           "XE_MAXWELL", "integrate", "main_tether_direction", "no_towing_load", "point_position"]
