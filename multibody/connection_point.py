@@ -44,13 +44,11 @@ def point_force(x, v, points, point_velocities, stiffness, damping, rest, force,
     force[:] = 0.0
     jac_x[:] = 0.0
     jac_v[:] = 0.0
-    u, rel = np.empty(3), np.empty(3)
     for i in range(points.shape[0]):
-        for a in range(3):
-            u[a] = x[a] - points[i, a]
-            rel[a] = v[a] - point_velocities[i, a]
-        length = math.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
-        u /= length
+        dx, dy, dz = x[0] - points[i, 0], x[1] - points[i, 1], x[2] - points[i, 2]
+        rel = (v[0] - point_velocities[i, 0], v[1] - point_velocities[i, 1], v[2] - point_velocities[i, 2])
+        length = math.sqrt(dx * dx + dy * dy + dz * dz)
+        u = (dx / length, dy / length, dz / length)  # tuples, not arrays: no allocation in the Newton loop
         rate = rel[0] * u[0] + rel[1] * u[1] + rel[2] * u[2]
         tension = tension_only_kelvin_voigt(length - rest[i], rate, stiffness[i], damping[i])
         if tension <= 0.0:
@@ -72,10 +70,10 @@ def implicit_point_step(x_hat, v_hat, beta, mass, reference, mu, points, point_v
     is left out of the Newton matrix only). ``reference`` is P's reference position (absolute, m)
     for gravity (eq. 1; ``mu`` = 0 turns it off). Returns the new position and velocity (3,) each."""
     force, jac_x, jac_v, matrix, residual = np.empty(3), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty(3)
-    v = v_guess.copy()
-    x = x_hat + beta * v
+    v, x = v_guess.copy(), np.empty(3)
     for _ in range(MAX_ITERATIONS):
-        x = x_hat + beta * v
+        for a in range(3):
+            x[a] = x_hat[a] + beta * v[a]
         point_force(x, v, points, point_velocities, stiffness, damping, rest, force, jac_x, jac_v)
         for a in range(3):
             force[a] += external[a]   # other loads on P, held over the step (e.g. a diagnosis effect)

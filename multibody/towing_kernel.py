@@ -29,7 +29,6 @@ from control.attitude import desired_attitude, sliding_mode_torque
 from control.thrust import thrust_command
 from multibody.connection_point import STATE_SIZE, TIME, V_N, X_N, advance_point, initial_point_state
 from multibody.kernel import rotation_matrix_from_rotation_vector, verlet_evaluation_state
-from multibody.linalg3 import cross3, matvec3
 from multibody.net import tension_only_kelvin_voigt
 from multibody.orbit import two_body_acceleration_xyz
 
@@ -163,9 +162,12 @@ def accelerations(v, force, masses, inertia, inverse_inertia):
     a[0:3] = 0.0  # P is advanced implicitly (multibody.connection_point), not by the Verlet kicks
     for b in range(2):
         base = CHASER + 6 * b
-        omega = v[base + 3:base + 6]
-        a[base:base + 3] = force[base:base + 3] / masses[b + 1]
-        a[base + 3:base + 6] = matvec3(inverse_inertia[b], force[base + 3:base + 6] - cross3(omega, matvec3(inertia[b], omega)))
+        wx, wy, wz = v[base + 3], v[base + 4], v[base + 5]
+        for i in range(3):
+            a[base + i] = force[base + i] / masses[b + 1]
+        jw = _rotate(inertia[b], wx, wy, wz)  # scalar tuples instead of temporaries (runs every step)
+        gx, gy, gz = _cross(wx, wy, wz, jw[0], jw[1], jw[2])
+        a[base + 3:base + 6] = _rotate(inverse_inertia[b], force[base + 3] - gx, force[base + 4] - gy, force[base + 5] - gz)
     return a
 
 
@@ -218,8 +220,12 @@ def _attachments(q, v, reference, attach_chaser, attach_debris):
         for i in range(1 if b == 1 else n):
             r = attach_chaser if b == 1 else attach_debris[i]
             row = 0 if b == 1 else i + 1
-            points[row] = reference[b] - reference[0] + q[base:base + 3] + matvec3(rot, r)
-            velocities[row] = v[base:base + 3] + matvec3(rot, cross3(v[base + 3:base + 6], r))
+            arm = _rotate(rot, r[0], r[1], r[2])  # scalar tuples: this runs every step, allocations dominated it
+            wx, wy, wz = _cross(v[base + 3], v[base + 4], v[base + 5], r[0], r[1], r[2])
+            arm_rate = _rotate(rot, wx, wy, wz)
+            for a in range(3):
+                points[row, a] = reference[b, a] - reference[0, a] + q[base + a] + arm[a]
+                velocities[row, a] = v[base + a] + arm_rate[a]
     return points, velocities
 
 
