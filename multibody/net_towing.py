@@ -116,7 +116,7 @@ def _bodies(q, v, reference_c, reference_d):
 
 
 @njit(cache=True)
-def step_forces(q, v, t, advance, x, xv, clock, masses, radii, threads, rest, stiffness, damping, reference, mu, central,
+def step_forces(q, v, t, advance, x, xv, lag, clock, masses, radii, threads, rest, stiffness, damping, reference, mu, central,
                 main_tether, attach_c, body_masses, inertia, inverse_inertia_d, geometry, law, n_sub, step, attitude,
                 thrust_kind, along_z, thrust_params, thrust_state, body_reference, acc, diag, f, work):
     """Generalized forces (12,) on chaser and debris at time ``t`` (s, absolute) for Exudyn's object.
@@ -128,31 +128,33 @@ def step_forces(q, v, t, advance, x, xv, clock, masses, radii, threads, rest, st
     force = np.zeros(12)
     if advance:
         h_step = t - clock[CLOCK_TIME]
-        tension, z, rate = advance_net(x, xv, clock[CLOCK_TIME], t, n_sub, masses, radii, threads, rest, stiffness,
+        tension, z, rate = advance_net(x, xv, lag, clock[CLOCK_TIME], t, n_sub, masses, radii, threads, rest, stiffness,
                                        damping, reference, mu, central, main_tether, attach_c, bodies, body_masses[1],
                                        inverse_inertia_d, geometry, law, f, acc, work)
         clock[CLOCK_TIME] = t
         clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3] += acc[ACC_EXTERNAL:ACC_EXTERNAL + 3]
         scale = 1.0 / h_step
     else:
-        h_step, scale = step, 1.0
+        h_step = step
+        h = step / n_sub
+        scale = 1.0 / h  # one sub-step's impulses, from a copy of the contact lags (the state is not advanced)
         rot_c = rotation_matrix_from_rotation_vector(bodies[0, 3:6])
         rot_d = rotation_matrix_from_rotation_vector(bodies[1, 3:6])
         arm = rot_c @ attach_c
         a_point = bodies[0, 0:3] + arm
         a_velocity = bodies[0, 6:9] + rot_c @ np.cross(bodies[0, 9:12], attach_c)
         acc[:] = 0.0
-        tension, z, rate = net_forces(x, xv, masses, radii, threads, rest, stiffness, damping, reference, mu, central,
+        tension, z, rate = net_forces(x, xv, lag.copy(), masses, radii, threads, rest, stiffness, damping, reference, mu, central,
                                       main_tether, a_point, a_velocity, bodies[0, 0:3], bodies[1, 0:3] - reference,
                                       rot_d, bodies[1, 6:9], rot_d @ bodies[1, 9:12], body_masses[1], inverse_inertia_d,
-                                      geometry, law, 1.0, f, acc, work)
+                                      geometry, law, h, f, acc, work)
     rot_c = rotation_matrix_from_rotation_vector(bodies[0, 3:6])
     rot_d = rotation_matrix_from_rotation_vector(bodies[1, 3:6])
     force[0:3] = scale * acc[ACC_CHASER_F:ACC_CHASER_F + 3]
     force[3:6] = rot_c.T @ (scale * acc[ACC_CHASER_T:ACC_CHASER_T + 3])
     force[6:9] = scale * acc[ACC_DEBRIS_F:ACC_DEBRIS_F + 3]
     force[9:12] = rot_d.T @ (scale * acc[ACC_DEBRIS_T:ACC_DEBRIS_T + 3])
-    diag[D_TENSION] = scale * acc[ACC_TENSION] if advance else tension
+    diag[D_TENSION] = scale * acc[ACC_TENSION]
     diag[D_ELONGATION], diag[D_RATE] = z, rate
     diag[D_CONTACTS] = scale * acc[ACC_CONTACTS]
     diag[D_CONTACT_F] = scale * acc[ACC_CONTACT_F]
@@ -188,14 +190,14 @@ class NetTowState:
         self.stiffness = top.stiffness.copy()
         self.thrust_state = np.array(model.thrust_state, float)
         self.acc, self.diag = np.zeros(ACC_SIZE), np.zeros(D_SIZE)
-        self.f, self.work = np.zeros_like(self.x), np.zeros(21)
+        self.f, self.work, self.lag = np.zeros_like(self.x), np.zeros(21), np.zeros_like(self.x)
         self.tether_on = np.array(model.main_tether, float)
         self.tether_off = np.array([0.0, 0.0, model.main_tether[2]])
 
     def forces(self, q, v, t, advance):
         m, top = self.model, self.model.net.topology
         tether = self.tether_on if t >= m.closing_time else self.tether_off
-        return step_forces(q, v, t, advance, self.x, self.v, self.clock, top.masses, top.radii, top.threads, self.rest,
+        return step_forces(q, v, t, advance, self.x, self.v, self.lag, self.clock, top.masses, top.radii, top.threads, self.rest,
                            self.stiffness, top.damping, self.reference, m.mu, m.net.central, tether,
                            m.attach_chaser_body, m.masses, m.inertia_body, m.inverse_inertia_debris, m.geometry,
                            m.contact_law, m.substeps, m.step, m.attitude, m.thrust_kind, m.thrust_along_body_z,

@@ -28,8 +28,9 @@ from numba import njit
 
 from control.attitude import desired_attitude, sliding_mode_torque
 from control.thrust import thrust_command
+from multibody.connection_point import implicit_point_step
 from multibody.contact import contact_over_step
-from multibody.kernel import _effective_mass_along_normal, rotation_matrix_from_rotation_vector
+from multibody.kernel import _effective_mass_along_normal, _substeps_to_resolve_contact, rotation_matrix_from_rotation_vector
 from multibody.net import add_thread_forces, tension_only_kelvin_voigt
 from multibody.orbit import two_body_acceleration_xyz
 
@@ -81,39 +82,43 @@ def _near(i, x, v, node_radius, com, rot, vel, omega, geometry, h):
     return penetration, nbx, nby, nbz, penetration + 2.0 * h * reach >= 0.0
 
 
+#: Most contact sub-steps per net sub-step (the impact model sizes them at 0.02 rad of the contact's
+#: linearized oscillation, multibody.kernel.CONTACT_PHASE_PER_SUBSTEP).
+MAX_CONTACT_SUBSTEPS = 64
+
+
 @njit(cache=True, inline="always")
-def _node_contact(i, x, v, f, node_mass, penetration, nbx, nby, nbz, com, rot, vel, omega, mass, inverse_inertia, law,
-                  h, work):
+def _node_contact(i, x, v, lag, f, node_mass, penetration, nbx, nby, nbz, com, rot, vel, omega, mass, inverse_inertia,
+                  law, h, work):
     """Contact of node ``i`` (``penetration`` (m) along the debris-frame normal ``nb``) with the debris
-    over one sub-step (the impact model's law and friction, :func:`multibody.contact.contact_over_step`
-    with one sub-step). Adds the contact force to ``f[i]`` and returns it (N, inertial) with the
-    dissipated energy (J)."""
+    over one net sub-step, sub-cycled in time exactly as the impact model does
+    (:func:`multibody.contact.contact_over_step`, sub-steps sized by
+    :func:`multibody.kernel._substeps_to_resolve_contact`; starting from the node's velocity plus the
+    ``lag`` carried from the last sub-step). Returns the mean and end velocity changes (m/s) and the
+    dissipated energy (J); the caller kicks with the mean and carries end - mean as the next lag."""
     ax, ay, az = x[i, 0] - com[0], x[i, 1] - com[1], x[i, 2] - com[2]
     pen, rel, normal, ext, masses = work[0:1], work[1:4].reshape(1, 3), work[4:7].reshape(1, 3), work[7:10], work[10:11]
     pen[0] = penetration
     normal[0, 0] = rot[0, 0] * nbx + rot[0, 1] * nby + rot[0, 2] * nbz
     normal[0, 1] = rot[1, 0] * nbx + rot[1, 1] * nby + rot[1, 2] * nbz
     normal[0, 2] = rot[2, 0] * nbx + rot[2, 1] * nby + rot[2, 2] * nbz
-    rel[0, 0] = v[i, 0] - vel[0] - (omega[1] * az - omega[2] * ay)
-    rel[0, 1] = v[i, 1] - vel[1] - (omega[2] * ax - omega[0] * az)
-    rel[0, 2] = v[i, 2] - vel[2] - (omega[0] * ay - omega[1] * ax)
+    rel[0, 0] = v[i, 0] + lag[i, 0] - vel[0] - (omega[1] * az - omega[2] * ay)
+    rel[0, 1] = v[i, 1] + lag[i, 1] - vel[1] - (omega[2] * ax - omega[0] * az)
+    rel[0, 2] = v[i, 2] + lag[i, 2] - vel[2] - (omega[0] * ay - omega[1] * ax)
     ext[0], ext[1], ext[2] = f[i, 0], f[i, 1], f[i, 2]
     masses[0] = _effective_mass_along_normal(rot, inverse_inertia, mass, ax, ay, az,
                                              normal[0, 0], normal[0, 1], normal[0, 2])
-    _, _, _, ux, uy, uz, dissipated = contact_over_step(
-        work[0:1], rel, normal, ext, node_mass, masses, h, 1, law[C_K], law[C_EXP], law[C_D], law[C_MUS], law[C_MUK],
+    n_sub = min(MAX_CONTACT_SUBSTEPS, _substeps_to_resolve_contact(pen, rel, normal, masses, 1, ext, node_mass, h,
+                                                                    law[C_K], law[C_EXP], law[C_D]))
+    return contact_over_step(
+        pen, rel, normal, ext, node_mass, masses, h, n_sub, law[C_K], law[C_EXP], law[C_D], law[C_MUS], law[C_MUK],
         law[C_VT], work[11:14].reshape(1, 3), work[14:15], work[15:18].reshape(1, 3), work[18:21].reshape(1, 3))
-    fx, fy, fz = node_mass * ux / h, node_mass * uy / h, node_mass * uz / h
-    f[i, 0] += fx
-    f[i, 1] += fy
-    f[i, 2] += fz
-    return fx, fy, fz, dissipated
 
 
 @njit(cache=True)
-def net_forces(x, v, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu, central, main_tether,
-               a_point, a_velocity, com_c, com_d, rot_d, vel_d, omega_d, mass_d, inverse_inertia_d, geometry, law, h,
-               f, acc, work):
+def net_forces(x, v, lag, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu, central,
+               main_tether, a_point, a_velocity, com_c, com_d, rot_d, vel_d, omega_d, mass_d, inverse_inertia_d, geometry,
+               law, h, f, acc, work, explicit_tether=True):
     """Forces on every node (``f`` (n, 3), N) at positions ``x`` (displacements from ``reference``, m)
     and velocities ``v`` (m/s); the reactions on the bodies (force, torque about the CoM, inertial)
     are added to ``acc`` times ``h`` (impulses), with the main tether's tension, contact count, total
@@ -123,7 +128,8 @@ def net_forces(x, v, node_mass, node_radius, threads, rest, stiffness, damping, 
     ``a_point`` (absolute, m) moving with ``a_velocity`` (m/s); chaser CoM ``com_c`` (absolute, m);
     the debris (CoM ``com_d``, relative to ``reference`` like the nodes, attitude
     ``rot_d``, velocity ``vel_d``, angular velocity ``omega_d`` inertial) is the cylinder ``geometry``.
-    Returns the main tether's (tension, elongation, elongation rate).
+    Returns the main tether's (tension, elongation, elongation rate). With ``explicit_tether`` False
+    the main tether is left out (the sub-cycle steps it implicitly, :func:`_implicit_tether_step`).
     """
     f[:] = 0.0
     add_thread_forces(x, v, threads, rest, stiffness, damping, f)
@@ -138,7 +144,43 @@ def net_forces(x, v, node_mass, node_radius, threads, rest, stiffness, damping, 
         acc[ACC_EXTERNAL] += h * node_mass[i] * gx
         acc[ACC_EXTERNAL + 1] += h * node_mass[i] * gy
         acc[ACC_EXTERNAL + 2] += h * node_mass[i] * gz
-    # main tether: node -> chaser attachment A
+    tension, stretch, rate = 0.0, 0.0, 0.0
+    if explicit_tether:
+        tension, stretch, rate = _main_tether(x, v, reference, central, main_tether, a_point, a_velocity, com_c, h, f,
+                                              acc)
+    for t in range(threads.shape[0] - 12, threads.shape[0]):  # the closing loop is the last 12 threads
+        a, b = threads[t, 0], threads[t, 1]
+        length = math.sqrt((x[b, 0] - x[a, 0]) ** 2 + (x[b, 1] - x[a, 1]) ** 2 + (x[b, 2] - x[a, 2]) ** 2)
+        acc[ACC_CLOSING] = max(acc[ACC_CLOSING], stiffness[t] * (length - rest[t]))
+    for i in range(n):
+        kx, ky, kz = lag[i, 0], lag[i, 1], lag[i, 2]  # release the lag of the last sub-step
+        lag[i, 0] = lag[i, 1] = lag[i, 2] = 0.0
+        penetration, nbx, nby, nbz, near = _near(i, x, v, node_radius[i], com_d, rot_d, vel_d, omega_d, geometry, h)
+        if near:
+            mx, my, mz, ex, ey, ez, dissipated = _node_contact(
+                i, x, v, lag, f, node_mass[i], penetration, nbx, nby, nbz, com_d, rot_d, vel_d, omega_d, mass_d,
+                inverse_inertia_d, law, h, work)
+            kx, ky, kz = kx + mx, ky + my, kz + mz
+            lag[i, 0], lag[i, 1], lag[i, 2] = ex - mx, ey - my, ez - mz
+            acc[ACC_DISSIPATED] += dissipated
+        if kx != 0.0 or ky != 0.0 or kz != 0.0:
+            fx, fy, fz = node_mass[i] * kx / h, node_mass[i] * ky / h, node_mass[i] * kz / h
+            f[i, 0] += fx
+            f[i, 1] += fy
+            f[i, 2] += fz
+            rx, ry, rz = x[i, 0] - com_d[0], x[i, 1] - com_d[1], x[i, 2] - com_d[2]
+            _add_impulse(acc, ACC_DEBRIS_F, -fx * h, -fy * h, -fz * h, rx, ry, rz)
+            acc[ACC_CONTACT_F] += math.sqrt(fx * fx + fy * fy + fz * fz) * h
+        if penetration > 0.0:
+            acc[ACC_CONTACTS] += h
+    return tension, stretch, rate
+
+
+@njit(cache=True)
+def _main_tether(x, v, reference, central, main_tether, a_point, a_velocity, com_c, h, f, acc):
+    """Main tether (eq. 5a) from node ``central`` to the chaser's attachment ``a_point`` (absolute, m)
+    at the current state: its pull into ``f``, the reaction's impulse over ``h`` on the chaser into
+    ``acc``. Returns (tension (N), elongation (m), elongation rate (m/s))."""
     dx = reference[0] + x[central, 0] - a_point[0]
     dy = reference[1] + x[central, 1] - a_point[1]
     dz = reference[2] + x[central, 2] - a_point[2]
@@ -153,23 +195,6 @@ def net_forces(x, v, node_mass, node_radius, threads, rest, stiffness, damping, 
     rx, ry, rz = a_point[0] - com_c[0], a_point[1] - com_c[1], a_point[2] - com_c[2]
     _add_impulse(acc, ACC_CHASER_F, tension * ux * h, tension * uy * h, tension * uz * h, rx, ry, rz)
     acc[ACC_TENSION] += tension * h
-    for t in range(threads.shape[0] - 12, threads.shape[0]):  # the closing loop is the last 12 threads
-        a, b = threads[t, 0], threads[t, 1]
-        stretch = math.sqrt((x[b, 0] - x[a, 0]) ** 2 + (x[b, 1] - x[a, 1]) ** 2 + (x[b, 2] - x[a, 2]) ** 2) - rest[t]
-        acc[ACC_CLOSING] = max(acc[ACC_CLOSING], stiffness[t] * stretch)
-    for i in range(n):
-        penetration, nbx, nby, nbz, near = _near(i, x, v, node_radius[i], com_d, rot_d, vel_d, omega_d, geometry, h)
-        if not near:
-            continue
-        fx, fy, fz, dissipated = _node_contact(i, x, v, f, node_mass[i], penetration, nbx, nby, nbz, com_d, rot_d, vel_d,
-                                               omega_d, mass_d, inverse_inertia_d, law, h, work)
-        if fx != 0.0 or fy != 0.0 or fz != 0.0:
-            rx, ry, rz = x[i, 0] - com_d[0], x[i, 1] - com_d[1], x[i, 2] - com_d[2]
-            _add_impulse(acc, ACC_DEBRIS_F, -fx * h, -fy * h, -fz * h, rx, ry, rz)
-            acc[ACC_CONTACT_F] += math.sqrt(fx * fx + fy * fy + fz * fz) * h
-        if penetration > 0.0:
-            acc[ACC_CONTACTS] += h
-        acc[ACC_DISSIPATED] += dissipated
     return tension, length - main_tether[2], rate
 
 
@@ -193,7 +218,7 @@ def _geodesic(rot_end, omega_body, back):
 
 
 @njit(cache=True)
-def advance_net(x, v, t_start, t_end, n_sub, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu,
+def advance_net(x, v, lag, t_start, t_end, n_sub, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu,
                 central, main_tether, attach_chaser_body, bodies, mass_d, inverse_inertia_d, geometry, law, f, acc,
                 work):
     """Advance the net from ``t_start`` to ``t_end`` (s) by ``n_sub`` symplectic-Euler sub-steps while
@@ -210,24 +235,56 @@ def advance_net(x, v, t_start, t_end, n_sub, node_mass, node_radius, threads, re
     com_c, com_d, a_point, a_velocity = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     for k in range(n_sub):
         back = t_end - (t_start + k * h)
-        rot_c = _geodesic(rot_c_end, bodies[0, 9:12], back)
         rot_d = _geodesic(rot_d_end, bodies[1, 9:12], back)
-        arm = rot_c @ attach_chaser_body
-        spin = rot_c @ np.cross(bodies[0, 9:12], attach_chaser_body)
         for a in range(3):
-            com_c[a] = bodies[0, a] - back * bodies[0, 6 + a]
-            com_d[a] = bodies[1, a] - back * bodies[1, 6 + a]
-            a_point[a] = com_c[a] + arm[a]
-            a_velocity[a] = bodies[0, 6 + a] + spin[a]
+            com_d[a] = bodies[1, a] - back * bodies[1, 6 + a] - reference[a]
+        _attachment(bodies[0], rot_c_end, attach_chaser_body, back, com_c, a_point, a_velocity)
         omega_d = rot_d @ bodies[1, 9:12]
-        out = net_forces(x, v, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu, central,
-                         main_tether, a_point, a_velocity, com_c, com_d - reference, rot_d, bodies[1, 6:9], omega_d,
-                         mass_d, inverse_inertia_d, geometry, law, h, f, acc, work)
+        net_forces(x, v, lag, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu, central,
+                   main_tether, a_point, a_velocity, com_c, com_d, rot_d, bodies[1, 6:9], omega_d,
+                   mass_d, inverse_inertia_d, geometry, law, h, f, acc, work, False)
         for i in range(x.shape[0]):
+            if i == central:
+                continue
             for a in range(3):
                 v[i, a] += h * f[i, a] / node_mass[i]
                 x[i, a] += h * v[i, a]
+        _attachment(bodies[0], rot_c_end, attach_chaser_body, back - h, com_c, a_point, a_velocity)
+        out = _implicit_tether_step(x, v, f, node_mass[central], reference, central, main_tether, a_point, a_velocity,
+                                    com_c, h, acc)
     return out
+
+
+@njit(cache=True)
+def _attachment(chaser, rot_end, attach_body, back, com, point, velocity):
+    """Chaser CoM, attachment point A (absolute, m) and A's velocity (m/s) ``back`` seconds before
+    the step's end, on Verlet's path (``chaser``: a row of ``bodies``, see :func:`advance_net`)."""
+    rot = _geodesic(rot_end, chaser[9:12], back)
+    arm = rot @ attach_body
+    spin = rot @ np.cross(chaser[9:12], attach_body)
+    for a in range(3):
+        com[a] = chaser[a] - back * chaser[6 + a]
+        point[a] = com[a] + arm[a]
+        velocity[a] = chaser[6 + a] + spin[a]
+
+
+@njit(cache=True)
+def _implicit_tether_step(x, v, f, mass, reference, central, main_tether, a_point, a_velocity, com_c, h, acc):
+    """Backward-Euler sub-step of the central node under the main tether, the node's other forces
+    ``f[central]`` held: :math:`m(v_{k+1} - v_k) = h(F_{MT}(x_k + h v_{k+1}, v_{k+1}) + f)`, Newton on the
+    tether Jacobians (:func:`multibody.connection_point.implicit_point_step`, the lower-order model's
+    P solver), A at the sub-step's end. The tether's damping on a 10 g node (c_MT/m ~ 3e4 1/s) would
+    need an explicit sub-step below ~60 us; backward Euler is L-stable. The chaser gets the reaction
+    of the tension at the new state, so the momentum exchange stays exact. Returns (tension,
+    elongation, rate) at the new state."""
+    points = np.empty((1, 3))
+    for a in range(3):
+        points[0, a] = a_point[a] - reference[a]
+    k, c, rest = np.full(1, main_tether[0]), np.full(1, main_tether[1]), np.full(1, main_tether[2])
+    x_new, v_new = implicit_point_step(x[central], v[central], h, mass, reference, 0.0, points,
+                                       a_velocity.reshape(1, 3), k, c, rest, v[central], f[central])
+    x[central], v[central] = x_new, v_new
+    return _main_tether(x, v, reference, central, main_tether, a_point, a_velocity, com_c, h, f, acc)
 
 
 @njit(cache=True)

@@ -105,7 +105,7 @@ def _drape(x, v, masses, radii, threads, rest, stiffness, damping, central, rest
            up, fall, reel, settle, gravity, drag, h):
     n_closing = rest_open.shape[0]
     first = threads.shape[0] - n_closing
-    f = np.zeros_like(x)
+    f, lag = np.zeros_like(x), np.zeros_like(x)
     acc, work = np.zeros(ACC_SIZE), np.zeros(21)
     zeros3, big = np.zeros(3), 1e30
     rot, tether = np.eye(3), np.zeros(3)
@@ -118,7 +118,7 @@ def _drape(x, v, masses, radii, threads, rest, stiffness, damping, central, rest
         for c in range(n_closing):
             rest[first + c] = rest_open[c] + ramp * (rest_closed[c] - rest_open[c])
             stiffness[first + c] = ea / rest[first + c]
-        net_forces(x, v, masses, radii, threads, rest, stiffness, damping, zeros3, 0.0, central, tether, far, zeros3,
+        net_forces(x, v, lag, masses, radii, threads, rest, stiffness, damping, zeros3, 0.0, central, tether, far, zeros3,
                    zeros3, zeros3, rot, zeros3, zeros3, big, inverse, geometry, law, h, f, acc, work)
         g = gravity if t < fall + reel else 0.0
         for i in range(x.shape[0]):

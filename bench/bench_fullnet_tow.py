@@ -1,0 +1,88 @@
+"""Full-net towing benchmark (issue 7 item 6: the 300 s full-net tow in under 10 min on 2 cores).
+
+    python bench/bench_fullnet_tow.py                      # the case's full run (25 -> 300 s)
+    python bench/bench_fullnet_tow.py --study --end 45     # step-convergence study over 20 s of towing
+
+Prints the wrapped-state preparation time, the run's wall time, steps per second, the step and
+sub-step, and sanity figures: momentum balance (|P(t) - P(t0) - external impulse|, N s, against the
+external impulse), main-tether and closing-loop tension, debris spin. The study runs the case at
+several (step, sub-steps) pairs and prints the RMSE of r_D/C, omega_C, omega_D and T_MT against the
+finest pair (the identification's channels, eqs. 19 and 21). Timings are upper bounds on a shared machine.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+from multibody.net_towing import run_exudyn
+from riskassess.case import load_model
+from riskassess.identify import compared_series, rmse
+from riskassess.tow_fullnet import full_net_model, momentum_residual, wrapped_net
+from riskassess.towing_case import TowingCase
+
+CASE = os.path.join(os.path.dirname(__file__), "..", "cases", "zenit2_towing.toml")
+
+
+def run(case, wrapped, rate, end, step=None, substeps=None):
+    model = full_net_model(case, rate, wrapped=wrapped, end_time=end, step=step, substeps=substeps)
+    return model, run_exudyn(model)
+
+
+def report(model, result):
+    s = result.series()
+    t, tension = s["time"], s["main_tether_tension"]
+    impulse = np.linalg.norm(s["external_impulse_inertial"][-1] - s["external_impulse_inertial"][0])
+    print(f"simulated {model.end_time - model.start_time:g} s: {model.n_steps} steps of {model.step * 1e3:g} ms, "
+          f"{model.substeps} net sub-steps each ({model.step / model.substeps * 1e6:g} us), {len(model.node_positions)} nodes")
+    print(f"wall {result.wall_time:.1f} s, {model.n_steps / result.wall_time:.0f} steps/s, "
+          f"{model.n_steps * model.substeps / result.wall_time:.0f} net sub-steps/s")
+    print(f"momentum balance: max |P - P0 - J_ext| = {momentum_residual(s):.3e} N s against |J_ext| = {impulse:.4e} N s")
+    thrust = s["thrust"] > 0
+    print(f"main tether: peak {tension.max():.1f} N, final {tension[-1]:.1f} N, slack while thrusting "
+          f"{np.sum(np.diff(t, prepend=t[0])[thrust & (tension <= 0)]):.2f} s; closing loop peak "
+          f"{s['closing_thread_peak_tension'].max():.1f} N; mean nodes in contact {s['net_contacts'].mean():.1f}")
+    w = np.degrees(np.linalg.norm(s["debris_omega_body"], axis=1))
+    sep = np.linalg.norm(s["debris_com_inertial"] - s["chaser_com_inertial"], axis=1)
+    print(f"debris spin {w[0]:.3f} -> {w[-1]:.3f} deg/s; chaser-debris distance {sep[0]:.3f} -> {sep[-1]:.3f} m "
+          f"(min {sep.min():.3f}, max {sep.max():.3f})")
+
+
+def study(case, wrapped, rate, end, pairs):
+    reference = None
+    rows = []
+    for step, substeps in pairs:
+        model, result = run(case, wrapped, rate, end, step, substeps)
+        rows.append((step, substeps, compared_series(result), result.wall_time))
+    reference = rows[-1][2]
+    print("| step (ms) | sub-steps | net step (us) | r_D/C (m) | omega_C (rad/s) | omega_D (rad/s) | T_MT (N) | wall (s) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for step, substeps, series, wall in rows:
+        e = [rmse(series[k], reference[k]) for k in ("relative_position", "chaser_omega_body", "debris_omega_body",
+                                                      "main_tether_tension")]
+        print(f"| {step * 1e3:g} | {substeps} | {step / substeps * 1e6:g} | {e[0]:.2e} | {e[1]:.2e} | {e[2]:.2e} | "
+              f"{e[3]:.2e} | {wall:.1f} |")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--case", default=CASE)
+    parser.add_argument("--rate", type=float, default=None, help="debris spin (deg/s); default the case's")
+    parser.add_argument("--end", type=float, default=None, help="end time (s); default the case's")
+    parser.add_argument("--study", action="store_true", help="step-convergence study instead of one run")
+    args = parser.parse_args()
+    case = load_model(args.case, TowingCase)
+    start = time.perf_counter()
+    wrapped = wrapped_net(case)
+    print(f"wrapped state prepared in {time.perf_counter() - start:.1f} s (drape and close, compiled)")
+    if args.study:
+        pairs = [(4e-3, 20), (4e-3, 40), (2e-3, 10), (2e-3, 20), (2e-3, 40), (1e-3, 20)]
+        study(case, wrapped, args.rate, args.end or 45.0, pairs)
+        return
+    report(*run(case, wrapped, args.rate, args.end))
+
+
+if __name__ == "__main__":
+    main()
