@@ -21,24 +21,31 @@ def quaternion_from_matrix(body_to_inertial):
 
     Inverse of paper eq. (6); the sign is chosen with a non-negative scalar part.
     """
-    a = body_to_inertial
+    out = np.empty(4)
+    out[0], out[1], out[2], out[3] = _quaternion_from_matrix(body_to_inertial)
+    return out
+
+
+@njit(cache=True, inline="always")
+def _quaternion_from_matrix(a):
+    """:func:`quaternion_from_matrix` as a tuple (no allocation: the attitude controller runs every step)."""
     trace = a[0, 0] + a[1, 1] + a[2, 2]
-    q = np.empty(4)
     if trace > max(a[0, 0], a[1, 1], a[2, 2]):
         s = 2.0 * math.sqrt(1.0 + trace)
-        q[0], q[1], q[2], q[3] = 0.25 * s, (a[2, 1] - a[1, 2]) / s, (a[0, 2] - a[2, 0]) / s, (a[1, 0] - a[0, 1]) / s
+        q = 0.25 * s, (a[2, 1] - a[1, 2]) / s, (a[0, 2] - a[2, 0]) / s, (a[1, 0] - a[0, 1]) / s
     elif a[0, 0] >= a[1, 1] and a[0, 0] >= a[2, 2]:
         s = 2.0 * math.sqrt(1.0 + a[0, 0] - a[1, 1] - a[2, 2])
-        q[0], q[1], q[2], q[3] = (a[2, 1] - a[1, 2]) / s, 0.25 * s, (a[0, 1] + a[1, 0]) / s, (a[0, 2] + a[2, 0]) / s
+        q = (a[2, 1] - a[1, 2]) / s, 0.25 * s, (a[0, 1] + a[1, 0]) / s, (a[0, 2] + a[2, 0]) / s
     elif a[1, 1] >= a[2, 2]:
         s = 2.0 * math.sqrt(1.0 + a[1, 1] - a[0, 0] - a[2, 2])
-        q[0], q[1], q[2], q[3] = (a[0, 2] - a[2, 0]) / s, (a[0, 1] + a[1, 0]) / s, 0.25 * s, (a[1, 2] + a[2, 1]) / s
+        q = (a[0, 2] - a[2, 0]) / s, (a[0, 1] + a[1, 0]) / s, 0.25 * s, (a[1, 2] + a[2, 1]) / s
     else:
         s = 2.0 * math.sqrt(1.0 + a[2, 2] - a[0, 0] - a[1, 1])
-        q[0], q[1], q[2], q[3] = (a[1, 0] - a[0, 1]) / s, (a[0, 2] + a[2, 0]) / s, (a[1, 2] + a[2, 1]) / s, 0.25 * s
+        q = (a[1, 0] - a[0, 1]) / s, (a[0, 2] + a[2, 0]) / s, (a[1, 2] + a[2, 1]) / s, 0.25 * s
     if q[0] < 0.0:
-        q = -q
-    return q / math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+        q = -q[0], -q[1], -q[2], -q[3]
+    norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    return q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm
 
 
 @njit(cache=True)
@@ -64,23 +71,17 @@ def kinematics_matrix(q):
 
 @njit(cache=True, inline="always")
 def _kinematics_times(q, w):
-    """:math:`Q(q)\\,w` (4,) without forming Q."""
-    out = np.empty(4)
-    out[0] = -q[1] * w[0] - q[2] * w[1] - q[3] * w[2]
-    out[1] = q[0] * w[0] - q[3] * w[1] + q[2] * w[2]
-    out[2] = q[3] * w[0] + q[0] * w[1] - q[1] * w[2]
-    out[3] = -q[2] * w[0] + q[1] * w[1] + q[0] * w[2]
-    return out
+    """:math:`Q(q)\\,w` (4-tuple) without forming Q."""
+    return (-q[1] * w[0] - q[2] * w[1] - q[3] * w[2], q[0] * w[0] - q[3] * w[1] + q[2] * w[2],
+            q[3] * w[0] + q[0] * w[1] - q[1] * w[2], -q[2] * w[0] + q[1] * w[1] + q[0] * w[2])
 
 
 @njit(cache=True, inline="always")
 def _kinematics_transpose_times(q, x):
-    """:math:`Q(q)^T x` (3,) for a 4-vector x without forming Q."""
-    out = np.empty(3)
-    out[0] = -q[1] * x[0] + q[0] * x[1] + q[3] * x[2] - q[2] * x[3]
-    out[1] = -q[2] * x[0] - q[3] * x[1] + q[0] * x[2] + q[1] * x[3]
-    out[2] = -q[3] * x[0] + q[2] * x[1] - q[1] * x[2] + q[0] * x[3]
-    return out
+    """:math:`Q(q)^T x` (3-tuple) for a 4-vector x without forming Q."""
+    return (-q[1] * x[0] + q[0] * x[1] + q[3] * x[2] - q[2] * x[3],
+            -q[2] * x[0] - q[3] * x[1] + q[0] * x[2] + q[1] * x[3],
+            -q[3] * x[0] + q[2] * x[1] - q[1] * x[2] + q[0] * x[3])
 
 
 @njit(cache=True)
@@ -96,14 +97,23 @@ def desired_attitude(u_main_tether_inertial, r_chaser_inertial):
     r_chaser_inertial : (3,) float
         Chaser CoM from the Earth's centre (m), inertial.
     """
-    ez = -u_main_tether_inertial / math.sqrt(dot3(u_main_tether_inertial, u_main_tether_inertial))
-    radial = r_chaser_inertial / math.sqrt(dot3(r_chaser_inertial, r_chaser_inertial))
-    ex = cross3(ez, radial)
-    ex /= math.sqrt(dot3(ex, ex))
-    ey = cross3(ez, ex)
+    u, r = u_main_tether_inertial, r_chaser_inertial
+    u_norm, r_norm = math.sqrt(dot3(u, u)), math.sqrt(dot3(r, r))
+    ez = -u[0] / u_norm, -u[1] / u_norm, -u[2] / u_norm  # tuples: this runs every step of a tow
+    radial = r[0] / r_norm, r[1] / r_norm, r[2] / r_norm
+    ex = _cross(ez, radial)
+    ex_norm = math.sqrt(dot3(ex, ex))
+    ex = ex[0] / ex_norm, ex[1] / ex_norm, ex[2] / ex_norm
+    ey = _cross(ez, ex)
     out = np.empty((3, 3))
-    out[:, 0], out[:, 1], out[:, 2] = ex, ey, ez
+    for i in range(3):
+        out[i, 0], out[i, 1], out[i, 2] = ex[i], ey[i], ez[i]
     return out
+
+
+@njit(cache=True, inline="always")
+def _cross(a, b):
+    return a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]
 
 
 @njit(cache=True)
@@ -161,13 +171,16 @@ def sliding_mode_torque(body_to_inertial, omega_body, desired_to_inertial, inert
     width : (3,) float
         Boundary-layer width per axis (rad/s), see :func:`sampled_boundary_layer`.
     """
-    q = quaternion_from_matrix(body_to_inertial)
-    qd = quaternion_from_matrix(desired_to_inertial)
+    q = _quaternion_from_matrix(body_to_inertial)
+    qd = _quaternion_from_matrix(desired_to_inertial)
     sign = 1.0 if qd[0] * q[0] + qd[1] * q[1] + qd[2] * q[2] + qd[3] * q[3] >= 0.0 else -1.0
-    s = omega_body + k_gain * sign * _kinematics_transpose_times(qd, q)
-    feedforward = -0.5 * k_gain * sign * _kinematics_transpose_times(qd, _kinematics_times(q, omega_body))
-    demand = np.empty(3)
+    error = _kinematics_transpose_times(qd, q)
+    feedforward = _kinematics_transpose_times(qd, _kinematics_times(q, omega_body))
+    w = omega_body
+    jw = matvec3(inertia_body, w)
+    s, demand = np.empty(3), np.empty(3)
     for i in range(3):
-        demand[i] = feedforward[i] - gain[i] * min(1.0, max(-1.0, s[i] / width[i]))
-    torque = cross3(omega_body, matvec3(inertia_body, omega_body)) + matvec3(inertia_body, demand)
+        s[i] = w[i] + k_gain * sign * error[i]
+        demand[i] = -0.5 * k_gain * sign * feedforward[i] - gain[i] * min(1.0, max(-1.0, s[i] / width[i]))
+    torque = cross3(w, jw) + matvec3(inertia_body, demand)
     return torque, s
