@@ -146,8 +146,13 @@ def _cmd_identify(args) -> int:
 
     case = load_model(args.case, TowingCase)
     if not args.benchmark:
-        raise ValueError("identification against full-net runs needs the full-net towing model, which is not "
-                         "built yet; run the Sec. 4.3 benchmark with --benchmark")
+        from riskassess.identify_fullnet import identify_full_net
+
+        out = Path(args.out) if args.out else Path("runs") / f"{case.name}_identify_fullnet"
+        answer = identify_full_net(args.case, out, case)
+        print(json.dumps(answer, indent=2) if args.json else f"s = {answer['s']}, cost {answer['cost']:.4g}, "
+              f"{answer['wall_s']:.0f} s\nresults: {out}")
+        return 0
     out = Path(args.out) if args.out else Path("runs") / f"{case.name}_identify"
     answer = benchmark_case(args.case, out, case=case)
     if args.json:

@@ -1,0 +1,105 @@
+"""`riskassess identify CASE` (without --benchmark): sub-tether identification against full-net runs
+(Boonrath, Singh & Botta 2024, Sec. 4.1, 4.4).
+
+1. Full-net runs (:mod:`riskassess.tow_fullnet`, wrapped start) at the training and validation spin
+   rates of Table 3 (``full_net.identification_training_runs`` / ``_validation_runs`` take the first k),
+   in parallel worker processes, each cached in ``OUT/fullnet/rate_<deg_s>.npz`` (a re-run reuses them).
+2. The lower-order runs start from the full-net state at the start time, as the paper does (Sec. 4.1):
+   debris and chaser states, P at the net node the main tether holds. With the wrapped start the debris
+   has the case's Table 2 state, so this is the case with the chaser moved where the full-net run
+   starts it and ``sub_tethers.connection_point_start_inertial`` at the central node
+   (:func:`lower_order_case`); P's velocity is the debris' rigid motion there, as the node's.
+3. s is identified on the training runs with the optimizers of :mod:`riskassess.identify` (its public
+   :func:`~riskassess.identify.identify`), and the identified model is compared with the unseen
+   validation runs: RMSE per channel (r_D/C, omega_C, omega_D, T_MT, eqs. 19, 21) and the costs.
+"""
+from __future__ import annotations
+
+import multiprocessing
+import time
+from pathlib import Path
+
+import numpy as np
+
+from riskassess import results
+from riskassess.identify import COSTS, identify, rmse, simulate
+from riskassess.towing_case import TowingCase
+
+CHANNELS = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
+
+
+def _run_full_net(task):
+    """One full-net run in a worker: (case, wrapped net, rate, end) -> compared series (+ start state)."""
+    from multibody.net_towing import run_exudyn
+    from riskassess.tow_fullnet import full_net_model
+
+    case, wrapped, rate, end = task
+    model = full_net_model(case, rate, wrapped=wrapped, end_time=end)
+    result = run_exudyn(model)
+    s = result.series()
+    series = {"relative_position": s["debris_com_inertial"] - s["chaser_com_inertial"],
+              "chaser_omega_body": s["chaser_omega_body"], "debris_omega_body": s["debris_omega_body"],
+              "main_tether_tension": s["main_tether_tension"]}   # the channels of identify.compared_series
+    return {**series, "rate_deg_s": rate, "chaser_start_inertial": model.positions[0],
+            "node_start_inertial": model.node_positions[model.net.central], "wall_s": result.wall_time}
+
+
+def full_net_runs(case: TowingCase, rates, out: Path, end, workers) -> list[dict]:
+    """Full-net runs at ``rates`` (deg/s), read from ``out``'s cache where present (same end time)."""
+    from riskassess.tow_fullnet import wrapped_net
+
+    cache = out / "fullnet"
+    cache.mkdir(parents=True, exist_ok=True)
+    path = {rate: cache / f"rate_{rate:.2f}_end_{end:g}.npz" for rate in rates}
+    missing = [rate for rate in rates if not path[rate].exists()]
+    if missing:
+        wrapped = wrapped_net(case)
+        with multiprocessing.get_context("fork").Pool(min(workers, len(missing))) as pool:
+            for rate, run in zip(missing, pool.map(_run_full_net, [(case, wrapped, r, end) for r in missing])):
+                results.atomic_write_npz(path[rate], run)
+    return [{k: (float(v) if v.ndim == 0 else v) for k, v in np.load(path[rate]).items()} for rate in rates]
+
+
+def lower_order_case(case: TowingCase, run: dict) -> TowingCase:
+    """The case whose lower-order runs start from the full-net start state (module doc, item 2)."""
+    chaser = case.chaser.model_copy(update={"position_inertial": list(map(float, run["chaser_start_inertial"]))})
+    tethers = case.sub_tethers.model_copy(
+        update={"connection_point_start_inertial": list(map(float, run["node_start_inertial"]))})
+    return case.model_copy(update={"chaser": chaser, "sub_tethers": tethers})
+
+
+def validation_rmse(case: TowingCase, s, data: list[dict], end) -> list[dict]:
+    """Per validation run: RMSE of each channel and both costs of the lower-order model with ``s``."""
+    rows = []
+    for run in data:
+        model = simulate(case, run["rate_deg_s"], s, end)
+        rows.append({"rate_deg_s": run["rate_deg_s"], **{f"rmse_{c}": rmse(model[c], run[c]) for c in CHANNELS},
+                     "f1": COSTS["f1"](model, run, case.identification.weights), "f2": COSTS["f2"](model, run)})
+    return rows
+
+
+def identify_full_net(case_path, out_dir, case: TowingCase, optimizer: str = "pattern") -> dict:
+    """Steps 1-3 of the module doc; writes ``identification.json`` and a manifest to ``out_dir``."""
+    fn = case.full_net
+    if fn is None:
+        raise ValueError(f"{case_path}: identification against full-net runs needs a [full_net] section")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    end = fn.identification_end_time or case.simulation.end_time
+    training = case.rates.training_deg_s[:fn.identification_training_runs]
+    validation = case.rates.validation_deg_s[:fn.identification_validation_runs]
+    start = time.perf_counter()
+    data = full_net_runs(case, list(training) + list(validation), out, end, case.identification.workers)
+    data_wall = time.perf_counter() - start
+    lower = lower_order_case(case, data[0])
+    found = identify(lower, data[:len(training)], optimizer, end_time=end)
+    answer = {"case": case.name, "s": found.s.tolist(), "cost": found.cost, "optimizer": optimizer,
+              "cost_function": case.identification.cost, "evaluations": found.evaluations, "wall_s": None,
+              "end_time_s": end, "training_rates_deg_s": list(training), "validation_rates_deg_s": list(validation),
+              "full_net_runs_wall_s": data_wall, "identification_wall_s": found.wall_s,
+              "validation": validation_rmse(lower, found.s, data[len(training):], end)}
+    answer["wall_s"] = time.perf_counter() - start
+    results.atomic_write_json(out / "identification.json", answer)
+    results.atomic_write_json(out / "manifest.json", {"format": "riskassess-identify", "version": 1, "case": case.name,
+                                                      "status": "complete", "files": ["identification.json"]})
+    return answer
