@@ -16,9 +16,10 @@ A towing law has the signature ``law(t, q, v, p, work, xe, h, load)``:
   (P's entries are stale: read P from :func:`point_position`);
 * ``p`` the effect's law parameters, ``work`` the packed model (geometry, masses, the last
   evaluation's diagnostics: main-tether elongation and rate, thrust);
-* ``xe`` (``EXTRA_STATES``,) the effects' own states (``XE_MAXWELL``: Maxwell-branch tension (N);
-  ``XE_DAMPER``: a nutation damper's angular velocity, debris frame (rad/s)), advanced in place by
-  the law over ``h`` (s; 0: do not advance);
+* ``xe`` (``EXTRA_STATES``,) the effects' own states (``XE_MAXWELL``: Maxwell-branch tension (N),
+  ``XE_ELONGATION``: the elongation it was last advanced at (m); ``XE_DAMPER``: a nutation damper's
+  angular velocity, debris frame (rad/s)), advanced in place by the law over ``h`` (s; 0: do not
+  advance);
 * ``load`` (15,) the generalized forces it ADDS, kernel layout: force on P (N, inertial), chaser
   and debris force (N, inertial) and torque (N m, body frame).
 
@@ -39,8 +40,18 @@ _VECTOR = types.float64[::1]
 #: compiled integrator takes any of them as a first-class function.
 TOWING_LAW_SIGNATURE = types.void(types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64, _VECTOR)
 _LAW = types.FunctionType(TOWING_LAW_SIGNATURE)
-#: Effects' own states: Maxwell-branch tension (N), damper angular velocity (3, debris frame, rad/s).
-XE_MAXWELL, XE_DAMPER, EXTRA_STATES = 0, 1, 4
+#: Effects' own states: Maxwell-branch tension (N), the main tether's elongation when it was last
+#: advanced (m), damper angular velocity (3, debris frame, rad/s).
+XE_MAXWELL, XE_ELONGATION, XE_DAMPER, EXTRA_STATES = 0, 1, 2, 5
+
+
+def initial_extra_states(omega_debris_body) -> np.ndarray:
+    """``xe`` at t = 0: no Maxwell tension, elongation not yet seen (NaN), the damper turning with the
+    debris (rad/s, debris frame)."""
+    xe = np.zeros(EXTRA_STATES)
+    xe[XE_ELONGATION] = np.nan
+    xe[XE_DAMPER:XE_DAMPER + 3] = omega_debris_body
+    return xe
 
 
 @njit(TOWING_LAW_SIGNATURE, cache=True)
@@ -82,8 +93,10 @@ def main_tether_direction(work, q):
     return d / np.sqrt(d @ d), rot_c
 
 
-@njit(cache=True)
-def _set_loads(law, t, q, v, p, work, xe, h, load):
+@njit(types.void(_LAW, types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64, _VECTOR), cache=True)
+def apply_loads(law, t, q, v, p, work, xe, h, load):
+    """Evaluate ``law`` at (``t``, ``q``, ``v``) into ``load`` and make it the packed model's further
+    forces for the coming force evaluation (advancing the effect states ``xe`` over ``h``)."""
     load[:] = 0.0
     law(t, q, v, p, work, xe, h, load)
     extra = extra_forces(work)
@@ -98,7 +111,7 @@ def integrate(law, p, q, v, t0, n_steps, work, xe, record, out_q, out_v, out_dia
     listed in ``record`` (increasing step indices, 0 = the initial state) into the ``out_*`` rows."""
     step = work[W_STEP]
     load = np.zeros(N_COORDINATES)
-    _set_loads(law, t0, q, v, p, work, xe, 0.0, load)
+    apply_loads(law, t0, q, v, p, work, xe, 0.0, load)
     start_forces(q, v, t0, work)
     acc = work[int(work[W_ACCEL]):int(work[W_ACCEL]) + N_COORDINATES]     # the stored accelerations (a view)
     k = 0
@@ -111,7 +124,7 @@ def integrate(law, p, q, v, t0, n_steps, work, xe, record, out_q, out_v, out_dia
         if n == n_steps or k == record.shape[0]:
             break
         q_next, v_half = verlet_evaluation_state(q, v, acc, step, 3, 2)
-        _set_loads(law, t + step, q_next, v_half, p, work, xe, step, load)
+        apply_loads(law, t + step, q_next, v_half, p, work, xe, step, load)
         start_forces(q_next, v_half, t + step, work)
         q[:] = q_next
         v[:] = v_half + (0.5 * step) * acc

@@ -21,9 +21,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from diagnosis.towing_dynamics import EXTRA_STATES, XE_DAMPER, XE_MAXWELL, diagnostics_size, integrate, no_towing_load
+from diagnosis.towing_dynamics import (EXTRA_STATES, diagnostics_size, initial_extra_states, integrate,
+                                      no_towing_load)
 from multibody.towing import packed
-from multibody.towing_kernel import K_MT, C_MT, MT_ELONGATION, MT_ELONGATION_RATE
+from multibody.towing_kernel import MT_TENSION
 
 #: Nominal parameters of the towing scenario: name -> (size, unit), the fitted vector's order.
 TOWING_PARAMETERS = {"attitude": (3, "rad"), "angular_velocity": (3, "rad/s"), "position": (3, "m"),
@@ -173,8 +174,7 @@ def simulate(plant: TowingPlant, times, law=no_towing_load, p=np.zeros(1), step:
     record = np.unique(np.r_[lower, lower[weight > 0] + 1]).astype(np.int64)
     q, v = model.initial_state()
     work = packed(model)
-    xe = np.zeros(EXTRA_STATES)
-    xe[XE_DAMPER:XE_DAMPER + 3] = model.omega_body[1]
+    xe = initial_extra_states(model.omega_body[1])
     out = [np.zeros((len(record), n)) for n in (15, 15, diagnostics_size(work), EXTRA_STATES)]
     integrate(law, np.ascontiguousarray(p, float), q, v, model.start_time, int(record[-1]), work, xe, record, *out)
     rows = channels(plant, model, *out)
@@ -193,12 +193,8 @@ def channels(plant: TowingPlant, model, q, v, diag, xe) -> dict:
     quat = (to_lvlh * debris).as_quat()[:, [3, 0, 1, 2]]
     quat *= np.where(quat[:, :1] < 0, -1.0, 1.0)
     rel = to_lvlh.apply(r_d - debris.apply(plant.com_offset) - r_c)
-    k, c = model.tether[K_MT], model.tether[C_MT]
-    elastic = k * diag[:, MT_ELONGATION] + c * diag[:, MT_ELONGATION_RATE]
     out = {f"omega_{a}": v[:, 12 + i] for i, a in enumerate("xyz")}
     out.update({f"q_{a}": quat[:, i] for i, a in enumerate("wxyz")})
     out.update({f"rel_{a}": rel[:, i] for i, a in enumerate("xyz")})
-    # the tension-only law of multibody.net.tension_only_kelvin_voigt, plus the Maxwell branch (0 without it)
-    stretched = diag[:, MT_ELONGATION] > 0.0
-    out["tether_tension"] = np.where(stretched, np.maximum(elastic + xe[:, XE_MAXWELL], 0.0), 0.0)
+    out["tether_tension"] = diag[:, MT_TENSION]      # a viscoelastic branch included (it acts through the kernel)
     return out
