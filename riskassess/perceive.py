@@ -344,19 +344,22 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         track.n_points.append(fit.n_points)
         track.true_positions.append(true_net)
         track.separation.append(float(nearest_segments(debris_world, estimate, net.threads)[2].min())
-                                if alignment.ok else 0.0)
+                                if alignment.ok else np.nan)   # unknown without a debris pose
         if progress:
             progress("collision", k, len(times) - 1)
     return track
 
 
 def free_flight_start(track: NetTrack) -> int:
-    """Index (into the collision frames) from which the debris stays clear of the net."""
-    clear = np.asarray(track.separation) > SEPARATION
-    if not clear[-1]:
+    """Index (into the collision frames) from which the debris stays clear of the net. Frames
+    whose debris registration failed have no measured gap and decide nothing (the track may be
+    lost late in the run, when the debris is far and seen through the net)."""
+    separation = np.asarray(track.separation, float)
+    measured = np.flatnonzero(np.isfinite(separation))
+    touching = measured[separation[measured] <= SEPARATION]
+    if len(measured) == 0 or separation[measured[-1]] <= SEPARATION:
         raise NotObservable("the debris is still touching the net (or its registration fails) at the end of the "
                             "collision run; lengthen simulation.end_time")
-    touching = np.flatnonzero(~clear)
     if len(touching) == 0:
         raise NotObservable("the net never came near the debris: the collision transferred no momentum")
     # The contact may end between frames and the gap is measured on an estimated net: the first

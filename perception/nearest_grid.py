@@ -1,0 +1,120 @@
+"""Nearest model point by table look-up: a distance transform of a frozen model on a regular grid.
+
+Point-to-plane ICP asks the same question thousands of times per frame: which model point is
+nearest to this scan point? A KD-tree answers in O(log n) with branchy pointer chasing (about
+10 us per point on the 50 000-point model of the perception case: most of a frame's
+registration time). Once the model is frozen the answer can be tabulated: every cell of a
+regular grid around the model holds the model point nearest to it, and a query is one array
+index per point.
+
+Built once per model: each model point is seeded into its cell (one point per cell, the one
+nearest the cell centre), and an exact Euclidean distance transform
+(``scipy.ndimage.distance_transform_edt`` with ``return_indices``) gives every other cell its
+nearest seeded cell. Cells farther than ``reach`` from every seed hold no point. A query takes
+its cell's point, then the nearest of that point's 8 model neighbours if nearer (one step of
+greedy descent on the model's neighbour graph).
+
+Accuracy, measured on the perception case's ellipsoid model (48 829 points 1.2 cm apart, 1 cm
+cells, 3000 scan points with 2 cm noise): the point found is the exact nearest for ~95 % of the
+queries; the point-to-plane residuals (whose plane is the found point's tangent plane) differ
+from the exact ones by 0.05 mm rms, -0.005 mm on average (without the descent step: 0.12 mm
+rms, -0.04 mm), against the LiDAR's 20 mm range noise. The query costs a tenth of the KD-tree's.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from scipy.ndimage import distance_transform_edt
+from scipy.spatial import cKDTree
+
+#: Model neighbours looked at per descent step, and the most steps.
+NEIGHBOURS = 8
+DESCENT_STEPS = 1
+#: Largest number of grid cells (int32 table: 128 MB); coarser cells for larger models.
+MAX_CELLS = 2**25
+
+
+class NearestPointGrid:
+    """Tabulated nearest-point query over model points (n, 3) (m, any fixed frame).
+
+    Parameters
+    ----------
+    points : (n, 3)  Model points (m).
+    cell : float     Requested cell edge (m); enlarged if the grid would exceed :data:`MAX_CELLS`.
+    reach : float    Queries farther than this from every model point find nothing (m).
+    """
+
+    def __init__(self, points, cell, reach):
+        self.points = np.asarray(points, float)
+        self.low = self.points.min(axis=0) - reach - cell
+        extent = self.points.max(axis=0) + reach + cell - self.low
+        self.cell = max(float(cell), float(np.prod(extent) / MAX_CELLS) ** (1 / 3))
+        self.shape = tuple(int(s) for s in np.ceil(extent / self.cell).astype(int))
+        owner = self._seed_cells()
+        distance, nearest_seed = distance_transform_edt(owner < 0, return_indices=True)
+        table = owner[tuple(nearest_seed)]
+        table[distance * self.cell > reach + self.cell] = -1
+        self.table = table.astype(np.int32).ravel()
+        # Each model point's nearest neighbours, for the descent that refines a cell's answer.
+        self.neighbours = cKDTree(self.points).query(self.points, k=NEIGHBOURS + 1)[1][:, 1:]
+
+    def _cell_index(self, points) -> np.ndarray:
+        return np.floor((points - self.low) / self.cell).astype(np.int64)
+
+    def _seed_cells(self) -> np.ndarray:
+        """Grid (shape) of model point indices: per occupied cell the point nearest its centre, -1 elsewhere."""
+        cells = self._cell_index(self.points)
+        flat = np.ravel_multi_index(cells.T, self.shape)
+        off_centre = np.linalg.norm(self.points - (self.low + (cells + 0.5) * self.cell), axis=1)
+        order = np.lexsort((off_centre, flat))
+        first = order[np.r_[True, flat[order][1:] != flat[order][:-1]]]
+        owner = np.full(int(np.prod(self.shape)), -1, np.int64)
+        owner[flat[first]] = first
+        return owner.reshape(self.shape)
+
+    def query(self, points, distance_upper_bound=np.inf) -> tuple[np.ndarray, np.ndarray]:
+        """Distance (m) to and index of the nearest model point for points (k, 3) (m), like
+        ``scipy.spatial.cKDTree.query``: no match gives distance inf and index n."""
+        points = np.ascontiguousarray(points, dtype=float)
+        return _nearest(points, self.low, self.cell, np.array(self.shape, np.int64), self.table, self.points,
+                        self.neighbours, float(distance_upper_bound), DESCENT_STEPS)
+
+
+@njit(cache=True)
+def _nearest(points, low, cell, shape, table, model, neighbours, upper, steps):
+    """Cell look-up, then up to ``steps`` moves to a nearer model neighbour (greedy descent)."""
+    n = len(points)
+    gap = np.full(n, np.inf)
+    index = np.full(n, len(model), np.int64)
+    for k in range(n):
+        flat = 0
+        inside = True
+        for a in range(3):
+            c = int(np.floor((points[k, a] - low[a]) / cell))
+            if c < 0 or c >= shape[a]:
+                inside = False
+            flat = flat * shape[a] + c
+        if not inside or table[flat] < 0:
+            continue
+        best = table[flat]
+        best_d2 = _distance2(points, k, model, best)
+        for _ in range(steps):
+            moved = False
+            centre = best
+            for m in range(neighbours.shape[1]):
+                j = neighbours[centre, m]
+                d2 = _distance2(points, k, model, j)
+                if d2 < best_d2:
+                    best, best_d2, moved = j, d2, True
+            if not moved:
+                break
+        if best_d2 <= upper * upper:
+            gap[k] = np.sqrt(best_d2)
+            index[k] = best
+    return gap, index
+
+
+@njit(cache=True, inline="always")
+def _distance2(points, k, model, j):
+    return ((points[k, 0] - model[j, 0]) ** 2 + (points[k, 1] - model[j, 1]) ** 2
+            + (points[k, 2] - model[j, 2]) ** 2)

@@ -1,0 +1,43 @@
+"""The tabulated nearest-point query against scipy's exact KD-tree."""
+import numpy as np
+import trimesh
+from scipy.spatial import cKDTree
+
+from perception.nearest_grid import NearestPointGrid
+from perception.registration import known_shape_model
+
+VOXEL = 0.03
+
+
+def _sphere_model(radius=0.7):
+    mesh = trimesh.creation.icosphere(subdivisions=5, radius=radius)
+    return known_shape_model(mesh, VOXEL, seed=0)
+
+
+def test_grid_matches_the_kd_tree_within_the_curvature_bound():
+    points, normals = _sphere_model()
+    grid = NearestPointGrid(points, VOXEL / 3, 0.1)
+    rng = np.random.default_rng(1)
+    queries = points[rng.choice(len(points), 3000)] + rng.normal(0.0, 0.02, (3000, 3))
+    gap, index = grid.query(queries, distance_upper_bound=0.1)
+    exact_gap, exact_index = cKDTree(points).query(queries, distance_upper_bound=0.1)
+    # 2 cm noise (5 sigma = 0.1 m): every query is within reach of the surface, both find a point.
+    assert np.array_equal(np.isfinite(gap), np.isfinite(exact_gap)) and np.isfinite(gap).all()
+    # Measured 95 % exact; the cell answer refined by one descent step is exact for most queries.
+    assert np.mean(index == exact_index) > 0.9
+    residual = np.einsum("ij,ij->i", queries - points[index], normals[index])
+    exact = np.einsum("ij,ij->i", queries - points[exact_index], normals[exact_index])
+    # A tangent plane taken a distance d along the surface from the exact one changes the
+    # residual by about kappa d^2 / 2; d < one cell diagonal (1.7 cm), kappa = 1/0.7 m^-1:
+    # 0.2 mm at worst, far below the 2 cm noise. Measured 0.05 mm rms.
+    assert np.sqrt(np.mean((residual - exact) ** 2)) < 2e-4
+    assert np.max(np.abs(residual - exact)) < 1e-3
+    assert np.all(gap >= exact_gap - 1e-12)   # never nearer than the exact nearest point
+
+
+def test_grid_finds_nothing_beyond_reach():
+    points, _ = _sphere_model()
+    grid = NearestPointGrid(points, VOXEL / 3, 0.1)
+    far = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.7 + 0.2], [5.0, 0.0, 0.0]])   # centre, 0.2 m out, outside the grid
+    gap, index = grid.query(far, distance_upper_bound=0.1)
+    assert np.all(np.isinf(gap)) and np.all(index == len(points))
