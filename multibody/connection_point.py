@@ -116,8 +116,10 @@ def advance_point(state, t, step, mass, reference, mu, points, point_velocities,
     x_n, v_n = state[X_N:X_N + 3].copy(), state[V_N:V_N + 3].copy()
     if state[HISTORY] > 0.0 and abs(h - step) <= 1e-9 * step:
         beta = 2.0 * h / 3.0
-        x_hat = (4.0 * x_n - state[X_PREVIOUS:X_PREVIOUS + 3]) / 3.0
-        v_hat = (4.0 * v_n - state[V_PREVIOUS:V_PREVIOUS + 3]) / 3.0
+        x_hat, v_hat = np.empty(3), np.empty(3)
+        for a in range(3):
+            x_hat[a] = (4.0 * x_n[a] - state[X_PREVIOUS + a]) / 3.0
+            v_hat[a] = (4.0 * v_n[a] - state[V_PREVIOUS + a]) / 3.0
     else:
         beta, x_hat, v_hat = h, x_n, v_n
     x, v = implicit_point_step(x_hat, v_hat, beta, mass, reference, mu, points, point_velocities, stiffness, damping,

@@ -244,7 +244,9 @@ def _advance_connection_point(q, v, t, work, attach):
     step = work[W_STEP]
     v_eval = v
     if t > state[TIME] + 0.5 * step:
-        v_eval = v + (0.5 * (t - state[TIME])) * work[int(work[W_ACCEL]):int(work[W_ACCEL]) + N_COORDINATES]
+        v_eval, half, acc = np.empty(N_COORDINATES), 0.5 * (t - state[TIME]), int(work[W_ACCEL])
+        for i in range(N_COORDINATES):
+            v_eval[i] = v[i] + half * work[acc + i]
         points, velocities = _attachments(q, v_eval, reference, work[W_ATTACH_CHASER:W_TETHER], attach)
         stiffness, damping, rest = np.full(n + 1, tether[K_ST]), np.full(n + 1, tether[C_ST]), np.full(n + 1, tether[L_ST])
         stiffness[0], damping[0], rest[0] = tether[K_MT], tether[C_MT], tether[L_MT]
@@ -359,5 +361,6 @@ def twin_run(q, v, t0, n_steps, every, work, out_q, out_v, out_diag):
             break
         _, q_next, v_half = step_forces(q, v, t + step, work)
         q[:] = q_next
-        v[:] = v_half + (0.5 * step) * work[acc:acc + N_COORDINATES]
+        for i in range(N_COORDINATES):
+            v[i] = v_half[i] + (0.5 * step) * work[acc + i]
     return t0 + n_steps * step
