@@ -67,3 +67,31 @@ def test_report_of_a_tow_folder_has_the_towing_section(tow_folder):
     assert section is not None and section.id == "towing" and section.figures
     html = write_report(out, pdf=False).html.read_text()
     assert '<section id="towing"' in html and "fig-towing" in html
+
+
+@pytest.fixture(scope="module")
+def full_net_tow_folder(tmp_path_factory):
+    """The case's full-net tow, shrunk: 7 x 7 net (same side, mass and threads), 2 s of towing."""
+    case = load_model(CASE, TowingCase)
+    case = case.model_copy(update=dict(simulation=case.simulation.model_copy(update=dict(end_time=27.0, model="full-net")),
+                                       full_net=case.full_net.model_copy(update=dict(nodes_per_side=7))))
+    out = tmp_path_factory.mktemp("tow_full_net")
+    tow_case(CASE, out, case=case)
+    return out, case
+
+
+def test_report_of_a_full_net_tow_folder_shows_the_net(full_net_tow_folder):
+    out, case = full_net_tow_folder
+    summary = json.loads((out / "towing.json").read_text())
+    assert summary["model"] == "full-net" and summary["simulated_s"] == pytest.approx(2.0)
+    # the momentum balance closes to Verlet's owed half kick of the external load (docs/towing.md):
+    # H/2 |F| with |F| <= gravity on chaser + debris + net (mu m / r^2, r >= 7.2e6 m) plus F_max
+    gravity = case.simulation.mu * (case.chaser.mass + case.debris.nominal_mass + case.net_mass) / 7.2e6**2
+    assert summary["net"]["momentum_residual_Ns"] <= summary["step_s"] / 2 * (gravity + case.thrust.max_force)
+    section = towing_section(RunFolder(out))
+    rows = dict(map(tuple, section.blocks[1].rows))
+    # 7 x 7 thread crossings plus the four corner masses (multibody.net_wrap.towing_net)
+    assert rows["net nodes / mean nodes in contact with the debris"].startswith("53 / ")
+    assert "sub-tether peak tension (N)" not in rows
+    html = write_report(out, pdf=False).html.read_text()
+    assert '<section id="towing"' in html and "Full-net towing run" in html
