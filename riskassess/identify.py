@@ -24,13 +24,16 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from pymoo.algorithms.soo.nonconvex.pattern import PatternSearch
+from pymoo.algorithms.soo.nonconvex.pattern import PatternSearch, calc_sign, exploration_move, pattern_move
 from pymoo.algorithms.soo.nonconvex.pso import PSO
+from pymoo.core.population import Population
 from pymoo.core.problem import Problem
+from pymoo.core.replacement import is_better
 from pymoo.optimize import minimize
 from pymoo.termination.default import DefaultSingleObjectiveTermination
 
 from multibody.towing import run_twin
+from multibody.towing_kernel import MT_TENSION
 from riskassess.tow import towing_model
 from riskassess.towing_case import TowingCase
 
@@ -39,11 +42,13 @@ COMPARED = ("relative_position", "chaser_omega_body", "debris_omega_body", "main
 
 
 def compared_series(result) -> dict:
-    """r_D/C (m, inertial), both angular velocities (rad/s, body frames) and the MT tension (N) of a run."""
-    s = result.series()
-    return {"relative_position": s["debris_com_inertial"] - s["chaser_com_inertial"],
-            "chaser_omega_body": s["chaser_omega_body"], "debris_omega_body": s["debris_omega_body"],
-            "main_tether_tension": s["main_tether_tension"]}
+    """r_D/C (m, inertial), both angular velocities (rad/s, body frames) and the MT tension (N) of a run:
+    the entries of :meth:`multibody.towing.TowResult.series`, bit for bit, taken straight from the samples
+    (``series`` also forms two rotation matrices per sample, a fifth of an identification run's time)."""
+    m, q, v = result.model, result.q, result.v
+    return {"relative_position": (m.positions[2] + q[:, 9:12]) - (m.positions[1] + q[:, 3:6]),
+            "chaser_omega_body": v[:, 6:9], "debris_omega_body": v[:, 12:15],
+            "main_tether_tension": result.diag[:, MT_TENSION]}
 
 
 def rmse(model, data) -> float:
@@ -125,23 +130,53 @@ class Identified:
     history: list
 
 
-def _pattern_search(problem, x0, settings, first_delta, budget):
-    """Hooke-Jeeves (pymoo) from ``x0`` with restarts: each leg runs at most
-    ``settings.restart_evaluations`` evaluations and restarts from the best point with the step
-    ``settings.polish_delta`` (a fresh step: Hooke-Jeeves only shrinks it, and in the narrow k_ST-c_ST
-    valley it shrinks long before the flat m_P direction is resolved); a leg without improvement
-    shrinks the restart step tenfold; stops at ``budget`` evaluations or a step below
-    ``settings.pattern_tolerance``. Returns (best s, best cost)."""
-    x, f, delta = np.asarray(x0, float), np.inf, first_delta
-    while len(problem.evaluations) < budget and delta >= settings.pattern_tolerance:
-        n = min(settings.restart_evaluations, budget - len(problem.evaluations))
-        result = minimize(problem, PatternSearch(x0=x, init_delta=delta), DefaultSingleObjectiveTermination(
-            xtol=settings.pattern_tolerance, ftol=0.0, period=20, n_max_evals=n), verbose=False)
-        cost = float(np.atleast_1d(result.F)[0])
-        if cost < f:
-            x, f, delta = np.asarray(result.X, float).ravel(), cost, settings.polish_delta
+class SeededPatternSearch(PatternSearch):
+    """pymoo's Hooke-Jeeves (:class:`pymoo.algorithms.soo.nonconvex.pattern.PatternSearch`), unchanged
+    except that the random order of each exploration move is drawn from the algorithm's seeded generator:
+    pymoo 0.6.2 calls ``exploration_move`` without it, so every exploration drew a fresh unseeded order and
+    two runs from the same start could end at different points."""
+
+    def _next(self):
+        if not is_better(self._explr, self._center):
+            self.n_not_improved += 1
+            self._rho = self.init_rho**self.n_not_improved
+            self._explr = yield from exploration_move(self.problem, self._center, self._sign, self._delta, self._rho,
+                                                      random_state=self.random_state)
         else:
-            delta *= 0.1
+            self._direction = self._explr.X - self._center.X
+            self._center = self._explr
+            self._trial = yield pattern_move(self.problem, self._center, self._direction, self.step_size)
+            self._sign = calc_sign(self._direction)
+            self._explr = yield from exploration_move(self.problem, self._trial, self._sign, self._delta, self._rho,
+                                                      random_state=self.random_state)
+        self.pop = Population.create(self._center, self._explr)
+
+
+def _pattern_search(problem, x0, settings, first_delta, budget):
+    """Hooke-Jeeves (:class:`SeededPatternSearch`) from ``x0`` in legs of at most
+    ``settings.restart_evaluations`` evaluations, each restarted from the best point so far.
+
+    Hooke-Jeeves shrinks one step factor for all variables, so in this problem (the cost ~200x flatter
+    along s4 than along s1, docs/towing.md) the step is at 1e-5 for s1 long before s4 has arrived. Each
+    restart therefore gives every variable its own first step (a fraction of its bound range): the distance
+    it travelled in the last leg, at least a tenth of its previous step and at most ``first_delta``. A
+    variable still on the move keeps a step of the size of its moves; a settled one shrinks tenfold per
+    leg. A leg without improvement shrinks all steps tenfold. Stops after ``budget`` evaluations or when
+    every step is below ``settings.pattern_tolerance``. Returns (best s, best cost)."""
+    span = problem.xu - problem.xl
+    x, f, delta = np.asarray(x0, float), np.inf, np.full(problem.n_var, float(first_delta))
+    leg = 0
+    while len(problem.evaluations) < budget and delta.max() >= settings.pattern_tolerance:
+        n = min(settings.restart_evaluations, budget - len(problem.evaluations))
+        result = minimize(problem, SeededPatternSearch(x0=x, init_delta=delta), DefaultSingleObjectiveTermination(
+            xtol=settings.pattern_tolerance, ftol=0.0, period=20, n_max_evals=n), seed=settings.seed + leg, verbose=False)
+        leg += 1
+        cost, found = float(np.atleast_1d(result.F)[0]), np.asarray(result.X, float).ravel()
+        if cost < f:
+            moved = np.abs(found - x) / span
+            x, f, delta = found, cost, np.minimum(np.maximum(moved, 0.1 * delta), first_delta)
+        else:
+            delta = 0.1 * delta
     return x, f
 
 
