@@ -142,31 +142,35 @@ def tautness(series: dict, target_elongation: float | None) -> dict:
             float(np.sqrt(np.mean((z[late] - target_elongation) ** 2)))}
 
 
-def summarize(case: TowingCase, result, s) -> dict:
-    """The numbers ``riskassess tow`` prints and writes to summary.json (SI)."""
-    series = result.series()
-    model = result.model
-    t = series["time"]
-    tension = series["main_tether_tension"]
+def run_figures(case: TowingCase, series: dict, model) -> dict:
+    """The figures every towing run reports, lower-order or full-net (SI): main-tether peak, final
+    tension, slack while thrusting and :func:`tautness`; separation; chaser peak and debris final
+    rate; step and step count. ``model`` is the run's model (``omega_body``, ``step``, times)."""
+    t, tension = series["time"], series["main_tether_tension"]
     dt = np.diff(t, prepend=t[0])
-    thrusting = series["thrust"] != 0.0
     separation = np.linalg.norm(series["debris_com_inertial"] - series["chaser_com_inertial"], axis=1)
     return {
         "case": case.name, "thrust_kind": case.thrust.kind,
         "spin_rate_deg_s": float(np.rad2deg(np.linalg.norm(model.omega_body[1]))),
-        "decision_vector_s": [float(x) for x in s],
         "main_tether_peak_tension_N": float(tension.max()),
         "main_tether_final_tension_N": float(tension[-1]),
-        "main_tether_slack_time_while_thrusting_s": float(np.sum(dt[thrusting & (tension <= 0.0)])),
+        "main_tether_slack_time_while_thrusting_s": float(np.sum(dt[(series["thrust"] != 0.0) & (tension <= 0.0)])),
         "main_tether": tautness(series, reference_elongation(case)),
-        "sub_tether_peak_tension_N": float(series["sub_tether_tension"].max()),
         "separation_m": {"initial": float(separation[0]), "min": float(separation.min()),
                          "max": float(separation.max()), "final": float(separation[-1])},
         "chaser_peak_rate_deg_s": float(np.rad2deg(np.linalg.norm(series["chaser_omega_body"], axis=1).max())),
         "debris_final_rate_deg_s": float(np.rad2deg(np.linalg.norm(series["debris_omega_body"][-1]))),
         "step_s": model.step, "n_steps": model.n_steps, "simulated_s": model.end_time - model.start_time,
-        "wall_time_s": result.wall_time, "steps_per_second": model.n_steps / result.wall_time,
     }
+
+
+def summarize(case: TowingCase, result, s) -> dict:
+    """The numbers ``riskassess tow`` prints and writes to towing.json (SI): :func:`run_figures`, the
+    decision vector s and the sub-tethers' peak tension, wall time."""
+    series = result.series()
+    return {**run_figures(case, series, result.model), "decision_vector_s": [float(x) for x in s],
+            "sub_tether_peak_tension_N": float(series["sub_tether_tension"].max()),
+            "wall_time_s": result.wall_time, "steps_per_second": result.model.n_steps / result.wall_time}
 
 
 def tow_case(case_path: str | Path, out_dir: str | Path, case: TowingCase | None = None) -> dict:

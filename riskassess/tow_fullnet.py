@@ -122,31 +122,19 @@ def momentum_residual(series: dict) -> float:
 
 
 def summarize_full_net(case: TowingCase, result, wrap: dict) -> dict:
-    """The lower-order summary's figures (:func:`riskassess.tow.summarize`) for a full-net run, plus
+    """The figures of every towing run (:func:`riskassess.tow.run_figures`) for a full-net run, plus
     the net's: wrapped-state shape, contact, closing-loop tension, momentum balance."""
-    from riskassess.tow import reference_elongation, tautness
+    from riskassess.tow import run_figures
 
     series = result.series()
     model = result.model
-    t, tension = series["time"], series["main_tether_tension"]
-    dt = np.diff(t, prepend=t[0])
-    separation = np.linalg.norm(series["debris_com_inertial"] - series["chaser_com_inertial"], axis=1)
     return {
-        "case": case.name, "model": "full-net", "thrust_kind": case.thrust.kind,
-        "spin_rate_deg_s": float(np.rad2deg(np.linalg.norm(model.omega_body[1]))),
-        "main_tether_peak_tension_N": float(tension.max()), "main_tether_final_tension_N": float(tension[-1]),
-        "main_tether_slack_time_while_thrusting_s": float(np.sum(dt[(series["thrust"] != 0.0) & (tension <= 0.0)])),
-        "main_tether": tautness(series, reference_elongation(case)),
-        "separation_m": {"initial": float(separation[0]), "min": float(separation.min()),
-                         "max": float(separation.max()), "final": float(separation[-1])},
-        "chaser_peak_rate_deg_s": float(np.rad2deg(np.linalg.norm(series["chaser_omega_body"], axis=1).max())),
-        "debris_final_rate_deg_s": float(np.rad2deg(np.linalg.norm(series["debris_omega_body"][-1]))),
+        **run_figures(case, series, model), "model": "full-net",
         "net": {"nodes": int(len(model.node_positions)), "wrapped_state": wrap,
                 "mean_contacts": float(series["net_contacts"].mean()),
                 "closing_thread_peak_tension_N": float(series["closing_thread_peak_tension"].max()),
                 "momentum_residual_Ns": momentum_residual(series)},
-        "step_s": model.step, "net_step_s": model.step / model.substeps, "n_steps": model.n_steps,
-        "simulated_s": model.end_time - model.start_time, "wall_time_s": result.wall_time,
+        "net_step_s": model.step / model.substeps, "wall_time_s": result.wall_time,
         "steps_per_second": model.n_steps / result.wall_time,
     }
 
