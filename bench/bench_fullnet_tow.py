@@ -1,13 +1,15 @@
 """Full-net towing benchmark (issue 7 item 6: the 300 s full-net tow in under 10 min on 2 cores).
 
     python bench/bench_fullnet_tow.py                      # the case's full run (25 -> 300 s)
-    python bench/bench_fullnet_tow.py --study --end 45     # step-convergence study over 20 s of towing
+    python bench/bench_fullnet_tow.py --study --end 60     # step study over 35 s of towing
 
 Prints the wrapped-state preparation time, the run's wall time, steps per second, the step and
 sub-step, and sanity figures: momentum balance (|P(t) - P(t0) - external impulse|, N s, against the
 external impulse), main-tether and closing-loop tension, debris spin. The study runs the case at
-several (step, sub-steps) pairs and prints the RMSE of r_D/C, omega_C, omega_D and T_MT against the
-finest pair (the identification's channels, eqs. 19 and 21). Timings are upper bounds on a shared machine.
+the case's step and net sub-step, both halved and both quartered, and prints the RMSE of r_D/C,
+omega_C, omega_D and T_MT (the identification's channels, eqs. 19 and 21) against the quartered
+one; then the sensitivity floor: the case's step with the spin rate changed by 1e-9 of itself.
+Timings are upper bounds on a shared machine.
 """
 from __future__ import annotations
 
@@ -51,23 +53,40 @@ def report(model, result):
           f"(min {sep.min():.3f}, max {sep.max():.3f})")
 
 
+def compared(series):
+    """The identification's channels (eqs. 19, 21) of a run's series."""
+    return {"relative_position": series["debris_com_inertial"] - series["chaser_com_inertial"],
+            **{k: series[k] for k in CHANNELS[1:]}}
+
+
+def study_row(label, series, reference, wall):
+    e = [rmse(series[k], reference[k]) for k in CHANNELS]
+    print(f"| {label} | {e[0]:.2e} | {e[1]:.2e} | {e[2]:.2e} | {e[3]:.2e} | {wall:.1f} |")
+
+
 def study(case, wrapped, rate, end, pairs):
-    reference = None
+    """Run every (step, sub-steps) pair to ``end``; print each pair's RMSE per channel against the last
+    (finest) pair and, for scale, the RMS of the finest run's channel. Then the sensitivity floor: the
+    first pair again with the initial spin rate changed by 1e-9 of itself, against the first pair."""
     rows = []
-    for step, substeps in pairs:
-        model, result = run(case, wrapped, rate, end, step, substeps)
+    rate = case.debris.spin_rate_deg_s if rate is None else rate
+    for step, substeps in pairs + [pairs[0]]:
+        model, result = run(case, wrapped, rate * (1.0 + 1e-9 * (len(rows) == len(pairs))), end, step, substeps)
         series = result.series()
-        compared = {"relative_position": series["debris_com_inertial"] - series["chaser_com_inertial"],
-                    **{k: series[k] for k in CHANNELS[1:]}}
-        rows.append((step, substeps, compared, result.wall_time))
-    reference = rows[-1][2]
+        tension = series["main_tether_tension"]
+        print(f"step {step * 1e3:g} ms x {substeps}: wall {result.wall_time:.1f} s, T_MT peak {tension.max():.1f} N "
+              f"at {series['time'][tension.argmax()]:.1f} s, slack samples {np.mean(tension <= 0):.2f}", flush=True)
+        rows.append((f"{step * 1e3:g} | {substeps} | {step / substeps * 1e6:g}", compared(series), result.wall_time))
+    reference = rows[len(pairs) - 1][1]
     print("| step (ms) | sub-steps | net step (us) | r_D/C (m) | omega_C (rad/s) | omega_D (rad/s) | T_MT (N) | wall (s) |")
     print("|---|---|---|---|---|---|---|---|")
-    for step, substeps, series, wall in rows:
-        e = [rmse(series[k], reference[k]) for k in ("relative_position", "chaser_omega_body", "debris_omega_body",
-                                                      "main_tether_tension")]
-        print(f"| {step * 1e3:g} | {substeps} | {step / substeps * 1e6:g} | {e[0]:.2e} | {e[1]:.2e} | {e[2]:.2e} | "
-              f"{e[3]:.2e} | {wall:.1f} |")
+    scale = [rmse(reference[k], 0.0 * reference[k]) for k in CHANNELS]
+    print(f"| RMS of the finest run | | | {scale[0]:.3g} | {scale[1]:.3g} | {scale[2]:.3g} | {scale[3]:.3g} | |")
+    for label, series, wall in rows[:len(pairs) - 1]:
+        study_row(label, series, reference, wall)
+    print(f"| {rows[len(pairs) - 1][0]} | reference | | | | {rows[len(pairs) - 1][2]:.1f} |")
+    label, series, wall = rows[-1]
+    study_row(label + " (rate x (1 + 1e-9), against the first row's run)", series, rows[0][1], wall)
 
 
 def main():
@@ -82,8 +101,8 @@ def main():
     wrapped = wrapped_net(case)
     print(f"wrapped state prepared in {time.perf_counter() - start:.1f} s (drape and close, compiled)")
     if args.study:
-        pairs = [(4e-3, 20), (4e-3, 40), (2e-3, 10), (2e-3, 20), (2e-3, 40), (1e-3, 20)]
-        study(case, wrapped, args.rate, args.end or 45.0, pairs)
+        h, m = case.full_net.step, case.full_net.substeps     # the case's step, halved, quartered (finest last)
+        study(case, wrapped, args.rate, args.end or 60.0, [(h, m), (h / 2, m), (h / 4, m)])
         return
     report(*run(case, wrapped, args.rate, args.end))
 
