@@ -29,8 +29,11 @@ from pymoo.algorithms.soo.nonconvex.pso import PSO
 from pymoo.core.population import Population
 from pymoo.core.problem import Problem
 from pymoo.core.replacement import is_better
+from pymoo.core.termination import Termination
 from pymoo.optimize import minimize
+from pymoo.termination.collection import TerminationCollection
 from pymoo.termination.default import DefaultSingleObjectiveTermination
+from pymoo.termination.max_eval import MaximumFunctionCallTermination
 
 from multibody.towing import run_twin
 from multibody.towing_kernel import MT_TENSION
@@ -152,6 +155,21 @@ class SeededPatternSearch(PatternSearch):
         self.pop = Population.create(self._center, self._explr)
 
 
+class StepTolerance(Termination):
+    """Ends a Hooke-Jeeves leg once its exploration step (:math:`\\rho\\,\\delta`) is below ``tolerance``
+    times every variable's bound range: smaller moves do not change s at the precision asked for."""
+
+    def __init__(self, tolerance):
+        super().__init__()
+        self.tolerance = tolerance
+
+    def _update(self, algorithm):
+        if getattr(algorithm, "_delta", None) is None:
+            return 0.0
+        lower, upper = algorithm.problem.bounds()
+        return float(np.all(algorithm._rho * algorithm._delta < self.tolerance * (upper - lower)))
+
+
 def _pattern_search(problem, x0, settings, first_delta, budget):
     """Hooke-Jeeves (:class:`SeededPatternSearch`) from ``x0`` in legs of at most
     ``settings.restart_evaluations`` evaluations, each restarted from the best point so far.
@@ -161,15 +179,18 @@ def _pattern_search(problem, x0, settings, first_delta, budget):
     restart therefore gives every variable its own first step (a fraction of its bound range): the distance
     it travelled in the last leg, at least a tenth of its previous step and at most ``first_delta``. A
     variable still on the move keeps a step of the size of its moves; a settled one shrinks tenfold per
-    leg. A leg without improvement shrinks all steps tenfold. Stops after ``budget`` evaluations or when
-    every step is below ``settings.pattern_tolerance``. Returns (best s, best cost)."""
+    leg. A leg without improvement shrinks all steps tenfold. A leg ends when its step is below
+    ``settings.pattern_tolerance`` of every bound range (:class:`StepTolerance`) or after
+    ``settings.restart_evaluations``; the search stops after ``budget`` evaluations or when every first step
+    is below the tolerance. Returns (best s, best cost)."""
     span = problem.xu - problem.xl
     x, f, delta = np.asarray(x0, float), np.inf, np.full(problem.n_var, float(first_delta))
     leg = 0
     while len(problem.evaluations) < budget and delta.max() >= settings.pattern_tolerance:
         n = min(settings.restart_evaluations, budget - len(problem.evaluations))
-        result = minimize(problem, SeededPatternSearch(x0=x, init_delta=delta), DefaultSingleObjectiveTermination(
-            xtol=settings.pattern_tolerance, ftol=0.0, period=20, n_max_evals=n), seed=settings.seed + leg, verbose=False)
+        result = minimize(problem, SeededPatternSearch(x0=x, init_delta=delta), TerminationCollection(
+            StepTolerance(settings.pattern_tolerance), MaximumFunctionCallTermination(n)), seed=settings.seed + leg,
+            verbose=False)
         leg += 1
         cost, found = float(np.atleast_1d(result.F)[0]), np.asarray(result.X, float).ravel()
         if cost < f:
