@@ -55,8 +55,9 @@ def full_net_runs(case: TowingCase, rates, out: Path, end, workers) -> list[dict
     if missing:
         wrapped = wrapped_net(case)
         with multiprocessing.get_context("fork").Pool(min(workers, len(missing))) as pool:
-            for rate, run in zip(missing, pool.map(_run_full_net, [(case, wrapped, r, end) for r in missing])):
-                results.atomic_write_npz(path[rate], run)
+            # each run cached as soon as it is done: an interrupted call keeps the finished ones
+            for run in pool.imap_unordered(_run_full_net, [(case, wrapped, r, end) for r in missing]):
+                results.atomic_write_npz(path[run["rate_deg_s"]], run)
     return [{k: (float(v) if v.ndim == 0 else v) for k, v in np.load(path[rate]).items()} for rate in rates]
 
 

@@ -148,7 +148,9 @@ def run_full_net(case: TowingCase, out: Path) -> tuple[dict, dict]:
     summary = summarize_full_net(case, result, wrap_summary(x_body, net, debris_geometry(case)))
     net_keys = ("net_time", "net_nodes_inertial")
     results.atomic_write_npz(out / "towing.npz", {k: v for k, v in series.items() if k not in net_keys})
+    top = net.topology
     results.atomic_write_npz(out / "net.npz", {"time": series["net_time"], "nodes_inertial": series["net_nodes_inertial"],
-                                               "threads": net.topology.threads})
+                                               "threads": top.threads, "rest_lengths": top.rest_lengths,
+                                               "stiffness": top.stiffness, "closing_threads": len(net.closing_rest_closed)})
     results.atomic_write_json(out / "towing.json", summary)
     return summary, series

@@ -138,6 +138,10 @@ def pvd_text(entries: list[tuple[float, int, str, str]], comment: str = "") -> s
 
 def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int = 1, progress=None) -> VtkExport:
     """Write the VTK files of a run folder (see the module docstring); returns where and how many."""
+    if RunFolder(run_dir).stage == "tow":  # a full-net tow folder: its own layout
+        from riskassess.tow_vtk import export_tow_vtk
+
+        return export_tow_vtk(run_dir, out, every, progress)
     if every < 1:
         raise ValueError(f"every must be >= 1 (frames to step); got {every}")
     run = RunFolder(run_dir)

@@ -1,6 +1,7 @@
 """`riskassess tow` (riskassess/tow.py): the run folder, the tautness figures and the report section."""
 import json
 
+import meshio
 import numpy as np
 import pytest
 
@@ -95,3 +96,23 @@ def test_report_of_a_full_net_tow_folder_shows_the_net(full_net_tow_folder):
     assert "sub-tether peak tension (N)" not in rows
     html = write_report(out, pdf=False).html.read_text()
     assert '<section id="towing"' in html and "Full-net towing run" in html
+
+
+def test_vtk_export_of_a_full_net_tow_folder(full_net_tow_folder):
+    from riskassess.vtk_export import export_vtk
+
+    out, case = full_net_tow_folder
+    result = export_vtk(out)
+    # one frame per net snapshot: 25, 26, 27 s (full_net.net_output_interval = 1 s)
+    assert result.n_frames == 3 and result.pvd.is_file()
+    np.testing.assert_allclose(result.times, [25.0, 26.0, 27.0])
+    net, bodies, tether = (meshio.read(result.folder / f"{name}_0002.vtu") for name in ("net", "bodies", "tether"))
+    assert len(net.points) == 53
+    # the tether starts at a net node (the central one) and ends |r_A/C| = 0.5 m from the chaser cube's
+    # centre (Table 1); both in the same LVLH frame, so to round-off of the LVLH rotation (1e-9 m at 20 m)
+    assert np.linalg.norm(net.points - tether.points[0], axis=1).min() < 1e-9
+    chaser = bodies.points[:8].mean(axis=0)            # trimesh box: 8 vertices around its centre
+    assert np.linalg.norm(tether.points[1] - chaser) == pytest.approx(0.5, abs=1e-9)
+    # slack threads carry no elastic tension, stretched ones k (l - l_0) > 0
+    strain, tension = net.cell_data["strain"][0], net.cell_data["elastic_tension_N"][0]
+    assert np.all(tension[strain <= 0] == 0.0) and np.all(tension[strain > 0] > 0.0)
