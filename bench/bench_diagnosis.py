@@ -19,12 +19,14 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 RUNS = (("diagnose_tumbling_rigid.toml", "tumbling_rigid_nutation.csv"),
-        ("diagnose_hinged_appendage.toml", "hinged_appendage_friction.csv"))
+        ("diagnose_hinged_appendage.toml", "hinged_appendage_friction.csv"),
+        ("diagnose_towing.toml", "towing_viscoelastic.csv"))
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--only", nargs="*", help="case file names to run (default: all)")
     args = parser.parse_args()
     tic = time.perf_counter()
     from riskassess.diagnose import diagnose_case   # numba compiled code loads from its cache here
@@ -36,9 +38,13 @@ def main() -> None:
         make_diagnosis_samples.main()
     print(f"load average before: {os.getloadavg()[0]:.2f} (2 cores; > 2 means other jobs share them)")
     for case_name, data_name in RUNS:
+        if args.only and case_name not in args.only:
+            continue
         with tempfile.TemporaryDirectory() as tmp:
             case = Path(tmp) / case_name
-            case.write_text((ROOT / "cases" / case_name).read_text())
+            # a towing diagnosis names its towing case relative to itself
+            case.write_text((ROOT / "cases" / case_name).read_text().replace(
+                'towing = "', f'towing = "{ROOT / "cases"}/'))
             tic = time.perf_counter()
             answer = diagnose_case(case, ROOT / "cases" / "data" / data_name, Path(tmp) / "out", workers=args.workers)
             wall = time.perf_counter() - tic

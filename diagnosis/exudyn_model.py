@@ -254,6 +254,8 @@ def simulate_case(case, times, step: float | None = None) -> dict:
     the order given."""
     from diagnosis.effects import CATALOG
 
+    if case.kind == "towing":
+        return _simulate_towing_case(case, times, CATALOG)
     plant = Plant.from_case(case)
     applied = []
     for entry in case.effects:
@@ -272,3 +274,18 @@ def simulate_case(case, times, step: float | None = None) -> dict:
     for effect, values, names in applied:
         out = effect.measure(out, values, names)
     return out
+
+
+def _simulate_towing_case(case, times, catalog) -> dict:
+    """:func:`simulate_case` of a towing case: its one effect (an extended case has one) in Exudyn."""
+    from diagnosis.plant import plant_of
+    from diagnosis.towing_exudyn import simulate_towing_exudyn
+
+    if len(case.effects) > 1:
+        raise NotImplementedError("the towing scenario's Exudyn model takes one effect at a time; the case lists "
+                                  f"{[e.id for e in case.effects]}")
+    if not case.effects:
+        return simulate_towing_exudyn(plant_of(case), times)
+    entry = case.effects[0]
+    names = list(entry.parameters)
+    return simulate_towing_exudyn(plant_of(case), times, catalog[entry.id], [entry.parameters[n] for n in names], names)

@@ -34,6 +34,8 @@ MAX_EVALUATIONS = 30
 #: Forward-difference step of the Jacobian, scaled parameters (1 = a prior sigma or a typical size);
 #: the RK4 model is smooth and deterministic to ~1e-13, so 1e-6 leaves ~1e-7 relative error.
 DIFFERENCE_STEP = 1e-6
+#: Broyden updates between two finite-difference Jacobians (towing model only, see CandidateFit.jacobian).
+BROYDEN_REFRESH = 3
 #: Nominal parameters whose effect on the residuals is linear (the CoM's initial position and
 #: velocity in the linear relative orbit): their Jacobian columns are computed once per fit.
 LINEAR_NOMINAL = ("position", "velocity")
@@ -112,6 +114,7 @@ class CandidateFit:
         self.step = max_step(problem.plant, effect.stiffness_rate(problem.plant, self.specs) if effect else 0.0)
         # (towing: the tether couples the debris' position to everything, nothing is linear)
         linear_nominal = [n in LINEAR_NOMINAL and not is_towing(problem.plant) for n in _expanded(problem.nominal_names)]
+        self.broyden = is_towing(problem.plant)
         self.linear = np.r_[np.array(linear_nominal, bool),
                             np.full(len(self.specs), bool(effect is not None and getattr(effect, "linear", False)))]
         self._cache = {}
@@ -151,6 +154,30 @@ class CandidateFit:
         return f
 
     def jacobian(self, z, use):
+        """Forward differences (:meth:`difference_jacobian`); for the towing model, whose runs cost
+        ~0.1 s, only every ``BROYDEN_REFRESH + 1``-th call, Broyden's rank-one update of the last one
+        in between (Broyden 1965; the linear parameters' columns stay exact)."""
+        if not self.broyden:
+            return self.difference_jacobian(z, use)
+        z_last, f0 = self._cache.get("last", (None, None))
+        if z_last is None or not np.array_equal(z_last, z):
+            f0 = self.residuals(z, use)
+        key = ("broyden", use.tobytes())
+        state = self._cache.get(key)
+        if state is None or state["age"] >= BROYDEN_REFRESH:
+            jac, age = self.difference_jacobian(z, use), 0
+        else:
+            dz, jac = z - state["z"], state["jac"].copy()
+            if dz @ dz > 0:
+                jac += np.outer(f0 - state["f"] - jac @ dz, dz) / (dz @ dz)
+            linear = self._cache.get(("linear", use.tobytes()), {})
+            for i, column in linear.items():
+                jac[:, i] = column
+            age = state["age"] + 1
+        self._cache[key] = {"z": z.copy(), "f": f0.copy(), "jac": jac, "age": age}
+        return jac
+
+    def difference_jacobian(self, z, use):
         """Forward differences, one column per parameter; the columns of linear parameters are
         computed once per sample set and reused."""
         z_last, f0 = self._cache.get("last", (None, None))
@@ -202,7 +229,7 @@ class CandidateFit:
         chi2_prior = float(result.x[:n_nominal] @ result.x[:n_nominal])
         chi2_data = float(2.0 * result.cost - chi2_prior)
         n_data = int(sum(np.isfinite(v[p.train]).sum() for v in p.values.values()))
-        jac = result.jac
+        jac = self.difference_jacobian(result.x, p.train) if self.broyden else result.jac    # exact at the optimum
         dof = max(n_data - len(result.x), 1)
         cov_z = np.linalg.pinv(jac.T @ jac) * max(1.0, chi2_data / dof)
         scale = np.r_[p.nominal_sigma, self.scale]

@@ -7,12 +7,12 @@ import numpy as np
 
 from diagnosis.effects import CATALOG
 from diagnosis.exudyn_model import ExudynScenario, simulate_exudyn
-from diagnosis.plant import Plant
+from diagnosis.plant import Plant, is_towing, plant_of
 
 #: Default 1-sigma noise per channel group (channel units): a MEMS gyro at 10 Hz (2e-4 rad/s), a
 #: star tracker (~1e-3 per quaternion component, ~7 arcmin), an encoder (1e-3 rad), its rate
-#: (1e-3 rad/s), relative navigation (1 cm).
-NOISE = {"omega": 2e-4, "q": 1e-3, "hinge_angle": 1e-3, "hinge_rate": 1e-3, "rel": 0.01}
+#: (1e-3 rad/s), relative navigation (1 cm), a tether load cell (0.5 N: 0.25 % of a 200 N range).
+NOISE = {"omega": 2e-4, "q": 1e-3, "hinge_angle": 1e-3, "hinge_rate": 1e-3, "rel": 0.01, "tether": 0.5}
 
 
 def channel_noise(channel: str, scale: float = 1.0) -> float:
@@ -31,13 +31,17 @@ def noisy(clean: dict, rng, noise_scale: float = 1.0) -> tuple[dict, dict]:
 
 
 def simulate_effect(case, times, effect_id: str | None = None, values=None) -> dict:
-    """Clean channels of the case's Exudyn model with ``effect_id`` at ``values`` (dict name -> SI)."""
-    plant = Plant.from_case(case)
+    """Clean channels of the case's Exudyn model with ``effect_id`` at ``values`` (dict name -> SI); the
+    towing scenario's is :func:`diagnosis.towing_exudyn.simulate_towing_exudyn`."""
+    plant = plant_of(case)
+    simulate = simulate_exudyn
+    if is_towing(plant):
+        from diagnosis.towing_exudyn import simulate_towing_exudyn as simulate
     if effect_id is None:
-        return simulate_exudyn(plant, times)
+        return simulate(plant, times)
     effect = CATALOG[effect_id]
     names = list(values)
-    return simulate_exudyn(plant, times, effect, np.array([values[n] for n in names]), names)
+    return simulate(plant, times, effect, np.array([values[n] for n in names]), names)
 
 
 def simulate_constant_body_torque(case, times, torque_body) -> dict:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from diagnosis.observation import OMEGA, QUATERNION, REL, TENSION
 from diagnosis.towing_dynamics import (EXTRA_STATES, diagnostics_size, initial_extra_states, integrate,
                                       no_towing_load)
 from multibody.towing import packed
@@ -29,6 +30,10 @@ from multibody.towing_kernel import MT_TENSION
 #: Nominal parameters of the towing scenario: name -> (size, unit), the fitted vector's order.
 TOWING_PARAMETERS = {"attitude": (3, "rad"), "angular_velocity": (3, "rad/s"), "position": (3, "m"),
                      "velocity": (3, "m/s")}
+
+
+#: Every channel's value when a run diverges (channel units): far from any data, so the fit steps back.
+FAILED = 1e6
 
 
 def lvlh_to_eci(r_eci, v_eci) -> np.ndarray:
@@ -177,6 +182,8 @@ def simulate(plant: TowingPlant, times, law=no_towing_load, p=np.zeros(1), step:
     xe = initial_extra_states(model.omega_body[1])
     out = [np.zeros((len(record), n)) for n in (15, 15, diagnostics_size(work), EXTRA_STATES)]
     integrate(law, np.ascontiguousarray(p, float), q, v, model.start_time, int(record[-1]), work, xe, record, *out)
+    if not all(np.isfinite(a).all() for a in out[:3]):      # a run that blew up (a parameter far off)
+        return {c: np.full(len(times), FAILED) for c in OMEGA + QUATERNION + REL + TENSION}
     rows = channels(plant, model, *out)
     index = np.searchsorted(record, lower)
     upper = np.searchsorted(record, np.minimum(lower + 1, record[-1]))

@@ -104,13 +104,18 @@ def extended_case(case_path: Path, problem: Problem, fit: FitResult) -> str:
     nominal = _parameters(fit, nominal=True)
     initial = raw.setdefault("initial", {})
     value = {n: p["value"] for n, p in nominal.items()}
-    if "attitude_x" in value:
+    if raw.get("kind") == "towing":
+        _towing_initial(raw, case_path, value)
+    elif "attitude_x" in value:
         delta = Rotation.from_rotvec([value[f"attitude_{a}"] for a in "xyz"])
         initial["attitude_rotation_vector"] = (Rotation.from_matrix(problem.plant.attitude0) * delta).as_rotvec().tolist()
     for key, field in (("angular_velocity", "angular_velocity"), ("position", "position_lvlh"),
                        ("velocity", "velocity_lvlh")):
         if f"{key}_x" in value:
             initial[field] = [value[f"{key}_{a}"] for a in "xyz"]
+    header_note = ""
+    if raw.get("kind") == "towing":
+        header_note = "# The towing case is referenced by its absolute path.\n"
     for key, field in (("hinge_angle", "initial_angle"), ("hinge_rate", "initial_rate"),
                        ("torsional_stiffness", "torsional_stiffness"), ("torsional_damping", "torsional_damping")):
         if key in value:
@@ -118,8 +123,21 @@ def extended_case(case_path: Path, problem: Problem, fit: FitResult) -> str:
     effect = {n: p["value"] for n, p in _parameters(fit, nominal=False).items()}
     raw["effects"] = [e for e in raw.get("effects", []) if e.get("id") != fit.id] + [{"id": fit.id, "parameters": effect}]
     header = (f"# Extended by 'riskassess diagnose' from {case_path.name}: effect '{fit.id}' added with its fitted\n"
-              f"# parameters; the initial state and hinge values are the fitted nominal ones.\n")
+              f"# parameters; the initial state and hinge values are the fitted nominal ones.\n") + header_note
     return header + toml_text(raw) + "\n"
+
+
+def _towing_initial(raw: dict, case_path: Path, value: dict) -> None:
+    """The towing case's fitted debris state into ``raw['initial']`` (TowingInitial keys); the attitude
+    change composed after the case's own; the towing reference made absolute."""
+    from scipy.spatial.transform import Rotation
+
+    initial = raw.setdefault("initial", {})
+    if "attitude_x" in value:
+        delta = Rotation.from_rotvec([value[f"attitude_{a}"] for a in "xyz"])
+        before = Rotation.from_rotvec(initial.get("attitude_change", [0.0, 0.0, 0.0]))
+        initial["attitude_change"] = (before * delta).as_rotvec().tolist()
+    raw["towing"] = str((case_path.parent / raw["towing"]).resolve())
 
 
 def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = None, workers: int = WORKERS,

@@ -5,12 +5,13 @@ from pathlib import Path
 
 import pytest
 
-from riskassess.diagnosis_case import DiagnosisCaseFile
+from riskassess.diagnosis_case import DiagnosisCaseFile, diagnosis_case_from_dict
 from riskassess.case import read_toml
 
 CASES = Path(__file__).parents[2] / "cases"
 TUMBLING_CASE = CASES / "diagnose_tumbling_rigid.toml"
 HINGED_CASE = CASES / "diagnose_hinged_appendage.toml"
+TOWING_CASE = CASES / "diagnose_towing.toml"
 
 
 def case_with(path: Path, **changes):
@@ -18,6 +19,8 @@ def case_with(path: Path, **changes):
     raw = read_toml(path)
     for key, value in changes.items():
         raw[key] = {**raw.get(key, {}), **value} if isinstance(value, dict) and key != "orbit" else value
+    if raw.get("kind") == "towing":       # its towing case is named relative to the case file
+        return diagnosis_case_from_dict(raw, path.parent)
     return DiagnosisCaseFile.model_validate(raw).root
 
 
@@ -31,3 +34,10 @@ def tumbling_rocket_body():
 def panel_on_hinge():
     """cases/diagnose_hinged_appendage.toml: 800 kg body, 60 kg panel released at 0.4 rad."""
     return case_with(HINGED_CASE)
+
+
+@pytest.fixture
+def zenit_tow():
+    """cases/diagnose_towing.toml: the Zenit-2 lower-order tow of cases/zenit2_towing.toml (Boonrath,
+    Singh & Botta 2024, Tables 1-3), record from thrust-on."""
+    return case_with(TOWING_CASE)
