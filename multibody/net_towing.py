@@ -54,6 +54,10 @@ class FullNetModel:
     omega_body : (2, 3) float          (rad/s), body frames.
     start_time, end_time, step, output_interval, net_output_interval, closing_time : float (s)
     substeps : int                     Net sub-steps per body step.
+    closing_duration : float or None   (s) None: the closing loop stays at the topology's natural lengths
+                                       (the wrapped start, already closed). Otherwise it starts open and is
+                                       reeled in linearly to ``net.closing_rest_closed`` over
+                                       [closing_time, closing_time + closing_duration] (capture start, Sec. 2.1).
     """
 
     net: TowingNet
@@ -82,6 +86,7 @@ class FullNetModel:
     output_interval: float
     net_output_interval: float
     closing_time: float = 15.0
+    closing_duration: float | None = None
     inverse_inertia_debris: np.ndarray = field(init=False)
 
     def __post_init__(self):
@@ -183,7 +188,7 @@ class NetTowState:
         self.model = model
         self.reference = np.array(model.positions[1], float)
         self.x = np.ascontiguousarray(model.node_positions - self.reference)
-        self.v = np.ascontiguousarray(model.node_velocities, float)
+        self.v = np.array(model.node_velocities, float)  # a copy: a run must not change its model
         self.clock = np.zeros(CLOCK_SIZE)
         self.clock[CLOCK_TIME] = model.start_time
         self.rest = top.rest_lengths.copy()
@@ -193,9 +198,23 @@ class NetTowState:
         self.f, self.work, self.lag = np.zeros_like(self.x), np.zeros(21), np.zeros_like(self.x)
         self.tether_on = np.array(model.main_tether, float)
         self.tether_off = np.array([0.0, 0.0, model.main_tether[2]])
+        self.reeling = model.closing_duration is not None
+        self.rest_open = top.rest_lengths[-len(model.net.closing_rest_closed):].copy()
+
+    def reel(self, t):
+        """Closing loop's natural lengths (m) and stiffnesses EA/l0 (N/m) at time ``t`` (s): open
+        before ``closing_time``, linear to closed over ``closing_duration``, closed after."""
+        m = self.model
+        ramp = min(1.0, (t - m.closing_time) / m.closing_duration)
+        k = len(self.rest_open)
+        self.rest[-k:] = self.rest_open + ramp * (m.net.closing_rest_closed - self.rest_open)
+        self.stiffness[-k:] = m.net.closing_stiffness(self.rest[-k:])
+        self.reeling = ramp < 1.0
 
     def forces(self, q, v, t, advance):
         m, top = self.model, self.model.net.topology
+        if self.reeling and t >= m.closing_time:
+            self.reel(t)
         tether = self.tether_on if t >= m.closing_time else self.tether_off
         return step_forces(q, v, t, advance, self.x, self.v, self.lag, self.clock, top.masses, top.radii, top.threads, self.rest,
                            self.stiffness, top.damping, self.reference, m.mu, m.net.central, tether,

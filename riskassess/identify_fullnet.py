@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from riskassess import results
+from riskassess.case import CaseError
 from riskassess.identify import COSTS, identify, rmse, simulate
 from riskassess.towing_case import TowingCase
 
@@ -84,6 +85,10 @@ def identify_full_net(case_path, out_dir, case: TowingCase, optimizer: str = "pa
     fn = case.full_net
     if fn is None:
         raise ValueError(f"{case_path}: identification against full-net runs needs a [full_net] section")
+    if fn.start == "capture":
+        raise CaseError(f"{case_path}: full_net.start = 'capture' is not supported by 'riskassess identify': its "
+                         f"lower-order runs would each need their own start state (the full-net state at "
+                         f"simulation.start_time, Sec. 4.1), which riskassess.identify does not take; use 'wrapped'")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     end = fn.identification_end_time or case.simulation.end_time

@@ -1,7 +1,8 @@
 """Full-net towing runs of a towing case (``simulation.model = "full-net"``; Boonrath, Singh & Botta
 2024, Sec. 2.1, 4.1): the case's ``[full_net]`` table turned into a
-:class:`multibody.net_towing.FullNetModel` started from the prepared wrapped state, and the run
-folder of ``riskassess tow`` for it (the lower-order files plus ``net.npz``).
+:class:`multibody.net_towing.FullNetModel` started from the prepared wrapped state or from the net's
+ejection (``full_net.start = "capture"``, :func:`capture_start`), and the run folder of
+``riskassess tow`` for it (the lower-order files plus ``net.npz``).
 
 Wrapped start (docs/towing.md): at ``simulation.start_time`` the debris has the Table 2 state and
 spins at the given rate about ``debris.spin_axis_body``; the net (draped and closed around it by
@@ -82,20 +83,49 @@ def wrapped_start(case: TowingCase, net, x_body, spin_rate_deg_s: float):
     return nodes, velocities, chaser, omega
 
 
+def capture_start(case: TowingCase, spin_rate_deg_s: float):
+    """Initial state of the capture start at t = 0 (Sec. 2.1, 4.1): chaser and debris at their
+    Table 2 states (v_D/C = 0), the debris spinning about ``debris.spin_axis_body``; the open net
+    flat, normal to r_D/C (the unit vector from the chaser's tether attachment to the debris CoM),
+    centred ``full_net.launch_offset`` ahead of the attachment, every node moving at the chaser's
+    velocity plus ``full_net.launch_speed`` along r_D/C. Returns (TowingNet, node positions (n, 3)
+    (m, inertial), node velocities (n, 3) (m/s, inertial), chaser CoM (m, inertial), debris angular
+    velocity (rad/s, body))."""
+    fn, de = case.full_net, case.debris
+    rot, com = _bodies(case)
+    a_point = com[0] + rot[0] @ np.asarray(case.chaser.tether_attachment_body, float)
+    direction = (com[1] - a_point) / np.linalg.norm(com[1] - a_point)
+    net = towing_net(fn.side_length, fn.nodes_per_side, case.net_mass, fn.corner_mass, fn.node_radius, fn.corner_radius,
+                     fn.thread_axial_rigidity, fn.thread_damping, fn.closing_axial_rigidity, fn.closed_fraction,
+                     a_point + fn.launch_offset * direction, direction)
+    nodes = net.topology.positions.copy()
+    velocities = np.tile(np.asarray(case.chaser.velocity_inertial, float) + fn.launch_speed * direction, (len(nodes), 1))
+    omega = np.deg2rad(spin_rate_deg_s) * np.asarray(de.spin_axis_body, float) / np.linalg.norm(de.spin_axis_body)
+    return net, nodes, velocities, com[0], omega
+
+
 def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapped=None, end_time=None, step=None,
                    substeps=None) -> FullNetModel:
-    """The full-net model of ``case`` at ``spin_rate_deg_s`` (default: the case's), from the wrapped
-    state (``wrapped`` = (net, x_body) of :func:`wrapped_net`, computed if not given)."""
+    """The full-net model of ``case`` at ``spin_rate_deg_s`` (default: the case's): from the wrapped
+    state at ``simulation.start_time`` (``wrapped`` = (net, x_body) of :func:`wrapped_net`, computed
+    if not given) or, with ``full_net.start = "capture"``, from the net's ejection at t = 0
+    (:func:`capture_start`; ``wrapped`` is not used)."""
     from riskassess.tow import thrust_law
 
     fn, sim, ch, de = case.full_net, case.simulation, case.chaser, case.debris
-    net, x_body = wrapped if wrapped is not None else wrapped_net(case)
     rate = de.spin_rate_deg_s if spin_rate_deg_s is None else spin_rate_deg_s
-    nodes, velocities, chaser, omega = wrapped_start(case, net, x_body, rate)
+    if fn.start == "capture":
+        net, nodes, velocities, chaser, omega = capture_start(case, rate)
+        start, closing_duration = 0.0, fn.closing_duration
+    else:
+        net, x_body = wrapped if wrapped is not None else wrapped_net(case)
+        nodes, velocities, chaser, omega = wrapped_start(case, net, x_body, rate)
+        start, closing_duration = sim.start_time, None
     rot, com = _bodies(case)
     mt = case.main_tether
     tether = np.array([mt.stiffness, mt.damping, mt.natural_length])
-    kind, params, state = thrust_law(case, tether, -fn.main_tether_slack, 0.0)
+    a_point = chaser + rot[0] @ np.asarray(ch.tether_attachment_body, float)
+    kind, params, state = thrust_law(case, tether, np.linalg.norm(nodes[net.central] - a_point) - mt.natural_length, 0.0)
     h = fn.step if step is None else step
     h = sim.output_interval / np.ceil(sim.output_interval / h - 1e-9)
     ac = case.attitude_control
@@ -109,9 +139,9 @@ def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapp
         thrust_kind=kind, thrust_along_body_z=kind != 0, thrust_params=params, thrust_state=state,
         positions=np.array([chaser, com[1]]), velocities=np.array([ch.velocity_inertial, de.velocity_inertial], float),
         body_to_inertial=rot, omega_body=np.array([ch.angular_velocity_body, omega], float),
-        start_time=sim.start_time, end_time=sim.end_time if end_time is None else end_time, step=h,
+        start_time=start, end_time=sim.end_time if end_time is None else end_time, step=h,
         substeps=fn.substeps if substeps is None else substeps, output_interval=sim.output_interval,
-        net_output_interval=fn.net_output_interval, closing_time=fn.closing_time)
+        net_output_interval=fn.net_output_interval, closing_time=fn.closing_time, closing_duration=closing_duration)
 
 
 def momentum_residual(series: dict) -> float:
@@ -142,10 +172,16 @@ def summarize_full_net(case: TowingCase, result, wrap: dict) -> dict:
 def run_full_net(case: TowingCase, out: Path) -> tuple[dict, dict]:
     """Run the case's full-net tow; write towing.npz, net.npz, towing.json to ``out``. Returns
     (summary, series)."""
-    net, x_body = wrapped_net(case)
-    result = run_exudyn(full_net_model(case, wrapped=(net, x_body)))
+    if case.full_net.start == "capture":
+        model = full_net_model(case)
+        net, wrap = model.net, None
+    else:
+        net, x_body = wrapped_net(case)
+        model = full_net_model(case, wrapped=(net, x_body))
+        wrap = wrap_summary(x_body, net, debris_geometry(case))
+    result = run_exudyn(model)
     series = result.series()
-    summary = summarize_full_net(case, result, wrap_summary(x_body, net, debris_geometry(case)))
+    summary = summarize_full_net(case, result, wrap)
     net_keys = ("net_time", "net_nodes_inertial")
     results.atomic_write_npz(out / "towing.npz", {k: v for k, v in series.items() if k not in net_keys})
     top = net.topology

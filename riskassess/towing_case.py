@@ -189,8 +189,16 @@ class FullNet(Strict):
     """The wrapped net of the full-net towing model (multibody/net_towing.py; docs/towing.md)."""
 
     start: Literal["wrapped", "capture"] = Field(
-        "wrapped", description="'wrapped': prepared wrapped state at simulation.start_time; 'capture': net ejected at "
-                               "t = 0 (not built: rejected with a message).")
+        "wrapped", description="'wrapped': prepared wrapped state at simulation.start_time; 'capture': the open net "
+                               "ejected from the chaser at t = 0 s towards the debris (Table 2 states), closed from "
+                               "closing_time on (Sec. 2.1, 4.1; docs/towing.md).")
+    launch_speed: Positive = Field(2.0, description="Capture start: speed of every net node relative to the chaser at "
+                                                    "t = 0, along r_D/C (m/s) [assumed: the authors' launch data are "
+                                                    "not available].")
+    launch_offset: NonNegative = Field(1.0, description="Capture start: distance of the flat net's centre ahead of the "
+                                                        "chaser's tether attachment along r_D/C at t = 0 (m).")
+    closing_duration: Positive = Field(5.0, description="Capture start: the closing loop is reeled in linearly from "
+                                                        "open to closed over this time from closing_time on (s).")
     side_length: Positive = Field(description="Side of the square net (m); (nodes_per_side - 1) sections of l_net,0.")
     nodes_per_side: Annotated[int, Field(ge=5, le=41)] = Field(description="Nodes along a side (-), odd so that a central node exists.")
     corner_mass: Positive = Field(description="Each of the four corner masses (kg), part of net_mass.")
@@ -221,9 +229,6 @@ class FullNet(Strict):
     def _odd(self):
         if self.nodes_per_side % 2 == 0:
             raise ValueError(f"nodes_per_side must be odd (the main tether needs a central node). Got {self.nodes_per_side}")
-        if self.start == "capture":
-            raise ValueError("start = 'capture' (net ejected from the chaser at t = 0) is not built; use 'wrapped' "
-                             "(docs/towing.md)")
         return self
 
 
