@@ -174,12 +174,13 @@ def _pattern_search(problem, x0, settings, first_delta, budget):
     """Hooke-Jeeves (:class:`SeededPatternSearch`) from ``x0`` in legs of at most
     ``settings.restart_evaluations`` evaluations, each restarted from the best point so far.
 
-    Hooke-Jeeves shrinks one step factor for all variables, so in this problem (the cost ~200x flatter
-    along s4 than along s1, docs/towing.md) the step is at 1e-5 for s1 long before s4 has arrived. Each
-    restart therefore gives every variable its own first step (a fraction of its bound range): the distance
-    it travelled in the last leg, at least a tenth of its previous step and at most ``first_delta``. A
-    variable still on the move keeps a step of the size of its moves; a settled one shrinks tenfold per
-    leg. A leg without improvement shrinks all steps tenfold. A leg ends when its step is below
+    Hooke-Jeeves shrinks one step factor for all variables, so in this problem (the cost ~260x flatter
+    along s4 than along s1, docs/towing.md) the step along s4 is down to 1e-3 of its range while s1-s3 are
+    still being tuned, and s4 then crawls. Each restart therefore gives every variable its own first step
+    (a fraction of its bound range): a variable that travelled at least a tenth of its first step in the
+    last leg keeps that step (or the distance travelled, if larger, up to ``first_delta``); a settled one
+    gets the distance it travelled, at least a tenth of its step (at most tenfold smaller per leg).
+    A leg without improvement shrinks all steps tenfold. A leg ends when its step is below
     ``settings.pattern_tolerance`` of every bound range (:class:`StepTolerance`) or after
     ``settings.restart_evaluations``; the search stops after ``budget`` evaluations or when every first step
     is below the tolerance. Returns (best s, best cost)."""
@@ -195,7 +196,9 @@ def _pattern_search(problem, x0, settings, first_delta, budget):
         cost, found = float(np.atleast_1d(result.F)[0]), np.asarray(result.X, float).ravel()
         if cost < f:
             moved = np.abs(found - x) / span
-            x, f, delta = found, cost, np.minimum(np.maximum(moved, 0.1 * delta), first_delta)
+            travelling = moved >= 0.1 * delta
+            delta = np.where(travelling, np.minimum(np.maximum(moved, delta), first_delta), np.maximum(moved, 0.1 * delta))
+            x, f = found, cost
         else:
             delta = 0.1 * delta
     return x, f
