@@ -2,6 +2,7 @@
 
     python bench/bench_fullnet_tow.py                      # the case's full run (25 -> 300 s)
     python bench/bench_fullnet_tow.py --study --end 60     # step study over 35 s of towing
+    python bench/bench_fullnet_tow.py --capture --end 40   # capture start: ejection at 0 s, closing 15 s, tow 25 s
 
 Prints the wrapped-state preparation time, the run's wall time, steps per second, the step and
 sub-step, and sanity figures: momentum balance (|P(t) - P(t0) - external impulse|, N s, against the
@@ -95,8 +96,13 @@ def main():
     parser.add_argument("--rate", type=float, default=None, help="debris spin (deg/s); default the case's")
     parser.add_argument("--end", type=float, default=None, help="end time (s); default the case's")
     parser.add_argument("--study", action="store_true", help="step-convergence study instead of one run")
+    parser.add_argument("--capture", action="store_true", help="capture start (full_net.start = 'capture')")
     args = parser.parse_args()
     case = load_model(args.case, TowingCase)
+    if args.capture:
+        case = case.model_copy(update={"full_net": case.full_net.model_copy(update={"start": "capture"})})
+        report(*run(case, None, args.rate, args.end))
+        return
     start = time.perf_counter()
     wrapped = wrapped_net(case)
     print(f"wrapped state prepared in {time.perf_counter() - start:.1f} s (drape and close, compiled)")
