@@ -24,8 +24,6 @@ from the nearest sample of ``towing.npz``.
 """
 from __future__ import annotations
 
-import shutil
-import tempfile
 from pathlib import Path
 
 import meshio
@@ -34,8 +32,8 @@ import trimesh
 
 from diagnosis.towing_plant import lvlh_to_eci
 from multibody.net import thread_tension_strain
-from riskassess.results import MissingData, RunFolder, atomic_write_bytes
-from riskassess.vtk_export import VtkExport, _swap_in, nearest_samples, pvd_text, surface_lvlh
+from riskassess.results import MissingData, RunFolder
+from riskassess.vtk_export import VtkExport, nearest_samples, surface_lvlh, write_collection
 
 
 def body_meshes(case) -> list[trimesh.Trimesh]:
@@ -113,25 +111,11 @@ def export_tow_vtk(run_dir: str | Path, out: str | Path | None = None, every: in
     run = RunFolder(run_dir)
     frames = _TowFrames(run)  # raises MissingData before anything is written
     out = Path(out) if out else run.path / "vtk"
-    out.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.partial-"))
-    try:
-        picked = np.arange(0, len(frames.net["time"]), every)
-        entries = []
-        for n, f in enumerate(picked):
-            for part, (name, mesh) in enumerate((("net", frames.net_mesh(f)), ("bodies", frames.bodies_mesh(f)),
-                                                 ("tether", frames.tether_mesh(f)))):
-                file = f"{name}_{n:04d}.vtu"
-                meshio.write(staging / file, mesh, file_format="vtu", binary=True, compression="zlib")
-                entries.append((float(frames.net["time"][f]), part, name, file))
-            if progress:
-                progress(n + 1, len(picked))
-        atomic_write_bytes(staging / "towing.pvd", pvd_text(
-            entries, f"case {run.manifest.get('case')}: positions in the debris' LVLH frame (m)").encode())
-        _swap_in(staging, out)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
+    picked = np.arange(0, len(frames.net["time"]), every)
+    write_collection(out, ((float(frames.net["time"][f]), (("net", frames.net_mesh(f)), ("bodies", frames.bodies_mesh(f)),
+                                                          ("tether", frames.tether_mesh(f)))) for f in picked),
+                     len(picked), "towing.pvd", f"case {run.manifest.get('case')}: positions in the debris' LVLH frame (m)",
+                     progress)
     if out == run.path / "vtk":
         run.add_product("vtk/towing.pvd")
     return VtkExport(out, out / "towing.pvd", len(picked), frames.net["time"][picked])

@@ -136,6 +136,32 @@ def pvd_text(entries: list[tuple[float, int, str, str]], comment: str = "") -> s
     return "\n".join(line for line in lines if line)
 
 
+def write_collection(out: Path, frames, n_frames: int, pvd_name: str, comment: str, progress=None,
+                     extra=None) -> None:
+    """Write ``frames``, an iterable of (time (s), ((part name, meshio.Mesh), ...)) per frame, as
+    ``<part>_NNNN.vtu`` files and the ParaView collection ``pvd_name`` into ``out``. The folder is
+    staged beside ``out`` and swapped in at the end, so an interrupted export leaves the previous one
+    intact; ``extra(staging)`` may add files before the collection is written."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.partial-"))
+    try:
+        entries = []
+        for n, (t, parts) in enumerate(frames):
+            for part, (name, mesh) in enumerate(parts):
+                file = f"{name}_{n:04d}.vtu"
+                meshio.write(staging / file, mesh, file_format="vtu", binary=True, compression="zlib")
+                entries.append((t, part, name, file))
+            if progress:
+                progress(n + 1, n_frames)
+        if extra:
+            extra(staging)
+        atomic_write_bytes(staging / pvd_name, pvd_text(entries, comment).encode())
+        _swap_in(staging, out)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+
+
 def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int = 1, progress=None) -> VtkExport:
     """Write the VTK files of a run folder (see the module docstring); returns where and how many."""
     if RunFolder(run_dir).stage == "tow":  # a full-net tow folder: its own layout
@@ -147,31 +173,15 @@ def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int = 
     run = RunFolder(run_dir)
     frames = _Frames(run)  # raises MissingData before anything is written
     out = Path(out) if out else run.path / "vtk"
-    out.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.partial-"))
-    try:
-        picked = np.arange(0, len(frames.net["time"]), every)
-        entries = []
-        for n, f in enumerate(picked):
-            t = float(frames.net["time"][f])
-            for part, (name, mesh) in enumerate((("net", frames.net_mesh(f)), ("bodies", frames.bodies_mesh(f)),
-                                                 ("bullets", frames.bullets_mesh(f)))):
-                file = f"{name}_{n:04d}.vtu"
-                meshio.write(staging / file, mesh, file_format="vtu", binary=True, compression="zlib")
-                entries.append((t, part, name, file))
-            if progress:
-                progress(n + 1, len(picked))
-        bodies = [{"index": k, "name": name, "mass_kg": float(m),
-                   "released_at_s": None if np.isinf(r) else float(r)}
-                  for k, (name, m, r) in enumerate(zip(frames.body_names, frames.series["body_masses"],
-                                                       frames.released_from))]
-        (staging / "bodies.json").write_text(json.dumps(bodies, indent=2) + "\n")
-        atomic_write_bytes(staging / "impact.pvd", pvd_text(
-            entries, f"case {run.manifest.get('case')}: positions LVLH (m); body_index -> bodies.json").encode())
-        _swap_in(staging, out)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
+    picked = np.arange(0, len(frames.net["time"]), every)
+    bodies = [{"index": k, "name": name, "mass_kg": float(m), "released_at_s": None if np.isinf(r) else float(r)}
+              for k, (name, m, r) in enumerate(zip(frames.body_names, frames.series["body_masses"],
+                                                   frames.released_from))]
+    write_collection(out, ((float(frames.net["time"][f]), (("net", frames.net_mesh(f)), ("bodies", frames.bodies_mesh(f)),
+                                                          ("bullets", frames.bullets_mesh(f)))) for f in picked),
+                     len(picked), "impact.pvd", f"case {run.manifest.get('case')}: positions LVLH (m); body_index -> "
+                     "bodies.json", progress,
+                     lambda staging: (staging / "bodies.json").write_text(json.dumps(bodies, indent=2) + "\n"))
     if out == run.path / "vtk":
         run.add_product("vtk/impact.pvd")
     return VtkExport(out, out / "impact.pvd", len(picked), frames.net["time"][picked])
