@@ -34,6 +34,8 @@ MAX_EVALUATIONS = 30
 #: Forward-difference step of the Jacobian, scaled parameters (1 = a prior sigma or a typical size);
 #: the RK4 model is smooth and deterministic to ~1e-13, so 1e-6 leaves ~1e-7 relative error.
 DIFFERENCE_STEP = 1e-6
+#: Largest discretization error of the towing model (RMS, in noise sigmas) the fit accepts (resolved_step).
+STEP_ERROR_SIGMA = 0.2
 #: Broyden updates between two finite-difference Jacobians (towing model only, see CandidateFit.jacobian).
 BROYDEN_REFRESH = 3
 #: Nominal parameters whose effect on the residuals is linear (the CoM's initial position and
@@ -63,8 +65,11 @@ class Problem:
         time = measured.time
         split = time[0] + (1.0 - holdout_fraction) * (time[-1] - time[0])
         names = nominal_parameter_names(case, used)
-        return cls(case, plant, time, {c: measured.values[c] for c in used}, {c: measured.noise[c] for c in used},
-                   time <= split, names, nominal_vector(plant, names), prior_sigmas(case, names))
+        noise = {c: measured.noise[c] for c in used}
+        if is_towing(plant):
+            plant = plant.replace(fit_step=resolved_step(plant, time, noise))
+        return cls(case, plant, time, {c: measured.values[c] for c in used}, noise, time <= split, names,
+                   nominal_vector(plant, names), prior_sigmas(case, names))
 
     @property
     def channels(self) -> list[str]:
@@ -219,7 +224,13 @@ class CandidateFit:
                   (self.effect.starts(self.specs) if self.effect else [np.zeros(0)])]
         stage1 = [self._solve(z0, first) for z0 in starts]
         best = min(stage1, key=lambda r: r.cost)
-        result = self._solve(best.x, p.train)
+        # the second stage starts from the better, on the whole training span, of the first stage's best
+        # and (for a candidate) the nominal fit with the effect at its first start: a first stage that
+        # wandered off on the early span must not leave a candidate worse than the nominal model
+        low, high = self._bounds()
+        options = [best.x] + ([np.clip(starts[0], low, high)] if nominal_start is not None else [])
+        z2 = min(options, key=lambda z: float(np.sum(self.residuals(z, p.train) ** 2)))
+        result = self._solve(z2, p.train)
         evaluations = sum(r.nfev for r in stage1) + result.nfev
         return self._result(result, evaluations, clock.perf_counter() - start)
 
@@ -239,6 +250,22 @@ class CandidateFit:
         return FitResult(self.effect.id if self.effect else "nominal", names, units, np.r_[nominal, values],
                          scale * np.sqrt(np.clip(np.diag(cov_z), 0.0, None)), n_nominal, chi2_data, chi2_prior,
                          n_data, seconds, evaluations, result.message, values)
+
+
+def resolved_step(plant, times, noise: dict, halvings: int = 3) -> float:
+    """The towing model's step (s): the case's ``fit_step``, halved until the nominal model's
+    discretization error, estimated by the step-doubling difference |y(h) - y(h/2)| (RMS per
+    channel), is below ``STEP_ERROR_SIGMA`` of each channel's noise (at most ``halvings`` times): quiet
+    sensors must not see the fit model's step as a discrepancy."""
+    step = plant.fit_step
+    coarse = predict(plant, times, step=step)
+    for _ in range(halvings):
+        fine = predict(plant, times, step=step / 2)
+        error = max(np.sqrt(np.mean((coarse[c] - fine[c]) ** 2)) / sigma for c, sigma in noise.items() if c in fine)
+        if error <= STEP_ERROR_SIGMA:
+            break
+        step, coarse = step / 2, fine
+    return step
 
 
 def _expanded(names) -> list[str]:
