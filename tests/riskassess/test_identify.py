@@ -97,7 +97,7 @@ def test_pso_and_pattern_search_recover_known_sub_tether_parameters(small_benchm
     assert lower <= found.s[3] <= upper
 
 
-@pytest.mark.slow  # not yet robust: one run in two ended in the k-c valley at the c bound (cost 0.145)
+@pytest.mark.slow  # not robust at this budget: seeded now, seeds 0, 1, 4 pass; 2 and 3 end with c_ST 8-9 % off (k-c valley)
 def test_pattern_search_recovers_known_sub_tether_parameters(reduced_benchmark):
     case, data, end = reduced_benchmark
     found = identify(case, data, "pattern", end_time=end, workers=2)
