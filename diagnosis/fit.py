@@ -224,11 +224,12 @@ class CandidateFit:
                   (self.effect.starts(self.specs) if self.effect else [np.zeros(0)])]
         stage1 = [self._solve(z0, first) for z0 in starts]
         best = min(stage1, key=lambda r: r.cost)
-        # the second stage starts from the better, on the whole training span, of the first stage's best
-        # and (for a candidate) the nominal fit with the effect at its first start: a first stage that
-        # wandered off on the early span must not leave a candidate worse than the nominal model
+        # towing: the second stage starts from the better, on the whole training span, of the first
+        # stage's best and (for a candidate) the nominal fit with the effect at its first start: with the
+        # Broyden Jacobians a first stage that wandered off on the early span left candidates worse than
+        # the nominal model (the free scenarios keep the plain continuation their slow test validated)
         low, high = self._bounds()
-        options = [best.x] + ([np.clip(starts[0], low, high)] if nominal_start is not None else [])
+        options = [best.x] + ([np.clip(starts[0], low, high)] if nominal_start is not None and self.broyden else [])
         z2 = min(options, key=lambda z: float(np.sum(self.residuals(z, p.train) ** 2)))
         result = self._solve(z2, p.train)
         evaluations = sum(r.nfev for r in stage1) + result.nfev

@@ -198,7 +198,9 @@ def channels(plant: TowingPlant, model, q, v, diag, xe) -> dict:
     debris = Rotation.from_rotvec(q[:, 12:15])
     to_lvlh = Rotation.from_matrix(np.transpose(lvlh_to_eci(r_c, v_c), (0, 2, 1)))
     quat = (to_lvlh * debris).as_quat()[:, [3, 0, 1, 2]]
-    quat *= np.where(quat[:, :1] < 0, -1.0, 1.0)
+    # q and -q are one attitude: keep the sign continuous (rows are interpolated, plotted, and aligned
+    # with the measured quaternion sample by sample)
+    quat *= np.r_[1.0, np.cumprod(np.where(np.sum(quat[1:] * quat[:-1], axis=1) < 0, -1.0, 1.0))][:, None]
     rel = to_lvlh.apply(r_d - debris.apply(plant.com_offset) - r_c)
     out = {f"omega_{a}": v[:, 12 + i] for i, a in enumerate("xyz")}
     out.update({f"q_{a}": quat[:, i] for i, a in enumerate("wxyz")})

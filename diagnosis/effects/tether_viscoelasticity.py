@@ -83,7 +83,8 @@ class TetherViscoelasticity(Effect):
         return np.r_[np.asarray(values, float), tether.stiffness, tether.natural_length]
 
     def parameter_specs(self, case, channels=None):
-        k = case.towing_case.main_tether.stiffness
+        # (outside towing the effect is not applicable; 1 kN/m only sizes the listed parameters)
+        k = case.towing_case.main_tether.stiffness if case.kind == "towing" else 1000.0
         # typical: a branch as stiff as the tether relaxing over tens of seconds (creep of a polymer braid);
         # weaker or faster branches hide in the damped tether (c = 300 N s/m in the Zenit-2 case)
         return [Parameter("maxwell_stiffness", "N/m", "stiffness of the relaxing branch k_m", k, 0.0, 30.0 * k),

@@ -9,18 +9,20 @@ from diagnosis.effects import CATALOG
 from diagnosis.effects.gravity_gradient_torque import gravity_gradient
 from diagnosis.model import max_step
 from diagnosis.plant import Plant
-from tests.diagnosis.conftest import HINGED_CASE, TUMBLING_CASE, case_with
+from tests.diagnosis.conftest import HINGED_CASE, TOWING_CASE, TUMBLING_CASE, case_with
 
 REQUIRED = {"hinge_coulomb_friction", "hinge_stiffness_hardening", "hinge_backlash", "internal_energy_dissipation",
             "eddy_current_damping", "gravity_gradient_torque", "j2_perturbation", "tether_viscoelasticity",
             "thrust_misalignment", "com_offset", "sensor_time_delay", "sensor_bias"}
 
 
-@pytest.mark.parametrize("path", [TUMBLING_CASE, HINGED_CASE])
+@pytest.mark.parametrize("path", [TUMBLING_CASE, HINGED_CASE, TOWING_CASE])
 def test_catalog_has_every_required_effect_with_units_and_bounds(path):
     case = case_with(path)
     assert REQUIRED <= set(CATALOG)
     for effect in CATALOG.values():
+        if case.kind == "towing" and case.kind not in effect.scenarios:   # the hinge effects: no hinge to size
+            continue
         for p in effect.parameter_specs(case):
             assert p.unit and p.lower <= p.typical <= p.upper, (effect.id, p)
 
@@ -28,6 +30,13 @@ def test_catalog_has_every_required_effect_with_units_and_bounds(path):
 def test_towing_effects_are_not_applicable_to_the_free_scenarios(tumbling_rocket_body):
     for effect_id in ("tether_viscoelasticity", "thrust_misalignment"):
         assert "towing" in CATALOG[effect_id].not_applicable(tumbling_rocket_body, ["omega_x"])
+
+
+def test_towing_scenario_takes_every_effect_but_the_hinge_ones(zenit_tow):
+    channels = ["omega_x", "omega_y", "omega_z", "q_w", "q_x", "q_y", "q_z", "rel_x", "rel_y", "rel_z", "tether_tension"]
+    open_ = {k for k, e in CATALOG.items() if e.not_applicable(zenit_tow, channels) is None}
+    assert open_ == set(CATALOG) - {"hinge_coulomb_friction", "hinge_stiffness_hardening", "hinge_backlash"}
+    assert "bias_tether_tension" in [p.name for p in CATALOG["sensor_bias"].parameter_specs(zenit_tow, channels)]
 
 
 def _run(case, effect_id, values, duration=200.0):
