@@ -30,7 +30,8 @@ class _EffectForces:
     """Force user function: the effect's loads, then :func:`multibody.towing_kernel.body_forces`."""
 
     def __init__(self, model, law, p):
-        self.model, self.law, self.p = model, law, np.ascontiguousarray(p, float)
+        self.model, self.law = model, law
+        self.p = np.zeros(1) if len(p) == 0 else np.ascontiguousarray(p, float)
         self.work = packed(model)
         self.xe = initial_extra_states(model.omega_body[1])
         self.load = np.zeros(N_COORDINATES)

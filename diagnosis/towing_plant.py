@@ -166,7 +166,7 @@ def model_step(plant: TowingPlant, times, step: float | None = None) -> float:
     return dt / np.ceil(dt / h - 1e-9)
 
 
-def simulate(plant: TowingPlant, times, law=no_towing_load, p=np.zeros(1), step: float | None = None) -> dict:
+def simulate(plant: TowingPlant, times, law=no_towing_load, p=None, step: float | None = None) -> dict:
     """Channels (dict of (k,) arrays) at ``times`` (s from the record's t = 0, non-decreasing) of the
     fast model with the towing ``law`` at parameters ``p``; linear between the steps around a time."""
     times = np.asarray(times, float)
@@ -181,7 +181,8 @@ def simulate(plant: TowingPlant, times, law=no_towing_load, p=np.zeros(1), step:
     work = packed(model)
     xe = initial_extra_states(model.omega_body[1])
     out = [np.zeros((len(record), n)) for n in (15, 15, diagnostics_size(work), EXTRA_STATES)]
-    integrate(law, np.ascontiguousarray(p, float), q, v, model.start_time, int(record[-1]), work, xe, record, *out)
+    p = np.zeros(1) if p is None or len(p) == 0 else np.ascontiguousarray(p, float)
+    integrate(law, p, q, v, model.start_time, int(record[-1]), work, xe, record, *out)
     if not all(np.isfinite(a).all() for a in out[:3]):      # a run that blew up (a parameter far off)
         return {c: np.full(len(times), FAILED) for c in OMEGA + QUATERNION + REL + TENSION}
     rows = channels(plant, model, *out)
