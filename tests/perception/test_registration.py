@@ -62,9 +62,7 @@ def _icp_from(tracker, points, truth, position, wrong_turn):
 def test_check_rejects_a_wrong_pose_that_open3d_scores_well(paper_ellipsoid, c_fans_lidar):
     # ICP seeded 90 deg off about the body x axis stays ~90 deg off; Open3D still reports
     # ~0.78 fitness at its correspondence distance (above the 0.6-0.7 often used to accept).
-    # Geometry alone (no motion prediction) rejects it: tight fitness. (The free-space check,
-    # interior bins only, measured 0.035-0.09 for such poses at 10-30 m, against <= 0.025 for
-    # correct ones: a second, weaker witness.)
+    # Geometry alone (no motion prediction) rejects it: tight fitness and free-space violation.
     truth = Rotation.from_rotvec([0.3, 0.2, 0.1]).as_matrix()
     position = np.array([RANGE, 0.0, 0.0])
     points = _scan(paper_ellipsoid, c_fans_lidar, truth, position, 0)
@@ -73,25 +71,7 @@ def test_check_rejects_a_wrong_pose_that_open3d_scores_well(paper_ellipsoid, c_f
     assert error > np.radians(45.0) and fitness > 0.7
     check = tracker._judge(0.0, points, pose, pose, SENSOR, has_motion=False)
     assert not check.ok
-    assert check.tight_fitness < 0.8 and check.free_space_violation > 0.02
-
-
-@pytest.mark.parametrize("distance", [10.0, 25.0])
-def test_free_space_check_passes_correct_poses_near_and_far_and_sees_occlusion(paper_ellipsoid, c_fans_lidar,
-                                                                               distance):
-    # At 25 m a two-voxel bin holds about one ray: judged on every bin, the limb made correct
-    # poses fail (0.05-0.1 measured in a collision run); interior bins at least two rays wide
-    # keep them at <= 0.025 (measured at 10-30 m). A model put 0.3 m in front of what the
-    # LiDAR saw blocks every interior ray (violation 1).
-    truth = Rotation.from_rotvec([0.3, 0.2, 0.1]).as_matrix()
-    position = np.array([distance, 0.0, 0.0])
-    points = _scan(paper_ellipsoid, c_fans_lidar, truth, position, 0)
-    tracker = DebrisTracker(0.03, 0.1, 30, *known_shape_model(paper_ellipsoid, 0.03, seed=0),
-                            ray_spacing=c_fans_lidar.resolution_elevation)
-    correct = tracker._judge(0.0, points, _pose(truth, position), _pose(truth, position), SENSOR, has_motion=True)
-    assert correct.ok and correct.free_space_violation < 0.03
-    in_front = _pose(truth, position - np.array([0.3, 0.0, 0.0]))
-    assert tracker._judge(0.0, points, in_front, in_front, SENSOR, has_motion=False).free_space_violation > 0.9
+    assert check.tight_fitness < 0.8 and check.free_space_violation > 0.05
 
 
 def test_symmetric_flip_is_caught_by_the_motion_check(paper_ellipsoid, c_fans_lidar):
