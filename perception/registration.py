@@ -59,7 +59,10 @@ reg = o3d.pipelines.registration
 MIN_TIGHT_FITNESS = 0.8          # share of points within 3 sigma; a correct pose leaves only outliers (net, noise tails)
 MAX_FREE_SPACE_VIOLATION = 0.05  # share of viewing directions where the model blocks a measured return
 MAX_INNOVATION = np.radians(10.0)  # rad; the constant-rate prediction is good to ~0.2 deg for 2.3 rad/s tumbles at 10 Hz
-MAX_COAST = 3                      # failed frames bridged by the constant-rate prediction (torque-free drift ~4 deg over 0.3 s)
+# Failed frames the constant-rate prediction may bridge. 0: a failure ends the prediction and
+# the next frame is searched. Coasting over 3 frames was tried: in the 60 s observation it let
+# wrong branches (6-10 deg about the near-symmetry axis) persist, 549/601 frames against 601/601.
+MAX_COAST = 0
 SEARCH_TURN = np.radians(30.0)     # rad; largest turn between frames searched without a prediction (3 rad/s at 10 Hz, paper Sec. 2)
 MIN_POINTS = 50                    # thinned scan points below which a frame is not registered (too few for the check)
 
