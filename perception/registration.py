@@ -59,10 +59,6 @@ reg = o3d.pipelines.registration
 MIN_TIGHT_FITNESS = 0.8          # share of points within 3 sigma; a correct pose leaves only outliers (net, noise tails)
 MAX_FREE_SPACE_VIOLATION = 0.05  # share of viewing directions where the model blocks a measured return
 MAX_INNOVATION = np.radians(10.0)  # rad; the constant-rate prediction is good to ~0.2 deg for 2.3 rad/s tumbles at 10 Hz
-# Failed frames the constant-rate prediction may bridge. 0: a failure ends the prediction and
-# the next frame is searched. Coasting over 3 frames was tried: in the 60 s observation it let
-# wrong branches (6-10 deg about the near-symmetry axis) persist, 549/601 frames against 601/601.
-MAX_COAST = 0
 SEARCH_TURN = np.radians(30.0)     # rad; largest turn between frames searched without a prediction (3 rad/s at 10 Hz, paper Sec. 2)
 MIN_POINTS = 50                    # thinned scan points below which a frame is not registered (too few for the check)
 
@@ -223,31 +219,10 @@ def known_shape_model(mesh, voxel, seed) -> tuple[np.ndarray, np.ndarray]:
     return points, mesh.face_normals[faces]
 
 
-def predict_pose(previous, before, ratio=1.0) -> np.ndarray:
-    """world_to_body ``ratio`` frame intervals after ``previous``, from the last two poses at
-    constant rotation and translation rates (a screw motion): T = (T_prev T_before^-1)^ratio T_prev."""
-    delta = previous @ _rigid_inverse(before)
-    if ratio == 1.0:
-        return delta @ previous
-    return _se3_power(delta, ratio) @ previous
-
-
-def _se3_power(transform, ratio) -> np.ndarray:
-    """``transform`` (4, 4) raised to a real power: its twist (log) scaled by ``ratio``, exponentiated."""
-    rotvec = Rotation.from_matrix(transform[:3, :3]).as_rotvec()
-    moved = np.eye(4)
-    moved[:3, :3] = Rotation.from_rotvec(ratio * rotvec).as_matrix()
-    moved[:3, 3] = _left_jacobian(ratio * rotvec) @ np.linalg.solve(_left_jacobian(rotvec), transform[:3, 3]) * ratio
-    return moved
-
-
-def _left_jacobian(rotvec) -> np.ndarray:
-    """SO(3) left Jacobian V(phi) = I + (1 - cos a)/a^2 K + (a - sin a)/a^3 K^2 (translation part of exp on SE(3))."""
-    angle = np.linalg.norm(rotvec)
-    k = np.array([[0.0, -rotvec[2], rotvec[1]], [rotvec[2], 0.0, -rotvec[0]], [-rotvec[1], rotvec[0], 0.0]])
-    if angle < 1e-9:
-        return np.eye(3) + 0.5 * k
-    return np.eye(3) + (1 - np.cos(angle)) / angle**2 * k + (angle - np.sin(angle)) / angle**3 * (k @ k)
+def predict_pose(previous, before) -> np.ndarray:
+    """world_to_body at the next frame from the last two, at constant rotation and translation
+    rates (equal frame spacing): T_next = (T_prev T_before^-1) T_prev."""
+    return previous @ np.linalg.inv(before) @ previous
 
 
 class DebrisTracker:
@@ -263,17 +238,11 @@ class DebrisTracker:
                                 known mesh's face normals, used as they are (no thinning, no
                                 normal estimation, which blurs a faceted surface's normals over
                                 a few voxels and biased the fitted inertia ratios by ~0.04 %).
-    ray_spacing : float         The sensor's angular step between rays (rad), optional: the
-                                free-space check's viewing-direction bins are kept at least two
-                                rays wide. Without it they are two voxels wide at the scan's range,
-                                which far away (beyond ~15 m for the case's LiDAR) holds a single
-                                ray: every limb return then looks like a violation.
     """
 
     def __init__(self, voxel=0.03, max_correspondence=0.1, model_frames=30, model_points_body=None,
-                 model_normals_body=None, ray_spacing=0.0):
+                 model_normals_body=None):
         self.voxel = voxel
-        self.ray_spacing = ray_spacing
         self.max_correspondence = max_correspondence
         self.model_frames = model_frames
         self.alignments: list[Alignment] = []
@@ -352,7 +321,7 @@ class DebrisTracker:
         if self._model is None:   # the first scan starts the model and defines the frame B
             alignment = self._start_model(time_s, np.asarray(scan.points))
         else:
-            predicted, has_motion = self.prediction(time_s)
+            predicted, has_motion = self._prediction()
             if gate is not None and has_motion:
                 scan = self._gated(scan, predicted, gate)
             alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
@@ -392,32 +361,19 @@ class DebrisTracker:
         retry = self._judge(time_s, points, pose, reference, sensor_world, has_motion, global_init=True)
         return retry if retry.ok or retry.tight_fitness > failed.tight_fitness else failed
 
-    def predicted_world_to_body(self, time_s) -> np.ndarray | None:
-        """The expected pose (world -> B) at ``time_s`` (s); see :meth:`prediction`."""
-        return self.prediction(time_s)[0]
+    def predicted_world_to_body(self) -> np.ndarray | None:
+        """The next frame's expected pose (world -> B): from the motion of the last two good
+        frames, else the last good pose; None before any good frame."""
+        return self._prediction()[0]
 
-    def prediction(self, time_s) -> tuple[np.ndarray | None, bool]:
-        """Predicted pose (world -> B) at ``time_s`` (s) and whether it carries the motion.
-
-        With the motion: constant rates from the last two good frames, when they are at most
-        MAX_COAST frames apart and the last of them at most MAX_COAST frames old (a few frames
-        may fail, e.g. while the net covers the debris, without losing the track). Otherwise the
-        last good pose (None before any good frame) and no motion."""
-        good = []
-        for k in range(len(self.alignments) - 1, -1, -1):
-            if self.alignments[k].ok:
-                good.append(k)
-                if len(good) == 2:
-                    break
-        if not good:
-            return None, False
-        last = self.alignments[good[0]]
-        fresh = len(good) == 2 and len(self.alignments) - 1 - good[0] <= MAX_COAST and good[0] - good[1] <= 1 + MAX_COAST
-        if not fresh:
-            return last.world_to_body, False
-        before = self.alignments[good[1]]
-        ratio = (time_s - last.time) / (last.time - before.time)
-        return predict_pose(last.world_to_body, before.world_to_body, ratio), True
+    def _prediction(self) -> tuple[np.ndarray | None, bool]:
+        """Predicted pose (None before any good frame) and whether it carries the motion (two
+        consecutive good frames); without the motion, the last good pose."""
+        last = self.alignments[-2:]
+        if len(last) == 2 and all(a.ok for a in last):
+            return predict_pose(last[1].world_to_body, last[0].world_to_body), True
+        good = [a for a in self.alignments if a.ok]
+        return (good[-1].world_to_body if good else None), False
 
     def _acquisition_start(self, points, last) -> np.ndarray:
         """Pose putting the scan centroid on the model centroid, at the last good attitude if any."""
@@ -491,8 +447,8 @@ class DebrisTracker:
         tight, sigma, information = self._surface_fit(points_world, pose)
         model_world = _transform(self._coarse_points, _rigid_inverse(pose))
         range_scale = np.median(np.linalg.norm(points_world - sensor_world, axis=1))
-        bin_angle = 2 * max(self.voxel / range_scale, self.ray_spacing)
-        violation = free_space_violation(points_world, model_world, sensor_world, bin_angle, 3 * sigma + self.voxel)
+        violation = free_space_violation(points_world, model_world, sensor_world, 2 * self.voxel / range_scale,
+                                         3 * sigma + self.voxel)
         innovation = _turn_angle(pose[:3, :3], predicted[:3, :3])
         ok = (tight >= MIN_TIGHT_FITNESS and violation <= MAX_FREE_SPACE_VIOLATION
               and (innovation <= MAX_INNOVATION or not has_motion))

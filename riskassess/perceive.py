@@ -42,7 +42,7 @@ from perception.momentum import (mass_from_linear_momentum, point_masses_momentu
 from perception.motion import (NotObservable, attitude_sqrt_information, center_of_mass_line, isotropic_attitude_weights,
                                rates_from_attitudes)
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
-from perception.registration import DebrisTracker, known_shape_model
+from perception.registration import DebrisTracker, known_shape_model, predict_pose
 from perception.shape import half_turn_symmetries, rotation_error
 from riskassess import results
 from riskassess.assemble import body_meshes_target_frame, model_inputs
@@ -143,10 +143,10 @@ def _scan_world(scene, meshes_world, sensor_world, sensor_to_world, t, rng):
     return scan.points_sensor @ sensor_to_world.T + sensor_world, scan.label
 
 
-def _aim_point(tracker: DebrisTracker, time_s):
-    """Where the debris is expected at ``time_s`` (m, world): its model centroid at the
+def _aim_point(tracker: DebrisTracker):
+    """Where the debris is expected in this frame (m, world): its model centroid at the
     tracker's predicted pose; None before any good frame."""
-    pose = tracker.predicted_world_to_body(time_s)
+    pose = tracker.predicted_world_to_body()
     if pose is None:
         return None
     body_to_world = np.linalg.inv(pose)
@@ -159,14 +159,15 @@ def _thinned(points_world, voxel) -> np.ndarray:
     return np.asarray(cloud.voxel_down_sample(voxel).points)
 
 
-def _crop_to_predicted(tracker: DebrisTracker, points_world, time_s) -> np.ndarray:
-    """Scan points near the debris surface predicted at ``time_s`` from the tracked motion (others
-    belong to the net); all points when there is no motion prediction. Done here on the full scan,
+def _crop_to_predicted(tracker: DebrisTracker, points_world) -> np.ndarray:
+    """Scan points near the debris surface predicted from the last two good frames (others
+    belong to the net); all points when there is no prediction. Done here on the full scan,
     before the tracker thins it: the tracker's own ``gate`` (after thinning) registered fewer
     free-flight frames in the shortened test case (7 against 16)."""
-    predicted, has_motion = tracker.prediction(time_s)
-    if not has_motion:
+    last = tracker.alignments[-2:]
+    if len(last) < 2 or not all(a.ok for a in last):
         return points_world
+    predicted = predict_pose(last[1].world_to_body, last[0].world_to_body)
     body = points_world @ predicted[:3, :3].T + predicted[:3, 3]
     return points_world[np.isfinite(tracker.distance_to_model(body, DEBRIS_GATE))]
 
@@ -183,7 +184,7 @@ def observe_tumble(scene: Scene, tracker: DebrisTracker, frames: Frames, symmetr
     chaser_com = debris.com_lvlh - p.hold_distance * scene.direction
     com_target = scene.truth["com_target"]
     for k, t in enumerate(sample_times - p.observation_time):
-        sensor_world, sensor_to_world = scene.sensor_pose(chaser_com, np.eye(3), _aim_point(tracker, t))
+        sensor_world, sensor_to_world = scene.sensor_pose(chaser_com, np.eye(3), _aim_point(tracker))
         rot, com = states["body_to_lvlh"][k, 0], states["body_com_lvlh"][k, 0]
         origin = com - rot @ com_target
         tic = time.perf_counter()
@@ -313,7 +314,7 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         chaser_pose = _pose(series["body_to_lvlh"][i, chaser], series["body_com_lvlh"][i, chaser])
         rot, com = series["body_to_lvlh"][i, 0], series["body_com_lvlh"][i, 0]
         true_net = net_snapshots["positions_lvlh"][k]
-        sensor_world, sensor_to_world = scene.sensor_pose(chaser_pose[:3, 3], chaser_pose[:3, :3], _aim_point(tracker, t))
+        sensor_world, sensor_to_world = scene.sensor_pose(chaser_pose[:3, 3], chaser_pose[:3, :3], _aim_point(tracker))
         tic = time.perf_counter()
         points, _ = _scan_world(scene, [(scene.debris_vertices_world(rot, com - rot @ com_target), scene.mesh_target.faces),
                                         thread_mesh(true_net, net.threads, radius)],
@@ -325,7 +326,7 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         start_pose = previous_chaser if previous_chaser is not None else _pose(np.eye(3), assembly.bodies[chaser].com_lvlh)
         predicted = carried_by_chaser(estimate, start_pose, chaser_pose)
         on_net = nearest_segments(points, predicted, net.threads)[2] < NET_GATE if len(points) else np.zeros(0, bool)
-        _register(tracker, frames, t, 1, _crop_to_predicted(tracker, points[~on_net], t), sensor_world, rot, com,
+        _register(tracker, frames, t, 1, _crop_to_predicted(tracker, points[~on_net]), sensor_world, rot, com,
                   symmetries)
         # The net's nodes are fitted to the returns the debris does not explain, the rim held at
         # the rod tips.
@@ -350,20 +351,22 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
 
 
 def free_flight_start(track: NetTrack) -> int:
-    """Index (into the collision frames) from which the debris stays clear of the net. Frames
-    whose debris registration failed have no measured gap and decide nothing (the track may be
-    lost late in the run, when the debris is far and seen through the net)."""
+    """Index (into the collision frames) from which the debris stays clear of the net.
+
+    A frame whose debris registration failed has no measured gap and counts as touching (during
+    the contact the failures are the net covering the debris), except at the end of the run:
+    trailing failures are the track lost far away and decide nothing."""
     separation = np.asarray(track.separation, float)
     measured = np.flatnonzero(np.isfinite(separation))
-    touching = measured[separation[measured] <= SEPARATION]
     if len(measured) == 0 or separation[measured[-1]] <= SEPARATION:
         raise NotObservable("the debris is still touching the net (or its registration fails) at the end of the "
                             "collision run; lengthen simulation.end_time")
-    if len(touching) == 0:
+    clear = separation[:measured[-1] + 1] > SEPARATION   # NaN compares False: not clear
+    if not np.any(separation[measured] <= SEPARATION):
         raise NotObservable("the net never came near the debris: the collision transferred no momentum")
     # The contact may end between frames and the gap is measured on an estimated net: the first
     # clear frame is a margin, free flight is taken from the second.
-    return int(touching[-1] + 2)
+    return int(np.flatnonzero(~clear)[-1] + 2)
 
 
 # ------------------------------------------------------------------------------ momentum step
@@ -544,8 +547,7 @@ def perceive_case(case_path, out_dir, progress=None, case: Case | None = None) -
     manifest = begin_run_folder(out, case_path, case)
     rng = np.random.default_rng(p.seed)
     tracker = DebrisTracker(p.registration.voxel, p.registration.max_correspondence, p.registration.model_frames,
-                            *known_shape_model(scene.mesh_target, p.registration.voxel, p.seed),
-                            ray_spacing=max(scene.spec.resolution_azimuth, scene.spec.resolution_elevation))
+                            *known_shape_model(scene.mesh_target, p.registration.voxel, p.seed))
     symmetries = half_turn_symmetries(scene.mesh_target, 0.5 * p.registration.voxel)
     frames = Frames()
     wall = time.perf_counter()

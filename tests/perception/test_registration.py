@@ -138,22 +138,3 @@ def test_gate_drops_returns_in_front_of_the_debris(paper_ellipsoid, c_fans_lidar
     assert abs(gated.n_points - debris_points) <= 0.02 * debris_points
     assert alignments[None].n_points > 1.1 * gated.n_points
     assert alignments[None].tight_fitness < gated.tight_fitness
-
-
-def test_prediction_over_a_gap_follows_a_constant_screw_motion():
-    """predict_pose extrapolates a constant screw motion exactly (to round-off) over any number
-    of frame intervals: the track can coast over frames that failed."""
-    from scipy.linalg import expm
-
-    from perception.registration import predict_pose
-
-    twist = np.array([0.3, -0.2, 0.25, 0.05, 0.1, -0.02])   # (rotation rad, translation m) per frame
-    generator = np.zeros((4, 4))
-    generator[:3, :3] = np.array([[0, -twist[2], twist[1]], [twist[2], 0, -twist[0]], [-twist[1], twist[0], 0]])
-    generator[:3, 3] = twist[3:]
-    start = np.eye(4)
-    start[:3, :3] = Rotation.from_rotvec([0.4, 0.1, -0.7]).as_matrix()
-    start[:3, 3] = [1.0, -2.0, 0.5]
-    pose_at = lambda k: expm(k * generator) @ start   # noqa: E731
-    for ratio in (1.0, 2.5, 4.0):
-        np.testing.assert_allclose(predict_pose(pose_at(1), pose_at(0), ratio), pose_at(1 + ratio), atol=1e-12)

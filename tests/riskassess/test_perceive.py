@@ -87,17 +87,18 @@ def test_an_empty_scan_is_not_observable(tmp_path, capsys):
 
 
 def test_free_flight_starts_after_the_last_measured_contact():
-    """Frames without a debris pose (NaN gap) decide nothing: neither contact nor free flight."""
+    """Frames without a debris pose (NaN gap) count as contact, except trailing ones (track lost)."""
     import numpy as np
 
     from perception.motion import NotObservable
     from riskassess.perceive import NetTrack, free_flight_start
 
     nan = float("nan")
-    # Contact (gap <= 0.1 m) up to frame 3, a failed registration at frame 4, clear from 5 on,
-    # the track lost in the last frames: free flight from the second frame after the contact.
+    # Contact (gap <= 0.1 m) up to frame 3, a failed registration at frame 4 (still contact for
+    # all we know), clear from 5 on, the track lost in the last frames: free flight from the
+    # second frame after the last frame that was not clear.
     track = NetTrack(separation=[0.0, 0.01, nan, 0.05, nan, 0.4, 0.9, 1.5, nan, nan])
-    assert free_flight_start(track) == 5
+    assert free_flight_start(track) == 6
     with pytest.raises(NotObservable, match="still touching"):
         free_flight_start(NetTrack(separation=[0.5, 0.0, 0.05, nan]))
     with pytest.raises(NotObservable, match="never came near"):
