@@ -547,7 +547,7 @@ def perceive_case(case_path, out_dir, progress=None, case: Case | None = None) -
     manifest = begin_run_folder(out, case_path, case)
     rng = np.random.default_rng(p.seed)
     tracker = DebrisTracker(p.registration.voxel, p.registration.max_correspondence, p.registration.model_frames,
-                            *known_shape_model(scene.mesh_target, p.registration.voxel, p.seed))
+                            *known_shape_model(scene.mesh_target, p.registration.voxel, p.seed), seed=p.seed)
     symmetries = half_turn_symmetries(scene.mesh_target, 0.5 * p.registration.voxel)
     frames = Frames()
     wall = time.perf_counter()
