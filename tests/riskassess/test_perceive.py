@@ -87,18 +87,21 @@ def test_an_empty_scan_is_not_observable(tmp_path, capsys):
 
 
 def test_free_flight_starts_after_the_last_measured_contact():
-    """Frames without a debris pose (NaN gap) count as contact, except trailing ones (track lost)."""
+    """Frames without a debris pose (NaN gap) count as contact next to a touching frame, as
+    clear between clear frames (a registration failure far from the net)."""
     import numpy as np
 
     from perception.motion import NotObservable
     from riskassess.perceive import NetTrack, free_flight_start
 
     nan = float("nan")
-    # Contact (gap <= 0.1 m) up to frame 3, a failed registration at frame 4 (still contact for
-    # all we know), clear from 5 on, the track lost in the last frames: free flight from the
-    # second frame after the last frame that was not clear.
-    track = NetTrack(separation=[0.0, 0.01, nan, 0.05, nan, 0.4, 0.9, 1.5, nan, nan])
+    # Contact (gap <= 0.1 m) up to frame 3, a failed registration at frame 4 next to it (still
+    # contact for all we know), clear from 5 on, a failure between clear frames at 8 and the
+    # track lost in the last frames: free flight from the second frame after the last contact.
+    track = NetTrack(separation=[0.0, 0.01, nan, 0.05, nan, 0.4, 0.9, 1.5, nan, 2.6, nan, nan])
     assert free_flight_start(track) == 6
+    # the failed frames right after the last touching frame count as touching
+    assert free_flight_start(NetTrack(separation=[0.3, 0.02, nan, nan, 0.5, 0.8, 1.0])) == 5
     with pytest.raises(NotObservable, match="still touching"):
         free_flight_start(NetTrack(separation=[0.5, 0.0, 0.05, nan]))
     with pytest.raises(NotObservable, match="never came near"):
