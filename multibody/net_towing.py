@@ -13,7 +13,7 @@ Frame: Earth-centred inertial; angular velocities in the body frames.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import exudyn as exu
 import numpy as np
@@ -28,32 +28,27 @@ from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING
                                          D_CONTACT_F, D_CONTACTS, D_ELONGATION, D_RATE, D_SIZE, D_TENSION, advance_net,
                                          body_gravity, chaser_actuation, net_forces)
 from multibody.net_wrap import TowingNet
+from multibody.towing import TowedBodies
 
 #: Layout of the run state ``clock``: net time (s), external impulse (3, N s) since the start.
 CLOCK_TIME, CLOCK_IMPULSE, CLOCK_SIZE = 0, 1, 4
 
 
 @dataclass
-class FullNetModel:
-    """Everything one full-net run needs (SI units; inertial frame unless ``_body``).
+class FullNetModel(TowedBodies):
+    """One full-net run: :class:`multibody.towing.TowedBodies` (chaser, debris, controls, times;
+    ``positions``, ``velocities`` (2, 3): chaser and debris CoM) plus the net and the main tether.
 
     Attributes
     ----------
     net : TowingNet                    Topology, closing loop; its thread arrays are the state's (copied).
     node_positions, node_velocities : (n, 3) float  Nodes at ``start_time`` (m, absolute; m/s).
     masses : (2,) float                m_C, m_D (kg).
-    inertia_body : (2, 3, 3) float     J_C, J_D (kg m^2), body frames.
-    attach_chaser_body : (3,) float    r_A/C (m), chaser frame.
     main_tether : (3,) float           k_MT (N/m), c_MT (N s/m), l_MT0 (m); zero stiffness before ``closing_time``.
     geometry : (3,) float              Debris cylinder: radius (m), half length (m), axial centre z_body (m).
     contact_law : (6,) float           k_n, n, d_n, mu_s, mu_k, V_t0 (:mod:`multibody.net_towing_kernel`).
-    mu : float                         (m^3/s^2).
-    attitude, thrust_kind, thrust_along_body_z, thrust_params, thrust_state : as :class:`multibody.towing.TowingModel`.
-    positions, velocities : (2, 3) float    Chaser and debris CoM (m) and velocity (m/s) at ``start_time``.
-    body_to_inertial : (2, 3, 3) float
-    omega_body : (2, 3) float          (rad/s), body frames.
-    start_time, end_time, step, output_interval, net_output_interval, closing_time : float (s)
     substeps : int                     Net sub-steps per body step.
+    net_output_interval, closing_time : float (s)
     closing_duration : float or None   (s) None: the closing loop stays at the topology's natural lengths
                                        (the wrapped start, already closed). Otherwise it starts open and is
                                        reeled in linearly to ``net.closing_rest_closed`` over
@@ -64,41 +59,13 @@ class FullNetModel:
     node_positions: np.ndarray
     node_velocities: np.ndarray
     masses: np.ndarray
-    inertia_body: np.ndarray
-    attach_chaser_body: np.ndarray
     main_tether: np.ndarray
     geometry: np.ndarray
     contact_law: np.ndarray
-    mu: float
-    attitude: np.ndarray
-    thrust_kind: int
-    thrust_along_body_z: bool
-    thrust_params: np.ndarray
-    thrust_state: np.ndarray
-    positions: np.ndarray
-    velocities: np.ndarray
-    body_to_inertial: np.ndarray
-    omega_body: np.ndarray
-    start_time: float
-    end_time: float
-    step: float
     substeps: int
-    output_interval: float
     net_output_interval: float
     closing_time: float = 15.0
     closing_duration: float | None = None
-    inverse_inertia_debris: np.ndarray = field(init=False)
-
-    def __post_init__(self):
-        self.inverse_inertia_debris = np.linalg.inv(self.inertia_body[1])
-
-    @property
-    def n_steps(self) -> int:
-        return int(round((self.end_time - self.start_time) / self.step))
-
-    @property
-    def every(self) -> int:
-        return max(1, int(round(self.output_interval / self.step)))
 
     @property
     def net_every(self) -> int:
@@ -218,7 +185,7 @@ class NetTowState:
         tether = self.tether_on if t >= m.closing_time else self.tether_off
         return step_forces(q, v, t, advance, self.x, self.v, self.lag, self.clock, top.masses, top.radii, top.threads, self.rest,
                            self.stiffness, top.damping, self.reference, m.mu, m.net.central, tether,
-                           m.attach_chaser_body, m.masses, m.inertia_body, m.inverse_inertia_debris, m.geometry,
+                           m.attach_chaser_body, m.masses, m.inertia_body, m.inverse_inertia[1], m.geometry,
                            m.contact_law, m.substeps, m.step, m.attitude, m.thrust_kind, m.thrust_along_body_z,
                            m.thrust_params, self.thrust_state, m.positions, self.acc, self.diag, self.f, self.work)
 

@@ -29,32 +29,29 @@ from multibody.towing_kernel import N_COORDINATES, ST_TENSION, body_forces, pack
 
 
 @dataclass
-class TowingModel:
-    """Everything one lower-order run needs (SI units; inertial frame unless ``_body``).
+class TowedBodies:
+    """What every towing run needs besides its tethers: chaser and debris, their controls and the
+    times (SI units; inertial frame unless ``_body``). Base of :class:`TowingModel` (lower-order) and
+    :class:`multibody.net_towing.FullNetModel` (full net); the subclasses add the masses and tethers.
 
     Attributes
     ----------
-    masses : (3,) float             m_P, m_C, m_D (kg).
     inertia_body : (2, 3, 3) float  J_C, J_D about the CoMs, body frames (kg m^2).
     attach_chaser_body : (3,) float MT attachment r_A/C, chaser frame (m).
-    attach_debris_body : (n, 3) float  ST attachments r_i/D, debris frame (m).
-    tether : (6,) float             k_MT (N/m), c_MT (N s/m), l_MT0 (m), k_ST, c_ST, l_ST0.
     mu : float                      Gravitational parameter (m^3/s^2).
     attitude : (8,) float           Controller on (1/0), K (1/s), G (3,) (rad/s^2), epsilon (3,) (rad/s).
     thrust_kind : int               :data:`control.thrust.KINDS` code.
     thrust_along_body_z : bool      Thrust along the chaser's body z (MRAC) or against its velocity (ramp).
     thrust_params, thrust_state : (k,) float   The thrust law's constants and initial states.
-    positions, velocities : (3, 3) float       P, chaser CoM, debris CoM at ``start_time`` (m, m/s).
+    positions, velocities : (b, 3) float       Point masses' and CoMs' positions (m, absolute) and velocities
+                                               (m/s) at ``start_time``, in the subclass's order.
     body_to_inertial : (2, 3, 3) float         Chaser and debris attitude at ``start_time``.
     omega_body : (2, 3) float                  Chaser and debris angular velocity, body frames (rad/s).
     start_time, end_time, step, output_interval : float   (s)
     """
 
-    masses: np.ndarray
     inertia_body: np.ndarray
     attach_chaser_body: np.ndarray
-    attach_debris_body: np.ndarray
-    tether: np.ndarray
     mu: float
     attitude: np.ndarray
     thrust_kind: int
@@ -69,7 +66,7 @@ class TowingModel:
     end_time: float
     step: float
     output_interval: float
-    inverse_inertia: np.ndarray = field(init=False)
+    inverse_inertia: np.ndarray = field(init=False)   # (2, 3, 3) inverse of inertia_body (1/(kg m^2))
 
     def __post_init__(self):
         self.inverse_inertia = np.linalg.inv(self.inertia_body)
@@ -82,6 +79,23 @@ class TowingModel:
     def every(self) -> int:
         """Steps between output samples."""
         return max(1, int(round(self.output_interval / self.step)))
+
+
+@dataclass
+class TowingModel(TowedBodies):
+    """One lower-order run: :class:`TowedBodies` plus the connection point P and the tethers.
+
+    Attributes
+    ----------
+    masses : (3,) float             m_P, m_C, m_D (kg).
+    attach_debris_body : (n, 3) float  ST attachments r_i/D, debris frame (m).
+    tether : (6,) float             k_MT (N/m), c_MT (N s/m), l_MT0 (m), k_ST, c_ST, l_ST0.
+    positions, velocities : (3, 3) float       P, chaser CoM, debris CoM at ``start_time`` (m, m/s).
+    """
+
+    masses: np.ndarray
+    attach_debris_body: np.ndarray
+    tether: np.ndarray
 
     def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
         """Coordinates and velocities (15,) each at ``start_time`` (layout of :mod:`multibody.towing_kernel`)."""

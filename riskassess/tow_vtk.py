@@ -33,7 +33,7 @@ import trimesh
 from diagnosis.towing_plant import lvlh_to_eci
 from multibody.net import thread_tension_strain
 from riskassess.results import MissingData, RunFolder
-from riskassess.vtk_export import VtkExport, nearest_samples, surface_lvlh, write_collection
+from riskassess.vtk_export import VtkExport, export_frames, nearest_samples, surface_lvlh
 
 
 def body_meshes(case) -> list[trimesh.Trimesh]:
@@ -106,16 +106,5 @@ class _TowFrames:
 
 def export_tow_vtk(run_dir: str | Path, out: str | Path | None = None, every: int = 1, progress=None) -> VtkExport:
     """Write the VTK files of a full-net tow folder (module docstring); returns where and how many."""
-    if every < 1:
-        raise ValueError(f"every must be >= 1 (frames to step); got {every}")
-    run = RunFolder(run_dir)
-    frames = _TowFrames(run)  # raises MissingData before anything is written
-    out = Path(out) if out else run.path / "vtk"
-    picked = np.arange(0, len(frames.net["time"]), every)
-    write_collection(out, ((float(frames.net["time"][f]), (("net", frames.net_mesh(f)), ("bodies", frames.bodies_mesh(f)),
-                                                          ("tether", frames.tether_mesh(f)))) for f in picked),
-                     len(picked), "towing.pvd", f"case {run.manifest.get('case')}: positions in the debris' LVLH frame (m)",
-                     progress)
-    if out == run.path / "vtk":
-        run.add_product("vtk/towing.pvd")
-    return VtkExport(out, out / "towing.pvd", len(picked), frames.net["time"][picked])
+    return export_frames(run_dir, out, every, progress, _TowFrames, ("net", "bodies", "tether"), "towing.pvd",
+                         "positions in the debris' LVLH frame (m)")

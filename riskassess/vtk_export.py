@@ -162,29 +162,43 @@ def write_collection(out: Path, frames, n_frames: int, pvd_name: str, comment: s
         raise
 
 
+def export_frames(run_dir: str | Path, out: str | Path | None, every: int, progress, frames_type, parts: tuple,
+                  pvd_name: str, comment: str, extra=None) -> VtkExport:
+    """The front shared by the impact and the tow export: checks ``every``, reads the run folder into
+    ``frames_type(run)`` (which raises MissingData before anything is written), writes every ``every``-th
+    net snapshot's ``parts`` (each the ``<part>_mesh(f)`` of the frames) with :func:`write_collection`
+    into ``out`` (default ``RUN_DIR/vtk``, then registered as a product of the run) and returns where
+    and how many. ``extra(frames, staging)`` may add files to the export."""
+    if every < 1:
+        raise ValueError(f"every must be >= 1 (frames to step); got {every}")
+    run = RunFolder(run_dir)
+    frames = frames_type(run)
+    out = Path(out) if out else run.path / "vtk"
+    picked = np.arange(0, len(frames.net["time"]), every)
+    write_collection(out, ((float(frames.net["time"][f]), tuple((part, getattr(frames, f"{part}_mesh")(f)) for part in parts))
+                           for f in picked), len(picked), pvd_name, f"case {run.manifest.get('case')}: {comment}", progress,
+                     None if extra is None else lambda staging: extra(frames, staging))
+    if out == run.path / "vtk":
+        run.add_product(f"vtk/{pvd_name}")
+    return VtkExport(out, out / pvd_name, len(picked), frames.net["time"][picked])
+
+
+def _write_bodies_json(frames: _Frames, staging: Path) -> None:
+    """``bodies.json``: body index -> name, mass (kg), release time of its piece (s, null if never)."""
+    bodies = [{"index": k, "name": name, "mass_kg": float(m), "released_at_s": None if np.isinf(r) else float(r)}
+              for k, (name, m, r) in enumerate(zip(frames.body_names, frames.series["body_masses"],
+                                                   frames.released_from))]
+    (staging / "bodies.json").write_text(json.dumps(bodies, indent=2) + "\n")
+
+
 def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int = 1, progress=None) -> VtkExport:
     """Write the VTK files of a run folder (see the module docstring); returns where and how many."""
     if RunFolder(run_dir).stage == "tow":  # a full-net tow folder: its own layout
         from riskassess.tow_vtk import export_tow_vtk
 
         return export_tow_vtk(run_dir, out, every, progress)
-    if every < 1:
-        raise ValueError(f"every must be >= 1 (frames to step); got {every}")
-    run = RunFolder(run_dir)
-    frames = _Frames(run)  # raises MissingData before anything is written
-    out = Path(out) if out else run.path / "vtk"
-    picked = np.arange(0, len(frames.net["time"]), every)
-    bodies = [{"index": k, "name": name, "mass_kg": float(m), "released_at_s": None if np.isinf(r) else float(r)}
-              for k, (name, m, r) in enumerate(zip(frames.body_names, frames.series["body_masses"],
-                                                   frames.released_from))]
-    write_collection(out, ((float(frames.net["time"][f]), (("net", frames.net_mesh(f)), ("bodies", frames.bodies_mesh(f)),
-                                                          ("bullets", frames.bullets_mesh(f)))) for f in picked),
-                     len(picked), "impact.pvd", f"case {run.manifest.get('case')}: positions LVLH (m); body_index -> "
-                     "bodies.json", progress,
-                     lambda staging: (staging / "bodies.json").write_text(json.dumps(bodies, indent=2) + "\n"))
-    if out == run.path / "vtk":
-        run.add_product("vtk/impact.pvd")
-    return VtkExport(out, out / "impact.pvd", len(picked), frames.net["time"][picked])
+    return export_frames(run_dir, out, every, progress, _Frames, ("net", "bodies", "bullets"), "impact.pvd",
+                         "positions LVLH (m); body_index -> bodies.json", _write_bodies_json)
 
 
 def _swap_in(staging: Path, out: Path) -> None:
