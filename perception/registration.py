@@ -259,6 +259,13 @@ class DebrisTracker:
                                 known mesh's face normals, used as they are (no thinning, no
                                 normal estimation, which blurs a faceted surface's normals over
                                 a few voxels and biased the fitted inertia ratios by ~0.04 %).
+    symmetries_body : list of (4, 4), optional
+                                Transforms of frame B that map the model onto itself (the
+                                shape's half turns, :mod:`perception.shape`). A frame searched
+                                without a motion prediction takes the variant nearest the last
+                                pose: the surface cannot tell them apart, and a jump between them
+                                breaks the torque-free fit of the free flight (seen once after a
+                                failed frame at 18 m: a 176 deg flip made the collision "not observable").
     seed : int                  Seed of the global (RANSAC) alignments: Open3D's generator is
                                 re-seeded with ``seed`` + the frame number before each, so a run
                                 repeats exactly (unseeded, two runs of one case tracked 189 and
@@ -266,8 +273,9 @@ class DebrisTracker:
     """
 
     def __init__(self, voxel=0.03, max_correspondence=0.1, model_frames=30, model_points_body=None,
-                 model_normals_body=None, seed=0):
+                 model_normals_body=None, symmetries_body=None, seed=0):
         self.voxel = voxel
+        self.symmetries_body = [np.eye(4)] if symmetries_body is None else [np.asarray(s, float) for s in symmetries_body]
         self.seed = seed
         self.max_correspondence = max_correspondence
         self.model_frames = model_frames
@@ -385,7 +393,7 @@ class DebrisTracker:
     def _retry_from_global(self, time_s, scan, failed, predicted, has_motion, sensor_world) -> Alignment:
         """The frame again from FPFH + RANSAC; kept when it passes or fits tighter than ``failed``."""
         reference = failed.world_to_body if predicted is None else predicted
-        pose = self._icp(scan, self._global(scan, reference))
+        pose = self._nearest_variant(self._icp(scan, self._global(scan, reference)), reference)
         points = np.asarray(scan.points)
         retry = self._judge(time_s, points, pose, reference, sensor_world, has_motion, global_init=True)
         return retry if retry.ok or retry.tight_fitness > failed.tight_fitness else failed
@@ -424,10 +432,17 @@ class DebrisTracker:
         fits.sort(key=lambda fit: -fit[1])
         best = None
         for pose in _distinct([pose for pose, _ in fits], SEARCH_REFINED):
-            candidate = self._judge(time_s, points, self._icp(scan, pose), start, sensor_world, False)
+            candidate = self._judge(time_s, points, self._nearest_variant(self._icp(scan, pose), start), start,
+                                    sensor_world, False)
             if best is None or _score(candidate) > _score(best):
                 best = candidate
         return best
+
+    def _nearest_variant(self, pose, reference) -> np.ndarray:
+        """Of the poses S @ ``pose`` (world -> B) the surface cannot tell apart, the one whose
+        attitude is nearest ``reference``'s."""
+        variants = [symmetry @ pose for symmetry in self.symmetries_body]
+        return min(variants, key=lambda variant: _turn_angle(variant[:3, :3], reference[:3, :3]))
 
     def _icp(self, scan, initial) -> np.ndarray:
         """Point-to-plane ICP, robust to outliers (Tukey loss) such as net threads lying on the

@@ -1,5 +1,7 @@
 """Rotational symmetries of a debris shape: the poses a surface-only measurement cannot tell
-apart (for scoring registrations against the truth; the estimators never use them)."""
+apart. The tracker uses them to stay on one branch of its attitude (a frame searched without a
+motion prediction takes the variant nearest the last pose); the scoring against the truth counts
+every variant as right."""
 from __future__ import annotations
 
 import numpy as np
@@ -12,6 +14,12 @@ def half_turn_symmetries(mesh: trimesh.Trimesh, tolerance: float, samples: int =
     half turns about the principal axes (through the centroid) after which every sampled surface
     point lies within ``tolerance`` (m) of the surface. A uniform ellipsoid has all three; a
     generic body only the identity."""
+    return [transform[:3, :3] for transform in half_turn_symmetry_transforms(mesh, tolerance, samples)]
+
+
+def half_turn_symmetry_transforms(mesh: trimesh.Trimesh, tolerance: float, samples: int = 4000) -> list[np.ndarray]:
+    """The same symmetries as homogeneous transforms (4, 4) of the mesh frame, turning about the
+    centroid: x -> S (x - c) + c."""
     points = trimesh.sample.sample_surface(mesh, samples, seed=1)[0]
     scene = o3d.t.geometry.RaycastingScene()
     scene.add_triangles(o3d.core.Tensor(np.asarray(mesh.vertices, np.float32)),
@@ -26,7 +34,12 @@ def half_turn_symmetries(mesh: trimesh.Trimesh, tolerance: float, samples: int =
         moved = (points - center) @ turn.T + center
         if scene.compute_distance(o3d.core.Tensor(moved.astype(np.float32))).numpy().max() < tolerance:
             found.append(turn)
-    return found
+    transforms = []
+    for turn in found:
+        transform = np.eye(4)
+        transform[:3, :3], transform[:3, 3] = turn, center - turn @ center
+        transforms.append(transform)
+    return transforms
 
 
 def rotation_error(estimated_body_to_world, true_body_to_world, symmetries) -> float:

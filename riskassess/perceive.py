@@ -43,7 +43,7 @@ from perception.motion import (NotObservable, attitude_sqrt_information, center_
                                rates_from_attitudes)
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
 from perception.registration import DebrisTracker, known_shape_model, predict_pose
-from perception.shape import half_turn_symmetries, rotation_error
+from perception.shape import half_turn_symmetry_transforms, rotation_error
 from riskassess import results
 from riskassess.assemble import body_meshes_target_frame, model_inputs
 from riskassess.case import Case, CaseError, load_case
@@ -560,9 +560,11 @@ def perceive_case(case_path, out_dir, progress=None, case: Case | None = None) -
     out = Path(out_dir)
     manifest = begin_run_folder(out, case_path, case)
     rng = np.random.default_rng(p.seed)
+    symmetry_transforms = half_turn_symmetry_transforms(scene.mesh_target, 0.5 * p.registration.voxel)
     tracker = DebrisTracker(p.registration.voxel, p.registration.max_correspondence, p.registration.model_frames,
-                            *known_shape_model(scene.mesh_target, p.registration.voxel, p.seed), seed=p.seed)
-    symmetries = half_turn_symmetries(scene.mesh_target, 0.5 * p.registration.voxel)
+                            *known_shape_model(scene.mesh_target, p.registration.voxel, p.seed),
+                            symmetries_body=symmetry_transforms, seed=p.seed)
+    symmetries = [transform[:3, :3] for transform in symmetry_transforms]
     frames = Frames()
     wall = time.perf_counter()
     # Open3D's RANSAC warnings go to stdout, which --json keeps for the answer.
