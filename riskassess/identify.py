@@ -240,25 +240,35 @@ def _entry(found: Identified, truth) -> dict:
             "evaluations": found.evaluations, "wall_s": found.wall_s, "history": found.history}
 
 
-def benchmark(case: TowingCase, optimizers=("pso", "pattern"), rates=None, end_time=None, workers=None) -> dict:
+def run_optimizers(case: TowingCase, data: list[dict], optimizers=None, end_time=None, workers=None) -> dict:
+    """Each of ``optimizers`` (default ``identification.searches``: 'pso' and/or 'pattern') on ``data``
+    with :func:`identify`; with ``optimizers.polish_evaluations`` > 0 the PSO's best is polished by a
+    pattern search, reported as 'pso+pattern' (evaluations and wall time include the PSO's).
+    Returns {name: :class:`Identified`} in the order run."""
+    found = {}
+    for name in case.identification.searches if optimizers is None else optimizers:
+        found[name] = identify(case, data, name, end_time, workers)
+        if name == "pso" and case.identification.optimizers.polish_evaluations > 0:
+            swarm = found[name]
+            polish = identify(case, data, "polish", end_time, workers, initial_guess=swarm.s)
+            found["pso+pattern"] = Identified(polish.s, polish.cost, "pso+pattern", swarm.evaluations + polish.evaluations,
+                                              swarm.wall_s + polish.wall_s,
+                                              swarm.history + [min(swarm.cost, c) for c in polish.history])
+    return found
+
+
+def benchmark(case: TowingCase, optimizers=None, rates=None, end_time=None, workers=None) -> dict:
     """Sec. 4.3: data from ``benchmark_truth`` at the training rates (same model and step as the
-    fit), identified by each optimizer; with ``optimizers.polish_evaluations`` > 0 the PSO's best is
-    polished by a pattern search, reported as 'pso+pattern' (evaluations and wall time include the
-    PSO's). Returns per optimizer s, cost, relative error against the truth, evaluations and wall time."""
+    fit), identified by each optimizer (:func:`run_optimizers`). Returns per optimizer s, cost,
+    relative error against the truth, evaluations and wall time."""
     truth = np.asarray(case.identification.benchmark_truth, float)
     rates = case.rates.training_deg_s if rates is None else rates
     start = time.perf_counter()
     data = training_data(case, truth, rates, end_time)
     out = {"truth": truth.tolist(), "cost_function": case.identification.cost, "rates_deg_s": list(rates),
            "data_wall_s": time.perf_counter() - start, "runs": {}}
-    for name in optimizers:
-        found = identify(case, data, name, end_time, workers)
+    for name, found in run_optimizers(case, data, optimizers, end_time, workers).items():
         out["runs"][name] = _entry(found, truth)
-        if name == "pso" and case.identification.optimizers.polish_evaluations > 0:
-            polish = identify(case, data, "polish", end_time, workers, initial_guess=found.s)
-            out["runs"]["pso+pattern"] = _entry(Identified(
-                polish.s, polish.cost, "pso+pattern", found.evaluations + polish.evaluations,
-                found.wall_s + polish.wall_s, found.history + [min(found.cost, c) for c in polish.history]), truth)
     return out
 
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from riskassess import results
 from riskassess.case import CaseError
-from riskassess.identify import COSTS, identify, rmse, simulate
+from riskassess.identify import COSTS, rmse, simulate
 from riskassess.towing_case import TowingCase
 
 CHANNELS = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
@@ -70,8 +70,8 @@ def lower_order_case(case: TowingCase, run: dict) -> TowingCase:
     return case.model_copy(update={"chaser": chaser, "sub_tethers": tethers})
 
 
-def validation_rmse(case: TowingCase, s, data: list[dict], end) -> list[dict]:
-    """Per validation run: RMSE of each channel and both costs of the lower-order model with ``s``."""
+def comparison_rows(case: TowingCase, s, data: list[dict], end) -> list[dict]:
+    """Per run of ``data``: RMSE of each channel and both costs (eqs. 18-21) of the lower-order model with ``s``."""
     rows = []
     for run in data:
         model = simulate(case, run["rate_deg_s"], s, end)
@@ -80,11 +80,31 @@ def validation_rmse(case: TowingCase, s, data: list[dict], end) -> list[dict]:
     return rows
 
 
-def identify_full_net(case_path, out_dir, case: TowingCase, optimizer: str = "pattern") -> dict:
-    """Steps 1-3 of the module doc; writes ``identification.json`` and a manifest to ``out_dir``."""
+def _totals(rows: list[dict]) -> dict:
+    """Sums of f1 and f2 over the runs (eqs. 18, 20) and the mean RMSE of each channel."""
+    return {"f1": sum(r["f1"] for r in rows), "f2": sum(r["f2"] for r in rows),
+            **{f"mean_rmse_{c}": float(np.mean([r[f"rmse_{c}"] for r in rows])) for c in CHANNELS}}
+
+
+def _entry(case: TowingCase, found, training: list[dict], validation: list[dict], end) -> dict:
+    """One optimizer's answer: s, its training cost and history, and the identified model against the
+    training and the unseen validation runs (per run and totals)."""
+    train_rows, valid_rows = comparison_rows(case, found.s, training, end), comparison_rows(case, found.s, validation, end)
+    return {"s": found.s.tolist(), "cost": found.cost, "optimizer": found.optimizer, "evaluations": found.evaluations,
+            "wall_s": found.wall_s, "history": found.history, "training_totals": _totals(train_rows),
+            "validation_totals": _totals(valid_rows), "training": train_rows, "validation": valid_rows}
+
+
+def identify_full_net(case_path, out_dir, case: TowingCase, optimizers=None) -> dict:
+    """Steps 1-3 of the module doc with ``optimizers`` (default ``identification.searches``) on the case's
+    cost; writes ``identification.json`` (every optimizer's run), ``convergence.png`` and a manifest to
+    ``out_dir``. Returns the answer with the best run's ``s``, ``cost`` and ``optimizer`` on top."""
+    from riskassess.identify import run_optimizers
+    from riskassess.towing_plots import plot_convergence
+
     fn = case.full_net
     if fn is None:
-        raise ValueError(f"{case_path}: identification against full-net runs needs a [full_net] section")
+        raise CaseError(f"{case_path}: identification against full-net runs needs a [full_net] section")
     if fn.start == "capture":
         raise CaseError(f"{case_path}: full_net.start = 'capture' is not supported by 'riskassess identify': its "
                          f"lower-order runs would each need their own start state (the full-net state at "
@@ -98,14 +118,18 @@ def identify_full_net(case_path, out_dir, case: TowingCase, optimizer: str = "pa
     data = full_net_runs(case, list(training) + list(validation), out, end, case.identification.workers)
     data_wall = time.perf_counter() - start
     lower = lower_order_case(case, data[0])
-    found = identify(lower, data[:len(training)], optimizer, end_time=end)
-    answer = {"case": case.name, "s": found.s.tolist(), "cost": found.cost, "optimizer": optimizer,
-              "cost_function": case.identification.cost, "evaluations": found.evaluations, "wall_s": None,
-              "end_time_s": end, "training_rates_deg_s": list(training), "validation_rates_deg_s": list(validation),
-              "full_net_runs_wall_s": data_wall, "identification_wall_s": found.wall_s,
-              "validation": validation_rmse(lower, found.s, data[len(training):], end)}
-    answer["wall_s"] = time.perf_counter() - start
+    train, valid = data[:len(training)], data[len(training):]
+    runs = {name: _entry(lower, found, train, valid, end)
+            for name, found in run_optimizers(lower, train, optimizers, end_time=end).items()}
+    best = min(runs.values(), key=lambda r: r["cost"])
+    answer = {"case": case.name, "s": best["s"], "cost": best["cost"], "optimizer": best["optimizer"],
+              "cost_function": case.identification.cost, "wall_s": time.perf_counter() - start, "end_time_s": end,
+              "training_rates_deg_s": list(training), "validation_rates_deg_s": list(validation),
+              "full_net_runs_wall_s": data_wall, "runs": runs}
     results.atomic_write_json(out / "identification.json", answer)
+    plot_convergence({name: (np.arange(1, len(r["history"]) + 1), np.asarray(r["history"])) for name, r in runs.items()},
+                     out / "convergence.png", f"{case.name}: against full-net runs, cost {case.identification.cost}")
     results.atomic_write_json(out / "manifest.json", {"format": "riskassess-identify", "version": 1, "case": case.name,
-                                                      "status": "complete", "files": ["identification.json"]})
+                                                      "status": "complete",
+                                                      "files": ["identification.json", "convergence.png"]})
     return answer

@@ -157,6 +157,10 @@ class Identification(Strict):
     initial_guess: DecisionVector = Field(description="Pattern-search start s_0, Sec. 4.3.")
     benchmark_truth: DecisionVector = Field(description="s of the benchmark's data, Sec. 4.3.")
     optimizers: Optimizers = Optimizers()
+    searches: Annotated[list[Literal["pso", "pattern"]], Field(min_length=1)] = Field(
+        ["pso", "pattern"], description="Optimizers 'riskassess identify' runs, in order: 'pso' (pymoo PSO; then the "
+                                        "pattern-search polish, reported as 'pso+pattern', if optimizers.polish_evaluations "
+                                        "> 0) and 'pattern' (pattern search from initial_guess); --optimizers overrides it.")
     workers: Annotated[int, Field(ge=1)] = Field(2, description="Processes evaluating simulations in parallel (-).")
     step: Annotated[float, Field(gt=0, le=0.05)] = Field(
         0.02, description="Step of the identification's lower-order runs (s); the connection point is implicit, so it "
