@@ -9,9 +9,11 @@
    has the case's Table 2 state, so this is the case with the chaser moved where the full-net run
    starts it and ``sub_tethers.connection_point_start_inertial`` at the central node
    (:func:`lower_order_case`); P's velocity is the debris' rigid motion there, as the node's.
-3. s is identified on the training runs with the optimizers of :mod:`riskassess.identify` (its public
-   :func:`~riskassess.identify.identify`), and the identified model is compared with the unseen
-   validation runs: RMSE per channel (r_D/C, omega_C, omega_D, T_MT, eqs. 19, 21) and the costs.
+3. s is identified on the training runs by each optimizer of ``identification.searches`` (PSO, then the
+   pattern-search polish, and/or the pattern search; :func:`riskassess.identify.run_optimizers`) on the
+   case's cost, f1 or f2 (eqs. 18, 20), and each identified model is compared with the training runs and
+   the unseen validation runs: RMSE per channel (r_D/C, omega_C, omega_D, T_MT, eqs. 19, 21) and both
+   costs, per run and summed (the paper's Tables 7, 8 and 10).
 """
 from __future__ import annotations
 
