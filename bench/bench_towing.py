@@ -18,20 +18,15 @@ import numpy as np
 
 from multibody.towing import run_exudyn, run_twin, stable_step
 from riskassess.case import load_model
+from riskassess.identify import COMPARED, compared_series, rmse
 from riskassess.tow import case_decision_vector, towing_model
 from riskassess.towing_case import TowingCase
 
 
-def _rmse(a, b):
-    """RMSE of the vector (or scalar) difference over the samples, as eq. (19)."""
-    diff = (np.asarray(a) - np.asarray(b)).reshape(len(a), -1)
-    return float(np.sqrt(np.mean(np.sum(diff**2, axis=1))))
-
-
 def compared(result) -> tuple:
-    s = result.series()
-    return (s["debris_com_inertial"] - s["chaser_com_inertial"], s["chaser_omega_body"], s["debris_omega_body"],
-            s["main_tether_tension"])
+    """The quantities the identification compares (r_D/C, omega_C, omega_D, T_MT), eqs. (17)-(21)."""
+    series = compared_series(result)
+    return tuple(series[name] for name in COMPARED)
 
 
 def decision_vectors(case) -> dict:
@@ -66,7 +61,7 @@ def convergence(case):
         print(f"  {'step ms':>8} {'r_D/C m':>10} {'w_C rad/s':>10} {'w_D rad/s':>10} {'T_MT N':>10}")
         for h in steps[1:]:
             values = compared(run_twin(towing_model(case, s=s, step=h)))
-            errors = [_rmse(a, b) for a, b in zip(values, reference)]
+            errors = [rmse(a, b) for a, b in zip(values, reference)]
             print(f"  {h * 1e3:8.3f} " + " ".join(f"{e:10.2e}" for e in errors))
 
 
