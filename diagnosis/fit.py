@@ -4,7 +4,9 @@ Noise-weighted least squares (:func:`scipy.optimize.least_squares`, trust region
 bounds from the effect's parameters): residuals are (model - measured) / sigma of every
 training sample plus (theta - theta_case) / sigma_prior of each uncertain nominal parameter
 (Gaussian prior from the case's ``[uncertain]`` table). Parameters are scaled (prior sigma,
-effect's typical size) so that the optimizer sees unit-sized steps. The fit runs first on the
+effect's typical size) so that the optimizer sees unit-sized steps; an effect parameter marked
+``log`` is fitted as ln(value / typical) (a product of two parameters that the data see better
+than its factors is then a straight valley, which Gauss-Newton steps follow, not a hyperbola). The fit runs first on the
 first part of the training span, then on all of it (a long tumble's phase error has many
 local minima when it is seen at once), from each of the effect's starting points.
 The parameter covariance is (J^T J)^-1 at the optimum, scaled by chi^2 / dof when that exceeds 1.
@@ -34,10 +36,25 @@ MAX_EVALUATIONS = 30
 #: Forward-difference step of the Jacobian, scaled parameters (1 = a prior sigma or a typical size);
 #: the RK4 model is smooth and deterministic to ~1e-13, so 1e-6 leaves ~1e-7 relative error.
 DIFFERENCE_STEP = 1e-6
+#: The same for the towing model: it integrates Earth-centred positions (~7e6 m, round-off ~1e-9 m) and
+#: the tension's damper term takes differences of 7.5 km/s velocities, so its channels carry round-off
+#: noise that a small step amplifies: against 1e-3, the columns at 1e-6 were 50-800 % off, at 1e-5
+#: 10-90 %, at 1e-4 1-8 % (the error falls as 1/step: noise); at 1e-2 some were 100 % off the other way
+#: (the tension-only tethers' kinks). Measured on the sample record's first 80 s (docs/diagnosis.md).
+TOWING_DIFFERENCE_STEP = 1e-3
 #: Largest discretization error of the towing model (RMS, in noise sigmas) the fit accepts (resolved_step).
 STEP_ERROR_SIGMA = 0.2
 #: Broyden updates between two finite-difference Jacobians (towing model only, see CandidateFit.jacobian).
 BROYDEN_REFRESH = 3
+#: Stopping rule of the towing fits (CandidateFit._refine): converged when one Gauss-Newton step from a fresh
+#: finite-difference Jacobian predicts a chi^2 decrease below this: the parameters are then within about
+#: sqrt(0.25) = 0.5 of their standard deviations of the minimum, the BIC within 0.25 (the decisive margin is 10).
+CONVERGED_CHI2 = 0.25
+#: Further legs from a fresh Jacobian when the rule is not met: one. The towing model's chi^2 is only piecewise
+#: smooth (a tether that snaps taut within one step or the next changes that sample's tension by c e', up to
+#: 30 sigma: jumps of ~1000 in chi^2 a millimetre apart in the initial position, docs/diagnosis.md), so the
+#: rule often cannot be met; a second further leg gained < 10 in chi^2 on the sample record.
+MAX_LEGS = 1
 #: Nominal parameters whose effect on the residuals is linear (the CoM's initial position and
 #: velocity in the linear relative orbit): their Jacobian columns are computed once per fit.
 LINEAR_NOMINAL = ("position", "velocity")
@@ -111,15 +128,22 @@ class FitResult:
 class CandidateFit:
     """Fit of the nominal model (``effect`` None) or nominal + one effect to a :class:`Problem`."""
 
-    def __init__(self, problem: Problem, effect: Effect | None = None):
+    def __init__(self, problem: Problem, effect: Effect | None = None, columns=None):
+        """``columns``: None, or a function (list of parameter vectors z, sample mask) -> their residual
+        vectors (:meth:`residuals` of this problem and effect, e.g. in worker processes) that computes the
+        finite-difference columns of a Jacobian together."""
         self.problem = problem
         self.effect = effect
+        self.columns = columns
         self.specs: list[Parameter] = effect.parameter_specs(problem.case, problem.channels) if effect else []
-        self.scale = np.array([max(abs(p.typical), (p.upper - p.lower) / 20.0) for p in self.specs])
+        self.log = np.array([p.log for p in self.specs], bool)
+        self.scale = np.array([p.typical if p.log else max(abs(p.typical), (p.upper - p.lower) / 20.0)
+                               for p in self.specs])
         self.step = max_step(problem.plant, effect.stiffness_rate(problem.plant, self.specs) if effect else 0.0)
         # (towing: the tether couples the debris' position to everything, nothing is linear)
         linear_nominal = [n in LINEAR_NOMINAL and not is_towing(problem.plant) for n in _expanded(problem.nominal_names)]
         self.broyden = is_towing(problem.plant)
+        self.difference_step = TOWING_DIFFERENCE_STEP if self.broyden else DIFFERENCE_STEP
         self.linear = np.r_[np.array(linear_nominal, bool),
                             np.full(len(self.specs), bool(effect is not None and getattr(effect, "linear", False)))]
         self._cache = {}
@@ -128,7 +152,18 @@ class CandidateFit:
     def unpack(self, z):
         n = len(self.problem.nominal_center)
         nominal = self.problem.nominal_center + self.problem.nominal_sigma * z[:n]
-        return nominal, self.scale * z[n:]
+        return nominal, self.physical(z[n:])
+
+    def physical(self, z_effect) -> np.ndarray:
+        """The effect's parameters (SI) from their fit variables: value / scale, or ln(value / typical)
+        for a ``log`` parameter."""
+        return self.scale * np.where(self.log, np.exp(np.where(self.log, z_effect, 0.0)), z_effect)
+
+    def scaled(self, values) -> np.ndarray:
+        """The fit variables of the effect's parameters ``values`` (SI): the inverse of :meth:`physical`."""
+        values = np.asarray(values, float)
+        ratio = values / self.scale
+        return np.where(self.log, np.log(np.where(self.log, np.maximum(ratio, 1e-300), 1.0)), ratio)
 
     def _bounds(self):
         p = self.problem
@@ -136,9 +171,13 @@ class CandidateFit:
         for k, name in enumerate(_expanded(p.nominal_names)):
             if name in ("torsional_stiffness", "torsional_damping"):
                 low[k] = -p.nominal_center[k] / p.nominal_sigma[k]
-        low = np.r_[low, [s.lower for s in self.specs] / self.scale]
-        high = np.r_[np.full(len(p.nominal_center), np.inf), [s.upper for s in self.specs] / self.scale]
+        low = np.r_[low, self.scaled([s.lower for s in self.specs])]
+        high = np.r_[np.full(len(p.nominal_center), np.inf), self.scaled([s.upper for s in self.specs])]
         return low, high
+
+    def null(self) -> np.ndarray:
+        """The effect's parameters at zero, clipped into their bounds (SI): the effect switched off."""
+        return np.clip(np.zeros(len(self.specs)), [p.lower for p in self.specs], [p.upper for p in self.specs])
 
     # -- model ---------------------------------------------------------------------------
     def predict(self, z, times) -> dict:
@@ -183,22 +222,28 @@ class CandidateFit:
         return jac
 
     def difference_jacobian(self, z, use):
-        """Forward differences, one column per parameter; the columns of linear parameters are
-        computed once per sample set and reused."""
+        """Forward differences, one column per parameter (together through ``columns`` when given);
+        the columns of linear parameters are computed once per sample set and reused."""
         z_last, f0 = self._cache.get("last", (None, None))
         if z_last is None or not np.array_equal(z_last, z):
             f0 = self.residuals(z, use)
         key = ("linear", use.tobytes())
         jac = np.empty((f0.size, z.size))
         _, high = self._bounds()
+        todo, shifted, steps = [], [], []
         for i in range(z.size):
             if self.linear[i] and key in self._cache:
                 jac[:, i] = self._cache[key][i]
                 continue
-            h = DIFFERENCE_STEP * max(1.0, abs(z[i])) * (-1.0 if z[i] + 2 * DIFFERENCE_STEP > high[i] else 1.0)
-            shifted = z.copy()
-            shifted[i] += h
-            jac[:, i] = (self.residuals(shifted, use) - f0) / h
+            step = self.difference_step
+            h = step * max(1.0, abs(z[i])) * (-1.0 if z[i] + 2 * step > high[i] else 1.0)
+            todo.append(i)
+            steps.append(h)
+            shifted.append(z.copy())
+            shifted[-1][i] += h
+        values = self.columns(shifted, use) if self.columns else [self.residuals(zi, use) for zi in shifted]
+        for i, h, f in zip(todo, steps, values):
+            jac[:, i] = (f - f0) / h
         if key not in self._cache:
             self._cache[key] = {i: jac[:, i].copy() for i in np.flatnonzero(self.linear)}
         return jac
@@ -220,44 +265,81 @@ class CandidateFit:
         n_nominal = len(p.nominal_center)
         z_nominal = np.zeros(n_nominal) if nominal_start is None else \
             (nominal_start.values[:n_nominal] - p.nominal_center) / p.nominal_sigma
-        starts = [np.r_[z_nominal, s / self.scale] for s in
+        starts = [np.r_[z_nominal, self.scaled(s)] for s in
                   (self.effect.starts(self.specs) if self.effect else [np.zeros(0)])]
-        stage1 = [self._solve(z0, first) for z0 in starts]
-        best = min(stage1, key=lambda r: r.cost)
-        # towing: the second stage starts from the better, on the whole training span, of the first
-        # stage's best and (for a candidate) the nominal fit with the effect at its first start: with the
-        # Broyden Jacobians a first stage that wandered off on the early span left candidates worse than
-        # the nominal model (the free scenarios keep the plain continuation their slow test validated)
         low, high = self._bounds()
-        options = [best.x] + ([np.clip(starts[0], low, high)] if nominal_start is not None and self.broyden else [])
+        if nominal_start is not None and self.broyden:
+            # towing candidate: no continuation on the early span (the nominal fit it starts from has
+            # the motion's phase already); the fit starts from the best, on the training span, of the
+            # effect's starting points and the effect switched off (its parameters at zero, clipped into
+            # their bounds: the nominal model for every catalog effect), so that a candidate never ends
+            # worse than the nominal model it contains. The first stage cost a third of the fits and
+            # left the same minima on the sample record (docs/diagnosis.md)
+            stage1 = []
+            options = [np.clip(z, low, high) for z in starts + [np.r_[z_nominal, self.scaled(self.null())]]]
+        else:
+            stage1 = [self._solve(z0, first) for z0 in starts]
+            options = [min(stage1, key=lambda r: r.cost).x]
         z2 = min(options, key=lambda z: float(np.sum(self.residuals(z, p.train) ** 2)))
         result = self._solve(z2, p.train)
         evaluations = sum(r.nfev for r in stage1) + result.nfev
-        if self.broyden and result.status == 0:
-            # towing: the budget ran out on Broyden Jacobians (a long valley, e.g. k_m against tau_m of a
-            # viscoelastic tether): one more leg from a fresh finite-difference Jacobian
-            self._cache.pop(("broyden", p.train.tobytes()), None)
+        jac = None
+        if self.broyden:
+            result, jac, more = self._refine(result)
+            evaluations += more
+        return self._result(result, evaluations, clock.perf_counter() - start, jac)
+
+    def _refine(self, result):
+        """Towing (Broyden Jacobians): the stopping rule. A fresh finite-difference Jacobian at the end of
+        a leg (the one the uncertainties need anyway) tells how much one Gauss-Newton step would still
+        lower chi^2 (:func:`predicted_decrease`); above ``CONVERGED_CHI2`` another leg starts from it (at
+        most ``MAX_LEGS``): Broyden's secant updates stop early, short of the minimum, along a valley.
+        Returns the result, the Jacobian at its optimum and the further evaluations."""
+        p = self.problem
+        low, high = self._bounds()
+        evaluations = 0
+        for leg in range(MAX_LEGS + 1):
+            jac = self.difference_jacobian(result.x, p.train)
+            if leg == MAX_LEGS or predicted_decrease(jac, result.fun, result.x, low, high) <= CONVERGED_CHI2:
+                break
+            self._cache[("broyden", p.train.tobytes())] = {"z": result.x.copy(), "f": result.fun.copy(),
+                                                           "jac": jac, "age": 0}
             more = self._solve(result.x, p.train)
             evaluations += more.nfev
-            result = more if more.cost <= result.cost else result
-        return self._result(result, evaluations, clock.perf_counter() - start)
+            if more.cost >= result.cost:
+                break
+            result = more
+        return result, jac, evaluations
 
-    def _result(self, result, evaluations, seconds) -> FitResult:
+    def _result(self, result, evaluations, seconds, jac=None) -> FitResult:
         p = self.problem
         n_nominal = len(p.nominal_center)
         chi2_prior = float(result.x[:n_nominal] @ result.x[:n_nominal])
         chi2_data = float(2.0 * result.cost - chi2_prior)
         n_data = int(sum(np.isfinite(v[p.train]).sum() for v in p.values.values()))
-        jac = self.difference_jacobian(result.x, p.train) if self.broyden else result.jac    # exact at the optimum
+        if jac is None:      # the optimizer's own Jacobian: a finite-difference one, exact at the optimum
+            jac = result.jac
         dof = max(n_data - len(result.x), 1)
         cov_z = np.linalg.pinv(jac.T @ jac) * max(1.0, chi2_data / dof)
-        scale = np.r_[p.nominal_sigma, self.scale]
         nominal, values = self.unpack(result.x)
+        scale = np.r_[p.nominal_sigma, np.where(self.log, np.abs(values), self.scale)]   # d value / d z
         names = _expanded(p.nominal_names) + [s.name for s in self.specs]
         units = _expanded_units(p.nominal_names) + [s.unit for s in self.specs]
         return FitResult(self.effect.id if self.effect else "nominal", names, units, np.r_[nominal, values],
                          scale * np.sqrt(np.clip(np.diag(cov_z), 0.0, None)), n_nominal, chi2_data, chi2_prior,
                          n_data, seconds, evaluations, result.message, values)
+
+
+def predicted_decrease(jac, f, z, low, high) -> float:
+    """Decrease of chi^2 = |f|^2 that a Gauss-Newton step from ``z`` (residuals ``f``, Jacobian ``jac``)
+    predicts, |J d|^2 with d the least-squares solution of J d = -f; a variable at a bound that the
+    gradient pushes outwards is held. Near a minimum the parameters are then about sqrt(decrease)
+    standard deviations from it (the quadratic model)."""
+    g = jac.T @ f
+    held = ((z <= low + 1e-10) & (g > 0)) | ((z >= high - 1e-10) & (g < 0))
+    free = jac[:, ~held]
+    step = np.linalg.lstsq(free, -f, rcond=None)[0]
+    return float(np.sum((free @ step) ** 2))
 
 
 def resolved_step(plant, times, noise: dict, halvings: int = 3) -> float:
@@ -292,7 +374,7 @@ def prediction(problem: Problem, effect: Effect | None, fit: FitResult, times) -
     """Channels of a fitted model at ``times`` (s)."""
     candidate = CandidateFit(problem, effect)
     z = np.r_[(fit.values[:fit.nominal_count] - problem.nominal_center) / problem.nominal_sigma,
-              fit.effect_values / candidate.scale]
+              candidate.scaled(fit.effect_values)]
     return candidate.predict(z, times)
 
 

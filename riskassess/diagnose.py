@@ -33,35 +33,56 @@ from riskassess.diagnosis_case import load_diagnosis_case, toml_text
 
 #: Worker processes fitting candidates in parallel (the issue's 2-core machine).
 WORKERS = 2
-_PROBLEM: Problem | None = None    # what the forked workers fit (inherited, not pickled) ...
-_NOMINAL: FitResult | None = None   # ... starting from the nominal model's fit
+_PROBLEM: Problem | None = None    # what the forked workers fit (inherited, not pickled)
 
 
-def _fit_one(effect_id: str) -> FitResult:
-    single_threaded_blas()
-    return CandidateFit(_PROBLEM, CATALOG[effect_id]).fit(_NOMINAL)
+def _fit_one(task) -> FitResult:
+    effect_id, nominal = task
+    return CandidateFit(_PROBLEM, CATALOG[effect_id]).fit(nominal)
+
+
+def _residuals_of(task):
+    """One finite-difference column's residual vector, in a worker."""
+    effect_id, z, use = task
+    return CandidateFit(_PROBLEM, CATALOG.get(effect_id)).residuals(z, use)
+
+
+def _cost_order(problem: Problem, effect_ids: list[str]) -> list[str]:
+    """Candidates, the dearest first (starts x parameters): the workers then finish together (LPT)."""
+    def cost(effect_id):
+        effect = CATALOG[effect_id]
+        specs = effect.parameter_specs(problem.case, problem.channels)
+        return (len(effect.starts(specs)) + 1) * (len(problem.nominal_center) + len(specs))
+    return sorted(effect_ids, key=cost, reverse=True)
 
 
 def fit_candidates(problem: Problem, effect_ids: list[str], workers: int = WORKERS, progress=None) -> dict:
-    """The nominal model, then every effect from the nominal fit (forked workers when > 1);
-    returns id -> :class:`FitResult`."""
-    global _PROBLEM, _NOMINAL
+    """The nominal model (its finite-difference Jacobian columns in the worker processes), then every
+    effect from the nominal fit, one per worker process (forked when ``workers`` > 1); returns
+    id -> :class:`FitResult`."""
+    global _PROBLEM
     single_threaded_blas()
     _PROBLEM = problem
-    _NOMINAL = CandidateFit(problem).fit()
-    fits = {"nominal": _NOMINAL}
     total = len(effect_ids) + 1
-    if progress:
-        progress("fitting", 1, total)
-    if workers > 1 and "fork" in multiprocessing.get_all_start_methods():
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
-            for fit in pool.imap_unordered(_fit_one, effect_ids):
-                fits[fit.id] = fit
-                if progress:
-                    progress("fitting", len(fits), total)
-    else:
-        for effect_id in effect_ids:
-            fits[effect_id] = _fit_one(effect_id)
+    order = _cost_order(problem, effect_ids)
+    if workers <= 1 or "fork" not in multiprocessing.get_all_start_methods():
+        fits = {"nominal": CandidateFit(problem).fit()}
+        for effect_id in order:
+            if progress:
+                progress("fitting", len(fits), total)
+            fits[effect_id] = _fit_one((effect_id, fits["nominal"]))
+        if progress:
+            progress("fitting", len(fits), total)
+        return fits
+    with multiprocessing.get_context("fork").Pool(workers, initializer=single_threaded_blas) as pool:
+        def columns(vectors, use):
+            return pool.map(_residuals_of, [(None, z, use) for z in vectors])
+
+        fits = {"nominal": CandidateFit(problem, columns=columns).fit()}
+        if progress:
+            progress("fitting", 1, total)
+        for fit in pool.imap_unordered(_fit_one, [(k, fits["nominal"]) for k in order]):
+            fits[fit.id] = fit
             if progress:
                 progress("fitting", len(fits), total)
     return fits

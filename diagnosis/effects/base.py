@@ -26,7 +26,9 @@ from diagnosis.towing_dynamics import no_towing_load
 @dataclass(frozen=True)
 class Parameter:
     """A physical parameter: name, unit, meaning, a typical magnitude for this case (scale of
-    the fit and of test draws) and hard bounds."""
+    the fit and of test draws) and hard bounds. ``log``: the fit works on ln(value / typical)
+    (a positive parameter known to within orders of magnitude, or one of a product that the data
+    see better than its factors; ``lower`` must then be > 0)."""
 
     name: str
     unit: str
@@ -34,6 +36,7 @@ class Parameter:
     typical: float
     lower: float
     upper: float
+    log: bool = False
 
 
 class Effect:

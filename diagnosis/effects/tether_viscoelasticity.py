@@ -87,8 +87,13 @@ class TetherViscoelasticity(Effect):
         k = case.towing_case.main_tether.stiffness if case.kind == "towing" else 1000.0
         # typical: a branch as stiff as the tether relaxing over tens of seconds (creep of a polymer braid);
         # weaker or faster branches hide in the damped tether (c = 300 N s/m in the Zenit-2 case)
-        return [Parameter("maxwell_stiffness", "N/m", "stiffness of the relaxing branch k_m", k, 0.0, 30.0 * k),
-                Parameter("relaxation_time", "s", "relaxation time of the branch tau_m", 20.0, 0.05, 1000.0)]
+        # both on a log scale: a ramp that loads the tether slowly against tau_m sees mostly the product
+        # k_m tau_m (the viscous limit), a straight valley in (ln k_m, ln tau_m) that Gauss-Newton steps
+        # follow; on a linear scale it is a hyperbola, and the fit stopped 30 % off along it (docs).
+        # (k_m >= 1e-4 k: a log scale needs a positive bound; the nominal model is the k_m -> 0 limit)
+        return [Parameter("maxwell_stiffness", "N/m", "stiffness of the relaxing branch k_m", k, 1e-4 * k, 30.0 * k,
+                          log=True),
+                Parameter("relaxation_time", "s", "relaxation time of the branch tau_m", 20.0, 0.05, 1000.0, log=True)]
 
     def starts(self, specs):
         return [np.array([specs[0].typical / 3.0, 3.0]), np.array([specs[0].typical / 3.0, 60.0])]
