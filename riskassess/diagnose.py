@@ -162,8 +162,9 @@ def _towing_initial(raw: dict, case_path: Path, value: dict) -> None:
 
 
 def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = None, workers: int = WORKERS,
-                  progress=None) -> dict:
-    """Run the diagnosis; returns the answer (also written to ``diagnosis.json``)."""
+                  progress=None, candidates: list[str] | None = None) -> dict:
+    """Run the diagnosis; returns the answer (also written to ``diagnosis.json``). ``candidates``: the
+    effect ids to fit (default: the whole catalog; the applicable ones among them are fitted)."""
     wall = time.perf_counter()
     case_path = Path(case_path)
     case = load_diagnosis_case(case_path)
@@ -175,7 +176,8 @@ def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = N
                          f"'{case.kind}' scenario ({', '.join(scenario_channels(problem.plant))})")
     not_applicable = {k: e.not_applicable(case, problem.channels) for k, e in CATALOG.items()}
     not_applicable = {k: v for k, v in not_applicable.items() if v}
-    fits = fit_candidates(problem, [k for k in CATALOG if k not in not_applicable], workers, progress)
+    fitted = [k for k in CATALOG if k not in not_applicable and (candidates is None or k in candidates)]
+    fits = fit_candidates(problem, fitted, workers, progress)
     predictions = {k: prediction(problem, CATALOG.get(k), f, problem.time) for k, f in fits.items()}
     scores = score(problem, predictions)
     decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms)

@@ -96,7 +96,12 @@ class TetherViscoelasticity(Effect):
                 Parameter("relaxation_time", "s", "relaxation time of the branch tau_m", 20.0, 0.05, 1000.0, log=True)]
 
     def starts(self, specs):
-        return [np.array([specs[0].typical / 3.0, 3.0]), np.array([specs[0].typical / 3.0, 60.0])]
+        """A grid over both parameters' decades (k_m: k / 3 .. 3 k; tau_m: 3 .. 300 s): a towing candidate's
+        fit starts from the best of them on the training span (one run each, diagnosis.fit), as the
+        fit from one start stopped in another basin (k_m 8384 N/m and tau_m 151 s, chi^2 1060 above
+        the truth's, for a 12000 N/m, 80 s tether; docs/diagnosis.md)."""
+        return [np.array([k_m, tau]) for k_m in specs[0].typical * np.array([1 / 3, 1.0, 3.0])
+                for tau in (3.0, 30.0, 300.0)]
 
 
 EFFECT = TetherViscoelasticity()
