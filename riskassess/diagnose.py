@@ -162,9 +162,10 @@ def _towing_initial(raw: dict, case_path: Path, value: dict) -> None:
 
 
 def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = None, workers: int = WORKERS,
-                  progress=None, candidates: list[str] | None = None) -> dict:
+                  progress=None, candidates: list[str] | None = None, figures: bool = True) -> dict:
     """Run the diagnosis; returns the answer (also written to ``diagnosis.json``). ``candidates``: the
-    effect ids to fit (default: the whole catalog; the applicable ones among them are fitted)."""
+    effect ids to fit (default: the whole catalog; the applicable ones among them are fitted);
+    ``figures``: write the PNG plots (the report needs them; tests about the answer leave them out)."""
     wall = time.perf_counter()
     case_path = Path(case_path)
     case = load_diagnosis_case(case_path)
@@ -213,7 +214,7 @@ def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = N
     extended = extended_case(case_path, problem, fits[chosen]) if chosen != "nominal" and \
         decision["cause"] == chosen else None
     answer["wall_s"] = time.perf_counter() - wall
-    _write(out, case_path, answer, problem, predictions, chosen, before, after, extended)
+    _write(out, case_path, answer, problem, predictions, chosen, before, after, extended, figures)
     return answer
 
 
@@ -222,7 +223,8 @@ def _unfitted(problem: Problem) -> FitResult:
     return FitResult("nominal", [], [], problem.nominal_center, np.zeros(n), n, 0.0, 0.0, 1, 0.0, 0, "")
 
 
-def _write(out: Path, case_path: Path, answer, problem, predictions, chosen, before, after, extended) -> None:
+def _write(out: Path, case_path: Path, answer, problem, predictions, chosen, before, after, extended,
+           figures: bool = True) -> None:
     from riskassess.report.diagnosis import write_figures
 
     out.mkdir(parents=True, exist_ok=True)
@@ -246,7 +248,8 @@ def _write(out: Path, case_path: Path, answer, problem, predictions, chosen, bef
         arrays[f"residual_before/{c}"] = before[c]["residual"]
         arrays[f"residual_after/{c}"] = after[c]["residual"]
     results.atomic_write_npz(out / "diagnosis.npz", arrays)
-    files += write_figures(out, answer, arrays)
+    if figures:
+        files += write_figures(out, answer, arrays)
     results.atomic_write_json(out / "diagnosis.json", answer)
     manifest = {"format": results.FORMAT, "version": results.VERSION, "case": answer["case"], "stage": "diagnose",
                 "status": "complete", "files": files,

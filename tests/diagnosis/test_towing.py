@@ -136,7 +136,8 @@ def _tow_data(case, effect_id, rng, times):
 def _diagnose(tmp_path, channels, times, candidates=None, uncertain=None):
     """Diagnose a copy of the sample case, by default with the debris' attitude and rate uncertain (its
     position and velocity known: 6 fitted nominal parameters instead of 12 keep the fast tests' diagnoses
-    at a few seconds each on 2 idle cores); ``candidates``: the effects fitted (default: the catalog)."""
+    at a few seconds each on 2 idle cores); ``candidates``: the effects fitted (default: the catalog). No
+    plots (test_diagnose.py checks them): they took 40 % of a fast diagnosis."""
     data = tmp_path / "measured.csv"
     write_measured(data, times, channels)
     raw = read_toml(TOWING_CASE)
@@ -144,13 +145,18 @@ def _diagnose(tmp_path, channels, times, candidates=None, uncertain=None):
     raw["uncertain"] = {"attitude": 0.01, "angular_velocity": 2e-3} if uncertain is None else uncertain
     case = tmp_path / TOWING_CASE.name
     case.write_text(toml_text(raw))
-    return diagnose_case(case, data, tmp_path / "out", candidates=candidates)
+    return diagnose_case(case, data, tmp_path / "out", candidates=candidates, figures=False)
 
 
 #: Candidates of the fast hidden-effect tests (each is about one law): the two towing-only effects and the
 #: generic ones nearest to them in these records (a bias absorbs a tension offset, a CoM offset moves the
-#: sub-tethers' lever arms); the no-effect test and the slow test fit the whole catalog.
+#: sub-tethers' lever arms); the fast no-effect test fits every effect a tow can show (SLOW_EFFECTS), the
+#: slow tests the whole catalog.
 FAST_CANDIDATES = ["tether_viscoelasticity", "thrust_misalignment", "sensor_bias", "com_offset"]
+#: Effects a 300 s tow of the 9 t Zenit-2 shows above typical noise (gravity gradient, J2 and a nutation
+#: damper on its major-axis spin do not: docs/diagnosis.md); the slow test hides one of them.
+SLOW_EFFECTS = ["tether_viscoelasticity", "thrust_misalignment", "com_offset", "sensor_bias", "sensor_time_delay",
+                "eddy_current_damping"]
 
 
 @pytest.mark.parametrize("effect_id", ["tether_viscoelasticity", "thrust_misalignment"])
@@ -178,16 +184,11 @@ def test_towing_without_effect_gives_no_significant_discrepancy(tmp_path, zenit_
     clean = predict(plant_of(zenit_tow), times, step=DATA_STEP)
     scale = 10 ** rng.uniform(-1.0, 0.0)
     channels = {c: v + rng.normal(0.0, channel_noise(c, scale), v.shape) for c, v in clean.items()}
-    answer = _diagnose(tmp_path, channels, times)
+    answer = _diagnose(tmp_path, channels, times, SLOW_EFFECTS)
     assert answer["cause"] == "none", answer["statement"]
     assert answer["extended_case"] is None
     assert {"hinge_coulomb_friction", "hinge_backlash", "hinge_stiffness_hardening"} <= set(answer["not_applicable"])
 
-
-#: Effects the slow test hides in 300 s tows: those a 300 s tow of the 9 t Zenit-2 shows above typical
-#: noise (gravity gradient, J2 and a nutation damper on its major-axis spin do not: docs/diagnosis.md).
-SLOW_EFFECTS = ["tether_viscoelasticity", "thrust_misalignment", "com_offset", "sensor_bias", "sensor_time_delay",
-                "eddy_current_damping"]
 
 
 @pytest.mark.slow
