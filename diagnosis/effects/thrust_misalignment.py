@@ -66,7 +66,11 @@ class ThrustMisalignment(Effect):
                 Parameter("tilt_y", "rad", "thrust tilt about the tug's body y axis", 0.02, -0.3, 0.3)]
 
     def starts(self, specs):
-        return [np.zeros(2)]
+        """A 3 x 3 grid of tilts (0, +-2 x typical): a towing candidate's fit starts from the best of them
+        on the training span (one run each, diagnosis.fit); from zero tilt alone the fit stopped at
+        chi^2 1.8e6 for a record whose truth has 2.3e4 (0.013 / -0.032 rad; docs/diagnosis.md)."""
+        return [np.array([a * specs[0].typical, b * specs[1].typical]) for a in (-2.0, 0.0, 2.0)
+                for b in (-2.0, 0.0, 2.0)]
 
 
 EFFECT = ThrustMisalignment()
