@@ -6,9 +6,12 @@ training sample plus (theta - theta_case) / sigma_prior of each uncertain nomina
 (Gaussian prior from the case's ``[uncertain]`` table). Parameters are scaled (prior sigma,
 effect's typical size) so that the optimizer sees unit-sized steps; an effect parameter marked
 ``log`` is fitted as ln(value / typical) (a product of two parameters that the data see better
-than its factors is then a straight valley, which Gauss-Newton steps follow, not a hyperbola). The fit runs first on the
-first part of the training span, then on all of it (a long tumble's phase error has many
-local minima when it is seen at once), from each of the effect's starting points.
+than its factors is then a straight valley, which Gauss-Newton steps follow, not a hyperbola).
+The fit runs first on the first part of the training span, then on all of it (a long tumble's
+phase error has many local minima when it is seen at once), from each of the effect's starting
+points; a towing candidate instead starts from the best of its starting points scored by one run
+each (:meth:`CandidateFit.fit`; Broyden Jacobians, a coarser difference step and a Gauss-Newton
+stopping rule for that model: its chi^2 is piecewise smooth, docs/diagnosis.md).
 The parameter covariance is (J^T J)^-1 at the optimum, scaled by chi^2 / dof when that exceeds 1.
 """
 from __future__ import annotations
