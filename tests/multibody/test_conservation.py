@@ -1,6 +1,5 @@
 """Momentum and energy of a free impact (no orbit): net + tumbling box, one coupled system."""
 import numpy as np
-import pytest
 
 from multibody.impact import ImpactSimulation
 

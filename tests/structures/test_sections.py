@@ -1,7 +1,6 @@
 """Section properties and stresses against closed-form beam results (Roark, 8th ed.; Gere, Mechanics of Materials)."""
 import math
 
-import numpy as np
 import pytest
 
 from structures.sections import circular_tube, hollow_rectangle, i_section, section_stresses, solid_rectangle, \
