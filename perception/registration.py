@@ -360,7 +360,7 @@ class DebrisTracker:
         if self._model is None:   # the first scan starts the model and defines the frame B
             alignment = self._start_model(time_s, np.asarray(scan.points))
         else:
-            predicted, has_motion = self._prediction()
+            predicted, has_motion = self.prediction()
             if gate is not None and has_motion:
                 scan = self._gated(scan, predicted, gate)
             alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
@@ -406,16 +406,15 @@ class DebrisTracker:
     def predicted_world_to_body(self) -> np.ndarray | None:
         """The next frame's expected pose (world -> B): from the motion of the last two good
         frames, else the last good pose; None before any good frame."""
-        return self._prediction()[0]
+        return self.prediction()[0]
 
-    def _prediction(self) -> tuple[np.ndarray | None, bool]:
+    def prediction(self) -> tuple[np.ndarray | None, bool]:
         """Predicted pose (None before any good frame) and whether it carries the motion (two
         consecutive good frames); without the motion, the last good pose."""
         last = self.alignments[-2:]
         if len(last) == 2 and all(a.ok for a in last):
             return predict_pose(last[1].world_to_body, last[0].world_to_body), True
-        good = [a for a in self.alignments if a.ok]
-        return (good[-1].world_to_body if good else None), False
+        return next((a.world_to_body for a in reversed(self.alignments) if a.ok), None), False
 
     def _acquisition_start(self, points, last) -> np.ndarray:
         """Pose putting the scan centroid on the model centroid, at the last good attitude if any."""

@@ -42,7 +42,7 @@ from perception.momentum import (mass_from_linear_momentum, point_masses_momentu
 from perception.motion import (NotObservable, attitude_sqrt_information, center_of_mass_line, isotropic_attitude_weights,
                                rates_from_attitudes)
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
-from perception.registration import DebrisTracker, known_shape_model, predict_pose
+from perception.registration import DebrisTracker, known_shape_model
 from perception.shape import half_turn_symmetry_transforms, rotation_error
 from riskassess import results
 from riskassess.assemble import body_meshes_target_frame, model_inputs
@@ -164,10 +164,9 @@ def _crop_to_predicted(tracker: DebrisTracker, points_world) -> np.ndarray:
     belong to the net); all points when there is no prediction. Done here on the full scan,
     before the tracker thins it: the tracker's own ``gate`` (after thinning) registered fewer
     free-flight frames in the shortened test case (7 against 16)."""
-    last = tracker.alignments[-2:]
-    if len(last) < 2 or not all(a.ok for a in last):
+    predicted, has_motion = tracker.prediction()
+    if not has_motion:
         return points_world
-    predicted = predict_pose(last[1].world_to_body, last[0].world_to_body)
     body = points_world @ predicted[:3, :3].T + predicted[:3, 3]
     return points_world[np.isfinite(tracker.distance_to_model(body, DEBRIS_GATE))]
 
