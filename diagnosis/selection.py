@@ -11,7 +11,9 @@ held-out part it was not fitted on. A cause is named only when all of these hold
    apart and the answer is "unexplained" (ambiguous);
 3. adequate: the extended model's training residual RMS is within ``adequate_rms`` sigma in every
    channel (what is left is noise), otherwise the effect only absorbs part of something else;
-4. material: it predicts the held-out data better by at least ``MIN_GAIN_PERCENT``.
+4. material: it improves the residual RMS by at least ``MIN_GAIN_PERCENT``, over all channels or in
+   the channel where the nominal model departs most (training or held-out part), and does not
+   predict the held-out part worse overall.
 
 Otherwise the answer is "none" (no significant discrepancy: the nominal model is adequate) or
 "unexplained" (the nominal model is not, and no single catalog effect explains it).
@@ -25,9 +27,12 @@ import numpy as np
 from diagnosis.fit import FitResult, Problem
 from diagnosis.residuals import normalized_residuals
 
-#: Smallest gain (aggregate normalized RMS, %, training or held-out) for a named cause: an effect that
-#: is decisive but improves the fit by less than 5 % absorbs a small model difference, it is not the
-#: cause the user is after.
+#: Smallest gain (normalized RMS, %, training or held-out; over all channels or in the nominal model's
+#: worst channel) for a named cause: an effect that is decisive but improves the fit by less than 5 %
+#: absorbs a small model difference (a residual excess below ~0.3 sigma RMS), it is not the cause the
+#: user is after. The worst channel counts on its own because an aggregate over a dozen channels
+#: dilutes an effect seen in one of them: a soft, fast viscoelastic tether (2000 N/m, 10 s) moves only
+#: the tension and gained 3 % overall with a delta BIC of 1231 (docs/diagnosis.md).
 MIN_GAIN_PERCENT = 5.0
 
 
@@ -71,6 +76,18 @@ def gain_percent(before: float, after: float) -> float:
     return float(100.0 * (before - after) / before) if before > 0 else 0.0
 
 
+def material_gain(scores: dict[str, dict], key: str) -> float:
+    """Largest gain (%) of model ``key`` over the nominal model: overall or in the channel the nominal
+    model fits worst, on the training or the held-out part."""
+    gains = []
+    for part in ("train", "holdout"):
+        nominal, model = scores["nominal"][part], scores[key][part]
+        worst = max(nominal, key=lambda c: nominal[c]["rms_sigma"])
+        gains += [gain_percent(scores["nominal"][f"{part}_rms_sigma"], scores[key][f"{part}_rms_sigma"]),
+                  gain_percent(nominal[worst]["rms_sigma"], model[worst]["rms_sigma"])]
+    return max(gains)
+
+
 def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float, adequate_rms: float) -> dict:
     """The answer: cause (an effect id, "none" or "unexplained"), confidence, and why."""
     weights = posterior_weights(fits)
@@ -84,7 +101,7 @@ def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float,
         margin = fits[ranked[1]].bic - fits[best].bic if len(ranked) > 1 else np.inf
         gain = gain_percent(scores["nominal"]["holdout_rms_sigma"], scores[best]["holdout_rms_sigma"])
         gain_train = gain_percent(scores["nominal"]["train_rms_sigma"], scores[best]["train_rms_sigma"])
-        if delta > decisive and adequate[best] and max(gain, gain_train) >= MIN_GAIN_PERCENT and gain >= 0:
+        if delta > decisive and adequate[best] and material_gain(scores, best) >= MIN_GAIN_PERCENT and gain >= 0:
             if margin > decisive:
                 return {**answer, "cause": best, "model": best, "confidence": weights[best],
                         "reason": f"{best}: BIC lower by {delta:.1f} than the nominal model and by {margin:.1f} than "

@@ -46,11 +46,11 @@ VISIBLE = 8.0
 
 def draw_effect(case, effect_id, rng):
     """Physical parameters of ``effect_id`` drawn around their typical size (x 0.5 .. x 3, random signs
-    for offsets and biases, random field direction)."""
+    for offsets, biases and tilts, random field direction)."""
     values = {}
     for p in CATALOG[effect_id].parameter_specs(case):
         value = p.typical * 10 ** rng.uniform(-0.3, 0.5)
-        if p.lower < 0 < p.upper and p.name.startswith(("offset", "bias")):
+        if p.lower < 0 < p.upper and p.name.startswith(("offset", "bias", "tilt")):
             value *= rng.choice([-1.0, 1.0])
         if p.name == "field_azimuth":
             value = rng.uniform(-np.pi, np.pi)

@@ -28,7 +28,7 @@ from riskassess.case import read_toml
 from riskassess.diagnose import diagnose_case
 from riskassess.diagnosis_case import toml_text
 from tests.diagnosis.conftest import TOWING_CASE, case_with
-from tests.diagnosis.test_diagnose import _check_named
+from tests.diagnosis.test_diagnose import _check_named, draw_effect
 
 SEED = int(os.environ.get("DIAGNOSIS_SEED", "0"))
 #: Data step (s): the towing case's Exudyn step.
@@ -114,17 +114,15 @@ def test_tilted_thrust_keeps_its_magnitude_and_turns_by_the_tilts():
 
 
 def _tow_data(case, effect_id, rng, times):
-    """(values, noisy channels): the effect drawn around its typical size until its signal stands out
-    (chi^2 of the clean difference >= 400 at the drawn noise: far beyond the BIC's penalty for 2
-    parameters, 2 ln 3000 = 16, and the decisive 10), noise scale log-uniform 0.1-1 x NOISE."""
+    """(values, noisy channels): the effect drawn as in the free scenarios' tests (draw_effect: around
+    its typical size, random signs, random field direction) until its signal stands out (chi^2 of the
+    clean difference >= 400 at the drawn noise: far beyond the BIC's penalty for 2 parameters,
+    2 ln 3000 = 16, and the decisive 10), noise scale log-uniform 0.1-1 x NOISE."""
     plant = plant_of(case)
     nominal = predict(plant, times, step=DATA_STEP)
     effect = CATALOG[effect_id]
     for _ in range(30):
-        specs = effect.parameter_specs(case)
-        values = {p.name: float(np.clip(p.typical * 10 ** rng.uniform(-0.3, 0.5) * rng.choice([-1.0, 1.0])
-                                        if p.lower < 0 else p.typical * 10 ** rng.uniform(-0.3, 0.5), p.lower, p.upper))
-                  for p in specs}
+        values = draw_effect(case, effect_id, rng)
         clean = predict(plant, times, effect, list(values.values()), list(values), step=DATA_STEP)
         scale = 10 ** rng.uniform(-1.0, 0.0)
         chi2 = sum(np.sum((clean[c] - nominal[c]) ** 2) / channel_noise(c, scale) ** 2 for c in clean)
