@@ -36,17 +36,23 @@ def misaligned_thrust(thrust, direction_body, nozzle_body, tilt_x, tilt_y):
     return force, cross(nozzle_body, force)
 
 
+@njit(cache=True)
+def thrust_direction_eci(q, v, work):
+    """Unit direction (ECI) of the thrust law's force (multibody.towing_kernel.towing_forces): the
+    chaser's body z for the MRAC laws, against its velocity for the ramp."""
+    if work[W_ALONG_Z] > 0.0:
+        return rotation_matrix_from_rotation_vector(q[CHASER + 3:CHASER + 6])[:, 2].copy()
+    speed = math.sqrt(v[CHASER] ** 2 + v[CHASER + 1] ** 2 + v[CHASER + 2] ** 2)
+    return -v[CHASER:CHASER + 3] / speed
+
+
 @njit(TOWING_LAW_SIGNATURE, cache=True)
 def towing_law(t, q, v, p, work, xe, h, load):
     thrust = last_diagnostics(work)[THRUST]
     if thrust == 0.0:
         return
     rot_c = rotation_matrix_from_rotation_vector(q[CHASER + 3:CHASER + 6])
-    if work[W_ALONG_Z] > 0.0:
-        direction = rot_c[:, 2].copy()
-    else:
-        speed = math.sqrt(v[CHASER] ** 2 + v[CHASER + 1] ** 2 + v[CHASER + 2] ** 2)
-        direction = -v[CHASER:CHASER + 3] / speed
+    direction = thrust_direction_eci(q, v, work)
     force_body, torque_body = misaligned_thrust(thrust, rot_c.T @ direction, np.zeros(3), p[0], p[1])
     change = rot_c @ force_body - thrust * direction
     for i in range(3):

@@ -12,18 +12,22 @@ import os
 
 import numpy as np
 import pytest
+from numba import njit
 from scipy.spatial.transform import Rotation
 
 from diagnosis.effects import CATALOG
+from diagnosis.effects.base import Effect
 from diagnosis.effects.tether_viscoelasticity import branch_after, step_gain
-from diagnosis.effects.thrust_misalignment import misaligned_thrust
+from diagnosis.effects.thrust_misalignment import misaligned_thrust, thrust_direction_eci
 from diagnosis.measured import write_measured
 from diagnosis.model import predict
 from diagnosis.plant import plant_of
 from diagnosis.synthetic import channel_noise, sample_times
+from diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, last_diagnostics
 from diagnosis.towing_exudyn import simulate_towing_exudyn
 from diagnosis.towing_plant import lvlh_to_eci, simulate
 from multibody.towing import run_twin
+from multibody.towing_kernel import CHASER, THRUST
 from riskassess.case import read_toml
 from riskassess.diagnose import diagnose_case
 from riskassess.diagnosis_case import toml_text
@@ -113,21 +117,27 @@ def test_tilted_thrust_keeps_its_magnitude_and_turns_by_the_tilts():
     assert np.linalg.norm(torque) == 0.0
 
 
+def _noisy(plant, times, effect, values, rng):
+    """(chi^2 of the effect's clean difference from the nominal model at the noise, noisy channels): the
+    record of ``effect`` at ``values`` (dict) with noise drawn at 0.1-1 x NOISE (log-uniform)."""
+    nominal = predict(plant, times, step=DATA_STEP)
+    clean = predict(plant, times, effect, list(values.values()), list(values), step=DATA_STEP)
+    scale = 10 ** rng.uniform(-1.0, 0.0)
+    chi2 = sum(np.sum((clean[c] - nominal[c]) ** 2) / channel_noise(c, scale) ** 2 for c in clean)
+    return chi2, {c: v + rng.normal(0.0, channel_noise(c, scale), v.shape) for c, v in clean.items()}
+
+
 def _tow_data(case, effect_id, rng, times):
     """(values, noisy channels): the effect drawn as in the free scenarios' tests (draw_effect: around
     its typical size, random signs, random field direction) until its signal stands out (chi^2 of the
     clean difference >= 400 at the drawn noise: far beyond the BIC's penalty for 2 parameters,
     2 ln 3000 = 16, and the decisive 10), noise scale log-uniform 0.1-1 x NOISE."""
     plant = plant_of(case)
-    nominal = predict(plant, times, step=DATA_STEP)
-    effect = CATALOG[effect_id]
     for _ in range(30):
         values = draw_effect(case, effect_id, rng)
-        clean = predict(plant, times, effect, list(values.values()), list(values), step=DATA_STEP)
-        scale = 10 ** rng.uniform(-1.0, 0.0)
-        chi2 = sum(np.sum((clean[c] - nominal[c]) ** 2) / channel_noise(c, scale) ** 2 for c in clean)
+        chi2, channels = _noisy(plant, times, CATALOG[effect_id], values, rng)
         if chi2 >= 400.0:
-            return values, {c: v + rng.normal(0.0, channel_noise(c, scale), v.shape) for c, v in clean.items()}
+            return values, channels
     raise AssertionError(f"{effect_id}: no visible draw in 30 tries")
 
 
@@ -187,6 +197,40 @@ def test_towing_without_effect_gives_no_significant_discrepancy(tmp_path, zenit_
     assert answer["extended_case"] is None
     assert {"hinge_coulomb_friction", "hinge_backlash", "hinge_stiffness_hardening"} <= set(answer["not_applicable"])
 
+
+
+@njit(TOWING_LAW_SIGNATURE)
+def _thrust_ripple_law(t, q, v, p, work, xe, h, load):
+    """The thrust law's force modulated, F (1 + a sin(2 pi f t + phase)) (p = a, f, phase), on the chaser."""
+    thrust = last_diagnostics(work)[THRUST]
+    if thrust != 0.0:
+        change = thrust * p[0] * np.sin(2.0 * np.pi * p[1] * t + p[2]) * thrust_direction_eci(q, v, work)
+        for i in range(3):
+            load[CHASER + i] += change[i]
+
+
+class _ThrustRipple(Effect):
+    """An engine whose thrust oscillates (combustion or valve cycling): in no catalog entry."""
+    id = "thrust_ripple"
+    scenarios = ("towing",)
+    towing_law = staticmethod(_thrust_ripple_law)
+
+
+def test_towing_effect_outside_the_catalog_is_not_pinned_on_a_catalog_cause(tmp_path, zenit_tow):
+    """A thrust ripple of 5-20 % at 0.1-0.3 Hz (out of the catalog: no catalog effect changes the thrust's
+    magnitude over time) must not be named as a catalog cause with high confidence, nor called noise."""
+    rng = np.random.default_rng(SEED + 9000)
+    times = sample_times(DURATION, 10.0)
+    plant = plant_of(zenit_tow)
+    for _ in range(30):
+        values = {"amplitude": rng.uniform(0.05, 0.2), "frequency": rng.uniform(0.1, 0.3),
+                  "phase": rng.uniform(0.0, 2 * np.pi)}
+        chi2, channels = _noisy(plant, times, _ThrustRipple(), values, rng)
+        if chi2 >= 400.0:        # as _tow_data: far beyond the BIC's penalties
+            break
+    answer = _diagnose(tmp_path, channels, times, SLOW_EFFECTS)
+    assert answer["cause"] == "unexplained" or answer["confidence"] < 0.9, (values, answer["statement"])
+    assert answer["cause"] != "none", (values, answer["statement"])
 
 
 @pytest.mark.slow
