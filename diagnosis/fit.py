@@ -402,12 +402,30 @@ def _expanded_units(names) -> list[str]:
     return [NOMINAL_PARAMETERS[n][1] for n in names for _ in range(NOMINAL_PARAMETERS[n][0])]
 
 
-def prediction(problem: Problem, effect: Effect | None, fit: FitResult, times) -> dict:
-    """Channels of a fitted model at ``times`` (s)."""
+def _fitted(problem: Problem, effect: Effect | None, fit: FitResult):
+    """(the candidate of ``effect``, the fit variables z of ``fit``)."""
     candidate = CandidateFit(problem, effect)
     z = np.r_[(fit.values[:fit.nominal_count] - problem.nominal_center) / problem.nominal_sigma,
               candidate.scaled(fit.effect_values)]
+    return candidate, z
+
+
+def prediction(problem: Problem, effect: Effect | None, fit: FitResult, times) -> dict:
+    """Channels of a fitted model at ``times`` (s)."""
+    candidate, z = _fitted(problem, effect, fit)
     return candidate.predict(z, times)
 
 
-__all__ = ["CandidateFit", "FitResult", "Problem", "prediction", "QUATERNION"]
+def step_error_sigma(problem: Problem, effect: Effect | None, fit: FitResult) -> dict:
+    """Per channel: the fitted model's own discretization error on the training part (RMS, noise sigmas),
+    estimated as 2 |y(h) - y(h/2)| (the error of y(h) for a first-order scheme: the tension-only tethers'
+    kinks make the towing scheme's convergence no better than first order)."""
+    candidate, z = _fitted(problem, effect, fit)
+    times = problem.time[problem.train]
+    coarse = candidate.predict(z, times)
+    candidate.step /= 2.0
+    fine = candidate.predict(z, times)
+    return {c: float(2.0 * np.sqrt(np.mean((coarse[c] - fine[c]) ** 2)) / problem.noise[c]) for c in problem.values}
+
+
+__all__ = ["CandidateFit", "FitResult", "Problem", "prediction", "step_error_sigma", "QUATERNION"]

@@ -10,7 +10,9 @@ held-out part it was not fitted on. A cause is named only when all of these hold
 2. decisive against the runner-up effect (same threshold), otherwise the data cannot tell them
    apart and the answer is "unexplained" (ambiguous);
 3. adequate: the extended model's training residual RMS is within ``adequate_rms`` sigma in every
-   channel (what is left is noise), otherwise the effect only absorbs part of something else;
+   channel (what is left is noise), otherwise the effect only absorbs part of something else; a
+   model's own discretization error e (noise sigmas, when given) widens that to
+   sqrt(adequate_rms^2 + e^2): no model can be asked to fit better than it integrates;
 4. material: it improves the residual RMS by at least ``MIN_GAIN_PERCENT``, over all channels or in
    the channel where the nominal model departs most (training or held-out part), and does not
    predict the held-out part worse overall.
@@ -61,12 +63,15 @@ def aggregate_rms(per_channel: dict) -> float:
     return float(np.sqrt(np.mean([v["rms_sigma"] ** 2 for v in per_channel.values()])))
 
 
-def score(problem: Problem, predictions: dict[str, dict]) -> dict[str, dict]:
-    """Training and held-out figures of every model's prediction over the whole record."""
+def score(problem: Problem, predictions: dict[str, dict], step_errors: dict | None = None) -> dict[str, dict]:
+    """Training and held-out figures of every model's prediction over the whole record; ``step_errors``:
+    model -> channel -> its discretization error on the training part (sigmas, fit.step_error_sigma)."""
     test = ~problem.train
     out = {}
     for key, model in predictions.items():
         train, held = channel_rms(problem, model, problem.train), channel_rms(problem, model, test)
+        for c, error in (step_errors or {}).get(key, {}).items():
+            train[c]["step_error_sigma"] = error
         out[key] = {"train": train, "holdout": held, "train_rms_sigma": aggregate_rms(train),
                     "holdout_rms_sigma": aggregate_rms(held)}
     return out
@@ -88,12 +93,19 @@ def material_gain(scores: dict[str, dict], key: str) -> float:
     return max(gains)
 
 
+def _step_note(scores: dict) -> str:
+    """What the statement adds when the model's own step error widened the adequacy bound."""
+    error = max(v.get("step_error_sigma", 0.0) for v in scores["train"].values())
+    return f" plus the model's own step error (up to {error:.2g} sigma)" if error > 0.1 else ""
+
+
 def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float, adequate_rms: float) -> dict:
     """The answer: cause (an effect id, "none" or "unexplained"), confidence, and why."""
     weights = posterior_weights(fits)
     nominal = fits["nominal"]
     ranked = sorted((k for k in fits if k != "nominal"), key=lambda k: fits[k].bic)
-    adequate = {k: max(v["rms_sigma"] for v in s["train"].values()) <= adequate_rms for k, s in scores.items()}
+    adequate = {k: all(v["rms_sigma"] ** 2 <= adequate_rms ** 2 + v.get("step_error_sigma", 0.0) ** 2
+                       for v in s["train"].values()) for k, s in scores.items()}
     answer = {"weights": weights, "ranked": ranked, "adequate": adequate}
     if ranked:
         best = ranked[0]
@@ -106,8 +118,8 @@ def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float,
                 return {**answer, "cause": best, "model": best, "confidence": weights[best],
                         "reason": f"{best}: BIC lower by {delta:.1f} than the nominal model and by {margin:.1f} than "
                                   f"the runner-up {ranked[1] if len(ranked) > 1 else '-'}; residual within "
-                                  f"{adequate_rms:g} sigma; fit {gain_train:.0f} % and held-out prediction "
-                                  f"{gain:.0f} % better"}
+                                  f"{adequate_rms:g} sigma{_step_note(scores[best])}; fit {gain_train:.0f} % and "
+                                  f"held-out prediction {gain:.0f} % better"}
             close = [k for k in ranked if fits[k].bic - fits[best].bic <= decisive]
             return {**answer, "cause": "unexplained", "model": best, "confidence": None,
                     "reason": f"ambiguous: {', '.join(close)} explain the data about equally (BIC within "

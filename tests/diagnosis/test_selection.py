@@ -84,3 +84,16 @@ def test_effect_seen_in_one_of_many_channels_is_material():
     scores["nominal"] = _channels({**quiet, "tension": 1.02}, {**quiet, "tension": 1.02})
     scores["a"] = _channels({**quiet, "tension": 1.015}, {**quiet, "tension": 1.015})
     assert decide(fits, scores, 10.0, 1.25)["cause"] == "none"
+
+
+def test_model_step_error_widens_the_adequacy_bound():
+    # a residual of 3 sigma left by a model whose own discretization error is 3 sigma in that channel is
+    # what the model can do (3^2 <= 1.25^2 + 3^2); without the step error it is only a partial explanation
+    fits = {"nominal": _fit("nominal", 3.0e6, 2), "a": _fit("a", 3.0e4, 3)}
+    scores = {"nominal": _score(30.0, 30.0), "a": _score(3.0, 3.0)}
+    assert decide(fits, scores, 10.0, 1.25)["cause"] == "unexplained"
+    scores["a"]["train"]["omega_x"]["step_error_sigma"] = 3.0
+    answer = decide(fits, scores, 10.0, 1.25)
+    assert answer["cause"] == "a" and "step error (up to 3 sigma)" in answer["reason"]
+    scores["a"]["train"]["omega_x"]["step_error_sigma"] = 2.5      # 9 > 1.5625 + 6.25
+    assert decide(fits, scores, 10.0, 1.25)["cause"] == "unexplained"
