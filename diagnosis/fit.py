@@ -416,16 +416,16 @@ def prediction(problem: Problem, effect: Effect | None, fit: FitResult, times) -
     return candidate.predict(z, times)
 
 
-def step_error_sigma(problem: Problem, effect: Effect | None, fit: FitResult) -> dict:
+def step_error_sigma(problem: Problem, effect: Effect | None, fit: FitResult, predicted: dict) -> dict:
     """Per channel: the fitted model's own discretization error on the training part (RMS, noise sigmas),
     estimated as 2 |y(h) - y(h/2)| (the error of y(h) for a first-order scheme: the tension-only tethers'
-    kinks make the towing scheme's convergence no better than first order)."""
+    kinks make the towing scheme's convergence no better than first order); ``predicted``: y(h) over the
+    whole record (:func:`prediction`), so that only y(h/2) is run here."""
     candidate, z = _fitted(problem, effect, fit)
-    times = problem.time[problem.train]
-    coarse = candidate.predict(z, times)
     candidate.step /= 2.0
-    fine = candidate.predict(z, times)
-    return {c: float(2.0 * np.sqrt(np.mean((coarse[c] - fine[c]) ** 2)) / problem.noise[c]) for c in problem.values}
+    fine = candidate.predict(z, problem.time[problem.train])
+    return {c: float(2.0 * np.sqrt(np.mean((predicted[c][problem.train] - fine[c]) ** 2)) / problem.noise[c])
+            for c in problem.values}
 
 
 __all__ = ["CandidateFit", "FitResult", "Problem", "prediction", "step_error_sigma", "QUATERNION"]

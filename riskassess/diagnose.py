@@ -180,7 +180,7 @@ def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = N
     fitted = [k for k in CATALOG if k not in not_applicable and (candidates is None or k in candidates)]
     fits = fit_candidates(problem, fitted, workers, progress)
     predictions = {k: prediction(problem, CATALOG.get(k), f, problem.time) for k, f in fits.items()}
-    step_errors = {k: step_error_sigma(problem, CATALOG.get(k), f) for k, f in fits.items()}
+    step_errors = {k: step_error_sigma(problem, CATALOG.get(k), f, predictions[k]) for k, f in fits.items()}
     scores = score(problem, predictions, step_errors)
     decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms)
     chosen = decision["model"]
