@@ -6,6 +6,13 @@ import numpy as np
 from structures.release import ReleaseEvent, released_pieces
 from structures.weak_location import WeakLocation, assess, demands
 
+#: The three answers to "does this capture create secondary debris?" (``debris_state`` in
+#: structures.json, the CLI, the report and the sweep store). ``secondary_debris`` carries the
+#: same as True / False / None: None is "indeterminate" (a failed or diverged run, or no judged
+#: evidence), which no consumer may read as "no debris".
+DEBRIS, NO_DEBRIS, INDETERMINATE = "debris", "no_debris", "indeterminate"
+DEBRIS_STATES = (DEBRIS, NO_DEBRIS, INDETERMINATE)
+
 
 def structures_verdict(locations: list[WeakLocation], series: dict, assembly, events: list[ReleaseEvent],
                        net_positions_final, skip_until: float, policy: str) -> dict:
