@@ -12,7 +12,8 @@ import numpy as np
 
 from multibody.assembly import RigidBodySpec
 from multibody.hinge import add_penalty_joint
-from multibody.impact import add_rigid_bodies, explicit_settings, solver_chatter_to_stderr
+from multibody.health import HealthWatch
+from multibody.impact import add_rigid_bodies, checked_post_step, explicit_settings, solve_checked
 from multibody.kernel import rotation_matrix_from_rotation_vector
 
 
@@ -57,8 +58,9 @@ def free_motion(bodies: list[RigidBodySpec], joints, sample_times, step: float =
         return True
 
     record(mbs, 0.0)
-    mbs.SetPostStepUserFunction(record)
+    watch = HealthWatch(f"at the step {step:g} s the free motion lost stability: check the joint stiffness "
+                        f"against the step and the initial rates for extreme values")
+    mbs.SetPostStepUserFunction(checked_post_step(watch, record))
     settings = explicit_settings(step, int(round(sample_times[-1] / step)))
-    with solver_chatter_to_stderr():
-        exu.SolveDynamic(mbs, settings, solverType=exu.DynamicSolverType.RK44)
+    solve_checked(mbs, settings, exu.DynamicSolverType.RK44, watch)
     return {key: np.array(value, float) for key, value in states.items()}

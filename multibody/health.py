@@ -93,8 +93,8 @@ def check_energy(time: float, total_energy: float, initial_energy: float, refere
     """The relative drift of :func:`energy_drift`; :class:`SimulationFailed` when it exceeds ``limit``."""
     drift = energy_drift(total_energy, initial_energy, reference_energy)
     if drift > limit:
-        raise SimulationFailed(time, f"energy balance drifted by {drift:.3g} of the reference energy "
-                                     f"{reference_energy:.4g} J (limit {limit:g})", cause)
+        raise SimulationFailed(time, f"energy balance drifted by {100 * drift:.3g} % of the reference energy "
+                                     f"{reference_energy:.4g} J (limit {100 * limit:g} %)", cause)
     return drift
 
 
@@ -102,3 +102,66 @@ def check_solver_flag(success, end_time: float, reached_time: float, cause: str)
     """Raise :class:`SimulationFailed` when the integrator reported failure (``success`` False)."""
     if success is False:
         raise SimulationFailed(reached_time, f"the integrator stopped before the end time {end_time:g} s", cause)
+
+
+class HealthWatch:
+    """Checks a running simulation at the instants its loop chooses; remembers the first failure.
+
+    A solver hook calls :meth:`state` (finite coordinates) and :meth:`energy` (balance drift) and
+    stops the integration when either returns False; the caller then raises :attr:`failure`.
+
+    Parameters
+    ----------
+    cause : str
+        The likely cause of a failure in words (for example the step against the stable step),
+        added to every failure message.
+    reference_energy : float, optional
+        Energy (J) the drift is measured against; None turns the energy check off (runs driven by
+        thrust or control, whose balance the tool does not close).
+    limit : float
+        Allowed drift as a fraction of ``reference_energy`` (default :data:`ENERGY_DRIFT_LIMIT`).
+    """
+
+    def __init__(self, cause: str, reference_energy: float | None = None, limit: float = ENERGY_DRIFT_LIMIT):
+        self.cause = cause
+        self.reference_energy = reference_energy
+        self.limit = limit
+        self.initial_energy: float | None = None
+        self.max_drift = 0.0
+        self.failure: SimulationFailed | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.failure is None
+
+    def _guard(self, check, *args) -> bool:
+        try:
+            check(*args)
+        except SimulationFailed as failure:
+            self.failure = self.failure or failure
+        return self.ok
+
+    def state(self, time: float, *arrays, quantity: str = "state") -> bool:
+        """False (and :attr:`failure` set) when any of ``arrays`` holds a NaN or an infinity."""
+        return all(self._guard(check_finite, time, a, quantity, self.cause) for a in arrays)
+
+    def energy(self, time: float, total_energy: float) -> bool:
+        """False (and :attr:`failure` set) when the balance ``total_energy`` (J) drifted past the limit.
+        The first call sets the initial energy."""
+        if self.reference_energy is None:
+            return self.ok
+        if self.initial_energy is None:
+            self.initial_energy = float(total_energy)
+        drift = energy_drift(total_energy, self.initial_energy, self.reference_energy)
+        if math.isfinite(drift):
+            self.max_drift = max(self.max_drift, drift)
+        return self._guard(check_energy, time, total_energy, self.initial_energy, self.reference_energy,
+                           self.cause, self.limit)
+
+    def summary(self) -> dict:
+        """JSON-ready record of the checks (for summary.json and the manifest)."""
+        return {"healthy": self.ok, "energy_reference_J": self.reference_energy,
+                "energy_drift_limit": self.limit if self.reference_energy is not None else None,
+                "energy_max_drift": self.max_drift if self.reference_energy is not None else None,
+                "failure": None if self.ok else {"time_s": self.failure.time, "quantity": self.failure.quantity,
+                                                 "cause": self.failure.cause}}

@@ -20,6 +20,7 @@ from scipy.spatial.transform import Rotation
 
 from multibody.assembly import ImpactAssembly
 from multibody.geometry import contact_shapes_body_frame
+from multibody.health import HealthWatch, SimulationFailed, check_solver_flag
 from multibody.hinge import add_penalty_joint
 from multibody.kernel import KernelData, verlet_evaluation_state
 from multibody.recorder import Recorder
@@ -280,6 +281,80 @@ def solver_chatter_to_stderr():
         os.close(saved)
 
 
+def net_stable_step(net) -> float:
+    """Explicit (Verlet) stability limit of the net's threads (s).
+
+    The highest mode of a flat lumped-mass net is about :math:`\\omega = 2\\sqrt{k/m}` (a chain's
+    zig-zag mode, docs/model.md "Step size"); Verlet is stable for :math:`h < 2/\\omega = \\sqrt{m/k}`,
+    taken here with the stiffest thread on the lightest node. Contact and joints need smaller
+    steps still: contact is sub-cycled and the joints are tuned to the step.
+    """
+    if not len(net.stiffness):
+        return np.inf
+    return float(np.sqrt(np.min(net.masses) / np.max(net.stiffness)))
+
+
+def likely_failure_cause(assembly: ImpactAssembly) -> str:
+    """Words for a failed impact run: the step against the threads' stable step, or the inputs."""
+    step, limit = assembly.solver.step, net_stable_step(assembly.net)
+    if step > 0.5 * limit:
+        return (f"the step {step:g} s is too large for the net threads (explicit stability limit "
+                f"sqrt(m/k) = {limit:.3g} s for the stiffest thread on the lightest node); "
+                f"use simulation.step <= {0.5 * limit:.2g} s")
+    return (f"the step {step:g} s is within the threads' stable step {limit:.3g} s, so look at the contact "
+            f"stiffness, a joint's stiffness or damping, or an extreme input value")
+
+
+def initial_kinetic_energy(assembly: ImpactAssembly) -> float:
+    """Kinetic energy (J) of net and bodies at t = 0: the reference of the energy-balance check."""
+    v = np.asarray(assembly.net_velocity, float).reshape(-1, 3)
+    energy = 0.5 * float(np.sum(assembly.net.masses * np.sum(v * v, axis=1))) if len(v) else 0.0
+    for b in assembly.bodies:
+        omega = np.asarray(b.omega_body, float)
+        energy += 0.5 * b.mass * float(np.dot(b.velocity_lvlh, b.velocity_lvlh)) + 0.5 * omega @ b.inertia_body @ omega
+    return energy
+
+
+#: Floor of the energy reference (J): a run with (almost) nothing moving still gets a finite bound.
+MIN_REFERENCE_ENERGY_J = 1.0
+
+
+def checked_post_step(watch: HealthWatch, post_step=None, every: int = 1):
+    """A post-step function that calls ``post_step`` (if any) and checks the state is finite every
+    ``every`` steps; it stops the solver (returns False) at the first failure, kept in ``watch``."""
+    count = [0]
+
+    def hook(mbs, t):
+        keep = post_step(mbs, t) if post_step is not None else True
+        count[0] += 1
+        if count[0] % every == 0:
+            data = mbs.systemData
+            watch.state(t, data.GetODE2Coordinates(), data.GetODE2Coordinates_t())
+        return bool(keep) and watch.ok
+
+    return hook
+
+
+def solve_checked(mbs, settings, solver_type, watch: HealthWatch) -> None:
+    """``exudyn.SolveDynamic`` with the health checks: raise :class:`SimulationFailed` when a hook
+    stopped the run (``watch.failure``), when the solver reports failure, or when it raised."""
+    end_time = settings.timeIntegration.endTime
+    try:
+        with solver_chatter_to_stderr():
+            success = exu.SolveDynamic(mbs, settings, solverType=solver_type)
+    except Exception as exc:  # Exudyn's C++ errors (ModelError, RuntimeError) after a failed step
+        if watch.failure is not None:
+            raise watch.failure from exc
+        raise SimulationFailed(mbs.systemData.GetTime(), f"the integrator raised {type(exc).__name__}: "
+                               f"{str(exc).strip().splitlines()[0] if str(exc).strip() else ''}", watch.cause) from exc
+    if watch.failure is not None:
+        raise watch.failure
+    reached = mbs.systemData.GetTime()
+    check_solver_flag(bool(success), end_time, reached, watch.cause)
+    if reached < end_time - 0.5 * settings.timeIntegration.endTime / max(settings.timeIntegration.numberOfSteps, 1):
+        raise SimulationFailed(reached, f"the integrator stopped before the end time {end_time:g} s", watch.cause)
+
+
 class ImpactSimulation:
     """Build and run one coupled impact; ``run()`` returns the recorder with all time series."""
 
@@ -287,18 +362,29 @@ class ImpactSimulation:
         self.assembly = assembly
         self.system = build_impact_system(assembly, rest_attitudes, rest_coms)
         self.wall_time = None
+        self.health = HealthWatch(likely_failure_cause(assembly),
+                                  max(initial_kinetic_energy(assembly), MIN_REFERENCE_ENERGY_J))
 
     def run(self, progress=None, monitor=None) -> Recorder:
         """Integrate to the end time; ``progress(t)`` is called at every output sample, and
-        ``monitor.check(...)`` after it (see :class:`~multibody.recorder.Recorder`)."""
-        recorder = Recorder(self.assembly, self.system, progress=progress, monitor=monitor)
+        ``monitor.check(...)`` after it (see :class:`~multibody.recorder.Recorder`).
+
+        Raises :class:`~multibody.health.SimulationFailed` at the first failed health check
+        (non-finite state, energy balance drift, integrator failure); the recorder then holds
+        the samples up to it (``self.recorder``).
+        """
+        recorder = Recorder(self.assembly, self.system, progress=progress, monitor=monitor, health=self.health)
+        self.recorder = recorder
         mbs = self.system.mbs
         mbs.SetPostStepUserFunction(recorder.post_step)
         settings = simulation_settings(self.assembly)
         recorder.sample(0.0)
         start = time.perf_counter()
-        with solver_chatter_to_stderr():
-            exu.SolveDynamic(mbs, settings, solverType=INTEGRATORS[self.assembly.solver.integrator][0])
-        self.wall_time = time.perf_counter() - start
-        recorder.finish(self.wall_time)
+        try:
+            if not self.health.ok:
+                raise self.health.failure
+            solve_checked(mbs, settings, INTEGRATORS[self.assembly.solver.integrator][0], self.health)
+        finally:
+            self.wall_time = time.perf_counter() - start
+            recorder.finish(self.wall_time)
         return recorder

@@ -23,7 +23,9 @@ from exudyn.itemInterface import LoadForceVector, MarkerBodyPosition
 from scipy.interpolate import CubicSpline
 
 from multibody.assembly import ContactLaw, ImpactAssembly, NetMount, RigidBodySpec, SolverSpec
-from multibody.impact import INTEGRATORS, build_impact_system, simulation_settings, solver_chatter_to_stderr
+from multibody.health import HealthWatch
+from multibody.impact import (INTEGRATORS, build_impact_system, checked_post_step, likely_failure_cause,
+                              simulation_settings, solve_checked)
 from multibody.net import flat_square_net
 
 #: MU bodies are spheres of this radius for their (unused) inertia (m).
@@ -130,10 +132,11 @@ def replay(t_plan, unit_paths, unit_masses, net_spec: dict, debris, keep_out_rad
             mbs, built.body_nodes[k], unit_masses[k], splines[k], gains, logs[k])))
     mbs.Assemble()
     samples = _Sampler(mbs, built, net.n_nodes, mouth_nodes, logs, max(1, int(round(1.0 / (output_rate * step)))))
-    mbs.SetPostStepUserFunction(samples)
+    # thrust-driven tracking: no closed energy balance, so the checks are a finite state and the solver's flag
+    watch = HealthWatch(likely_failure_cause(assembly))
+    mbs.SetPostStepUserFunction(checked_post_step(watch, samples))
     samples(mbs, 0.0)
-    with solver_chatter_to_stderr():
-        exu.SolveDynamic(mbs, simulation_settings(assembly), solverType=INTEGRATORS[assembly.solver.integrator][0])
+    solve_checked(mbs, simulation_settings(assembly), INTEGRATORS[assembly.solver.integrator][0], watch)
     samples(mbs, float(t_plan[-1]), force=True)
     return samples.result(debris, keep_out_radius)
 

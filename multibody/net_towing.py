@@ -21,14 +21,15 @@ from exudyn.itemInterface import NodeRigidBodyRotVecLG, ObjectGenericODE2, Objec
 from numba import njit
 from scipy.spatial.transform import Rotation
 
-from multibody.impact import explicit_settings, solver_chatter_to_stderr
+from multibody.health import HealthWatch
+from multibody.impact import checked_post_step, explicit_settings, solve_checked
 from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING, ACC_CONTACT_F, ACC_CONTACTS,
                                          ACC_DEBRIS_F, ACC_DEBRIS_T, ACC_EXTERNAL, ACC_SIZE, ACC_TENSION, D_CLOSING,
                                          D_CONTACT_F, D_CONTACTS, D_ELONGATION, D_RATE, D_SIZE, D_TENSION, advance_net,
                                          body_gravity, chaser_actuation, net_forces)
 from multibody.net_wrap import TowingNet
-from multibody.towing import TowedBodies
+from multibody.towing import HEALTH_EVERY_STEPS, TowedBodies, tow_failure_cause
 
 #: Layout of the run state ``clock``: net time (s), external impulse (3, N s) since the start.
 CLOCK_TIME, CLOCK_IMPULSE, CLOCK_SIZE = 0, 1, 4
@@ -312,11 +313,11 @@ def run_exudyn(model: FullNetModel) -> NetTowResult:
     forces = _Forces(state)
     sc, mbs = build_system(model, forces)
     sampler = _Sampler(state)
-    mbs.SetPostStepUserFunction(sampler)
+    watch = HealthWatch(tow_failure_cause(model.step))
+    mbs.SetPostStepUserFunction(checked_post_step(watch, sampler, HEALTH_EVERY_STEPS))
     settings = explicit_settings(model.step, model.n_steps)
     start = time.perf_counter()
-    with solver_chatter_to_stderr():
-        exu.SolveDynamic(mbs, settings, solverType=exu.DynamicSolverType.VelocityVerlet)
+    solve_checked(mbs, settings, exu.DynamicSolverType.VelocityVerlet, watch)
     wall = time.perf_counter() - start
     k = sampler.sample
     return NetTowResult(model, sampler.time[:k], sampler.q[:k], sampler.v[:k], sampler.node[:k], sampler.diag[:k],

@@ -38,10 +38,16 @@ from __future__ import annotations
 import numpy as np
 import exudyn as exu
 
+from multibody.health import HealthWatch
 from multibody.hinge import relative_rotation_vector_joint_frame
 from multibody.kernel import (BENDING_ELASTIC, rotation_matrix_from_rotation_vector, CONTACT_DISSIPATED, CONTACT_ELASTIC, THREAD_DISSIPATED,
                               THREAD_ELASTIC)
 from multibody.orbit import clohessy_wiltshire_potential
+
+
+#: Longest simulated time between two finite-state checks when the output rate is lower (s):
+#: a NaN spreads through the coupled state within a few steps and stays, so 1 ms loses nothing.
+HEALTH_INTERVAL_S = 1e-3
 
 
 def _sum_of_cross_products(a, b):
@@ -54,13 +60,16 @@ def _sum_of_cross_products(a, b):
 class Recorder:
     """Samples the running system from Exudyn's post-step hook."""
 
-    def __init__(self, assembly, system, progress=None, monitor=None):
+    def __init__(self, assembly, system, progress=None, monitor=None, health=None):
         self.assembly = assembly
         self.system = system
         self.progress = progress
         #: optional ``check(t, force_joint, moment_joint, joint_energies)`` called after each
         #: sample (structures.release.ReleaseMonitor switches failed joints off there)
         self.monitor = monitor
+        #: :class:`~multibody.health.HealthWatch`: finite state at every sample and at least every
+        #: HEALTH_INTERVAL_S, energy balance at every sample; a failed check stops the solver
+        self.health = health or HealthWatch(cause="")
         self.joint_active = np.ones(len(assembly.joints), bool)
         self._released_energy = 0.0
         solver = assembly.solver
@@ -68,6 +77,9 @@ class Recorder:
         self.output_interval = 1.0 / solver.output_rate
         self.net_interval = 1.0 / solver.net_output_rate
         self._next_output = self.output_interval
+        self._end_time = solver.n_steps * solver.step
+        self._health_every = max(1, int(HEALTH_INTERVAL_S / solver.step))
+        self._steps = 0
         self._next_net = self.net_interval
         self._last_output_time = 0.0
         mbs = system.mbs
@@ -84,22 +96,32 @@ class Recorder:
     # -- Exudyn hook -----------------------------------------------------------------
     def post_step(self, mbs, t):
         half = 0.5 * self.step
-        if t >= self._next_output - half:
+        self._steps += 1
+        if t >= self._next_output - half or t >= self._end_time - half:
+            # the last step is always sampled, so a run's series ends at its end time whatever the rate
             self.sample(t)
-            self._next_output += self.output_interval
-        return True
+            while self._next_output - half <= t:
+                self._next_output += self.output_interval
+        elif self._steps % self._health_every == 0:
+            data = mbs.systemData
+            self.health.state(t, data.GetODE2Coordinates(), data.GetODE2Coordinates_t())
+        return self.health.ok
 
     # -- sampling --------------------------------------------------------------------
     def sample(self, t):
         mbs = self.system.mbs
         q = mbs.systemData.GetODE2Coordinates()
         qt = mbs.systemData.GetODE2Coordinates_t()
+        if not self.health.state(t, q, qt):
+            return  # nothing recorded from a lost state; the run stops at this step
         row = {"time": t}
         x, v = self._net_state(q, qt)
         self._body_rows(row, q, qt, t)
         self._joint_rows(row)
         self._energy_rows(row, x, v)
         self._momentum_rows(row, x, v)
+        if not self.health.energy(t, row["energy_total"]):
+            return
         for key, value in row.items():
             self._rows.setdefault(key, []).append(np.asarray(value, float))
         if self.monitor is not None:

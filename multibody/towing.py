@@ -23,7 +23,8 @@ import numpy as np
 from exudyn.itemInterface import NodeRigidBodyRotVecLG, ObjectGenericODE2, ObjectRigidBody
 from scipy.spatial.transform import Rotation
 
-from multibody.impact import _object_state_index, explicit_settings, solver_chatter_to_stderr
+from multibody.health import HealthWatch
+from multibody.impact import _object_state_index, checked_post_step, explicit_settings, solve_checked
 from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import N_COORDINATES, ST_TENSION, body_forces, pack, sampled_state, twin_run
 
@@ -243,14 +244,25 @@ def run_exudyn(model: TowingModel) -> TowResult:
     forces = _TowForces(model)
     sc, mbs, nodes = build_towing_system(model, forces)
     sampler = _Sampler(forces, _object_state_index(mbs, nodes, [6, 6]), _sample_buffers(model))
-    mbs.SetPostStepUserFunction(sampler)
+    watch = HealthWatch(tow_failure_cause(model.step))
+    mbs.SetPostStepUserFunction(checked_post_step(watch, sampler, HEALTH_EVERY_STEPS))
     settings = explicit_settings(model.step, model.n_steps)
     start = time.perf_counter()
-    with solver_chatter_to_stderr():
-        exu.SolveDynamic(mbs, settings, solverType=exu.DynamicSolverType.VelocityVerlet)
+    solve_checked(mbs, settings, exu.DynamicSolverType.VelocityVerlet, watch)
     wall = time.perf_counter() - start
     times = model.start_time + model.step * model.every * np.arange(len(sampler.out_q))
     return TowResult(model, times, sampler.out_q, sampler.out_v, sampler.out_diag, wall)
+
+
+#: Steps between two finite-state checks of a tow: a NaN stays once it appears, and 10 steps
+#: keep the check below 1 % of a lower-order step (bench/bench_towing.py).
+HEALTH_EVERY_STEPS = 10
+
+
+def tow_failure_cause(step: float) -> str:
+    """Words for a failed tow (the connection point is implicit, so no single explicit limit applies)."""
+    return (f"at the step {step:g} s the bodies' rotation or the tethers lost stability: reduce simulation.step "
+            f"and check the tether stiffness and damping, the thrust and the initial rates for extreme values")
 
 
 def stable_step(model: TowingModel, safety: float = 0.5) -> float:

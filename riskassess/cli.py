@@ -7,7 +7,16 @@ import sys
 from pathlib import Path
 
 from riskassess.case import Case, CaseError, load_case
+from multibody.health import SimulationFailed
 from riskassess.results import MissingData
+from rich.markup import escape
+
+
+#: Exit codes (docs/outputs.md): 0 done; 1 a product after a finished run failed; 2 invalid input or
+#: refused output; 3 perceive: not observable; 4 approach: constraints not met; 5 the simulation
+#: failed its numerical health check; 6 the structural verdict is indeterminate (no evidence).
+EXIT_SIMULATION_FAILED = SimulationFailed.exit_code
+EXIT_INDETERMINATE = 6
 
 
 def _cmd_run(args) -> int:
@@ -30,7 +39,10 @@ def _cmd_run(args) -> int:
         print_summary(result.summary, result.run_dir)
         if result.structures is not None:
             print_verdict(result.structures)
-    return _products(result.run_dir, args.report, args.vtk, quiet=args.json)
+    status = _products(result.run_dir, args.report, args.vtk, quiet=args.json)
+    if result.structures is not None and result.structures.get("debris_state") == "indeterminate":
+        return EXIT_INDETERMINATE  # a script must not read "no verdict" as success
+    return status
 
 
 def _products(run_dir: Path, report: bool, vtk: bool, quiet: bool = False) -> int:
@@ -201,10 +213,11 @@ def _console():
 
 def print_verdict(verdict: dict) -> None:
     """The verdict table: location, criterion, peak demand, allowable, margin, fails?, released piece."""
-    from riskassess.tables import VERDICT_COLUMNS, piece_fate, verdict_rows
+    from riskassess.tables import STATE_TEXT, VERDICT_COLUMNS, debris_line, piece_fate, verdict_rows
 
     console = _console()
-    rows = [[("[red]FAIL[/red]" if r["fails"] else "pass") if c == "fails?" else r[c] for c in VERDICT_COLUMNS]
+    marked = {"fails": "[red]FAIL[/red]", "indeterminate": "[yellow]indeterminate[/yellow]"}
+    rows = [[marked.get(r["state"], STATE_TEXT[r["state"]]) if c == "fails?" else r[c] for c in VERDICT_COLUMNS]
             for r in verdict_rows(verdict)]
     right = {c: "right" for c in ("max demand", "at", "allowable", "margin", "likelihood")}
     console.print(_table(f"structural verdict (loads after {verdict['skip_initial_s']:g} s; range allowables "
@@ -214,7 +227,9 @@ def print_verdict(verdict: dict) -> None:
         console.print(f"released {'+'.join(p['bodies'])}: {piece_fate(p)}")
     if verdict["released_pieces"]:
         console.print("likelihoods of released locations are lower bounds: their loads after release are not known")
-    console.print("secondary debris: " + ("[red]YES[/red]" if verdict["secondary_debris"] else "none"))
+    line = escape(debris_line(verdict))
+    colour = {"debris": "red", "indeterminate": "yellow"}.get(verdict.get("debris_state"))
+    console.print(f"[{colour}]{line}[/{colour}]" if colour else line)
 
 
 def print_summary(summary: dict, run_dir: Path) -> None:
@@ -462,6 +477,14 @@ def main(argv=None) -> int:
     except CaseError as exc:
         print(f"error: invalid case\n{exc}", file=sys.stderr)
         return 2
+    except SimulationFailed as exc:
+        if getattr(args, "json", False):
+            print(json.dumps({"status": "failed", "debris_state": "indeterminate", "secondary_debris": None,
+                              "failure": {"time_s": exc.time, "quantity": exc.quantity, "cause": exc.cause}},
+                             indent=2))
+        print(f"error: {exc}\nThe run is recorded as failed; secondary debris: INDETERMINATE (nothing after "
+              f"the failure was simulated, so nothing can be called safe).", file=sys.stderr)
+        return EXIT_SIMULATION_FAILED
     except (ValueError, MissingData) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -19,7 +19,8 @@ from riskassess.assemble import model_inputs, weak_locations
 from riskassess.case import Case, load_case
 from riskassess.summary import run_summary
 from structures.release import ReleaseMonitor
-from structures.verdict import demand_series, structures_verdict
+from multibody.health import SimulationFailed
+from structures.verdict import INDETERMINATE, demand_series, structures_verdict
 
 
 @dataclass
@@ -55,7 +56,11 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
     monitor = None
     if locations and case.structures.release != "never":
         monitor = ReleaseMonitor(locations, simulation.system, case.structures.skip_initial, case.structures.release)
-    recorder = simulation.run(progress=progress, monitor=monitor)
+    try:
+        recorder = simulation.run(progress=progress, monitor=monitor)
+    except BaseException as exc:
+        record_failed_run(out, manifest, exc, simulation)
+        raise
     summary = finish_simulation(out, manifest, recorder, simulation, case)
     verdict = None
     if locations:
@@ -73,6 +78,20 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
         manifest["files"] += ["structures.json", "structures.npz"]
         results.atomic_write_json(out / "manifest.json", manifest)
     return RunOutput(out, summary, verdict)
+
+
+def record_failed_run(out: Path, manifest: dict, exc: BaseException, simulation: ImpactSimulation) -> None:
+    """The manifest of a run whose simulation stopped: status 'failed' (numerical health, see
+    :mod:`multibody.health`) or 'interrupted' / 'error', the verdict 'indeterminate', and the reason."""
+    if isinstance(exc, SimulationFailed):
+        status = "failed"
+    elif isinstance(exc, KeyboardInterrupt):
+        status = "interrupted"
+    else:
+        status = "error"
+    manifest.update(status=status, debris_state=INDETERMINATE, error=f"{type(exc).__name__}: {exc}",
+                    health=simulation.health.summary())
+    results.atomic_write_json(out / "manifest.json", manifest)
 
 
 def begin_run_folder(out: Path, case_path: Path, case: Case) -> dict:

@@ -110,5 +110,6 @@ def run_summary(recorder, assembly, case_name: str) -> dict:
         "debris_final_omega_body_rad_s": s["body_omega_body"][-1, 0].tolist(),
         "joints": joint_extremes(s, assembly.joints),
         "checks": conservation_checks(s, assembly.mean_motion),
+        "health": recorder.health.summary(),
         "paper_reference": PAPER_REFERENCE,
     }

@@ -31,8 +31,43 @@ def piece_text(piece: dict) -> str:
     return f"{'+'.join(piece['bodies'])}, {piece['mass_kg']:.4g} kg, {size} m, at {piece['release_time_s']:.3f} s"
 
 
+#: What the "fails?" column says for each location state (structures.verdict.location_state).
+STATE_TEXT = {"fails": "FAIL", "holds": "pass", "indeterminate": "indeterminate"}
+#: The one-line answer for each debris state (structures.verdict.DEBRIS_STATES).
+DEBRIS_TEXT = {"debris": "YES", "no_debris": "none", "indeterminate": "INDETERMINATE"}
+
+
+def debris_line(verdict: dict) -> str:
+    """'secondary debris: YES | none | INDETERMINATE (why)'; a verdict from before the three states
+    counts as its boolean."""
+    state = verdict.get("debris_state") or ("debris" if verdict["secondary_debris"] else "no_debris")
+    line = f"secondary debris: {DEBRIS_TEXT[state]}"
+    if state == "indeterminate":
+        line += " (" + "; ".join(verdict.get("indeterminate_reasons") or ["no evidence"]) + ")"
+    return line
+
+
+def location_state(loc: dict) -> str:
+    """'fails' | 'holds' | 'indeterminate' of a verdict row (older folders: from ``fails``)."""
+    return loc.get("state") or ("fails" if loc["fails"] else "holds")
+
+
+def _criterion_state(criterion: dict, state_of_location: str) -> str:
+    """A criterion row's state: its own exceedance, else its location's lack of evidence, else a pass."""
+    if criterion["fails"]:
+        return "fails"
+    if criterion["peak"] is None or state_of_location == "indeterminate":
+        return "indeterminate"
+    return "holds"
+
+
+def _or_dash(value, text) -> str:
+    return "-" if value is None else text(value)
+
+
 def verdict_rows(verdict: dict) -> list[dict]:
-    """One row per location and criterion, keyed by :data:`VERDICT_COLUMNS`; ``fails`` stays a bool.
+    """One row per location and criterion, keyed by :data:`VERDICT_COLUMNS`; ``fails`` stays a bool,
+    ``state`` is the location's state ('fails', 'holds', 'indeterminate').
 
     Likelihoods of released locations read '>= x': their loads after the release are not
     known, so the value is a lower bound.
@@ -45,12 +80,14 @@ def verdict_rows(verdict: dict) -> list[dict]:
             rows.append({
                 "location": loc["name"] if k == 0 else "",
                 "criterion": f"{name} ({c['mode']})",
-                "max demand": format_value(c["peak"], c["unit"]),
+                "max demand": _or_dash(c["peak"], lambda v: format_value(v, c["unit"])),
                 "at": f"{c['peak_time_s']:.3f} s" if c.get("peak_time_s") is not None else "-",
                 "allowable": format_allowable(*c["allowable"], c["unit"]),
-                "margin": format_margin(c["margin_of_safety"]),
+                "margin": _or_dash(c["margin_of_safety"], format_margin),
                 "fails": bool(c["fails"]),
-                "likelihood": (">= " if loc["released_at_s"] is not None else "") + f"{c['likelihood']:.0%}",
+                "state": _criterion_state(c, location_state(loc)),
+                "likelihood": _or_dash(c["likelihood"], lambda v: (">= " if loc["released_at_s"] is not None
+                                                                   else "") + f"{v:.0%}"),
                 "released piece": (piece_text(piece) if piece else "-") if k == 0 else "",
             })
     return rows

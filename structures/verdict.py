@@ -14,11 +14,64 @@ DEBRIS, NO_DEBRIS, INDETERMINATE = "debris", "no_debris", "indeterminate"
 DEBRIS_STATES = (DEBRIS, NO_DEBRIS, INDETERMINATE)
 
 
+#: A verdict needs at least this many judged samples (after ``skip_initial``): a peak read from
+#: fewer is not a load history (the reproducer of issue 20: end_time below skip_initial, or an
+#: output rate of 1e-300 Hz, judged nothing and said "pass").
+MIN_JUDGED_SAMPLES = 10
+#: Longest sample interval a verdict accepts (s). Joint loads are sampled, not averaged, so a
+#: coarser rate misses peaks: the penalty joints ring at hundreds of Hz and their single-sample
+#: peaks move by several per cent even between 1e-4 s steps (docs/model.md, "Step size").
+#: 100 Hz is a floor for a verdict, not a recommendation; the shipped cases sample at 1 kHz.
+MAX_SAMPLE_INTERVAL_S = 1e-2
+
+
+def evidence_gaps(time, contact_force_debris_lvlh, skip_until: float) -> list[str]:
+    """Why the recorded samples cannot support a structural verdict (empty when they can).
+
+    Parameters
+    ----------
+    time : (k,) float
+        Sample times (s).
+    contact_force_debris_lvlh : (k, nd, 3) float
+        Net contact force on each debris body (N, LVLH), averaged over each output interval.
+    skip_until : float
+        Loads before this time are not judged (s).
+    """
+    time = np.asarray(time, float)
+    judged = time >= skip_until
+    gaps = []
+    if judged.sum() < MIN_JUDGED_SAMPLES:
+        gaps.append(f"{int(judged.sum())} samples after skip_initial = {skip_until:g} s (the run ends at "
+                    f"{time[-1] if time.size else 0.0:g} s); a verdict needs at least {MIN_JUDGED_SAMPLES}")
+    if time.size > 1 and np.max(np.diff(time)) > MAX_SAMPLE_INTERVAL_S * (1 + 1e-9):
+        gaps.append(f"samples up to {np.max(np.diff(time)):.3g} s apart; a verdict needs at least "
+                    f"{1 / MAX_SAMPLE_INTERVAL_S:g} Hz (simulation.output_rate) to see the load peaks")
+    force = np.asarray(contact_force_debris_lvlh, float)
+    if judged.any() and not np.any(np.linalg.norm(force[judged], axis=-1) > 0.0):
+        gaps.append(f"no contact between the net and the debris after skip_initial = {skip_until:g} s: "
+                    f"the judged window holds no capture load")
+    return gaps
+
+
+def location_state(result: dict, gaps: list[str]) -> tuple[str, str | None]:
+    """('fails' | 'holds' | 'indeterminate', reason) of one judged location. An exceedance seen
+    is a failure whatever else is missing; a pass needs judged, finite loads and no evidence gap."""
+    if result["fails"] or result["released_at_s"] is not None:
+        return "fails", None
+    if not result["judged"]:
+        return "indeterminate", "; ".join(gaps) or "load samples that are not finite"
+    if gaps:
+        return "indeterminate", "; ".join(gaps)
+    return "holds", None
+
+
 def structures_verdict(locations: list[WeakLocation], series: dict, assembly, events: list[ReleaseEvent],
                        net_positions_final, skip_until: float, policy: str) -> dict:
-    """JSON-ready verdict: per location the criteria, margins, likelihood and any release."""
+    """JSON-ready verdict: per location the criteria, margins, likelihood and any release, and the
+    answer ``debris_state`` (:data:`DEBRIS_STATES`) with the reasons when it is indeterminate."""
     time = series["time"]
     released_at = {e.location: e for e in events}
+    gaps = evidence_gaps(time, series["contact_force_lvlh"][:, list(assembly.debris_indices)], skip_until)
     rows = []
     for loc in locations:
         result = assess(loc, time, series["joint_force_joint"][:, loc.joint], series["joint_moment_joint"][:, loc.joint],
@@ -29,10 +82,19 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
         # After a release the location carries nothing, so its peak (and likelihood) only
         # covers the loads up to the release: a lower bound of what the intact joint would see.
         result["likelihood_is_lower_bound"] = event is not None
+        result["state"], result["indeterminate_reason"] = location_state(result, gaps)
         rows.append(result)
     pieces = released_pieces(events, assembly, series, net_positions_final)
+    states = [r["state"] for r in rows]
+    if pieces or "fails" in states:
+        answer = DEBRIS
+    elif "indeterminate" in states:
+        answer = INDETERMINATE
+    else:
+        answer = NO_DEBRIS
     return {"skip_initial_s": skip_until, "release_policy": policy, "locations": rows, "released_pieces": pieces,
-            "secondary_debris": bool(pieces) or any(r["fails"] for r in rows)}
+            "debris_state": answer, "secondary_debris": {DEBRIS: True, NO_DEBRIS: False}.get(answer),
+            "indeterminate_reasons": sorted({r["indeterminate_reason"] for r in rows if r["indeterminate_reason"]})}
 
 
 def demand_series(locations: list[WeakLocation], series: dict) -> dict:

@@ -91,29 +91,38 @@ def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0
     judged = time >= skip_until
     result = {"name": location.name, "criteria": {}}
     for name, allowable in location.criteria().items():
-        demand = series[name]
-        k = int(np.argmax(np.where(judged, demand, -np.inf))) if judged.any() else 0
-        peak = float(demand[k]) if judged.any() else 0.0
-        threshold = allowable.threshold(policy)
-        result["criteria"][name] = {
-            "mode": CRITERION_MODE[name], "unit": CRITERION_UNIT[name],
-            "peak": peak, "peak_time_s": float(time[k]) if judged.any() else None,
-            "allowable": [allowable.low, allowable.high], "decisive_allowable": threshold,
-            "margin_of_safety": allowable.margin_of_safety(peak, policy),
-            "fails": bool(peak >= threshold), "likelihood": allowable.likelihood_of_failure(peak),
-            "first_exceedance_s": first_exceedance_time(time, demand, threshold, skip_until),
-        }
+        result["criteria"][name] = _criterion_verdict(name, allowable, time, series[name], judged, skip_until, policy)
     crit = result["criteria"].values()
     result["fails_normal"] = any(c["fails"] for c in crit if c["mode"] == "normal")
     result["fails_shear"] = any(c["fails"] for c in crit if c["mode"] == "shear")
     result["fails"] = result["fails_normal"] or result["fails_shear"]
-    result["likelihood"] = combined_likelihood([c["likelihood"] for c in crit])
+    # no judged sample, or a demand that is not a number: nothing to stand on (never a "pass")
+    result["judged"] = all(c["peak"] is not None for c in crit)
+    result["likelihood"] = combined_likelihood([c["likelihood"] for c in crit]) if result["judged"] else None
     times = [c["first_exceedance_s"] for c in crit if c["first_exceedance_s"] is not None]
     result["first_exceedance_s"] = min(times) if times else None
     if "von_mises_stress" in series:
-        vm = np.where(judged, series["von_mises_stress"], 0.0)
-        result["peak_von_mises_stress_Pa"] = float(vm.max()) if judged.any() else 0.0
+        vm = series["von_mises_stress"][judged]
+        result["peak_von_mises_stress_Pa"] = float(vm.max()) if vm.size and np.isfinite(vm).all() else None
     return result
+
+
+def _criterion_verdict(name, allowable, time, demand, judged, skip_until, policy) -> dict:
+    """One criterion over the judged samples; peak, margin and likelihood None without judged,
+    finite demands (the location's verdict is then indeterminate, never a pass)."""
+    values = demand[judged]
+    threshold = allowable.threshold(policy)
+    out = {"mode": CRITERION_MODE[name], "unit": CRITERION_UNIT[name], "allowable": [allowable.low, allowable.high],
+           "decisive_allowable": threshold,
+           "first_exceedance_s": first_exceedance_time(time, demand, threshold, skip_until)}
+    if not values.size or not np.isfinite(values).all():
+        return {**out, "peak": None, "peak_time_s": None, "margin_of_safety": None, "fails": False,
+                "likelihood": None}
+    k = int(np.flatnonzero(judged)[np.argmax(values)])
+    peak = float(demand[k])
+    return {**out, "peak": peak, "peak_time_s": float(time[k]),
+            "margin_of_safety": allowable.margin_of_safety(peak, policy), "fails": bool(peak >= threshold),
+            "likelihood": allowable.likelihood_of_failure(peak)}
 
 
 def exceeds_now(location: WeakLocation, force_joint, moment_joint, policy="low"):

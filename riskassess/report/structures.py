@@ -7,7 +7,7 @@ import numpy as np
 from riskassess.report.blocks import Figure, Note, Section, Table
 from riskassess.report.plotting import allowable_band, legend, mark_release, panels, shade_not_judged
 from riskassess.results import RunFolder
-from riskassess.tables import VERDICT_COLUMNS, format_margin, format_vector, verdict_rows
+from riskassess.tables import STATE_TEXT, VERDICT_COLUMNS, format_margin, format_vector, verdict_rows
 
 NOT_ASSESSED = ("Not assessed: the case declares no weak locations. Add [[structures.weak_locations]] to the case "
                 "(docs/case-format.md) and run it again to get failure verdicts and released pieces.")
@@ -24,9 +24,13 @@ def verdict_section(run: RunFolder) -> Section:
     verdict = run.structures  # MissingData names the file when a case with weak locations lacks it
     pieces = verdict["released_pieces"]
     failing = [loc["name"] for loc in verdict["locations"] if loc["fails"]]
-    if verdict["secondary_debris"]:
+    state = verdict.get("debris_state") or ("debris" if verdict["secondary_debris"] else "no_debris")
+    if state == "debris":
         headline = Note(f"SECONDARY DEBRIS: {len(pieces)} piece(s) released"
                         + (f"; failing locations: {', '.join(failing)}" if failing else ""), "alarm")
+    elif state == "indeterminate":
+        headline = Note("INDETERMINATE: the run gives no evidence for a verdict, so it cannot say that the capture "
+                        "is safe. " + "; ".join(verdict.get("indeterminate_reasons") or []), "alarm")
     else:
         headline = Note("No secondary debris: every weak location holds with its decisive allowable.", "info")
     blocks = [headline]
@@ -41,16 +45,25 @@ def verdict_section(run: RunFolder) -> Section:
              for p in pieces], "Released pieces (size: oriented bounding box of the piece's shapes)"))
     rows = verdict_rows(verdict)
     columns = [c for c in VERDICT_COLUMNS if c != "released piece"]
-    blocks.append(Table(columns, [[("FAIL" if r["fails"] else "pass") if c == "fails?" else r[c] for c in columns]
+    blocks.append(Table(columns, [[STATE_TEXT[r["state"]] if c == "fails?" else r[c] for c in columns]
                                   for r in rows],
                         f"Weak locations: peak demand after {verdict['skip_initial_s']:g} s against the allowable; "
                         f"range allowables decide at their '{verdict['release_policy']}' value. Margin of safety = "
                         f"allowable / demand - 1.",
-                        alarm_rows={k for k, r in enumerate(rows) if r["fails"]}, css_class="verdict"))
+                        alarm_rows={k for k, r in enumerate(rows) if r["state"] != "holds"}, css_class="verdict"))
     blocks.append(Note("Likelihood: probability of failure with the allowable uniformly distributed over its "
                        "range. For a released location it is a lower bound ('>='), because the joint carries "
                        "nothing after its release."))
     return Section("verdict", "Verdict: secondary debris", blocks)
+
+
+def _mpa(value) -> str:
+    """A stress (Pa) in MPa; '-' when the run judged none (indeterminate location)."""
+    return "-" if value is None else f"{value / 1e6:.4g}"
+
+
+def _margin(value) -> str:
+    return "-" if value is None else format_margin(value)
 
 
 def _locations_with(verdict: dict, criteria: set) -> list[dict]:
@@ -117,11 +130,9 @@ def stresses_section(run: RunFolder) -> Section:
         ax.set_ylabel("stress (MPa)")
         ax.set_title(f"{loc['name']} (joint {loc['joint']})")
         legend(ax)
-        rows.append([loc["name"], f"{loc['criteria']['normal_stress']['peak'] / 1e6:.4g}",
-                     f"{loc['criteria']['shear_stress']['peak'] / 1e6:.4g}",
-                     f"{loc.get('peak_von_mises_stress_Pa', float('nan')) / 1e6:.4g}",
-                     f"{format_margin(loc['criteria']['normal_stress']['margin_of_safety'])} / "
-                     f"{format_margin(loc['criteria']['shear_stress']['margin_of_safety'])}"])
+        normal, shear = loc["criteria"]["normal_stress"], loc["criteria"]["shear_stress"]
+        rows.append([loc["name"], _mpa(normal["peak"]), _mpa(shear["peak"]), _mpa(loc.get("peak_von_mises_stress_Pa")),
+                     f"{_margin(normal['margin_of_safety'])} / {_margin(shear['margin_of_safety'])}"])
     return Section("stresses", title, [
         Figure.from_matplotlib("fig-stresses", "Peak normal (axial + bending) and shear (torsion + transverse) "
                                "stress at each section, log axis, against the material's ultimate strength "
