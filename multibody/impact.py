@@ -384,6 +384,8 @@ class ImpactSimulation:
             if not self.health.ok:
                 raise self.health.failure
             solve_checked(mbs, settings, INTEGRATORS[self.assembly.solver.integrator][0], self.health)
+            if not self.health.finish():
+                raise self.health.failure
         finally:
             self.wall_time = time.perf_counter() - start
             recorder.finish(self.wall_time)

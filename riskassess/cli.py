@@ -25,6 +25,7 @@ def _cmd_run(args) -> int:
     from riskassess.pipeline import run_case
 
     case = load_case(args.case)  # fail fast on a bad case, before any output folder exists
+    _check_work(impact_estimate_of(case), args)
     out = Path(args.out) if args.out else Path("runs") / case.name
     end = case.simulation.end_time
     columns = [TextColumn("[bold]simulating[/bold] {task.fields[t]:.3f} / %.3g s" % end), BarColumn(),
@@ -43,6 +44,23 @@ def _cmd_run(args) -> int:
     if result.structures is not None and result.structures.get("debris_state") == "indeterminate":
         return EXIT_INDETERMINATE  # a script must not read "no verdict" as success
     return status
+
+
+def impact_estimate_of(case: Case):
+    from riskassess.estimate import impact_estimate
+
+    sim = case.simulation
+    return impact_estimate(sim.end_time, sim.step, case.net.nodes_per_side ** 2 + 4, len(case.target.bodies) + 1,
+                           sim.output_rate, sim.net_output_rate)
+
+
+def _check_work(estimate, args) -> None:
+    """Say what the simulation will cost; refuse above the limits unless --force (riskassess.estimate)."""
+    from riskassess.estimate import check_budget
+
+    check_budget(estimate, getattr(args, "force", False))
+    if not getattr(args, "json", False):
+        print(estimate.text(), file=sys.stderr)
 
 
 def _products(run_dir: Path, report: bool, vtk: bool, quiet: bool = False) -> int:
@@ -116,6 +134,7 @@ def _cmd_perceive(args) -> int:
     from riskassess.perceive import perceive_case
 
     case = load_case(args.case)
+    _check_work(impact_estimate_of(case), args)
     out = Path(args.out) if args.out else Path("runs") / f"{case.name}"
     with _progress_bar("perceive", args.json) as bar:
         task = bar.add_task("", total=None)
@@ -138,6 +157,7 @@ def _cmd_tow(args) -> int:
     from riskassess.towing_case import TowingCase
 
     case = load_model(args.case, TowingCase)
+    _check_work(tow_estimate_of(case), args)
     out = Path(args.out) if args.out else Path("runs") / case.name
     summary = tow_case(args.case, out, case=case)
     if args.json:
@@ -149,6 +169,16 @@ def _cmd_tow(args) -> int:
               f"slack while thrusting {summary['main_tether_slack_time_while_thrusting_s']:.2f} s; "
               f"{summary['wall_time_s']:.2f} s wall\nresults: {out}")
     return 0
+
+
+def tow_estimate_of(case):
+    from riskassess.estimate import tow_estimate
+
+    sim = case.simulation
+    if sim.model == "full-net":
+        net = case.full_net
+        return tow_estimate(sim.end_time, net.step, net.nodes_per_side ** 2 + 4, net.substeps)
+    return tow_estimate(sim.end_time - sim.start_time, sim.step)
 
 
 def _cmd_identify(args) -> int:
@@ -384,8 +414,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "track the tumbling debris by LiDAR, simulate the net collision, estimate mass and inertia",
                         "case file (TOML) with [perception] and [chaser]",
                         "print the estimates (mass_estimate, inertia_estimate, errors, timings) as JSON")
-    _case_command(sub, "tow", _cmd_tow, "lower-order towing run of a towing case (chaser, tethers, net-wrapped debris)",
-                  "towing case file (TOML), e.g. cases/zenit2_towing.toml", "print the summary as JSON")
+    tow = _case_command(sub, "tow", _cmd_tow,
+                        "lower-order towing run of a towing case (chaser, tethers, net-wrapped debris)",
+                        "towing case file (TOML), e.g. cases/zenit2_towing.toml", "print the summary as JSON")
+    tow.add_argument("--force", action="store_true", help="run even when the estimated work is above the limit")
     diagnose = sub.add_parser("diagnose", help="compare a simulated scenario with measured data, name the missing "
                                                "effect, fit it and report the prediction gain")
     diagnose.add_argument("case", help="diagnosis case file (TOML, kind tumbling_rigid or hinged_appendage)")
@@ -468,6 +500,8 @@ def _simulation_command(sub, name, func, help_text, case_help, json_help) -> Non
     parser = _case_command(sub, name, func, help_text, case_help, json_help)
     parser.add_argument("--report", action="store_true", help="also write report.html and report.pdf")
     parser.add_argument("--vtk", action="store_true", help="also export VTK files (RUN_DIR/vtk/impact.pvd)")
+    parser.add_argument("--force", action="store_true", help="run even when the estimated work is above the limit "
+                                                             "(1 h wall or 8 GB recorded; docs/outputs.md)")
 
 
 def main(argv=None) -> int:

@@ -47,7 +47,7 @@ from perception.shape import half_turn_symmetry_transforms, rotation_error
 from riskassess import results
 from riskassess.assemble import body_meshes_target_frame, model_inputs
 from riskassess.case import Case, CaseError, load_case
-from riskassess.pipeline import begin_run_folder, finish_simulation
+from riskassess.pipeline import begin_run_folder, finish_simulation, record_failed_run
 
 #: Scan points farther than this from the predicted debris surface are not registered to it (m):
 #: a frame's motion is predicted to ~1 cm; net threads sit decimetres to metres in front.
@@ -582,8 +582,12 @@ def perceive_case(case_path, out_dir, progress=None, case: Case | None = None) -
     collision = collision_case(case, scene.truth["com_target"], *state_at_zero, scene.spec.rate)
     inputs = model_inputs(collision, scene.base)
     simulation = ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
-    recorder = simulation.run(progress=(lambda t: progress("simulation", t, case.simulation.end_time))
-                              if progress else None)
+    try:
+        recorder = simulation.run(progress=(lambda t: progress("simulation", t, case.simulation.end_time))
+                                  if progress else None)
+    except BaseException as exc:
+        record_failed_run(out, manifest, exc, simulation)
+        raise
     finish_simulation(out, manifest, recorder, simulation, collision)
     assembly = simulation.assembly
     with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):

@@ -1,0 +1,93 @@
+"""What a simulation will cost, said before it starts, and refused above a limit unless forced.
+
+A stated cost model (not a calibration run): the figures are the project's own measurements on
+the 2-core machine CI uses, quiet (load < 1), and a run on a loaded or slower machine takes
+longer. They only need to be right within a factor of a few: their job is to stop a mistyped
+``end_time = 1e6`` (1e10 steps, years of wall time) before it starts, not to schedule work.
+
+* impact (``run``, ``assess``, ``perceive``, sweeps): 60 us per step for Exudyn's bodies, joints
+  and the recorder plus 0.33 us per net node and step (the numba kernel): the 35 x 35 reference
+  case measured 468 us per step, 381 ns per node-step (bench/bench_impact.py, issue 22);
+* lower-order tow: 15 us per step (0.97 s for 71 100 steps, docs/towing.md);
+* full-net tow: 0.11 us per net node and net sub-step (300 s of the 15 x 15 net, 229 nodes, with
+  20 sub-steps of each 2 ms step: 6.9e8 node sub-steps in 75.7 s, docs/towing.md).
+
+Memory: the impact recorder keeps every net snapshot (positions float64 and velocities float32,
+36 bytes per node) and about 1 kB per time-series sample and body.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+IMPACT_US_PER_STEP = 60.0
+IMPACT_US_PER_NODE_STEP = 0.33
+TOW_US_PER_STEP = 15.0
+FULL_NET_US_PER_NODE_SUBSTEP = 0.11
+
+#: Work refused without ``--force``: one hour of estimated wall time (a full reference impact is
+#: about 40 s; a 60 s impact of the full net about 5 min) or 8 GB of recorded data.
+LIMIT_WALL_S = 3600.0
+LIMIT_MEMORY_BYTES = 8e9
+#: Never started, even with ``--force``: beyond this the estimate itself says the run cannot finish.
+HARD_LIMIT_STEPS = 1e10
+
+
+class TooMuchWork(ValueError):
+    """The estimated work is above the limit; the message gives the estimate and how to go on."""
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """Steps, expected wall time (s) and recorded data (bytes) of one simulation."""
+
+    what: str
+    steps: float
+    wall_s: float
+    memory_bytes: float
+
+    def text(self) -> str:
+        return (f"estimate: {self.what}: {self.steps:.3g} steps, about {_duration(self.wall_s)} wall on one core "
+                f"of a quiet 2-core machine, {self.memory_bytes / 1e6:.3g} MB recorded")
+
+
+def _duration(seconds: float) -> str:
+    for unit, size in (("days", 86400.0), ("h", 3600.0), ("min", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.3g} {unit}"
+    return f"{seconds:.2g} s"
+
+
+def impact_estimate(end_time: float, step: float, n_nodes: int, n_bodies: int, output_rate: float,
+                    net_output_rate: float) -> Estimate:
+    """Cost of an impact run of ``end_time`` (s) at ``step`` (s) with ``n_nodes`` net nodes."""
+    steps = end_time / step
+    wall = steps * (IMPACT_US_PER_STEP + IMPACT_US_PER_NODE_STEP * n_nodes) * 1e-6
+    samples = min(end_time * output_rate, steps) + 2
+    snapshots = min(end_time * net_output_rate, steps) + 2
+    memory = samples * 1e3 * max(n_bodies, 1) + snapshots * 36.0 * n_nodes
+    return Estimate(f"{end_time:g} s of impact with {n_nodes} net nodes", steps, wall, memory)
+
+
+def tow_estimate(duration: float, step: float, net_nodes: int = 0, substeps: int = 1) -> Estimate:
+    """Cost of a tow of ``duration`` (s): lower-order (``net_nodes`` 0) or full-net."""
+    steps = duration / step
+    if net_nodes:
+        wall = steps * substeps * net_nodes * FULL_NET_US_PER_NODE_SUBSTEP * 1e-6
+        what = f"{duration:g} s of full-net tow with {net_nodes} nodes"
+    else:
+        wall = steps * TOW_US_PER_STEP * 1e-6
+        what = f"{duration:g} s of lower-order tow"
+    return Estimate(what, steps, wall, steps * 200.0)
+
+
+def check_budget(estimate: Estimate, force: bool) -> None:
+    """Raise :class:`TooMuchWork` when ``estimate`` is above the limits (the soft ones unless ``force``)."""
+    if estimate.steps > HARD_LIMIT_STEPS:
+        raise TooMuchWork(f"{estimate.text()}; more than {HARD_LIMIT_STEPS:.0e} steps is refused even with --force "
+                          f"(check simulation.end_time and simulation.step)")
+    if force:
+        return
+    if estimate.wall_s > LIMIT_WALL_S or estimate.memory_bytes > LIMIT_MEMORY_BYTES:
+        raise TooMuchWork(f"{estimate.text()}; above the limit of {_duration(LIMIT_WALL_S)} or "
+                          f"{LIMIT_MEMORY_BYTES / 1e9:g} GB: check simulation.end_time, simulation.step and the output "
+                          f"rates, or pass --force to run it anyway")
