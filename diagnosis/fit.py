@@ -135,6 +135,30 @@ class FitResult:
         return self.chi2_data + self.chi2_prior + self.n_parameters * np.log(self.n_data)
 
 
+#: Residual (sigmas) of a sample the model failed to predict (not finite) where a measurement
+#: exists: a diverged model must lose the fit, never look perfect (issue 20: a NaN residual used
+#: to count as 0).
+DIVERGED_RESIDUAL_SIGMA = 1e6
+
+
+def sample_residuals(model, measured, sigma) -> np.ndarray:
+    """(model - measured) / sigma per sample: 0 where the measurement is missing (NaN), and
+    :data:`DIVERGED_RESIDUAL_SIGMA` where it exists but the model's value is not finite."""
+    model, measured = np.asarray(model, float), np.asarray(measured, float)
+    present = np.isfinite(measured)
+    r = np.where(np.isfinite(model), (model - np.where(present, measured, 0.0)) / sigma, DIVERGED_RESIDUAL_SIGMA)
+    return np.where(present, r, 0.0)
+
+
+def first_unpredicted_time(times, model: dict, measured: dict) -> float | None:
+    """Time (s) of the first measured sample a model prediction leaves non-finite, or None."""
+    bad = np.zeros(len(times), bool)
+    for c, values in measured.items():
+        if c in model:
+            bad |= np.isfinite(values) & ~np.isfinite(np.asarray(model[c], float))
+    return float(np.asarray(times)[np.argmax(bad)]) if bad.any() else None
+
+
 class CandidateFit:
     """Fit of the nominal model (``effect`` None) or nominal + one effect to a :class:`Problem`."""
 
@@ -198,9 +222,8 @@ class CandidateFit:
     def residuals(self, z, use) -> np.ndarray:
         p = self.problem
         model = aligned_quaternion(self.predict(z, p.time[use]), {c: v[use] for c, v in p.values.items()})
-        parts = [((model[c] - v[use]) / p.noise[c]) for c, v in p.values.items()]
-        r = np.concatenate(parts)
-        return np.r_[np.where(np.isfinite(r), r, 0.0), z[:len(p.nominal_center)]]
+        r = np.concatenate([sample_residuals(model[c], v[use], p.noise[c]) for c, v in p.values.items()])
+        return np.r_[r, z[:len(p.nominal_center)]]
 
     def _fun(self, z, use):
         f = self.residuals(z, use)

@@ -20,7 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from diagnosis.effects import CATALOG
-from diagnosis.fit import CandidateFit, FitResult, Problem, prediction, step_error_sigma
+from diagnosis.fit import (CandidateFit, FitResult, Problem, first_unpredicted_time, prediction,
+                           step_error_sigma)
+from multibody.health import SimulationFailed
 from diagnosis.hint import describe_terms, library, sparse_terms
 from diagnosis.measured import read_measured
 from diagnosis.observation import CHANNELS, scenario_channels
@@ -161,6 +163,18 @@ def _towing_initial(raw: dict, case_path: Path, value: dict) -> None:
     raw["towing"] = str((case_path.parent / raw["towing"]).resolve())
 
 
+def _without_diverged(problem: Problem, fits: dict, predictions: dict):
+    """Drop candidates whose fitted prediction is not finite where data exist (they cannot be the
+    cause); a nominal model that diverges stops the diagnosis (:class:`SimulationFailed`)."""
+    diverged = {k: t for k, pred in predictions.items()
+                if (t := first_unpredicted_time(problem.time, pred, problem.values)) is not None}
+    if "nominal" in diverged:
+        raise SimulationFailed(diverged["nominal"], "the nominal model's prediction is not finite",
+                               "the scenario's own simulation diverges: check the case's parameters and step")
+    keep = [k for k in fits if k not in diverged]
+    return {k: fits[k] for k in keep}, {k: predictions[k] for k in keep}, diverged
+
+
 def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = None, workers: int = WORKERS,
                   progress=None, candidates: list[str] | None = None, figures: bool = True) -> dict:
     """Run the diagnosis; returns the answer (also written to ``diagnosis.json``). ``candidates``: the
@@ -180,6 +194,7 @@ def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = N
     fitted = [k for k in CATALOG if k not in not_applicable and (candidates is None or k in candidates)]
     fits = fit_candidates(problem, fitted, workers, progress)
     predictions = {k: prediction(problem, CATALOG.get(k), f, problem.time) for k, f in fits.items()}
+    fits, predictions, diverged = _without_diverged(problem, fits, predictions)
     step_errors = {k: step_error_sigma(problem, CATALOG.get(k), f, predictions[k]) for k, f in fits.items()}
     scores = score(problem, predictions, step_errors)
     decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms)
@@ -195,6 +210,7 @@ def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = N
         "rmse_before": rmse_before, "rmse_after": rmse_after, "gain_percent": gain,
         "rmse_case_as_given": None, "candidates": _candidate_rows(fits, scores, decision),
         "not_applicable": not_applicable,
+        "diverged": {k: f"prediction not finite from t = {t:g} s" for k, t in diverged.items()},
         "nominal": {"bic": fits["nominal"].bic, "train_rms_sigma": scores["nominal"]["train_rms_sigma"],
                     "holdout_rms_sigma": scores["nominal"]["holdout_rms_sigma"], "fit_seconds": fits["nominal"].seconds},
         "channels": {"used": problem.channels, "unknown": measured.unknown,
