@@ -58,6 +58,10 @@ class SimulationFailed(RuntimeError):
         self.cause = cause
         super().__init__(f"simulation failed at t = {self.time:.6g} s: {quantity}; {cause}")
 
+    def __reduce__(self):
+        # sent back from sweep worker processes: rebuild from the three fields, not from the message
+        return type(self), (self.time, self.quantity, self.cause)
+
 
 def stable_step_estimate(stiffness: float, mass: float) -> float:
     """Largest explicit step (s) that resolves a spring ``stiffness`` (N/m) on a ``mass`` (kg).

@@ -23,6 +23,14 @@ def test_check_finite_names_the_first_bad_entry():
     assert info.value.time == 0.1 and info.value.exit_code == 5
 
 
+def test_failure_survives_pickling():
+    """Sweep workers send it back to the scheduler process."""
+    import pickle
+    failure = pickle.loads(pickle.dumps(SimulationFailed(0.25, "state is not finite", "step too large")))
+    assert (failure.time, failure.quantity, failure.cause) == (0.25, "state is not finite", "step too large")
+    assert str(failure) == "simulation failed at t = 0.25 s: state is not finite; step too large"
+
+
 def test_energy_drift_is_relative_to_the_reference():
     assert energy_drift(103.0, 100.0, 60.0) == pytest.approx(0.05)
     assert energy_drift(np.nan, 100.0, 60.0) == math.inf
