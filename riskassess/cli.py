@@ -284,7 +284,8 @@ def _cmd_sweep(args) -> int:
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
     from riskassess.sweep.envelope import envelope_statement
-    from riskassess.sweep.products import PRODUCTS, check_products, products_dir, write_sweep_products
+    from riskassess.sweep.products import (PRODUCTS, check_products, check_products_at, products_dir,
+                                           write_sweep_products)
     from riskassess.sweep.runner import UNKNOWN_RUNS_EXIT, run_sweep, validate_runs
     from riskassess.sweep.spec import check_options, check_sweep, parse_uncertain, parse_vary, run_specs
     from riskassess.sweep.store import ResultStore, default_store_path
@@ -298,14 +299,18 @@ def _cmd_sweep(args) -> int:
     validated = validate_runs(args.case, Path(args.case).read_text(), specs)  # before the store exists
     if not args.json:
         print(f"sweep: {validated}", file=sys.stderr)
-    store = ResultStore(Path(args.store) if args.store else default_store_path(case.name))
+    store_path = Path(args.store) if args.store else default_store_path(case.name)
+    products = PRODUCTS[:2] if args.no_pdf else PRODUCTS
+    if not store_path.exists():
+        check_products_at(store_path, {}, products)   # a new store owns no file yet: refuse before making it
+    store = ResultStore(store_path)
     arguments = [f"--vary {v}" for v in args.vary] + [f"--uncertain {u}" for u in args.uncertain] + (
         [f"--monte-carlo {args.monte_carlo}", f"--seed {args.seed}"] if args.uncertain else [])
     columns = [TextColumn("[bold]sweep[/bold] done {task.fields[done]}, failed {task.fields[failed]}, "
                           "remaining {task.fields[remaining]}"), BarColumn(), TimeElapsedColumn(), TextColumn("ETA"),
                TimeRemainingColumn()]
     try:
-        check_products(store, PRODUCTS[:2] if args.no_pdf else PRODUCTS)   # no run before a refusal
+        check_products(store, products)   # no run before a refusal
         with Progress(*columns, disable=args.json or not sys.stderr.isatty()) as bar:
             task = bar.add_task("sweep", total=None, done=0, failed=0, remaining="?")
 

@@ -55,15 +55,19 @@ def _owned(store: ResultStore) -> dict[str, list[str]]:
 
 def check_products(store: ResultStore, names=PRODUCTS) -> Path:
     """The products folder, after checking that no product path holds a file the store did not write."""
-    folder = products_dir(store.path)
-    owned = _owned(store)
+    return check_products_at(store.path, _owned(store), names)
+
+
+def check_products_at(store_path: Path, owned: dict[str, list[str]], names=PRODUCTS) -> Path:
+    """:func:`check_products` for a store that may not exist yet (``owned`` then empty)."""
+    folder = products_dir(store_path)
     for name in names:
         path = folder / name
         if path.is_symlink() or (path.exists() and not path.is_file()):
             raise ProductConflict(f"{path}: not a regular file; the sweep's {name} would replace it (move it, or "
                                   f"give another --store)")
         if path.exists() and _sha256(path.read_bytes()) not in owned.get(name, []):
-            raise ProductConflict(f"{path}: exists and was not written for the store {store.path}; it is left "
+            raise ProductConflict(f"{path}: exists and was not written for the store {store_path}; it is left "
                                   f"as it is (move it, or give another --store)")
     return folder
 
