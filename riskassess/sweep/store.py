@@ -151,7 +151,8 @@ class _WriterLock:
         try:
             fcntl.flock(self.file, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            holder = self.file.read().strip().replace("\n", ", ") or "unknown process"
+            lines = [line for line in self.file.read().splitlines() if line and line != LOCK_MARK]
+            holder = ", ".join(lines) or "holder not written yet"
             self.file.close()
             raise StoreLocked(f"{store_path}: another sweep is writing to this store ({holder}); wait for it to "
                               f"end, or give another --store") from None

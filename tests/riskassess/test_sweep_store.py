@@ -9,6 +9,7 @@ import sys
 import pytest
 
 from riskassess.cli import main
+from tests.riskassess.conftest import CASES
 from riskassess.sweep.spec import RunSpec, run_id
 from riskassess.sweep.store import (APPLICATION_ID, SCHEMA_VERSION, ResultStore, StoreError, StoreLocked,
                                     check_store_file)
@@ -157,7 +158,7 @@ def test_schema_1_store_is_read_and_migrated(tmp_path):
     assert check_store_file(path) == SCHEMA_VERSION
 
 
-def test_second_writer_is_refused_naming_the_holder(store_path):
+def test_second_writer_is_refused_naming_the_holder(store_path, capsys):
     """Another process holds the store: the message names its pid; after it ends, the lock is free."""
     holder = subprocess.Popen(
         [sys.executable, "-c", "import sys, time; from riskassess.sweep.store import ResultStore; "
@@ -167,6 +168,10 @@ def test_second_writer_is_refused_naming_the_holder(store_path):
         assert holder.stdout.readline().strip() == "ready"
         with pytest.raises(StoreLocked, match=f"another sweep is writing to this store.*pid {holder.pid}"):
             ResultStore(store_path)
+        argv = ["sweep", str(CASES / "envisat_small.toml"), "--vary", "launch.velocity=12:20:2", "--store",
+                str(store_path)]
+        assert main(argv) == 2                                  # the second sweep of the issue's reproducer
+        assert f"another sweep is writing to this store (pid {holder.pid}, host " in capsys.readouterr().err
         with ResultStore.open_readonly(store_path) as store:   # readers are not locked out
             assert len(store.rows()) == 2
     finally:
