@@ -17,7 +17,7 @@ interpolation of the largest utilization (peak demand over decisive allowable) t
 Unknown runs are never safe. A run that failed (diverged, or any other error), whose verdict
 is indeterminate, or that is still pending counts as a run *with* debris in the bound:
 with u unknown runs, a value is safe when its n known runs have no debris and
-:math:`B^{-1}(1 - c;\; n,\; u + 1) \ge R`, a bound that holds whatever the unknown runs
+:math:`B^{-1}(1 - c;\\; n,\\; u + 1) \\ge R`, a bound that holds whatever the unknown runs
 would have given; deterministically, a value with any unknown run is not safe. Every value
 with a run is a point, so the limit never steps over a value whose runs all failed.
 """

@@ -9,10 +9,10 @@ import sys
 import pytest
 
 from riskassess.cli import main
-from tests.riskassess.conftest import CASES
 from riskassess.sweep.spec import RunSpec, run_id
 from riskassess.sweep.store import (APPLICATION_ID, SCHEMA_VERSION, ResultStore, StoreError, StoreLocked,
                                     check_store_file)
+from tests.riskassess.conftest import CASES
 
 CASE_TEXT = "name = 'hand_made'\n"
 
@@ -161,8 +161,8 @@ def test_schema_1_store_is_read_and_migrated(tmp_path):
 def test_second_writer_is_refused_naming_the_holder(store_path, capsys):
     """Another process holds the store: the message names its pid; after it ends, the lock is free."""
     holder = subprocess.Popen(
-        [sys.executable, "-c", "import sys, time; from riskassess.sweep.store import ResultStore; "
-                               f"s = ResultStore({str(store_path)!r}); print('ready', flush=True); time.sleep(60)"],
+        [sys.executable, "-c", ("import sys, time; from riskassess.sweep.store import ResultStore; "
+                                f"s = ResultStore({str(store_path)!r}); print('ready', flush=True); time.sleep(60)")],
         stdout=subprocess.PIPE, text=True)
     try:
         assert holder.stdout.readline().strip() == "ready"
