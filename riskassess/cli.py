@@ -326,45 +326,61 @@ def _cmd_approach(args) -> int:
 
 
 def _cmd_sweep(args) -> int:
-    from riskassess.sweep.runner import run_sweep, validate_runs, write_sweep_products
-    from riskassess.sweep.spec import parse_uncertain, parse_vary, run_specs
-    from riskassess.sweep.store import ResultStore
-
-    case = load_case(args.case)  # a bad base case fails before any worker starts
-    specs = run_specs([parse_vary(v) for v in args.vary], [parse_uncertain(u) for u in args.uncertain],
-                      args.monte_carlo, args.seed)
-    validate_runs(args.case, Path(args.case).read_text(), specs)  # every run's case, before the store exists
-    store = ResultStore(Path(args.store) if args.store else Path("sweeps") / case.name / "results.sqlite")
-    arguments = [f"--vary {v}" for v in args.vary] + [f"--uncertain {u}" for u in args.uncertain] + (
-        [f"--monte-carlo {args.monte_carlo}", f"--seed {args.seed}"] if args.uncertain else [])
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
+    from riskassess.sweep.envelope import envelope_statement
+    from riskassess.sweep.products import (PRODUCTS, check_products, check_products_at, products_dir,
+                                           write_sweep_products)
+    from riskassess.sweep.runner import UNKNOWN_RUNS_EXIT, run_sweep, validate_runs
+    from riskassess.sweep.spec import check_options, check_sweep, parse_uncertain, parse_vary, run_specs
+    from riskassess.sweep.store import ResultStore, default_store_path
+
+    # every option checked before any work
+    check_options(args.workers, args.confidence, args.reliability)
+    case = load_case(args.case)  # a bad base case fails before any worker starts
+    vary, uncertain = [parse_vary(v) for v in args.vary], [parse_uncertain(u) for u in args.uncertain]
+    check_sweep(vary, uncertain, args.monte_carlo, args.seed, force=args.force)
+    specs = run_specs(vary, uncertain, args.monte_carlo, args.seed)
+    validated = validate_runs(args.case, Path(args.case).read_text(), specs)  # before the store exists
+    if not args.json:
+        print(f"sweep: {validated}", file=sys.stderr)
+    store_path = Path(args.store) if args.store else default_store_path(case.name)
+    products = PRODUCTS[:2] if args.no_pdf else PRODUCTS
+    if not store_path.exists():
+        check_products_at(store_path, {}, products)   # a new store owns no file yet: refuse before making it
+    store = ResultStore(store_path)
+    arguments = [f"--vary {v}" for v in args.vary] + [f"--uncertain {u}" for u in args.uncertain] + (
+        [f"--monte-carlo {args.monte_carlo}", f"--seed {args.seed}"] if args.uncertain else [])
     columns = [TextColumn("[bold]sweep[/bold] done {task.fields[done]}, failed {task.fields[failed]}, "
                           "remaining {task.fields[remaining]}"), BarColumn(), TimeElapsedColumn(), TextColumn("ETA"),
                TimeRemainingColumn()]
-    with Progress(*columns, disable=args.json or not sys.stderr.isatty()) as bar:
-        task = bar.add_task("sweep", total=None, done=0, failed=0, remaining="?")
+    try:
+        check_products(store, products)   # no run before a refusal
+        with Progress(*columns, disable=args.json or not sys.stderr.isatty()) as bar:
+            task = bar.add_task("sweep", total=None, done=0, failed=0, remaining="?")
 
-        def progress(done, failed, remaining):
-            bar.update(task, completed=done + failed, total=done + failed + remaining, done=done, failed=failed,
-                       remaining=remaining)
+            def progress(done, failed, remaining):
+                bar.update(task, completed=done + failed, total=done + failed + remaining, done=done, failed=failed,
+                           remaining=remaining)
 
-        outcome = run_sweep(args.case, specs, store, {"arguments": arguments, "created": _now()},
-                            scheduler=args.scheduler, n_workers=args.workers, retry_failed=args.retry_failed,
-                            keep_runs=args.keep_runs, progress=progress, validate=False)
-    env = write_sweep_products(store, args.confidence, args.reliability, pdf=not args.no_pdf)
-    from riskassess.sweep.envelope import envelope_statement
-
+            outcome = run_sweep(args.case, specs, store, {"arguments": arguments, "created": _now()},
+                                scheduler=args.scheduler, n_workers=args.workers, retry_failed=args.retry_failed,
+                                keep_runs=args.keep_runs, progress=progress, validate=False)
+        env = write_sweep_products(store, args.confidence, args.reliability, pdf=not args.no_pdf)
+    finally:
+        store.close()   # releases the writer lock
     if args.json:
         print(json.dumps({"store": str(store.path), "total": outcome.total, "skipped": outcome.skipped,
-                          "done": outcome.done, "failed": outcome.failed, "wall_s": outcome.wall_s,
-                          "envelope": env, "statement": envelope_statement(env)}, indent=2))
+                          "done": outcome.done, "failed": outcome.failed, "indeterminate": outcome.indeterminate,
+                          "wall_s": outcome.wall_s, "envelope": env, "statement": envelope_statement(env)}, indent=2))
     else:
-        print(f"sweep: {outcome.total} runs ({outcome.skipped} already in the store, {outcome.done} done now, "
-              f"{outcome.failed} failed) in {outcome.wall_s:.1f} s; store {store.path}")
+        print(f"sweep: {outcome.total} runs ({outcome.skipped} already in the store, {outcome.done} done now "
+              f"({outcome.indeterminate} of them indeterminate), {outcome.failed} failed) in {outcome.wall_s:.1f} s; "
+              f"store {store.path}")
         print(envelope_statement(env))
-        print(f"report: {store.path.parent / 'report.html'}")
-    return 0
+        print(f"report: {products_dir(store.path) / 'report.html'}")
+    # failed, indeterminate or pending runs: the envelope holds runs it cannot count as safe
+    return UNKNOWN_RUNS_EXIT if env["failed_runs"] + env["indeterminate_runs"] + env["pending_runs"] else 0
 
 
 def _now() -> str:
@@ -374,14 +390,18 @@ def _now() -> str:
 
 
 def _cmd_sweep_status(args) -> int:
+    """Read-only: SQLite mode=ro, no lock, nothing written to the store or beside it."""
+    from riskassess.sweep.envelope import run_status
     from riskassess.sweep.store import ResultStore
 
-    store = ResultStore.open_existing(args.store)
-    for r in store.rows():
+    with ResultStore.open_readonly(args.store) as store:
+        rows = store.rows()
+    for r in rows:
         values = " ".join(f"{k}={v:.6g}" for k, v in r["overrides"].items())
         line = f"{r['run_id']} {r['state']} {values}"
-        if r["state"] == "done" and r["result"]["secondary_debris"] is not None:
-            line += f" secondary_debris={'yes' if r['result']['secondary_debris'] else 'no'}"
+        status = run_status(r)
+        if status in ("debris", "no_debris", "indeterminate"):
+            line += " secondary_debris=" + {"debris": "yes", "no_debris": "no"}.get(status, status)
         if r["state"] == "failed":
             line += f" error={r['error_kind']}: {r['error'].splitlines()[0] if r['error'] else ''}"
         print(line)
@@ -453,7 +473,8 @@ def build_parser() -> argparse.ArgumentParser:
     vtk.add_argument("--out", help="output folder (default RUN_DIR/vtk)")
     vtk.add_argument("--every", type=int, default=1, help="export every N-th net snapshot (default 1: all)")
     vtk.set_defaults(func=_cmd_export_vtk)
-    sweep = sub.add_parser("sweep", help="run a grid / Monte Carlo of cases on Dask; results survive interruption")
+    sweep = sub.add_parser("sweep", help="run a grid / Monte Carlo of cases on Dask; results survive interruption; "
+                           "exit code 5 when runs failed, are indeterminate or pending")
     sweep.add_argument("case", help="base case file (TOML)")
     sweep.add_argument("--vary", action="append", default=[], metavar="KEY=START:STOP:N",
                        help="grid of a case key, N values with both ends (repeat for a cartesian grid)")
@@ -465,7 +486,8 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--seed", type=int, default=0, help="random seed of the Monte Carlo draws (default 0)")
     sweep.add_argument("--scheduler", help="address of a running Dask scheduler (default: a LocalCluster here)")
     sweep.add_argument("--workers", type=int, default=2, help="LocalCluster worker processes (default 2)")
-    sweep.add_argument("--store", help="results store (SQLite; default sweeps/<case name>/results.sqlite)")
+    sweep.add_argument("--store", help="results store (SQLite; default sweeps/<case name>/results.sqlite); the "
+                       "report goes beside a store named results.sqlite, else into STORE_STEM.products/")
     sweep.add_argument("--retry-failed", action="store_true", help="also re-run runs that failed in the run itself")
     sweep.add_argument("--keep-runs", metavar="DIR", help="keep every run folder under DIR/<run id>")
     sweep.add_argument("--confidence", type=float, default=0.95, help="confidence of the safe limit (default 0.95)")
@@ -473,8 +495,10 @@ def build_parser() -> argparse.ArgumentParser:
                        help="required P(no secondary debris) of the safe limit (default 0.9)")
     sweep.add_argument("--no-pdf", action="store_true", help="HTML report only")
     sweep.add_argument("--json", action="store_true", help="print outcome and envelope as JSON")
+    sweep.add_argument("--force", action="store_true", help="allow more than 100000 runs (at most 10 million)")
     sweep.set_defaults(func=_cmd_sweep)
-    status = sub.add_parser("sweep-status", help="list every run of a results store: id, state, inputs")
+    status = sub.add_parser("sweep-status", help="list every run of a results store: id, state, inputs "
+                            "(opens the store read-only)")
     status.add_argument("store", help="results store written by 'riskassess sweep'")
     status.set_defaults(func=_cmd_sweep_status)
     val = sub.add_parser("validate", help="check a case file and exit")

@@ -8,13 +8,19 @@ import numpy as np
 from riskassess.casedoc import key_unit
 from riskassess.report.blocks import Figure, Note, Section, Table
 from riskassess.report.plotting import legend, panels
-from riskassess.sweep.envelope import envelope, envelope_statement, is_probabilistic
+from riskassess.sweep.envelope import UNKNOWN, envelope, envelope_statement, is_probabilistic, run_status
+from structures.verdict import DEBRIS, NO_DEBRIS
+
+#: How the runs table shows a run's outcome.
+STATUS_TEXT = {DEBRIS: "YES", NO_DEBRIS: "no", "indeterminate": "INDETERMINATE", "failed": "-", "pending": "-",
+               "unassessed": "-"}
 
 
 def _by_value(rows: list[dict], key: str) -> dict[float, list[dict]]:
+    """Records of the runs with a known verdict (debris or no debris), by value of ``key``."""
     groups = defaultdict(list)
     for r in rows:
-        if r["state"] == "done" and r["result"]["secondary_debris"] is not None:
+        if run_status(r) in (DEBRIS, NO_DEBRIS):
             groups[r["overrides"][key]].append(r["result"])
     return dict(sorted(groups.items()))
 
@@ -72,22 +78,33 @@ def envelope_figure(rows: list[dict], env: dict, figure_id: str = "fig-envelope"
 def envelope_section(rows: list[dict], env: dict, other_keys=()) -> Section:
     """The envelope against ``env['key']``, plus one figure against each other varied key."""
     blocks = [Note(envelope_statement(env), "info" if env["deterministic_safe_limit"] is not None else "alarm")]
-    if env["points"]:
+    if any(p["runs"] for p in env["points"]):
         blocks.append(envelope_figure(rows, env))
         for k, key in enumerate(other_keys):
             blocks.append(envelope_figure(rows, envelope(rows, key, env["confidence"], env["reliability"]),
                                           f"fig-envelope-{k + 2}"))
+    if env["points"]:
         blocks.append(Table(
-            [env["key"], "runs", "with debris", f"P(no debris) lower bound ({env['confidence']:.0%})",
-             "safe", "max utilization", "max breakup likelihood"],
-            [[f"{p['value']:.4g}", str(p["runs"]), str(p["with_debris"]), f"{p['no_debris_lower_bound']:.3f}",
+            [env["key"], "runs", "with debris", "failed", "indeterminate", "pending",
+             f"P(no debris) lower bound ({env['confidence']:.0%})", "safe", "max utilization",
+             "max breakup likelihood"],
+            [[f"{p['value']:.4g}", str(p["runs"]), str(p["with_debris"]), str(p["failed_runs"]),
+              str(p["indeterminate_runs"]), str(p["pending_runs"]), f"{p['no_debris_lower_bound']:.3f}",
               "yes" if (p["safe"] if is_probabilistic(env) else p["deterministic_safe"]) else "NO",
-              f"{p['max_utilization']:.3f}", f"{p['max_breakup_likelihood']:.3f}"] for p in env["points"]],
-            "Envelope points", alarm_rows={k for k, p in enumerate(env["points"]) if p["with_debris"]}))
-    if env["failed_runs"] or env["pending_runs"]:
-        blocks.append(Note(f"{env['failed_runs']} failed and {env['pending_runs']} pending runs are not in the "
-                           f"envelope (see the runs table; re-run the sweep to finish them).", "warning"))
+              _number(p["max_utilization"]), _number(p["max_breakup_likelihood"])] for p in env["points"]],
+            "Envelope points (failed, indeterminate and pending runs count as runs with debris)",
+            alarm_rows={k for k, p in enumerate(env["points"]) if p["with_debris"] or p["unknown_runs"]}))
+    if any(env[f"{what}_runs"] for what in UNKNOWN):
+        blocks.append(Note(f"{env['failed_runs']} failed ({env['diverged_runs']} diverged), "
+                           f"{env['indeterminate_runs']} indeterminate and {env['pending_runs']} pending runs are "
+                           f"unknown: the envelope counts each as a run with secondary debris, never as safe (see "
+                           f"the runs table; --retry-failed re-runs failed runs, a re-run finishes pending ones).",
+                           "warning"))
     return Section("envelope", "Safe impact envelope", blocks)
+
+
+def _number(value) -> str:
+    return "-" if value is None else f"{value:.3f}"
 
 
 def runs_section(rows: list[dict]) -> Section:
@@ -95,11 +112,13 @@ def runs_section(rows: list[dict]) -> Section:
     table_rows = []
     for r in rows:
         result = r["result"] or {}
-        debris = result.get("secondary_debris")
-        table_rows.append([r["run_id"], *(f"{r['overrides'][k]:.5g}" for k in keys), r["state"],
-                           "-" if debris is None else ("YES" if debris else "no"),
+        status = run_status(r)
+        table_rows.append([r["run_id"], *(f"{r['overrides'][k]:.5g}" for k in keys),
+                           r["state"] + (f" ({r['error_kind']})" if r["state"] == "failed" else ""),
+                           STATUS_TEXT[status],
                            f"{result['peak_contact_force_N']:.4g}" if result else "-",
                            f"{result['wall_time_s']:.1f}" if result else "-", (r["error"] or "")[:120]])
     return Section("sweep-runs", "Runs", [Table(["run", *keys, "state", "secondary debris", "peak contact force (N)",
                                                   "wall time (s)", "error"], table_rows,
-                                                 alarm_rows={k for k, r in enumerate(rows) if r["state"] == "failed"})])
+                                                 alarm_rows={k for k, r in enumerate(rows)
+                                                             if run_status(r) in ("failed", "indeterminate")})])

@@ -13,6 +13,13 @@ no probability can be stated: the answer is then deterministic, and n >= ln(1-c)
 runs per value (29 for c = 0.95, R = 0.9) would be needed for the statement.
 Between the last safe and the first unsafe value the limit is also estimated by linear
 interpolation of the largest utilization (peak demand over decisive allowable) to 1.
+
+Unknown runs are never safe. A run that failed (diverged, or any other error), whose verdict
+is indeterminate, or that is still pending counts as a run *with* debris in the bound:
+with u unknown runs, a value is safe when its n known runs have no debris and
+:math:`B^{-1}(1 - c;\\; n,\\; u + 1) \\ge R`, a bound that holds whatever the unknown runs
+would have given; deterministically, a value with any unknown run is not safe. Every value
+with a run is a point, so the limit never steps over a value whose runs all failed.
 """
 from __future__ import annotations
 
@@ -22,7 +29,12 @@ from collections import defaultdict
 import numpy as np
 from scipy.stats import beta
 
+from riskassess.sweep.records import debris_state_of
+from structures.verdict import DEBRIS, NO_DEBRIS
+
 DEFAULT_KEY = "launch.velocity"
+#: Run outcomes that say nothing about debris; the envelope counts each as a run with debris.
+UNKNOWN = ("failed", "indeterminate", "pending")
 
 
 def no_debris_lower_bound(n: int, k: int, confidence: float) -> float:
@@ -44,28 +56,66 @@ def envelope_key(rows: list[dict]) -> str | None:
     return DEFAULT_KEY if DEFAULT_KEY in varied else (varied[0] if varied else None)
 
 
+def run_status(row: dict) -> str:
+    """``debris``, ``no_debris``, ``indeterminate``, ``failed``, ``pending``, or ``unassessed``
+    (done, in a case without weak locations: no verdict to count). A "no debris" record whose
+    evidence is not finite is ``indeterminate`` (:func:`~riskassess.sweep.records.debris_state_of`)."""
+    if row["state"] != "done":
+        return row["state"]
+    record = dict(row["result"] or {})
+    if row.get("debris_state"):
+        record["debris_state"] = row["debris_state"]
+    return debris_state_of(record) or "unassessed"
+
+
+def unknown_counts(rows: list[dict]) -> dict[str, int]:
+    """Runs the envelope cannot count as safe or unsafe: failed, indeterminate, pending."""
+    status = [run_status(r) for r in rows]
+    return {what: status.count(what) for what in UNKNOWN}
+
+
+def _finite_max(values) -> float | None:
+    finite = [v for v in values if v is not None and math.isfinite(v)]
+    return max(finite) if finite else None
+
+
+def _point(value: float, rows: list[dict], confidence: float, reliability: float) -> dict:
+    """One envelope point from the runs at ``value``; unknown runs count as runs with debris."""
+    status = [run_status(r) for r in rows]
+    known = [r["result"] for r, s in zip(rows, status) if s in (DEBRIS, NO_DEBRIS)]
+    n, k = len(known), status.count(DEBRIS)
+    unknown = {what: status.count(what) for what in UNKNOWN}
+    u = sum(unknown.values())
+    utilization = [_finite_max(loc["utilization"] for loc in r["locations"].values()) for r in known]
+    finite_u = [x for x in utilization if x is not None]
+    lower = no_debris_lower_bound(n + u, k + u, confidence)
+    return {"value": value, "runs": n, "with_debris": k, **{f"{what}_runs": c for what, c in unknown.items()},
+            "unknown_runs": u, "total_runs": n + u, "no_debris_lower_bound": lower,
+            "safe": n > 0 and k == 0 and lower >= reliability, "deterministic_safe": n > 0 and k == 0 and u == 0,
+            "max_utilization": max(finite_u) if finite_u else None,
+            "mean_utilization": float(np.mean(finite_u)) if finite_u else None,
+            "max_breakup_likelihood": _finite_max(r["breakup_likelihood"] for r in known)}
+
+
 def envelope(rows: list[dict], key: str | None = None, confidence: float = 0.95, reliability: float = 0.9) -> dict:
-    """Per value of ``key``: runs, debris count, bound, utilizations; and the safe limit."""
+    """Per value of ``key``: runs, debris count, unknown runs, bound, utilizations; and the safe limit.
+
+    Every value with a run is a point, including values whose runs all failed or are pending
+    (they are never safe, so the limit cannot step over them). Runs of a case without weak
+    locations (no verdict) are left out.
+    """
     key = key or envelope_key(rows)
-    done = [r for r in rows if r["state"] == "done" and r["result"]["secondary_debris"] is not None]
     groups = defaultdict(list)
-    for r in done:
-        groups[r["overrides"][key]].append(r["result"])
-    points = []
-    for value in sorted(groups):
-        results = groups[value]
-        n, k = len(results), sum(r["secondary_debris"] for r in results)
-        utilization = [max(loc["utilization"] for loc in r["locations"].values()) for r in results]
-        lower = no_debris_lower_bound(n, k, confidence)
-        points.append({"value": value, "runs": n, "with_debris": k, "no_debris_lower_bound": lower,
-                       "safe": k == 0 and lower >= reliability, "deterministic_safe": k == 0,
-                       "max_utilization": max(utilization), "mean_utilization": float(np.mean(utilization)),
-                       "max_breakup_likelihood": max(r["breakup_likelihood"] for r in results)})
+    for r in rows:
+        if run_status(r) != "unassessed":
+            groups[r["overrides"][key]].append(r)
+    points = [_point(value, groups[value], confidence, reliability) for value in sorted(groups)]
+    status = [run_status(r) for r in rows]
     return {"key": key, "confidence": confidence, "reliability": reliability, "points": points,
             "runs_needed_per_value": runs_needed(confidence, reliability),
             **_limits(points, "safe"), **{f"deterministic_{k}": v for k, v in _limits(points, "deterministic_safe").items()},
-            "failed_runs": sum(r["state"] == "failed" for r in rows),
-            "pending_runs": sum(r["state"] == "pending" for r in rows)}
+            **{f"{what}_runs": status.count(what) for what in UNKNOWN},
+            "diverged_runs": sum(r["state"] == "failed" and r.get("error_kind") == "diverged" for r in rows)}
 
 
 def _limits(points: list[dict], flag: str) -> dict:
@@ -78,7 +128,7 @@ def _limits(points: list[dict], flag: str) -> dict:
             break
         last_safe = p
     estimate = None
-    if last_safe and first_unsafe:
+    if last_safe and first_unsafe and None not in (last_safe["max_utilization"], first_unsafe["max_utilization"]):
         u0, u1 = last_safe["max_utilization"], first_unsafe["max_utilization"]
         v0, v1 = last_safe["value"], first_unsafe["value"]
         estimate = v0 + (1.0 - u0) * (v1 - v0) / (u1 - u0) if u1 > u0 and u0 <= 1.0 <= u1 else None
@@ -89,7 +139,7 @@ def _limits(points: list[dict], flag: str) -> dict:
 
 def is_probabilistic(env: dict) -> bool:
     """Enough runs at every value for the confidence statement."""
-    return bool(env["points"]) and min(p["runs"] for p in env["points"]) >= env["runs_needed_per_value"]
+    return bool(env["points"]) and min(p["total_runs"] for p in env["points"]) >= env["runs_needed_per_value"]
 
 
 def envelope_statement(env: dict) -> str:
@@ -109,11 +159,20 @@ def envelope_statement(env: dict) -> str:
     text = (f"Largest {key} {what}: {limit:.4g}" if limit is not None
             else f"No {key} of the sweep is safe ({what})")
     if first is not None:
-        text += f"; first unsafe value: {first:.4g}"
+        point = next(p for p in env["points"] if p["value"] == first)
+        if point["with_debris"] or not point["unknown_runs"]:
+            text += f"; first unsafe value: {first:.4g}"
+        else:
+            text += (f"; first value not shown safe: {first:.4g} ({point['unknown_runs']} of its "
+                     f"{point['total_runs']} runs unknown)")
     if interpolated is not None:
         text += f"; the largest utilization reaches 1 at about {interpolated:.4g} (linear interpolation)"
     if prefix:
         text += (f". Deterministic: {min(p['runs'] for p in env['points'])} run(s) per value; a statement at "
                  f"{env['confidence']:.0%} confidence needs {env['runs_needed_per_value']} debris-free runs per "
                  f"value (--monte-carlo {env['runs_needed_per_value']} with --uncertain inputs)")
+    if any(env[f"{what}_runs"] for what in UNKNOWN):
+        text += (f". Unknown runs, counted as runs with debris (never safe): {env['failed_runs']} failed "
+                 f"({env['diverged_runs']} diverged), {env['indeterminate_runs']} indeterminate, "
+                 f"{env['pending_runs']} pending")
     return text + "."

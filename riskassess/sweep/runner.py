@@ -8,8 +8,10 @@ sweep goes on.
 """
 from __future__ import annotations
 
+import itertools
 import json
 import logging
+import math
 import shutil
 import tempfile
 import time
@@ -17,12 +19,37 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from multibody.health import SimulationFailed
 from riskassess.case import CaseError, validate_case
+from riskassess.sweep.records import debris_state_of
 from riskassess.sweep.spec import RunSpec, SweepSpecError, case_with
 from riskassess.sweep.store import ResultStore
+from structures.verdict import INDETERMINATE
 
 #: Error types that come from the cluster, not from the run: a resume retries these runs.
 INFRASTRUCTURE_ERRORS = ("KilledWorker", "CommClosedError", "CancelledError", "TimeoutError", "FutureCancelledError")
+#: Validating one run's case costs about 36 ms (envisat_small, this machine); up to this many
+#: runs every run is validated before the sweep (about 7 s), above it a sample (validate_runs).
+VALIDATE_ALL_UP_TO = 200
+#: Exit code of a sweep that ended with failed, indeterminate or pending runs: the code of a
+#: failed single run, since the envelope has runs it cannot count as safe.
+UNKNOWN_RUNS_EXIT = SimulationFailed.exit_code
+
+
+class RunFailed(RuntimeError):
+    """A run's failure as it crosses from the worker to the client: ``kind`` and message.
+
+    :class:`multibody.health.SimulationFailed` itself does not survive pickling (its
+    constructor takes three arguments, its ``args`` hold one), so the worker sends this.
+    """
+
+    def __init__(self, kind: str, message: str):
+        super().__init__(kind, message)
+        self.kind = kind
+        self.message = message
+
+    def __str__(self) -> str:
+        return self.message
 
 
 @dataclass
@@ -32,13 +59,37 @@ class SweepOutcome:
     done: int
     failed: int
     wall_s: float
+    indeterminate: int = 0   # of ``done``: runs whose verdict is indeterminate
+
+
+def _ratio(peak, allowable) -> float:
+    """Peak over allowable; NaN when either is missing (an indeterminate verdict)."""
+    if peak is None or not allowable:
+        return math.nan
+    return peak / allowable
+
+
+def _location_record(loc: dict) -> dict:
+    criteria = loc["criteria"]
+    return {"fails": loc["fails"], "likelihood": loc["likelihood"], "released_at_s": loc["released_at_s"],
+            "utilization": max((_ratio(c["peak"], c["decisive_allowable"]) for c in criteria.values()),
+                               default=math.nan),
+            "min_margin_of_safety": min((c["margin_of_safety"] for c in criteria.values()
+                                         if c["margin_of_safety"] is not None), default=None),
+            "peaks": {name: c["peak"] for name, c in criteria.items()},
+            "units": {name: c["unit"] for name, c in criteria.items()}}
 
 
 def run_record(summary: dict, verdict: dict | None, overrides: dict) -> dict:
-    """What the store keeps of one run: inputs, verdict, margins, peak loads, wall time (SI)."""
+    """What the store keeps of one run: inputs, verdict, margins, peak loads, wall time (SI).
+
+    ``debris_state`` is the verdict's (``debris`` / ``no_debris`` / ``indeterminate``; None for
+    a case without weak locations) and ``secondary_debris`` the same as True / False / None.
+    """
     record = {
         "inputs": overrides,
-        "secondary_debris": None if verdict is None else bool(verdict["secondary_debris"]),
+        "secondary_debris": None,
+        "debris_state": None,
         "peak_contact_force_N": summary["peak_contact_force_N"]["value"],
         "peak_contact_moment_Nm": summary["peak_contact_moment_about_debris_com_Nm"]["value"],
         "joint_peak_moment_after_transient_Nm": {
@@ -53,30 +104,37 @@ def run_record(summary: dict, verdict: dict | None, overrides: dict) -> dict:
         return record
     survival = 1.0
     for loc in verdict["locations"]:
-        criteria = loc["criteria"]
-        record["locations"][loc["name"]] = {
-            "fails": loc["fails"], "likelihood": loc["likelihood"], "released_at_s": loc["released_at_s"],
-            "utilization": max(c["peak"] / c["decisive_allowable"] for c in criteria.values()),
-            "min_margin_of_safety": min(c["margin_of_safety"] for c in criteria.values()),
-            "peaks": {name: c["peak"] for name, c in criteria.items()},
-            "units": {name: c["unit"] for name, c in criteria.items()},
-        }
-        survival *= 1.0 - loc["likelihood"]
+        record["locations"][loc["name"]] = _location_record(loc)
+        survival *= 1.0 - (math.nan if loc["likelihood"] is None else loc["likelihood"])
     # independent locations: the run breaks up when any location fails
     record["breakup_likelihood"] = 1.0 - survival
     record["released_pieces"] = [{k: p[k] for k in ("location", "bodies", "mass_kg", "release_time_s",
                                                     "inside_net_at_end")} for p in verdict["released_pieces"]]
+    debris = verdict.get("secondary_debris")
+    record["secondary_debris"] = None if debris is None else bool(debris)
+    record["debris_state"] = verdict.get("debris_state")
+    # the stored state: the verdict's, and indeterminate when its evidence is not finite
+    record["debris_state"] = debris_state_of(record)
+    if record["debris_state"] == INDETERMINATE:
+        record["secondary_debris"] = None
     return record
 
 
 def simulate_run(case_path: str, case_text: str, overrides: dict, keep_dir: str | None = None) -> dict:
-    """One run of the sweep (runs on a worker): case + overrides -> record for the store."""
-    from riskassess.pipeline import run_case
+    """One run of the sweep (runs on a worker): case + overrides -> record for the store.
+
+    A simulation stopped by the numerical health checks raises :class:`RunFailed` of kind
+    ``diverged``, with the check's message.
+    """
+    from riskassess.pipeline import run_case  # the pipeline imports Exudyn: only on the worker
 
     case = validate_case(case_with(tomllib.loads(case_text), overrides), case_path)
     out = Path(keep_dir) if keep_dir else Path(tempfile.mkdtemp(prefix="riskassess-sweep-"))
     try:
-        result = run_case(case_path, out, case=case)
+        try:
+            result = run_case(case_path, out, case=case)
+        except SimulationFailed as exc:
+            raise RunFailed("diverged", f"SimulationFailed: {exc}") from None
         if keep_dir:
             (out / "overrides.json").write_text(json.dumps(overrides, indent=2) + "\n")
         return run_record(result.summary, result.structures, overrides)
@@ -85,11 +143,54 @@ def simulate_run(case_path: str, case_text: str, overrides: dict, keep_dir: str 
             shutil.rmtree(out, ignore_errors=True)
 
 
-def validate_runs(case_path: str, case_text: str, specs: list[RunSpec]) -> None:
-    """Every run's case must load before any runs: one message listing the bad ones."""
-    raw = tomllib.loads(case_text)
-    problems = []
+def failure_kind(exc: BaseException) -> str:
+    """``diverged``, ``infrastructure`` (a resume retries it) or ``simulation`` (any other error of the run)."""
+    if isinstance(exc, RunFailed):
+        return exc.kind
+    if isinstance(exc, SimulationFailed):
+        return "diverged"
+    return "infrastructure" if type(exc).__name__ in INFRASTRUCTURE_ERRORS else "simulation"
+
+
+def failure_message(exc: BaseException) -> str:
+    return str(exc) if isinstance(exc, RunFailed) else f"{type(exc).__name__}: {exc}"
+
+
+def validation_sample(specs: list[RunSpec], limit: int = VALIDATE_ALL_UP_TO) -> tuple[list[RunSpec], str]:
+    """The runs whose cases are validated before the sweep, and a sentence saying which.
+
+    Up to ``limit`` runs: all. Above: for each overridden key, the first run with each of its
+    distinct values, plus the runs at the corners of the grid (every key at its smallest or
+    largest value), so every value of every key is checked at least once. A combination of
+    values that only fails together is then found when its run starts, and recorded as a
+    failed run (never as safe).
+    """
+    if len(specs) <= limit:
+        return specs, f"all {len(specs)} runs validated"
+    keys = list(specs[0].overrides)
+    bounds = {k: (min(s.overrides[k] for s in specs), max(s.overrides[k] for s in specs)) for k in keys}
+    corners = {tuple(corner) for corner in itertools.product(*bounds.values())} if len(keys) <= 10 else set()
+    chosen, seen = {}, set()
     for spec in specs:
+        values = tuple(spec.overrides[k] for k in keys)
+        new = [(k, v) for k, v in zip(keys, values) if (k, v) not in seen]
+        if new or values in corners:
+            chosen[spec.run_id] = spec
+            seen.update(new)
+            corners.discard(values)
+    distinct = len(seen)
+    return list(chosen.values()), (f"{len(chosen)} of {len(specs)} runs validated before the sweep (each of the "
+                                   f"{distinct} distinct values of the {len(keys)} overridden keys at least once, "
+                                   f"and the corners of the grid); the others are validated when they run")
+
+
+def validate_runs(case_path: str, case_text: str, specs: list[RunSpec], limit: int = VALIDATE_ALL_UP_TO) -> str:
+    """The runs' cases must load before any run (:func:`validation_sample` says which are
+    checked): one message listing the bad ones. Returns the sentence of what was validated."""
+    raw = tomllib.loads(case_text)
+    sample, what = validation_sample(specs, limit)
+    problems = []
+    for spec in sample:
         try:
             validate_case(case_with(raw, spec.overrides), case_path)
         except KeyError as exc:
@@ -98,8 +199,9 @@ def validate_runs(case_path: str, case_text: str, specs: list[RunSpec]) -> None:
             problems.append(f"run {spec.run_id} {spec.overrides}:\n  {str(exc).replace(chr(10), chr(10) + '  ')}")
     if problems:
         more = f"\n... and {len(problems) - 5} more" if len(problems) > 5 else ""
-        raise SweepSpecError(f"{len(problems)} of {len(specs)} sweep runs give an invalid case:\n"
-                             + "\n".join(problems[:5]) + more)
+        raise SweepSpecError(f"{len(problems)} of {len(sample)} validated sweep runs give an invalid case "
+                             f"({what}):\n" + "\n".join(problems[:5]) + more)
+    return what
 
 
 def _client(scheduler: str | None, n_workers: int):
@@ -122,6 +224,8 @@ def run_sweep(case_path: str | Path, specs: list[RunSpec], store: ResultStore, d
     """
     from dask.distributed import as_completed
 
+    if n_workers < 1:
+        raise ValueError(f"n_workers must be >= 1. Got {n_workers} instead.")
     case_path = str(case_path)
     case_text = Path(case_path).read_text()
     if validate:
@@ -130,7 +234,7 @@ def run_sweep(case_path: str | Path, specs: list[RunSpec], store: ResultStore, d
     todo = store.to_run([s.run_id for s in specs], retry_failed)
     by_id = {s.run_id: s for s in specs}
     start = time.perf_counter()
-    done = failed = 0
+    done = failed = indeterminate = 0
     if progress:
         progress(done, failed, len(todo))
     if todo:
@@ -142,11 +246,12 @@ def run_sweep(case_path: str | Path, specs: list[RunSpec], store: ResultStore, d
             for future in as_completed(futures):
                 rid = futures[future]
                 try:
-                    store.write_done(rid, future.result())
+                    record = future.result()
+                    store.write_done(rid, record)
                     done += 1
+                    indeterminate += debris_state_of(record) == INDETERMINATE
                 except Exception as exc:  # noqa: BLE001 -- every failure is recorded, the sweep goes on
-                    kind = "infrastructure" if type(exc).__name__ in INFRASTRUCTURE_ERRORS else "simulation"
-                    store.write_failed(rid, f"{type(exc).__name__}: {exc}", kind)
+                    store.write_failed(rid, failure_message(exc), failure_kind(exc))
                     failed += 1
                 if progress:
                     progress(done, failed, len(todo) - done - failed)
@@ -154,32 +259,4 @@ def run_sweep(case_path: str | Path, specs: list[RunSpec], store: ResultStore, d
             client.close()
             if cluster is not None:
                 cluster.close()
-    return SweepOutcome(len(specs), len(specs) - len(todo), done, failed, time.perf_counter() - start)
-
-
-def write_sweep_products(store: ResultStore, confidence: float = 0.95, reliability: float = 0.9,
-                         pdf: bool = True) -> dict:
-    """envelope.json and report.html (+ .pdf) beside the store; returns the envelope."""
-    from riskassess import results
-    from riskassess.report.document import render_document, render_pdf
-    from riskassess.report.plotting import STYLE
-    from riskassess.report.sweep import envelope_section, runs_section
-    from riskassess.sweep.envelope import envelope
-
-    import matplotlib.pyplot as plt
-
-    rows = store.rows()
-    info = store.info()
-    env = envelope(rows, confidence=confidence, reliability=reliability)
-    folder = store.path.parent
-    results.atomic_write_json(folder / "envelope.json", env)
-    varied = [a.split(" ", 1)[1].split("=")[0] for a in info.get("arguments", []) if a.startswith("--vary ")]
-    with plt.rc_context(STYLE):
-        sections = [envelope_section(rows, env, [k for k in varied if k != env["key"]]), runs_section(rows)]
-    problems = [f"{env['pending_runs']} runs pending"] if env["pending_runs"] else []
-    html = render_document(f"Sweep: {Path(info.get('case_path', '?')).name}",
-                           " ".join(info.get("arguments", [])), folder, info.get("created", "-"), problems, sections)
-    results.atomic_write_bytes(folder / "report.html", html.encode("utf-8"))
-    if pdf:
-        results.atomic_write_bytes(folder / "report.pdf", render_pdf(html, folder)[0])
-    return env
+    return SweepOutcome(len(specs), len(specs) - len(todo), done, failed, time.perf_counter() - start, indeterminate)

@@ -16,6 +16,7 @@ import copy
 import hashlib
 import itertools
 import json
+import math
 import re
 from dataclasses import dataclass
 
@@ -28,6 +29,19 @@ DISTRIBUTIONS = {
     "lognormal": (("median", "sigma_log"), lambda rng, n, med, s: med * np.exp(rng.normal(0.0, s, n))),
     "triangular": (("low", "mode", "high"), lambda rng, n, a, c, b: rng.triangular(a, c, b, n)),
 }
+#: name -> check(params) -> problem or None: the parameter ranges each distribution accepts.
+DISTRIBUTION_CHECKS = {
+    "uniform": lambda a, b: None if a < b else "low < high",
+    "normal": lambda m, s: None if s >= 0 else "std >= 0",
+    "lognormal": lambda med, s: None if med > 0 and s >= 0 else "median > 0 and sigma_log >= 0",
+    "triangular": lambda a, c, b: None if a <= c <= b and a < b else "low <= mode <= high and low < high",
+}
+#: Runs of one sweep above which ``--force`` is needed: 100 000 runs of the smallest case
+#: (about 25 s each, docs/sweeps.md) are some 300 core-days, more than anyone asks by accident.
+MAX_RUNS = 100_000
+#: Runs of one sweep even with ``--force``: every run is a spec in memory and a row in the
+#: store (about 1 kB each), so 10 million is about 10 GB.
+HARD_MAX_RUNS = 10_000_000
 _TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[[^\]]+\])*)")
 
 
@@ -51,11 +65,14 @@ def parse_vary(text: str) -> tuple[str, np.ndarray]:
         if len(parts) != 3:
             raise ValueError
         start, stop, n = float(parts[0]), float(parts[1]), int(parts[2])
-        if n < 1:
+        if n < 1 or not (math.isfinite(start) and math.isfinite(stop)):
             raise ValueError
     except ValueError:
-        raise SweepSpecError(f"--vary {text!r}: expected KEY=START:STOP:N with numbers and N >= 1, "
+        raise SweepSpecError(f"--vary {text!r}: expected KEY=START:STOP:N with finite numbers and N >= 1, "
                              f"e.g. launch.velocity=10:30:5") from None
+    if n > HARD_MAX_RUNS:
+        raise SweepSpecError(f"--vary {text!r}: N must be <= {HARD_MAX_RUNS} (the most runs of one sweep). "
+                             f"Got {n} instead.")
     _check_key(key, "--vary", text)
     return key, np.linspace(start, stop, n)
 
@@ -75,6 +92,11 @@ def parse_uncertain(text: str) -> tuple[str, str, tuple]:
     if len(params) != len(DISTRIBUTIONS[name][0]):
         raise SweepSpecError(f"--uncertain {text!r}: {name} takes {len(DISTRIBUTIONS[name][0])} parameters "
                              f"({', '.join(DISTRIBUTIONS[name][0])}); got {len(params)}")
+    if not all(math.isfinite(p) for p in params):
+        raise SweepSpecError(f"--uncertain {text!r}: parameters must be finite numbers")
+    problem = DISTRIBUTION_CHECKS[name](*params)
+    if problem:
+        raise SweepSpecError(f"--uncertain {text!r}: {name}({', '.join(DISTRIBUTIONS[name][0])}) needs {problem}")
     _check_key(key, "--uncertain", text)
     return key, name, params
 
@@ -131,6 +153,46 @@ def run_id(overrides: dict) -> str:
     """Stable id of a run from its overrides (values to 12 significant digits)."""
     canonical = json.dumps({k: float(f"{v:.12g}") for k, v in sorted(overrides.items())}, sort_keys=True)
     return hashlib.sha1(canonical.encode()).hexdigest()[:12]
+
+
+def check_options(workers: int, confidence: float, reliability: float) -> None:
+    """``workers`` >= 1; ``confidence`` and ``reliability`` strictly between 0 and 1."""
+    if workers < 1:
+        raise SweepSpecError(f"--workers must be >= 1. Got {workers} instead.")
+    for name, value in (("confidence", confidence), ("reliability", reliability)):
+        if not 0.0 < value < 1.0:
+            raise SweepSpecError(f"--{name} must be between 0 and 1 (both excluded). Got {value} instead.")
+
+
+def check_sweep(vary: list[tuple[str, np.ndarray]], uncertain: list[tuple[str, str, tuple]] = (),
+                monte_carlo: int = 0, seed: int = 0, force: bool = False) -> int:
+    """Check a sweep definition before any work; returns its number of runs.
+
+    Each key at most once; ``--monte-carlo`` >= 0, and >= 1 exactly when there are uncertain
+    keys; something to vary; ``seed`` >= 0; at most :data:`MAX_RUNS` runs unless ``force``,
+    and never more than :data:`HARD_MAX_RUNS`.
+    """
+    keys = [key for key, _ in vary] + [key for key, _, _ in uncertain]
+    repeated = sorted({k for k in keys if keys.count(k) > 1})
+    if repeated:
+        raise SweepSpecError(f"each key may be varied or uncertain once; repeated: {', '.join(repeated)}")
+    if monte_carlo < 0:
+        raise SweepSpecError(f"--monte-carlo must be >= 0. Got {monte_carlo} instead.")
+    if uncertain and monte_carlo < 1:
+        raise SweepSpecError("--uncertain needs --monte-carlo N (samples per grid point, N >= 1)")
+    if monte_carlo and not uncertain:
+        raise SweepSpecError(f"--monte-carlo {monte_carlo} needs --uncertain keys: without them every sample "
+                             f"would be the same run")
+    if not keys:
+        raise SweepSpecError("nothing to sweep: give --vary KEY=START:STOP:N and/or --uncertain KEY=DIST(...)")
+    if seed < 0:
+        raise SweepSpecError(f"--seed must be >= 0. Got {seed} instead.")
+    total = math.prod(len(values) for _, values in vary) * max(monte_carlo, 1)
+    limit = HARD_MAX_RUNS if force else MAX_RUNS
+    if total > limit:
+        more = "" if force else f" without --force (at most {HARD_MAX_RUNS} with it)"
+        raise SweepSpecError(f"the sweep has {total} runs; at most {limit} are allowed{more}")
+    return total
 
 
 def run_specs(vary: list[tuple[str, np.ndarray]], uncertain: list[tuple[str, str, tuple]] = (),

@@ -12,7 +12,7 @@ import pytest
 from riskassess.cli import main
 from riskassess.sweep.runner import run_sweep, simulate_run
 from riskassess.sweep.spec import RunSpec, parse_vary, run_id, run_specs
-from riskassess.sweep.store import ResultStore
+from riskassess.sweep.store import ResultStore, StoreError
 from tests.riskassess.conftest import shortened_case
 
 #: 0.4 s of the reduced case: the net (3 m away) hits at 12-20 m/s and loads the joints.
@@ -56,7 +56,10 @@ def test_sweep_on_two_workers_equals_runs_one_by_one(short_case, tmp_path):
 def _done(store_path) -> dict:
     if not store_path.exists():
         return {}
-    store = ResultStore(store_path)
+    try:
+        store = ResultStore.open_readonly(store_path)   # read-only: the sweep holds the writer lock
+    except StoreError:
+        return {}                                        # created, not yet stamped
     try:
         return {r["run_id"]: r["finished"] for r in store.rows() if r["state"] == "done"}
     finally:
@@ -78,7 +81,7 @@ def test_killed_sweep_resumes_with_every_run_once(short_case, tmp_path, capsys):
         sweep.wait()
     assert 1 <= len(before) < 5, "the sweep should be killed part-way"
     assert main(["sweep", *args]) == 0
-    rows = ResultStore(store_path).rows()
+    rows = ResultStore.open_readonly(store_path).rows()
     assert len(rows) == 5 and len({r["run_id"] for r in rows}) == 5
     assert all(r["state"] == "done" and r["attempts"] == 1 for r in rows)   # each run finished exactly once
     assert {rid: _done(store_path)[rid] for rid in before} == before         # finished runs were not redone
@@ -112,5 +115,79 @@ def test_killing_a_worker_loses_no_run(short_case, tmp_path):
         os.kill(victim.process.process.pid, signal.SIGKILL)   # a worker dies while runs are queued
         thread.join(timeout=240)
     assert not thread.is_alive()
-    rows = ResultStore(store_path).rows()
+    rows = ResultStore.open_readonly(store_path).rows()
     assert outcome["result"].done == 4 and all(r["state"] == "done" for r in rows) and len(rows) == 4
+
+
+def test_diverged_run_is_unknown_never_safe(tmp_path, capsys):
+    """Issue 20 item 2: envisat_small for 0.6 s at step = 1e-2 gives NaN everywhere and was stored
+    as debris-free. Now it is a failed run of kind "diverged" (the health checks stop it) or,
+    where no check stopped it, a done run whose NaN verdict is indeterminate; either way the
+    envelope does not call that step safe, and the sweep exits 5."""
+    case = tmp_path / "small_06.toml"
+    case.write_text(shortened_case(0.6))
+    store_path = tmp_path / "sweep" / "results.sqlite"
+    argv = ["sweep", str(case), "--vary", "simulation.step=0.0001:0.01:2", "--vary", "simulation.output_rate=100:100:1",
+            "--store", str(store_path), "--workers", "1", "--no-pdf", "--json"]
+    assert main(argv) == 5
+    answer = json.loads(capsys.readouterr().out)
+    rows = {r["overrides"]["simulation.step"]: r for r in ResultStore.open_readonly(store_path).rows()}
+    nan_run = rows[0.01]
+    assert (nan_run["state"], nan_run["error_kind"]) == ("failed", "diverged") or \
+        (nan_run["state"], nan_run["debris_state"]) == ("done", "indeterminate")
+    assert rows[0.0001]["state"] == "done" and rows[0.0001]["debris_state"] in ("debris", "no_debris")
+    env = answer["envelope"]
+    assert env["key"] == "simulation.step" and not env["points"][1]["deterministic_safe"]
+    assert env["deterministic_safe_limit"] in (None, 0.0001)
+    assert env["failed_runs"] + env["indeterminate_runs"] == 1
+    assert "Unknown runs, counted as runs with debris (never safe)" in answer["statement"]
+    assert "nan" not in (store_path.parent / "envelope.json").read_text().lower()
+    assert "unknown: the envelope counts each as a run with secondary debris" in (store_path.parent / "report.html").read_text()
+    assert main(["sweep-status", str(store_path)]) == 0
+    status = capsys.readouterr().out
+    assert "secondary_debris=indeterminate" in status or "error=diverged: SimulationFailed" in status
+
+
+def test_simulation_failed_is_recorded_as_diverged(short_case, tmp_path, monkeypatch):
+    """A run stopped by the health checks (multibody.health.SimulationFailed) is a failed run of
+    kind "diverged" with the check's message; a re-run does not retry it unless --retry-failed."""
+    from dask.distributed import LocalCluster
+
+    import riskassess.pipeline
+    from multibody.health import SimulationFailed
+
+    def diverging(*args, **kwargs):
+        raise SimulationFailed(0.123, "state is not finite (entry 7)", "step too large; stable step ~ 2e-4 s")
+
+    monkeypatch.setattr(riskassess.pipeline, "run_case", diverging)
+    specs = run_specs([parse_vary("launch.velocity=12:12:1")])
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cluster, \
+            ResultStore(tmp_path / "results.sqlite") as store:   # in-process worker: it sees the patched pipeline
+        outcome = run_sweep(short_case, specs, store, {"arguments": []}, scheduler=cluster.scheduler_address)
+        assert (outcome.done, outcome.failed) == (0, 1)
+        [row] = store.rows()
+        assert (row["state"], row["error_kind"], row["debris_state"]) == ("failed", "diverged", None)
+        assert row["error"] == ("SimulationFailed: simulation failed at t = 0.123 s: state is not finite (entry 7); "
+                                "step too large; stable step ~ 2e-4 s")
+        again = run_sweep(short_case, specs, store, {"arguments": []}, scheduler=cluster.scheduler_address)
+        assert (again.skipped, again.failed) == (1, 0)
+
+
+def test_diverged_failure_survives_the_trip_from_a_worker_process(short_case, monkeypatch):
+    """SimulationFailed does not unpickle (three-argument constructor), so the worker sends
+    RunFailed("diverged", message), which does."""
+    import pickle
+
+    import riskassess.pipeline
+    from multibody.health import SimulationFailed
+    from riskassess.sweep.runner import RunFailed, failure_kind, failure_message
+
+    def diverging(*args, **kwargs):
+        raise SimulationFailed(0.5, "energy balance drift 0.3 > 0.05", "step too large")
+
+    monkeypatch.setattr(riskassess.pipeline, "run_case", diverging)
+    with pytest.raises(RunFailed) as caught:
+        simulate_run(str(short_case), short_case.read_text(), {"launch.velocity": 12.0})
+    travelled = pickle.loads(pickle.dumps(caught.value))
+    assert failure_kind(travelled) == "diverged"
+    assert failure_message(travelled) == "SimulationFailed: simulation failed at t = 0.5 s: energy balance drift 0.3 > 0.05; step too large"

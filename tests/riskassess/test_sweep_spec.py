@@ -1,10 +1,14 @@
 """Sweep definitions and the envelope statistics, without running simulations."""
+import json
+import time
 import tomllib
 
 import numpy as np
 import pytest
 
-from riskassess.sweep.envelope import envelope, no_debris_lower_bound, runs_needed
+from riskassess.cli import main
+from riskassess.sweep.envelope import envelope, envelope_statement, no_debris_lower_bound, runs_needed
+from riskassess.sweep.runner import VALIDATE_ALL_UP_TO, validate_runs, validation_sample
 from riskassess.sweep.spec import (SweepSpecError, case_with, parse_uncertain, parse_vary, run_id, run_specs)
 from tests.riskassess.conftest import CASES
 
@@ -92,3 +96,122 @@ def test_envelope_limit_and_interpolation():
     many = [_row(10, False, 0.5, m) for m in range(30)] + [_row(15, m == 0, 1.01, m) for m in range(30)]
     env = envelope(many)
     assert env["safe_limit"] == 10 and env["first_unsafe"] == 15
+
+
+# --- issue 20: failed and indeterminate runs are unknown, never safe (item 2, sweep part) ---
+
+def _known(v, debris, utilization=0.5, sample=0):
+    row = _row(v, debris, utilization, sample)
+    row["debris_state"] = "debris" if debris else "no_debris"
+    return row
+
+
+def _unknown(v, how, sample=0):
+    """A run at ``v`` that says nothing about debris: 'diverged', 'failed', 'pending' or 'indeterminate'."""
+    if how == "indeterminate":
+        return {**_known(v, False, sample=sample), "debris_state": "indeterminate",
+                "result": {"secondary_debris": None, "debris_state": "indeterminate", "breakup_likelihood": None,
+                           "locations": {"hinge": {"utilization": float("nan")}}}}
+    state = "pending" if how == "pending" else "failed"
+    return {"state": state, "overrides": {"launch.velocity": v}, "grid_index": int(v), "sample": sample,
+            "result": None, "debris_state": None, "error_kind": {"diverged": "diverged", "failed": "simulation"}.get(how),
+            "error": "SimulationFailed: simulation failed at t = 0.1 s" if how == "diverged" else None}
+
+
+def test_nan_grid_gives_no_safe_limit():
+    """Issue 20 item 2: a NaN grid gave a safe limit of "nan". Records of a diverged run that no
+    health check stopped (every load NaN, verdict "no debris") are indeterminate."""
+    nan = float("nan")
+    rows = [{"state": "done", "overrides": {"launch.velocity": v}, "grid_index": k, "sample": 0,
+             "result": {"secondary_debris": False, "peak_contact_force_N": nan, "breakup_likelihood": nan,
+                        "locations": {"hinge": {"utilization": nan, "likelihood": nan}}}}
+            for k, v in enumerate((10.0, 15.0, 20.0))]
+    env = envelope(rows)
+    assert env["safe_limit"] is None and env["deterministic_safe_limit"] is None
+    assert env["indeterminate_runs"] == 3 and [p["indeterminate_runs"] for p in env["points"]] == [1, 1, 1]
+    json.dumps(env, allow_nan=False)                       # no NaN anywhere in envelope.json
+    text = envelope_statement(env)
+    assert "No launch.velocity of the sweep is safe" in text and "nan" not in text.lower()
+    assert "3 indeterminate" in text
+
+
+def test_a_value_whose_runs_failed_stops_the_safe_limit():
+    """10 and 20 are debris-free, 15 diverged: the limit is 10, never 20 (the failed value is a point)."""
+    rows = [_known(10.0, False, 0.4), _unknown(15.0, "diverged"), _known(20.0, False, 0.6)]
+    env = envelope(rows)
+    assert [p["value"] for p in env["points"]] == [10.0, 15.0, 20.0]
+    assert env["deterministic_safe_limit"] == 10.0 and env["deterministic_first_unsafe"] == 15.0
+    assert env["deterministic_interpolated_limit"] is None   # no utilization known at 15
+    assert (env["failed_runs"], env["diverged_runs"]) == (1, 1)
+    text = envelope_statement(env)
+    assert "first value not shown safe: 15 (1 of its 1 runs unknown)" in text
+    assert "1 failed (1 diverged), 0 indeterminate, 0 pending" in text
+
+
+@pytest.mark.parametrize("how", ["diverged", "failed", "indeterminate", "pending"])
+def test_any_unknown_run_removes_the_deterministic_safe_claim(how):
+    rows = [_known(10.0, False), _known(10.0, False, sample=1), _unknown(10.0, how, sample=2)]
+    point = envelope(rows)["points"][0]
+    assert (point["runs"], point["unknown_runs"], point["total_runs"]) == (2, 1, 3)
+    assert not point["deterministic_safe"] and not point["safe"]
+
+
+def test_unknown_runs_count_as_debris_in_the_bound():
+    """The rule: safe when the known runs have no debris and the bound holds even if every
+    unknown run had made debris. 49 clean + 1 failed: B^-1(0.05; 49, 2) = 0.909 >= 0.9, safe;
+    29 clean + 1 failed: 0.851, not safe (29 clean runs alone would be: 0.05^(1/29) = 0.902)."""
+    enough = [_known(10.0, False, sample=m) for m in range(49)] + [_unknown(10.0, "diverged", sample=49)]
+    point = envelope(enough)["points"][0]
+    assert point["no_debris_lower_bound"] == pytest.approx(no_debris_lower_bound(50, 1, 0.95))
+    assert point["safe"] and not point["deterministic_safe"]
+    few = [_known(10.0, False, sample=m) for m in range(29)] + [_unknown(10.0, "indeterminate", sample=29)]
+    assert not envelope(few)["points"][0]["safe"]
+    assert envelope(few[:29])["points"][0]["safe"]
+
+
+# --- issue 20 item 7 (sweep part): options checked before any work ---
+
+@pytest.mark.parametrize("argv, message", [
+    (["--workers", "0"], "--workers must be >= 1. Got 0"),
+    (["--confidence", "1.5"], "--confidence must be between 0 and 1"),
+    (["--reliability", "0"], "--reliability must be between 0 and 1"),
+    (["--confidence", "nan"], "--confidence must be between 0 and 1"),
+    (["--monte-carlo", "-1"], "--monte-carlo must be >= 0"),
+    (["--monte-carlo", "3"], "needs --uncertain"),
+    (["--seed", "-1", "--monte-carlo", "2", "--uncertain", "contact.mu_kinetic=uniform(0.1,0.2)"], "--seed must be >= 0"),
+    (["--vary", "launch.velocity=10:30:10000000"], "the sweep has 10000000 runs; at most 100000"),
+    (["--vary", "launch.velocity=10:30:1000", "--vary", "contact.mu_kinetic=0.1:0.2:1000"], "1000000 runs"),
+    (["--vary", "launch.velocity=10:nan:3"], "finite numbers"),
+    (["--vary", "launch.velocity=10:30:3", "--vary", "launch.velocity=1:2:2"], "repeated: launch.velocity"),
+    (["--monte-carlo", "2", "--uncertain", "contact.mu_kinetic=normal(0.1,-1)"], "needs std >= 0"),
+    (["--monte-carlo", "2", "--uncertain", "contact.mu_kinetic=uniform(0.2,0.1)"], "needs low < high"),
+    ([], "nothing to sweep"),
+])
+def test_sweep_options_are_refused_before_any_work(argv, message, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    start = time.perf_counter()
+    assert main(["sweep", str(CASES / "envisat_small.toml"), *argv]) == 2
+    assert message in capsys.readouterr().err
+    assert time.perf_counter() - start < 5.0                 # no validation of millions of runs
+    assert list(tmp_path.iterdir()) == []                    # no store, no folder
+
+
+def test_large_grid_validates_each_value_once():
+    """A 1000 x 30 grid: each of the 1030 values (and the 4 corners) is validated once, not 30 000 cases."""
+    specs = run_specs([parse_vary("launch.velocity=10:30:1000"), parse_vary("contact.mu_kinetic=0.1:0.2:30")])
+    sample, what = validation_sample(specs)
+    values = {(k, s.overrides[k]) for s in sample for k in s.overrides}
+    assert len(values) == 1030 and len(sample) <= 1030 + 4
+    corners = {(s.overrides["launch.velocity"], s.overrides["contact.mu_kinetic"]) for s in sample}
+    assert {(10.0, 0.1), (10.0, 0.2), (30.0, 0.1), (30.0, 0.2)} <= corners
+    assert "of 30000 runs validated" in what and "1030 distinct values" in what
+    small = specs[:VALIDATE_ALL_UP_TO]
+    assert validation_sample(small) == (small, f"all {VALIDATE_ALL_UP_TO} runs validated")
+
+
+def test_sampled_validation_still_finds_a_bad_value():
+    """-1 m/s in a 300-run grid (above the validate-all limit) is caught before any run."""
+    text = (CASES / "envisat_small.toml").read_text()
+    specs = run_specs([parse_vary("launch.velocity=-1:20:30"), parse_vary("contact.mu_kinetic=0.1:0.2:10")])
+    with pytest.raises(SweepSpecError, match=r"of \d+ validated sweep runs give an invalid case \(\d+ of 300 runs"):
+        validate_runs(str(CASES / "envisat_small.toml"), text, specs)
