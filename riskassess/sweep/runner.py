@@ -39,8 +39,8 @@ UNKNOWN_RUNS_EXIT = SimulationFailed.exit_code
 class RunFailed(RuntimeError):
     """A run's failure as it crosses from the worker to the client: ``kind`` and message.
 
-    :class:`multibody.health.SimulationFailed` itself does not survive pickling (its
-    constructor takes three arguments, its ``args`` hold one), so the worker sends this.
+    Carries every failure the same way (a numerical failure, :class:`multibody.health.SimulationFailed`,
+    as kind "diverged"), so the store and the report need one form only.
     """
 
     def __init__(self, kind: str, message: str):
