@@ -481,16 +481,18 @@ MAX_SHOWN = 120
 
 
 def _format_location(loc) -> str:
-    parts = []
+    parts, tag = [], False
     for item in loc:
         if isinstance(item, str) and _UNION_TAG.fullmatch(item):
             continue
         if isinstance(item, int):
             parts[-1] = f"{parts[-1]}[{item}]" if parts else f"[{item}]"
-        elif item in _discriminator_tags():
-            continue  # discriminator tags add nothing for the user
+        elif item in _discriminator_tags() and not tag:
+            tag = True  # a discriminator tag adds nothing for the user (a key after it may share its name)
+            continue
         else:
             parts.append(str(item))
+        tag = False
     return ".".join(parts) or "(top level)"
 
 
@@ -507,6 +509,8 @@ def format_validation_error(path: Path, error: ValidationError) -> str:
             shown = repr(e["input"])
             shown = shown if len(shown) <= MAX_SHOWN else shown[:MAX_SHOWN] + "..."
             msg = f"{msg}. Got {shown} instead"
+        if where == "(top level)" and re.match(r"[\w.\[\]]+: ", msg):
+            where, msg = msg.split(": ", 1)   # a whole-case check that names its key itself
         lines.append(f"{path}: {where}: {msg}")
     return "\n".join(lines)
 

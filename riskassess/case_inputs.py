@@ -51,8 +51,8 @@ class CaseError(ValueError):
 
 
 # ---------------------------------------------------------------------------- files
-def _size_text(n: float) -> str:
-    return f"{n / 1e6:.3g} MB" if n >= 1e5 else f"{n:.0f} bytes"
+def _size_text(n: int) -> str:
+    return f"{n:,} bytes"
 
 
 def check_regular_file(path: Path, limit: int) -> int:
