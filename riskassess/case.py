@@ -201,7 +201,7 @@ Shape = Annotated[Union[Box, Cylinder, Sphere, Ellipsoid, MeshFile], Field(discr
 
 
 class Body(Strict):
-    name: ItemName
+    name: ItemName = Field(description="Body name; joints name it as parent or child.")
     mass: Positive = Field(description="(kg)")
     center_of_mass: Vector3 | None = Field(None, description="CoM, target frame (m); default: shapes' centroid.")
     inertia: Annotated[list[Vector3], Field(min_length=3, max_length=3)] | None = Field(
@@ -219,7 +219,7 @@ class Body(Strict):
 
 
 class Joint(Strict):
-    name: ItemName
+    name: ItemName = Field(description="Joint name; weak locations name it.")
     kind: Literal["revolute", "clamped"] = Field(description="Hinge with torsional spring-damper, or clamped.")
     parent: str = Field(description="Name of the parent body.")
     child: str = Field(description="Name of the child (appendage) body.")
@@ -386,7 +386,7 @@ class Material(Strict):
 
 
 class WeakLocationSpec(Strict):
-    name: ItemName
+    name: ItemName = Field(description="Weak-location name, used in the results.")
     joint: str = Field(description="Joint whose reaction loads this location (its name in target.joints).")
     offset: Vector3 = Field([0.0, 0.0, 0.0], description="Cut point minus joint point, target frame (m), on the child side.")
     beam_axis: Vector3 = Field([1.0, 0.0, 0.0], description="Section axis 1 (along the member, normal to the cut), target frame (-).")

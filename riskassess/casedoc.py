@@ -7,7 +7,7 @@ from __future__ import annotations
 import re
 from typing import get_args
 
-from pydantic import BaseModel
+from pydantic import AfterValidator, BaseModel
 
 from riskassess import case as c
 from riskassess import case_inputs as limits
@@ -168,7 +168,7 @@ def model_table(model: type[BaseModel]) -> str:
     for name, field in model.model_fields.items():
         if name == "kind":
             continue
-        limits = "; ".join(str(m) for m in field.metadata)
+        limits = "; ".join(str(m) for m in field.metadata if not isinstance(m, AfterValidator))
         meaning = (field.description or "") + (f" ({limits})" if limits else "")
         default = "" if field.is_required() else repr(field.default)
         rows.append(f"| `{name}` | {'yes' if field.is_required() else ''} | {default} | {meaning} |")
