@@ -200,8 +200,8 @@ def _set_noise(measured: MeasuredData, given: dict) -> None:
         raise MeasuredDataError(f"--noise: unknown channels {unknown}; known channels are {', '.join(CHANNELS)}")
     for name, column in measured.values.items():
         if name in given:
-            if not given[name] > 0:
-                raise MeasuredDataError(f"--noise {name}: sigma must be > 0. Got {given[name]} instead")
+            if not (np.isfinite(given[name]) and given[name] > 0):
+                raise MeasuredDataError(f"--noise {name}: sigma must be finite and > 0. Got {given[name]} instead")
             measured.noise[name], measured.noise_source[name] = float(given[name]), "given"
         else:
             measured.noise[name] = difference_noise(column)

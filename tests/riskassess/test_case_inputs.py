@@ -347,3 +347,18 @@ def test_measured_csv_is_checked(tmp_path, make, expected):
     with pytest.raises(MeasuredDataError) as info:
         read_measured(path)
     assert str(info.value) == f"{path}: {expected}"
+
+
+def test_diagnose_cli_refuses_a_device_as_measured_data(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["diagnose", str(CASES / HINGED), "--measured", "/dev/zero", "--out", str(out)]) == 2
+    assert ("error: /dev/zero: the measured-data file is not a regular file (a device, pipe or socket); a file is "
+            "expected") in capsys.readouterr().err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("sigma", [float("nan"), float("inf"), 0.0])
+def test_noise_sigma_must_be_finite_and_positive(tmp_path, sigma):
+    with pytest.raises(MeasuredDataError) as info:
+        read_measured(_record(tmp_path / "m.csv"), {"omega_x": sigma})
+    assert str(info.value) == f"--noise omega_x: sigma must be finite and > 0. Got {sigma} instead"
