@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from diagnosis.observation import CHANNELS, QUATERNION
-from riskassess.case_inputs import decode_utf8, read_limited
+from riskassess.case_inputs import read_text
 
 #: Fewest samples a record must have: the noise estimate and a held-out part need a few dozen.
 MIN_SAMPLES = 30
@@ -87,12 +87,7 @@ def _read_rows(path: Path):
     """Header and data rows of a regular UTF-8 file (a byte-order mark is allowed) of at most
     MEASURED_FILE_LIMIT bytes."""
     try:
-        data = read_limited(path, MEASURED_FILE_LIMIT)
-    except ValueError as exc:
-        text = "no such measured-data file" if str(exc) == "no such file" else f"the measured-data file {exc}"
-        raise MeasuredDataError(f"{path}: {text}") from None
-    try:
-        text = decode_utf8(data, path, "CSV file", bom=True)
+        text = read_text(path, MEASURED_FILE_LIMIT, "measured-data file", bom=True)
         rows = [r for r in csv.reader(io.StringIO(text, newline="")) if r and any(cell.strip() for cell in r)]
     except ValueError as exc:
         raise MeasuredDataError(str(exc)) from None

@@ -589,7 +589,7 @@ def _fill_perceived(body: dict, source: str, base: Path) -> str | None:
         return f"the mass properties come from '{source}'; remove {given} from this body"
     try:
         path = resolve_reference(base, source, JSON_FILE_LIMIT)
-        answer = json.loads(decode_utf8(read_limited(path, JSON_FILE_LIMIT), path, "JSON file"))
+        answer = json.loads(decode_utf8(read_limited(path, JSON_FILE_LIMIT), path, "perception.json"))
     except ValueError as exc:   # JSONDecodeError is a ValueError
         return f"perception result {exc}" if str(exc).startswith("'") else f"'{source}' is not a perception.json ({exc})"
     except RecursionError:

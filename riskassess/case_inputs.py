@@ -92,8 +92,19 @@ def decode_utf8(data: bytes, path: Path, what: str, bom: bool = False) -> str:
     try:
         return data.decode("utf-8-sig" if bom else "utf-8")
     except UnicodeDecodeError as exc:
-        raise ValueError(f"{path}: not a UTF-8 text {what}: byte {exc.start} is 0x{data[exc.start]:02x} "
-                         f"(save the file as UTF-8)") from None
+        raise ValueError(f"{path}: not UTF-8 text: byte {exc.start} is 0x{data[exc.start]:02x} "
+                         f"(save the {what} as UTF-8)") from None
+
+
+def read_text(path: Path, limit: int, what: str, bom: bool = False) -> str:
+    """The text of the regular UTF-8 file ``path`` (a ``what`` such as "case file") of at most
+    ``limit`` bytes, a byte-order mark dropped if ``bom``; ValueError starting with the path otherwise."""
+    try:
+        data = read_limited(path, limit)
+    except ValueError as exc:
+        raise ValueError(f"{path}: " + (f"no such {what}" if str(exc) == "no such file" else f"the {what} {exc}")) \
+            from None
+    return decode_utf8(data, path, what, bom)
 
 
 def reference_problem(name: str) -> str | None:
@@ -155,12 +166,7 @@ def read_toml(path: str | Path) -> dict:
     :data:`MAX_NESTING`."""
     path = Path(path)
     try:
-        data = read_limited(path, CASE_FILE_LIMIT)
-    except ValueError as exc:
-        text = "no such case file" if str(exc) == "no such file" else f"the case file {exc}"
-        raise CaseError(f"{path}: {text}") from None
-    try:
-        text = decode_utf8(data, path, "case file")
+        text = read_text(path, CASE_FILE_LIMIT, "case file")
     except ValueError as exc:
         raise CaseError(str(exc)) from None
     try:

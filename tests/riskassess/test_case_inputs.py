@@ -177,7 +177,7 @@ def test_non_utf8_case_file_is_named(tmp_path):
     path = tmp_path / "latin1.toml"
     path.write_bytes('name = "d\xe9bris"\n'.encode("latin-1"))
     # byte 9 is the 0xe9 of the Latin-1 e-acute: 'name = "d' is 9 bytes
-    assert _message(read_toml, path) == f"{path}: not a UTF-8 text case file: byte 9 is 0xe9 (save the file as UTF-8)"
+    assert _message(read_toml, path) == f"{path}: not UTF-8 text: byte 9 is 0xe9 (save the case file as UTF-8)"
 
 
 @pytest.mark.parametrize("depth, expected", [
@@ -334,7 +334,7 @@ def test_measured_csv_with_a_byte_order_mark_is_read(tmp_path):
     (lambda p: _sparse(p, MEASURED_FILE_LIMIT + 1),
      "the measured-data file is 50,000,001 bytes; at most 50,000,000 bytes are read"),
     (lambda p: p.write_bytes(b"time,omega_x\n0.0,0.1\xff\n"),
-     "not a UTF-8 text CSV file: byte 20 is 0xff (save the file as UTF-8)"),   # 13 + 7 bytes before it
+     "not UTF-8 text: byte 20 is 0xff (save the measured-data file as UTF-8)"),   # 13 + 7 bytes before it
     (lambda p: p.write_text("time,omega_x\n0.0," + "1" * 200_000 + "\n"),   # csv's default field limit: 131072
      "not a CSV file (field larger than field limit (131072))"),
     (lambda p: p.write_text("time,omega_x\n" + "".join(f"{t},inf\n" for t in range(40))),
