@@ -362,3 +362,16 @@ def test_noise_sigma_must_be_finite_and_positive(tmp_path, sigma):
     with pytest.raises(MeasuredDataError) as info:
         read_measured(_record(tmp_path / "m.csv"), {"omega_x": sigma})
     assert str(info.value) == f"--noise omega_x: sigma must be finite and > 0. Got {sigma} instead"
+
+
+def test_diagnose_output_folder_holds_the_towing_case(tmp_path):
+    # the extended case and case.toml in a diagnosis output folder name the towing case relative to
+    # themselves (no absolute path), so 'riskassess diagnose' copies it there
+    from riskassess.diagnose import _copy_towing_reference
+
+    path, out = _case(tmp_path, DIAGNOSE_TOWING), tmp_path / "out"
+    out.mkdir()
+    assert _copy_towing_reference(out, path) == [TOWING]
+    (out / "case.toml").write_bytes(path.read_bytes())
+    assert load_diagnosis_case(out / "case.toml").towing_case.name == "zenit2_towing"
+    assert _copy_towing_reference(out, _case(tmp_path, HINGED, name="hinged.toml")) == []
