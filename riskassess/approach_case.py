@@ -13,6 +13,7 @@ from typing import Annotated, Literal, Union
 from pydantic import Field, model_validator
 
 from riskassess.case import NonNegative, Positive, Strict
+from riskassess.case_inputs import CaseName, Text
 
 Vector2 = Annotated[list[float], Field(min_length=2, max_length=2)]
 
@@ -110,7 +111,7 @@ class Collocation(Strict):
 
 
 class Reference(Strict):
-    source: str = Field(description="Where the reference figures come from.")
+    source: Text = Field(description="Where the reference figures come from.")
     final_time: Positive | None = Field(None, description="Reported final time (s).")
     fuel: Positive | None = Field(None, description="Reported fuel of both MUs (kg).")
     solve_time: Positive | None = Field(None, description="Reported solver wall time (s).")
@@ -134,8 +135,8 @@ Objective = Annotated[Union[MinFuel, MinTime, Combined], Field(discriminator="ki
 
 
 class ApproachCase(Strict):
-    name: str = Field(description="Case name; default output folder runs/<name>.")
-    description: str = Field("", description="What the case is.")
+    name: CaseName = Field(description="Case name; default output folder runs/<name>.")
+    description: Text = Field("", description="What the case is.")
     model: Model
     debris: Debris
     thrust: Thrust

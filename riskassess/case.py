@@ -13,12 +13,18 @@ are the schema documentation (``riskassess schema`` prints them). Frames:
 """
 from __future__ import annotations
 
-import tomllib
+import copy
+import json
+import re
 from pathlib import Path
 from typing import Annotated, Literal, Union, get_args
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
+
+from riskassess.case_inputs import (JSON_FILE_LIMIT, MESH_FILE_LIMIT, CaseError, CaseName, ItemName, RelativeFile,
+                                    Strict, Text, decode_utf8, read_limited, read_toml, resolve_reference,
+                                    unique_names)
 
 Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Positive = Annotated[float, Field(gt=0)]
@@ -37,14 +43,6 @@ def check_physical_inertia(j):
     if eig[0] + eig[1] < eig[2] * (1 - 1e-9):
         raise ValueError(f"principal moments {eig.round(6).tolist()} violate the triangle inequality")
     return j
-
-
-class CaseError(ValueError):
-    """A case file that cannot be used; the message names the file, the key and what is allowed."""
-
-
-class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 # ---------------------------------------------------------------------------- simulation
@@ -192,7 +190,8 @@ class Ellipsoid(Strict):
 
 class MeshFile(Strict):
     kind: Literal["mesh"]
-    file: str = Field(description="Closed triangle mesh (STL, OBJ, PLY...), path relative to the case file.")
+    file: RelativeFile = Field(description="Closed triangle mesh (STL, OBJ, PLY...), path relative to the case file, "
+                                           "in its folder or below.")
     scale: Positive = Field(1.0, description="Factor taking file units to metres (-).")
     center: Vector3 = Field([0.0, 0.0, 0.0], description="Translation of the mesh, target frame (m).")
     rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Mesh->target rotation (rad).")
@@ -202,14 +201,15 @@ Shape = Annotated[Union[Box, Cylinder, Sphere, Ellipsoid, MeshFile], Field(discr
 
 
 class Body(Strict):
-    name: str
+    name: ItemName = Field(description="Body name; joints name it as parent or child.")
     mass: Positive = Field(description="(kg)")
     center_of_mass: Vector3 | None = Field(None, description="CoM, target frame (m); default: shapes' centroid.")
     inertia: Annotated[list[Vector3], Field(min_length=3, max_length=3)] | None = Field(
         None, description="Inertia about the CoM, target-frame axes (kg m^2); default: uniform density over the shapes.")
     shapes: Annotated[list[Shape], Field(min_length=1)]
-    mass_properties_from: str | None = Field(
-        None, description="perception.json written by 'riskassess perceive' (path relative to the case file): mass, "
+    mass_properties_from: RelativeFile | None = Field(
+        None, description="perception.json written by 'riskassess perceive' (path relative to the case file, in its "
+                          "folder or below): mass, "
                           "center_of_mass and inertia are taken from its estimates (then leave those three keys out).")
 
     @field_validator("inertia")
@@ -219,7 +219,7 @@ class Body(Strict):
 
 
 class Joint(Strict):
-    name: str
+    name: ItemName = Field(description="Joint name; weak locations name it.")
     kind: Literal["revolute", "clamped"] = Field(description="Hinge with torsional spring-damper, or clamped.")
     parent: str = Field(description="Name of the parent body.")
     child: str = Field(description="Name of the child (appendage) body.")
@@ -253,11 +253,14 @@ class Target(Strict):
     bodies: Annotated[list[Body], Field(min_length=1)]
     joints: list[Joint] = []
 
+    @field_validator("bodies", "joints")
+    @classmethod
+    def _unique(cls, items, info):
+        return unique_names(items, {"bodies": "body", "joints": "joint"}[info.field_name])
+
     @model_validator(mode="after")
     def _joint_tree(self):
         names = [b.name for b in self.bodies]
-        if len(set(names)) != len(names):
-            raise ValueError(f"body names must be unique. Got {names}")
         children = []
         for j in self.joints:
             for role in ("parent", "child"):
@@ -324,48 +327,52 @@ class Registration(Strict):
 class Perception(Strict):
     observation_time: Positive = Field(description="LiDAR tracking of the free tumble before the chaser moves in (s).")
     hold_distance: Positive = Field(10.0, description="Chaser CoM to debris CoM while it observes, back along the launch direction (m).")
-    seed: int = Field(0, description="Seed of the range noise (-).")
+    seed: Annotated[int, Field(ge=0)] = Field(0, description="Seed of the range noise (-).")
     lidar: Lidar
     registration: Registration = Registration()
 
 
 # ---------------------------------------------------------------------------- structures
 ValueOrRange = Union[Positive, Annotated[list[Positive], Field(min_length=2, max_length=2)]]
+#: A dimension of a cross-section (m): a cut through a spacecraft member. The widest rocket bodies in
+#: orbit are about 4-5 m across; 20 m bounds every member while the section formulas (fourth powers of
+#: the dimensions) stay far from float overflow.
+SectionLength = Annotated[float, Field(gt=0, le=20.0)]
 
 
 class SolidRectangle(Strict):
     kind: Literal["solid_rectangle"]
-    width: Positive = Field(description="Extent along section axis 2 (m).")
-    height: Positive = Field(description="Extent along section axis 3 (m).")
+    width: SectionLength = Field(description="Extent along section axis 2 (m).")
+    height: SectionLength = Field(description="Extent along section axis 3 (m).")
 
 
 class HollowRectangle(Strict):
     kind: Literal["hollow_rectangle"]
-    width: Positive = Field(description="Outer extent along section axis 2 (m).")
-    height: Positive = Field(description="Outer extent along section axis 3 (m).")
-    wall: Positive = Field(description="Uniform wall thickness (m).")
+    width: SectionLength = Field(description="Outer extent along section axis 2 (m).")
+    height: SectionLength = Field(description="Outer extent along section axis 3 (m).")
+    wall: SectionLength = Field(description="Uniform wall thickness (m).")
 
 
 class ThinWalledBox(Strict):
     kind: Literal["thin_walled_box"]
-    width: Positive = Field(description="Midline extent along section axis 2 (m).")
-    height: Positive = Field(description="Midline extent along section axis 3 (m).")
-    flange_thickness: Positive = Field(description="Thickness of the two walls along axis 2 (m).")
-    web_thickness: Positive = Field(description="Thickness of the two walls along axis 3 (m).")
+    width: SectionLength = Field(description="Midline extent along section axis 2 (m).")
+    height: SectionLength = Field(description="Midline extent along section axis 3 (m).")
+    flange_thickness: SectionLength = Field(description="Thickness of the two walls along axis 2 (m).")
+    web_thickness: SectionLength = Field(description="Thickness of the two walls along axis 3 (m).")
 
 
 class CircularTube(Strict):
     kind: Literal["circular_tube"]
-    outer_diameter: Positive = Field(description="(m)")
-    wall: Positive = Field(description="Wall thickness (m); outer_diameter / 2 for a solid shaft.")
+    outer_diameter: SectionLength = Field(description="(m)")
+    wall: SectionLength = Field(description="Wall thickness (m); outer_diameter / 2 for a solid shaft.")
 
 
 class ISection(Strict):
     kind: Literal["i_section"]
-    height: Positive = Field(description="Overall depth along section axis 3, the web direction (m).")
-    flange_width: Positive = Field(description="Flange extent along section axis 2 (m).")
-    flange_thickness: Positive = Field(description="(m)")
-    web_thickness: Positive = Field(description="(m)")
+    height: SectionLength = Field(description="Overall depth along section axis 3, the web direction (m).")
+    flange_width: SectionLength = Field(description="Flange extent along section axis 2 (m).")
+    flange_thickness: SectionLength = Field(description="(m)")
+    web_thickness: SectionLength = Field(description="(m)")
 
 
 Section = Annotated[Union[SolidRectangle, HollowRectangle, ThinWalledBox, CircularTube, ISection],
@@ -379,7 +386,7 @@ class Material(Strict):
 
 
 class WeakLocationSpec(Strict):
-    name: str
+    name: ItemName = Field(description="Weak-location name, used in the results.")
     joint: str = Field(description="Joint whose reaction loads this location (its name in target.joints).")
     offset: Vector3 = Field([0.0, 0.0, 0.0], description="Cut point minus joint point, target frame (m), on the child side.")
     beam_axis: Vector3 = Field([1.0, 0.0, 0.0], description="Section axis 1 (along the member, normal to the cut), target frame (-).")
@@ -421,10 +428,15 @@ class Structures(Strict):
                            "('low': conservative, most debris), or 'never' to judge without releasing.")
     weak_locations: Annotated[list[WeakLocationSpec], Field(min_length=1)]
 
+    @field_validator("weak_locations")
+    @classmethod
+    def _unique(cls, items):
+        return unique_names(items, "weak location")
+
 
 class Case(Strict):
-    name: str
-    description: str = ""
+    name: CaseName = Field(description="Case name; default output folder runs/<name>.")
+    description: Text = ""
     simulation: Simulation
     orbit: Annotated[Union[CircularOrbit, NoOrbit], Field(discriminator="kind")]
     net: Net
@@ -445,30 +457,42 @@ class Case(Strict):
             if loc.joint not in joints:
                 raise ValueError(f"structures: weak location '{loc.name}': joint '{loc.joint}' is not in "
                                  f"target.joints {joints}")
-        names = [loc.name for loc in self.structures.weak_locations]
-        if len(set(names)) != len(names):
-            raise ValueError(f"structures: weak location names must be unique. Got {names}")
         return self
 
 
 # ---------------------------------------------------------------------------- loading
+def _all_subclasses(model: type) -> list[type]:
+    return [sub for direct in model.__subclasses__() for sub in [direct, *_all_subclasses(direct)]]
+
+
 def _discriminator_tags() -> set:
     """The ``kind`` values that tag the members of a discriminated union (orbit, shape and
     section kinds): models whose ``kind`` admits exactly one value."""
     kinds = [get_args(model.model_fields["kind"].annotation)
-             for model in Strict.__subclasses__() if "kind" in model.model_fields]
+             for model in _all_subclasses(Strict) if "kind" in model.model_fields]
     return {values[0] for values in kinds if len(values) == 1}
 
 
+#: Tags pydantic puts in an error's location for the member of a plain union that failed
+#: (``allowable_moment.constrained-float``); they name types, not keys.
+_UNION_TAG = re.compile(r"constrained-\w+|(list|dict|nullable|function-\w+)\[.*\]")
+#: Longest rendering of a rejected value in a message (characters).
+MAX_SHOWN = 120
+
+
 def _format_location(loc) -> str:
-    parts = []
+    parts, tag = [], False
     for item in loc:
+        if isinstance(item, str) and _UNION_TAG.fullmatch(item):
+            continue
         if isinstance(item, int):
             parts[-1] = f"{parts[-1]}[{item}]" if parts else f"[{item}]"
-        elif item in _discriminator_tags():
-            continue  # discriminator tags add nothing for the user
+        elif item in _discriminator_tags() and not tag:
+            tag = True  # a discriminator tag adds nothing for the user (a key after it may share its name)
+            continue
         else:
             parts.append(str(item))
+        tag = False
     return ".".join(parts) or "(top level)"
 
 
@@ -480,21 +504,20 @@ def format_validation_error(path: Path, error: ValidationError) -> str:
         msg = e["msg"].removeprefix("Value error, ")
         if e["type"] == "extra_forbidden":
             msg = "unknown key (check spelling; see 'riskassess schema')"
-        elif "input" in e and e["type"] not in ("missing",) and not isinstance(e["input"], dict):
-            msg = f"{msg}. Got {e['input']!r} instead"
+        elif "input" in e and e["type"] not in ("missing",) and not _is_table(e["input"]) \
+                and "Got " not in msg:
+            shown = repr(e["input"])
+            shown = shown if len(shown) <= MAX_SHOWN else shown[:MAX_SHOWN] + "..."
+            msg = f"{msg}. Got {shown} instead"
+        if where == "(top level)" and re.match(r"[\w.\[\]]+: ", msg):
+            where, msg = msg.split(": ", 1)   # a whole-case check that names its key itself
         lines.append(f"{path}: {where}: {msg}")
     return "\n".join(lines)
 
 
-def read_toml(path: str | Path) -> dict:
-    """The parsed TOML of a case file; :class:`CaseError` when it is missing or not TOML."""
-    path = Path(path)
-    try:
-        return tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise CaseError(f"{path}: no such case file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CaseError(f"{path}: not valid TOML: {exc}") from None
+def _is_table(value) -> bool:
+    """A table or a list of tables: too long to repeat in a message, which names its key instead."""
+    return isinstance(value, dict) or (isinstance(value, list) and any(isinstance(v, dict) for v in value))
 
 
 def load_model(path: str | Path, model: type[BaseModel]):
@@ -536,49 +559,62 @@ PERCEIVED_KEYS = {"mass_kg": "mass", "center_of_mass_target_m": "center_of_mass"
 
 
 def _with_perceived_mass_properties(raw: dict, base: Path) -> tuple[dict, list[str]]:
-    """Fill the mass properties of bodies that name a perception result; problems name the key."""
-    import copy
-    import json
-
-    bodies = raw.get("target", {}).get("bodies", []) if isinstance(raw.get("target"), dict) else []
-    if not any(isinstance(b, dict) and b.get("mass_properties_from") for b in bodies):
+    """Fill the mass properties of bodies that name a perception result; problems name the key.
+    Anything not shaped like a case (bodies not a list, a file name not a string) is left to the
+    schema, which names it."""
+    target = raw.get("target")
+    bodies = target.get("bodies") if isinstance(target, dict) else None
+    if not isinstance(bodies, list) or not any(_perceived_source(b) for b in bodies):
         return raw, []
     raw = copy.deepcopy(raw)
     problems = []
     for i, body in enumerate(raw["target"]["bodies"]):
-        source = body.get("mass_properties_from") if isinstance(body, dict) else None
-        if not source:
-            continue
-        key = f"target.bodies[{i}].mass_properties_from"
-        given = [k for k in PERCEIVED_KEYS.values() if k in body]
-        if given:
-            problems.append(f"{key}: the mass properties come from '{source}'; remove {given} from this body")
-            continue
-        try:
-            answer = json.loads((base / source).read_text())
-        except FileNotFoundError:
-            problems.append(f"{key}: perception result '{source}' not found (paths are relative to the case file)")
-            continue
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            problems.append(f"{key}: '{source}' is not a perception.json ({exc})")
-            continue
-        missing = [k for k in PERCEIVED_KEYS if answer.get(k) is None]
-        if missing:
-            reason = answer.get("not_observable") or "keys missing"
-            problems.append(f"{key}: '{source}' has no estimate of {missing}: {reason}")
-            continue
-        for source_key, body_key in PERCEIVED_KEYS.items():
-            body[body_key] = answer[source_key]
+        source = _perceived_source(body)
+        if source:
+            problem = _fill_perceived(body, source, base)
+            if problem:
+                problems.append(f"target.bodies[{i}].mass_properties_from: {problem}")
     return raw, problems
 
 
+def _perceived_source(body) -> str | None:
+    source = body.get("mass_properties_from") if isinstance(body, dict) else None
+    return source if isinstance(source, str) and source else None
+
+
+def _fill_perceived(body: dict, source: str, base: Path) -> str | None:
+    """Copy the estimates of the perception result ``source`` into ``body``; the problem, or None."""
+    given = [k for k in PERCEIVED_KEYS.values() if k in body]
+    if given:
+        return f"the mass properties come from '{source}'; remove {given} from this body"
+    try:
+        path = resolve_reference(base, source, JSON_FILE_LIMIT)
+        answer = json.loads(decode_utf8(read_limited(path, JSON_FILE_LIMIT), path, "perception.json"))
+    except ValueError as exc:   # JSONDecodeError is a ValueError
+        return f"perception result {exc}" if str(exc).startswith("'") else f"'{source}' is not a perception.json ({exc})"
+    except RecursionError:
+        return f"'{source}' is not a perception.json (nested too deeply)"
+    if not isinstance(answer, dict):
+        return f"'{source}' is not a perception.json (a JSON object is expected)"
+    missing = [k for k in PERCEIVED_KEYS if answer.get(k) is None]
+    if missing:
+        reason = answer.get("not_observable") or "keys missing"
+        return f"'{source}' has no estimate of {missing}: {reason}"
+    for source_key, body_key in PERCEIVED_KEYS.items():
+        body[body_key] = answer[source_key]
+    return None
+
+
 def _check_files(case: Case, base: Path) -> list[str]:
+    """Every mesh file is a regular file below the case's folder, at most MESH_FILE_LIMIT bytes."""
     problems = []
     for i, body in enumerate(case.target.bodies):
         for k, shape in enumerate(body.shapes):
-            if isinstance(shape, MeshFile) and not (base / shape.file).is_file():
-                problems.append(f"target.bodies[{i}].shapes[{k}].file: mesh file '{shape.file}' not found "
-                                f"(paths are relative to the case file)")
+            if isinstance(shape, MeshFile):
+                try:
+                    resolve_reference(base, shape.file, MESH_FILE_LIMIT)
+                except ValueError as exc:
+                    problems.append(f"target.bodies[{i}].shapes[{k}].file: mesh file {exc}")
     return problems
 
 
@@ -590,7 +626,7 @@ def _check_sections(case: Case) -> list[str]:
         if loc.section is not None:
             try:
                 section_properties(loc.section)
-            except ValueError as exc:
+            except (ValueError, ArithmeticError) as exc:
                 problems.append(f"structures.weak_locations[{i}].section: {exc}")
     return problems
 
@@ -599,7 +635,10 @@ def _check_reach(case: Case, base: Path) -> list[str]:
     """Reject a net that cannot reach the target before any simulation starts."""
     from riskassess.assemble import target_points_lvlh, target_vertices_lvlh  # geometry needs the mesh loader
 
-    points = target_vertices_lvlh(case, base)
+    try:
+        points = target_vertices_lvlh(case, base)
+    except Exception as exc:  # noqa: BLE001 - trimesh's many file parsers raise many types on a malformed file
+        return [f"target.bodies: a mesh file cannot be read as a triangle mesh ({type(exc).__name__}: {exc})"]
     launch = case.launch
     d = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
     net_center = target_points_lvlh(case, launch.aim_point) - launch.distance * d

@@ -7,9 +7,11 @@ from __future__ import annotations
 import re
 from typing import get_args
 
-from pydantic import BaseModel
+from pydantic import AfterValidator, BaseModel
 
 from riskassess import case as c
+from riskassess import case_inputs as limits
+from diagnosis.measured import MEASURED_FILE_LIMIT
 
 HEADER = """# Case file format
 
@@ -21,6 +23,39 @@ that cannot reach the target are rejected on load, each error naming the file an
 `riskassess schema` prints the same as JSON schema; `cases/envisat_net_impact.toml` is an annotated example.
 
 This page is generated from `riskassess/case.py` (`python -m riskassess.casedoc`).
+"""
+
+REFUSED = f"""## What the checker refuses
+
+Every case kind (impact, towing, diagnosis, approach; `riskassess validate` takes any of them) is checked
+on load, before any work; each error names the file, the key and what is allowed.
+
+- **Numbers**: NaN and infinities (`nan`, `inf` and the strings `"nan"`, `"inf"`), and any number beyond
+  +-{limits.MAX_MAGNITUDE:g} (no physical input comes near it: the largest, the Earth's mu, is 3.986e14;
+  larger values overflow the checks' arithmetic). Cross-section dimensions are at most 20 m.
+- **Types are strict**: a number written as a string (`"0.2"`), a boolean as a string or a number
+  (`"no"`, `0`), an integer key given a float (`nodes_per_side = 15.0`) are refused. A TOML integer is
+  accepted where a float is expected (`mass = 350`).
+- **Names**: the case `name` becomes the default output folder `runs/<name>`, so it is 1 to 64 letters,
+  digits, `.`, `_` or `-`, starting with a letter or digit (`{limits.CASE_NAME_PATTERN}`); `"../x"`, an
+  absolute path and `""` are refused. Body, joint and weak-location names follow the same rule but start
+  with a letter (`{limits.ITEM_NAME_PATTERN}`), so a sweep key such as `target.joints[hinge]` never reads a
+  name as an index. Each body, joint, weak location and (diagnosis) effect id appears once.
+- **Text** (`description`, `reference.source`): at most {limits.MAX_TEXT} characters, no control characters
+  other than newline and tab.
+- **Files a case names** (a mesh `file`, `mass_properties_from`, a diagnosis case's `towing`): a path
+  relative to the case file, in its folder or below: no absolute path and no `..` component. The file must
+  be a regular file (a directory, a device such as /dev/zero or a pipe is refused), at most
+  {limits.MESH_FILE_LIMIT:,} bytes for a mesh, {limits.JSON_FILE_LIMIT:,} bytes for a perception.json and
+  {limits.CASE_FILE_LIMIT:,} bytes for a towing case; the size is checked before reading. A symbolic link is
+  followed and its target checked the same way. `riskassess diagnose` copies a towing case's towing file
+  into its output folder, so the copies there load too.
+- **The case file itself**: a regular file of at most {limits.CASE_FILE_LIMIT:,} bytes (the largest shipped
+  case is about 9 kB), UTF-8 (otherwise the error names the file and the first bad byte), tables and
+  arrays nested at most {limits.MAX_NESTING} levels deep (the shipped cases nest 5).
+- **Measured data** (`riskassess diagnose --measured FILE`): a regular UTF-8 file of at most
+  {MEASURED_FILE_LIMIT:,} bytes; a byte-order mark before `time` is accepted; every cell a finite number,
+  empty or `nan` for a missing sample.
 """
 
 SECTIONS = [
@@ -133,7 +168,7 @@ def model_table(model: type[BaseModel]) -> str:
     for name, field in model.model_fields.items():
         if name == "kind":
             continue
-        limits = "; ".join(str(m) for m in field.metadata)
+        limits = "; ".join(str(m) for m in field.metadata if not isinstance(m, AfterValidator))
         meaning = (field.description or "") + (f" ({limits})" if limits else "")
         default = "" if field.is_required() else repr(field.default)
         rows.append(f"| `{name}` | {'yes' if field.is_required() else ''} | {default} | {meaning} |")
@@ -141,7 +176,7 @@ def model_table(model: type[BaseModel]) -> str:
 
 
 def render() -> str:
-    parts = [HEADER]
+    parts = [HEADER, REFUSED]
     for title, model in SECTIONS:
         parts.append(f"## {title}\n\n{model_table(model)}\n")
     return "\n".join(parts)

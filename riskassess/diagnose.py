@@ -138,7 +138,8 @@ def extended_case(case_path: Path, problem: Problem, fit: FitResult) -> str:
             initial[field] = [value[f"{key}_{a}"] for a in "xyz"]
     header_note = ""
     if raw.get("kind") == "towing":
-        header_note = "# The towing case is referenced by its absolute path.\n"
+        header_note = ("# The towing case is referenced relative to this file, as in the input case; the output\n"
+                       "# folder holds a copy of it beside this file.\n")
     for key, field in (("hinge_angle", "initial_angle"), ("hinge_rate", "initial_rate"),
                        ("torsional_stiffness", "torsional_stiffness"), ("torsional_damping", "torsional_damping")):
         if key in value:
@@ -152,7 +153,8 @@ def extended_case(case_path: Path, problem: Problem, fit: FitResult) -> str:
 
 def _towing_initial(raw: dict, case_path: Path, value: dict) -> None:
     """The towing case's fitted debris state into ``raw['initial']`` (TowingInitial keys); the attitude
-    change composed after the case's own; the towing reference made absolute."""
+    change composed after the case's own. The towing reference stays relative (case files name no
+    absolute path); :func:`_write` copies the towing case into the output folder beside the extended case."""
     from scipy.spatial.transform import Rotation
 
     initial = raw.setdefault("initial", {})
@@ -160,7 +162,6 @@ def _towing_initial(raw: dict, case_path: Path, value: dict) -> None:
         delta = Rotation.from_rotvec([value[f"attitude_{a}"] for a in "xyz"])
         before = Rotation.from_rotvec(initial.get("attitude_change", [0.0, 0.0, 0.0]))
         initial["attitude_change"] = (before * delta).as_rotvec().tolist()
-    raw["towing"] = str((case_path.parent / raw["towing"]).resolve())
 
 
 def _without_diverged(problem: Problem, fits: dict, predictions: dict):
@@ -240,6 +241,18 @@ def _unfitted(problem: Problem) -> FitResult:
     return FitResult("nominal", [], [], problem.nominal_center, np.zeros(n), n, 0.0, 0.0, 1, 0.0, 0, "")
 
 
+def _copy_towing_reference(out: Path, case_path: Path) -> list[str]:
+    """Copy a towing diagnosis case's towing case into ``out`` at the same relative path, so that
+    ``case.toml`` and the extended case there load; the copied names (none for other kinds)."""
+    raw = read_toml(case_path)
+    if raw.get("kind") != "towing":
+        return []
+    name = raw["towing"]        # validated on load: relative, in the case's folder or below
+    (out / name).parent.mkdir(parents=True, exist_ok=True)
+    results.atomic_write_bytes(out / name, (case_path.parent / name).read_bytes())
+    return [name]
+
+
 def _write(out: Path, case_path: Path, answer, problem, predictions, chosen, before, after, extended,
            figures: bool = True) -> None:
     from riskassess.report.diagnosis import write_figures
@@ -247,6 +260,7 @@ def _write(out: Path, case_path: Path, answer, problem, predictions, chosen, bef
     out.mkdir(parents=True, exist_ok=True)
     files = ["case.toml", "diagnosis.json", "diagnosis.npz"]
     results.atomic_write_bytes(out / "case.toml", case_path.read_bytes())
+    files += _copy_towing_reference(out, case_path)
     if extended is not None:
         target = case_path.with_name(f"{case_path.stem}.extended.toml")
         results.atomic_write_bytes(out / target.name, extended.encode())

@@ -25,6 +25,7 @@ from pydantic import Field, PrivateAttr, RootModel, ValidationError, ValidationI
 
 from riskassess.case import (CaseError, NonNegative, Positive, Strict, Vector3, check_physical_inertia,
                              format_validation_error, load_model, read_toml)
+from riskassess.case_inputs import CASE_FILE_LIMIT, CaseName, RelativeFile, Text, resolve_reference, unique_names
 
 Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3)]
 
@@ -124,14 +125,19 @@ class Diagnosis(Strict):
 
 
 class _ScenarioBase(Strict):
-    name: str
-    description: str = ""
+    name: CaseName = Field(description="Case name; default output folder runs/<name>-diagnosis.")
+    description: Text = ""
     main_body: MainBody
     initial: InitialState
     orbit: Orbit = NoOrbit(kind="none")
     uncertain: Uncertain = Uncertain()
     diagnosis: Diagnosis = Diagnosis()
     effects: list[EffectEntry] = Field([], description="Effects switched on in this model (an extended case).")
+
+    @field_validator("effects")
+    @classmethod
+    def _unique(cls, effects):
+        return unique_names(effects, "effect", "id")
 
     @model_validator(mode="after")
     def _known_effects(self):
@@ -192,10 +198,11 @@ class TowingInitial(Strict):
 class TowingDiagnosisCase(Strict):
     """Post-capture towing: the lower-order model of the towing case ``towing`` is the nominal."""
     kind: Literal["towing"]
-    name: str
-    description: str = ""
-    towing: str = Field(description="Towing case file (riskassess/towing_case.py), relative to this file: tethers, "
-                                    "masses, thrust law, attitude control and the state at the record's t = 0.")
+    name: CaseName = Field(description="Case name; default output folder runs/<name>-diagnosis.")
+    description: Text = ""
+    towing: RelativeFile = Field(description="Towing case file (riskassess/towing_case.py), relative to this file, in "
+                                             "its folder or below: tethers, masses, thrust law, attitude control and "
+                                             "the state at the record's t = 0.")
     fit_step: Annotated[float, Field(gt=0, le=0.05)] = Field(
         0.02, description="Step of the fit's towing runs (s); the identification's step (docs/towing.md: within 2 % "
                           "of the paper's RMSE scales at 20 ms).")
@@ -205,17 +212,23 @@ class TowingDiagnosisCase(Strict):
     effects: list[EffectEntry] = Field([], description="Effects switched on in this model (an extended case).")
     _towing_case: object = PrivateAttr(None)
 
+    @field_validator("effects")
+    @classmethod
+    def _unique(cls, effects):
+        return unique_names(effects, "effect", "id")
+
     @model_validator(mode="after")
     def _load_towing(self, info: ValidationInfo):
-        from riskassess.case import CaseError
         from riskassess.towing_case import TowingCase
 
-        path = Path(self.towing)
-        if not path.is_absolute():
-            path = Path((info.context or {}).get("case_dir", ".")) / path
+        base = Path((info.context or {}).get("case_dir", "."))
+        try:
+            path = resolve_reference(base, self.towing, CASE_FILE_LIMIT)
+        except ValueError as exc:
+            raise ValueError(f"towing: towing case {exc}") from None
         try:
             self._towing_case = load_model(path, TowingCase)
-        except (CaseError, OSError) as exc:
+        except CaseError as exc:
             raise ValueError(f"towing: the towing case cannot be loaded: {exc}") from None
         return _check_effects(self)
 

@@ -14,6 +14,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from riskassess.case import NonNegative, Positive, Strict, Vector3
+from riskassess.case_inputs import CaseName, Text
 
 Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
 PositiveVector3 = Annotated[list[Positive], Field(min_length=3, max_length=3)]
@@ -144,7 +145,7 @@ class Optimizers(Strict):
         1000, description="Evaluations of one pattern-search leg before it restarts from its best point (-).")
     polish_delta: Annotated[float, Field(gt=0, le=0.5)] = Field(
         0.02, description="Pattern-search step of the polish and of every restart, in units of each bound range (-).")
-    seed: int = Field(0, description="Seed of the PSO (-).")
+    seed: Annotated[int, Field(ge=0)] = Field(0, description="Seed of the PSO (-).")
 
 
 class Identification(Strict):
@@ -237,8 +238,8 @@ class FullNet(Strict):
 
 
 class TowingCase(Strict):
-    name: str
-    description: str = ""
+    name: CaseName = Field(description="Case name; default output folder runs/<name>.")
+    description: Text = ""
     simulation: TowSimulation
     chaser: TowChaser
     debris: TowDebris

@@ -9,6 +9,7 @@ case's 20 ms, so data and fit differ by the step as with an independent simulati
 from __future__ import annotations
 
 import os
+import shutil
 
 import numpy as np
 import pytest
@@ -149,7 +150,7 @@ def _diagnose(tmp_path, channels, times, candidates=None, uncertain=None):
     data = tmp_path / "measured.csv"
     write_measured(data, times, channels)
     raw = read_toml(TOWING_CASE)
-    raw["towing"] = str(TOWING_CASE.parent / raw["towing"])
+    shutil.copy(TOWING_CASE.parent / raw["towing"], tmp_path / raw["towing"])  # case files name no absolute path
     raw["uncertain"] = {"attitude": 0.01, "angular_velocity": 2e-3} if uncertain is None else uncertain
     case = tmp_path / TOWING_CASE.name
     case.write_text(toml_text(raw))
