@@ -77,6 +77,11 @@ def atomic_write_npz(path: Path, arrays: dict) -> None:
         raise
 
 
+def write_manifest(folder: Path, manifest: dict) -> None:
+    """The one writer of ``manifest.json`` (atomically); :mod:`riskassess.outfolder` keeps its content."""
+    atomic_write_json(Path(folder) / "manifest.json", manifest)
+
+
 def _json_default(obj):
     if isinstance(obj, np.ndarray):
         return obj.tolist()
@@ -128,7 +133,9 @@ class RunFolder:
 
     @property
     def complete(self) -> bool:
-        return self.manifest.get("status") == "complete"
+        """The stage's results are all written (``outcome``; older folders: ``status``), even while
+        products of the same command (report, VTK) are still to come or one of them failed."""
+        return self.manifest.get("outcome", self.manifest.get("status")) == "complete"
 
     @property
     def stage(self) -> str:
@@ -212,7 +219,7 @@ class RunFolder:
         products = self.manifest.setdefault("products", [])
         if relative_path not in products:
             products.append(relative_path)
-            atomic_write_json(self.path / "manifest.json", self.manifest)
+            write_manifest(self.path, self.manifest)
 
 
 def load_timeseries(run_dir: Path) -> dict[str, np.ndarray]:
