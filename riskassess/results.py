@@ -19,8 +19,10 @@ structures.json    the structural verdict (cases with weak locations)
 structures.npz     demand time series per weak location, ``<location>/<demand>``
 =================  ==============================================================
 
-Products made later from the folder (``report.html``, ``report.pdf``, ``vtk/impact.pvd``)
-are listed under ``products`` in the manifest; deleting one does not spoil the folder.
+Products made later from the folder (``report.html``, ``report.pdf``, the ``vtk`` folder with
+its own manifest) are listed under ``products`` in the manifest; deleting one does not spoil the
+folder. Which folders the tool may write, and the manifest's states: :mod:`riskassess.outfolder`
+and docs/outputs.md.
 
 Every file is written to a temporary name and renamed, so a folder never holds a
 half-written file; the manifest is written last and lists what is complete.
