@@ -136,7 +136,9 @@ def check(out: Path, identity: dict, overwrite: bool) -> dict | None:
     ``identity``: ``format``, ``case``, ``command`` and any further keys that must match
     (a VTK export's ``run``)."""
     out = Path(out)
-    if out.is_symlink() or (out.exists() and not out.is_dir()):
+    if out.is_symlink():
+        raise OutputRefused(f"{out}: is a symbolic link; give the folder it points to ({out.resolve()}) as --out")
+    if out.exists() and not out.is_dir():
         raise OutputRefused(f"{out}: is not a folder; choose a new or empty output folder")
     if not out.exists() or not any(out.iterdir()):
         return None
