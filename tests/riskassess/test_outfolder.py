@@ -224,3 +224,30 @@ def test_report_never_overwrites_a_file_it_did_not_write(tmp_path, small_case, c
     assert main(["report", str(out), "--no-pdf"]) == 2
     assert "report.html: exists and was not written by riskassess" in capsys.readouterr().err
     assert (out / "report.html").read_text() == "my own notes" and _manifest(out)["status"] == "complete"
+
+
+def test_a_failed_product_is_recorded_and_the_results_stay(tmp_path, small_case, monkeypatch, capsys):
+    """Issue 20 item 4: `run --report --vtk` is 'running' until its last product; a product that fails
+    leaves 'products_failed' (exit code 1) with readable results, and a retry of the step clears it."""
+    import riskassess.report
+
+    out = tmp_path / "run"
+    statuses = []
+    real = riskassess.report.write_report
+
+    def full_disk(run_dir, **kwargs):
+        statuses.append(_manifest(Path(run_dir))["status"])
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(riskassess.report, "write_report", full_disk)
+    assert main(["run", str(small_case), "--out", str(out), "--report", "--vtk", "--json"]) == 1
+    assert statuses == ["running"]
+    manifest = _manifest(out)
+    assert manifest["status"] == "products_failed" and manifest["outcome"] == "complete"
+    assert "No space left" in manifest["product_errors"]["report"] and manifest["products"] == ["vtk"]
+    assert "retry this step alone with 'riskassess report" in capsys.readouterr().err
+    assert RunFolder(out).summary["case"] == "envisat_small"   # the results stay readable
+    monkeypatch.setattr(riskassess.report, "write_report", real)
+    assert main(["report", str(out), "--no-pdf"]) == 0
+    manifest = _manifest(out)
+    assert manifest["status"] == "complete" and "product_errors" not in manifest
