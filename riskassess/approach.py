@@ -18,8 +18,6 @@ approach_*.png     trajectories, thrust magnitudes and angles, masses and widths
 """
 from __future__ import annotations
 
-import datetime
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +26,9 @@ from control.mu_approach import ApproachProblem, collocation_points, constraint_
 from control.mu_dynamics import IndependentMUs, RigidRodMUs, thrust_angles
 from riskassess import results
 from riskassess.approach_case import ApproachCase
+from riskassess.approach_plots import write_plots
 from riskassess.case import CaseError, load_model
+from riskassess.outfolder import claim
 
 #: Tolerances of the checks on the re-simulation (open-loop replay of the collocation controls,
 #: which drifts from the nodes where the thrust switches inside an interval): the mouth width may
@@ -146,27 +146,28 @@ def _replay(case: ApproachCase, solution, resim) -> tuple[dict, dict]:
     return {**out.summary, "net_nodes_per_side": r.nodes_per_side, "net_mass_kg": r.net_mass}, arrays
 
 
-def approach_case(case_path, out_dir, replay: bool = False, case: ApproachCase | None = None) -> dict:
-    """Load (unless given), solve, check, optionally replay, and write the output folder."""
-    case_path, out = Path(case_path), Path(out_dir)
+def approach_case(case_path, out_dir, replay: bool = False, case: ApproachCase | None = None,
+                  overwrite: bool = False) -> dict:
+    """Load (unless given), claim the output folder (:func:`riskassess.outfolder.claim`), solve, check,
+    optionally replay, and write the output folder."""
+    case_path = Path(case_path)
     case = case or load_model(case_path, ApproachCase)
-    answer, solution, resim = solve_case(case, str(case_path))
-    out.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(case_path, out / "case.toml")
-    results.atomic_write_json(out / "approach_case.json", case.model_dump())
-    arrays = _arrays(solution, resim)
-    if replay:
-        answer["replay"], more = _replay(case, solution, resim)
-        arrays.update(more)
-    results.atomic_write_npz(out / "approach.npz", arrays)
-    results.atomic_write_json(out / "approach.json", answer)
-    from riskassess.approach_plots import write_plots
-
-    pngs = write_plots(out, answer, arrays)
-    manifest = {"format": results.FORMAT, "version": results.VERSION, "stage": "approach", "case": case.name,
-                "created": datetime.datetime.now(datetime.timezone.utc).isoformat(), "status": "complete",
-                "files": ["case.toml", "approach_case.json", "approach.npz", "approach.json", *pngs]}
-    results.atomic_write_json(out / "manifest.json", manifest)
+    folder = claim(out_dir, case.name, "approach", overwrite, stage="approach")
+    out = folder.path
+    with folder.recording():
+        results.atomic_write_bytes(out / "case.toml", case_path.read_bytes())
+        results.atomic_write_json(out / "approach_case.json", case.model_dump())
+        folder.add_files("case.toml", "approach_case.json")
+        answer, solution, resim = solve_case(case, str(case_path))
+        arrays = _arrays(solution, resim)
+        if replay:
+            answer["replay"], more = _replay(case, solution, resim)
+            arrays.update(more)
+        results.atomic_write_npz(out / "approach.npz", arrays)
+        results.atomic_write_json(out / "approach.json", answer)
+        pngs = write_plots(out, answer, arrays)
+        folder.add_files("approach.npz", "approach.json", *pngs)
+    folder.finish("complete")
     return answer
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from riskassess.report.plotting import legend, panels, plt, write_png
+from riskassess.report.plotting import legend, panels, plain, plt, write_png
 
 
 def trajectory_figure(answer: dict, arrays: dict):
@@ -26,7 +26,7 @@ def trajectory_figure(answer: dict, arrays: dict):
     ax.set_aspect("equal")
     ax.set_xlabel("x (m, world)")
     ax.set_ylabel("y (m, world)")
-    ax.set_title(f"{answer['case']}: t_f = {answer['final_time']:.4g} s, fuel {answer['fuel_kg']:.4g} kg")
+    ax.set_title(f"{plain(answer['case'])}: t_f = {answer['final_time']:.4g} s, fuel {answer['fuel_kg']:.4g} kg")
     legend(ax)
     return fig
 

@@ -6,11 +6,13 @@ import json
 import sys
 from pathlib import Path
 
-from riskassess.case import Case, CaseError, load_case
-from multibody.health import SimulationFailed
-from riskassess.results import MissingData
 from rich.markup import escape
+from rich.text import Text
 
+from multibody.health import SimulationFailed
+from riskassess.case import Case, CaseError, load_case
+from riskassess.outfolder import OutputRefused, default_out, step_done
+from riskassess.results import MissingData, RunFolder
 
 #: Exit codes (docs/outputs.md): 0 done; 1 a product after a finished run failed; 2 invalid input or
 #: refused output; 3 perceive: not observable; 4 approach: constraints not met; 5 the simulation
@@ -26,13 +28,15 @@ def _cmd_run(args) -> int:
 
     case = load_case(args.case)  # fail fast on a bad case, before any output folder exists
     _check_work(impact_estimate_of(case), args)
-    out = Path(args.out) if args.out else Path("runs") / case.name
+    out = Path(args.out) if args.out else default_out(case.name)
     end = case.simulation.end_time
     columns = [TextColumn("[bold]simulating[/bold] {task.fields[t]:.3f} / %.3g s" % end), BarColumn(),
                TimeElapsedColumn(), TimeRemainingColumn()]
+    steps = _steps(args)
     with Progress(*columns, disable=args.json or not sys.stderr.isatty(), transient=True) as bar:
         task = bar.add_task("run", total=end, t=0.0)
-        result = run_case(args.case, out, progress=lambda t: bar.update(task, completed=t, t=t), case=case)
+        result = run_case(args.case, out, progress=lambda t: bar.update(task, completed=t, t=t), case=case,
+                          overwrite=args.overwrite, pending=steps, command=args.command)
     if args.json:
         extra = {"structures": result.structures} if result.structures is not None else {}
         print(json.dumps({**result.summary, **extra}, indent=2))
@@ -40,7 +44,7 @@ def _cmd_run(args) -> int:
         print_summary(result.summary, result.run_dir)
         if result.structures is not None:
             print_verdict(result.structures)
-    status = _products(result.run_dir, args.report, args.vtk, quiet=args.json)
+    status = _products(result.run_dir, steps, quiet=args.json)
     if result.structures is not None and result.structures.get("debris_state") == "indeterminate":
         return EXIT_INDETERMINATE  # a script must not read "no verdict" as success
     return status
@@ -63,18 +67,29 @@ def _check_work(estimate, args) -> None:
         print(estimate.text(), file=sys.stderr)
 
 
-def _products(run_dir: Path, report: bool, vtk: bool, quiet: bool = False) -> int:
-    """Report and VTK export after a run; a failure here keeps the finished run folder."""
+def _steps(args) -> list[str]:
+    """The product steps a simulation command was asked for, in the order they run."""
+    return [step for step, wanted in (("report", args.report), ("vtk", args.vtk)) if wanted]
+
+
+def _products(run_dir: Path, steps, quiet: bool = False, make=None) -> int:
+    """Product steps (report, VTK export) from a finished run folder, each recorded in its manifest
+    (:func:`riskassess.outfolder.step_done`); a failure keeps the finished results: exit code 1
+    (2 when the step's output is refused)."""
     status = 0
-    for wanted, make in ((report, _make_report), (vtk, _make_vtk)):
-        if not wanted:
-            continue
+    for step in steps:
         try:
-            make(run_dir, quiet=quiet)
-        except (ValueError, OSError, MissingData) as exc:
-            print(f"error: {exc}\n(the run folder {run_dir} is complete; retry this step alone with "
-                  f"'riskassess {'report' if make is _make_report else 'export-vtk'} {run_dir}')", file=sys.stderr)
+            (make or {"report": _make_report, "vtk": _make_vtk}[step])(run_dir, quiet=quiet)
+        except OutputRefused as exc:
+            step_done(run_dir, step, exc)
+            raise
+        except Exception as exc:  # any failure of a product: the results stay readable, the manifest says so
+            step_done(run_dir, step, exc)
+            print(f"error: {type(exc).__name__}: {exc}\n(the results in {run_dir} are kept; retry this step alone "
+                  f"with 'riskassess {'report' if step == 'report' else 'export-vtk'} {run_dir}')", file=sys.stderr)
             status = 1
+        else:
+            step_done(run_dir, step)
     return status
 
 
@@ -100,12 +115,13 @@ def _make_report(run_dir: Path, pdf: bool = True, quiet: bool = False):
     return out
 
 
-def _make_vtk(run_dir: Path, out=None, every: int = 1, quiet: bool = False):
+def _make_vtk(run_dir: Path, out=None, every: int = 1, quiet: bool = False, overwrite: bool = False):
     from riskassess.vtk_export import export_vtk
 
     with _progress_bar("VTK export", quiet) as bar:
         task = bar.add_task("frames", total=None)
-        result = export_vtk(run_dir, out, every, progress=lambda k, n: bar.update(task, completed=k, total=n))
+        result = export_vtk(run_dir, out, every, progress=lambda k, n: bar.update(task, completed=k, total=n),
+                            overwrite=overwrite)
     if not quiet:
         print(f"VTK: {result.pvd} ({result.n_frames} frames, {result.times[0]:g}-{result.times[-1]:g} s); "
               f"open it in ParaView")
@@ -113,13 +129,15 @@ def _make_vtk(run_dir: Path, out=None, every: int = 1, quiet: bool = False):
 
 
 def _cmd_report(args) -> int:
-    _make_report(Path(args.run_dir), pdf=not args.no_pdf)
-    return 0
+    RunFolder(args.run_dir)   # not a run folder: exit code 2 before anything is written
+    return _products(Path(args.run_dir), ["report"],
+                     make=lambda run_dir, quiet: _make_report(run_dir, pdf=not args.no_pdf, quiet=quiet))
 
 
 def _cmd_export_vtk(args) -> int:
-    _make_vtk(Path(args.run_dir), args.out, args.every)
-    return 0
+    RunFolder(args.run_dir)
+    return _products(Path(args.run_dir), ["vtk"], make=lambda run_dir, quiet: _make_vtk(
+        run_dir, args.out, args.every, quiet=quiet, overwrite=args.overwrite))
 
 
 def _cmd_assess(args) -> int:
@@ -135,19 +153,20 @@ def _cmd_perceive(args) -> int:
 
     case = load_case(args.case)
     _check_work(impact_estimate_of(case), args)
-    out = Path(args.out) if args.out else Path("runs") / f"{case.name}"
+    out = Path(args.out) if args.out else default_out(case.name)
+    steps = _steps(args)
     with _progress_bar("perceive", args.json) as bar:
         task = bar.add_task("", total=None)
 
         def progress(stage, done, total):
             bar.update(task, description=stage, completed=done, total=total)
 
-        answer = perceive_case(args.case, out, progress=progress, case=case)
+        answer = perceive_case(args.case, out, progress=progress, case=case, overwrite=args.overwrite, pending=steps)
     if args.json:
         print(json.dumps(answer, indent=2))
     else:
         print_perception(answer, out)
-    status = _products(out, args.report, args.vtk, quiet=args.json)
+    status = _products(out, steps, quiet=args.json)
     return 3 if answer["not_observable"] and status == 0 else status
 
 
@@ -158,8 +177,8 @@ def _cmd_tow(args) -> int:
 
     case = load_model(args.case, TowingCase)
     _check_work(tow_estimate_of(case), args)
-    out = Path(args.out) if args.out else Path("runs") / case.name
-    summary = tow_case(args.case, out, case=case)
+    out = Path(args.out) if args.out else default_out(case.name)
+    summary = tow_case(args.case, out, case=case, overwrite=args.overwrite)
     if args.json:
         print(json.dumps(summary, indent=2))
     else:
@@ -192,11 +211,11 @@ def _cmd_identify(args) -> int:
     if not args.benchmark:
         from riskassess.identify_fullnet import identify_full_net
 
-        out = Path(args.out) if args.out else Path("runs") / f"{case.name}_identify_fullnet"
-        answer = identify_full_net(args.case, out, case)
+        out = Path(args.out) if args.out else default_out(case.name, "_identify_fullnet")
+        answer = identify_full_net(args.case, out, case, overwrite=args.overwrite)
     else:
-        out = Path(args.out) if args.out else Path("runs") / f"{case.name}_identify"
-        answer = benchmark_case(args.case, out, case=case)
+        out = Path(args.out) if args.out else default_out(case.name, "_identify")
+        answer = benchmark_case(args.case, out, case=case, overwrite=args.overwrite)
     if args.json:
         print(json.dumps(answer, indent=2))
         return 0
@@ -215,30 +234,34 @@ def print_perception(answer: dict, out: Path) -> None:
     from riskassess.tables import perception_rows
 
     console = _console()
-    console.print(_table(f"{answer['case']}: debris mass and inertia from LiDAR and the net collision",
+    console.print(_table(f"{escape(answer['case'])}: debris mass and inertia from LiDAR and the net collision",
                          ("quantity", "estimate", "1 sigma", "error vs truth"), perception_rows(answer),
                          {"estimate": "right", "1 sigma": "right", "error vs truth": "right"}))
     if answer["not_observable"]:
-        console.print(f"[red]not observable[/red]: {answer['not_observable']}")
-    console.print(f"results: {out}")
+        console.print(f"[red]not observable[/red]: {escape(str(answer['not_observable']))}")
+    console.print(f"results: {escape(str(out))}")
 
 
 def _table(title: str, columns, rows, justify=None):
+    """A rich table; ``title`` is markup (user text in it escaped by the caller), every string cell
+    is shown literally (names are user text); a cell that is a rich ``Text`` keeps its style."""
     from rich.table import Table
 
     table = Table(title=title)
     for k, column in enumerate(columns):
         # the first column names the row: never cut it
-        table.add_column(column, justify=(justify or {}).get(column, "left"), no_wrap=k == 0)
+        table.add_column(escape(column), justify=(justify or {}).get(column, "left"), no_wrap=k == 0)
     for row in rows:
-        table.add_row(*row)
+        table.add_row(*(cell if isinstance(cell, Text) else Text(str(cell)) for cell in row))
     return table
 
 
 def _console():
+    """The terminal: markup only where the CLI writes it, every user string passed through
+    ``escape`` (issue 20: ``x[/red]`` in a name crashed, ``[link=...]`` was followed); no emoji codes."""
     from rich.console import Console
 
-    return Console(width=None if sys.stdout.isatty() else 150)
+    return Console(width=None if sys.stdout.isatty() else 150, emoji=False)
 
 
 def print_verdict(verdict: dict) -> None:
@@ -246,15 +269,15 @@ def print_verdict(verdict: dict) -> None:
     from riskassess.tables import STATE_TEXT, VERDICT_COLUMNS, debris_line, piece_fate, verdict_rows
 
     console = _console()
-    marked = {"fails": "[red]FAIL[/red]", "indeterminate": "[yellow]indeterminate[/yellow]"}
+    marked = {"fails": Text("FAIL", style="red"), "indeterminate": Text("indeterminate", style="yellow")}
     rows = [[marked.get(r["state"], STATE_TEXT[r["state"]]) if c == "fails?" else r[c] for c in VERDICT_COLUMNS]
             for r in verdict_rows(verdict)]
     right = {c: "right" for c in ("max demand", "at", "allowable", "margin", "likelihood")}
     console.print(_table(f"structural verdict (loads after {verdict['skip_initial_s']:g} s; range allowables "
-                         f"decide at their '{verdict['release_policy']}' value)", VERDICT_COLUMNS, rows,
+                         f"decide at their '{escape(str(verdict['release_policy']))}' value)", VERDICT_COLUMNS, rows,
                          {**right, "fails?": "center"}))
     for p in verdict["released_pieces"]:
-        console.print(f"released {'+'.join(p['bodies'])}: {piece_fate(p)}")
+        console.print(f"released {escape('+'.join(p['bodies']))}: {escape(piece_fate(p))}")
     if verdict["released_pieces"]:
         console.print("likelihoods of released locations are lower bounds: their loads after release are not known")
     line = escape(debris_line(verdict))
@@ -266,9 +289,9 @@ def print_summary(summary: dict, run_dir: Path) -> None:
     from riskassess.tables import summary_rows
 
     console = _console()
-    console.print(_table(f"{summary['case']}: coupled net impact", ("quantity", "this run", "paper (decoupled)"),
+    console.print(_table(f"{escape(summary['case'])}: coupled net impact", ("quantity", "this run", "paper (decoupled)"),
                          summary_rows(summary), {"this run": "right", "paper (decoupled)": "right"}))
-    console.print(f"results: {run_dir}")
+    console.print(f"results: {escape(str(run_dir))}")
 
 
 def _cmd_diagnose(args) -> int:
@@ -284,7 +307,8 @@ def _cmd_diagnose(args) -> int:
     with _progress_bar("diagnose", args.json) as bar:
         task = bar.add_task("", total=None)
         answer = diagnose_case(args.case, args.measured, args.out, noise, progress=lambda stage, done, total:
-                               bar.update(task, description=stage, completed=done, total=total))
+                               bar.update(task, description=stage, completed=done, total=total),
+                               overwrite=args.overwrite)
     if args.json:
         print(json.dumps(answer, indent=2, default=float))
     else:
@@ -301,7 +325,7 @@ def _cmd_diagnose(args) -> int:
                                                                                            "does not predict")):
             if answer["channels"][key]:
                 print(f"{label}: {', '.join(answer['channels'][key])}")
-        print(f"results: {args.out or 'runs/' + answer['case'] + '-diagnosis'}")
+        print(f"results: {args.out or default_out(answer['case'], '-diagnosis')}")
     return 0
 
 
@@ -311,8 +335,8 @@ def _cmd_approach(args) -> int:
     from riskassess.case import load_model
 
     case = load_model(args.case, ApproachCase)
-    out = Path(args.out) if args.out else Path("runs") / case.name
-    answer = approach_case(args.case, out, replay=args.replay, case=case)
+    out = Path(args.out) if args.out else default_out(case.name)
+    answer = approach_case(args.case, out, replay=args.replay, case=case, overwrite=args.overwrite)
     if args.json:
         print(json.dumps(answer, indent=2))
     else:
@@ -443,6 +467,7 @@ def build_parser() -> argparse.ArgumentParser:
     diagnose.add_argument("case", help="diagnosis case file (TOML, kind tumbling_rigid or hinged_appendage)")
     diagnose.add_argument("--measured", required=True, help="measured data (CSV: time, then named channels, SI)")
     diagnose.add_argument("--out", help="output folder (default runs/<case name>-diagnosis)")
+    diagnose.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     diagnose.add_argument("--json", action="store_true", help="print the diagnosis (cause, confidence, parameters, "
                                                               "rmse_before, rmse_after, gain_percent) as JSON")
     diagnose.add_argument("--noise", action="append", default=[], metavar="CHANNEL=SIGMA",
@@ -470,7 +495,10 @@ def build_parser() -> argparse.ArgumentParser:
     report.set_defaults(func=_cmd_report)
     vtk = sub.add_parser("export-vtk", help="write the impact as VTK files and a ParaView collection (impact.pvd)")
     vtk.add_argument("run_dir", help="run folder written by 'riskassess run'")
-    vtk.add_argument("--out", help="output folder (default RUN_DIR/vtk)")
+    vtk.add_argument("--out", help="output folder (default RUN_DIR/vtk): new, empty, or this run's earlier export "
+                                   "with --overwrite")
+    vtk.add_argument("--overwrite", action="store_true", help="replace this run's earlier export in that folder "
+                                                              "(only the files its manifest lists)")
     vtk.add_argument("--every", type=int, default=1, help="export every N-th net snapshot (default 1: all)")
     vtk.set_defaults(func=_cmd_export_vtk)
     sweep = sub.add_parser("sweep", help="run a grid / Monte Carlo of cases on Dask; results survive interruption; "
@@ -509,11 +537,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+OVERWRITE_HELP = ("replace this case's earlier output in --out: only the files its manifest lists are removed "
+                  "(see docs/outputs.md)")
+
+
 def _case_command(sub, name, func, help_text, case_help, json_help, out_default="runs/<case name>"):
     """A command that runs a stage on one case file into an output folder; returns its parser."""
     parser = sub.add_parser(name, help=help_text)
     parser.add_argument("case", help=case_help)
-    parser.add_argument("--out", help=f"output folder (default {out_default})")
+    parser.add_argument("--out", help=f"output folder (default {out_default}); new, empty, or this case's "
+                                      f"earlier output with --overwrite")
+    parser.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)
     parser.add_argument("--json", action="store_true", help=json_help)
     parser.set_defaults(func=func)
     return parser

@@ -8,8 +8,10 @@ held-out part and select (:mod:`diagnosis.selection`); analyse the residuals bef
 
 Writes into the output folder (default ``runs/<case name>-diagnosis``), each file atomically:
 ``diagnosis.json`` (the answer), ``diagnosis.npz`` (time series behind the plots), PNG plots,
-``case.toml`` (the input case) and, when a cause is named, the extended case, also written next
-to the input case as ``<case stem>.extended.toml``; ``manifest.json`` last.
+``case.toml`` (the input case) and, when a cause is named, the extended case
+``<case stem>.extended.toml`` (only there: nothing is written beside the input case). The folder is
+claimed before the fits start (:func:`riskassess.outfolder.claim`), its manifest ``running`` until
+the last file is written.
 """
 from __future__ import annotations
 
@@ -32,6 +34,7 @@ from diagnosis.threads import single_threaded_blas
 from riskassess import results
 from riskassess.case import read_toml
 from riskassess.diagnosis_case import load_diagnosis_case, toml_text
+from riskassess.outfolder import OutputFolder, claim, default_out, safe_name
 
 #: Worker processes fitting candidates in parallel (the issue's 2-core machine).
 WORKERS = 2
@@ -177,19 +180,34 @@ def _without_diverged(problem: Problem, fits: dict, predictions: dict):
 
 
 def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = None, workers: int = WORKERS,
-                  progress=None, candidates: list[str] | None = None, figures: bool = True) -> dict:
+                  progress=None, candidates: list[str] | None = None, figures: bool = True,
+                  overwrite: bool = False) -> dict:
     """Run the diagnosis; returns the answer (also written to ``diagnosis.json``). ``candidates``: the
     effect ids to fit (default: the whole catalog; the applicable ones among them are fitted);
-    ``figures``: write the PNG plots (the report needs them; tests about the answer leave them out)."""
-    wall = time.perf_counter()
+    ``figures``: write the PNG plots (the report needs them; tests about the answer leave them out);
+    ``out_dir`` default ``runs/<safe case name>-diagnosis``."""
     case_path = Path(case_path)
     case = load_diagnosis_case(case_path)
     measured = read_measured(measured_path, noise)
-    out = Path(out_dir) if out_dir else Path("runs") / f"{case.name}-diagnosis"
     problem = Problem.build(case, measured, case.diagnosis.holdout_fraction)
     if not problem.channels:
         raise ValueError(f"{measured_path}: none of its channels ({', '.join(measured.channels)}) is predicted by the "
                          f"'{case.kind}' scenario ({', '.join(scenario_channels(problem.plant))})")
+    folder = claim(out_dir or default_out(case.name, "-diagnosis"), case.name, "diagnose", overwrite, stage="diagnose")
+    with folder.recording():
+        results.atomic_write_bytes(folder.path / "case.toml", case_path.read_bytes())
+        folder.add_files("case.toml", *_copy_towing_reference(folder.path, case_path))
+        answer, data = _diagnose(case, case_path, measured, measured_path, problem, workers, progress, candidates)
+        _write(folder, case_path, answer, data, figures)
+    folder.finish("complete")
+    return answer
+
+
+def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, workers, progress,
+              candidates) -> tuple[dict, tuple]:
+    """Fit, score, select and analyse (module docstring); returns the answer and the data behind the
+    files (problem, predictions, chosen model, residuals before and after, extended case text)."""
+    wall = time.perf_counter()
     not_applicable = {k: e.not_applicable(case, problem.channels) for k, e in CATALOG.items()}
     not_applicable = {k: v for k, v in not_applicable.items() if v}
     fitted = [k for k in CATALOG if k not in not_applicable and (candidates is None or k in candidates)]
@@ -232,8 +250,7 @@ def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = N
     extended = extended_case(case_path, problem, fits[chosen]) if chosen != "nominal" and \
         decision["cause"] == chosen else None
     answer["wall_s"] = time.perf_counter() - wall
-    _write(out, case_path, answer, problem, predictions, chosen, before, after, extended, figures)
-    return answer
+    return answer, (problem, predictions, chosen, before, after, extended)
 
 
 def _unfitted(problem: Problem) -> FitResult:
@@ -253,23 +270,17 @@ def _copy_towing_reference(out: Path, case_path: Path) -> list[str]:
     return [name]
 
 
-def _write(out: Path, case_path: Path, answer, problem, predictions, chosen, before, after, extended,
-           figures: bool = True) -> None:
+def _write(folder: OutputFolder, case_path: Path, answer, data: tuple, figures: bool = True) -> None:
+    """The diagnosis files into the claimed ``folder``; the extended case only there."""
     from riskassess.report.diagnosis import write_figures
 
-    out.mkdir(parents=True, exist_ok=True)
-    files = ["case.toml", "diagnosis.json", "diagnosis.npz"]
-    results.atomic_write_bytes(out / "case.toml", case_path.read_bytes())
-    files += _copy_towing_reference(out, case_path)
+    problem, predictions, chosen, before, after, extended = data
+    out = folder.path
+    files = ["diagnosis.json", "diagnosis.npz"]
     if extended is not None:
-        target = case_path.with_name(f"{case_path.stem}.extended.toml")
-        results.atomic_write_bytes(out / target.name, extended.encode())
+        target = out / f"{safe_name(case_path.stem)}.extended.toml"
+        results.atomic_write_bytes(target, extended.encode())
         files.append(target.name)
-        try:
-            results.atomic_write_bytes(target, extended.encode())
-        except OSError as exc:   # a read-only case folder: the copy in the output folder is the result
-            answer["extended_case_note"] = f"not written next to the case ({exc}); see the output folder"
-            target = out / target.name
         answer["extended_case"] = str(target)
     arrays = {"time": problem.time, "train": problem.train, "channels": np.array(problem.channels)}
     for c in problem.channels:
@@ -282,10 +293,7 @@ def _write(out: Path, case_path: Path, answer, problem, predictions, chosen, bef
     if figures:
         files += write_figures(out, answer, arrays)
     results.atomic_write_json(out / "diagnosis.json", answer)
-    manifest = {"format": results.FORMAT, "version": results.VERSION, "case": answer["case"], "stage": "diagnose",
-                "status": "complete", "files": files,
-                "created": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
-    results.atomic_write_json(out / "manifest.json", manifest)
+    folder.add_files(*files)
 
 
 __all__ = ["diagnose_case", "fit_candidates", "extended_case", "CHANNELS"]

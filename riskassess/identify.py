@@ -22,6 +22,7 @@ from __future__ import annotations
 import multiprocessing
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from pymoo.algorithms.soo.nonconvex.pattern import PatternSearch, calc_sign, exploration_move, pattern_move
@@ -37,6 +38,8 @@ from pymoo.termination.max_eval import MaximumFunctionCallTermination
 
 from multibody.towing import run_twin
 from multibody.towing_kernel import MT_TENSION
+from riskassess import results
+from riskassess.outfolder import OutputFolder, claim
 from riskassess.tow import towing_model
 from riskassess.towing_case import TowingCase
 
@@ -272,19 +275,39 @@ def benchmark(case: TowingCase, optimizers=None, rates=None, end_time=None, work
     return out
 
 
-def benchmark_case(case_path, out_dir, case: TowingCase | None = None, end_time=None) -> dict:
+def benchmark_case(case_path, out_dir, case: TowingCase | None = None, end_time=None,
+                   overwrite: bool = False) -> dict:
     """`riskassess identify CASE --benchmark`: run :func:`benchmark` and write ``identification.json``
-    (every run, history included), ``convergence.png`` and a manifest to ``out_dir``; returns the
-    answer with the best run's ``s``, ``cost``, ``optimizer`` and ``wall_s`` on top."""
-    from pathlib import Path
-
-    from riskassess import results
+    (every run, history included), ``convergence.png`` and a manifest to ``out_dir`` (claimed by
+    :func:`riskassess.outfolder.claim`); returns the answer with the best run's ``s``, ``cost``,
+    ``optimizer`` and ``wall_s`` on top."""
     from riskassess.case import load_model
-    from riskassess.towing_plots import plot_convergence
 
     case = case or load_model(case_path, TowingCase)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    folder = claim_identify_folder(out_dir, case_path, case.name, overwrite)
+    with folder.recording():
+        answer = _benchmark_into(case, folder, end_time)
+    folder.finish("complete")
+    return answer
+
+
+def claim_identify_folder(out_dir, case_path, case_name: str, overwrite: bool) -> OutputFolder:
+    """Claim the folder of `riskassess identify` and copy the case into it; on ``overwrite`` the cached
+    full-net runs (``fullnet/``) stay when the folder's ``case.toml`` is byte-identical to the case file."""
+    out, case_path = Path(out_dir), Path(case_path)
+    same_case = (out / "case.toml").is_file() and (out / "case.toml").read_bytes() == case_path.read_bytes()
+    folder = claim(out, case_name, "identify", overwrite, stage="identify",
+                   keep=(lambda name: name.startswith("fullnet/")) if same_case else None)
+    with folder.recording():
+        results.atomic_write_bytes(folder.path / "case.toml", case_path.read_bytes())
+        folder.add_files("case.toml")
+    return folder
+
+
+def _benchmark_into(case: TowingCase, folder: OutputFolder, end_time) -> dict:
+    from riskassess.towing_plots import plot_convergence
+
+    out = folder.path
     start = time.perf_counter()
     answer = benchmark(case, end_time=end_time)
     best = min(answer["runs"].values(), key=lambda r: r["cost"])
@@ -294,7 +317,5 @@ def benchmark_case(case_path, out_dir, case: TowingCase | None = None, end_time=
     plot_convergence({name: (np.arange(1, len(r["history"]) + 1), np.maximum(r["history"], 1e-12))
                       for name, r in answer["runs"].items()}, out / "convergence.png",
                      f"{case.name}: Sec. 4.3 benchmark, cost {answer['cost_function']}")
-    results.atomic_write_json(out / "manifest.json", {"format": "riskassess-identify", "version": 1, "case": case.name,
-                                                      "status": "complete",
-                                                      "files": ["identification.json", "convergence.png"]})
+    folder.add_files("identification.json", "convergence.png")
     return answer

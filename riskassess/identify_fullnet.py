@@ -25,7 +25,8 @@ import numpy as np
 
 from riskassess import results
 from riskassess.case import CaseError
-from riskassess.identify import COSTS, rmse, simulate
+from riskassess.identify import COSTS, claim_identify_folder, rmse, simulate
+from riskassess.outfolder import OutputFolder
 from riskassess.towing_case import TowingCase
 
 CHANNELS = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
@@ -47,8 +48,9 @@ def _run_full_net(task):
             "node_start_inertial": model.node_positions[model.net.central], "wall_s": result.wall_time}
 
 
-def full_net_runs(case: TowingCase, rates, out: Path, end, workers) -> list[dict]:
-    """Full-net runs at ``rates`` (deg/s), read from ``out``'s cache where present (same end time)."""
+def full_net_runs(case: TowingCase, rates, out: Path, end, workers, record=None) -> list[dict]:
+    """Full-net runs at ``rates`` (deg/s), read from ``out``'s cache where present (same end time);
+    ``record(relative path)`` is told of each new cache file (the output folder lists it)."""
     from riskassess.tow_fullnet import wrapped_net
 
     cache = out / "fullnet"
@@ -61,6 +63,8 @@ def full_net_runs(case: TowingCase, rates, out: Path, end, workers) -> list[dict
             # each run cached as soon as it is done: an interrupted call keeps the finished ones
             for run in pool.imap_unordered(_run_full_net, [(case, wrapped, r, end) for r in missing]):
                 results.atomic_write_npz(path[run["rate_deg_s"]], run)
+                if record:
+                    record(path[run["rate_deg_s"]].relative_to(out).as_posix())
     return [{k: (float(v) if v.ndim == 0 else v) for k, v in np.load(path[rate]).items()} for rate in rates]
 
 
@@ -97,13 +101,12 @@ def _entry(case: TowingCase, found, training: list[dict], validation: list[dict]
             "validation_totals": _totals(valid_rows), "training": train_rows, "validation": valid_rows}
 
 
-def identify_full_net(case_path, out_dir, case: TowingCase, optimizers=None) -> dict:
+def identify_full_net(case_path, out_dir, case: TowingCase, optimizers=None, overwrite: bool = False) -> dict:
     """Steps 1-3 of the module doc with ``optimizers`` (default ``identification.searches``) on the case's
     cost; writes ``identification.json`` (every optimizer's run), ``convergence.png`` and a manifest to
-    ``out_dir``. Returns the answer with the best run's ``s``, ``cost`` and ``optimizer`` on top."""
-    from riskassess.identify import run_optimizers
-    from riskassess.towing_plots import plot_convergence
-
+    ``out_dir`` (claimed by :func:`riskassess.outfolder.claim`; with ``overwrite`` the cached full-net runs
+    are kept when the folder's ``case.toml`` is the same file, byte for byte). Returns the answer with the
+    best run's ``s``, ``cost`` and ``optimizer`` on top."""
     fn = case.full_net
     if fn is None:
         raise CaseError(f"{case_path}: identification against full-net runs needs a [full_net] section")
@@ -111,13 +114,25 @@ def identify_full_net(case_path, out_dir, case: TowingCase, optimizers=None) -> 
         raise CaseError(f"{case_path}: full_net.start = 'capture' is not supported by 'riskassess identify': its "
                          f"lower-order runs would each need their own start state (the full-net state at "
                          f"simulation.start_time, Sec. 4.1), which riskassess.identify does not take; use 'wrapped'")
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    folder = claim_identify_folder(out_dir, case_path, case.name, overwrite)
+    with folder.recording():
+        answer = _identify(case, folder, optimizers)
+    folder.finish("complete")
+    return answer
+
+
+def _identify(case: TowingCase, folder: OutputFolder, optimizers) -> dict:
+    """Steps 1-3 into the claimed ``folder``; returns the answer."""
+    from riskassess.identify import run_optimizers
+    from riskassess.towing_plots import plot_convergence
+
+    fn, out = case.full_net, folder.path
     end = fn.identification_end_time or case.simulation.end_time
     training = case.rates.training_deg_s[:fn.identification_training_runs]
     validation = case.rates.validation_deg_s[:fn.identification_validation_runs]
     start = time.perf_counter()
-    data = full_net_runs(case, list(training) + list(validation), out, end, case.identification.workers)
+    data = full_net_runs(case, list(training) + list(validation), out, end, case.identification.workers,
+                         record=folder.add_files)
     data_wall = time.perf_counter() - start
     lower = lower_order_case(case, data[0])
     train, valid = data[:len(training)], data[len(training):]
@@ -131,7 +146,5 @@ def identify_full_net(case_path, out_dir, case: TowingCase, optimizers=None) -> 
     results.atomic_write_json(out / "identification.json", answer)
     plot_convergence({name: (np.arange(1, len(r["history"]) + 1), np.asarray(r["history"])) for name, r in runs.items()},
                      out / "convergence.png", f"{case.name}: against full-net runs, cost {case.identification.cost}")
-    results.atomic_write_json(out / "manifest.json", {"format": "riskassess-identify", "version": 1, "case": case.name,
-                                                      "status": "complete",
-                                                      "files": ["identification.json", "convergence.png"]})
+    folder.add_files("identification.json", "convergence.png")
     return answer

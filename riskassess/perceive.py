@@ -47,7 +47,7 @@ from perception.shape import half_turn_symmetry_transforms, rotation_error
 from riskassess import results
 from riskassess.assemble import body_meshes_target_frame, model_inputs
 from riskassess.case import Case, CaseError, load_case
-from riskassess.pipeline import begin_run_folder, finish_simulation, record_failed_run
+from riskassess.pipeline import begin_run_folder, run_recorded, write_simulation
 
 #: Scan points farther than this from the predicted debris surface are not registered to it (m):
 #: a frame's motion is predicted to ~1 cm; net threads sit decimetres to metres in front.
@@ -548,16 +548,23 @@ def _tracking_figures(tracker, frames) -> dict:
     return figures
 
 
-def perceive_case(case_path, out_dir, progress=None, case: Case | None = None) -> dict:
-    """Run the perception stage of a case into ``out_dir`` (see module docstring); returns the
-    content of perception.json. A quantity the data cannot determine is reported under
+def perceive_case(case_path, out_dir, progress=None, case: Case | None = None, overwrite: bool = False,
+                  pending=()) -> dict:
+    """Run the perception stage of a case into ``out_dir`` (see module docstring; the folder is
+    claimed by :func:`riskassess.outfolder.claim`, ``pending`` as in :func:`riskassess.pipeline.run_case`);
+    returns the content of perception.json. A quantity the data cannot determine is reported under
     ``not_observable`` with the reason, never as a number."""
     case_path = Path(case_path)
     case = case or load_case(case_path)
     scene = Scene.from_case(case, case_path.parent, str(case_path))
+    folder = begin_run_folder(Path(out_dir), case_path, case, overwrite, "perceive")
+    with folder.recording():
+        return _perceive(case, scene, folder, progress, pending)
+
+
+def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
+    """The stage's body (module docstring) into the claimed ``folder``."""
     p = case.perception
-    out = Path(out_dir)
-    manifest = begin_run_folder(out, case_path, case)
     rng = np.random.default_rng(p.seed)
     symmetry_transforms = half_turn_symmetry_transforms(scene.mesh_target, 0.5 * p.registration.voxel)
     tracker = DebrisTracker(p.registration.voxel, p.registration.max_correspondence, p.registration.model_frames,
@@ -576,19 +583,14 @@ def perceive_case(case_path, out_dir, progress=None, case: Case | None = None) -
     except NotObservable as exc:
         # Nothing to scale by the collision: stop before simulating it.
         answer["not_observable"] = f"before the collision: {exc}"
-        manifest["status"] = "not_observable"
-        return _conclude(out, manifest, answer, tracker, frames, NetTrack(), None, wall)
+        return _conclude(folder, answer, tracker, frames, NetTrack(), None, wall, pending)
 
     collision = collision_case(case, scene.truth["com_target"], *state_at_zero, scene.spec.rate)
     inputs = model_inputs(collision, scene.base)
     simulation = ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
-    try:
-        recorder = simulation.run(progress=(lambda t: progress("simulation", t, case.simulation.end_time))
-                                  if progress else None)
-    except BaseException as exc:
-        record_failed_run(out, manifest, exc, simulation)
-        raise
-    finish_simulation(out, manifest, recorder, simulation, collision)
+    recorder = run_recorded(simulation, folder, progress=(lambda t: progress("simulation", t, case.simulation.end_time))
+                            if progress else None)
+    write_simulation(folder, recorder, simulation, collision)
     assembly = simulation.assembly
     with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
         track = observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembly, progress)
@@ -605,18 +607,20 @@ def perceive_case(case_path, out_dir, progress=None, case: Case | None = None) -
     except NotObservable as exc:
         answer["not_observable"] = f"after the collision: {exc}"
     answer.update(estimates(scene, before, after, step, state_at_zero))
-    return _conclude(out, manifest, answer, tracker, frames, track, assembly, wall)
+    return _conclude(folder, answer, tracker, frames, track, assembly, wall, pending)
 
 
-def _conclude(out, manifest, answer, tracker, frames, track: NetTrack, assembly, wall) -> dict:
-    """Add the timing and tracking figures (and the net's, after a collision run) to the answer
-    and write the perception files."""
+def _conclude(folder, answer, tracker, frames, track: NetTrack, assembly, wall, pending) -> dict:
+    """Add the timing and tracking figures (and the net's, after a collision run) to the answer,
+    write the perception files and finish the folder: ``complete`` after the collision run (a
+    quantity not observable after it is named in the answer), ``not_observable`` before it."""
     answer.update(_timing(tracker, frames))
     answer["tracking"] = _tracking_figures(tracker, frames)
     if assembly is not None:
         answer["net"] = _net_figures(track, assembly)
     answer["wall_s"] = time.perf_counter() - wall
-    _write_perception(out, manifest, answer, tracker, frames, track)
+    _write_perception(folder, answer, tracker, frames, track)
+    folder.finish("complete" if assembly is not None else "not_observable", pending)
     return answer
 
 
@@ -626,7 +630,8 @@ def _net_figures(track: NetTrack, assembly) -> dict:
             "returns_per_frame_mean": float(np.mean(track.n_points)), "mass_kg": float(assembly.net.masses.sum())}
 
 
-def _write_perception(out, manifest, answer, tracker, frames, track: NetTrack) -> None:
+def _write_perception(folder, answer, tracker, frames, track: NetTrack) -> None:
+    out = folder.path
     poses = np.array([a.body_to_world for a in tracker.alignments])
     results.atomic_write_npz(out / "perception.npz", {
         "time": np.array(frames.time), "phase": np.array(frames.phase), "ok": np.array([a.ok for a in tracker.alignments]),
@@ -637,5 +642,4 @@ def _write_perception(out, manifest, answer, tracker, frames, track: NetTrack) -
         "net_time": np.array(track.times), "net_positions_world": np.array(track.positions),
         "net_true_positions_world": np.array(track.true_positions), "net_separation_m": np.array(track.separation)})
     results.atomic_write_json(out / "perception.json", answer)
-    manifest["files"] += ["perception.json", "perception.npz"]
-    results.atomic_write_json(out / "manifest.json", manifest)
+    folder.add_files("perception.json", "perception.npz")

@@ -4,9 +4,7 @@ Later stages (structures, reports, VTK) read the run folder; nothing here re-run
 """
 from __future__ import annotations
 
-import datetime
 import platform
-import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,9 +15,9 @@ from multibody.impact import ImpactSimulation
 from riskassess import results
 from riskassess.assemble import model_inputs, weak_locations
 from riskassess.case import Case, load_case
+from riskassess.outfolder import OutputFolder, claim
 from riskassess.summary import run_summary
 from structures.release import ReleaseMonitor
-from multibody.health import SimulationFailed
 from structures.verdict import INDETERMINATE, demand_series, structures_verdict
 
 
@@ -45,23 +43,23 @@ def prepare_simulation(case: Case, case_path: Path) -> ImpactSimulation:
     return ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
 
 
-def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Case | None = None) -> RunOutput:
-    """Load (unless ``case`` is the already validated file), simulate and write the run folder."""
+def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Case | None = None,
+             overwrite: bool = False, pending=(), command: str = "run") -> RunOutput:
+    """Load (unless ``case`` is the already validated file), claim the output folder
+    (:func:`riskassess.outfolder.claim`), simulate and write the run folder. ``pending``: product
+    steps (``report``, ``vtk``) the caller makes next; the status stays ``running`` until they end."""
     case_path = Path(case_path)
     case = case or load_case(case_path)
     simulation = prepare_simulation(case, case_path)
-    out = Path(out_dir)
-    manifest = begin_run_folder(out, case_path, case)
-    locations = weak_locations(case, simulation.assembly)
-    monitor = None
-    if locations and case.structures.release != "never":
-        monitor = ReleaseMonitor(locations, simulation.system, case.structures.skip_initial, case.structures.release)
-    try:
-        recorder = simulation.run(progress=progress, monitor=monitor)
-    except BaseException as exc:
-        record_failed_run(out, manifest, exc, simulation)
-        raise
-    summary = finish_simulation(out, manifest, recorder, simulation, case)
+    folder = begin_run_folder(Path(out_dir), case_path, case, overwrite, command)
+    with folder.recording():
+        locations = weak_locations(case, simulation.assembly)
+        monitor = None
+        if locations and case.structures.release != "never":
+            monitor = ReleaseMonitor(locations, simulation.system, case.structures.skip_initial,
+                                     case.structures.release)
+        recorder = run_recorded(simulation, folder, progress=progress, monitor=monitor)
+        summary = write_simulation(folder, recorder, simulation, case)
     verdict = None
     if locations:
         # A later stage that fails leaves the finished simulation results and says so.
@@ -69,52 +67,46 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
             verdict = structures_verdict(
                 locations, recorder.series, simulation.assembly, monitor.events if monitor else [],
                 recorder.net["positions_lvlh"][-1], case.structures.skip_initial, case.structures.release)
-            results.atomic_write_npz(out / "structures.npz", demand_series(locations, recorder.series))
-            results.atomic_write_json(out / "structures.json", verdict)
-        except Exception as exc:
-            manifest.update(status="structures_failed", error=f"{type(exc).__name__}: {exc}")
-            results.atomic_write_json(out / "manifest.json", manifest)
+            results.atomic_write_npz(folder.path / "structures.npz", demand_series(locations, recorder.series))
+            results.atomic_write_json(folder.path / "structures.json", verdict)
+        except BaseException as exc:
+            folder.fail("structures_failed", exc)
             raise
-        manifest["files"] += ["structures.json", "structures.npz"]
-        results.atomic_write_json(out / "manifest.json", manifest)
-    return RunOutput(out, summary, verdict)
+        folder.add_files("structures.json", "structures.npz")
+    folder.finish("complete", pending)
+    return RunOutput(folder.path, summary, verdict)
 
 
-def record_failed_run(out: Path, manifest: dict, exc: BaseException, simulation: ImpactSimulation) -> None:
-    """The manifest of a run whose simulation stopped: status 'failed' (numerical health, see
-    :mod:`multibody.health`) or 'interrupted' / 'error', the verdict 'indeterminate', and the reason."""
-    if isinstance(exc, SimulationFailed):
-        status = "failed"
-    elif isinstance(exc, KeyboardInterrupt):
-        status = "interrupted"
-    else:
-        status = "error"
-    manifest.update(status=status, debris_state=INDETERMINATE, error=f"{type(exc).__name__}: {exc}",
-                    health=simulation.health.summary())
-    results.atomic_write_json(out / "manifest.json", manifest)
+def run_recorded(simulation: ImpactSimulation, folder: OutputFolder, **run_options):
+    """``simulation.run(**run_options)``; when it stops (a failed health check, :mod:`multibody.health`,
+    or any error) the manifest also gets the verdict 'indeterminate' and the health record, and the
+    folder's recording marks it 'failed'."""
+    try:
+        return simulation.run(**run_options)
+    except BaseException:
+        folder.manifest.update(debris_state=INDETERMINATE, health=simulation.health.summary())
+        raise
 
 
-def begin_run_folder(out: Path, case_path: Path, case: Case) -> dict:
-    """Create the run folder with the case and a manifest saying 'running', so an interrupted
-    run is recognisable by later stages; returns the manifest to update."""
-    out.mkdir(parents=True, exist_ok=True)
-    manifest = {"format": results.FORMAT, "version": results.VERSION, "case": case.name,
-                "created": datetime.datetime.now(datetime.timezone.utc).isoformat(),
-                "status": "running", "files": ["case.toml", "case.json"], "software": software_versions()}
-    shutil.copyfile(case_path, out / "case.toml")
-    results.atomic_write_json(out / "case.json", case.model_dump())
-    results.atomic_write_json(out / "manifest.json", manifest)
-    return manifest
+def begin_run_folder(out: Path, case_path: Path, case: Case, overwrite: bool = False,
+                     command: str = "run") -> OutputFolder:
+    """Claim the run folder and write the case into it; the manifest says 'running', so an
+    interrupted run is recognisable by later stages."""
+    folder = claim(out, case.name, command, overwrite, stage="impact", software=software_versions())
+    with folder.recording():
+        results.atomic_write_bytes(folder.path / "case.toml", case_path.read_bytes())
+        results.atomic_write_json(folder.path / "case.json", case.model_dump())
+        folder.add_files("case.toml", "case.json")
+    return folder
 
 
-def finish_simulation(out: Path, manifest: dict, recorder, simulation: ImpactSimulation, case: Case) -> dict:
-    """Write the simulation's results and summary; the manifest then says 'complete'."""
+def write_simulation(folder: OutputFolder, recorder, simulation: ImpactSimulation, case: Case) -> dict:
+    """Write the simulation's results and summary and list them in the manifest (the status stays
+    'running': the caller finishes the folder)."""
     summary = run_summary(recorder, simulation.assembly, case.name)
-    write_simulation_results(out, recorder, simulation)
-    results.atomic_write_json(out / "summary.json", summary)
-    manifest.update(status="complete", files=manifest["files"] + ["summary.json", "timeseries.npz", "net.npz",
-                                                                  "bodies.npz"])
-    results.atomic_write_json(out / "manifest.json", manifest)
+    write_simulation_results(folder.path, recorder, simulation)
+    results.atomic_write_json(folder.path / "summary.json", summary)
+    folder.add_files("summary.json", "timeseries.npz", "net.npz", "bodies.npz")
     return summary
 
 

@@ -19,8 +19,10 @@ structures.json    the structural verdict (cases with weak locations)
 structures.npz     demand time series per weak location, ``<location>/<demand>``
 =================  ==============================================================
 
-Products made later from the folder (``report.html``, ``report.pdf``, ``vtk/impact.pvd``)
-are listed under ``products`` in the manifest; deleting one does not spoil the folder.
+Products made later from the folder (``report.html``, ``report.pdf``, the ``vtk`` folder with
+its own manifest) are listed under ``products`` in the manifest; deleting one does not spoil the
+folder. Which folders the tool may write, and the manifest's states: :mod:`riskassess.outfolder`
+and docs/outputs.md.
 
 Every file is written to a temporary name and renamed, so a folder never holds a
 half-written file; the manifest is written last and lists what is complete.
@@ -77,6 +79,11 @@ def atomic_write_npz(path: Path, arrays: dict) -> None:
         raise
 
 
+def write_manifest(folder: Path, manifest: dict) -> None:
+    """The one writer of ``manifest.json`` (atomically); :mod:`riskassess.outfolder` keeps its content."""
+    atomic_write_json(Path(folder) / "manifest.json", manifest)
+
+
 def _json_default(obj):
     if isinstance(obj, np.ndarray):
         return obj.tolist()
@@ -128,7 +135,9 @@ class RunFolder:
 
     @property
     def complete(self) -> bool:
-        return self.manifest.get("status") == "complete"
+        """The stage's results are all written (``outcome``; older folders: ``status``), even while
+        products of the same command (report, VTK) are still to come or one of them failed."""
+        return self.manifest.get("outcome", self.manifest.get("status")) == "complete"
 
     @property
     def stage(self) -> str:
@@ -212,7 +221,7 @@ class RunFolder:
         products = self.manifest.setdefault("products", [])
         if relative_path not in products:
             products.append(relative_path)
-            atomic_write_json(self.path / "manifest.json", self.manifest)
+            write_manifest(self.path, self.manifest)
 
 
 def load_timeseries(run_dir: Path) -> dict[str, np.ndarray]:

@@ -19,8 +19,6 @@ tow.png        main-tether tension, thrust, separation and angular rates
 """
 from __future__ import annotations
 
-import datetime
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +30,7 @@ from control.thrust import KINDS
 from multibody.towing import TowingModel, run_exudyn
 from riskassess import results
 from riskassess.case import load_model
+from riskassess.outfolder import claim
 from riskassess.pipeline import software_versions
 from riskassess.towing_case import TowingCase
 
@@ -173,38 +172,36 @@ def summarize(case: TowingCase, result, s) -> dict:
             "wall_time_s": result.wall_time, "steps_per_second": result.model.n_steps / result.wall_time}
 
 
-def tow_case(case_path: str | Path, out_dir: str | Path, case: TowingCase | None = None) -> dict:
-    """Load the case (unless given), run the lower-order tow in Exudyn (or the full-net tow when
-    ``simulation.model = "full-net"``, :mod:`riskassess.tow_fullnet`), write the run folder; return
-    the summary."""
+def tow_case(case_path: str | Path, out_dir: str | Path, case: TowingCase | None = None,
+             overwrite: bool = False) -> dict:
+    """Load the case (unless given), claim the output folder (:func:`riskassess.outfolder.claim`),
+    run the lower-order tow in Exudyn (or the full-net tow when ``simulation.model = "full-net"``,
+    :mod:`riskassess.tow_fullnet`), write the run folder; return the summary."""
     case_path = Path(case_path)
     case = case or load_model(case_path, TowingCase)
     model = towing_model(case)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    manifest = {"format": results.FORMAT, "version": results.VERSION, "stage": "tow", "case": case.name,
-                "status": "running",
-                "created": datetime.datetime.now(datetime.timezone.utc).isoformat(),
-                "files": ["case.toml"], "software": software_versions()}
-    shutil.copyfile(case_path, out / "case.toml")
-    results.atomic_write_json(out / "manifest.json", manifest)
-    if case.simulation.model == "full-net":
-        from riskassess.tow_fullnet import run_full_net
+    folder = claim(out_dir, case.name, "tow", overwrite, stage="tow", software=software_versions())
+    out = folder.path
+    with folder.recording():
+        results.atomic_write_bytes(out / "case.toml", case_path.read_bytes())
+        folder.add_files("case.toml")
+        if case.simulation.model == "full-net":
+            from riskassess.tow_fullnet import run_full_net
 
-        summary, series = run_full_net(case, out)
-        return _finish(case, out, manifest, series, summary, ["towing.json", "towing.npz", "net.npz", "tow.png"])
-    result = run_exudyn(model)
-    summary = summarize(case, result, case_decision_vector(case))
-    results.atomic_write_npz(out / "towing.npz", result.series())
-    results.atomic_write_json(out / "towing.json", summary)
-    return _finish(case, out, manifest, result.series(), summary, ["towing.json", "towing.npz", "tow.png"])
+            summary, series = run_full_net(case, out)
+            return _finish(case, folder, series, summary, ["towing.json", "towing.npz", "net.npz", "tow.png"])
+        result = run_exudyn(model)
+        summary = summarize(case, result, case_decision_vector(case))
+        results.atomic_write_npz(out / "towing.npz", result.series())
+        results.atomic_write_json(out / "towing.json", summary)
+        return _finish(case, folder, result.series(), summary, ["towing.json", "towing.npz", "tow.png"])
 
 
-def _finish(case, out, manifest, series, summary, files) -> dict:
+def _finish(case, folder, series, summary, files) -> dict:
     """Plot, mark the run folder complete with ``files``, return ``summary``."""
     from riskassess.towing_plots import plot_tow
 
-    plot_tow(series, out / "tow.png", case.name)
-    manifest.update(status="complete", files=manifest["files"] + files)
-    results.atomic_write_json(out / "manifest.json", manifest)
+    plot_tow(series, folder.path / "tow.png", case.name)
+    folder.add_files(*files)
+    folder.finish("complete")
     return summary

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from riskassess.report.plotting import STYLE, legend, panels, plt, write_png
+from riskassess.report.plotting import STYLE, legend, panels, plain, plt, write_png
 
 
 def _save(fig, path: Path) -> None:
@@ -14,6 +14,7 @@ def _save(fig, path: Path) -> None:
 
 
 def _tow_panels(axes, s, label, style="-"):
+    label = plain(label)
     t = s["time"]
     axes[0].plot(t, s["main_tether_tension"], style, label=f"{label} main tether")
     axes[0].plot(t, s["thrust"], style, color="0.5", lw=0.8, label=f"{label} thrust")
@@ -32,7 +33,7 @@ def tow_figure(series: dict, title: str, others: dict | None = None):
     for label, other in (others or {}).items():
         _tow_panels(axes, other, label, "--")
     axes[0].set_ylabel("force (N)")
-    axes[0].set_title(f"{title}: main-tether tension and thrust")
+    axes[0].set_title(f"{plain(title)}: main-tether tension and thrust")
     axes[1].set_ylabel("|r_D/C| (m)")
     axes[2].set_ylabel("|omega| (deg/s)")
     for ax in axes:
@@ -51,10 +52,10 @@ def plot_convergence(histories: dict, path: Path, title: str) -> None:
     with plt.rc_context(STYLE):
         fig, (ax,) = panels(1, 2.6, sharex=False)
         for label, (evaluations, best) in histories.items():
-            ax.semilogy(evaluations, best, label=label)
+            ax.semilogy(evaluations, best, label=plain(label))
         ax.set_xlabel("cost evaluations (each: one simulation per spin rate)")
         ax.set_ylabel("best cost")
-        ax.set_title(title)
+        ax.set_title(plain(title))
         legend(ax)
         _save(fig, path)
 
@@ -66,7 +67,7 @@ def plot_fit(data: dict, fitted: dict, path: Path, title: str) -> None:
         _tow_panels(axes, data, "data")
         _tow_panels(axes, fitted, "identified", "--")
         axes[0].set_ylabel("force (N)")
-        axes[0].set_title(title)
+        axes[0].set_title(plain(title))
         axes[1].set_ylabel("|r_D/C| (m)")
         axes[2].set_ylabel("|omega| (deg/s)")
         for ax in axes:

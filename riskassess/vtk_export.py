@@ -20,13 +20,19 @@ file                        content
 One frame per net snapshot (the case's ``net_output_rate``). Body poses come from the time
 series sample nearest to the snapshot (at most half an output interval away; the same time
 when the output rate is a multiple of the net output rate, as in the shipped cases).
-The folder is written beside the old one and swapped in at the end, so an interrupted
-export leaves the previous export intact.
+
+The export goes only into a new or empty folder, or, with ``overwrite``, into a VTK folder this
+tool made earlier for the same run (its ``manifest.json``, format ``riskassess-vtk``, names the
+run and lists the files); the run folder itself or any folder holding other files is refused
+(:class:`riskassess.outfolder.OutputRefused`). It is written into a hidden staging folder beside
+``out`` and moved in at the end, so an interrupted export leaves the previous export intact; of
+a replaced export only the files its manifest lists are removed.
 """
 from __future__ import annotations
 
+import contextlib
 import json
-import shutil
+import os
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,7 +42,11 @@ import meshio
 import numpy as np
 
 from multibody.net import thread_tension_strain
-from riskassess.results import MissingData, RunFolder, atomic_write_bytes
+from riskassess import outfolder
+from riskassess.results import MissingData, RunFolder, atomic_write_bytes, write_manifest
+
+#: Format of the manifest that marks a folder as a VTK export of one run.
+VTK_FORMAT = "riskassess-vtk"
 
 
 @dataclass
@@ -136,12 +146,15 @@ def pvd_text(entries: list[tuple[float, int, str, str]], comment: str = "") -> s
     return "\n".join(line for line in lines if line)
 
 
-def write_collection(out: Path, frames, n_frames: int, pvd_name: str, comment: str, progress=None,
-                     extra=None) -> None:
+def write_collection(out: Path, frames, n_frames: int, pvd_name: str, comment: str, identity: dict,
+                     progress=None, extra=None, overwrite: bool = False) -> None:
     """Write ``frames``, an iterable of (time (s), ((part name, meshio.Mesh), ...)) per frame, as
-    ``<part>_NNNN.vtu`` files and the ParaView collection ``pvd_name`` into ``out``. The folder is
-    staged beside ``out`` and swapped in at the end, so an interrupted export leaves the previous one
-    intact; ``extra(staging)`` may add files before the collection is written."""
+    ``<part>_NNNN.vtu`` files and the ParaView collection ``pvd_name`` into ``out``, with a manifest
+    ``identity`` (format, case, command, run) plus the files. ``out`` is checked first
+    (:func:`riskassess.outfolder.check`: new, empty, or this run's earlier export with ``overwrite``);
+    the files are staged beside it and moved in at the end, so an interrupted export leaves the
+    previous one intact; ``extra(staging)`` may add files before the collection is written."""
+    old = outfolder.check(out, identity, overwrite)
     out.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.partial-"))
     try:
@@ -156,30 +169,63 @@ def write_collection(out: Path, frames, n_frames: int, pvd_name: str, comment: s
         if extra:
             extra(staging)
         atomic_write_bytes(staging / pvd_name, pvd_text(entries, comment).encode())
-        _swap_in(staging, out)
+        write_manifest(staging, {**identity, "version": 1, "status": "complete",
+                                 "files": sorted(p.name for p in staging.iterdir())})
+        _move_in(staging, out, old)
     except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
+        _remove_staging(staging)
         raise
 
 
+def _move_in(staging: Path, out: Path, old: dict | None) -> None:
+    """Put the staged export at ``out``: renamed there when ``out`` does not exist; file by file
+    into an empty ``out`` (the user's folder stays); swapped with this run's earlier export
+    (``old``, its manifest), of which only the listed files are then removed."""
+    staging.chmod(0o755)
+    if not out.exists():
+        staging.rename(out)
+    elif old is None:                      # an empty folder, checked just before
+        names = sorted(p.name for p in staging.iterdir())
+        for name in sorted(names, key=lambda n: n == outfolder.MANIFEST):   # the manifest last
+            os.replace(staging / name, out / name)
+        staging.rmdir()
+    else:
+        previous = out.with_name(f".{out.name}.old-{staging.name.rsplit('-', 1)[-1]}")
+        out.rename(previous)
+        staging.rename(out)
+        outfolder.remove_own(previous, old)
+        with contextlib.suppress(OSError):   # something else appeared in it meanwhile: it stays
+            previous.rmdir()
+
+
+def _remove_staging(staging: Path) -> None:
+    """Remove the staging folder this export made (its files only, never a tree walk)."""
+    for path in staging.iterdir():
+        path.unlink(missing_ok=True)
+    staging.rmdir()
+
+
 def export_frames(run_dir: str | Path, out: str | Path | None, every: int, progress, frames_type, parts: tuple,
-                  pvd_name: str, comment: str, extra=None) -> VtkExport:
+                  pvd_name: str, comment: str, extra=None, overwrite: bool = False) -> VtkExport:
     """The front shared by the impact and the tow export: checks ``every``, reads the run folder into
     ``frames_type(run)`` (which raises MissingData before anything is written), writes every ``every``-th
     net snapshot's ``parts`` (each the ``<part>_mesh(f)`` of the frames) with :func:`write_collection`
-    into ``out`` (default ``RUN_DIR/vtk``, then registered as a product of the run) and returns where
-    and how many. ``extra(frames, staging)`` may add files to the export."""
+    into ``out`` (default ``RUN_DIR/vtk``; a folder directly inside the run folder is registered as a
+    product of the run) and returns where and how many. ``extra(frames, staging)`` may add files."""
     if every < 1:
         raise ValueError(f"every must be >= 1 (frames to step); got {every}")
     run = RunFolder(run_dir)
-    frames = frames_type(run)
     out = Path(out) if out else run.path / "vtk"
+    identity = {"format": VTK_FORMAT, "case": run.manifest.get("case"), "command": "export-vtk",
+                "run": str(run.path.resolve())}
+    outfolder.check(out, identity, overwrite)   # refuse before reading the run's arrays
+    frames = frames_type(run)
     picked = np.arange(0, len(frames.net["time"]), every)
     write_collection(out, ((float(frames.net["time"][f]), tuple((part, getattr(frames, f"{part}_mesh")(f)) for part in parts))
-                           for f in picked), len(picked), pvd_name, f"case {run.manifest.get('case')}: {comment}", progress,
-                     None if extra is None else lambda staging: extra(frames, staging))
-    if out == run.path / "vtk":
-        run.add_product(f"vtk/{pvd_name}")
+                           for f in picked), len(picked), pvd_name, f"case {run.manifest.get('case')}: {comment}", identity,
+                     progress, None if extra is None else lambda staging: extra(frames, staging), overwrite)
+    if out.resolve().parent == run.path.resolve():
+        run.add_product(out.name)
     return VtkExport(out, out / pvd_name, len(picked), frames.net["time"][picked])
 
 
@@ -191,23 +237,12 @@ def _write_bodies_json(frames: _Frames, staging: Path) -> None:
     (staging / "bodies.json").write_text(json.dumps(bodies, indent=2) + "\n")
 
 
-def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int = 1, progress=None) -> VtkExport:
+def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int = 1, progress=None,
+               overwrite: bool = False) -> VtkExport:
     """Write the VTK files of a run folder (see the module docstring); returns where and how many."""
     if RunFolder(run_dir).stage == "tow":  # a full-net tow folder: its own layout
         from riskassess.tow_vtk import export_tow_vtk
 
-        return export_tow_vtk(run_dir, out, every, progress)
+        return export_tow_vtk(run_dir, out, every, progress, overwrite)
     return export_frames(run_dir, out, every, progress, _Frames, ("net", "bodies", "bullets"), "impact.pvd",
-                         "positions LVLH (m); body_index -> bodies.json", _write_bodies_json)
-
-
-def _swap_in(staging: Path, out: Path) -> None:
-    """Replace ``out`` by ``staging``; the old export is removed only once the new one is in place."""
-    old = None
-    if out.exists():
-        old = out.with_name(f".{out.name}.old-{staging.name.rsplit('-', 1)[-1]}")
-        out.rename(old)
-    staging.chmod(0o755)
-    staging.rename(out)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
+                         "positions LVLH (m); body_index -> bodies.json", _write_bodies_json, overwrite)

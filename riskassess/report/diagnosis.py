@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.report.blocks import Figure, Note, Section, Table
-from riskassess.report.plotting import STYLE, legend, panels, write_png
+from riskassess.report.plotting import STYLE, legend, panels, plain, write_png
 
 #: Channels shown in the time-series figures: the ones with the largest residual before.
 SHOWN_CHANNELS = 6
@@ -32,7 +32,7 @@ def channels_figure(answer: dict, arrays: dict):
         if answer["model"] != "nominal":
             ax.plot(t, arrays[f"chosen/{c}"], "--", color="tab:red", label=answer["model"])
         ax.axvline(answer["split_time_s"], color="k", lw=0.8, ls=":")
-        ax.set_ylabel(c)
+        ax.set_ylabel(plain(c))
     axes[0].set_title("measured vs simulated (dotted line: end of the fitted part; the rest is held out)")
     legend(axes[0])
     return fig
@@ -49,7 +49,7 @@ def residuals_figure(answer: dict, arrays: dict):
             ax.plot(t, arrays[f"residual_after/{c}"], color="tab:red", lw=0.6, label=answer["model"])
         ax.axhspan(-2, 2, color="tab:green", alpha=0.08, lw=0)
         ax.axvline(answer["split_time_s"], color="k", lw=0.8, ls=":")
-        ax.set_ylabel(f"{c} (sigma)")
+        ax.set_ylabel(f"{plain(c)} (sigma)")
     axes[0].set_title("residual / noise (green band: +-2 sigma, where white noise stays)")
     legend(axes[0])
     return fig
@@ -69,8 +69,8 @@ def spectrum_figure(answer: dict, arrays: dict):
         ax.semilogy(s["frequency_hz"][1:], s["psd"][1:], color=color, label=label)
     ax.axhline(2 * float(np.median(np.diff(t))), color="tab:green", ls="--", lw=0.8, label="white noise")
     ax.set_xlabel("frequency (Hz)")
-    ax.set_ylabel(f"PSD of {worst} (sigma^2/Hz)")
-    ax.set_title(f"where in frequency the residual of {worst} lives")
+    ax.set_ylabel(f"PSD of {plain(worst)} (sigma^2/Hz)")
+    ax.set_title(f"where in frequency the residual of {plain(worst)} lives")
     legend(ax)
     return fig
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import jinja2
 
 from riskassess import results
+from riskassess.outfolder import claim_product
 from riskassess.report.approach import approach_section
 from riskassess.report.blocks import Figure, Note, Section, Table
 from riskassess.report.diagnosis import diagnosis_section
@@ -137,8 +138,11 @@ def render_pdf(html: str, base_url: Path):
 
 
 def write_report(run_dir: str | Path, pdf: bool = True, progress=None) -> ReportOutput:
-    """Write ``report.html`` (and ``report.pdf``) into the run folder, each atomically."""
+    """Write ``report.html`` (and ``report.pdf``) into the run folder, each atomically; refused
+    (:class:`riskassess.outfolder.OutputRefused`) where a file of that name is not the run's own."""
     run = RunFolder(run_dir)
+    for name in ("report.html", "report.pdf") if pdf else ("report.html",):
+        claim_product(run.path, run.manifest, name)
     sections = build_sections(run, progress)
     html = render_html(run, sections)
     html_path = run.path / "report.html"

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.report.blocks import Figure, Note, Section, Table
-from riskassess.report.plotting import COMPONENT_COLORS, legend, mark_release, panels
+from riskassess.report.plotting import COMPONENT_COLORS, legend, mark_release, panels, plain
 from riskassess.results import RunFolder
 from riskassess.summary import contact_totals_debris
 from riskassess.tables import format_vector
@@ -26,7 +26,7 @@ def contact_section(run: RunFolder) -> Section:
     fig, (ax_f, ax_m) = panels(2, 2.1)
     ax_f.plot(t, np.linalg.norm(force, axis=1) / 1e3, color="k", lw=1.2, label="whole debris")
     for k, name in enumerate(names):
-        ax_f.plot(t, np.linalg.norm(s["contact_force_lvlh"][:, k], axis=1) / 1e3, lw=0.8, label=name)
+        ax_f.plot(t, np.linalg.norm(s["contact_force_lvlh"][:, k], axis=1) / 1e3, lw=0.8, label=plain(name))
     ax_f.set_ylabel("|contact force| (kN)")
     ax_f.set_title("net contact force on the debris bodies")
     legend(ax_f)
@@ -67,7 +67,7 @@ def debris_motion_section(run: RunFolder) -> Section:
     ax_v.set_title("debris centre-of-mass velocity change, LVLH")
     legend(ax_v)
     ax_w.set_ylabel("angular velocity (deg/s)")
-    ax_w.set_title(f"angular velocity of {s['body_names'][0]}, its body frame")
+    ax_w.set_title(f"angular velocity of {plain(s['body_names'][0])}, its body frame")
     legend(ax_w)
     mean = np.asarray(summary["debris_velocity_change_final_third_mean_lvlh_m_s"]) * 1e3
     rows = [["final velocity change (mm/s, LVLH)", format_vector(dv[-1], 4)],
@@ -99,7 +99,7 @@ def hinge_section(run: RunFolder) -> Section:
         angle = np.degrees(s["joint_rotation_joint"][:, j, 1])
         rate = np.degrees(s["joint_rate_joint"][:, j, 1])
         for ax, values in ((ax_a, angle), (ax_r, rate)):
-            line, = ax.plot(t[joined], values[joined], label=names[j])
+            line, = ax.plot(t[joined], values[joined], label=plain(names[j]))
             if not joined.all():
                 ax.plot(t[~joined], values[~joined], color="0.6", ls="--", lw=0.8, label="after release")
                 mark_release(ax, released[names[j]], f"{names[j]} released")

@@ -22,6 +22,18 @@ STYLE = {"font.size": 8.5, "axes.titlesize": 9, "axes.labelsize": 8.5, "legend.f
 COMPONENT_COLORS = ("tab:blue", "tab:orange", "tab:green")
 
 
+def plain(text) -> str:
+    """User text (a case, body, joint, location or channel name) as a literal matplotlib label.
+
+    Matplotlib reads a string with an even number of unescaped ``$`` as math text (``$x^{$`` stops
+    the figure with a ParseException) and hides legend entries whose label starts with ``_``.
+    Every ``$`` is escaped (outside math text a ``\\$`` shows as ``$``, and a backslash is literal),
+    and a leading ``_`` gets a space before it. Every plot passes user text through this helper.
+    """
+    text = str(text).replace("$", r"\$")
+    return f" {text}" if text.startswith("_") else text
+
+
 def png_bytes(fig, dpi: float) -> bytes:
     """Render a matplotlib figure as PNG at ``dpi`` (dots per inch) and close it."""
     buffer = io.BytesIO()

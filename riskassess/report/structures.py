@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.report.blocks import Figure, Note, Section, Table
-from riskassess.report.plotting import allowable_band, legend, mark_release, panels, shade_not_judged
+from riskassess.report.plotting import allowable_band, legend, mark_release, panels, plain, shade_not_judged
 from riskassess.results import RunFolder
 from riskassess.tables import STATE_TEXT, VERDICT_COLUMNS, format_margin, format_vector, verdict_rows
 
@@ -95,7 +95,7 @@ def joint_loads_section(run: RunFolder) -> Section:
         allowable_band(ax, *c["allowable"], c["decisive_allowable"], 1.0, units[name])
         _decorate(ax, verdict, loc, t[-1])
         ax.set_ylabel(f"{name} ({units[name]})")
-        ax.set_title(f"{loc['name']} (joint {loc['joint']})")
+        ax.set_title(plain(f"{loc['name']} (joint {loc['joint']})"))
         legend(ax)
     return Section("joint-loads", title, [Figure.from_matplotlib(
         "fig-joint-loads", "Demand of each location with a moment or force allowable (the resultant of the "
@@ -128,7 +128,7 @@ def stresses_section(run: RunFolder) -> Section:
         ax.set_ylim(bottom=floor)
         _decorate(ax, verdict, loc, t[-1])
         ax.set_ylabel("stress (MPa)")
-        ax.set_title(f"{loc['name']} (joint {loc['joint']})")
+        ax.set_title(plain(f"{loc['name']} (joint {loc['joint']})"))
         legend(ax)
         normal, shear = loc["criteria"]["normal_stress"], loc["criteria"]["shear_stress"]
         rows.append([loc["name"], _mpa(normal["peak"]), _mpa(shear["peak"]), _mpa(loc.get("peak_von_mises_stress_Pa")),

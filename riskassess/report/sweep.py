@@ -7,7 +7,7 @@ import numpy as np
 
 from riskassess.casedoc import key_unit
 from riskassess.report.blocks import Figure, Note, Section, Table
-from riskassess.report.plotting import legend, panels
+from riskassess.report.plotting import legend, panels, plain
 from riskassess.sweep.envelope import UNKNOWN, envelope, envelope_statement, is_probabilistic, run_status
 from structures.verdict import DEBRIS, NO_DEBRIS
 
@@ -29,7 +29,7 @@ def _band(ax, x, values_per_x, label, color=None, scale=1.0):
     """Max over the runs at each x (line) and the min-max band over Monte Carlo samples."""
     high = np.array([max(v) for v in values_per_x]) * scale
     low = np.array([min(v) for v in values_per_x]) * scale
-    line, = ax.plot(x, high, marker="o", ms=3, color=color, label=label)
+    line, = ax.plot(x, high, marker="o", ms=3, color=color, label=plain(label))
     if (high > low).any():
         ax.fill_between(x, low, high, color=line.get_color(), alpha=0.15, lw=0)
 
@@ -69,7 +69,7 @@ def envelope_figure(rows: list[dict], env: dict, figure_id: str = "fig-envelope"
     ax_b.set_title("breakup")
     legend(ax_b)
     unit = key_unit(key)
-    ax_b.set_xlabel(f"{key} ({unit})" if unit else key)
+    ax_b.set_xlabel(plain(f"{key} ({unit})" if unit else key))
     return Figure.from_matplotlib(figure_id, f"Envelope against {key}: lines are the largest value over "
                                   f"the runs at each {key}, bands the spread over those runs (Monte Carlo samples and the values "
                                   f"of any other varied key).", fig)

@@ -77,7 +77,7 @@ def hidden_effect_data(case, effect_id, rng, times):
 
 
 def _diagnose(tmp_path, case_path, channels, times):
-    """Diagnose a copy of the case (the extended case is written next to it, in ``tmp_path``)."""
+    """Diagnose a copy of the case in ``tmp_path``; the output folder is ``tmp_path / "out"``."""
     data = tmp_path / "measured.csv"
     write_measured(data, times, channels)
     case = tmp_path / case_path.name
@@ -112,8 +112,11 @@ def test_hidden_effect_in_a_tumbling_body_is_named(tmp_path, tumbling_rocket_bod
     values, _, channels = hidden_effect_data(tumbling_rocket_body, effect_id, rng, times)
     answer = _diagnose(tmp_path, TUMBLING_CASE, channels, times)
     _check_named(answer, effect_id, values)
-    extended = tmp_path / "diagnose_tumbling_rigid.extended.toml"
+    # issue 20 item 11: the extended case goes under --out only, never beside the input case
+    extended = tmp_path / "out" / "diagnose_tumbling_rigid.extended.toml"
     assert answer["extended_case"] == str(extended) and extended.is_file()
+    assert "diagnose_tumbling_rigid.extended.toml" in json.loads((tmp_path / "out" / "manifest.json").read_text())["files"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["diagnose_tumbling_rigid.toml", "measured.csv", "out"]
 
 
 def test_hidden_effect_on_a_hinged_panel_is_named(tmp_path, panel_on_hinge):

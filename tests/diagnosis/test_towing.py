@@ -182,8 +182,8 @@ def test_hidden_towing_effect_is_named_with_a_gain(tmp_path, zenit_tow, effect_i
     before = answer["nominal"]["holdout_rms_sigma"]
     assert after ** 2 - 1.0 <= 0.5 * (before ** 2 - 1.0) + 0.05, (before, after)
     assert answer["gain_percent"]["overall"] > 0.0
-    assert (tmp_path / "diagnose_towing.extended.toml").is_file()
-    extended = case_with(tmp_path / "diagnose_towing.extended.toml")
+    assert not (tmp_path / "diagnose_towing.extended.toml").exists()   # nothing beside the input case
+    extended = case_with(tmp_path / "out" / "diagnose_towing.extended.toml")
     assert extended.effects[0].id == effect_id
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from riskassess import results
 from riskassess.case import CaseError, load_model
-from riskassess.identify import simulate
+from riskassess.identify import claim_identify_folder, simulate
 from riskassess.identify_fullnet import comparison_rows, full_net_runs, identify_full_net, lower_order_case
 from riskassess.tow import towing_model
 from riskassess.towing_case import TowingCase
@@ -38,10 +38,15 @@ def _stand_in_full_net_runs(case, out):
     start = towing_model(case, case.rates.training_deg_s[0], truth, step=case.identification.step, end_time=END)
     state = {"chaser_start_inertial": start.positions[1], "node_start_inertial": start.positions[0], "wall_s": 0.0}
     lower = lower_order_case(case, state)
+    # an earlier identify folder of this very case file, its cache listed by its manifest: a re-run
+    # with --overwrite keeps the cache (docs/outputs.md, rule 7)
+    folder = claim_identify_folder(out, CASE, case.name, overwrite=False)
     (out / "fullnet").mkdir(parents=True)
     for rate in (*case.rates.training_deg_s, *case.rates.validation_deg_s):
-        results.atomic_write_npz(out / "fullnet" / f"rate_{rate:.2f}_end_{END:g}.npz",
-                                 {**simulate(lower, rate, truth, END), "rate_deg_s": rate, **state})
+        name = f"fullnet/rate_{rate:.2f}_end_{END:g}.npz"
+        results.atomic_write_npz(out / name, {**simulate(lower, rate, truth, END), "rate_deg_s": rate, **state})
+        folder.add_files(name)
+    folder.finish("complete")
 
 
 def test_pso_on_f2_recovers_s_and_reproduces_the_unseen_rate(tmp_path):
@@ -49,7 +54,7 @@ def test_pso_on_f2_recovers_s_and_reproduces_the_unseen_rate(tmp_path):
     --cost f2` runs it."""
     case = _small_case("f2", swarm_size=10, pso_generations=6, polish_evaluations=150, pattern_tolerance=1e-4)
     _stand_in_full_net_runs(case, tmp_path)
-    answer = identify_full_net(CASE, tmp_path, case, optimizers=["pso"])
+    answer = identify_full_net(CASE, tmp_path, case, optimizers=["pso"], overwrite=True)
     assert set(answer["runs"]) == {"pso", "pso+pattern"} and answer["optimizer"] == "pso+pattern"
     run = answer["runs"]["pso+pattern"]
     assert run["evaluations"] == answer["runs"]["pso"]["evaluations"] + len(run["history"]) - len(
@@ -66,6 +71,8 @@ def test_pso_on_f2_recovers_s_and_reproduces_the_unseen_rate(tmp_path):
     guess = comparison_rows(lower_order_case(case, data[0]), case.identification.initial_guess, data, END)[0]
     assert run["validation_totals"]["f2"] < 0.03 * guess["f2"]
     assert run["validation"][0]["f2"] == run["validation_totals"]["f2"] == run["validation"][0]["rmse_main_tether_tension"]
+    manifest = json.loads((tmp_path / "manifest.json").read_text())
+    assert manifest["status"] == "complete" and sum(f.startswith("fullnet/") for f in manifest["files"]) == 2
     on_disk = json.loads((tmp_path / "identification.json").read_text())
     assert on_disk["runs"]["pso+pattern"]["s"] == run["s"] and (tmp_path / "convergence.png").stat().st_size > 0
 

@@ -112,6 +112,7 @@ def test_report_of_an_interrupted_run_and_of_no_run(assessed, tmp_path, capsys):
         shutil.copy(assessed / name, run / name)
     manifest = json.loads((assessed / "manifest.json").read_text())
     manifest.update(status="running", files=["case.toml", "case.json"])
+    manifest.pop("outcome")   # a run killed while simulating: its stage never ended
     (run / "manifest.json").write_text(json.dumps(manifest))
     assert main(["report", str(run), "--no-pdf"]) == 0
     html = (run / "report.html").read_text()
@@ -142,7 +143,8 @@ def test_run_writes_report_and_vtk_when_asked(tmp_path):
     out = tmp_path / "run"
     assert main(["run", str(case), "--out", str(out), "--json", "--report", "--vtk"]) == 0
     manifest = json.loads((out / "manifest.json").read_text())
-    assert manifest["products"] == ["report.html", "report.pdf", "vtk/impact.pvd"]
+    assert manifest["products"] == ["report.html", "report.pdf", "vtk"] and manifest["status"] == "complete"
+    assert json.loads((out / "vtk" / "manifest.json").read_text())["format"] == "riskassess-vtk"
     assert (out / "report.pdf").stat().st_size > 0
     # 0.1 s at 50 Hz net snapshots: t = 0, 0.02, ..., 0.1
     assert len(list((out / "vtk").glob("net_*.vtu"))) == 6

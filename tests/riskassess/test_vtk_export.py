@@ -124,8 +124,48 @@ def test_every_nth_frame_and_an_interrupted_export_keeps_the_old_one(assessed, t
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        export_vtk(assessed, out, every=1, progress=interrupt)
+        export_vtk(assessed, out, every=1, progress=interrupt, overwrite=True)
     assert sorted(p.name for p in out.iterdir()) == before     # the old export is untouched
     assert [p.name for p in tmp_path.iterdir()] == ["vtk"]      # no partial folder left behind
     with pytest.raises(ValueError, match="every must be >= 1"):
         export_vtk(assessed, out, every=0)
+    # with --overwrite the export replaces its own files (every frame now), and only those
+    result = export_vtk(assessed, out, every=1, overwrite=True)
+    assert sorted(p.name for p in out.iterdir()) == sorted(json.loads((out / "manifest.json").read_text())["files"]
+                                                          + ["manifest.json"])
+    assert len(list(out.glob("net_*.vtu"))) == result.n_frames == n
+
+
+def _tree(folder):
+    return {p.relative_to(folder).as_posix(): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_export_never_deletes_a_folder_it_did_not_make(assessed, tmp_path, capsys):
+    """Issue 20 item 1: `export-vtk RUN --out DIR` renamed DIR away and deleted it recursively (a
+    thesis folder; the run folder itself when DIR is the run)."""
+    thesis = tmp_path / "thesis"
+    (thesis / "figures").mkdir(parents=True)
+    (thesis / "chapter1.tex").write_text("years of work")
+    run_before, thesis_before = _tree(assessed), _tree(thesis)
+    for out in (thesis, assessed, assessed.parent):
+        for extra in ([], ["--overwrite"]):
+            capsys.readouterr()
+            assert main(["export-vtk", str(assessed), "--out", str(out), "--every", "50", *extra]) == 2
+            assert str(out) in capsys.readouterr().err
+    assert _tree(thesis) == thesis_before and _tree(assessed) == run_before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["thesis"]   # no staging folder left either
+
+
+def test_export_into_an_empty_folder_then_only_into_its_own(assessed, tmp_path, capsys):
+    out = tmp_path / "empty"
+    out.mkdir()
+    assert main(["export-vtk", str(assessed), "--out", str(out), "--every", "50"]) == 0
+    made = _tree(out)
+    assert main(["export-vtk", str(assessed), "--out", str(out), "--every", "50"]) == 2   # needs --overwrite
+    assert "--overwrite" in capsys.readouterr().err and _tree(out) == made
+    (out / "my_view.pvsm").write_text("a ParaView state of mine")
+    assert main(["export-vtk", str(assessed), "--out", str(out), "--every", "50", "--overwrite"]) == 2
+    assert "my_view.pvsm" in capsys.readouterr().err and (out / "my_view.pvsm").is_file()
+    (out / "my_view.pvsm").unlink()
+    assert main(["export-vtk", str(assessed), "--out", str(out), "--every", "25", "--overwrite"]) == 0
+    assert _tree(out) != made and sorted(p.name for p in tmp_path.iterdir()) == ["empty"]
