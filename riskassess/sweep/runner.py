@@ -9,7 +9,6 @@ sweep goes on.
 from __future__ import annotations
 
 import itertools
-import json
 import logging
 import math
 import shutil
@@ -21,6 +20,8 @@ from pathlib import Path
 
 from multibody.health import SimulationFailed
 from riskassess.case import CaseError, validate_case
+from riskassess.outfolder import open_existing
+from riskassess.results import atomic_write_json
 from riskassess.sweep.records import debris_state_of
 from riskassess.sweep.spec import RunSpec, SweepSpecError, case_with
 from riskassess.sweep.store import ResultStore
@@ -132,11 +133,13 @@ def simulate_run(case_path: str, case_text: str, overrides: dict, keep_dir: str 
     out = Path(keep_dir) if keep_dir else Path(tempfile.mkdtemp(prefix="riskassess-sweep-"))
     try:
         try:
-            result = run_case(case_path, out, case=case)
+            # a kept folder of this run from an earlier attempt (a retry) is this run's own: replace it
+            result = run_case(case_path, out, case=case, overwrite=bool(keep_dir))
         except SimulationFailed as exc:
             raise RunFailed("diverged", f"SimulationFailed: {exc}") from None
         if keep_dir:
-            (out / "overrides.json").write_text(json.dumps(overrides, indent=2) + "\n")
+            atomic_write_json(out / "overrides.json", overrides)
+            open_existing(out).add_files("overrides.json")
         return run_record(result.summary, result.structures, overrides)
     finally:
         if not keep_dir:
