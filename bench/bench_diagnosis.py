@@ -34,8 +34,8 @@ def towing_truths(workers: int) -> None:
     standard deviations."""
     import numpy as np
 
-    from diagnosis.measured import write_measured
-    from diagnosis.synthetic import noisy, sample_times, simulate_effect
+    from riskassess.diagnosis.measured import write_measured
+    from riskassess.diagnosis.synthetic import noisy, sample_times, simulate_effect
     from riskassess.diagnose import diagnose_case
     from riskassess.diagnosis_case import load_diagnosis_case
 

@@ -1,5 +1,5 @@
 """Main-tether control over the Table 3 rate range: open-loop ramp against MRAC-1 and MRAC-2
-(control/mrac.py) on the lower-order towing model in Exudyn (cases/zenit2_towing.toml).
+(multibody/control/mrac.py) on the lower-order towing model in Exudyn (cases/zenit2_towing.toml).
 
     python bench/bench_tow_control.py [--case cases/zenit2_towing.toml] [--rates training|validation|all]
 

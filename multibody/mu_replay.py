@@ -1,6 +1,6 @@
 """Replay of an approach trajectory in 3-D: two MU bodies pull the corners of the Exudyn net.
 
-The guidance (:mod:`control.mu_approach`) treats the net mouth as a massless segment between two
+The guidance (:mod:`multibody.control.mu_approach`) treats the net mouth as a massless segment between two
 maneuverable units (MUs). Here the same square lumped-mass net as the impact model
 (:func:`multibody.net.flat_square_net`, :func:`multibody.impact.build_impact_system`) hangs from
 two rigid MU bodies: its two mouth corners are held on the MUs by stiff mounts

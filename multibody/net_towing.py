@@ -7,7 +7,7 @@ As in the lower-order model (:mod:`multibody.towing`), chaser and debris are Exu
 ``ObjectGenericODE2`` spanning both carries every force through its force user function; the light,
 stiff net is the sub-system advanced inside that function, sub-cycled over each step
 (:mod:`multibody.net_towing_kernel`: why and how, and the consistency argument). Thrust law and
-attitude control are the lower-order model's (:mod:`control.thrust`, :mod:`control.attitude`).
+attitude control are the lower-order model's (:mod:`multibody.control.thrust`, :mod:`multibody.control.attitude`).
 Frame: Earth-centred inertial; angular velocities in the body frames.
 """
 from __future__ import annotations

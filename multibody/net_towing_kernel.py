@@ -26,8 +26,8 @@ import math
 import numpy as np
 from numba import njit
 
-from control.attitude import desired_attitude, sliding_mode_torque
-from control.thrust import thrust_command
+from multibody.control.attitude import desired_attitude, sliding_mode_torque
+from multibody.control.thrust import thrust_command
 from multibody.connection_point import implicit_point_step
 from multibody.contact import contact_over_step
 from multibody.kernel import _effective_mass_along_normal, _substeps_to_resolve_contact, rotation_matrix_from_rotation_vector
@@ -290,9 +290,9 @@ def _implicit_tether_step(x, v, f, mass, reference, central, main_tether, a_poin
 @njit(cache=True)
 def chaser_actuation(t, elongation, rate, u_inertial, rot_c, com_c, vel_c, omega_c, inertia_c, attitude, thrust_kind,
                      along_body_z, thrust_params, thrust_state, step, advance, force, diag):
-    """Thrust (the case's law, :func:`control.thrust.thrust_command`, along the chaser's body z or
+    """Thrust (the case's law, :func:`multibody.control.thrust.thrust_command`, along the chaser's body z or
     against its velocity as in the lower-order model) and the sliding-mode torque (eqs. 7-10,
-    :mod:`control.attitude`) from the main tether's elongation and direction ``u_inertial`` (A -> net
+    :mod:`multibody.control.attitude`) from the main tether's elongation and direction ``u_inertial`` (A -> net
     node). Adds them to ``force`` (6,: chaser force inertial, torque body) and fills ``diag``."""
     magnitude = thrust_command(thrust_kind, t, elongation, rate, thrust_params, thrust_state, step, advance)
     diag[D_THRUST] = magnitude

@@ -41,7 +41,7 @@ class TowedBodies:
     attach_chaser_body : (3,) float MT attachment r_A/C, chaser frame (m).
     mu : float                      Gravitational parameter (m^3/s^2).
     attitude : (8,) float           Controller on (1/0), K (1/s), G (3,) (rad/s^2), epsilon (3,) (rad/s).
-    thrust_kind : int               :data:`control.thrust.KINDS` code.
+    thrust_kind : int               :data:`multibody.control.thrust.KINDS` code.
     thrust_along_body_z : bool      Thrust along the chaser's body z (MRAC) or against its velocity (ramp).
     thrust_params, thrust_state : (k,) float   The thrust law's constants and initial states.
     positions, velocities : (b, 3) float       Point masses' and CoMs' positions (m, absolute) and velocities

@@ -25,8 +25,8 @@ import math
 import numpy as np
 from numba import njit
 
-from control.attitude import desired_attitude, sliding_mode_torque
-from control.thrust import thrust_command
+from multibody.control.attitude import desired_attitude, sliding_mode_torque
+from multibody.control.thrust import thrust_command
 from multibody.connection_point import STATE_SIZE, TIME, V_N, X_N, advance_point, initial_point_state
 from multibody.kernel import rotation_matrix_from_rotation_vector, verlet_evaluation_state
 from multibody.net import tension_only_kelvin_voigt
@@ -104,7 +104,7 @@ def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, att
     """Generalized forces (``out_force``, (15,)) of the lower-order model at time ``t`` (s).
 
     MT and ST tensions (eqs. 4, 5, 13, 14), two-body gravity on P, chaser and debris (eq. 1),
-    thrust (the ramp after eq. 2 or a :mod:`control.thrust` law), sliding-mode torque (eqs. 7-10).
+    thrust (the ramp after eq. 2 or a :mod:`multibody.control.thrust` law), sliding-mode torque (eqs. 7-10).
     ``reference`` (3, 3) holds the reference positions of P, chaser and debris (m);
     ``masses`` = [m_P, m_C, m_D] (kg); ``tether`` = [k_MT, c_MT, l_MT0, k_ST, c_ST, l_ST0];
     ``attitude`` = [on, K, G (3), width (3)]. The thrust law's state advances by ``step`` when

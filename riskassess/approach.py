@@ -1,7 +1,7 @@
 """`riskassess approach`: optimal net-approach guidance of two maneuverable units (MUs).
 
 Load the case (:mod:`riskassess.approach_case`), solve the optimal-control problem by
-Hermite-Simpson collocation and IPOPT (:mod:`control.mu_approach`), re-simulate the controls with
+Hermite-Simpson collocation and IPOPT (:mod:`multibody.control.mu_approach`), re-simulate the controls with
 an independent integrator to check the constraints between the collocation points, optionally
 replay the path with the 3-D Exudyn net (:mod:`multibody.mu_replay`), and write the output folder:
 
@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from control.mu_approach import ApproachProblem, collocation_points, constraint_report, resimulate, solve
-from control.mu_dynamics import IndependentMUs, RigidRodMUs, thrust_angles
+from multibody.control.mu_approach import ApproachProblem, collocation_points, constraint_report, resimulate, solve
+from multibody.control.mu_dynamics import IndependentMUs, RigidRodMUs, thrust_angles
 from riskassess import results
 from riskassess.approach_case import ApproachCase
 from riskassess.approach_plots import write_plots

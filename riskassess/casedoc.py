@@ -11,7 +11,7 @@ from pydantic import AfterValidator, BaseModel
 
 from riskassess import case as c
 from riskassess import case_inputs as limits
-from diagnosis.measured import MEASURED_FILE_LIMIT
+from riskassess.diagnosis.measured import MEASURED_FILE_LIMIT
 
 HEADER = """# Case file format
 

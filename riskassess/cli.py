@@ -10,6 +10,7 @@ from rich.markup import escape
 from rich.text import Text
 
 from multibody.health import SimulationFailed
+from riskassess import __version__
 from riskassess.case import Case, CaseError, load_case
 from riskassess.outfolder import OutputRefused, default_out, step_done
 from riskassess.results import MissingData, RunFolder
@@ -447,6 +448,7 @@ def _cmd_schema(args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="riskassess", description="Net-capture co-simulation and risk assessment.")
+    parser.add_argument("--version", action="version", version=f"riskassess {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     _simulation_command(sub, "run", _cmd_run, "simulate a case and write a run folder", "case file (TOML)",
                         "print the run summary as JSON")

@@ -1,10 +1,10 @@
 """`riskassess diagnose`: where the simulation departs from measured data, the missing effect, its gain.
 
 Steps: read the case (:mod:`riskassess.diagnosis_case`) and the measured CSV
-(:mod:`diagnosis.measured`); fit the nominal model and nominal + each applicable catalog effect
-on the training part (:mod:`diagnosis.fit`, two worker processes); score every model on the
-held-out part and select (:mod:`diagnosis.selection`); analyse the residuals before and after
-(:mod:`diagnosis.residuals`) and hint at the form of what is left (:mod:`diagnosis.hint`).
+(:mod:`riskassess.diagnosis.measured`); fit the nominal model and nominal + each applicable catalog effect
+on the training part (:mod:`riskassess.diagnosis.fit`, two worker processes); score every model on the
+held-out part and select (:mod:`riskassess.diagnosis.selection`); analyse the residuals before and after
+(:mod:`riskassess.diagnosis.residuals`) and hint at the form of what is left (:mod:`riskassess.diagnosis.hint`).
 
 Writes into the output folder (default ``runs/<case name>-diagnosis``), each file atomically:
 ``diagnosis.json`` (the answer), ``diagnosis.npz`` (time series behind the plots), PNG plots,
@@ -21,16 +21,16 @@ from pathlib import Path
 
 import numpy as np
 
-from diagnosis.effects import CATALOG
-from diagnosis.fit import (CandidateFit, FitResult, Problem, first_unpredicted_time, prediction,
+from riskassess.diagnosis.effects import CATALOG
+from riskassess.diagnosis.fit import (CandidateFit, FitResult, Problem, first_unpredicted_time, prediction,
                            step_error_sigma)
 from multibody.health import SimulationFailed
-from diagnosis.hint import describe_terms, library, sparse_terms
-from diagnosis.measured import read_measured
-from diagnosis.observation import CHANNELS, scenario_channels
-from diagnosis.residuals import analyse, describe
-from diagnosis.selection import decide, gain_percent, score
-from diagnosis.threads import single_threaded_blas
+from riskassess.diagnosis.hint import describe_terms, library, sparse_terms
+from riskassess.diagnosis.measured import read_measured
+from riskassess.diagnosis.observation import CHANNELS, scenario_channels
+from riskassess.diagnosis.residuals import analyse, describe
+from riskassess.diagnosis.selection import decide, gain_percent, score
+from riskassess.diagnosis.threads import single_threaded_blas
 from riskassess import results
 from riskassess.case import read_toml
 from riskassess.diagnosis_case import load_diagnosis_case, toml_text

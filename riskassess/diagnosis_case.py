@@ -146,7 +146,7 @@ class _ScenarioBase(Strict):
 
 def _check_effects(case):
     """Every ``[[effects]]`` entry names a catalog effect that applies and gives its parameters."""
-    from diagnosis.effects import CATALOG
+    from riskassess.diagnosis.effects import CATALOG
 
     for k, entry in enumerate(case.effects):
         if entry.id not in CATALOG:

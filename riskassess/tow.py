@@ -24,9 +24,9 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from control.attitude import quaternion_to_matrix, sampled_boundary_layer
-from control.mrac import mrac_initial_state, mrac_params, reference_steady_elongation
-from control.thrust import KINDS
+from multibody.control.attitude import quaternion_to_matrix, sampled_boundary_layer
+from multibody.control.mrac import mrac_initial_state, mrac_params, reference_steady_elongation
+from multibody.control.thrust import KINDS
 from multibody.towing import TowingModel, run_exudyn
 from riskassess import results
 from riskassess.case import load_model
@@ -118,7 +118,7 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
 
 def reference_elongation(case: TowingCase) -> float | None:
     """Where the MRAC laws steer the elongation (m): the steady state of their reference model
-    (:func:`control.mrac.reference_steady_elongation`); None without an [mrac] section."""
+    (:func:`multibody.control.mrac.reference_steady_elongation`); None without an [mrac] section."""
     if case.mrac is None:
         return None
     return reference_steady_elongation(case.main_tether.stiffness, case.mrac.k_p, case.mrac.desired_elongation)

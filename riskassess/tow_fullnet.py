@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from control.attitude import quaternion_to_matrix, sampled_boundary_layer
+from multibody.control.attitude import quaternion_to_matrix, sampled_boundary_layer
 from multibody.net_towing import FullNetModel, run_exudyn
 from multibody.net_wrap import drape_and_close, towing_net, wrap_summary
 from riskassess import results

@@ -30,7 +30,7 @@ import meshio
 import numpy as np
 import trimesh
 
-from diagnosis.towing_plant import lvlh_to_eci
+from riskassess.diagnosis.towing_plant import lvlh_to_eci
 from multibody.net import thread_tension_strain
 from riskassess.results import MissingData, RunFolder
 from riskassess.vtk_export import VtkExport, export_frames, nearest_samples, surface_lvlh

@@ -102,7 +102,7 @@ class AttitudeControl(Strict):
     k_gain: Positive = Field(description="K (1/s), Sec. 4.1.")
     gain: PositiveVector3 = Field(description="Diagonal of G (rad/s^2), Sec. 4.1.")
     boundary_layer: Positive = Field(description="epsilon (rad/s), Sec. 4.1; widened to the sampled-loop value "
-                                                 "for the step (control.attitude.sampled_boundary_layer).")
+                                                 "for the step (multibody.control.attitude.sampled_boundary_layer).")
 
 
 class TowSimulation(Strict):

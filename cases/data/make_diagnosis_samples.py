@@ -8,10 +8,10 @@
   Coulomb friction (``hinge_coulomb_friction``: 1.2 N m);
 * ``cases/data/towing_viscoelastic.csv``: cases/diagnose_towing.toml with a viscoelastic main tether
   (``tether_viscoelasticity``: k_m = 6000 N/m, tau_m = 30 s), from the towing model in Exudyn
-  (diagnosis.towing_exudyn, 4 ms steps);
+  (riskassess.diagnosis.towing_exudyn, 4 ms steps);
 
-each 300 s at 10 Hz from the Exudyn model (diagnosis.exudyn_model), with white Gaussian noise at the
-levels of ``diagnosis.synthetic.NOISE`` (seed 2024 in turn for the first two, 2025 for the towing
+each 300 s at 10 Hz from the Exudyn model (riskassess.diagnosis.exudyn_model), with white Gaussian noise at the
+levels of ``riskassess.diagnosis.synthetic.NOISE`` (seed 2024 in turn for the first two, 2025 for the towing
 sample, so that ``python cases/data/make_diagnosis_samples.py towing_viscoelastic.csv`` remakes it
 alone). Try them with
 ``riskassess diagnose cases/diagnose_tumbling_rigid.toml --measured cases/data/tumbling_rigid_nutation.csv``.
@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from diagnosis.measured import write_measured
-from diagnosis.synthetic import noisy, sample_times, simulate_effect
+from riskassess.diagnosis.measured import write_measured
+from riskassess.diagnosis.synthetic import noisy, sample_times, simulate_effect
 from riskassess.diagnosis_case import load_diagnosis_case
 
 ROOT = Path(__file__).resolve().parents[2]

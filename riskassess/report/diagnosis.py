@@ -57,7 +57,7 @@ def residuals_figure(answer: dict, arrays: dict):
 
 def spectrum_figure(answer: dict, arrays: dict):
     """Welch PSD of the worst channel's normalized residual, before and after."""
-    from diagnosis.residuals import spectrum
+    from riskassess.diagnosis.residuals import spectrum
 
     worst = _shown(answer, arrays)[0]
     fig, (ax,) = panels(1, 2.2)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from control.thrust import KINDS
+from multibody.control.thrust import KINDS
 from multibody.net_towing import FullNetModel, run_exudyn
 from multibody.net_towing_kernel import cylinder_distance
 from multibody.net_wrap import DrapeSchedule, drape_and_close, towing_net, wrap_summary

@@ -2,7 +2,7 @@
 
 Each test writes a shipped case with one change and asserts the exact message: a CaseError naming
 the file, the key and what is allowed. The limits asserted are the module constants of
-riskassess/case_inputs.py and diagnosis/measured.py (their reasons are stated there).
+riskassess/case_inputs.py and riskassess/diagnosis/measured.py (their reasons are stated there).
 """
 import re
 from pathlib import Path
@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from diagnosis.measured import MEASURED_FILE_LIMIT, MeasuredDataError, read_measured, write_measured
+from riskassess.diagnosis.measured import MEASURED_FILE_LIMIT, MeasuredDataError, read_measured, write_measured
 from riskassess.approach_case import ApproachCase
 from riskassess.case import CaseError, load_case, load_model
 from riskassess.case_inputs import (CASE_FILE_LIMIT, CASE_NAME_PATTERN, ITEM_NAME_PATTERN, JSON_FILE_LIMIT,

@@ -5,7 +5,7 @@ import meshio
 import numpy as np
 import pytest
 
-from control.mrac import reference_steady_elongation
+from multibody.control.mrac import reference_steady_elongation
 from multibody.net import tension_only_kelvin_voigt
 from riskassess.case import load_model
 from riskassess.report import write_report

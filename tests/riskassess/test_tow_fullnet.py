@@ -3,7 +3,7 @@ initial state and its free flight towards the debris."""
 import numpy as np
 import pytest
 
-from control.attitude import quaternion_to_matrix
+from multibody.control.attitude import quaternion_to_matrix
 from multibody.net_towing import NetTowState, run_exudyn
 from riskassess.case import load_model
 from riskassess.tow_fullnet import capture_start, full_net_model

@@ -1,0 +1,88 @@
+"""``eddy_current_damping``: braking torque of eddy currents induced by the geomagnetic field.
+
+For a conductive body spinning in a field B (Gomez & Walker 2015, Ortiz Gomez & Walker,
+"Eddy currents applied to de-tumbling of space debris"), the torque opposes the spin
+component normal to the field:
+
+.. math:: \\boldsymbol\\tau = -c\\,(\\boldsymbol\\omega - (\\boldsymbol\\omega\\cdot\\hat b)\\hat b)
+
+with c = k_e |B|^2 (N m s) and the field direction b fixed in the inertial frame over the record
+(a few minutes of a LEO orbit); the angular momentum is not conserved (an external torque).
+Parameters: c and the field direction (azimuth, elevation in I = LVLH at t = 0). Main body only
+(towing: the debris; I = the chaser's LVLH at the record's t = 0).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_Q, X_W, quaternion_rows, tdot, tmtv, tmv
+from riskassess.diagnosis.effects.base import Effect, Parameter
+from riskassess.diagnosis.plant import plant_of
+from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
+from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.towing_kernel import DEBRIS
+
+
+@njit(cache=True)
+def field_direction(azimuth, elevation):
+    """Unit field direction (3-tuple) in I from azimuth (about z, from x) and elevation (rad)."""
+    return (np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation))
+
+
+@njit(cache=True)
+def eddy_torque(omega_body, field_body, coefficient):
+    """Eddy-current torque (N m, B, 3-tuple) at ``omega_body`` (rad/s, B), unit field ``field_body`` (B)."""
+    along = tdot(omega_body, field_body)
+    return (-coefficient * (omega_body[0] - along * field_body[0]), -coefficient * (omega_body[1] - along * field_body[1]),
+            -coefficient * (omega_body[2] - along * field_body[2]))
+
+
+@njit(LAW_SIGNATURE, cache=True)
+def law(t, x, p, env, load):
+    field = tmtv(quaternion_rows(x[X_Q:X_Q + 4]), field_direction(p[1], p[2]))
+    torque = eddy_torque((x[X_W], x[X_W + 1], x[X_W + 2]), field, p[0])
+    for i in range(3):
+        load[L_TM + i] += torque[i]
+
+
+@njit(TOWING_LAW_SIGNATURE, cache=True)
+def towing_law(t, q, v, p, work, xe, h, load):
+    """On the towed debris; ``p`` = [c, azimuth, elevation, I -> ECI (9, row-major)]."""
+    b_eci = tmv(p[3:12], field_direction(p[1], p[2]))
+    rot = rotation_matrix_from_rotation_vector(q[DEBRIS + 3:DEBRIS + 6])
+    field = rot.T @ np.array(b_eci)
+    torque = eddy_torque((v[DEBRIS + 3], v[DEBRIS + 4], v[DEBRIS + 5]), field, p[0])
+    for i in range(3):
+        load[DEBRIS + 3 + i] += torque[i]
+
+
+class EddyCurrentDamping(Effect):
+    id = "eddy_current_damping"
+    title = "eddy-current braking in the geomagnetic field (spin normal to the field decays)"
+    channels = ("omega_x", "omega_y", "omega_z", "q_w")
+    scenarios = ("tumbling_rigid", "hinged_appendage", "towing")
+    law = staticmethod(law)
+    towing_law = staticmethod(towing_law)
+
+    def towing_law_parameters(self, plant, values):
+        return np.r_[np.asarray(values, float), plant.lvlh0.ravel()]
+
+    def parameter_specs(self, case, channels=None):
+        j_max = float(np.linalg.eigvalsh(plant_of(case).inertia_main)[-1])
+        return [Parameter("coefficient", "N m s", "k_e |B|^2, torque per unit spin rate", j_max / 3000.0, 0.0,
+                          j_max / 10.0),
+                Parameter("field_azimuth", "rad", "field direction about I z, from I x", 0.0, -2 * np.pi, 2 * np.pi),
+                Parameter("field_elevation", "rad", "field direction above the I x-y plane", 0.0, -np.pi / 2, np.pi / 2)]
+
+    def starts(self, specs):
+        c = specs[0].typical
+        return [np.array([c, 0.0, 1.2]), np.array([c, 0.0, 0.0]), np.array([c, np.pi / 2, 0.0])]
+
+    def add_to_exudyn(self, builder, values, names):
+        b = np.array(field_direction(values[1], values[2]))
+        builder.add_body_torque(lambda t, body, rot, omega: np.array(eddy_torque(omega, rot.T @ b, values[0]))
+                                if body == 0 else np.zeros(3))
+
+
+EFFECT = EddyCurrentDamping()

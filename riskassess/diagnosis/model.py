@@ -1,0 +1,52 @@
+"""One prediction of the measured channels: plant + at most one effect, by the fast model."""
+from __future__ import annotations
+
+import numpy as np
+
+from riskassess.diagnosis.dynamics import environment, initial_state, integrate, no_load
+from riskassess.diagnosis.effects.base import Effect
+from riskassess.diagnosis.observation import outputs
+from riskassess.diagnosis.plant import Plant, is_towing
+from riskassess.diagnosis.towing_plant import simulate as simulate_towing
+
+#: RK4 step as a fraction of the fastest motion's period / 2 pi (rad): 0.1 rad per step keeps the
+#: RK4 error of a 300 s record near 1e-4 of the signal's range, a tenth of typical sensor noise
+#: (checked against a halved step in tests/diagnosis/test_dynamics.py).
+ANGLE_PER_STEP = 0.1
+#: Longest RK4 step (s).
+MAX_STEP = 0.25
+
+
+def max_step(plant: Plant, stiffness_rate: float = 0.0) -> float:
+    """The RK4 step (s) for a plant and an effect's fastest decay rate (1/s); the towing model's
+    Verlet step is the case's ``fit_step``."""
+    step = plant.fit_step if is_towing(plant) else min(MAX_STEP, ANGLE_PER_STEP / plant.rate_scale())
+    return min(step, 1.5 / stiffness_rate) if stiffness_rate > 0 else step
+
+
+def predict(plant: Plant, times, effect: Effect | None = None, values=(), names=(), step: float | None = None) -> dict:
+    """Channels (dict of (k,) arrays) at ``times`` (s) of ``plant`` with ``effect`` at ``values``."""
+    times = np.asarray(times, float)
+    values = np.asarray(values, float)
+    if is_towing(plant):
+        return _predict_towing(plant, times, effect, values, names, step)
+    if effect is None:
+        law, p, sample_times = no_load, np.zeros(1), times
+    else:
+        plant = effect.modify_plant(plant, values)
+        law, p, sample_times = effect.law, effect.law_parameters(plant, values), effect.sample_times(times, values)
+    step = step or max_step(plant)
+    states = integrate(law, np.ascontiguousarray(p if p.size else np.zeros(1), float), environment(plant),
+                       initial_state(plant), np.ascontiguousarray(sample_times, float), step)
+    out = outputs(plant, sample_times, states)
+    return effect.measure(out, values, names) if effect is not None else out
+
+
+def _predict_towing(plant, times, effect, values, names, step) -> dict:
+    """:func:`predict` of the towing scenario (:func:`riskassess.diagnosis.towing_plant.simulate`)."""
+    if effect is None:
+        return simulate_towing(plant, times, step=step)
+    plant = effect.modify_plant(plant, values)
+    out = simulate_towing(plant, effect.sample_times(times, values), effect.towing_law,
+                          effect.towing_law_parameters(plant, values), step)
+    return effect.measure(out, values, names)
