@@ -11,7 +11,7 @@ import pytest
 from riskassess.cli import main
 from riskassess.results import RunFolder, read_manifest
 from structures.verdict import MAX_SAMPLE_INTERVAL_S, MIN_JUDGED_SAMPLES, evidence_gaps
-from tests.riskassess.conftest import CASES, shortened_case
+from tests.riskassess.conftest import shortened_case
 
 
 def _case(tmp_path, end_time, **simulation):
@@ -22,7 +22,6 @@ def _case(tmp_path, end_time, **simulation):
         k = next(i for i, line in enumerate(lines) if line.startswith(f"{key} = "))
         lines[k] = f"{key} = {value}"
         text = "\n".join(lines) + "\n"
-    text = text.replace('file = "', f'file = "{CASES}/')  # meshes stay where they are
     path = tmp_path / "case.toml"
     path.write_text(text)
     return path
