@@ -19,7 +19,8 @@ from multibody.assembly import ImpactAssembly
 from multibody.geometry import contact_shapes_body_frame
 from multibody.health import HealthWatch, SimulationFailed, check_solver_flag
 from multibody.hinge import add_penalty_joint
-from multibody.kernel import KernelData, verlet_evaluation_state
+from multibody.jit_cache import all_compiled_on_disk
+from multibody.kernel import KernelData, coupled_generalized_forces, verlet_evaluation_state
 from multibody.recorder import Recorder
 from multibody.solver_output import solver_chatter_captured
 
@@ -260,6 +261,16 @@ def simulation_settings(assembly: ImpactAssembly) -> exu.SimulationSettings:
     s = explicit_settings(assembly.solver.step, assembly.solver.n_steps)
     s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     return s
+
+
+#: The compiled functions an impact run calls from Python; the others compile inside them.
+COMPILED_KERNELS = (coupled_generalized_forces, verlet_evaluation_state)
+
+
+def kernels_compiled() -> bool:
+    """The impact kernels are in numba's disk cache: a run starts at once (else it first compiles
+    them, about 30 s on one core; :mod:`multibody.jit_cache`)."""
+    return all_compiled_on_disk(COMPILED_KERNELS)
 
 
 def net_stable_step(net) -> float:
