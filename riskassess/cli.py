@@ -395,6 +395,7 @@ def _cmd_approach(args) -> int:
 def _cmd_sweep(args) -> int:
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
+    from riskassess.sweep.cluster_log import CLUSTER_LOG
     from riskassess.sweep.envelope import envelope_statement
     from riskassess.sweep.products import (PRODUCTS, check_products, check_products_at, products_dir,
                                            write_sweep_products)
@@ -432,7 +433,8 @@ def _cmd_sweep(args) -> int:
 
             outcome = run_sweep(args.case, specs, store, {"arguments": arguments, "created": _now()},
                                 scheduler=args.scheduler, n_workers=args.workers, retry_failed=args.retry_failed,
-                                keep_runs=args.keep_runs, progress=progress, validate=False)
+                                keep_runs=args.keep_runs, progress=progress, validate=False,
+                                log_path=products_dir(store.path) / CLUSTER_LOG)
         env = write_sweep_products(store, args.confidence, args.reliability, pdf=not args.no_pdf)
     finally:
         store.close()   # releases the writer lock
