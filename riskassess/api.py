@@ -27,7 +27,6 @@ from riskassess.case import Case, CaseError, read_toml, validate_case
 from riskassess.case_kinds import case_kind
 from riskassess.outfolder import open_existing
 from riskassess.pipeline import run_case
-from riskassess.report import write_report
 from riskassess.results import RunFolder, atomic_write_json
 from riskassess.sweep.spec import case_with
 
@@ -201,6 +200,10 @@ def report(run: RunResult | str | Path, pdf: bool = False, progress=None):
     riskassess.report.ReportOutput
         ``.html`` and ``.pdf`` paths, ``.sections`` (each says whether its data was missing).
     """
+    # Imported here, not at the top: riskassess.report selects matplotlib's headless backend on
+    # import, which would switch off a notebook's inline plots for anyone importing this module.
+    from riskassess.report import write_report
+
     folder = run.path if isinstance(run, RunResult) else Path(run)
     return write_report(folder, pdf=pdf, progress=progress)
 
