@@ -7,9 +7,6 @@ records the time series through :mod:`multibody.recorder`.
 """
 from __future__ import annotations
 
-import contextlib
-import os
-import sys
 import time
 from dataclasses import dataclass
 
@@ -22,8 +19,10 @@ from multibody.assembly import ImpactAssembly
 from multibody.geometry import contact_shapes_body_frame
 from multibody.health import HealthWatch, SimulationFailed, check_solver_flag
 from multibody.hinge import add_penalty_joint
-from multibody.kernel import KernelData, verlet_evaluation_state
+from multibody.jit_cache import all_compiled_on_disk
+from multibody.kernel import KernelData, coupled_generalized_forces, verlet_evaluation_state
 from multibody.recorder import Recorder
+from multibody.solver_output import solver_chatter_captured
 
 #: Exudyn explicit integrators a case may choose, with their force evaluations per step.
 INTEGRATORS = {
@@ -264,21 +263,14 @@ def simulation_settings(assembly: ImpactAssembly) -> exu.SimulationSettings:
     return s
 
 
-@contextlib.contextmanager
-def solver_chatter_to_stderr():
-    """Send what Exudyn's C++ core prints (e.g. its VelocityVerlet notice) to stderr, so that
-    standard output carries only the tool's own results (``riskassess run --json``)."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    try:
-        os.dup2(2, 1)
-        # pybind's print goes through sys.stdout, which need not be file descriptor 1
-        with contextlib.redirect_stdout(sys.stderr):
-            yield
-    finally:
-        sys.stdout.flush()
-        os.dup2(saved, 1)
-        os.close(saved)
+#: The compiled functions an impact run calls from Python; the others compile inside them.
+COMPILED_KERNELS = (coupled_generalized_forces, verlet_evaluation_state)
+
+
+def kernels_compiled() -> bool:
+    """The impact kernels are in numba's disk cache: a run starts at once (else it first compiles
+    them, about 30 s on one core; :mod:`multibody.jit_cache`)."""
+    return all_compiled_on_disk(COMPILED_KERNELS)
 
 
 def net_stable_step(net) -> float:
@@ -340,7 +332,7 @@ def solve_checked(mbs, settings, solver_type, watch: HealthWatch) -> None:
     stopped the run (``watch.failure``), when the solver reports failure, or when it raised."""
     end_time = settings.timeIntegration.endTime
     try:
-        with solver_chatter_to_stderr():
+        with solver_chatter_captured():
             success = exu.SolveDynamic(mbs, settings, solverType=solver_type)
     except Exception as exc:  # Exudyn's C++ errors (ModelError, RuntimeError) after a failed step
         if watch.failure is not None:

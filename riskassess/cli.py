@@ -12,6 +12,7 @@ from rich.text import Text
 from multibody.health import SimulationFailed
 from riskassess import __version__
 from riskassess.case import Case, CaseError, load_case
+from riskassess.case_kinds import KINDS as CASE_KINDS
 from riskassess.outfolder import OutputRefused, default_out, step_done
 from riskassess.results import MissingData, RunFolder
 
@@ -25,30 +26,42 @@ EXIT_INDETERMINATE = 6
 def _cmd_run(args) -> int:
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-    from riskassess.pipeline import run_case
+    from riskassess import api
 
-    case = load_case(args.case)  # fail fast on a bad case, before any output folder exists
-    _check_work(impact_estimate_of(case), args)
+    case = api.load_case(args.case)  # fail fast on a bad case, before any output folder exists
+    _check_work(impact_estimate_of(case.model), args)
     out = Path(args.out) if args.out else default_out(case.name)
     end = case.simulation.end_time
+    _announce_compilation(api.needs_compilation())
     columns = [TextColumn("[bold]simulating[/bold] {task.fields[t]:.3f} / %.3g s" % end), BarColumn(),
                TimeElapsedColumn(), TimeRemainingColumn()]
     steps = _steps(args)
     with Progress(*columns, disable=args.json or not sys.stderr.isatty(), transient=True) as bar:
         task = bar.add_task("run", total=end, t=0.0)
-        result = run_case(args.case, out, progress=lambda t: bar.update(task, completed=t, t=t), case=case,
-                          overwrite=args.overwrite, pending=steps, command=args.command)
+        result = api.run(case, out, progress=lambda t: bar.update(task, completed=t, t=t),
+                         overwrite=args.overwrite, pending=steps, command=args.command)
     if args.json:
-        extra = {"structures": result.structures} if result.structures is not None else {}
+        extra = {"structures": result.verdict} if result.verdict is not None else {}
         print(json.dumps({**result.summary, **extra}, indent=2))
     else:
-        print_summary(result.summary, result.run_dir)
-        if result.structures is not None:
-            print_verdict(result.structures)
-    status = _products(result.run_dir, steps, quiet=args.json)
-    if result.structures is not None and result.structures.get("debris_state") == "indeterminate":
+        print_summary(result.summary, result.path)
+        if result.verdict is not None:
+            print_verdict(result.verdict)
+    status = _products(result.path, steps, quiet=args.json)
+    if result.debris_state == "indeterminate":
         return EXIT_INDETERMINATE  # a script must not read "no verdict" as success
     return status
+
+
+#: Said on stderr before a run whose force kernels are not in numba's disk cache yet.
+COMPILING = ("compiling the simulation kernels, once: ~30 s (numba keeps them in __pycache__; "
+             "later runs start at once)")
+
+
+def _announce_compilation(needed: bool) -> None:
+    """The first run after an install sits ~30 s at t = 0 while numba compiles: say so (stderr)."""
+    if needed:
+        print(COMPILING, file=sys.stderr, flush=True)
 
 
 def impact_estimate_of(case: Case):
@@ -102,12 +115,12 @@ def _progress_bar(label: str, quiet: bool):
 
 
 def _make_report(run_dir: Path, pdf: bool = True, quiet: bool = False):
-    from riskassess.report import write_report
+    from riskassess import api
 
     with _progress_bar("report", quiet) as bar:
         task = bar.add_task("", total=None)
-        out = write_report(run_dir, pdf=pdf,
-                           progress=lambda k, n, title: bar.update(task, completed=k, total=n, description=title))
+        out = api.report(run_dir, pdf=pdf,
+                         progress=lambda k, n, title: bar.update(task, completed=k, total=n, description=title))
     if not quiet:
         missing = [s.title for s in out.sections if s.missing]
         print(f"report: {out.html}" + (f" and {out.pdf} ({out.pdf_pages} pages)" if out.pdf else ""))
@@ -142,7 +155,9 @@ def _cmd_export_vtk(args) -> int:
 
 
 def _cmd_assess(args) -> int:
-    case = load_case(args.case)
+    from riskassess import api
+
+    case = api.load_case(args.case)
     if case.structures is None:
         raise CaseError(f"{args.case}: structures: missing; 'assess' needs [[structures.weak_locations]] "
                         f"(see docs/case-format.md)")
@@ -150,12 +165,14 @@ def _cmd_assess(args) -> int:
 
 
 def _cmd_perceive(args) -> int:
+    from riskassess.api import needs_compilation
     from riskassess.perceive import perceive_case
 
     case = load_case(args.case)
     _check_work(impact_estimate_of(case), args)
     out = Path(args.out) if args.out else default_out(case.name)
     steps = _steps(args)
+    _announce_compilation(needs_compilation())
     with _progress_bar("perceive", args.json) as bar:
         task = bar.add_task("", total=None)
 
@@ -231,30 +248,55 @@ def _cmd_identify(args) -> int:
     return 0
 
 
-def print_perception(answer: dict, out: Path) -> None:
+def print_perception(answer: dict, out: Path, console=None) -> None:
     from riskassess.tables import perception_rows
 
-    console = _console()
-    console.print(_table(f"{escape(answer['case'])}: debris mass and inertia from LiDAR and the net collision",
-                         ("quantity", "estimate", "1 sigma", "error vs truth"), perception_rows(answer),
-                         {"estimate": "right", "1 sigma": "right", "error vs truth": "right"}))
+    console = console or _console()
+    _print_table(console, f"{escape(answer['case'])}: debris mass and inertia from LiDAR and the net collision",
+                 ("quantity", "estimate", "1 sigma", "error vs truth"), perception_rows(answer),
+                 {"estimate": "right", "1 sigma": "right", "error vs truth": "right"})
     if answer["not_observable"]:
         console.print(f"[red]not observable[/red]: {escape(str(answer['not_observable']))}")
     console.print(f"results: {escape(str(out))}")
 
 
+def _cells(row) -> list[Text]:
+    """Every string cell shown literally (names are user text); a rich ``Text`` keeps its style."""
+    return [cell if isinstance(cell, Text) else Text(str(cell)) for cell in row]
+
+
 def _table(title: str, columns, rows, justify=None):
-    """A rich table; ``title`` is markup (user text in it escaped by the caller), every string cell
-    is shown literally (names are user text); a cell that is a rich ``Text`` keeps its style."""
+    """A rich table; ``title`` is markup (user text in it escaped by the caller)."""
     from rich.table import Table
 
     table = Table(title=title)
-    for k, column in enumerate(columns):
-        # the first column names the row: never cut it
-        table.add_column(escape(column), justify=(justify or {}).get(column, "left"), no_wrap=k == 0)
+    for column in columns:
+        table.add_column(escape(column), justify=(justify or {}).get(column, "left"), no_wrap=True)
     for row in rows:
-        table.add_row(*(cell if isinstance(cell, Text) else Text(str(cell)) for cell in row))
+        table.add_row(*_cells(row))
     return table
+
+
+def _print_table(console, title: str, columns, rows, justify=None) -> None:
+    """A table when it fits the console without wrapping a cell; otherwise the rows stacked, one
+    block per row: its first cell, then 'column: value' lines (empty cells left out; a row that
+    continues the one above, with an empty first cell, repeats that cell). Never a cut cell."""
+    from rich.measure import Measurement
+
+    table = _table(title, columns, rows, justify)
+    # its natural width, measured as if the console were unbounded (console.measure clamps to it)
+    if Measurement.get(console, console.options.update_width(1_000_000), table).maximum <= console.width:
+        console.print(table)
+        return
+    console.print(title, style="italic")
+    head = Text("")
+    for row in rows:
+        cells = _cells(row)
+        head = cells[0] if cells[0].plain else head
+        console.print(Text.assemble(head, style="bold"), overflow="fold")
+        for column, cell in zip(columns[1:], cells[1:]):
+            if cell.plain:
+                console.print(Text.assemble(f"  {column}: ", cell), overflow="fold")
 
 
 def _console():
@@ -265,18 +307,18 @@ def _console():
     return Console(width=None if sys.stdout.isatty() else 150, emoji=False)
 
 
-def print_verdict(verdict: dict) -> None:
+def print_verdict(verdict: dict, console=None) -> None:
     """The verdict table: location, criterion, peak demand, allowable, margin, fails?, released piece."""
     from riskassess.tables import STATE_TEXT, VERDICT_COLUMNS, debris_line, piece_fate, verdict_rows
 
-    console = _console()
+    console = console or _console()
     marked = {"fails": Text("FAIL", style="red"), "indeterminate": Text("indeterminate", style="yellow")}
     rows = [[marked.get(r["state"], STATE_TEXT[r["state"]]) if c == "fails?" else r[c] for c in VERDICT_COLUMNS]
             for r in verdict_rows(verdict)]
     right = {c: "right" for c in ("max demand", "at", "allowable", "margin", "likelihood")}
-    console.print(_table(f"structural verdict (loads after {verdict['skip_initial_s']:g} s; range allowables "
-                         f"decide at their '{escape(str(verdict['release_policy']))}' value)", VERDICT_COLUMNS, rows,
-                         {**right, "fails?": "center"}))
+    _print_table(console, f"structural verdict (loads after {verdict['skip_initial_s']:g} s; range allowables "
+                          f"decide at their '{escape(str(verdict['release_policy']))}' value)", VERDICT_COLUMNS, rows,
+                 {**right, "fails?": "center"})
     for p in verdict["released_pieces"]:
         console.print(f"released {escape('+'.join(p['bodies']))}: {escape(piece_fate(p))}")
     if verdict["released_pieces"]:
@@ -286,12 +328,12 @@ def print_verdict(verdict: dict) -> None:
     console.print(f"[{colour}]{line}[/{colour}]" if colour else line)
 
 
-def print_summary(summary: dict, run_dir: Path) -> None:
+def print_summary(summary: dict, run_dir: Path, console=None) -> None:
     from riskassess.tables import summary_rows
 
-    console = _console()
-    console.print(_table(f"{escape(summary['case'])}: coupled net impact", ("quantity", "this run", "paper (decoupled)"),
-                         summary_rows(summary), {"this run": "right", "paper (decoupled)": "right"}))
+    console = console or _console()
+    _print_table(console, f"{escape(summary['case'])}: coupled net impact", ("quantity", "this run", "paper (decoupled)"),
+                 summary_rows(summary), {"this run": "right", "paper (decoupled)": "right"})
     console.print(f"results: {escape(str(run_dir))}")
 
 
@@ -353,6 +395,7 @@ def _cmd_approach(args) -> int:
 def _cmd_sweep(args) -> int:
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
+    from riskassess.sweep.cluster_log import CLUSTER_LOG
     from riskassess.sweep.envelope import envelope_statement
     from riskassess.sweep.products import (PRODUCTS, check_products, check_products_at, products_dir,
                                            write_sweep_products)
@@ -390,7 +433,8 @@ def _cmd_sweep(args) -> int:
 
             outcome = run_sweep(args.case, specs, store, {"arguments": arguments, "created": _now()},
                                 scheduler=args.scheduler, n_workers=args.workers, retry_failed=args.retry_failed,
-                                keep_runs=args.keep_runs, progress=progress, validate=False)
+                                keep_runs=args.keep_runs, progress=progress, validate=False,
+                                log_path=products_dir(store.path) / CLUSTER_LOG)
         env = write_sweep_products(store, args.confidence, args.reliability, pdf=not args.no_pdf)
     finally:
         store.close()   # releases the writer lock
@@ -442,7 +486,9 @@ def _cmd_validate(args) -> int:
 
 
 def _cmd_schema(args) -> int:
-    print(json.dumps(Case.model_json_schema(), indent=2))
+    from riskassess.case_kinds import case_schema
+
+    print(json.dumps(case_schema(args.kind), indent=2))
     return 0
 
 
@@ -534,7 +580,10 @@ def build_parser() -> argparse.ArgumentParser:
     val = sub.add_parser("validate", help="check a case file and exit")
     val.add_argument("case")
     val.set_defaults(func=_cmd_validate)
-    schema = sub.add_parser("schema", help="print the case-file JSON schema (keys, units, limits)")
+    schema = sub.add_parser("schema", help="print the JSON schema of a kind of case file (keys, units, limits)")
+    schema.add_argument("--kind", choices=list(CASE_KINDS), default="impact",
+                        help="case kind: impact (run, assess, perceive, sweep; the default), towing (tow, identify), "
+                             "diagnosis (diagnose), approach")
     schema.set_defaults(func=_cmd_schema)
     return parser
 

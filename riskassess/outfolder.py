@@ -25,6 +25,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from multibody.solver_output import SOLVER_LOG, solver_log
 from riskassess.results import FORMAT, VERSION, write_manifest
 
 MANIFEST = "manifest.json"
@@ -222,13 +223,19 @@ class OutputFolder:
 
     @contextlib.contextmanager
     def recording(self):
-        """Any exception (Ctrl-C included) while the folder is ``running`` is recorded as ``failed``."""
+        """Any exception (Ctrl-C included) while the folder is ``running`` is recorded as ``failed``.
+        What the solver prints meanwhile goes to :data:`~multibody.solver_output.SOLVER_LOG` here
+        (listed in the manifest; lines that are not routine notices also reach standard error)."""
         try:
-            yield self
+            with solver_log(self.path / SOLVER_LOG):
+                yield self
         except BaseException as exc:
             if self.manifest.get("status") == "running" and "outcome" not in self.manifest:
                 self.fail("failed", exc)
             raise
+        finally:
+            if (self.path / SOLVER_LOG).is_file() and SOLVER_LOG not in self.manifest.get("files", []):
+                self.add_files(SOLVER_LOG)
 
 
 def claim(out: str | Path, case_name: str, command: str, overwrite: bool = False, stage: str | None = None,

@@ -22,7 +22,8 @@ from riskassess.diagnosis.observation import HINGE, OMEGA, QUATERNION, REL, lvlh
 from riskassess.diagnosis.plant import Plant
 from multibody.assembly import JointSpec, RigidBodySpec
 from multibody.hinge import add_penalty_joint, hinge_frame_lvlh
-from multibody.impact import add_rigid_bodies, explicit_settings, solver_chatter_to_stderr
+from multibody.impact import add_rigid_bodies, explicit_settings
+from multibody.solver_output import solver_chatter_captured
 
 #: Exudyn RK44 step (s) with a hinge: the penalty hinge is tuned to it (mode at 0.5 / step = 125
 #: rad/s, far above hinge and tumble rates of ~0.01-3 rad/s; its compliance changes the hinge
@@ -165,7 +166,7 @@ class ExudynScenario:
         recorder.sample(0.0)
         mbs.SetPostStepUserFunction(recorder.post_step)
         n_steps = int(np.ceil(times[-1] / self.step)) + 1
-        with solver_chatter_to_stderr():
+        with solver_chatter_captured():
             exu.SolveDynamic(mbs, explicit_settings(self.step, n_steps), solverType=exu.DynamicSolverType.RK44)
         return self._channels(times, recorder.states())
 

@@ -14,9 +14,10 @@ import numpy as np
 
 from riskassess.diagnosis.towing_dynamics import apply_loads, initial_extra_states, no_towing_load
 from riskassess.diagnosis.towing_plant import TowingPlant, channels
-from multibody.impact import _object_state_index, explicit_settings, solver_chatter_to_stderr
+from multibody.impact import _object_state_index, explicit_settings
 from multibody.towing import build_towing_system, packed
 from multibody.towing_kernel import N_COORDINATES, body_forces, sampled_state
+from multibody.solver_output import solver_chatter_captured
 
 #: Exudyn step (s): the towing case's default (docs/towing.md: step study, 1.3e-4 m and 3.5e-5 rad/s
 #: from a 0.25 ms run over 275 s); the fast model runs at 20 ms.
@@ -71,7 +72,7 @@ def simulate_towing_exudyn(plant: TowingPlant, times, effect=None, values=(), na
         return True
 
     mbs.SetPostStepUserFunction(record)      # Exudyn also calls it at the initial time
-    with solver_chatter_to_stderr():
+    with solver_chatter_captured():
         exu.SolveDynamic(mbs, explicit_settings(step, model.n_steps), solverType=exu.DynamicSolverType.VelocityVerlet)
     grid = every * step * np.arange(len(rows))
     out = channels(plant, model, *(np.array([r[k] for r in rows]) for k in range(4)))

@@ -8,6 +8,7 @@ sweep goes on.
 """
 from __future__ import annotations
 
+import contextlib
 import itertools
 import logging
 import math
@@ -22,6 +23,7 @@ from multibody.health import SimulationFailed
 from riskassess.case import CaseError, validate_case
 from riskassess.outfolder import open_existing
 from riskassess.results import atomic_write_json
+from riskassess.sweep.cluster_log import StderrToFile, distributed_logging_to
 from riskassess.sweep.records import debris_state_of
 from riskassess.sweep.spec import RunSpec, SweepSpecError, case_with
 from riskassess.sweep.store import ResultStore
@@ -207,26 +209,31 @@ def validate_runs(case_path: str, case_text: str, specs: list[RunSpec], limit: i
     return what
 
 
-def _client(scheduler: str | None, n_workers: int):
+def _client(scheduler: str | None, n_workers: int, log_path: Path | None = None):
+    """A client of the scheduler at ``scheduler``, or of a new local cluster whose workers write
+    their standard error to ``log_path`` (:mod:`riskassess.sweep.cluster_log`)."""
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
         return Client(scheduler), None
     # processes, one thread each: Exudyn systems are not shared between threads
     cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=logging.ERROR)
-    return Client(cluster), cluster
+                           silence_logs=logging.WARNING if log_path else logging.ERROR)
+    client = Client(cluster)
+    if log_path is not None:
+        client.register_plugin(StderrToFile(log_path))
+    return client, cluster
 
 
 def run_sweep(case_path: str | Path, specs: list[RunSpec], store: ResultStore, definition: dict,
               scheduler: str | None = None, n_workers: int = 2, retry_failed: bool = False,
-              keep_runs: str | Path | None = None, progress=None, validate: bool = True) -> SweepOutcome:
+              keep_runs: str | Path | None = None, progress=None, validate: bool = True,
+              log_path: str | Path | None = None) -> SweepOutcome:
     """Run every spec not finished in ``store``; ``progress(done, failed, remaining)`` after each.
 
-    ``validate=False`` when the caller already ran :func:`validate_runs`.
+    ``validate=False`` when the caller already ran :func:`validate_runs`. ``log_path``: the Dask
+    cluster's warnings go to this file instead of the terminal (:mod:`riskassess.sweep.cluster_log`).
     """
-    from dask.distributed import as_completed
-
     if n_workers < 1:
         raise ValueError(f"n_workers must be >= 1. Got {n_workers} instead.")
     case_path = str(case_path)
@@ -241,25 +248,41 @@ def run_sweep(case_path: str | Path, specs: list[RunSpec], store: ResultStore, d
     if progress:
         progress(done, failed, len(todo))
     if todo:
-        client, cluster = _client(scheduler, n_workers)
-        try:
-            futures = {client.submit(simulate_run, case_path, case_text, by_id[rid].overrides,
-                                     str(Path(keep_runs) / rid) if keep_runs else None,
-                                     key=f"riskassess-run-{rid}", pure=False): rid for rid in todo}
-            for future in as_completed(futures):
-                rid = futures[future]
-                try:
-                    record = future.result()
-                    store.write_done(rid, record)
-                    done += 1
-                    indeterminate += debris_state_of(record) == INDETERMINATE
-                except Exception as exc:  # noqa: BLE001 -- every failure is recorded, the sweep goes on
-                    store.write_failed(rid, failure_message(exc), failure_kind(exc))
-                    failed += 1
-                if progress:
-                    progress(done, failed, len(todo) - done - failed)
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+        with contextlib.ExitStack() as stack:
+            if log_path is not None:
+                stack.enter_context(distributed_logging_to(log_path))
+            done, failed, indeterminate = _run_on_cluster(
+                _client(scheduler, n_workers, Path(log_path) if log_path else None), case_path, case_text,
+                [by_id[rid] for rid in todo], store, keep_runs, progress)
     return SweepOutcome(len(specs), len(specs) - len(todo), done, failed, time.perf_counter() - start, indeterminate)
+
+
+def _run_on_cluster(client_cluster, case_path: str, case_text: str, todo: list[RunSpec], store: ResultStore,
+                    keep_runs, progress) -> tuple[int, int, int]:
+    """Submit every run, write each to the store as it finishes; (done, failed, indeterminate).
+    Closes the client (and the local cluster) at the end."""
+    from dask.distributed import as_completed
+
+    client, cluster = client_cluster
+    done = failed = indeterminate = 0
+    try:
+        futures = {client.submit(simulate_run, case_path, case_text, spec.overrides,
+                                 str(Path(keep_runs) / spec.run_id) if keep_runs else None,
+                                 key=f"riskassess-run-{spec.run_id}", pure=False): spec.run_id for spec in todo}
+        for future in as_completed(futures):
+            rid = futures[future]
+            try:
+                record = future.result()
+                store.write_done(rid, record)
+                done += 1
+                indeterminate += debris_state_of(record) == INDETERMINATE
+            except Exception as exc:  # noqa: BLE001 -- every failure is recorded, the sweep goes on
+                store.write_failed(rid, failure_message(exc), failure_kind(exc))
+                failed += 1
+            if progress:
+                progress(done, failed, len(todo) - done - failed)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return done, failed, indeterminate

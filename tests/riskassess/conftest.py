@@ -24,3 +24,15 @@ def assessed(tmp_path_factory):
     out = tmp / "run"
     assert main(["assess", str(case), "--out", str(out), "--json"]) == 0
     return out
+
+
+@pytest.fixture(scope="session")
+def envisat_small_first_0p3s(tmp_path_factory):
+    """The reduced Envisat case shortened to 0.3 s (first contact at ~0.15 s, the solar-array hinge
+    fails at ~0.27 s): (case file, run folder written by ``riskassess assess``)."""
+    tmp = tmp_path_factory.mktemp("short")
+    case = tmp / "small_0p3.toml"
+    case.write_text(shortened_case(0.3))
+    out = tmp / "cli_run"
+    assert main(["assess", str(case), "--out", str(out), "--json"]) == 0
+    return case, out

@@ -45,7 +45,7 @@ def test_a_diverging_run_is_failed_and_indeterminate(tmp_path, capsys):
     assert not manifest["health"]["healthy"] and manifest["health"]["failure"]["time_s"] < 0.6
     assert not (out / "summary.json").exists() and not (out / "structures.json").exists()
     assert not RunFolder(out).complete  # later stages do not take the folder for a complete run
-    assert manifest["files"] == ["case.toml", "case.json"]
+    assert manifest["files"] == ["case.toml", "case.json", "solver.log"]   # the failed solve's own output kept
 
 
 def test_a_run_ending_before_the_judged_window_is_indeterminate(tmp_path, capsys):
