@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -73,9 +74,11 @@ def _cpu_seconds() -> float:
 
 
 def _towing_case_copy(folder: Path) -> Path:
-    """cases/diagnose_towing.toml copied into ``folder``, its towing case named by its absolute path."""
+    """cases/diagnose_towing.toml copied into ``folder`` with the towing case it names (a case names
+    its files relative to itself)."""
     case = folder / "diagnose_towing.toml"
-    case.write_text((ROOT / "cases" / case.name).read_text().replace('towing = "', f'towing = "{ROOT / "cases"}/'))
+    case.write_text((ROOT / "cases" / case.name).read_text())
+    shutil.copyfile(ROOT / "cases" / "zenit2_towing.toml", folder / "zenit2_towing.toml")
     return case
 
 
@@ -102,10 +105,7 @@ def main() -> None:
         if args.only and case_name not in args.only:
             continue
         with tempfile.TemporaryDirectory() as tmp:
-            case = Path(tmp) / case_name
-            # a towing diagnosis names its towing case relative to itself
-            case.write_text((ROOT / "cases" / case_name).read_text().replace(
-                'towing = "', f'towing = "{ROOT / "cases"}/'))
+            case = ROOT / "cases" / case_name  # diagnose writes only under its output folder
             tic, cpu = time.perf_counter(), _cpu_seconds()
             answer = diagnose_case(case, ROOT / "cases" / "data" / data_name, Path(tmp) / "out", workers=args.workers)
             wall, cpu = time.perf_counter() - tic, _cpu_seconds() - cpu

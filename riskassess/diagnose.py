@@ -216,7 +216,7 @@ def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, 
     fits, predictions, diverged = _without_diverged(problem, fits, predictions)
     step_errors = {k: step_error_sigma(problem, CATALOG.get(k), f, predictions[k]) for k, f in fits.items()}
     scores = score(problem, predictions, step_errors)
-    decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms)
+    decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms, problem)
     chosen = decision["model"]
     before = analyse(problem.time, predictions["nominal"], problem.values, problem.noise)
     after = analyse(problem.time, predictions[chosen], problem.values, problem.noise)

@@ -12,7 +12,15 @@ held-out part it was not fitted on. A cause is named only when all of these hold
 3. adequate: the extended model's training residual RMS is within ``adequate_rms`` sigma in every
    channel (what is left is noise), otherwise the effect only absorbs part of something else; a
    model's own discretization error e (noise sigmas, when given) widens that to
-   sqrt(adequate_rms^2 + e^2): no model can be asked to fit better than it integrates;
+   sqrt(adequate_rms^2 + e^2): no model can be asked to fit better than it integrates; and what
+   is left has no structure, on the training and on the held-out part (:func:`structure`: not
+   white by Ljung-Box with a material autocorrelation, or a material trend). A model whose
+   residuals keep structure explains part of the data, not its cause: an effect outside the
+   catalog was once named with confidence 1.00 while its residual RMS passed (1.04 / 1.09 sigma)
+   and Ljung-Box gave p = 0;
+3b. plausible: no nominal parameter fitted more than ``PRIOR_PULL_LIMIT`` prior sigmas from its
+   prior centre; a fit that needs one there is evidence of a missing effect (a body rate fitted at
+   44 sigma once soaked up a sensor bias), so the answer is "unexplained" with the pull named;
 4. material: it improves the residual RMS by at least ``MIN_GAIN_PERCENT``, over all channels or in
    the channel where the nominal model departs most (training or held-out part), and does not
    predict the held-out part worse overall.
@@ -27,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.diagnosis.fit import FitResult, Problem
-from riskassess.diagnosis.residuals import normalized_residuals
+from riskassess.diagnosis.residuals import LJUNG_BOX_LAGS, ljung_box, normalized_residuals, trend
 
 #: Smallest gain (normalized RMS, %, training or held-out; over all channels or in the nominal model's
 #: worst channel) for a named cause: an effect that is decisive but improves the fit by less than 5 %
@@ -36,6 +44,25 @@ from riskassess.diagnosis.residuals import normalized_residuals
 #: dilutes an effect seen in one of them: a soft, fast viscoelastic tether (2000 N/m, 10 s) moves only
 #: the tension and gained 3 % overall with a delta BIC of 1231 (docs/diagnosis.md).
 MIN_GAIN_PERCENT = 5.0
+
+#: A residual is "not white" at a Ljung-Box p-value below this. Per test; with a dozen channels, two
+#: parts and two tests a model faces ~50 tests, so 1e-6 keeps the chance that noise alone rejects a
+#: right model below 1e-4 (Bonferroni).
+STRUCTURE_P = 1e-6
+#: ... and only when the autocorrelation is material: its RMS over the Ljung-Box lags above 0.05
+#: (white noise gives ~1/sqrt(n): 0.018 for 3000 samples). The failure this guards against had
+#: 0.08-0.3; a right model whose noise estimate is a little off stays near the white level.
+STRUCTURE_ACF_RMS = 0.05
+#: A trend is material when the straight line through the residual moves by more than this over
+#: the part (sigmas), at p < STRUCTURE_P.
+STRUCTURE_TREND_SIGMA = 0.5
+#: A channel whose model step error is above this (sigmas) is not tested for structure: the
+#: model's own discretization error is structured by nature (fit.step_error_sigma).
+STRUCTURE_STEP_ERROR = 0.5
+#: Largest pull of a fitted nominal parameter from its prior centre (prior sigmas) for a named
+#: answer. With ~10 nominal parameters drawn from their priors, all lie within 3.5 sigma with
+#: probability 0.995.
+PRIOR_PULL_LIMIT = 3.5
 
 
 def posterior_weights(fits: dict[str, FitResult]) -> dict[str, float]:
@@ -47,15 +74,65 @@ def posterior_weights(fits: dict[str, FitResult]) -> dict[str, float]:
 
 
 def channel_rms(problem: Problem, model: dict, part: np.ndarray) -> dict:
-    """Per channel: normalized RMS residual and RMSE (channel units) over the samples ``part``."""
+    """Per channel: normalized RMS residual and RMSE (channel units) over the samples ``part``, and
+    the residual's structure (:func:`structure`)."""
     measured = {c: v[part] for c, v in problem.values.items()}
     r = normalized_residuals({c: v[part] for c, v in model.items()}, measured, problem.noise)
     out = {}
     for c, res in r.items():
         ok = np.isfinite(res)
         rms = float(np.sqrt(np.mean(res[ok] ** 2)))
-        out[c] = {"rms_sigma": rms, "rmse": rms * problem.noise[c]}
+        out[c] = {"rms_sigma": rms, "rmse": rms * problem.noise[c], **structure(problem.time[part], res)}
     return out
+
+
+def structure(time, r) -> dict:
+    """What is left in a normalized residual ``r`` beyond white noise: Ljung-Box p-value and the RMS
+    of the autocorrelation over its lags, the trend's p-value and its rise over the part (sigmas);
+    ``structured`` when either is significant (p < :data:`STRUCTURE_P`) and material."""
+    ok = np.isfinite(r)
+    if ok.sum() < 16:
+        return {"white_p": 1.0, "acf_rms": 0.0, "trend_p": 1.0, "trend_rise_sigma": 0.0, "structured": False}
+    q, p_white = ljung_box(r)
+    lags = min(LJUNG_BOX_LAGS, int(ok.sum()) // 4)
+    n = int(ok.sum())
+    # Q = n (n + 2) sum acf_k^2 / (n - k): recover the RMS autocorrelation over the lags
+    acf_rms = float(np.sqrt(q / (n * (n + 2)) * (n - 0.5 * (lags + 1)) / lags))
+    slope, p_trend = trend(time, r)
+    rise = abs(slope) * float(np.ptp(time[ok]))
+    structured = bool((p_white < STRUCTURE_P and acf_rms > STRUCTURE_ACF_RMS)
+                      or (p_trend < STRUCTURE_P and rise > STRUCTURE_TREND_SIGMA))
+    return {"white_p": p_white, "acf_rms": acf_rms, "trend_p": p_trend, "trend_rise_sigma": rise,
+            "structured": structured}
+
+
+def structured_channels(model_scores: dict) -> list[str]:
+    """'channel (part)' of every channel whose residual keeps structure, training or held-out, leaving
+    out channels dominated by the model's own step error (:data:`STRUCTURE_STEP_ERROR`)."""
+    out = []
+    for part in ("train", "holdout"):
+        for c, v in model_scores[part].items():
+            step_error = model_scores["train"][c].get("step_error_sigma", 0.0)
+            if v.get("structured") and step_error <= STRUCTURE_STEP_ERROR:
+                out.append(f"{c} ({'training' if part == 'train' else 'held-out'}: {_structure_text(v)})")
+    return out
+
+
+def _structure_text(v: dict) -> str:
+    parts = []
+    if v["white_p"] < STRUCTURE_P and v["acf_rms"] > STRUCTURE_ACF_RMS:
+        parts.append(f"not white, autocorrelation {v['acf_rms']:.2f}")
+    if v["trend_p"] < STRUCTURE_P and v["trend_rise_sigma"] > STRUCTURE_TREND_SIGMA:
+        parts.append(f"trend of {v['trend_rise_sigma']:.2g} sigma")
+    return ", ".join(parts)
+
+
+def prior_pulls(fit: FitResult, problem: Problem) -> dict[str, float]:
+    """Fitted nominal parameters more than :data:`PRIOR_PULL_LIMIT` prior sigmas from their centre:
+    name -> pull (sigmas, signed)."""
+    n = fit.nominal_count
+    z = (np.asarray(fit.values[:n], float) - problem.nominal_center) / problem.nominal_sigma
+    return {name: float(v) for name, v in zip(fit.names[:n], z) if abs(v) > PRIOR_PULL_LIMIT}
 
 
 def aggregate_rms(per_channel: dict) -> float:
@@ -99,38 +176,67 @@ def _step_note(scores: dict) -> str:
     return f" plus the model's own step error (up to {error:.2g} sigma)" if error > 0.1 else ""
 
 
-def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float, adequate_rms: float) -> dict:
-    """The answer: cause (an effect id, "none" or "unexplained"), confidence, and why."""
+def _rms_adequate(model_scores: dict, adequate_rms: float) -> bool:
+    return all(v["rms_sigma"] ** 2 <= adequate_rms ** 2 + v.get("step_error_sigma", 0.0) ** 2
+               for v in model_scores["train"].values())
+
+
+def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float, adequate_rms: float,
+           problem: Problem | None = None) -> dict:
+    """The answer: cause (an effect id, "none" or "unexplained"), confidence, and why (module
+    docstring). ``problem`` gives the priors for the pull check (3b); without it the check is off."""
     weights = posterior_weights(fits)
     nominal = fits["nominal"]
     ranked = sorted((k for k in fits if k != "nominal"), key=lambda k: fits[k].bic)
-    adequate = {k: all(v["rms_sigma"] ** 2 <= adequate_rms ** 2 + v.get("step_error_sigma", 0.0) ** 2
-                       for v in s["train"].values()) for k, s in scores.items()}
-    answer = {"weights": weights, "ranked": ranked, "adequate": adequate}
+    structure_left = {k: structured_channels(s) for k, s in scores.items()}
+    pulls = {k: prior_pulls(f, problem) if problem is not None else {} for k, f in fits.items()}
+    adequate = {k: _rms_adequate(s, adequate_rms) and not structure_left[k] for k, s in scores.items()}
+    answer = {"weights": weights, "ranked": ranked, "adequate": adequate, "structure": structure_left,
+              "prior_pulls": pulls}
     if ranked:
         best = ranked[0]
         delta = nominal.bic - fits[best].bic
         margin = fits[ranked[1]].bic - fits[best].bic if len(ranked) > 1 else np.inf
         gain = gain_percent(scores["nominal"]["holdout_rms_sigma"], scores[best]["holdout_rms_sigma"])
         gain_train = gain_percent(scores["nominal"]["train_rms_sigma"], scores[best]["train_rms_sigma"])
-        if delta > decisive and adequate[best] and material_gain(scores, best) >= MIN_GAIN_PERCENT and gain >= 0:
+        decisive_and_material = (delta > decisive and material_gain(scores, best) >= MIN_GAIN_PERCENT
+                                 and gain >= 0 and _rms_adequate(scores[best], adequate_rms))
+        if decisive_and_material and structure_left[best]:
+            return {**answer, "cause": "unexplained", "model": best, "confidence": None,
+                    "reason": f"the best candidate ({best}, BIC lower by {delta:.1f} than the nominal model) leaves "
+                              f"structure in its residuals, so it explains part of the data, not its cause: "
+                              f"{'; '.join(structure_left[best])}"}
+        if decisive_and_material and pulls[best]:
+            return {**answer, "cause": "unexplained", "model": best, "confidence": None,
+                    "reason": f"the best candidate ({best}) needs {_pull_text(pulls[best])} from the case's priors: "
+                              f"evidence of a missing effect, not of {best} alone"}
+        if decisive_and_material:
             if margin > decisive:
                 return {**answer, "cause": best, "model": best, "confidence": weights[best],
                         "reason": f"{best}: BIC lower by {delta:.1f} than the nominal model and by {margin:.1f} than "
                                   f"the runner-up {ranked[1] if len(ranked) > 1 else '-'}; residual within "
-                                  f"{adequate_rms:g} sigma{_step_note(scores[best])}; fit {gain_train:.0f} % and "
-                                  f"held-out prediction {gain:.0f} % better"}
+                                  f"{adequate_rms:g} sigma{_step_note(scores[best])} and white, training and "
+                                  f"held-out; fit {gain_train:.0f} % and held-out prediction {gain:.0f} % better"}
             close = [k for k in ranked if fits[k].bic - fits[best].bic <= decisive]
             return {**answer, "cause": "unexplained", "model": best, "confidence": None,
                     "reason": f"ambiguous: {', '.join(close)} explain the data about equally (BIC within "
                               f"{decisive:g}); no single cause is decisive"}
-    if adequate["nominal"]:
+    if adequate["nominal"] and not pulls["nominal"]:
         return {**answer, "cause": "none", "model": "nominal", "confidence": weights["nominal"],
                 "reason": f"no significant discrepancy: the nominal model's residual is within {adequate_rms:g} "
-                          f"sigma in every channel and no effect is decisively better"}
+                          f"sigma and white in every channel and no effect is decisively better"}
     best = ranked[0] if ranked else "nominal"
+    if adequate["nominal"]:
+        why = f"it needs {_pull_text(pulls['nominal'])} from the case's priors (evidence of a missing effect)"
+        return {**answer, "cause": "unexplained", "model": "nominal", "confidence": None,
+                "reason": f"the nominal model fits only because {why}, and no catalog effect is decisively better"}
     why = "no candidate is decisively better" if not ranked or nominal.bic - fits[best].bic <= decisive else (
         f"the best candidate ({best}) leaves a residual above {adequate_rms:g} sigma or does not predict the "
         f"held-out data better")
+    left = f"; what is left: {'; '.join(structure_left['nominal'])}" if structure_left["nominal"] else ""
     return {**answer, "cause": "unexplained", "model": "nominal", "confidence": None,
-            "reason": f"the nominal model departs from the data and {why}"}
+            "reason": f"the nominal model departs from the data and {why}{left}"}
+
+
+def _pull_text(pulls: dict[str, float]) -> str:
+    return ", ".join(f"{name} at {z:+.1f} sigma" for name, z in sorted(pulls.items(), key=lambda kv: -abs(kv[1])))

@@ -97,3 +97,79 @@ def test_model_step_error_widens_the_adequacy_bound():
     assert answer["cause"] == "a" and "step error (up to 3 sigma)" in answer["reason"]
     scores["a"]["train"]["omega_x"]["step_error_sigma"] = 2.5      # 9 > 1.5625 + 6.25
     assert decide(fits, scores, 10.0, 1.25)["cause"] == "unexplained"
+
+
+# ---------------------------------------------------------------------------- structure and priors (issue 24)
+from types import SimpleNamespace  # noqa: E402
+
+from riskassess.diagnosis.selection import PRIOR_PULL_LIMIT, structure  # noqa: E402
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_white_noise_has_no_structure(seed):
+    """Unit white noise, 3000 samples at 10 Hz: Ljung-Box p is uniform, the ACF RMS ~1/sqrt(n) = 0.018."""
+    rng = np.random.default_rng(seed)
+    time = np.arange(3000) * 0.1
+    found = structure(time, rng.standard_normal(3000))
+    assert not found["structured"] and found["acf_rms"] < 0.04
+
+
+def test_a_slow_residual_at_rms_1_04_is_structure():
+    """The issue's failure: RMS 1.04 sigma passed, yet the residual was not white. Unit noise plus a
+    0.29 sigma sine of 0.05 Hz (RMS sqrt(1 + 0.29^2) = 1.04): the ACF at lags 1-20 is ~0.077, so the
+    ACF RMS is ~0.07 > 0.05, and Ljung-Box rejects whiteness by far."""
+    rng = np.random.default_rng(1)
+    time = np.arange(3000) * 0.1
+    r = rng.standard_normal(3000) + 0.29 * np.sqrt(2) * np.sin(2 * np.pi * 0.05 * time)
+    assert np.sqrt(np.mean(r ** 2)) == pytest.approx(1.04, abs=0.03)
+    found = structure(time, r)
+    assert found["structured"] and found["white_p"] < 1e-6 and found["acf_rms"] > 0.05
+
+
+def test_a_trend_is_structure():
+    rng = np.random.default_rng(2)
+    time = np.arange(3000) * 0.1
+    found = structure(time, rng.standard_normal(3000) + np.linspace(-0.5, 0.5, 3000))
+    # the line rises by 1 sigma over the part (> 0.5)
+    assert found["structured"] and found["trend_rise_sigma"] == pytest.approx(1.0, abs=0.15)
+
+
+def _structured_score(train_rms, holdout_rms):
+    score = _score(train_rms, holdout_rms)
+    score["holdout"]["omega_x"].update(white_p=1e-30, acf_rms=0.2, trend_p=1.0, trend_rise_sigma=0.0,
+                                       structured=True)
+    return score
+
+
+def test_a_decisive_candidate_with_structure_left_is_not_the_cause():
+    fits = {"nominal": _fit("nominal", 9000.0, 2), "a": _fit("a", 3000.0, 3)}
+    scores = {"nominal": _score(1.8, 1.8), "a": _structured_score(1.02, 1.05)}
+    answer = decide(fits, scores, 10.0, 1.25)
+    assert answer["cause"] == "unexplained" and answer["confidence"] is None
+    assert "leaves structure" in answer["reason"] and "omega_x (held-out: not white" in answer["reason"]
+
+
+def _problem(k):
+    return SimpleNamespace(nominal_center=np.zeros(k), nominal_sigma=np.ones(k))
+
+
+def test_a_candidate_that_needs_a_prior_pull_is_not_the_cause():
+    """A nominal parameter fitted 5 prior sigmas from its centre: evidence of a missing effect."""
+    fits = {"nominal": _fit("nominal", 9000.0, 2), "a": _fit("a", 3000.0, 3)}
+    fits["nominal"].nominal_count = fits["a"].nominal_count = 2
+    fits["a"].values[:2] = [0.5, 5.0]
+    fits["a"].names[:2] = ["body_rate_y", "hinge_damping"]
+    scores = {"nominal": _score(1.8, 1.8), "a": _score(1.02, 1.05)}
+    answer = decide(fits, scores, 10.0, 1.25, _problem(2))
+    assert answer["cause"] == "unexplained" and "hinge_damping at +5.0 sigma" in answer["reason"]
+    fits["a"].values[1] = PRIOR_PULL_LIMIT - 0.1   # within the limit: named
+    assert decide(fits, scores, 10.0, 1.25, _problem(2))["cause"] == "a"
+
+
+def test_an_adequate_nominal_fit_that_needs_a_prior_pull_is_not_none():
+    fits = {"nominal": _fit("nominal", 3000.0, 2)}
+    fits["nominal"].nominal_count = 2
+    fits["nominal"].values[:2] = [-44.0, 0.0]
+    fits["nominal"].names[:2] = ["omega_z", "c"]
+    answer = decide(fits, {"nominal": _score(1.0, 1.0)}, 10.0, 1.25, _problem(2))
+    assert answer["cause"] == "unexplained" and "omega_z at -44.0 sigma" in answer["reason"]
