@@ -43,7 +43,7 @@ class Scene:
     """
 
     def __init__(self, run: RunFolder):
-        net, series, meshes = run.net, run.timeseries, run.bodies
+        series, net, meshes = run.timeseries, run.net, run.bodies   # a tow folder has no time series
         self.run = run
         self.time = np.asarray(net["time"], float)
         self.positions = np.asarray(net["positions_lvlh"], float)
@@ -113,9 +113,7 @@ class Scene:
 
 def scene_of(run: RunFolder) -> Scene:
     """The run's scene, built once per :class:`RunFolder` (the report, the animation and the viewer share it)."""
-    if "scene" not in run._cache:
-        run._cache["scene"] = Scene(run)
-    return run._cache["scene"]
+    return run.cached("scene", Scene)
 
 
 def decimation(n_frames: int, max_frames: int) -> np.ndarray:
