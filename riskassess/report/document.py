@@ -150,9 +150,6 @@ def write_report(run_dir: str | Path, pdf: bool = True, progress=None, views: bo
     for name in ("report.html", "report.pdf") if pdf else ("report.html",):
         claim_product(run.path, run.manifest, name)
     sections = build_sections(run, progress)
-    view_files = None
-    if views and any(s.id == "capture" and not s.missing for s in sections):
-        view_files = write_views(run)
     html = render_html(run, sections)
     html_path = run.path / "report.html"
     results.atomic_write_bytes(html_path, html.encode("utf-8"))
@@ -164,4 +161,7 @@ def write_report(run_dir: str | Path, pdf: bool = True, progress=None, views: bo
         pdf_path = run.path / "report.pdf"
         results.atomic_write_bytes(pdf_path, data)
         run.add_product("report.pdf")
+    view_files = None
+    if views and any(s.id == "capture" and not s.missing for s in sections):
+        view_files = write_views(run)
     return ReportOutput(html_path, pdf_path, pages, section_pages, sections, view_files)
