@@ -71,11 +71,11 @@ def _locations_with(verdict: dict, criteria: set) -> list[dict]:
 
 
 def while_joined(t, demand, loc: dict) -> np.ndarray:
-    """The demand (any unit) with NaN from the location's release on: a released load path carries
+    """The demand (any unit) with NaN after the location's release: a released load path carries
     nothing, and a plotted 0 would read as a measured zero load."""
     demand = np.asarray(demand, float).copy()
     if loc["released_at_s"] is not None:
-        demand[np.asarray(t) >= loc["released_at_s"]] = np.nan
+        demand[np.asarray(t) > loc["released_at_s"]] = np.nan   # the sample that broke it stays
     return demand
 
 

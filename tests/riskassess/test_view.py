@@ -146,7 +146,7 @@ def test_no_demand_is_plotted_after_its_release(assessed):
     t = run.structures_series["time"]
     raw = run.structures_series[f"{loc['name']}/moment"]
     shown = while_joined(t, raw, loc)
-    after = t >= loc["released_at_s"]
+    after = t > loc["released_at_s"]
     assert after.any() and np.isnan(shown[after]).all()
     assert np.array_equal(shown[~after], raw[~after])
     assert (raw[after] == 0).all()   # what the plot drew before: a released joint reads 0 N m
