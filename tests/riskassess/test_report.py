@@ -22,7 +22,7 @@ FIGURES = {"capture": ["fig-capture"], "net-integrity": ["fig-net-tension"], "co
 def report(assessed, tmp_path_factory):
     run = tmp_path_factory.mktemp("report") / "run"
     shutil.copytree(assessed, run)
-    return write_report(run)
+    return write_report(run, views=False)   # the animation and the viewer: test_view.py
 
 
 def _html_section(html: str, section_id: str) -> str:
