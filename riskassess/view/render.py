@@ -34,8 +34,8 @@ VIEW_ELEV, VIEW_AZIM = 22.0, -58.0
 
 
 def tension_norm(scene: Scene) -> Normalize:
-    """Colour scale of the thread tension (N): 0 to the run's highest sampled tension."""
-    return Normalize(0.0, max(float(scene.tension.max()), 1e-9))
+    """Colour scale of the thread tension (N): 0 to :meth:`Scene.tension_scale` (higher: top colour)."""
+    return Normalize(0.0, max(scene.tension_scale(), 1e-9), clip=True)
 
 
 def _axes(ax, scene: Scene):
@@ -75,7 +75,7 @@ def draw_frame(ax, scene: Scene, f: int, norm: Normalize) -> list:
 
 def _colorbar(fig, norm: Normalize, axes) -> None:
     bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=TENSION_CMAP), ax=axes, orientation="horizontal",
-                       fraction=0.035, pad=0.03, aspect=40, shrink=0.6)
+                       fraction=0.035, pad=0.03, aspect=40, shrink=0.6, extend="max")
     bar.set_label("thread tension (N)", size=7)
     bar.ax.tick_params(labelsize=6)
 

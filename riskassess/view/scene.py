@@ -14,6 +14,10 @@ from riskassess.results import MissingData, RunFolder
 from riskassess.vtk_export import nearest_samples, release_times_by_body, surface_lvlh
 
 
+#: Percentile of the thread tension samples at the top of the colour scale (see Scene.tension_scale).
+TENSION_SCALE_PERCENTILE = 99.5
+
+
 @dataclass(frozen=True)
 class Instant:
     """A moment worth a picture: ``label`` (e.g. 'first contact'), snapshot index ``frame``."""
@@ -91,7 +95,7 @@ class Scene:
         touching = np.flatnonzero(force > 0.0)
         if len(touching):
             wanted.append(("first contact", float(s["time"][touching[0]])))
-            wanted.append(("peak contact load", float(s["time"][force.argmax()])))
+            wanted.append(("peak contact load", self._peak_time(force)))
         for t in sorted(set(self.released_from[np.isfinite(self.released_from)])):
             names = [n for n, r in zip(self.body_names, self.released_from) if r == t]
             wanted.append((f"release of {'+'.join(names)}", float(t)))
@@ -101,6 +105,21 @@ class Scene:
             f = min(int(np.searchsorted(self.time, t - 1e-12)), self.n_frames - 1)
             instants.append(Instant(label, f, float(self.time[f])))
         return instants
+
+    def tension_scale(self) -> float:
+        """Top of the tension colour scale (N): the 99.5th percentile of the pulling threads' samples,
+        so that one short spike (a bullet tether snapping taut) does not darken every other thread;
+        the few above it take the top colour."""
+        pulling = self.tension[self.tension > 0.0]
+        return float(np.percentile(pulling, TENSION_SCALE_PERCENTILE)) if pulling.size else 1.0
+
+    def _peak_time(self, force) -> float:
+        """Time (s) of the peak contact force the report's contact section states (summary.json); the
+        largest sum of the bodies' contact forces for folders without it."""
+        try:
+            return float(self.run.key(self.run.summary, "peak_contact_force_N", "time_s"))
+        except MissingData:
+            return float(self.series["time"][force.argmax()])
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Axis-aligned box (m, LVLH) holding the net and the bodies over the whole run."""

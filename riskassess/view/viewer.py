@@ -55,7 +55,7 @@ def scene_data(scene: Scene, max_frames: int = VIEWER_MAX_FRAMES) -> dict:
         "n_bullets": scene.n_bullets, "threads": scene.threads.ravel().tolist(),
         "net": [_round(scene.positions[f].ravel()) for f in frames],
         "tension": [_significant(scene.tension[f]) for f in frames],
-        "tension_max": float(scene.tension.max()), "force_max": float(np.linalg.norm(forces, axis=1).max()),
+        "tension_max": scene.tension_scale(), "force_max": float(np.linalg.norm(forces, axis=1).max()),
         "bodies": [{"name": name, "vertices": _round(v.ravel()), "faces": np.asarray(faces).ravel().tolist(),
                     "released_at": None if np.isinf(r) else float(r)}
                    for name, (v, faces), r in zip(scene.body_names, scene.meshes, scene.released_from)],
