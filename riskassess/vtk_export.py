@@ -159,7 +159,8 @@ class _Frames:
         first = 4 * np.arange(nb)
         lines = np.stack([np.repeat(first, 3), (first[:, None] + np.arange(1, 4)).ravel()], axis=1)
         loads = {}
-        for key, name in (("contact_force_lvlh", "contact_force_lvlh_N"), ("contact_moment_lvlh", "contact_moment_lvlh_Nm")):
+        for key, name in (("contact_force_lvlh", "contact_force_lvlh_N"),
+                          ("contact_moment_lvlh", "contact_moment_lvlh_Nm")):
             values = np.zeros((nb, 4, 3))
             values[:, 0] = s[key][i]
             loads[name] = values.reshape(-1, 3)
@@ -330,8 +331,8 @@ def export_frames(run_dir: str | Path, out: str | Path | None, every: int | None
     outfolder.check(out, identity, overwrite)   # refuse before reading the run's arrays
     frames = frames_type(run)
     n = len(frames.net["time"])
-    stride = frame_stride(n, every, max_frames, lambda: frame_bytes(frames, parts, n // 2))   # mid-run: a flat
-    # net at t = 0 compresses far better than the wrapped one
+    # sized on a mid-run snapshot: the flat net at t = 0 compresses far better than the wrapped one
+    stride = frame_stride(n, every, max_frames, lambda: frame_bytes(frames, parts, n // 2))
     picked = np.arange(0, n, stride)
     write_collection(out, ((float(frames.net["time"][f]), tuple((part, getattr(frames, f"{part}_mesh")(f)) for part in parts))
                            for f in picked), len(picked), pvd_name, f"case {run.manifest.get('case')}: {comment}", identity,

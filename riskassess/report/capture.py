@@ -25,8 +25,8 @@ def capture_section(run: RunFolder) -> Section:
     return Section("capture", "The capture in 3-D", [
         Figure("fig-capture", "The net and the debris at first contact, peak contact load, each release and the "
                "end of the run (LVLH, m; the view is the same in every panel). Threads coloured by tension "
-               "(one scale for all panels, slack: darkest; the top colour from the 99.5th percentile of the pulling threads up); debris bodies grey, released pieces cyan; bullets "
-               "black.", base64.b64encode(png).decode("ascii")),
+               "(one scale for all panels, slack: darkest; the top colour from the 99.5th percentile of the "
+               "pulling threads up); debris bodies grey, released pieces cyan; bullets black.", base64.b64encode(png).decode("ascii")),
         Table(["instant", "snapshot time (s)"], [[i.label, f"{i.time:.3f}"] for i in instants],
               "Instants shown (the net snapshot at or just after each)"),
         Note(f"Next to this report: {ANIMATION} (the capture as an animation) and {VIEWER} (interactive: scrub "
