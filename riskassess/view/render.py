@@ -22,7 +22,6 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.animation import PillowWriter  # noqa: E402
 from matplotlib.colors import LightSource, Normalize  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
-import numpy as np  # noqa: E402
 
 from riskassess.view.scene import Instant, Scene, decimation  # noqa: E402
 

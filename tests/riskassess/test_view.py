@@ -18,7 +18,6 @@ from riskassess.report.capture import net_integrity_section
 from riskassess.report.structures import while_joined
 from riskassess.results import RunFolder
 from riskassess.view.render import BODY_COLOR, RELEASED_COLOR, TENSION_CMAP
-from structures.net_threads import net_integrity
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
@@ -91,30 +90,16 @@ def test_viewer_loads_offline_without_errors_and_draws_the_scene(reported, tmp_p
     flags = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
              "--disable-component-update", "--no-first-run", f"--user-data-dir={tmp_path / 'profile'}",
              "--enable-logging=stderr", "--v=0", "--window-size=1000,700", "--virtual-time-budget=5000"]
-    dom = subprocess.run(flags + ["--dump-dom", viewer.as_uri()], capture_output=True, text=True, timeout=120)
+    dom = subprocess.run(flags + ["--dump-dom", viewer.as_uri()], capture_output=True, text=True, timeout=120, check=False)
     assert 'data-status="drawn"' in dom.stdout, dom.stdout[-2000:] + dom.stderr[-2000:]
     assert int(re.search(r'data-items="(\d+)"', dom.stdout).group(1)) > 100
     console = [line for line in dom.stderr.splitlines() if "CONSOLE" in line or "Uncaught" in line]
     assert not console, console
     shot = tmp_path / "viewer.png"
     done = subprocess.run(flags + [f"--screenshot={shot}", viewer.as_uri()], capture_output=True, text=True,
-                          timeout=120)
+                          timeout=120, check=False)
     assert shot.is_file(), done.stderr[-2000:]
     _assert_a_scene(_rgb(shot.read_bytes()), 0.005)
-
-
-def test_thread_tension_from_a_hand_computed_stretch():
-    """One thread of the reference net (k = E A / l0 = 62308.25 N/m, c = 1.6 N s/m [paper T1]) stretched
-    by 1 mm and opening at 2 mm/s: T = k s + c v = 62.30825 + 0.0032 N; a slack one carries nothing."""
-    k, c, l0 = 62308.25, 1.6, 0.8824
-    x = np.array([[[0.0, 0.0, 0.0], [l0 + 1e-3, 0.0, 0.0], [l0 + 1e-3, l0 - 1e-3, 0.0]]])
-    v = np.array([[[0.0, 0.0, 0.0], [2e-3, 0.0, 0.0], [2e-3, 0.0, 0.0]]])
-    threads = np.array([[0, 1], [1, 2]])
-    tension, _ = thread_tension_strain(x, v, threads, np.full(2, l0), np.full(2, k), np.full(2, c))
-    assert tension[0] == pytest.approx([k * 1e-3 + c * 2e-3, 0.0], rel=1e-9, abs=1e-12)
-    judged = net_integrity(tension, np.array([0.5]), breaking_load=60.0)
-    assert judged.over.tolist() == [0] and judged.margin_of_safety == pytest.approx(60.0 / 62.31145 - 1, rel=1e-6)
-    assert not net_integrity(tension, np.array([0.5]), None).assessed
 
 
 def test_net_integrity_lists_threads_over_the_breaking_load(assessed, tmp_path):
