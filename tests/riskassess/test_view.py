@@ -90,7 +90,8 @@ def test_viewer_loads_offline_without_errors_and_draws_the_scene(reported, tmp_p
     flags = [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
              "--disable-component-update", "--no-first-run", f"--user-data-dir={tmp_path / 'profile'}",
              "--enable-logging=stderr", "--v=0", "--window-size=1000,700", "--virtual-time-budget=5000"]
-    dom = subprocess.run(flags + ["--dump-dom", viewer.as_uri()], capture_output=True, text=True, timeout=120, check=False)
+    dom = subprocess.run(flags + ["--dump-dom", viewer.as_uri()], capture_output=True, text=True, timeout=120,
+                         check=False)
     assert 'data-status="drawn"' in dom.stdout, dom.stdout[-2000:] + dom.stderr[-2000:]
     assert int(re.search(r'data-items="(\d+)"', dom.stdout).group(1)) > 100
     console = [line for line in dom.stderr.splitlines() if "CONSOLE" in line or "Uncaught" in line]
