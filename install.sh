@@ -21,6 +21,9 @@ apt_install() {
 
 # libusb/libgl/libgomp/libx*: open3d, vtk (pyvista), numba; pango/harfbuzz/fonts: WeasyPrint's PDF reports
 DEBIAN_PACKAGES="libusb-1.0-0 libgl1 libgomp1 libxrender1 libx11-6 libpango-1.0-0 libpangoft2-1.0-0 libharfbuzz-subset0 fonts-dejavu-core"
+# chromium (--test only): the headless browser in which the tests open the offline viewer.html. The
+# report's 3-D pictures need no GL library: they are drawn by matplotlib's software (Agg) renderer.
+[ "${1:-}" = "--test" ] && DEBIAN_PACKAGES="$DEBIAN_PACKAGES chromium"
 if command -v dpkg >/dev/null 2>&1; then
   missing=""
   for p in $DEBIAN_PACKAGES; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done

@@ -152,6 +152,7 @@ class KernelData:
     mount_damping: float = 0.0       # (N s/m)
     force: np.ndarray = field(init=False)
     body_impulse: np.ndarray = field(init=False)   # (nb, 6) accumulated contact impulse and angular impulse about CoM, LVLH
+    node_impulse: np.ndarray = field(init=False)   # (n, 3) accumulated contact impulse on each net node (N s), LVLH
     velocity_lag: np.ndarray = field(init=False)   # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s)
     lag_body: np.ndarray = field(init=False)       # (n,) body of the node's last contact, -1 for none
     scalars: np.ndarray = field(init=False)
@@ -161,6 +162,7 @@ class KernelData:
         nb = len(self.body_mass)
         self.force = np.zeros(3 * n + 6 * nb)
         self.body_impulse = np.zeros((nb, 6))
+        self.node_impulse = np.zeros((n, 3))
         self.scalars = np.zeros(N_SCALARS)
         self.velocity_lag = np.zeros((n, 3))
         self.lag_body = np.full(n, -1, dtype=np.int64)
@@ -190,7 +192,7 @@ class KernelData:
             self.mu_static, self.mu_kinetic, self.transition_speed,
             self.mean_motion, self.step, n_sub, self.stage_weight, self.velocity_lag, self.lag_body,
             self.mount_node, self.mount_body, self.mount_point_body, self.mount_stiffness, self.mount_damping,
-            self.force, self.body_impulse, self.scalars)
+            self.force, self.body_impulse, self.node_impulse, self.scalars)
         return self.force
 
 
@@ -246,11 +248,12 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
                                k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
                                n_orbit, step, n_substeps, stage_weight, velocity_lag, lag_body,
                                mount_node, mount_body, mount_point_body, k_mount, d_mount,
-                               out_force, out_body_impulse, out_scalars):
+                               out_force, out_body_impulse, out_node_impulse, out_scalars):
     """Fill ``out_force`` with the generalized forces of the coupled system (see module doc).
 
     Also accumulates, per body, the contact impulse (N s) and angular impulse about the
-    CoM (N m s) in LVLH into ``out_body_impulse``, the dissipated energies into
+    CoM (N m s) in LVLH into ``out_body_impulse``, per net node the contact impulse (N s, LVLH)
+    into ``out_node_impulse``, the dissipated energies into
     ``out_scalars`` and sets the current elastic energies there. Accumulations are
     weighted by ``stage_weight`` (1 / force evaluations per step: exact for
     VelocityVerlet's single evaluation, an average for Runge-Kutta stages).
@@ -288,7 +291,7 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
         x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
         triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
         k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight,
-        velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_scalars)
+        velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_node_impulse, out_scalars)
     for b in range(nb):
         base = 3 * n + 6 * b
         out_force[base:base + 3] = f_body[b]
@@ -383,7 +386,8 @@ def _substeps_to_resolve_contact(penetrations, relative_velocities, normals, bod
 def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
                        triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
                        k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight,
-                       velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_scalars):
+                       velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_node_impulse,
+                       out_scalars):
     """Add node-body contact kicks to ``f_net`` and their reactions to ``f_body``/``torque_lvlh``.
 
     ``f_net`` enters holding every non-contact force on the nodes. Returns the elastic
@@ -510,4 +514,7 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
         velocity_lag[i, 0] = lag_x
         velocity_lag[i, 1] = lag_y
         velocity_lag[i, 2] = lag_z
+        # the node's contact force is what the contact added to its non-contact force
+        for d in range(3):
+            out_node_impulse[i, d] += (f_net[i, d] - f_non_contact[i, d]) * step * stage_weight
     return contact_energy, n_contacts

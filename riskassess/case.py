@@ -93,6 +93,10 @@ class Thread(Strict):
     damping: NonNegative = Field(description="Axial damping of a thread (N s/m).")
     bending: bool = Field(False, description="Add thread bending stiffness (EI from modulus or bending_rigidity).")
     bending_rigidity: Positive | None = Field(None, description="Thread bending rigidity EI (N m^2).")
+    breaking_load: Positive | None = Field(
+        None, description="Breaking load of one thread (N), e.g. the maker's minimum breaking strength of the "
+                          "line; the report compares every thread's peak tension with it. No default: without "
+                          "it the net's integrity is 'not assessed'.")
 
     @model_validator(mode="after")
     def _one_stiffness(self):

@@ -129,13 +129,14 @@ def _make_report(run_dir: Path, pdf: bool = True, quiet: bool = False):
     return out
 
 
-def _make_vtk(run_dir: Path, out=None, every: int = 1, quiet: bool = False, overwrite: bool = False):
+def _make_vtk(run_dir: Path, out=None, every: int | None = None, quiet: bool = False, overwrite: bool = False,
+              max_frames: int | None = None):
     from riskassess.vtk_export import export_vtk
 
     with _progress_bar("VTK export", quiet) as bar:
         task = bar.add_task("frames", total=None)
         result = export_vtk(run_dir, out, every, progress=lambda k, n: bar.update(task, completed=k, total=n),
-                            overwrite=overwrite)
+                            overwrite=overwrite, max_frames=max_frames)
     if not quiet:
         print(f"VTK: {result.pvd} ({result.n_frames} frames, {result.times[0]:g}-{result.times[-1]:g} s); "
               f"open it in ParaView")
@@ -151,7 +152,7 @@ def _cmd_report(args) -> int:
 def _cmd_export_vtk(args) -> int:
     RunFolder(args.run_dir)
     return _products(Path(args.run_dir), ["vtk"], make=lambda run_dir, quiet: _make_vtk(
-        run_dir, args.out, args.every, quiet=quiet, overwrite=args.overwrite))
+        run_dir, args.out, args.every, quiet=quiet, overwrite=args.overwrite, max_frames=args.max_frames))
 
 
 def _cmd_assess(args) -> int:
@@ -547,7 +548,10 @@ def build_parser() -> argparse.ArgumentParser:
                                    "with --overwrite")
     vtk.add_argument("--overwrite", action="store_true", help="replace this run's earlier export in that folder "
                                                               "(only the files its manifest lists)")
-    vtk.add_argument("--every", type=int, default=1, help="export every N-th net snapshot (default 1: all)")
+    frames = vtk.add_mutually_exclusive_group()
+    frames.add_argument("--every", type=int, help="export every N-th net snapshot (default: evenly strided to stay "
+                                                  "within 20 MB)")
+    frames.add_argument("--max-frames", type=int, help="export at most N net snapshots, evenly strided")
     vtk.set_defaults(func=_cmd_export_vtk)
     sweep = sub.add_parser("sweep", help="run a grid / Monte Carlo of cases on Dask; results survive interruption; "
                            "exit code 5 when runs failed, are indeterminate or pending")

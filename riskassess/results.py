@@ -177,6 +177,12 @@ class RunFolder:
                 self._cache[name] = {k: data[k] for k in data.files}
         return self._cache[name]
 
+    def cached(self, name: str, build):
+        """``build(self)`` once per folder object (a derived product several readers share)."""
+        if name not in self._cache:
+            self._cache[name] = build(self)
+        return self._cache[name]
+
     @property
     def summary(self) -> dict:
         return self.json("summary.json")

@@ -104,8 +104,9 @@ class _TowFrames:
                            cell_data={"tension_N": [np.array([s["main_tether_tension"][i]])]})
 
 
-def export_tow_vtk(run_dir: str | Path, out: str | Path | None = None, every: int = 1, progress=None,
-                   overwrite: bool = False) -> VtkExport:
-    """Write the VTK files of a full-net tow folder (module docstring); returns where and how many."""
+def export_tow_vtk(run_dir: str | Path, out: str | Path | None = None, every: int | None = None, progress=None,
+                   overwrite: bool = False, max_frames: int | None = None) -> VtkExport:
+    """Write the VTK files of a full-net tow folder (module docstring); returns where and how many
+    (``every``, ``max_frames``: :func:`riskassess.vtk_export.frame_stride`)."""
     return export_frames(run_dir, out, every, progress, _TowFrames, ("net", "bodies", "tether"), "towing.pvd",
-                         "positions in the debris' LVLH frame (m)", overwrite=overwrite)
+                         "positions in the debris' LVLH frame (m)", overwrite=overwrite, max_frames=max_frames)

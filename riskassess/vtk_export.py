@@ -13,13 +13,29 @@ file                        content
                             ``bodies.json``), ``released`` (1 once the body's piece is released)
 ``bullets_NNNN.vtu``        the bullets as vertex cells; point data ``velocity_lvlh_m_s``,
                             ``radius_m`` (for sphere glyphs)
-``impact.pvd``              the collection: open it in ParaView and press play
+``body_frames_NNNN.vtu``    per body its CoM (vertex) and its body axes x, y, z (lines from the
+                            CoM, half the body's size long); point data
+                            ``contact_force_lvlh_N``, ``contact_moment_lvlh_Nm`` (about the
+                            CoM; on the CoM point, zero on the axis ends), ``body_index``; cell
+                            data ``axis`` (-1 CoM, 0/1/2 x/y/z)
+``joints_NNNN.vtu``         every joint at its point (vertex), moving with its parent body;
+                            point data ``axis_lvlh`` (h2), ``joint_index`` (order of
+                            ``joints.json``), ``released`` (0/1), ``weak_location`` (0/1: a
+                            weak location is declared there), ``fails`` (0/1: it fails)
+``frame_NNNN.vtm``          the frame's parts as one multiblock with named blocks (net,
+                            bodies, bullets, body_frames, joints)
+``impact.pvd``              the collection of the frames: open it in ParaView and press play
 ``bodies.json``             body index -> name, mass, released piece
+``joints.json``             joint index -> name, parent, weak locations there
 ==========================  ==================================================================
 
-One frame per net snapshot (the case's ``net_output_rate``). Body poses come from the time
-series sample nearest to the snapshot (at most half an output interval away; the same time
-when the output rate is a multiple of the net output rate, as in the shipped cases).
+One frame per kept net snapshot (the case's ``net_output_rate``): every ``every``-th one, or, by
+default, evenly strided so that the export stays within ``max_frames`` frames, or within
+:data:`VTK_BUDGET_BYTES` when neither is given (the size of the middle snapshot sets the stride).
+Body poses come from the time series sample nearest to the snapshot (at most half an output
+interval away; the same time when the output rate is a multiple of the net output rate, as in
+the shipped cases). Net point data ``contact_force_lvlh_N`` (N) is the contact force on each node,
+averaged since the previous snapshot (run folders of older versions have none).
 
 The export goes only into a new or empty folder, or, with ``overwrite``, into a VTK folder this
 tool made earlier for the same run (its ``manifest.json``, format ``riskassess-vtk``, names the
@@ -44,9 +60,13 @@ import numpy as np
 from multibody.net import thread_tension_strain
 from riskassess import outfolder
 from riskassess.results import MissingData, RunFolder, atomic_write_bytes, write_manifest
+from riskassess.vtk_markers import joint_markers
 
 #: Format of the manifest that marks a folder as a VTK export of one run.
 VTK_FORMAT = "riskassess-vtk"
+#: Size an export aims to stay within when neither ``every`` nor ``max_frames`` is given (bytes):
+#: 20 MB keeps the reference run (1229 nodes, 376 snapshots) at every 3rd snapshot, 0.06 s apart.
+VTK_BUDGET_BYTES = 20_000_000
 
 
 @dataclass
@@ -101,15 +121,63 @@ class _Frames:
         n_nodes = len(self.net["masses"])
         self.n_bullets = int(self.net["n_bullets"])
         self.bullet_tether = (self.net["threads"] >= n_nodes - self.n_bullets).any(axis=1).astype(np.uint8)
+        self.joints = joint_markers(run.case, self.body_names, self.series["body_to_lvlh"][0],
+                                    self.series["body_com_lvlh"][0])
+        self.axis_length = np.array([0.5 * np.ptp(v, axis=0).max() for v, _ in self.meshes])
+        self.joint_released = np.full(len(self.joints.names), np.inf)
+        self.weak = {}   # joint name -> [(location name, fails)]
+        if run.has("structures.json"):
+            for loc in run.structures["locations"]:
+                self.weak.setdefault(loc["joint"], []).append((loc["name"], bool(loc["fails"])))
+            for piece in run.structures["released_pieces"]:
+                if piece["joint"] in self.joints.names:
+                    k = self.joints.names.index(piece["joint"])
+                    self.joint_released[k] = min(self.joint_released[k], piece["release_time_s"])
 
     def net_mesh(self, f: int) -> meshio.Mesh:
         x, v = self.net["positions_lvlh"][f], self.net["velocities_lvlh"][f]
         tension, strain = thread_tension_strain(x, v, self.net["threads"], self.net["rest_lengths"],
                                                 self.net["stiffness"], self.net["damping"])
         return meshio.Mesh(x, [("line", self.net["threads"])],
-                           point_data={"velocity_lvlh_m_s": v, "speed_m_s": np.linalg.norm(v, axis=1)},
+                           point_data={"velocity_lvlh_m_s": v, "speed_m_s": np.linalg.norm(v, axis=1),
+                                       **self._node_contact_force(f)},
                            cell_data={"tension_N": [tension], "strain": [strain],
                                       "bullet_tether": [self.bullet_tether]})
+
+    def _node_contact_force(self, f: int) -> dict:
+        if "contact_force_lvlh" not in self.net:   # a run folder of an older version
+            return {}
+        return {"contact_force_lvlh_N": np.asarray(self.net["contact_force_lvlh"][f], float)}
+
+    def body_frames_mesh(self, f: int) -> meshio.Mesh:
+        """Per body 4 points (CoM, then the ends of its x, y, z axes) with the contact loads on the CoM."""
+        s, i = self.series, self.sample[f]
+        nb = len(self.body_names)
+        rot, com = s["body_to_lvlh"][i], s["body_com_lvlh"][i]
+        ends = com[:, None, :] + self.axis_length[:, None, None] * np.swapaxes(rot, 1, 2)   # (nb, 3, 3): rows = axes
+        points = np.concatenate([com[:, None, :], ends], axis=1).reshape(-1, 3)
+        first = 4 * np.arange(nb)
+        lines = np.stack([np.repeat(first, 3), (first[:, None] + np.arange(1, 4)).ravel()], axis=1)
+        loads = {}
+        for key, name in (("contact_force_lvlh", "contact_force_lvlh_N"),
+                          ("contact_moment_lvlh", "contact_moment_lvlh_Nm")):
+            values = np.zeros((nb, 4, 3))
+            values[:, 0] = s[key][i]
+            loads[name] = values.reshape(-1, 3)
+        return meshio.Mesh(points, [("vertex", first[:, None]), ("line", lines)],
+                           point_data={**loads, "body_index": np.repeat(np.arange(nb, dtype=np.int32), 4)},
+                           cell_data={"axis": [np.full(nb, -1, np.int8), np.tile(np.arange(3, dtype=np.int8), nb)]})
+
+    def joints_mesh(self, f: int) -> meshio.Mesh:
+        """Every joint at its point in LVLH, with its axis, release and weak-location flags."""
+        i = self.sample[f]
+        points, axes = self.joints.at(self.series["body_to_lvlh"][i], self.series["body_com_lvlh"][i])
+        names = self.joints.names
+        return meshio.Mesh(points.reshape(-1, 3), [("vertex", np.arange(len(names))[:, None])], point_data={
+            "axis_lvlh": axes.reshape(-1, 3), "joint_index": np.arange(len(names), dtype=np.int32),
+            "released": (self.net["time"][f] >= self.joint_released).astype(np.uint8),
+            "weak_location": np.array([name in self.weak for name in names], np.uint8),
+            "fails": np.array([any(fails for _, fails in self.weak.get(name, [])) for name in names], np.uint8)})
 
     def bullets_mesh(self, f: int) -> meshio.Mesh:
         first = len(self.net["masses"]) - self.n_bullets
@@ -146,10 +214,21 @@ def pvd_text(entries: list[tuple[float, int, str, str]], comment: str = "") -> s
     return "\n".join(line for line in lines if line)
 
 
+def vtm_text(blocks: list[tuple[str, str]]) -> str:
+    """A VTK multiblock file whose blocks are the given (name, file) pairs: ParaView shows the names."""
+    lines = ['<?xml version="1.0"?>', '<VTKFile type="vtkMultiBlockDataSet" version="1.0" byte_order="LittleEndian">',
+             "  <vtkMultiBlockDataSet>"]
+    lines += [f'    <DataSet index="{k}" name={quoteattr(name)} file={quoteattr(file)}/>'
+              for k, (name, file) in enumerate(blocks)]
+    lines += ["  </vtkMultiBlockDataSet>", "</VTKFile>", ""]
+    return "\n".join(lines)
+
+
 def write_collection(out: Path, frames, n_frames: int, pvd_name: str, comment: str, identity: dict,
                      progress=None, extra=None, overwrite: bool = False) -> None:
     """Write ``frames``, an iterable of (time (s), ((part name, meshio.Mesh), ...)) per frame, as
-    ``<part>_NNNN.vtu`` files and the ParaView collection ``pvd_name`` into ``out``, with a manifest
+    ``<part>_NNNN.vtu`` files, one ``frame_NNNN.vtm`` per frame naming its parts, and the ParaView
+    collection ``pvd_name`` of the frames into ``out``, with a manifest
     ``identity`` (format, case, command, run) plus the files. ``out`` is checked first
     (:func:`riskassess.outfolder.check`: new, empty, or this run's earlier export with ``overwrite``);
     the files are staged beside it and moved in at the end, so an interrupted export leaves the
@@ -160,10 +239,13 @@ def write_collection(out: Path, frames, n_frames: int, pvd_name: str, comment: s
     try:
         entries = []
         for n, (t, parts) in enumerate(frames):
-            for part, (name, mesh) in enumerate(parts):
+            blocks = []
+            for name, mesh in parts:
                 file = f"{name}_{n:04d}.vtu"
                 meshio.write(staging / file, mesh, file_format="vtu", binary=True, compression="zlib")
-                entries.append((t, part, name, file))
+                blocks.append((name, file))
+            (staging / f"frame_{n:04d}.vtm").write_text(vtm_text(blocks))
+            entries.append((t, 0, "frame", f"frame_{n:04d}.vtm"))
             if progress:
                 progress(n + 1, n_frames)
         if extra:
@@ -205,14 +287,42 @@ def _remove_staging(staging: Path) -> None:
     staging.rmdir()
 
 
-def export_frames(run_dir: str | Path, out: str | Path | None, every: int, progress, frames_type, parts: tuple,
-                  pvd_name: str, comment: str, extra=None, overwrite: bool = False) -> VtkExport:
+def frame_bytes(frames, parts: tuple, f: int) -> int:
+    """Size (bytes) of snapshot ``f`` written as the export writes it (compressed VTU files)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        for part in parts:
+            meshio.write(Path(tmp) / f"{part}.vtu", getattr(frames, f"{part}_mesh")(f), file_format="vtu",
+                         binary=True, compression="zlib")
+        return sum(p.stat().st_size for p in Path(tmp).iterdir())
+
+
+def frame_stride(n_snapshots: int, every: int | None, max_frames: int | None, bytes_per_frame=None,
+                 budget: int = VTK_BUDGET_BYTES) -> int:
+    """Snapshots to step: ``every`` when given; else the smallest stride that keeps at most
+    ``max_frames`` frames; else at most ``budget // bytes_per_frame()`` frames (at least 2)."""
+    if every is not None:
+        if every < 1:
+            raise ValueError(f"every must be >= 1 (frames to step); got {every}")
+        if max_frames is not None:
+            raise ValueError("give 'every' or 'max_frames', not both")
+        return every
+    if max_frames is None:
+        max_frames = max(2, budget // max(1, bytes_per_frame()))
+    elif max_frames < 1:
+        raise ValueError(f"max_frames must be >= 1; got {max_frames}")
+    return max(1, -(-n_snapshots // max_frames))
+
+
+def export_frames(run_dir: str | Path, out: str | Path | None, every: int | None, progress, frames_type, parts: tuple,
+                  pvd_name: str, comment: str, extra=None, overwrite: bool = False,
+                  max_frames: int | None = None) -> VtkExport:
     """The front shared by the impact and the tow export: checks ``every``, reads the run folder into
-    ``frames_type(run)`` (which raises MissingData before anything is written), writes every ``every``-th
-    net snapshot's ``parts`` (each the ``<part>_mesh(f)`` of the frames) with :func:`write_collection`
-    into ``out`` (default ``RUN_DIR/vtk``; a folder directly inside the run folder is registered as a
-    product of the run) and returns where and how many. ``extra(frames, staging)`` may add files."""
-    if every < 1:
+    ``frames_type(run)`` (which raises MissingData before anything is written), writes every stride-th
+    net snapshot's ``parts`` (each the ``<part>_mesh(f)`` of the frames; stride: :func:`frame_stride`)
+    with :func:`write_collection` into ``out`` (default ``RUN_DIR/vtk``; a folder directly inside the run
+    folder is registered as a product of the run) and returns where and how many. ``extra(frames,
+    staging)`` may add files."""
+    if every is not None and every < 1:
         raise ValueError(f"every must be >= 1 (frames to step); got {every}")
     run = RunFolder(run_dir)
     out = Path(out) if out else run.path / "vtk"
@@ -220,7 +330,10 @@ def export_frames(run_dir: str | Path, out: str | Path | None, every: int, progr
                 "run": str(run.path.resolve())}
     outfolder.check(out, identity, overwrite)   # refuse before reading the run's arrays
     frames = frames_type(run)
-    picked = np.arange(0, len(frames.net["time"]), every)
+    n = len(frames.net["time"])
+    # sized on a mid-run snapshot: the flat net at t = 0 compresses far better than the wrapped one
+    stride = frame_stride(n, every, max_frames, lambda: frame_bytes(frames, parts, n // 2))
+    picked = np.arange(0, n, stride)
     write_collection(out, ((float(frames.net["time"][f]), tuple((part, getattr(frames, f"{part}_mesh")(f)) for part in parts))
                            for f in picked), len(picked), pvd_name, f"case {run.manifest.get('case')}: {comment}", identity,
                      progress, None if extra is None else lambda staging: extra(frames, staging), overwrite)
@@ -235,14 +348,22 @@ def _write_bodies_json(frames: _Frames, staging: Path) -> None:
               for k, (name, m, r) in enumerate(zip(frames.body_names, frames.series["body_masses"],
                                                    frames.released_from))]
     (staging / "bodies.json").write_text(json.dumps(bodies, indent=2) + "\n")
+    joints = [{"index": k, "name": name, "parent": frames.body_names[frames.joints.parent[k]],
+               "weak_locations": [{"name": loc, "fails": fails} for loc, fails in frames.weak.get(name, [])],
+               "released_at_s": None if np.isinf(frames.joint_released[k]) else float(frames.joint_released[k])}
+              for k, name in enumerate(frames.joints.names)]
+    (staging / "joints.json").write_text(json.dumps(joints, indent=2) + "\n")
 
 
-def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int = 1, progress=None,
-               overwrite: bool = False) -> VtkExport:
-    """Write the VTK files of a run folder (see the module docstring); returns where and how many."""
+def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int | None = None, progress=None,
+               overwrite: bool = False, max_frames: int | None = None) -> VtkExport:
+    """Write the VTK files of a run folder (see the module docstring); returns where and how many.
+    ``every``: export every N-th snapshot; ``max_frames``: at most that many, evenly strided; neither:
+    within :data:`VTK_BUDGET_BYTES`."""
     if RunFolder(run_dir).stage == "tow":  # a full-net tow folder: its own layout
         from riskassess.tow_vtk import export_tow_vtk
 
-        return export_tow_vtk(run_dir, out, every, progress, overwrite)
-    return export_frames(run_dir, out, every, progress, _Frames, ("net", "bodies", "bullets"), "impact.pvd",
-                         "positions LVLH (m); body_index -> bodies.json", _write_bodies_json, overwrite)
+        return export_tow_vtk(run_dir, out, every, progress, overwrite, max_frames)
+    return export_frames(run_dir, out, every, progress, _Frames, ("net", "bodies", "bullets", "body_frames", "joints"),
+                         "impact.pvd", "positions LVLH (m); body_index -> bodies.json, joint_index -> joints.json",
+                         _write_bodies_json, overwrite, max_frames)

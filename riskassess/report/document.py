@@ -23,6 +23,7 @@ from riskassess import results
 from riskassess.outfolder import claim_product
 from riskassess.report.approach import approach_section
 from riskassess.report.blocks import Figure, Note, Section, Table
+from riskassess.report.capture import capture_section, net_integrity_section
 from riskassess.report.diagnosis import diagnosis_section
 from riskassess.report.impact import contact_section, debris_motion_section, energy_section, hinge_section
 from riskassess.report.inputs import appendix_inputs_section, case_section, run_facts_section
@@ -31,12 +32,15 @@ from riskassess.report.plotting import STYLE
 from riskassess.report.structures import joint_loads_section, stresses_section, verdict_section
 from riskassess.report.towing import towing_section
 from riskassess.results import MissingData, RunFolder
+from riskassess.view.products import ViewFiles, write_views
 
 #: (section id, title, builder) in reading order: the verdict first.
 SECTIONS = (
     ("verdict", "Verdict: secondary debris", verdict_section),
+    ("capture", "The capture in 3-D", capture_section),
     ("case", "Case summary: inputs", case_section),
     ("contact", "Contact forces and moments", contact_section),
+    ("net-integrity", "Net threads: tension and integrity", net_integrity_section),
     ("debris-motion", "Debris velocity and angular velocity", debris_motion_section),
     ("hinges", "Hinge angles", hinge_section),
     ("joint-loads", "Hinge and joint loads against allowables", joint_loads_section),
@@ -59,6 +63,7 @@ class ReportOutput:
     pdf_pages: int | None
     section_pages: dict          # section id -> PDF page number (1-based) where it starts
     sections: list[Section]
+    views: ViewFiles | None = None   # capture.gif and viewer.html (None: the folder has no net to show)
 
 
 def tool_version() -> str:
@@ -137,9 +142,10 @@ def render_pdf(html: str, base_url: Path):
     return document.write_pdf(), len(document.pages), section_pages
 
 
-def write_report(run_dir: str | Path, pdf: bool = True, progress=None) -> ReportOutput:
-    """Write ``report.html`` (and ``report.pdf``) into the run folder, each atomically; refused
-    (:class:`riskassess.outfolder.OutputRefused`) where a file of that name is not the run's own."""
+def write_report(run_dir: str | Path, pdf: bool = True, progress=None, views: bool = True) -> ReportOutput:
+    """Write ``report.html`` (and ``report.pdf``) into the run folder, each atomically, and with
+    ``views`` the animation and the viewer beside it (:func:`riskassess.view.products.write_views`);
+    refused (:class:`riskassess.outfolder.OutputRefused`) where a file of that name is not the run's own."""
     run = RunFolder(run_dir)
     for name in ("report.html", "report.pdf") if pdf else ("report.html",):
         claim_product(run.path, run.manifest, name)
@@ -155,4 +161,7 @@ def write_report(run_dir: str | Path, pdf: bool = True, progress=None) -> Report
         pdf_path = run.path / "report.pdf"
         results.atomic_write_bytes(pdf_path, data)
         run.add_product("report.pdf")
-    return ReportOutput(html_path, pdf_path, pages, section_pages, sections)
+    view_files = None
+    if views and any(s.id == "capture" and not s.missing for s in sections):
+        view_files = write_views(run)
+    return ReportOutput(html_path, pdf_path, pages, section_pages, sections, view_files)

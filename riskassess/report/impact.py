@@ -24,15 +24,15 @@ def contact_section(run: RunFolder) -> Section:
     force, moment = contact_totals_debris(s)
     names = [str(n) for n in s["body_names"]]
     fig, (ax_f, ax_m) = panels(2, 2.1)
-    ax_f.plot(t, np.linalg.norm(force, axis=1) / 1e3, color="k", lw=1.2, label="whole debris")
+    ax_f.plot(t, np.linalg.norm(force, axis=1), color="k", lw=1.2, label="whole debris")
     for k, name in enumerate(names):
-        ax_f.plot(t, np.linalg.norm(s["contact_force_lvlh"][:, k], axis=1) / 1e3, lw=0.8, label=plain(name))
-    ax_f.set_ylabel("|contact force| (kN)")
+        ax_f.plot(t, np.linalg.norm(s["contact_force_lvlh"][:, k], axis=1), lw=0.8, label=plain(name))
+    ax_f.set_ylabel("|contact force| (N)")
     ax_f.set_title("net contact force on the debris bodies")
     legend(ax_f)
     for i, axis in enumerate("xyz"):
-        ax_m.plot(t, moment[:, i] / 1e3, color=COMPONENT_COLORS[i], label=f"M{axis} (LVLH)")
-    ax_m.set_ylabel("moment (kN m)")
+        ax_m.plot(t, moment[:, i], color=COMPONENT_COLORS[i], label=f"M{axis} (LVLH)")
+    ax_m.set_ylabel("moment (N m)")
     ax_m.set_title("contact moment about the debris centre of mass, LVLH")
     legend(ax_m)
     ref = run.key(summary, "paper_reference")
@@ -55,25 +55,25 @@ def debris_motion_section(run: RunFolder) -> Section:
     s = run.timeseries
     summary = run.summary
     t = s["time"]
-    dv = (s["debris_velocity_lvlh"] - s["debris_velocity_lvlh"][0]) * 1e3
-    estimate = np.asarray(run.key(summary, "momentum_exchange_estimate_lvlh_m_s")) * 1e3
-    omega = np.degrees(s["body_omega_body"][:, 0])
+    dv = s["debris_velocity_lvlh"] - s["debris_velocity_lvlh"][0]
+    estimate = np.asarray(run.key(summary, "momentum_exchange_estimate_lvlh_m_s"))
+    omega = s["body_omega_body"][:, 0]
     fig, (ax_v, ax_w) = panels(2, 2.0)
     for i, (axis, name) in enumerate(zip("xyz", ("radial", "along-track", "cross-track"))):
         ax_v.plot(t, dv[:, i], color=COMPONENT_COLORS[i], label=f"dv{axis} ({name})")
         ax_w.plot(t, omega[:, i], color=COMPONENT_COLORS[i], label=f"omega {axis}")
     ax_v.axhline(estimate[1], color=COMPONENT_COLORS[1], ls="--", lw=0.9, label="momentum-exchange\nestimate (y)")
-    ax_v.set_ylabel("velocity change (mm/s)")
+    ax_v.set_ylabel("velocity change (m/s)")
     ax_v.set_title("debris centre-of-mass velocity change, LVLH")
     legend(ax_v)
-    ax_w.set_ylabel("angular velocity (deg/s)")
+    ax_w.set_ylabel("angular velocity (rad/s)")
     ax_w.set_title(f"angular velocity of {plain(s['body_names'][0])}, its body frame")
     legend(ax_w)
-    mean = np.asarray(summary["debris_velocity_change_final_third_mean_lvlh_m_s"]) * 1e3
-    rows = [["final velocity change (mm/s, LVLH)", format_vector(dv[-1], 4)],
-            ["mean over the last third (mm/s, LVLH)", format_vector(mean, 4)],
-            ["momentum-exchange estimate (mm/s, LVLH)", format_vector(estimate, 4)],
-            [f"final angular velocity of {s['body_names'][0]} (deg/s, body frame)", format_vector(omega[-1], 4)]]
+    mean = np.asarray(summary["debris_velocity_change_final_third_mean_lvlh_m_s"])
+    rows = [["final velocity change (m/s, LVLH)", format_vector(dv[-1], 4)],
+            ["mean over the last third (m/s, LVLH)", format_vector(mean, 4)],
+            ["momentum-exchange estimate (m/s, LVLH)", format_vector(estimate, 4)],
+            [f"final angular velocity of {s['body_names'][0]} (rad/s, body frame)", format_vector(omega[-1], 4)]]
     return Section("debris-motion", "Debris velocity and angular velocity", [
         Figure.from_matplotlib("fig-debris-motion", "Velocity change of the debris centre of mass (all bodies) "
                                "and angular velocity of the main body.", fig),
@@ -96,24 +96,24 @@ def hinge_section(run: RunFolder) -> Section:
     rows = []
     for j in hinges:
         joined = t < released.get(names[j], np.inf)
-        angle = np.degrees(s["joint_rotation_joint"][:, j, 1])
-        rate = np.degrees(s["joint_rate_joint"][:, j, 1])
+        angle = s["joint_rotation_joint"][:, j, 1]
+        rate = s["joint_rate_joint"][:, j, 1]
         for ax, values in ((ax_a, angle), (ax_r, rate)):
             line, = ax.plot(t[joined], values[joined], label=plain(names[j]))
             if not joined.all():
                 ax.plot(t[~joined], values[~joined], color="0.6", ls="--", lw=0.8, label="after release")
                 mark_release(ax, released[names[j]], f"{names[j]} released")
-        rows.append([names[j], f"{np.abs(angle[joined]).max():.3f}", f"{np.abs(rate[joined]).max():.3f}",
+        rows.append([names[j], f"{np.abs(angle[joined]).max():.4g}", f"{np.abs(rate[joined]).max():.4g}",
                      f"{released[names[j]]:.3f}" if names[j] in released else "-"])
-    ax_a.set_ylabel("hinge angle (deg)")
+    ax_a.set_ylabel("hinge angle (rad)")
     ax_a.set_title("rotation about the hinge axis h2, child relative to parent")
     legend(ax_a)
-    ax_r.set_ylabel("hinge rate (deg/s)")
+    ax_r.set_ylabel("hinge rate (rad/s)")
     legend(ax_r)
     return Section("hinges", "Hinge angles", [
         Figure.from_matplotlib("fig-hinge-angle", "Hinge angle and rate of every revolute joint; grey dashed: "
                                "relative rotation after the joint was released (no longer a hinge angle).", fig),
-        Table(["hinge", "max |angle| while joined (deg)", "max |rate| while joined (deg/s)", "released at (s)"],
+        Table(["hinge", "max |angle| while joined (rad)", "max |rate| while joined (rad/s)", "released at (s)"],
               rows)])
 
 

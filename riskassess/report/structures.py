@@ -70,6 +70,15 @@ def _locations_with(verdict: dict, criteria: set) -> list[dict]:
     return [loc for loc in verdict["locations"] if criteria & set(loc["criteria"])]
 
 
+def while_joined(t, demand, loc: dict) -> np.ndarray:
+    """The demand (any unit) with NaN after the location's release: a released load path carries
+    nothing, and a plotted 0 would read as a measured zero load."""
+    demand = np.asarray(demand, float).copy()
+    if loc["released_at_s"] is not None:
+        demand[np.asarray(t) > loc["released_at_s"]] = np.nan   # the sample that broke it stays
+    return demand
+
+
 def _decorate(ax, verdict: dict, loc: dict, time_end: float) -> None:
     shade_not_judged(ax, verdict["skip_initial_s"])
     if loc["released_at_s"] is not None:
@@ -91,7 +100,8 @@ def joint_loads_section(run: RunFolder) -> Section:
     fig, axes = panels(len(judged), 1.9)
     for ax, (loc, name) in zip(axes, judged):
         c = loc["criteria"][name]
-        ax.plot(t, run.key(series, f"{loc['name']}/{name}"), color="k", label=f"{name} demand")
+        ax.plot(t, while_joined(t, run.key(series, f"{loc['name']}/{name}"), loc), color="k",
+                label=f"{name} demand")
         allowable_band(ax, *c["allowable"], c["decisive_allowable"], 1.0, units[name])
         _decorate(ax, verdict, loc, t[-1])
         ax.set_ylabel(f"{name} ({units[name]})")
@@ -99,7 +109,8 @@ def joint_loads_section(run: RunFolder) -> Section:
         legend(ax)
     return Section("joint-loads", title, [Figure.from_matplotlib(
         "fig-joint-loads", "Demand of each location with a moment or force allowable (the resultant of the "
-        "judged joint-frame components) against its allowable range; grey: initial transient not judged.", fig)])
+        "judged joint-frame components) against its allowable range; grey: initial transient not judged; the curve "
+        "ends where the location is released (red dotted).", fig)])
 
 
 def stresses_section(run: RunFolder) -> Section:
@@ -118,7 +129,7 @@ def stresses_section(run: RunFolder) -> Section:
         floor = np.inf
         for name, color in colors.items():
             c = loc["criteria"][name]
-            demand = np.asarray(run.key(series, f"{loc['name']}/{name}")) / 1e6
+            demand = while_joined(t, run.key(series, f"{loc['name']}/{name}"), loc) / 1e6
             ax.plot(t, np.maximum(demand, 1e-9), color=color, label=f"{name.replace('_', ' ')}")
             ax.axhspan(c["allowable"][0] / 1e6, c["allowable"][1] / 1e6, color=color, alpha=0.12, lw=0)
             ax.axhline(c["decisive_allowable"] / 1e6, color=color, ls="--", lw=1.0,

@@ -14,7 +14,7 @@ from riskassess.report import SECTIONS, write_report
 from riskassess.report.plotting import WIDTH_IN
 from riskassess.report.blocks import FIGURE_DPI
 
-FIGURES = {"contact": ["fig-contact"], "debris-motion": ["fig-debris-motion"], "hinges": ["fig-hinge-angle"],
+FIGURES = {"capture": ["fig-capture"], "net-integrity": ["fig-net-tension"], "contact": ["fig-contact"], "debris-motion": ["fig-debris-motion"], "hinges": ["fig-hinge-angle"],
            "joint-loads": ["fig-joint-loads"], "stresses": ["fig-stresses"], "energy": ["fig-energy"]}
 
 
@@ -22,7 +22,7 @@ FIGURES = {"contact": ["fig-contact"], "debris-motion": ["fig-debris-motion"], "
 def report(assessed, tmp_path_factory):
     run = tmp_path_factory.mktemp("report") / "run"
     shutil.copytree(assessed, run)
-    return write_report(run)
+    return write_report(run, views=False)   # the animation and the viewer: test_view.py
 
 
 def _html_section(html: str, section_id: str) -> str:
@@ -130,8 +130,8 @@ def test_release_marked_in_the_hinge_figure_data(report, assessed):
     assert f"<td>{t:.3f}</td>" in hinges
     series = np.load(assessed / "timeseries.npz")
     joined = series["time"] < t  # after the release the relative rotation is no hinge angle
-    max_angle = np.degrees(np.abs(series["joint_rotation_joint"][joined, 0, 1]).max())
-    assert f"<td>{max_angle:.3f}</td>" in hinges
+    max_angle = np.abs(series["joint_rotation_joint"][joined, 0, 1]).max()   # rad, as in the CLI
+    assert f"<td>{max_angle:.4g}</td>" in hinges
 
 
 def test_run_writes_report_and_vtk_when_asked(tmp_path):
@@ -143,7 +143,8 @@ def test_run_writes_report_and_vtk_when_asked(tmp_path):
     out = tmp_path / "run"
     assert main(["run", str(case), "--out", str(out), "--json", "--report", "--vtk"]) == 0
     manifest = json.loads((out / "manifest.json").read_text())
-    assert manifest["products"] == ["report.html", "report.pdf", "vtk"] and manifest["status"] == "complete"
+    assert manifest["products"] == ["report.html", "report.pdf", "capture.gif", "viewer.html", "vtk"]
+    assert manifest["status"] == "complete"
     assert json.loads((out / "vtk" / "manifest.json").read_text())["format"] == "riskassess-vtk"
     assert (out / "report.pdf").stat().st_size > 0
     # 0.1 s at 50 Hz net snapshots: t = 0, 0.02, ..., 0.1

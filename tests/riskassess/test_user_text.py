@@ -69,4 +69,5 @@ def test_a_hostile_description_runs_through_run_report_literally(tmp_path, capsy
     assert "<script>alert" not in page
     assert (out / "report.pdf").stat().st_size > 0
     manifest = json.loads((out / "manifest.json").read_text())
-    assert manifest["status"] == "complete" and manifest["products"] == ["report.html", "report.pdf"]
+    assert manifest["status"] == "complete"
+    assert manifest["products"] == ["report.html", "report.pdf", "capture.gif", "viewer.html"]

@@ -27,16 +27,81 @@ def run_data(assessed):
             "verdict": json.loads((assessed / "structures.json").read_text())}
 
 
-def test_collection_lists_every_snapshot_and_paraview_reader_sees_them(exported, run_data):
+PARTS = ["net", "bodies", "bullets", "body_frames", "joints"]
+
+
+def test_collection_lists_every_snapshot_and_paraview_reader_sees_named_blocks(exported, run_data):
     times = run_data["net"]["time"]
     datasets = ET.parse(exported / "impact.pvd").getroot().find("Collection").findall("DataSet")
-    assert len(datasets) == 3 * len(times)             # net, bodies, bullets per snapshot
-    assert [float(d.get("timestep")) for d in datasets[::3]] == pytest.approx(times, abs=1e-9)
+    assert len(datasets) == len(times)             # one multiblock per snapshot (the small run is within budget)
+    assert [float(d.get("timestep")) for d in datasets] == pytest.approx(times, abs=1e-9)
     reader = pv.get_reader(str(exported / "impact.pvd"))
     assert len(reader.time_values) == len(times)
     reader.set_active_time_value(reader.time_values[-1])
-    blocks = reader.read()
-    assert blocks[0].n_points == len(run_data["net"]["masses"])
+    frame = reader.read()[0]
+    assert frame.keys() == PARTS     # ParaView shows these names, not Block-00/01/02
+    assert frame["net"].n_points == len(run_data["net"]["masses"])
+
+
+def test_node_contact_forces_balance_the_body_contact_forces(exported, run_data):
+    """Newton's third law: over each net-snapshot interval the impulse the nodes get from the bodies
+    is minus the impulse the bodies get from the nodes (kernel: one action-reaction pair per contact)."""
+    net, s = run_data["net"], run_data["series"]
+    on_bodies = s["contact_force_lvlh"].sum(axis=1)          # (k, 3) N, each averaged over its 1 ms interval
+    checked = 0
+    for f in range(1, len(net["time"])):
+        mesh = meshio.read(exported / f"net_{f:04d}.vtu")
+        on_nodes = mesh.point_data["contact_force_lvlh_N"].sum(axis=0)
+        inside = (s["time"] > net["time"][f - 1] + 1e-9) & (s["time"] <= net["time"][f] + 1e-9)
+        expected = -on_bodies[inside].mean(axis=0)
+        # float32 storage of the node forces (~1e-7 relative per node, a few hundred nodes)
+        assert on_nodes == pytest.approx(expected, rel=1e-4, abs=1e-3 * (1 + np.abs(expected).max()))
+        checked += bool(np.abs(expected).max() > 1.0)
+    assert checked > 10   # the net touches the debris over most of the run
+
+
+def test_body_frames_carry_the_pose_and_the_contact_loads(exported, run_data):
+    s, net = run_data["series"], run_data["net"]
+    nb = len(s["body_names"])
+    f = len(net["time"]) // 2
+    i = int(np.argmin(np.abs(s["time"] - net["time"][f])))
+    mesh = meshio.read(exported / f"body_frames_{f:04d}.vtu")
+    points = mesh.points.reshape(nb, 4, 3)
+    assert np.allclose(points[:, 0], s["body_com_lvlh"][i], atol=1e-12)
+    axes = points[:, 1:] - points[:, :1]                       # (nb, 3 axes, 3)
+    unit = axes / np.linalg.norm(axes, axis=2, keepdims=True)
+    assert np.allclose(np.swapaxes(unit, 1, 2), s["body_to_lvlh"][i], atol=1e-9)   # columns of body->LVLH
+    force = mesh.point_data["contact_force_lvlh_N"].reshape(nb, 4, 3)
+    assert np.allclose(force[:, 0], s["contact_force_lvlh"][i]) and not force[:, 1:].any()
+    assert np.allclose(mesh.point_data["contact_moment_lvlh_Nm"].reshape(nb, 4, 3)[:, 0], s["contact_moment_lvlh"][i])
+
+
+def test_joint_and_weak_location_markers_follow_the_parent(exported, run_data, assessed):
+    case = json.loads((assessed / "case.json").read_text())
+    joints = json.loads((exported / "joints.json").read_text())
+    names = [str(n) for n in run_data["series"]["body_names"]]
+    hinge = next(j for j in case["target"]["joints"] if j["name"] == "solar_array_hinge")
+    k = [j["name"] for j in joints].index("solar_array_hinge")
+    # t = 0, target attitude zero in this case: the point is the target origin plus the declared position
+    assert case["target"]["attitude_rotation_vector"] == [0.0, 0.0, 0.0]
+    first = meshio.read(exported / "joints_0000.vtu")
+    assert np.allclose(first.points[k], np.add(case["target"]["position_lvlh"], hinge["position"]), atol=1e-6)
+    # later: fixed in the parent body (same body-frame coordinates as at t = 0)
+    s, net = run_data["series"], run_data["net"]
+    p = names.index(hinge["parent"])
+    f = len(net["time"]) - 1
+    i = int(np.argmin(np.abs(s["time"] - net["time"][f])))
+    last = meshio.read(exported / f"joints_{f:04d}.vtu")
+    body_point_0 = s["body_to_lvlh"][0, p].T @ (first.points[k] - s["body_com_lvlh"][0, p])
+    body_point_f = s["body_to_lvlh"][i, p].T @ (last.points[k] - s["body_com_lvlh"][i, p])
+    assert np.allclose(body_point_f, body_point_0, atol=1e-9)
+    release = run_data["verdict"]["released_pieces"][0]
+    assert release["joint"] == "solar_array_hinge" and joints[k]["released_at_s"] == release["release_time_s"]
+    assert first.point_data["released"][k] == 0 and last.point_data["released"][k] == 1
+    failing = {loc["joint"] for loc in run_data["verdict"]["locations"] if loc["fails"]}
+    declared = {loc["joint"] for loc in run_data["verdict"]["locations"]}
+    assert [bool(x) for x in last.point_data["fails"]] == [j["name"] in failing for j in joints]
+    assert [bool(x) for x in last.point_data["weak_location"]] == [j["name"] in declared for j in joints]
 
 
 def test_net_mesh_holds_the_snapshot_and_thread_loads(exported, run_data):
@@ -114,8 +179,11 @@ def test_bullets_are_the_last_net_nodes(exported, run_data):
 
 def test_every_nth_frame_and_an_interrupted_export_keeps_the_old_one(assessed, tmp_path, run_data):
     out = tmp_path / "vtk"
-    result = export_vtk(assessed, out, every=7)
     n = len(run_data["net"]["time"])
+    small = export_vtk(assessed, tmp_path / "small", max_frames=10)
+    assert small.n_frames <= 10 and small.n_frames == math.ceil(n / math.ceil(n / 10))
+    assert np.allclose(np.diff(small.times), np.diff(small.times)[0])   # a constant stride: ParaView plays evenly
+    result = export_vtk(assessed, out, every=7)
     assert result.n_frames == math.ceil(n / 7) and len(list(out.glob("net_*.vtu"))) == result.n_frames
     before = sorted(p.name for p in out.iterdir())
 
@@ -126,7 +194,7 @@ def test_every_nth_frame_and_an_interrupted_export_keeps_the_old_one(assessed, t
     with pytest.raises(KeyboardInterrupt):
         export_vtk(assessed, out, every=1, progress=interrupt, overwrite=True)
     assert sorted(p.name for p in out.iterdir()) == before     # the old export is untouched
-    assert [p.name for p in tmp_path.iterdir()] == ["vtk"]      # no partial folder left behind
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small", "vtk"]   # no partial folder left behind
     with pytest.raises(ValueError, match="every must be >= 1"):
         export_vtk(assessed, out, every=0)
     # with --overwrite the export replaces its own files (every frame now), and only those
@@ -169,3 +237,14 @@ def test_export_into_an_empty_folder_then_only_into_its_own(assessed, tmp_path, 
     (out / "my_view.pvsm").unlink()
     assert main(["export-vtk", str(assessed), "--out", str(out), "--every", "25", "--overwrite"]) == 0
     assert _tree(out) != made and sorted(p.name for p in tmp_path.iterdir()) == ["empty"]
+
+
+def test_frame_stride_keeps_the_export_within_its_budget():
+    from riskassess.vtk_export import frame_stride
+
+    # 376 snapshots of 120 kB in 20 MB: at most 166 frames, so every 3rd snapshot (126 frames)
+    assert frame_stride(376, None, None, lambda: 120_000, budget=20_000_000) == 3
+    assert frame_stride(376, None, 100, None) == 4 and frame_stride(376, 5, None, None) == 5
+    assert frame_stride(10, None, None, lambda: 1, budget=20_000_000) == 1
+    with pytest.raises(ValueError, match="not both"):
+        frame_stride(376, 5, 100, None)
