@@ -94,14 +94,16 @@ def _init_worker(case, data, cost, weights, end_time):
 
 
 def _run_term(task) -> float:
-    """Cost term of one (candidate, rate index) pair, in a worker; a run that fails scores inf."""
+    """Cost term of one (candidate, rate index) pair, in a worker; a run that fails or diverges (a
+    non-finite cost: the twin's state went NaN) scores inf, so it is never the identified answer."""
     s, j = task
     w = _WORKER
     rate = w["data"][j]["rate_deg_s"]
     try:
-        return w["cost"](simulate(w["case"], rate, s, w["end_time"]), w["data"][j], w["weights"])
+        term = w["cost"](simulate(w["case"], rate, s, w["end_time"]), w["data"][j], w["weights"])
     except (ValueError, ZeroDivisionError, FloatingPointError):
         return np.inf
+    return term if np.isfinite(term) else np.inf
 
 
 class TowingFit(Problem):

@@ -113,3 +113,16 @@ def test_pattern_search_recovers_known_sub_tether_parameters(reduced_benchmark):
     # (Table 5: s4 = 0.48 and 0.83 for truth 1): only its bounds are checked.
     np.testing.assert_allclose(found.s[:3], truth[:3], rtol=5e-2)
     assert case.identification.lower_bounds[3] <= found.s[3] <= 1.0
+
+
+def test_a_diverged_twin_run_scores_inf(monkeypatch):
+    """Issue 20: a lower-order run whose state went NaN must never be the identified answer (NaN
+    costs compare false and would survive the swarm's selection)."""
+    import numpy as np
+
+    from riskassess import identify
+
+    nan_run = {"main_tether_tension": np.full(5, np.nan)}
+    monkeypatch.setattr(identify, "simulate", lambda *args: nan_run)
+    identify._init_worker(None, [{"rate_deg_s": 1.0, "main_tether_tension": np.ones(5)}], "f2", None, None)
+    assert identify._run_term((np.ones(4), 0)) == np.inf
