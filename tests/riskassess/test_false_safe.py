@@ -11,7 +11,7 @@ import pytest
 from riskassess.cli import main
 from riskassess.results import RunFolder, read_manifest
 from structures.verdict import MAX_SAMPLE_INTERVAL_S, MIN_JUDGED_SAMPLES, evidence_gaps
-from tests.riskassess.conftest import shortened_case
+from tests.riskassess.conftest import CASES, shortened_case
 
 
 def _case(tmp_path, end_time, **simulation):
@@ -110,3 +110,14 @@ def test_huge_work_is_refused_before_any_folder_exists(tmp_path, capsys):
     # above the hard limit, --force does not help
     assert main(["run", str(_case(tmp_path, 2e6)), "--out", str(out), "--force"]) == 2
     assert "refused even with --force" in capsys.readouterr().err and not out.exists()
+
+
+def test_a_billion_second_tow_is_refused(tmp_path, capsys):
+    """Item 7: a towing end_time = 1e9 s was accepted; at the 4 ms step that is 2.5e11 steps."""
+    text = (CASES / "zenit2_towing.toml").read_text()
+    assert "end_time = 300.0" in text
+    case = tmp_path / "zenit2_towing.toml"
+    case.write_text(text.replace("end_time = 300.0", "end_time = 1e9", 1))
+    out = tmp_path / "tow"
+    assert main(["tow", str(case), "--out", str(out), "--force"]) == 2
+    assert "2.5e+11 steps" in capsys.readouterr().err and not out.exists()
