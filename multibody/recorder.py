@@ -83,7 +83,6 @@ class Recorder:
         self._next_net = self.net_interval
         self._last_output_time = 0.0
         mbs = system.mbs
-        self._net_index = mbs.GetNodeODE2Index(system.net_node) if system.net_node is not None else 0
         self._body_index = [mbs.GetNodeODE2Index(nd) for nd in system.body_nodes]
         self._joint_stiffness = [np.diag(mbs.GetObjectParameter(obj, "stiffness")) for obj in system.joint_objects]
         self._rows: dict[str, list] = {}
@@ -103,19 +102,17 @@ class Recorder:
             while self._next_output - half <= t:
                 self._next_output += self.output_interval
         elif self._steps % self._health_every == 0:
-            data = mbs.systemData
-            self.health.state(t, data.GetODE2Coordinates(), data.GetODE2Coordinates_t())
+            self.health.state(t, *self.system.state_arrays())
         return self.health.ok
 
     # -- sampling --------------------------------------------------------------------
     def sample(self, t):
-        mbs = self.system.mbs
-        q = mbs.systemData.GetODE2Coordinates()
-        qt = mbs.systemData.GetODE2Coordinates_t()
-        if not self.health.state(t, q, qt):
+        arrays = self.system.state_arrays()
+        q, qt = arrays[:2]
+        if not self.health.state(t, *arrays):
             return  # nothing recorded from a lost state; the run stops at this step
         row = {"time": t}
-        x, v = self._net_state(q, qt)
+        x, v = self.system.net_state(q, qt)
         self._body_rows(row, q, qt, t)
         self._joint_rows(row)
         self._energy_rows(row, x, v)
@@ -143,14 +140,6 @@ class Recorder:
             # energy it held leaves the balance as "released" energy, so the total stays closed.
             self.joint_active[event.joint] = False
             self._released_energy += event.stored_energy
-
-    def _net_state(self, q, qt):
-        net = self.assembly.net
-        n = net.n_nodes
-        i = self._net_index
-        x = net.positions + np.asarray(q[i:i + 3 * n]).reshape(n, 3)
-        v = np.asarray(qt[i:i + 3 * n]).reshape(n, 3)
-        return x, v
 
     def body_states(self, q, qt):
         """Per body: CoM (m), velocity (m/s), body->LVLH matrix, omega (rad/s, body frame)."""
