@@ -202,7 +202,7 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
     state_index = _object_state_index(mbs, generic_nodes, [3 * n_exudyn] * bool(n_exudyn) + [6] * len(body_nodes))
     kernel_net = None
     if in_kernel:
-        kernel_net = KernelNet(mbs, coupled, kernel, assembly.net_velocity, assembly.solver.step, state_index)
+        kernel_net = KernelNet(mbs, coupled, kernel, assembly.net_velocity, state_index)
         mbs.SetPreStepUserFunction(kernel_net)
     elif verlet:
         mbs.SetPreStepUserFunction(VerletForces(mbs, coupled, kernel, assembly.solver.step, 3 * n,

@@ -27,6 +27,7 @@ import numpy as np
 from numba import njit
 
 from multibody.contact import contact_over_step, hertz_elastic_energy, signed_distance_to_mesh
+from multibody.contact_implicit import IMPLICIT_CONTACT_SPEED, contact_implicit_step
 from multibody.net import add_bending_forces, add_thread_forces
 from multibody.orbit import clohessy_wiltshire_acceleration, clohessy_wiltshire_acceleration_xyz
 
@@ -292,7 +293,9 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     for b in range(nb):
         base = 3 * n + 6 * b
         out_force[base:base + 3] = f_body[b]
-        out_force[base + 3:base + 6] = rots[b].T @ torque_lvlh[b]
+        for r in range(3):  # body-frame torque R^T t, in scalars (no BLAS call)
+            out_force[base + 3 + r] = (rots[b, 0, r] * torque_lvlh[b, 0] + rots[b, 1, r] * torque_lvlh[b, 1]
+                                       + rots[b, 2, r] * torque_lvlh[b, 2])
     out_scalars[CONTACT_ELASTIC] = contact_energy
     out_scalars[N_CONTACTS] = n_contacts
     out_force[: 3 * n] = f_net.reshape(3 * n)
@@ -337,8 +340,10 @@ def body_states(q, qt, n_nodes, body_reference):
         base = 3 * n_nodes + 6 * b
         coms[b] = body_reference[b] + q[base:base + 3]
         vels[b] = qt[base:base + 3]
-        rots[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6].copy())
-        omegas[b] = rots[b] @ qt[base + 3:base + 6]
+        rots[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
+        # in scalars: numba sends small matrix products to BLAS, microseconds a call
+        for r in range(3):
+            omegas[b, r] = rots[b, r, 0] * qt[base + 3] + rots[b, r, 1] * qt[base + 4] + rots[b, r, 2] * qt[base + 5]
     return rots, coms, vels, omegas
 
 
@@ -414,8 +419,10 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
     shape_speed = np.empty(n_shapes)
     for s in range(n_shapes):
         b = shape_body[s]
-        reach = max(np.sqrt(np.sum(shape_box_min[s] ** 2)), np.sqrt(np.sum(shape_box_max[s] ** 2)))
-        shape_speed[s] = np.sqrt(np.sum(vels[b] ** 2)) + np.sqrt(np.sum(omegas[b] ** 2)) * reach
+        lo, hi = shape_box_min[s], shape_box_max[s]
+        reach = math.sqrt(max(lo[0] * lo[0] + lo[1] * lo[1] + lo[2] * lo[2], hi[0] * hi[0] + hi[1] * hi[1] + hi[2] * hi[2]))
+        shape_speed[s] = (math.sqrt(vels[b, 0] ** 2 + vels[b, 1] ** 2 + vels[b, 2] ** 2)
+                          + math.sqrt(omegas[b, 0] ** 2 + omegas[b, 1] ** 2 + omegas[b, 2] ** 2) * reach)
     # per-node contact lists and sub-cycle work space, reused
     c_body = np.empty(n_shapes, np.int64)
     c_pen = np.empty(n_shapes)
@@ -482,10 +489,18 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
                 n_node = min(n_substeps, _substeps_to_resolve_contact(
                     c_pen, c_rel, c_normal, c_mass, k, f_non_contact[i], net_mass[i], step,
                     k_contact, exponent, d_contact))
-            mx, my, mz, ex, ey, ez, dissipated = contact_over_step(
-                c_pen[:k], c_rel[:k], c_normal[:k], f_non_contact[i], net_mass[i], c_mass[:k], step, n_node,
-                k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
-                impulses, work_delta, work_recoil, work_forces)
+            normal_speed = abs(c_rel[0, 0] * c_normal[0, 0] + c_rel[0, 1] * c_normal[0, 1]
+                               + c_rel[0, 2] * c_normal[0, 2])
+            if n_node > 1 and k == 1 and normal_speed < IMPLICIT_CONTACT_SPEED:
+                # a resting or slow single contact: one implicit step (multibody.contact_implicit)
+                mx, my, mz, ex, ey, ez, dissipated = contact_implicit_step(
+                    c_pen[0], c_rel[0], c_normal[0], f_non_contact[i], net_mass[i], c_mass[0], step,
+                    k_contact, exponent, d_contact, mu_s, mu_k, v_transition, impulses[0])
+            else:
+                mx, my, mz, ex, ey, ez, dissipated = contact_over_step(
+                    c_pen[:k], c_rel[:k], c_normal[:k], f_non_contact[i], net_mass[i], c_mass[:k], step, n_node,
+                    k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
+                    impulses, work_delta, work_recoil, work_forces)
             scale = net_mass[i] / step
             # The reaction goes to the bodies in proportion to their impulses (weights sum to 1,
             # so momentum exchange stays exact).
