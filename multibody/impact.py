@@ -19,6 +19,7 @@ from exudyn.itemInterface import NodeGenericODE2, NodeRigidBodyRotVecLG, ObjectG
 from scipy.spatial.transform import Rotation
 
 from multibody.assembly import ImpactAssembly
+from multibody.broad_phase import box_shape_flags
 from multibody.geometry import contact_shapes_body_frame
 from multibody.health import HealthWatch, SimulationFailed, check_solver_flag
 from multibody.hinge import add_penalty_joint
@@ -88,6 +89,7 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
         triangles=shapes.triangles, triangle_normals=shapes.normals,
         shape_body=shapes.shape_body, shape_triangle_range=shapes.triangle_range,
         shape_box_min=shapes.box_min, shape_box_max=shapes.box_max,
+        shape_is_box=box_shape_flags(shapes.triangles, shapes.triangle_range, shapes.box_min, shapes.box_max),
         contact_stiffness=law.stiffness, contact_exponent=law.exponent, contact_damping=law.damping,
         mu_static=law.mu_static, mu_kinetic=law.mu_kinetic, transition_speed=law.transition_speed,
         mean_motion=assembly.mean_motion, step=assembly.solver.step,

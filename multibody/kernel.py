@@ -28,6 +28,7 @@ from numba import njit
 
 from multibody.contact import contact_over_step, hertz_elastic_energy, signed_distance_to_mesh
 from multibody.contact_implicit import IMPLICIT_CONTACT_SPEED, contact_implicit_step
+from multibody.broad_phase import box_signed_distance, flag_candidates
 from multibody.net import add_bending_forces, add_thread_forces
 from multibody.orbit import clohessy_wiltshire_acceleration, clohessy_wiltshire_acceleration_xyz
 
@@ -135,6 +136,7 @@ class KernelData:
     shape_triangle_range: np.ndarray # (ns, 2) int, triangle slice of each shape
     shape_box_min: np.ndarray        # (ns, 3) body-frame bounding box of each shape (m)
     shape_box_max: np.ndarray        # (ns, 3)
+    shape_is_box: np.ndarray         # (ns,) int, 1: the shape is its bounding box (multibody.broad_phase)
     contact_stiffness: float         # k_n (N/m^n)
     contact_exponent: float          # n (-)
     contact_damping: float           # d_n = 1.5 alpha k_n
@@ -156,10 +158,16 @@ class KernelData:
     velocity_lag: np.ndarray = field(init=False)   # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s)
     lag_body: np.ndarray = field(init=False)       # (n,) body of the node's last contact, -1 for none
     scalars: np.ndarray = field(init=False)
+    work: np.ndarray = field(init=False)          # (4, n, 3) work space: positions, forces, non-contact forces, start velocities
+    work_node: np.ndarray = field(init=False)     # (3, n) work space: speed, acceleration bound, reach
+    candidates: np.ndarray = field(init=False)    # (ns, n) uint8 work space: node near shape
 
     def __post_init__(self):
         n = len(self.net_mass)
         nb = len(self.body_mass)
+        self.work = np.zeros((4, n, 3))
+        self.work_node = np.zeros((3, n))
+        self.candidates = np.zeros((len(self.shape_body), n), np.uint8)
         self.force = np.zeros(3 * n + 6 * nb)
         self.body_impulse = np.zeros((nb, 6))
         self.scalars = np.zeros(N_SCALARS)
@@ -186,12 +194,12 @@ class KernelData:
             self.threads, self.rest_lengths, self.thread_stiffness, self.thread_damping,
             self.bending_triples, self.bending_stiffness,
             self.body_reference, self.body_mass, self.body_inverse_inertia, self.triangles, self.triangle_normals,
-            self.shape_body, self.shape_triangle_range, self.shape_box_min, self.shape_box_max,
+            self.shape_body, self.shape_triangle_range, self.shape_box_min, self.shape_box_max, self.shape_is_box,
             self.contact_stiffness, self.contact_exponent, self.contact_damping,
             self.mu_static, self.mu_kinetic, self.transition_speed,
             self.mean_motion, self.step, n_sub, self.stage_weight, self.velocity_lag, self.lag_body,
             self.mount_node, self.mount_body, self.mount_point_body, self.mount_stiffness, self.mount_damping,
-            self.force, self.body_impulse, self.scalars)
+            self.force, self.body_impulse, self.scalars, self.work, self.work_node, self.candidates)
         return self.force
 
 
@@ -243,24 +251,28 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
                                threads, rest_lengths, thread_stiffness, thread_damping,
                                bending_triples, bending_stiffness,
                                body_reference, body_mass_all, inverse_inertia, triangles, triangle_normals,
-                               shape_body, shape_triangle_range, shape_box_min, shape_box_max,
+                               shape_body, shape_triangle_range, shape_box_min, shape_box_max, shape_is_box,
                                k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
                                n_orbit, step, n_substeps, stage_weight, velocity_lag, lag_body,
                                mount_node, mount_body, mount_point_body, k_mount, d_mount,
-                               out_force, out_body_impulse, out_scalars):
+                               out_force, out_body_impulse, out_scalars, work, work_node, candidates):
     """Fill ``out_force`` with the generalized forces of the coupled system (see module doc).
 
     Also accumulates, per body, the contact impulse (N s) and angular impulse about the
     CoM (N m s) in LVLH into ``out_body_impulse``, the dissipated energies into
     ``out_scalars`` and sets the current elastic energies there. Accumulations are
     weighted by ``stage_weight`` (1 / force evaluations per step: exact for
-    VelocityVerlet's single evaluation, an average for Runge-Kutta stages).
+    VelocityVerlet's single evaluation, an average for Runge-Kutta stages). ``work``,
+    ``work_node``, ``candidates``: work space (:class:`KernelData`), so nothing is allocated per node.
     """
     n = net_mass.shape[0]
     nb = body_mass_all.shape[0]
-    x = net_reference + q[: 3 * n].reshape(n, 3)
+    x, f_net = work[0], work[1]
+    for i in range(n):
+        for d in range(3):
+            x[i, d] = net_reference[i, d] + q[3 * i + d]
+            f_net[i, d] = 0.0
     v = qt[: 3 * n].reshape(n, 3)
-    f_net = np.zeros((n, 3))
 
     elastic, power = add_thread_forces(x, v, threads, rest_lengths, thread_stiffness, thread_damping, f_net)
     out_scalars[THREAD_ELASTIC] = elastic
@@ -287,9 +299,10 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     out_scalars[THREAD_DISSIPATED] += mount_power * step * stage_weight
     contact_energy, n_contacts = add_contact_forces(
         x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
-        triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
+        triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max, shape_is_box,
         k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight,
-        velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_scalars)
+        velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_scalars,
+        work[2], work[3], work_node, candidates)
     for b in range(nb):
         base = 3 * n + 6 * b
         out_force[base:base + 3] = f_body[b]
@@ -298,7 +311,9 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
                                        + rots[b, 2, r] * torque_lvlh[b, 2])
     out_scalars[CONTACT_ELASTIC] = contact_energy
     out_scalars[N_CONTACTS] = n_contacts
-    out_force[: 3 * n] = f_net.reshape(3 * n)
+    for i in range(n):
+        for d in range(3):
+            out_force[3 * i + d] = f_net[i, d]
     return out_force
 
 
@@ -387,8 +402,9 @@ def _substeps_to_resolve_contact(penetrations, relative_velocities, normals, bod
 @njit(cache=True)
 def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
                        triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
-                       k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight,
-                       velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_scalars):
+                       shape_is_box, k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps,
+                       stage_weight, velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_scalars,
+                       f_non_contact, v_start, work_node, candidates):
     """Add node-body contact kicks to ``f_net`` and their reactions to ``f_body``/``torque_lvlh``.
 
     ``f_net`` enters holding every non-contact force on the nodes. Returns the elastic
@@ -405,24 +421,28 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
     n = net_mass.shape[0]
     contact_energy = 0.0
     n_contacts = 0
-    f_non_contact = f_net.copy()
     half_kick = 0.5 * step if n_substeps > 1 else 0.0
-    v_start = np.empty((n, 3))
-    speed = np.empty(n)
-    push = np.empty(n)  # acceleration bound (m/s^2)
+    speed, push, reach = work_node[0], work_node[1], work_node[2]  # push: acceleration bound (m/s^2)
     for i in range(n):
+        # An upper bound of the exact reach below (L1 norms, no square roots): it only feeds the
+        # bounding-sphere pass, which must never miss a node the exact tests would keep.
+        inverse_mass = 1.0 / net_mass[i]
+        speed_bound = 0.0
+        push_bound = 0.0
         for d in range(3):
-            v_start[i, d] = v[i, d] + velocity_lag[i, d] + half_kick * f_non_contact[i, d] / net_mass[i]
-        speed[i] = math.sqrt(v_start[i, 0] ** 2 + v_start[i, 1] ** 2 + v_start[i, 2] ** 2)
-        push[i] = math.sqrt(f_non_contact[i, 0] ** 2 + f_non_contact[i, 1] ** 2 + f_non_contact[i, 2] ** 2) / net_mass[i]
+            speed_bound += abs(v[i, d] + velocity_lag[i, d] + half_kick * f_net[i, d] * inverse_mass)
+            push_bound += abs(f_net[i, d])
+        reach[i] = 1.001 * (net_radius[i] + step * speed_bound + 0.5 * step * step * push_bound * inverse_mass)
     n_shapes = shape_body.shape[0]
     shape_speed = np.empty(n_shapes)
     for s in range(n_shapes):
         b = shape_body[s]
         lo, hi = shape_box_min[s], shape_box_max[s]
-        reach = math.sqrt(max(lo[0] * lo[0] + lo[1] * lo[1] + lo[2] * lo[2], hi[0] * hi[0] + hi[1] * hi[1] + hi[2] * hi[2]))
+        extent = math.sqrt(max(lo[0] * lo[0] + lo[1] * lo[1] + lo[2] * lo[2], hi[0] * hi[0] + hi[1] * hi[1] + hi[2] * hi[2]))
         shape_speed[s] = (math.sqrt(vels[b, 0] ** 2 + vels[b, 1] ** 2 + vels[b, 2] ** 2)
-                          + math.sqrt(omegas[b, 0] ** 2 + omegas[b, 1] ** 2 + omegas[b, 2] ** 2) * reach)
+                          + math.sqrt(omegas[b, 0] ** 2 + omegas[b, 1] ** 2 + omegas[b, 2] ** 2) * extent)
+    # bounding-sphere pass (multibody.broad_phase); the box test below stays the exact filter
+    flag_candidates(x, reach, rots, coms, shape_body, shape_box_min, shape_box_max, step * shape_speed, candidates)
     # per-node contact lists and sub-cycle work space, reused
     c_body = np.empty(n_shapes, np.int64)
     c_pen = np.empty(n_shapes)
@@ -435,8 +455,24 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
     work_recoil = np.empty((n_shapes, 3))
     work_forces = np.empty((n_shapes, 3))
     for i in range(n):
+        if lag_body[i] < 0:
+            near = False
+            for s in range(n_shapes):
+                if candidates[s, i]:
+                    near = True
+                    break
+            if not near:
+                continue  # far from every shape and nothing carried: no contact work for this node
+        # the node's non-contact force and its velocity at the evaluation time (see the doc above)
+        for d in range(3):
+            f_non_contact[i, d] = f_net[i, d]
+            v_start[i, d] = v[i, d] + velocity_lag[i, d] + half_kick * f_net[i, d] / net_mass[i]
+        speed[i] = math.sqrt(v_start[i, 0] ** 2 + v_start[i, 1] ** 2 + v_start[i, 2] ** 2)
+        push[i] = math.sqrt(f_net[i, 0] ** 2 + f_net[i, 1] ** 2 + f_net[i, 2] ** 2) / net_mass[i]
         k = 0
         for s in range(n_shapes):
+            if not candidates[s, i]:
+                continue
             b = shape_body[s]
             # Broad phase in scalars: node in the body frame against the shape's box, grown by
             # the node radius and the distance the pair can close within one step.
@@ -451,8 +487,11 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
                     or py < shape_box_min[s, 1] - margin or py > shape_box_max[s, 1] + margin
                     or pz < shape_box_min[s, 2] - margin or pz > shape_box_max[s, 2] + margin):
                 continue
-            distance, nbx, nby, nbz = signed_distance_to_mesh(
-                px, py, pz, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
+            if shape_is_box[s]:
+                distance, nbx, nby, nbz = box_signed_distance(px, py, pz, shape_box_min[s], shape_box_max[s])
+            else:
+                distance, nbx, nby, nbz = signed_distance_to_mesh(
+                    px, py, pz, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
             penetration = net_radius[i] - distance
             nx = rots[b, 0, 0] * nbx + rots[b, 0, 1] * nby + rots[b, 0, 2] * nbz
             ny = rots[b, 1, 0] * nbx + rots[b, 1, 1] * nby + rots[b, 1, 2] * nbz
@@ -484,19 +523,19 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
             # must feel both). The contact force is the kick that makes the integrator's next
             # drift follow the sub-cycled path; the true end velocity minus the mean velocity
             # is carried as a lag and released at the next evaluation.
-            n_node = n_substeps
-            if n_substeps > 1:
-                n_node = min(n_substeps, _substeps_to_resolve_contact(
-                    c_pen, c_rel, c_normal, c_mass, k, f_non_contact[i], net_mass[i], step,
-                    k_contact, exponent, d_contact))
             normal_speed = abs(c_rel[0, 0] * c_normal[0, 0] + c_rel[0, 1] * c_normal[0, 1]
                                + c_rel[0, 2] * c_normal[0, 2])
-            if n_node > 1 and k == 1 and normal_speed < IMPLICIT_CONTACT_SPEED:
+            if n_substeps > 1 and k == 1 and normal_speed < IMPLICIT_CONTACT_SPEED:
                 # a resting or slow single contact: one implicit step (multibody.contact_implicit)
                 mx, my, mz, ex, ey, ez, dissipated = contact_implicit_step(
                     c_pen[0], c_rel[0], c_normal[0], f_non_contact[i], net_mass[i], c_mass[0], step,
                     k_contact, exponent, d_contact, mu_s, mu_k, v_transition, impulses[0])
             else:
+                n_node = n_substeps
+                if n_substeps > 1:
+                    n_node = min(n_substeps, _substeps_to_resolve_contact(
+                        c_pen, c_rel, c_normal, c_mass, k, f_non_contact[i], net_mass[i], step,
+                        k_contact, exponent, d_contact))
                 mx, my, mz, ex, ey, ez, dissipated = contact_over_step(
                     c_pen[:k], c_rel[:k], c_normal[:k], f_non_contact[i], net_mass[i], c_mass[:k], step, n_node,
                     k_contact, exponent, d_contact, mu_s, mu_k, v_transition,

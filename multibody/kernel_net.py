@@ -49,10 +49,11 @@ class NetStepModelType(types.StructRef):
 KERNEL_FIELDS = (
     "net_reference", "net_mass", "net_radius", "threads", "rest_lengths", "thread_stiffness", "thread_damping",
     "bending_triples", "bending_stiffness", "body_reference", "body_mass", "body_inverse_inertia", "triangles",
-    "triangle_normals", "shape_body", "shape_triangle_range", "shape_box_min", "shape_box_max",
+    "triangle_normals", "shape_body", "shape_triangle_range", "shape_box_min", "shape_box_max", "shape_is_box",
     "contact_stiffness", "contact_exponent", "contact_damping", "mu_static", "mu_kinetic", "transition_speed",
     "mean_motion", "step", "stage_weight", "velocity_lag", "lag_body", "mount_node", "mount_body",
-    "mount_point_body", "mount_stiffness", "mount_damping", "force", "body_impulse", "scalars")
+    "mount_point_body", "mount_stiffness", "mount_damping", "force", "body_impulse", "scalars", "work", "work_node",
+    "candidates")
 STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "q_eval", "qt_eval")
 
 
@@ -91,12 +92,12 @@ def _forces(m, time, n_substeps):
         m.threads, m.rest_lengths, m.thread_stiffness, m.thread_damping,
         m.bending_triples, m.bending_stiffness,
         m.body_reference, m.body_mass, m.body_inverse_inertia, m.triangles, m.triangle_normals,
-        m.shape_body, m.shape_triangle_range, m.shape_box_min, m.shape_box_max,
+        m.shape_body, m.shape_triangle_range, m.shape_box_min, m.shape_box_max, m.shape_is_box,
         m.contact_stiffness, m.contact_exponent, m.contact_damping,
         m.mu_static, m.mu_kinetic, m.transition_speed,
         m.mean_motion, m.step, n_substeps, m.stage_weight, m.velocity_lag, m.lag_body,
         m.mount_node, m.mount_body, m.mount_point_body, m.mount_stiffness, m.mount_damping,
-        m.force, m.body_impulse, m.scalars)
+        m.force, m.body_impulse, m.scalars, m.work, m.work_node, m.candidates)
 
 
 @njit(cache=True)

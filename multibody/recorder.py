@@ -102,7 +102,8 @@ class Recorder:
         self._inertia = np.array([b.inertia_body for b in bodies], float).reshape(nb, 3, 3)
         self._net_masses = np.asarray(assembly.net.masses, float)
         self._debris = np.array(assembly.debris_indices, np.int64)
-        self._debris_masses = self._body_mass[self._debris]
+        self._debris_mask = np.isin(np.arange(nb), self._debris).astype(np.int64)
+        self._chaser = -1 if assembly.chaser is None else int(assembly.chaser)
         self._joint_arrays = (np.array([j.parent for j in joints], np.int64), np.array([j.child for j in joints], np.int64),
                               np.array(system.joint_to_parent, float).reshape(nj, 3, 3),
                               np.array(system.joint_to_child, float).reshape(nj, 3, 3),
@@ -112,7 +113,8 @@ class Recorder:
         self._work = {name: np.zeros(shape) for name, shape in (
             ("com", (nb, 3)), ("vel", (nb, 3)), ("rot", (nb, 3, 3)), ("omega", (nb, 3)), ("force", (nb, 3)),
             ("moment", (nb, 3)), ("force_body", (nb, 3)), ("moment_body", (nb, 3)), ("totals", (nb, 9)),
-            ("joint_rotation", (nj, 3)), ("joint_rate", (nj, 3)), ("joint_energy", (nj,)), ("net", (8,)))}
+            ("joint_rotation", (nj, 3)), ("joint_rate", (nj, 3)), ("joint_energy", (nj,)), ("net", (8,)),
+            ("summary", (17,)))}
 
     # -- Exudyn hook -----------------------------------------------------------------
     def post_step(self, mbs, t):
@@ -167,10 +169,11 @@ class Recorder:
         self._last_output_time = t
         body_sample(q, qt, self._body_index, self._body_reference, self._body_mass, self._inertia,
                     self.system.kernel.body_impulse, interval, *self._joint_arrays, self.joint_active.astype(float),
-                    self.assembly.mean_motion, w["com"], w["vel"], w["rot"], w["omega"], w["force"], w["moment"],
-                    w["force_body"], w["moment_body"], w["totals"], w["joint_rotation"], w["joint_rate"],
-                    w["joint_energy"])
-        net_sums(x, v, self._net_masses, self.assembly.mean_motion, w["net"])
+                    self.assembly.mean_motion, self._debris_mask, self._chaser, w["com"], w["vel"], w["rot"],
+                    w["omega"], w["force"], w["moment"], w["force_body"], w["moment_body"], w["totals"],
+                    w["joint_rotation"], w["joint_rate"], w["joint_energy"], w["summary"])
+        net = w["net"]
+        net_sums(x, v, self._net_masses, self.assembly.mean_motion, net)
         mbs = self.system.mbs
         nj = len(self.system.joint_objects)
         forces, moments = np.zeros((nj, 3)), np.zeros((nj, 3))
@@ -181,38 +184,35 @@ class Recorder:
                 forces[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)
                 moments[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)
         self._joint_energies = w["joint_energy"]
-        totals, net = w["totals"], w["net"]
-        debris, masses = self._debris, self._debris_masses
+        summary = w["summary"].tolist()
+        scalars = self.system.kernel.scalars.tolist()
         row = {"time": t,
                "contact_force_lvlh": w["force"], "contact_moment_lvlh": w["moment"],
                "contact_force_body": w["force_body"], "contact_moment_body": w["moment_body"],
                "body_com_lvlh": w["com"], "body_velocity_lvlh": w["vel"], "body_omega_body": w["omega"],
-               "body_to_lvlh": w["rot"],
-               "debris_com_lvlh": masses @ w["com"][debris] / masses.sum() if len(masses) else np.zeros(3),
-               "debris_velocity_lvlh": masses @ w["vel"][debris] / masses.sum() if len(masses) else np.zeros(3),
+               "body_to_lvlh": w["rot"], "debris_com_lvlh": summary[0:3], "debris_velocity_lvlh": summary[3:6],
                "joint_rotation_joint": w["joint_rotation"], "joint_rate_joint": w["joint_rate"],
                "joint_force_joint": -forces, "joint_moment_joint": -moments}
-        scalars = self.system.kernel.scalars
         e = {
             "net_kinetic": net[0],
             "net_elastic": scalars[THREAD_ELASTIC],
             "net_bending": scalars[BENDING_ELASTIC],
             "contact_elastic": scalars[CONTACT_ELASTIC],
-            "debris_translational": totals[debris, 0].sum(),
-            "debris_rotational": totals[debris, 1].sum(),
-            "joint_elastic": float(w["joint_energy"].sum()),
+            "debris_translational": summary[6],
+            "debris_rotational": summary[7],
+            "joint_elastic": summary[16],
             "released_joints": self._released_energy,
-            "orbital_potential": net[1] + totals[:, 2].sum() if self.assembly.mean_motion else 0.0,
+            "orbital_potential": net[1] + summary[8] if self.assembly.mean_motion else 0.0,
             "dissipated_threads": scalars[THREAD_DISSIPATED],
             "dissipated_contact": scalars[CONTACT_DISSIPATED],
         }
         if self.assembly.chaser is not None:
-            e["chaser_kinetic"] = totals[self.assembly.chaser, 0] + totals[self.assembly.chaser, 1]
+            e["chaser_kinetic"] = summary[9]
         e["total"] = sum(e.values())
         for key, value in e.items():
             row["energy_" + key] = value
-        row["momentum_linear_lvlh"] = net[2:5] + totals[:, 3:6].sum(axis=0)
-        row["momentum_angular_lvlh"] = net[5:8] + totals[:, 6:9].sum(axis=0)
+        row["momentum_linear_lvlh"] = net[2:5] + w["summary"][10:13]
+        row["momentum_angular_lvlh"] = net[5:8] + w["summary"][13:16]
         return row
 
     def _store(self, row):

@@ -90,8 +90,8 @@ def _mat_mat(a, b, transpose_a):
 @njit(cache=True)
 def body_sample(q, qt, body_index, body_reference, body_mass, inertia, impulse, interval,
                 joint_parent, joint_child, to_parent, to_child, point_parent, point_child, joint_stiffness, active,
-                n_orbit, com, vel, rot, omega, force_lvlh, moment_lvlh, force_body, moment_body, body_totals,
-                joint_rotation, joint_rate, joint_energy):
+                n_orbit, debris_mask, chaser, com, vel, rot, omega, force_lvlh, moment_lvlh, force_body, moment_body,
+                body_totals, joint_rotation, joint_rate, joint_energy, summary):
     """Body and joint states of one sample, into the output arrays (all preallocated).
 
     Parameters
@@ -108,11 +108,16 @@ def body_sample(q, qt, body_index, body_reference, body_mass, inertia, impulse, 
                               ``active`` (nj,) 1.0 or 0.0 (released).
     com, vel, omega : (nb, 3); rot : (nb, 3, 3)    Body states (omega in the body frame).
     n_orbit : float           Mean motion (rad/s) of the Clohessy-Wiltshire potential; 0 without orbit.
+    debris_mask : (nb,) int   1 for debris bodies; ``chaser`` (int) the chaser's index or -1.
     force_lvlh, moment_lvlh, force_body, moment_body : (nb, 3)   Mean contact force (N), moment about the CoM (N m).
     body_totals : (nb, 9)     Per body: translational and rotational kinetic energy (J), CW potential (J),
                               linear momentum (3, kg m/s), angular momentum about the LVLH origin (3, kg m^2/s).
     joint_rotation, joint_rate : (nj, 3)   Relative rotation vector (rad) and rate (rad/s), joint frame.
     joint_energy : (nj,)      Elastic energy of the penalty spring (J).
+    summary : (17,)           Debris CoM (3, m) and CoM velocity (3, m/s), LVLH; debris translational and
+                              rotational kinetic energy (J); CW potential of all bodies (J); the chaser's
+                              kinetic energy (J); linear (3) and angular (3) momentum of all bodies (as
+                              ``body_totals``); joint elastic energy (J).
     """
     nb = body_mass.shape[0]
     for b in range(nb):
@@ -154,3 +159,24 @@ def body_sample(q, qt, body_index, body_reference, body_mass, inertia, impulse, 
         for d in range(3):
             energy += joint_stiffness[j, d] * offset_joint[d] ** 2 + joint_stiffness[j, 3 + d] * joint_rotation[j, d] ** 2
         joint_energy[j] = 0.5 * energy * active[j]
+    for k in range(17):
+        summary[k] = 0.0
+    debris_mass = 0.0
+    for b in range(nb):
+        if debris_mask[b]:
+            debris_mass += body_mass[b]
+            for d in range(3):
+                summary[d] += body_mass[b] * com[b, d]
+                summary[3 + d] += body_mass[b] * vel[b, d]
+            summary[6] += body_totals[b, 0]
+            summary[7] += body_totals[b, 1]
+        summary[8] += body_totals[b, 2]
+        for d in range(6):
+            summary[10 + d] += body_totals[b, 3 + d]
+    if debris_mass > 0.0:
+        for d in range(6):
+            summary[d] /= debris_mass
+    if chaser >= 0:
+        summary[9] = body_totals[chaser, 0] + body_totals[chaser, 1]
+    for j in range(joint_parent.shape[0]):
+        summary[16] += joint_energy[j]
