@@ -28,6 +28,8 @@ Speed: the whole pre-step is one compiled call (:func:`kernel_net_step`) on a nu
 """
 from __future__ import annotations
 
+import os
+
 import numpy as np
 from numba import njit, types
 from numba.experimental import structref
@@ -142,6 +144,23 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
         m.qt[k] = m.qt_eval[k] + half * a
         m.q[k] = m.q_eval[k]
     return force[n3:].copy()
+
+
+#: Wall time (s) of the first run's compilation of the impact kernels with numba's cache empty: 72 s
+#: measured on the 2-core machine at load 3-4 (import, build and 10 steps of the reference case; 4.7 s
+#: once cached), so "30-60 s" on a quiet one. Every kernel is compiled with ``cache=True``: it happens
+#: once per installation (and Python version), not per run.
+FIRST_COMPILE_S = (30, 60)
+
+
+def kernels_cached() -> bool:
+    """Whether numba's on-disk cache already holds the impact kernels (False: the next run compiles
+    them first, :data:`FIRST_COMPILE_S`). True when numba's cache layout cannot be read (say nothing
+    rather than something wrong)."""
+    try:
+        return os.path.exists(kernel_net_step._cache._cache_file._index_path)
+    except AttributeError:
+        return True
 
 
 class KernelNet:

@@ -26,6 +26,8 @@ def _cmd_run(args) -> int:
 
     case = load_case(args.case)  # fail fast on a bad case, before any output folder exists
     _check_work(impact_estimate_of(case), args)
+    if not args.json:
+        announce_first_compile()
     out = Path(args.out) if args.out else Path("runs") / case.name
     end = case.simulation.end_time
     columns = [TextColumn("[bold]simulating[/bold] {task.fields[t]:.3f} / %.3g s" % end), BarColumn(),
@@ -61,6 +63,16 @@ def _check_work(estimate, args) -> None:
     check_budget(estimate, getattr(args, "force", False))
     if not getattr(args, "json", False):
         print(estimate.text(), file=sys.stderr)
+
+
+def announce_first_compile() -> None:
+    """Say so when this run compiles the simulation kernels first (numba's cache is empty: once per
+    installation, multibody.kernel_net.FIRST_COMPILE_S)."""
+    from multibody.kernel_net import FIRST_COMPILE_S, kernels_cached
+
+    if not kernels_cached():
+        low, high = FIRST_COMPILE_S
+        print(f"compiling the simulation kernels, once: ~{low}-{high} s", file=sys.stderr)
 
 
 def _products(run_dir: Path, report: bool, vtk: bool, quiet: bool = False) -> int:
@@ -135,6 +147,8 @@ def _cmd_perceive(args) -> int:
 
     case = load_case(args.case)
     _check_work(impact_estimate_of(case), args)
+    if not args.json:
+        announce_first_compile()
     out = Path(args.out) if args.out else Path("runs") / f"{case.name}"
     with _progress_bar("perceive", args.json) as bar:
         task = bar.add_task("", total=None)
