@@ -23,8 +23,12 @@ import time
 from pathlib import Path
 
 import exudyn as exu
-import numpy as np
-from exudyn.itemInterface import MarkerNodePosition, NodePoint, ObjectConnectorSpringDamper, ObjectMassPoint
+from exudyn.itemInterface import (
+    MarkerNodePosition,
+    NodePoint,
+    ObjectConnectorSpringDamper,
+    ObjectMassPoint,
+)
 
 from multibody.impact import ImpactSimulation, net_stable_step, solver_chatter_to_stderr
 from riskassess.assemble import model_inputs
@@ -35,7 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def load() -> str:
-    return "load %.2f" % os.getloadavg()[0]
+    return f"load {os.getloadavg()[0]:.2f}"
 
 
 def sized_inputs(case_path: Path, nodes_per_side: int, end_time: float, net_integration: str):
@@ -48,7 +52,7 @@ def sized_inputs(case_path: Path, nodes_per_side: int, end_time: float, net_inte
     case = case.model_copy(update={"net": net, "simulation": case.simulation.model_copy(update=simulation)})
     inputs = model_inputs(case, case_path.parent)
     step = min(case.simulation.step, 0.5 * net_stable_step(inputs.assembly.net))
-    step = float("%.2g" % step)
+    step = float(f"{step:.2g}")
     inputs.assembly.solver = dataclasses.replace(inputs.assembly.solver, step=step, end_time=end_time)
     return case, inputs
 

@@ -34,7 +34,11 @@ import numpy as np
 from numba import njit, types
 from numba.experimental import structref
 
-from multibody.kernel import KernelData, coupled_generalized_forces, verlet_evaluation_state
+from multibody.kernel import (
+    KernelData,
+    coupled_generalized_forces,
+    verlet_evaluation_state,
+)
 
 
 @structref.register
@@ -138,11 +142,14 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
     m.q_eval[n3:] = q_next
     m.qt_eval[n3:] = v_half_bodies
     force = _forces(m, time, m.n_substeps if time > 0.0 else 1)
-    for k in range(n3):
-        a = force[k] / m.net_mass[k // 3]
-        m.qtt[k] = a
-        m.qt[k] = m.qt_eval[k] + half * a
-        m.q[k] = m.q_eval[k]
+    inverse_mass = m.work_node[3]  # (n,) 1 / node mass (multibody.kernel.KernelData)
+    for i in range(n3 // 3):
+        for d in range(3):
+            k = 3 * i + d
+            a = force[k] * inverse_mass[i]
+            m.qtt[k] = a
+            m.qt[k] = m.qt_eval[k] + half * a
+            m.q[k] = m.q_eval[k]
     return force[n3:].copy()
 
 

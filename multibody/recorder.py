@@ -35,13 +35,18 @@ to ~5 um, a thread stretch worth ~0.3 N of tension.
 """
 from __future__ import annotations
 
-import numpy as np
 import exudyn as exu
+import numpy as np
 
 from multibody.health import HealthWatch
-from multibody.kernel import BENDING_ELASTIC, CONTACT_DISSIPATED, CONTACT_ELASTIC, THREAD_DISSIPATED, THREAD_ELASTIC
+from multibody.kernel import (
+    BENDING_ELASTIC,
+    CONTACT_DISSIPATED,
+    CONTACT_ELASTIC,
+    THREAD_DISSIPATED,
+    THREAD_ELASTIC,
+)
 from multibody.recorder_kernel import body_sample, net_sums
-
 
 #: Longest simulated time between two finite-state checks when the output rate is lower (s):
 #: a NaN spreads through the coupled state within a few steps and stays, so 1 ms loses nothing.
@@ -84,7 +89,6 @@ class Recorder:
 
     def _preallocate(self, assembly, system):
         """Series and snapshot arrays for every sample the run can take, and the recorder kernel's inputs."""
-        solver = assembly.solver
         self._capacity = int(np.ceil(self._end_time / self.output_interval)) + 3
         self._series: dict[str, np.ndarray] = {}
         self._n_rows = 0
