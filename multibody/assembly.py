@@ -112,6 +112,9 @@ class SolverSpec:
     net_output_rate: float = 50.0   # net snapshots per second (Hz)
     contact_substep: float = 2e-6   # shortest contact sub-step (s); multibody.kernel sizes each node's
     joint_tuning_step: float | None = None  # step the automatic penalty joints are tuned to (s); None: step
+    # who integrates the net: "kernel" (the compiled kernel, inside the bodies' Verlet step;
+    # multibody.kernel_net) or "exudyn" (one Exudyn node for the whole net, the reference path)
+    net_integration: str = "kernel"
 
     @property
     def n_steps(self) -> int:

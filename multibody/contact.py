@@ -333,4 +333,4 @@ def hertz_elastic_energy(penetration, stiffness, exponent):
     """Elastic energy stored in a Hertz contact (J): :math:`k\\delta^{n+1}/(n+1)`, zero without contact."""
     if penetration <= 0.0:
         return 0.0
-    return stiffness * penetration ** (exponent + 1.0) / (exponent + 1.0)
+    return stiffness * _power(penetration, exponent) * penetration / (exponent + 1.0)

@@ -157,6 +157,10 @@ class HealthWatch:
 
     def state(self, time: float, *arrays, quantity: str = "state") -> bool:
         """False (and :attr:`failure` set) when any of ``arrays`` holds a NaN or an infinity."""
+        # Fast path: a sum is finite only when every entry is (a NaN or an infinity propagates; a finite
+        # sum that overflows only sends the array to the full check).
+        if self.ok and all(math.isfinite(np.add.reduce(a, axis=None)) for a in arrays):
+            return True
         return all(self._guard(check_finite, time, a, quantity, self.cause) for a in arrays)
 
     def energy(self, time: float, total_energy: float) -> bool:

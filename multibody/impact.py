@@ -16,11 +16,13 @@ from exudyn.itemInterface import NodeGenericODE2, NodeRigidBodyRotVecLG, ObjectG
 from scipy.spatial.transform import Rotation
 
 from multibody.assembly import ImpactAssembly
+from multibody.broad_phase import box_shape_flags
 from multibody.geometry import contact_shapes_body_frame
 from multibody.health import HealthWatch, SimulationFailed, check_solver_flag
 from multibody.hinge import add_penalty_joint
 from multibody.jit_cache import all_compiled_on_disk
 from multibody.kernel import KernelData, coupled_generalized_forces, verlet_evaluation_state
+from multibody.kernel_net import KernelNet, kernel_net_start, kernel_net_step
 from multibody.recorder import Recorder
 from multibody.solver_output import solver_chatter_captured
 
@@ -47,6 +49,26 @@ class BuiltSystem:
     joint_to_child: list       # (3, 3) joint frame in child body frame (unrotated), per joint
     joint_point_parent: list   # (3,) joint point, parent body frame (m)
     joint_point_child: list    # (3,) joint point, child body frame (m)
+    kernel_net: KernelNet | None = None  # the net's state when the kernel integrates it
+
+    def net_state(self, q, qt):
+        """(n, 3) node positions (m) and velocities (m/s), LVLH, at the end of the last step, from
+        the kernel (``kernel_net``) or from Exudyn's system vectors ``q``, ``qt`` (net node)."""
+        if self.kernel_net is not None:
+            return self.kernel_net.positions(), self.kernel_net.velocities()
+        n = self.kernel.n_nodes
+        i = self.mbs.GetNodeODE2Index(self.net_node) if self.net_node is not None else 0
+        return (self.kernel.net_reference + np.asarray(q[i:i + 3 * n]).reshape(n, 3),
+                np.asarray(qt[i:i + 3 * n]).reshape(n, 3))
+
+    def state_arrays(self) -> tuple:
+        """Every state array of the run, for the finite-state check: Exudyn's coordinates and
+        velocities, and the net's when the kernel holds it (Exudyn does not see it then)."""
+        data = self.mbs.systemData
+        arrays = (data.GetODE2Coordinates(), data.GetODE2Coordinates_t())
+        if self.kernel_net is not None:
+            arrays += (self.kernel_net.q, self.kernel_net.qt)
+        return arrays
 
 
 def kernel_data(assembly: ImpactAssembly) -> KernelData:
@@ -66,6 +88,7 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
         triangles=shapes.triangles, triangle_normals=shapes.normals,
         shape_body=shapes.shape_body, shape_triangle_range=shapes.triangle_range,
         shape_box_min=shapes.box_min, shape_box_max=shapes.box_max,
+        shape_is_box=box_shape_flags(shapes.triangles, shapes.triangle_range, shapes.box_min, shapes.box_max),
         contact_stiffness=law.stiffness, contact_exponent=law.exponent, contact_damping=law.damping,
         mu_static=law.mu_static, mu_kinetic=law.mu_kinetic, transition_speed=law.transition_speed,
         mean_motion=assembly.mean_motion, step=assembly.solver.step,
@@ -123,10 +146,13 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     net = assembly.net
+    verlet = assembly.solver.integrator == "VelocityVerlet"
+    in_kernel = uses_kernel_net(assembly)
     n = net.n_nodes
+    n_exudyn = 0 if in_kernel else n  # net nodes Exudyn integrates
     generic_nodes = []
     net_node = None
-    if n:
+    if n_exudyn:
         net_node = mbs.AddNode(NodeGenericODE2(
             referenceCoordinates=net.positions.ravel().tolist(),
             initialCoordinates=[0.0] * (3 * n),
@@ -138,13 +164,12 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
     generic_nodes += body_nodes
 
     kernel = kernel_data(assembly)
-    size = 3 * n + 6 * len(assembly.bodies)
+    size = 3 * n_exudyn + 6 * len(assembly.bodies)
     mass = exu.MatrixContainer()
-    diagonal = np.arange(3 * n)
-    triplets = np.c_[diagonal, diagonal, np.repeat(net.masses, 3)] if n else np.zeros((0, 3))
+    diagonal = np.arange(3 * n_exudyn)
+    triplets = np.c_[diagonal, diagonal, np.repeat(net.masses, 3)] if n_exudyn else np.zeros((0, 3))
     mass.SetWithSparseMatrixCSR(size, size, triplets.tolist(), useDenseMatrix=False)
 
-    verlet = assembly.solver.integrator == "VelocityVerlet"
     if verlet:
         # Forces enter as the object's force vector, set once per step by a pre-step
         # function (VerletForces): no Python lists cross the C++ boundary.
@@ -175,14 +200,25 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
         p_parent.append(parent.body_to_lvlh.T @ (joint.point_lvlh - parent.com_lvlh))
         p_child.append(rest_attitudes[joint.child].T @ (joint.point_lvlh - rest_coms[joint.child]))
     mbs.Assemble()
-    state_index = _object_state_index(mbs, generic_nodes, [3 * n] * bool(n) + [6] * len(body_nodes))
-    if verlet:
+    state_index = _object_state_index(mbs, generic_nodes, [3 * n_exudyn] * bool(n_exudyn) + [6] * len(body_nodes))
+    kernel_net = None
+    if in_kernel:
+        kernel_net = KernelNet(mbs, coupled, kernel, assembly.net_velocity, state_index)
+        mbs.SetPreStepUserFunction(kernel_net)
+    elif verlet:
         mbs.SetPreStepUserFunction(VerletForces(mbs, coupled, kernel, assembly.solver.step, 3 * n,
                                                 len(body_nodes), state_index))
     else:
         layout["index"] = state_index
     return BuiltSystem(sc, mbs, kernel, net_node, body_nodes, body_objects, joint_objects,
-                       to_parent, to_child, p_parent, p_child)
+                       to_parent, to_child, p_parent, p_child, kernel_net)
+
+
+def uses_kernel_net(assembly: ImpactAssembly) -> bool:
+    """True when the compiled kernel integrates the net (``solver.net_integration = "kernel"``,
+    VelocityVerlet only: Runge-Kutta stages need Exudyn to hold every coordinate)."""
+    return (assembly.solver.net_integration == "kernel" and assembly.solver.integrator == "VelocityVerlet"
+            and assembly.net.n_nodes > 0 and len(assembly.bodies) > 0)
 
 
 def _object_state_index(mbs, nodes, sizes):
@@ -264,7 +300,7 @@ def simulation_settings(assembly: ImpactAssembly) -> exu.SimulationSettings:
 
 
 #: The compiled functions an impact run calls from Python; the others compile inside them.
-COMPILED_KERNELS = (coupled_generalized_forces, verlet_evaluation_state)
+COMPILED_KERNELS = (coupled_generalized_forces, verlet_evaluation_state, kernel_net_start, kernel_net_step)
 
 
 def kernels_compiled() -> bool:

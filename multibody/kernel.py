@@ -26,9 +26,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from multibody.contact import contact_over_step, hertz_elastic_energy, signed_distance_to_mesh
+from multibody.contact_kernel import add_contact_forces
 from multibody.net import add_bending_forces, add_thread_forces
-from multibody.orbit import clohessy_wiltshire_acceleration, clohessy_wiltshire_acceleration_xyz
+from multibody.orbit import (
+    clohessy_wiltshire_acceleration,
+    clohessy_wiltshire_acceleration_xyz,
+)
 
 #: Indices into the kernel's scalar output buffer.
 THREAD_ELASTIC, BENDING_ELASTIC, CONTACT_ELASTIC, THREAD_DISSIPATED, CONTACT_DISSIPATED, N_CONTACTS = range(6)
@@ -134,6 +137,7 @@ class KernelData:
     shape_triangle_range: np.ndarray # (ns, 2) int, triangle slice of each shape
     shape_box_min: np.ndarray        # (ns, 3) body-frame bounding box of each shape (m)
     shape_box_max: np.ndarray        # (ns, 3)
+    shape_is_box: np.ndarray         # (ns,) int, 1: the shape is its bounding box (multibody.broad_phase)
     contact_stiffness: float         # k_n (N/m^n)
     contact_exponent: float          # n (-)
     contact_damping: float           # d_n = 1.5 alpha k_n
@@ -156,10 +160,17 @@ class KernelData:
     velocity_lag: np.ndarray = field(init=False)   # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s)
     lag_body: np.ndarray = field(init=False)       # (n,) body of the node's last contact, -1 for none
     scalars: np.ndarray = field(init=False)
+    work: np.ndarray = field(init=False)          # (4, n, 3) work space: positions, forces, non-contact forces, start velocities
+    work_node: np.ndarray = field(init=False)     # (4, n) work space: speed, acceleration bound, reach; 1 / mass
+    candidates: np.ndarray = field(init=False)    # (ns, n) uint8 work space: node near shape
 
     def __post_init__(self):
         n = len(self.net_mass)
         nb = len(self.body_mass)
+        self.work = np.zeros((4, n, 3))
+        self.work_node = np.zeros((4, n))
+        self.work_node[3] = 1.0 / np.asarray(self.net_mass, float)  # constant: a product is cheaper than a division
+        self.candidates = np.zeros((len(self.shape_body), n), np.uint8)
         self.force = np.zeros(3 * n + 6 * nb)
         self.body_impulse = np.zeros((nb, 6))
         self.node_impulse = np.zeros((n, 3))
@@ -187,56 +198,14 @@ class KernelData:
             self.threads, self.rest_lengths, self.thread_stiffness, self.thread_damping,
             self.bending_triples, self.bending_stiffness,
             self.body_reference, self.body_mass, self.body_inverse_inertia, self.triangles, self.triangle_normals,
-            self.shape_body, self.shape_triangle_range, self.shape_box_min, self.shape_box_max,
+            self.shape_body, self.shape_triangle_range, self.shape_box_min, self.shape_box_max, self.shape_is_box,
             self.contact_stiffness, self.contact_exponent, self.contact_damping,
             self.mu_static, self.mu_kinetic, self.transition_speed,
             self.mean_motion, self.step, n_sub, self.stage_weight, self.velocity_lag, self.lag_body,
             self.mount_node, self.mount_body, self.mount_point_body, self.mount_stiffness, self.mount_damping,
-            self.force, self.body_impulse, self.node_impulse, self.scalars)
+            self.force, self.body_impulse, self.node_impulse, self.scalars, self.work, self.work_node,
+            self.candidates)
         return self.force
-
-
-@njit(cache=True)
-def _effective_mass_along_normal(rot, inverse_inertia_body, mass, ax, ay, az, nx, ny, nz):
-    """Mass (kg) a body shows to a push along n at arm a from its CoM: 1 / (1/m + (a x n)^T J^-1 (a x n))."""
-    lx = ay * nz - az * ny
-    ly = az * nx - ax * nz
-    lz = ax * ny - ay * nx
-    # lever in the body frame
-    bx = rot[0, 0] * lx + rot[1, 0] * ly + rot[2, 0] * lz
-    by = rot[0, 1] * lx + rot[1, 1] * ly + rot[2, 1] * lz
-    bz = rot[0, 2] * lx + rot[1, 2] * ly + rot[2, 2] * lz
-    j = inverse_inertia_body
-    quad = (bx * (j[0, 0] * bx + j[0, 1] * by + j[0, 2] * bz) + by * (j[1, 0] * bx + j[1, 1] * by + j[1, 2] * bz)
-            + bz * (j[2, 0] * bx + j[2, 1] * by + j[2, 2] * bz))
-    return 1.0 / (1.0 / mass + quad)
-
-
-@njit(cache=True)
-def _apply_contact_pair(i, b, fx, fy, fz, coms, weight, x, f_net, f_body, torque_lvlh, out_body_impulse):
-    """Force (fx, fy, fz) on node ``i`` and its reaction on body ``b`` on the same line of action."""
-    f_net[i, 0] += fx
-    f_net[i, 1] += fy
-    f_net[i, 2] += fz
-    f_body[b, 0] -= fx
-    f_body[b, 1] -= fy
-    f_body[b, 2] -= fz
-    ax = x[i, 0] - coms[b, 0]
-    ay = x[i, 1] - coms[b, 1]
-    az = x[i, 2] - coms[b, 2]
-    # moment of the reaction -f about the body CoM: a x (-f)
-    mx = -(ay * fz - az * fy)
-    my = -(az * fx - ax * fz)
-    mz = -(ax * fy - ay * fx)
-    torque_lvlh[b, 0] += mx
-    torque_lvlh[b, 1] += my
-    torque_lvlh[b, 2] += mz
-    out_body_impulse[b, 0] -= fx * weight
-    out_body_impulse[b, 1] -= fy * weight
-    out_body_impulse[b, 2] -= fz * weight
-    out_body_impulse[b, 3] += mx * weight
-    out_body_impulse[b, 4] += my * weight
-    out_body_impulse[b, 5] += mz * weight
 
 
 @njit(cache=True)
@@ -244,11 +213,12 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
                                threads, rest_lengths, thread_stiffness, thread_damping,
                                bending_triples, bending_stiffness,
                                body_reference, body_mass_all, inverse_inertia, triangles, triangle_normals,
-                               shape_body, shape_triangle_range, shape_box_min, shape_box_max,
+                               shape_body, shape_triangle_range, shape_box_min, shape_box_max, shape_is_box,
                                k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
                                n_orbit, step, n_substeps, stage_weight, velocity_lag, lag_body,
                                mount_node, mount_body, mount_point_body, k_mount, d_mount,
-                               out_force, out_body_impulse, out_node_impulse, out_scalars):
+                               out_force, out_body_impulse, out_node_impulse, out_scalars, work, work_node,
+                               candidates):
     """Fill ``out_force`` with the generalized forces of the coupled system (see module doc).
 
     Also accumulates, per body, the contact impulse (N s) and angular impulse about the
@@ -256,13 +226,17 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     into ``out_node_impulse``, the dissipated energies into
     ``out_scalars`` and sets the current elastic energies there. Accumulations are
     weighted by ``stage_weight`` (1 / force evaluations per step: exact for
-    VelocityVerlet's single evaluation, an average for Runge-Kutta stages).
+    VelocityVerlet's single evaluation, an average for Runge-Kutta stages). ``work``,
+    ``work_node``, ``candidates``: work space (:class:`KernelData`), so nothing is allocated per node.
     """
     n = net_mass.shape[0]
     nb = body_mass_all.shape[0]
-    x = net_reference + q[: 3 * n].reshape(n, 3)
+    x, f_net = work[0], work[1]
+    for i in range(n):
+        for d in range(3):
+            x[i, d] = net_reference[i, d] + q[3 * i + d]
+            f_net[i, d] = 0.0
     v = qt[: 3 * n].reshape(n, 3)
-    f_net = np.zeros((n, 3))
 
     elastic, power = add_thread_forces(x, v, threads, rest_lengths, thread_stiffness, thread_damping, f_net)
     out_scalars[THREAD_ELASTIC] = elastic
@@ -287,18 +261,24 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     # Mounts are the rods that hold the net's rim on the chaser: booked with the threads.
     out_scalars[THREAD_ELASTIC] += mount_elastic
     out_scalars[THREAD_DISSIPATED] += mount_power * step * stage_weight
-    contact_energy, n_contacts = add_contact_forces(
+    contact_energy, n_contacts, contact_dissipated = add_contact_forces(
         x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
-        triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
+        triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max, shape_is_box,
         k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight,
-        velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_node_impulse, out_scalars)
+        velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_node_impulse,
+        work[2], work[3], work_node, candidates)
     for b in range(nb):
         base = 3 * n + 6 * b
         out_force[base:base + 3] = f_body[b]
-        out_force[base + 3:base + 6] = rots[b].T @ torque_lvlh[b]
+        for r in range(3):  # body-frame torque R^T t, in scalars (no BLAS call)
+            out_force[base + 3 + r] = (rots[b, 0, r] * torque_lvlh[b, 0] + rots[b, 1, r] * torque_lvlh[b, 1]
+                                       + rots[b, 2, r] * torque_lvlh[b, 2])
     out_scalars[CONTACT_ELASTIC] = contact_energy
     out_scalars[N_CONTACTS] = n_contacts
-    out_force[: 3 * n] = f_net.reshape(3 * n)
+    out_scalars[CONTACT_DISSIPATED] += contact_dissipated
+    for i in range(n):
+        for d in range(3):
+            out_force[3 * i + d] = f_net[i, d]
     return out_force
 
 
@@ -340,181 +320,8 @@ def body_states(q, qt, n_nodes, body_reference):
         base = 3 * n_nodes + 6 * b
         coms[b] = body_reference[b] + q[base:base + 3]
         vels[b] = qt[base:base + 3]
-        rots[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6].copy())
-        omegas[b] = rots[b] @ qt[base + 3:base + 6]
+        rots[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
+        # in scalars: numba sends small matrix products to BLAS, microseconds a call
+        for r in range(3):
+            omegas[b, r] = rots[b, r, 0] * qt[base + 3] + rots[b, r, 1] * qt[base + 4] + rots[b, r, 2] * qt[base + 5]
     return rots, coms, vels, omegas
-
-
-#: Phase of a contact's linearized oscillation (rad) per contact sub-step. 0.06 is the
-#: 2 us sub-step of the seed paper's 7.7 g node striking at 20 m/s, which reproduces the
-#: analytic Hunt-Crossley rebound within 0.5 % (tests/multibody/test_contact.py).
-CONTACT_PHASE_PER_SUBSTEP = 0.02
-
-
-@njit(cache=True)
-def _substeps_to_resolve_contact(penetrations, relative_velocities, normals, body_masses, n_contacts,
-                                 external_force, node_mass, step, stiffness, exponent, damping):
-    """Sub-steps that resolve a node's contacts over one step at CONTACT_PHASE_PER_SUBSTEP.
-
-    The deepest penetration the step can reach is bounded by the energy of the approach
-    (reduced mass, closing speed grown by the non-contact force over the step) plus what
-    is stored now, and by twice the static penetration under the non-contact force (a
-    suddenly applied load). The contact's tangent stiffness n k delta^(n-1) and its
-    damping rate d delta^n / m there set the fastest time scale; parallel contacts add.
-    """
-    omega_squared = 0.0
-    fastest_damping = 0.0
-    for c in range(n_contacts):
-        nx, ny, nz = normals[c, 0], normals[c, 1], normals[c, 2]
-        reduced_mass = node_mass * body_masses[c] / (node_mass + body_masses[c])
-        push = abs(external_force[0] * nx + external_force[1] * ny + external_force[2] * nz)
-        closing = max(0.0, -(relative_velocities[c, 0] * nx + relative_velocities[c, 1] * ny
-                             + relative_velocities[c, 2] * nz)) + push / node_mass * step
-        stored = hertz_elastic_energy(penetrations[c], stiffness, exponent)
-        energy = 0.5 * reduced_mass * closing * closing + stored
-        deepest = max(((exponent + 1.0) * energy / stiffness) ** (1.0 / (exponent + 1.0)),
-                      2.0 * (push / stiffness) ** (1.0 / exponent))
-        if deepest <= 0.0:
-            continue
-        omega_squared += exponent * stiffness * deepest ** (exponent - 1.0) / reduced_mass
-        fastest_damping = max(fastest_damping, damping * deepest ** exponent / reduced_mass)
-    rate = max(math.sqrt(omega_squared), fastest_damping)
-    return max(1, int(math.ceil(step * rate / CONTACT_PHASE_PER_SUBSTEP)))
-
-
-@njit(cache=True)
-def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
-                       triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
-                       k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight,
-                       velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_node_impulse,
-                       out_scalars):
-    """Add node-body contact kicks to ``f_net`` and their reactions to ``f_body``/``torque_lvlh``.
-
-    ``f_net`` enters holding every non-contact force on the nodes. Returns the elastic
-    contact energy (J) and the number of penetrating contacts at this evaluation.
-
-    With sub-cycling (Verlet only), the node's state at the evaluation time is the
-    solver's position and its mid-step velocity ``v`` (Verlet evaluates the force before
-    its second half kick) plus the half kick of the non-contact force and the lag carried
-    from the previous step. Starting the sub-cycle from ``v`` alone would apply half of
-    every thread force one step late inside contact: a delayed restoring force, which
-    acts as a negative damping of about ``k step / 2`` per thread (3 N s/m at 1e-4 s
-    against the threads' own 1.6 N s/m) and pumped energy into nodes held on a surface.
-    """
-    n = net_mass.shape[0]
-    contact_energy = 0.0
-    n_contacts = 0
-    f_non_contact = f_net.copy()
-    half_kick = 0.5 * step if n_substeps > 1 else 0.0
-    v_start = np.empty((n, 3))
-    speed = np.empty(n)
-    push = np.empty(n)  # acceleration bound (m/s^2)
-    for i in range(n):
-        for d in range(3):
-            v_start[i, d] = v[i, d] + velocity_lag[i, d] + half_kick * f_non_contact[i, d] / net_mass[i]
-        speed[i] = math.sqrt(v_start[i, 0] ** 2 + v_start[i, 1] ** 2 + v_start[i, 2] ** 2)
-        push[i] = math.sqrt(f_non_contact[i, 0] ** 2 + f_non_contact[i, 1] ** 2 + f_non_contact[i, 2] ** 2) / net_mass[i]
-    n_shapes = shape_body.shape[0]
-    shape_speed = np.empty(n_shapes)
-    for s in range(n_shapes):
-        b = shape_body[s]
-        reach = max(np.sqrt(np.sum(shape_box_min[s] ** 2)), np.sqrt(np.sum(shape_box_max[s] ** 2)))
-        shape_speed[s] = np.sqrt(np.sum(vels[b] ** 2)) + np.sqrt(np.sum(omegas[b] ** 2)) * reach
-    # per-node contact lists and sub-cycle work space, reused
-    c_body = np.empty(n_shapes, np.int64)
-    c_pen = np.empty(n_shapes)
-    c_normal = np.empty((n_shapes, 3))
-    c_rel = np.empty((n_shapes, 3))
-    c_mass = np.empty(n_shapes)
-    impulses = np.empty((n_shapes, 3))
-    impulse_norm = np.empty(n_shapes)
-    work_delta = np.empty(n_shapes)
-    work_recoil = np.empty((n_shapes, 3))
-    work_forces = np.empty((n_shapes, 3))
-    for i in range(n):
-        k = 0
-        for s in range(n_shapes):
-            b = shape_body[s]
-            # Broad phase in scalars: node in the body frame against the shape's box, grown by
-            # the node radius and the distance the pair can close within one step.
-            ax = x[i, 0] - coms[b, 0]
-            ay = x[i, 1] - coms[b, 1]
-            az = x[i, 2] - coms[b, 2]
-            px = rots[b, 0, 0] * ax + rots[b, 1, 0] * ay + rots[b, 2, 0] * az
-            py = rots[b, 0, 1] * ax + rots[b, 1, 1] * ay + rots[b, 2, 1] * az
-            pz = rots[b, 0, 2] * ax + rots[b, 1, 2] * ay + rots[b, 2, 2] * az
-            margin = net_radius[i] + step * (speed[i] + shape_speed[s]) + 0.5 * step * step * push[i]
-            if (px < shape_box_min[s, 0] - margin or px > shape_box_max[s, 0] + margin
-                    or py < shape_box_min[s, 1] - margin or py > shape_box_max[s, 1] + margin
-                    or pz < shape_box_min[s, 2] - margin or pz > shape_box_max[s, 2] + margin):
-                continue
-            distance, nbx, nby, nbz = signed_distance_to_mesh(
-                px, py, pz, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
-            penetration = net_radius[i] - distance
-            nx = rots[b, 0, 0] * nbx + rots[b, 0, 1] * nby + rots[b, 0, 2] * nbz
-            ny = rots[b, 1, 0] * nbx + rots[b, 1, 1] * nby + rots[b, 1, 2] * nbz
-            nz = rots[b, 2, 0] * nbx + rots[b, 2, 1] * nby + rots[b, 2, 2] * nbz
-            wx, wy, wz = omegas[b, 0], omegas[b, 1], omegas[b, 2]
-            rx = v_start[i, 0] - vels[b, 0] - (wy * az - wz * ay)
-            ry = v_start[i, 1] - vels[b, 1] - (wz * ax - wx * az)
-            rz = v_start[i, 2] - vels[b, 2] - (wx * ay - wy * ax)
-            # Touches within the step if the gap closes under the current velocity and the
-            # non-contact force (a taut thread can pull a node 0.6 mm in 1e-4 s; missing that
-            # lets it sink unresisted for a step and come back out with the Hertz energy).
-            pull = (f_non_contact[i, 0] * nx + f_non_contact[i, 1] * ny + f_non_contact[i, 2] * nz) / net_mass[i]
-            if penetration - (rx * nx + ry * ny + rz * nz) * step - 0.5 * pull * step * step <= 0.0 and penetration <= 0.0:
-                continue
-            c_body[k] = b
-            c_pen[k] = penetration
-            c_normal[k, 0], c_normal[k, 1], c_normal[k, 2] = nx, ny, nz
-            c_rel[k, 0], c_rel[k, 1], c_rel[k, 2] = rx, ry, rz
-            c_mass[k] = _effective_mass_along_normal(rots[b], inverse_inertia[b], body_mass_all[b],
-                                                     ax, ay, az, nx, ny, nz)
-            k += 1
-            if penetration > 0.0:
-                contact_energy += hertz_elastic_energy(penetration, k_contact, exponent)
-                n_contacts += 1
-        lag_x = lag_y = lag_z = 0.0
-        strongest = -1
-        if k > 0:
-            # All of this node's contacts in one sub-cycle (a node pinched between two bodies
-            # must feel both). The contact force is the kick that makes the integrator's next
-            # drift follow the sub-cycled path; the true end velocity minus the mean velocity
-            # is carried as a lag and released at the next evaluation.
-            n_node = n_substeps
-            if n_substeps > 1:
-                n_node = min(n_substeps, _substeps_to_resolve_contact(
-                    c_pen, c_rel, c_normal, c_mass, k, f_non_contact[i], net_mass[i], step,
-                    k_contact, exponent, d_contact))
-            mx, my, mz, ex, ey, ez, dissipated = contact_over_step(
-                c_pen[:k], c_rel[:k], c_normal[:k], f_non_contact[i], net_mass[i], c_mass[:k], step, n_node,
-                k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
-                impulses, work_delta, work_recoil, work_forces)
-            scale = net_mass[i] / step
-            # The reaction goes to the bodies in proportion to their impulses (weights sum to 1,
-            # so momentum exchange stays exact).
-            for c in range(k):
-                impulse_norm[c] = math.sqrt(impulses[c, 0] ** 2 + impulses[c, 1] ** 2 + impulses[c, 2] ** 2)
-            total = impulse_norm[:k].sum()
-            strongest = int(np.argmax(impulse_norm[:k]))
-            for c in range(k):
-                weight = impulse_norm[c] / total if total > 0.0 else 1.0 / k
-                _apply_contact_pair(i, c_body[c], weight * scale * mx, weight * scale * my, weight * scale * mz,
-                                    coms, step * stage_weight, x, f_net, f_body, torque_lvlh, out_body_impulse)
-            lag_x, lag_y, lag_z = ex - mx, ey - my, ez - mz
-            out_scalars[CONTACT_DISSIPATED] += dissipated * stage_weight
-        # Release the lag carried from the previous step (zero without sub-cycling).
-        b = lag_body[i]
-        if b >= 0:
-            scale = net_mass[i] / step
-            _apply_contact_pair(i, b, scale * velocity_lag[i, 0], scale * velocity_lag[i, 1],
-                                scale * velocity_lag[i, 2], coms, step * stage_weight, x,
-                                f_net, f_body, torque_lvlh, out_body_impulse)
-        lag_body[i] = c_body[strongest] if k > 0 else -1
-        velocity_lag[i, 0] = lag_x
-        velocity_lag[i, 1] = lag_y
-        velocity_lag[i, 2] = lag_z
-        # the node's contact force is what the contact added to its non-contact force
-        for d in range(3):
-            out_node_impulse[i, d] += (f_net[i, d] - f_non_contact[i, d]) * step * stage_weight
-    return contact_energy, n_contacts

@@ -119,7 +119,9 @@ def replay(t_plan, unit_paths, unit_masses, net_spec: dict, debris, keep_out_rad
     corners = mouth_nodes[[0, -1]]
     assembly = ImpactAssembly(
         net=net, net_velocity=np.zeros((net.n_nodes, 3)), bodies=bodies, joints=[],
-        contact=ContactLaw(stiffness=1.0), solver=SolverSpec(end_time=float(t_plan[-1]), step=step),
+        contact=ContactLaw(stiffness=1.0), solver=SolverSpec(end_time=float(t_plan[-1]), step=step,
+                                                                  # the sampler reads the net from Exudyn's node
+                                                                  net_integration="exudyn"),
         mount=NetMount(nodes=corners, body=np.array([0, 1]), points_body=np.zeros((2, 3)),
                        stiffness=MOUNT_STIFFNESS, damping=MOUNT_DAMPING))
     built = build_impact_system(assembly)

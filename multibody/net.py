@@ -190,7 +190,10 @@ def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
         dx = x[b, 0] - x[a, 0]
         dy = x[b, 1] - x[a, 1]
         dz = x[b, 2] - x[a, 2]
-        length = np.sqrt(dx * dx + dy * dy + dz * dz)
+        squared = dx * dx + dy * dy + dz * dz
+        if squared <= rest_lengths[t] * rest_lengths[t]:
+            continue  # slack: no square root needed
+        length = np.sqrt(squared)
         stretch = length - rest_lengths[t]
         if stretch <= 0.0:
             continue

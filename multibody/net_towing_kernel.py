@@ -30,7 +30,8 @@ from multibody.control.attitude import desired_attitude, sliding_mode_torque
 from multibody.control.thrust import thrust_command
 from multibody.connection_point import implicit_point_step
 from multibody.contact import contact_over_step
-from multibody.kernel import _effective_mass_along_normal, _substeps_to_resolve_contact, rotation_matrix_from_rotation_vector
+from multibody.contact_kernel import _effective_mass_along_normal, _substeps_to_resolve_contact
+from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.net import add_thread_forces, tension_only_kelvin_voigt
 from multibody.orbit import two_body_acceleration_xyz
 
@@ -83,7 +84,7 @@ def _near(i, x, v, node_radius, com, rot, vel, omega, geometry, h):
 
 
 #: Most contact sub-steps per net sub-step (the impact model sizes them at 0.02 rad of the contact's
-#: linearized oscillation, multibody.kernel.CONTACT_PHASE_PER_SUBSTEP).
+#: linearized oscillation, multibody.contact_kernel.CONTACT_PHASE_PER_SUBSTEP).
 MAX_CONTACT_SUBSTEPS = 64
 
 
@@ -93,7 +94,7 @@ def _node_contact(i, x, v, lag, f, node_mass, penetration, nbx, nby, nbz, com, r
     """Contact of node ``i`` (``penetration`` (m) along the debris-frame normal ``nb``) with the debris
     over one net sub-step, sub-cycled in time exactly as the impact model does
     (:func:`multibody.contact.contact_over_step`, sub-steps sized by
-    :func:`multibody.kernel._substeps_to_resolve_contact`; starting from the node's velocity plus the
+    :func:`multibody.contact_kernel._substeps_to_resolve_contact`; starting from the node's velocity plus the
     ``lag`` carried from the last sub-step). Returns the mean and end velocity changes (m/s) and the
     dissipated energy (J); the caller kicks with the mean and carries end - mean as the next lag."""
     ax, ay, az = x[i, 0] - com[0], x[i, 1] - com[1], x[i, 2] - com[2]

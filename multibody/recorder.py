@@ -30,32 +30,29 @@ momentum_angular_lvlh                   (k, 3) about the LVLH origin (kg m^2/s)
 
 Net snapshots (``Recorder.net``): ``time`` (s), ``positions_lvlh`` (k, n, 3) float64,
 ``velocities_lvlh`` (k, n, 3) float32 and ``contact_force_lvlh`` (k, n, 3) float32, the contact
-force of the bodies on each node (N), averaged over the interval since the previous snapshot. Positions stay double: thread tensions are computed
+force of the bodies on each node (N), averaged over the interval since the previous snapshot.
+Positions stay double: thread tensions are computed
 from them afterwards (VTK export), and a float32 position 40 m from the chaser is only good
 to ~5 um, a thread stretch worth ~0.3 N of tension.
 """
 from __future__ import annotations
 
-import numpy as np
 import exudyn as exu
+import numpy as np
 
 from multibody.health import HealthWatch
-from multibody.hinge import relative_rotation_vector_joint_frame
-from multibody.kernel import (BENDING_ELASTIC, rotation_matrix_from_rotation_vector, CONTACT_DISSIPATED, CONTACT_ELASTIC, THREAD_DISSIPATED,
-                              THREAD_ELASTIC)
-from multibody.orbit import clohessy_wiltshire_potential
-
+from multibody.kernel import (
+    BENDING_ELASTIC,
+    CONTACT_DISSIPATED,
+    CONTACT_ELASTIC,
+    THREAD_DISSIPATED,
+    THREAD_ELASTIC,
+)
+from multibody.recorder_kernel import body_sample, net_sums
 
 #: Longest simulated time between two finite-state checks when the output rate is lower (s):
 #: a NaN spreads through the coupled state within a few steps and stays, so 1 ms loses nothing.
 HEALTH_INTERVAL_S = 1e-3
-
-
-def _sum_of_cross_products(a, b):
-    """sum_i a_i x b_i for (k, 3) arrays; written out because np.cross costs ~80 us a call."""
-    return np.array([a[:, 1] @ b[:, 2] - a[:, 2] @ b[:, 1],
-                     a[:, 2] @ b[:, 0] - a[:, 0] @ b[:, 2],
-                     a[:, 0] @ b[:, 1] - a[:, 1] @ b[:, 0]])
 
 
 class Recorder:
@@ -84,17 +81,48 @@ class Recorder:
         self._next_net = self.net_interval
         self._last_output_time = 0.0
         mbs = system.mbs
-        self._net_index = mbs.GetNodeODE2Index(system.net_node) if system.net_node is not None else 0
         self._body_index = [mbs.GetNodeODE2Index(nd) for nd in system.body_nodes]
         self._joint_stiffness = [np.diag(mbs.GetObjectParameter(obj, "stiffness")) for obj in system.joint_objects]
-        self._rows: dict[str, list] = {}
-        self._net_rows: dict[str, list] = {"time": [], "positions_lvlh": [], "velocities_lvlh": [],
-                                           "contact_force_lvlh": []}
-        self._last_net_time = 0.0
+        self._preallocate(assembly, system)
         self.series: dict[str, np.ndarray] = {}
         self.net: dict[str, np.ndarray] = {}
         self.wall_time = None
         self.stopped_early = False
+
+    def _preallocate(self, assembly, system):
+        """Series and snapshot arrays for every sample the run can take, and the recorder kernel's inputs."""
+        self._capacity = int(np.ceil(self._end_time / self.output_interval)) + 3
+        self._series: dict[str, np.ndarray] = {}
+        self._n_rows = 0
+        n_net = int(np.ceil(self._end_time / self.net_interval)) + 3
+        n = assembly.net.n_nodes
+        self._net_time = np.zeros(n_net)
+        self._net_positions = np.zeros((n_net, n, 3))
+        self._net_velocities = np.zeros((n_net, n, 3), np.float32)
+        self._net_contact_force = np.zeros((n_net, n, 3), np.float32)
+        self._last_net_time = 0.0
+        self._n_net = 0
+        bodies, joints = assembly.bodies, assembly.joints
+        nb, nj = len(bodies), len(joints)
+        self._body_index = np.array(self._body_index, np.int64)
+        self._body_reference = np.array([b.com_lvlh for b in bodies], float).reshape(nb, 3)
+        self._body_mass = np.array([b.mass for b in bodies], float)
+        self._inertia = np.array([b.inertia_body for b in bodies], float).reshape(nb, 3, 3)
+        self._net_masses = np.asarray(assembly.net.masses, float)
+        self._debris = np.array(assembly.debris_indices, np.int64)
+        self._debris_mask = np.isin(np.arange(nb), self._debris).astype(np.int64)
+        self._chaser = -1 if assembly.chaser is None else int(assembly.chaser)
+        self._joint_arrays = (np.array([j.parent for j in joints], np.int64), np.array([j.child for j in joints], np.int64),
+                              np.array(system.joint_to_parent, float).reshape(nj, 3, 3),
+                              np.array(system.joint_to_child, float).reshape(nj, 3, 3),
+                              np.array(system.joint_point_parent, float).reshape(nj, 3),
+                              np.array(system.joint_point_child, float).reshape(nj, 3),
+                              np.array(self._joint_stiffness, float).reshape(nj, 6))
+        self._work = {name: np.zeros(shape) for name, shape in (
+            ("com", (nb, 3)), ("vel", (nb, 3)), ("rot", (nb, 3, 3)), ("omega", (nb, 3)), ("force", (nb, 3)),
+            ("moment", (nb, 3)), ("force_body", (nb, 3)), ("moment_body", (nb, 3)), ("totals", (nb, 9)),
+            ("joint_rotation", (nj, 3)), ("joint_rate", (nj, 3)), ("joint_energy", (nj,)), ("net", (8,)),
+            ("summary", (17,)))}
 
     # -- Exudyn hook -----------------------------------------------------------------
     def post_step(self, mbs, t):
@@ -106,34 +134,29 @@ class Recorder:
             while self._next_output - half <= t:
                 self._next_output += self.output_interval
         elif self._steps % self._health_every == 0:
-            data = mbs.systemData
-            self.health.state(t, data.GetODE2Coordinates(), data.GetODE2Coordinates_t())
+            self.health.state(t, *self.system.state_arrays())
         return self.health.ok
 
     # -- sampling --------------------------------------------------------------------
     def sample(self, t):
-        mbs = self.system.mbs
-        q = mbs.systemData.GetODE2Coordinates()
-        qt = mbs.systemData.GetODE2Coordinates_t()
-        if not self.health.state(t, q, qt):
+        arrays = self.system.state_arrays()
+        q, qt = arrays[:2]
+        if not self.health.state(t, *arrays):
             return  # nothing recorded from a lost state; the run stops at this step
-        row = {"time": t}
-        x, v = self._net_state(q, qt)
-        self._body_rows(row, q, qt, t)
-        self._joint_rows(row)
-        self._energy_rows(row, x, v)
-        self._momentum_rows(row, x, v)
+        x, v = self.system.net_state(q, qt)
+        row = self._compute_row(t, q, qt, x, v)
         if not self.health.energy(t, row["energy_total"]):
             return
-        for key, value in row.items():
-            self._rows.setdefault(key, []).append(np.asarray(value, float))
+        self._store(row)
         if self.monitor is not None:
             self._check_monitor(t, row)
         if t == 0.0 or t >= self._next_net - 0.5 * self.step:
-            self._net_rows["time"].append(t)
-            self._net_rows["positions_lvlh"].append(np.array(x, dtype=np.float64))
-            self._net_rows["velocities_lvlh"].append(v.astype(np.float32))
-            self._net_rows["contact_force_lvlh"].append(self._node_contact_force(t))
+            k = self._n_net
+            self._net_time[k] = t
+            self._net_positions[k] = x
+            self._net_velocities[k] = v
+            self._net_contact_force[k] = self._node_contact_force(t)
+            self._n_net += 1
             if t > 0.0:
                 self._next_net += self.net_interval
         if self.progress is not None:
@@ -143,7 +166,7 @@ class Recorder:
         """Contact force on each net node (N, LVLH), averaged since the previous net snapshot."""
         impulse = self.system.kernel.node_impulse
         interval = t - self._last_net_time
-        force = (impulse / interval if interval > 0.0 else np.zeros_like(impulse)).astype(np.float32)
+        force = impulse / interval if interval > 0.0 else np.zeros_like(impulse)
         impulse[:] = 0.0
         self._last_net_time = t
         return force
@@ -157,123 +180,71 @@ class Recorder:
             self.joint_active[event.joint] = False
             self._released_energy += event.stored_energy
 
-    def _net_state(self, q, qt):
-        net = self.assembly.net
-        n = net.n_nodes
-        i = self._net_index
-        x = net.positions + np.asarray(q[i:i + 3 * n]).reshape(n, 3)
-        v = np.asarray(qt[i:i + 3 * n]).reshape(n, 3)
-        return x, v
-
-    def body_states(self, q, qt):
-        """Per body: CoM (m), velocity (m/s), body->LVLH matrix, omega (rad/s, body frame)."""
-        com, vel, rot, omega = [], [], [], []
-        for body, i in zip(self.assembly.bodies, self._body_index):
-            com.append(body.com_lvlh + q[i:i + 3])
-            vel.append(np.array(qt[i:i + 3]))
-            rot.append(rotation_matrix_from_rotation_vector(np.array(q[i + 3:i + 6])))
-            omega.append(np.array(qt[i + 3:i + 6]))
-        return np.array(com), np.array(vel), np.array(rot), np.array(omega)
-
-    def _body_rows(self, row, q, qt, t):
-        com, vel, rot, omega = self.body_states(q, qt)
-        self._bodies_now = (com, vel, rot, omega)
+    def _compute_row(self, t, q, qt, x, v) -> dict:
+        """One sample's values (see the module doc), from the compiled sums of multibody.recorder_kernel."""
+        w = self._work
         interval = t - self._last_output_time
-        impulse = self.system.kernel.body_impulse
-        if interval > 0.0:
-            force = impulse[:, :3] / interval
-            moment = impulse[:, 3:] / interval
-        else:
-            force = np.zeros_like(impulse[:, :3])
-            moment = np.zeros_like(force)
-        impulse[:] = 0.0
         self._last_output_time = t
-        debris = self.assembly.debris_indices
-        masses = np.array([self.assembly.bodies[k].mass for k in debris])
-        row["contact_force_lvlh"] = force
-        row["contact_moment_lvlh"] = moment
-        row["contact_force_body"] = np.einsum("bji,bj->bi", rot, force)
-        row["contact_moment_body"] = np.einsum("bji,bj->bi", rot, moment)
-        row["body_com_lvlh"] = com
-        row["body_velocity_lvlh"] = vel
-        row["body_omega_body"] = omega
-        row["body_to_lvlh"] = rot
-        row["debris_com_lvlh"] = masses @ com[debris] / masses.sum() if len(masses) else np.zeros(3)
-        row["debris_velocity_lvlh"] = masses @ vel[debris] / masses.sum() if len(masses) else np.zeros(3)
-
-    def _joint_rows(self, row):
+        body_sample(q, qt, self._body_index, self._body_reference, self._body_mass, self._inertia,
+                    self.system.kernel.body_impulse, interval, *self._joint_arrays, self.joint_active.astype(float),
+                    self.assembly.mean_motion, self._debris_mask, self._chaser, w["com"], w["vel"], w["rot"],
+                    w["omega"], w["force"], w["moment"], w["force_body"], w["moment_body"], w["totals"],
+                    w["joint_rotation"], w["joint_rate"], w["joint_energy"], w["summary"])
+        net = w["net"]
+        net_sums(x, v, self._net_masses, self.assembly.mean_motion, net)
         mbs = self.system.mbs
-        com, vel, rot, omega = self._bodies_now
-        rotations, rates, forces, moments, energies = [], [], [], [], []
-        for j, joint in enumerate(self.assembly.joints):
-            obj = self.system.joint_objects[j]
-            rv = relative_rotation_vector_joint_frame(rot[joint.parent], rot[joint.child],
-                                                      self.system.joint_to_parent[j], self.system.joint_to_child[j])
-            frame = rot[joint.parent] @ self.system.joint_to_parent[j]
-            omega_rel = rot[joint.child] @ omega[joint.child] - rot[joint.parent] @ omega[joint.parent]
-            rotations.append(rv)
-            rates.append(frame.T @ omega_rel)
-            # Exudyn's connector force is the spring force acting on marker 1 (child) with
-            # reversed sign; the parent's load on the child is its negative.
-            active = self.joint_active[j]
-            forces.append(-np.asarray(mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)) * active)
-            moments.append(-np.asarray(mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)) * active)
-            offset = (rot[joint.child] @ self.system.joint_point_child[j] + com[joint.child]
-                      - rot[joint.parent] @ self.system.joint_point_parent[j] - com[joint.parent])
-            offset_joint = frame.T @ offset
-            k = self._joint_stiffness[j]
-            energies.append(0.5 * (k[:3] @ offset_joint**2 + k[3:] @ rv**2) * active)
-        nj = len(self.assembly.joints)
-        row["joint_rotation_joint"] = np.reshape(rotations, (nj, 3))
-        row["joint_rate_joint"] = np.reshape(rates, (nj, 3))
-        row["joint_force_joint"] = np.reshape(forces, (nj, 3))
-        row["joint_moment_joint"] = np.reshape(moments, (nj, 3))
-        self._joint_energies = np.array(energies, float)
-
-    def _energy_rows(self, row, x, v):
-        scalars = self.system.kernel.scalars
-        net = self.assembly.net
-        com, vel, rot, omega = self._bodies_now
-        bodies = self.assembly.bodies
-        n_orbit = self.assembly.mean_motion
-        debris = self.assembly.debris_indices
-        chaser = self.assembly.chaser
+        nj = len(self.system.joint_objects)
+        forces, moments = np.zeros((nj, 3)), np.zeros((nj, 3))
+        for j, obj in enumerate(self.system.joint_objects):
+            if self.joint_active[j]:
+                # Exudyn's connector force is the spring force acting on marker 1 (child) with
+                # reversed sign; the parent's load on the child is its negative.
+                forces[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)
+                moments[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)
+        self._joint_energies = w["joint_energy"]
+        summary = w["summary"].tolist()
+        scalars = self.system.kernel.scalars.tolist()
+        row = {"time": t,
+               "contact_force_lvlh": w["force"], "contact_moment_lvlh": w["moment"],
+               "contact_force_body": w["force_body"], "contact_moment_body": w["moment_body"],
+               "body_com_lvlh": w["com"], "body_velocity_lvlh": w["vel"], "body_omega_body": w["omega"],
+               "body_to_lvlh": w["rot"], "debris_com_lvlh": summary[0:3], "debris_velocity_lvlh": summary[3:6],
+               "joint_rotation_joint": w["joint_rotation"], "joint_rate_joint": w["joint_rate"],
+               "joint_force_joint": -forces, "joint_moment_joint": -moments}
         e = {
-            "net_kinetic": 0.5 * np.sum(net.masses * np.sum(v * v, axis=1)),
+            "net_kinetic": net[0],
             "net_elastic": scalars[THREAD_ELASTIC],
             "net_bending": scalars[BENDING_ELASTIC],
             "contact_elastic": scalars[CONTACT_ELASTIC],
-            "debris_translational": sum(0.5 * bodies[k].mass * vel[k] @ vel[k] for k in debris),
-            "debris_rotational": sum(0.5 * omega[k] @ bodies[k].inertia_body @ omega[k] for k in debris),
-            "joint_elastic": float(self._joint_energies.sum()),
+            "debris_translational": summary[6],
+            "debris_rotational": summary[7],
+            "joint_elastic": summary[16],
             "released_joints": self._released_energy,
-            "orbital_potential": (np.sum(net.masses * clohessy_wiltshire_potential(x, n_orbit))
-                                  + sum(b.mass * clohessy_wiltshire_potential(com[k], n_orbit)[0]
-                                        for k, b in enumerate(bodies))) if n_orbit else 0.0,
+            "orbital_potential": net[1] + summary[8] if self.assembly.mean_motion else 0.0,
             "dissipated_threads": scalars[THREAD_DISSIPATED],
             "dissipated_contact": scalars[CONTACT_DISSIPATED],
         }
-        if chaser is not None:
-            b = bodies[chaser]
-            e["chaser_kinetic"] = 0.5 * b.mass * vel[chaser] @ vel[chaser] + 0.5 * omega[chaser] @ b.inertia_body @ omega[chaser]
+        if self.assembly.chaser is not None:
+            e["chaser_kinetic"] = summary[9]
         e["total"] = sum(e.values())
         for key, value in e.items():
             row["energy_" + key] = value
+        row["momentum_linear_lvlh"] = net[2:5] + w["summary"][10:13]
+        row["momentum_angular_lvlh"] = net[5:8] + w["summary"][13:16]
+        return row
 
-    def _momentum_rows(self, row, x, v):
-        net = self.assembly.net
-        com, vel, rot, omega = self._bodies_now
-        p_net = net.masses[:, None] * v
-        linear = p_net.sum(axis=0)
-        angular = _sum_of_cross_products(x, p_net)
-        for k, b in enumerate(self.assembly.bodies):
-            linear = linear + b.mass * vel[k]
-            angular = angular + b.mass * _sum_of_cross_products(com[k:k + 1], vel[k:k + 1]) + rot[k] @ (
-                b.inertia_body @ omega[k])
-        row["momentum_linear_lvlh"] = linear
-        row["momentum_angular_lvlh"] = angular
+    def _store(self, row):
+        """Write a row into the preallocated series (allocated at the first sample, from its shapes)."""
+        k = self._n_rows
+        if not self._series:
+            self._series = {key: np.zeros((self._capacity,) + np.shape(value)) for key, value in row.items()}
+        for key, value in row.items():
+            self._series[key][k] = value
+        self._n_rows += 1
 
     def finish(self, wall_time):
         self.wall_time = wall_time
-        self.series = {k: np.array(v) for k, v in self._rows.items()}
-        self.net = {k: np.array(v) for k, v in self._net_rows.items()}
+        self.series = {key: value[:self._n_rows].copy() for key, value in self._series.items()}
+        self.net = {"time": self._net_time[:self._n_net].copy(), "positions_lvlh": self._net_positions[:self._n_net].copy(),
+                    "velocities_lvlh": self._net_velocities[:self._n_net].copy(),
+                    "contact_force_lvlh": self._net_contact_force[:self._n_net].copy()}

@@ -58,6 +58,10 @@ class Simulation(Strict):
         2e-6, description="Shortest sub-step of the contact impulse integration (s); each node's sub-step resolves "
                           "its contact's period (0.02 rad per sub-step) and is never shorter; >= step turns "
                           "sub-cycling off.")
+    net_integration: Literal["kernel", "exudyn"] = Field(
+        "kernel", description="Who integrates the net nodes: 'kernel' (the compiled force kernel, inside the "
+                              "bodies' VelocityVerlet step; fast) or 'exudyn' (one Exudyn node for the whole net, "
+                              "the reference path). Runge-Kutta integrators always use 'exudyn'.")
 
     @model_validator(mode="after")
     def _rates_fit_step(self):

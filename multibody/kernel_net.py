@@ -1,0 +1,199 @@
+"""The net integrated inside the compiled kernel; Exudyn integrates the bodies and joints.
+
+Exudyn's VelocityVerlet step from (q, v, a) is: v += h/2 a; q += h v; a = M^-1 f(q, v);
+v += h/2 a. For the net's lumped masses M is diagonal, so the same step costs a handful of
+flops per coordinate, while Exudyn spends about 170 ns per object and a sparse LU solve on
+all 3 n coordinates every step (EXUDYN-NOTES). Here the kernel holds the net's state and
+takes exactly Exudyn's step for it, inside the bodies' step: the pre-step function
+
+1. predicts the state at which Verlet evaluates the forces, for the net (here) and for the
+   bodies (from Exudyn's coordinates, :func:`multibody.kernel.verlet_evaluation_state`);
+2. evaluates the coupled forces there with the same kernel as the all-Exudyn path
+   (:meth:`multibody.kernel.KernelData.evaluate`: threads, contact with its sub-cycled
+   impulses, friction, Clohessy-Wiltshire, mounts);
+3. completes the net's step (a = f / m, v += h/2 a) and hands the bodies their part of the
+   force vector, which Exudyn applies in its own step together with the joints.
+
+So the net follows the same trajectory as when Exudyn integrates it (to round-off: the
+all-Exudyn path solves f / m through a sparse LU), and every node-body impulse still goes
+to the bodies within the step it acts in. ``tests/multibody/test_kernel_net.py`` runs both
+paths on a small case and compares them.
+
+Layout of the net state: ``q`` (3 n,) node displacement from the reference position (m),
+``qt`` (3 n,) velocity (m/s), ``qtt`` (3 n,) acceleration (m/s^2), all LVLH, node-major.
+
+Speed: the whole pre-step is one compiled call (:func:`kernel_net_step`) on a numba structref
+(:class:`NetStepModel`) that holds the kernel's arrays and the net's state: a call with the kernel's
+40 arrays as arguments costs 5-10 us in numba's dispatcher alone, a structref about 2 us.
+"""
+from __future__ import annotations
+
+
+import numpy as np
+from numba import njit, types
+from numba.experimental import structref
+
+from multibody.kernel import (
+    KernelData,
+    coupled_generalized_forces,
+    verlet_evaluation_state,
+)
+
+
+@structref.register
+class NetStepModelType(types.StructRef):
+    """Numba type of :class:`NetStepModel`."""
+
+    def preprocess_fields(self, fields):
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)
+
+
+#: Fields of :class:`NetStepModel`: the arrays and constants of :class:`multibody.kernel.KernelData`
+#: (same names, same buffers: what the kernel accumulates there, the recorder reads there), then
+#: the net's state and the work vectors of this module.
+KERNEL_FIELDS = (
+    "net_reference", "net_mass", "net_radius", "threads", "rest_lengths", "thread_stiffness", "thread_damping",
+    "bending_triples", "bending_stiffness", "body_reference", "body_mass", "body_inverse_inertia", "triangles",
+    "triangle_normals", "shape_body", "shape_triangle_range", "shape_box_min", "shape_box_max", "shape_is_box",
+    "contact_stiffness", "contact_exponent", "contact_damping", "mu_static", "mu_kinetic", "transition_speed",
+    "mean_motion", "step", "stage_weight", "velocity_lag", "lag_body", "mount_node", "mount_body",
+    "mount_point_body", "mount_stiffness", "mount_damping", "force", "body_impulse", "node_impulse", "scalars", "work", "work_node",
+    "candidates")
+STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "q_eval", "qt_eval")
+
+
+class NetStepModel(structref.StructRefProxy):
+    """Everything :func:`kernel_net_step` reads and writes, as one numba structref.
+
+    Fields: those of :class:`multibody.kernel.KernelData` (:data:`KERNEL_FIELDS`, the same arrays)
+    and ``n_substeps`` (int, contact sub-steps per step), ``q``, ``qt``, ``qtt`` ((3 n,) the net's
+    state, module doc), ``q_eval``, ``qt_eval`` ((3 n + 6 nb,) the kernel's coordinates at the
+    evaluation state, work space).
+    """
+
+
+structref.define_proxy(NetStepModel, NetStepModelType, KERNEL_FIELDS + STATE_FIELDS)
+
+
+def net_step_model(kernel: KernelData, net_velocity) -> tuple:
+    """The structref for ``kernel`` with the net in its reference position, moving at ``net_velocity``
+    ((n, 3) m/s, LVLH); returns it and its ``q``, ``qt`` arrays (a structref proxy has no Python
+    attributes: its fields are read in compiled code)."""
+    n, nb = kernel.n_nodes, kernel.n_bodies
+    n_substeps = max(1, int(np.ceil(kernel.step / kernel.contact_substep - 1e-9))) if np.isfinite(
+        kernel.contact_substep) else 1
+    values = [getattr(kernel, name) for name in KERNEL_FIELDS]
+    values = [float(v) if isinstance(v, (float, np.floating)) else v for v in values]
+    state = [n_substeps, np.zeros(3 * n), np.ascontiguousarray(net_velocity, float).reshape(3 * n).copy(),
+             np.zeros(3 * n), np.zeros(3 * n + 6 * nb), np.zeros(3 * n + 6 * nb)]
+    return NetStepModel(*values, *state), state[1], state[2]
+
+
+@njit(cache=True)
+def _forces(m, time, n_substeps):
+    """The kernel at (m.q_eval, m.qt_eval): :meth:`multibody.kernel.KernelData.evaluate` on the structref."""
+    return coupled_generalized_forces(
+        m.q_eval, m.qt_eval, m.net_reference, m.net_mass, m.net_radius,
+        m.threads, m.rest_lengths, m.thread_stiffness, m.thread_damping,
+        m.bending_triples, m.bending_stiffness,
+        m.body_reference, m.body_mass, m.body_inverse_inertia, m.triangles, m.triangle_normals,
+        m.shape_body, m.shape_triangle_range, m.shape_box_min, m.shape_box_max, m.shape_is_box,
+        m.contact_stiffness, m.contact_exponent, m.contact_damping,
+        m.mu_static, m.mu_kinetic, m.transition_speed,
+        m.mean_motion, m.step, n_substeps, m.stage_weight, m.velocity_lag, m.lag_body,
+        m.mount_node, m.mount_body, m.mount_point_body, m.mount_stiffness, m.mount_damping,
+        m.force, m.body_impulse, m.node_impulse, m.scalars, m.work, m.work_node, m.candidates)
+
+
+@njit(cache=True)
+def kernel_net_start(m, q_bodies, qt_bodies):
+    """The forces at the initial state (the solver's initial acceleration; no sub-cycling, as
+    :meth:`~multibody.kernel.KernelData.evaluate` at time 0): sets the net's acceleration and
+    returns the bodies' generalized forces (6 nb,)."""
+    n3 = m.q.shape[0]
+    m.q_eval[:n3] = m.q
+    m.qt_eval[:n3] = m.qt
+    m.q_eval[n3:] = q_bodies
+    m.qt_eval[n3:] = qt_bodies
+    force = _forces(m, 0.0, 1)
+    for k in range(n3):
+        m.qtt[k] = force[k] / m.net_mass[k // 3]
+    return force[n3:].copy()
+
+
+@njit(cache=True)
+def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
+    """One VelocityVerlet step of the net inside the bodies' step (module doc); returns the bodies'
+    generalized forces (6 nb,) at the evaluation state, for Exudyn's coupled object.
+
+    ``q_bodies``, ``qt_bodies``, ``qtt_bodies`` (6 nb,): the bodies' coordinates, velocities and
+    accelerations at the start of the step (Exudyn's layout, multibody.kernel); ``time`` (s) the
+    time of the evaluation state (the step's end)."""
+    n3 = m.q.shape[0]
+    nb = q_bodies.shape[0] // 6
+    step = m.step
+    half = 0.5 * step
+    for k in range(n3):
+        v_half = m.qt[k] + half * m.qtt[k]
+        m.qt_eval[k] = v_half
+        m.q_eval[k] = m.q[k] + step * v_half
+    q_next, v_half_bodies = verlet_evaluation_state(q_bodies, qt_bodies, qtt_bodies, step, 0, nb)
+    m.q_eval[n3:] = q_next
+    m.qt_eval[n3:] = v_half_bodies
+    force = _forces(m, time, m.n_substeps if time > 0.0 else 1)
+    inverse_mass = m.work_node[3]  # (n,) 1 / node mass (multibody.kernel.KernelData)
+    for i in range(n3 // 3):
+        for d in range(3):
+            k = 3 * i + d
+            a = force[k] * inverse_mass[i]
+            m.qtt[k] = a
+            m.qt[k] = m.qt_eval[k] + half * a
+            m.q[k] = m.q_eval[k]
+    return force[n3:].copy()
+
+
+class KernelNet:
+    """The net's state held by the kernel, and the Exudyn pre-step function that advances it.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+    coupled_object : int
+        The ``ObjectGenericODE2`` spanning the rigid-body nodes, whose force vector carries
+        the net's (and the orbit's) forces on the bodies.
+    kernel : KernelData
+    net_velocity : (n, 3) float
+        Initial node velocities (m/s), LVLH.
+    state_index : (6 nb,) int or None
+        Where the bodies' coordinates sit in Exudyn's system vectors (None: the whole vector).
+    """
+
+    def __init__(self, mbs, coupled_object, kernel: KernelData, net_velocity, state_index):
+        self.mbs = mbs
+        self.coupled_object = coupled_object
+        self.kernel = kernel
+        self.state_index = state_index
+        self.model, self.q, self.qt = net_step_model(kernel, net_velocity)
+        # The solver's initial acceleration uses the force at the initial state.
+        data = mbs.systemData
+        q, qt = self._bodies(data.GetODE2Coordinates()), self._bodies(data.GetODE2Coordinates_t())
+        mbs.SetObjectParameter(coupled_object, "forceVector", kernel_net_start(self.model, q, qt))
+
+    def _bodies(self, vector):
+        return vector if self.state_index is None else np.asarray(vector)[self.state_index]
+
+    def __call__(self, mbs, t):
+        data = mbs.systemData
+        # t is the time of the evaluation state (see multibody.impact.VerletForces)
+        force = kernel_net_step(self.model, self._bodies(data.GetODE2Coordinates()),
+                                self._bodies(data.GetODE2Coordinates_t()), self._bodies(data.GetODE2Coordinates_tt()), t)
+        mbs.SetObjectParameter(self.coupled_object, "forceVector", force)
+        return True
+
+    def positions(self) -> np.ndarray:
+        """(n, 3) node positions (m), LVLH, at the end of the last step."""
+        return self.kernel.net_reference + self.q.reshape(-1, 3)
+
+    def velocities(self) -> np.ndarray:
+        """(n, 3) node velocities (m/s), LVLH, at the end of the last step (a view)."""
+        return self.qt.reshape(-1, 3)

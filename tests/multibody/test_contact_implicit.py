@@ -1,0 +1,67 @@
+"""The node-local implicit contact step (multibody/contact_implicit.py) against its invariants.
+
+The discrete-gradient step conserves kinetic plus Hertz energy exactly for any step (Gonzalez 1996),
+books the Hunt-Crossley damping's work exactly, and settles at the static Hertz penetration under a
+constant load: each is checked to round-off (1e-9 relative: the Newton tolerance is 1e-11 of the
+penetration scale, and a contact takes a few hundred steps).
+"""
+import numpy as np
+import pytest
+
+from multibody.contact_implicit import contact_implicit_step, implicit_normal_step
+from tests.conftest import KEVLAR_NODE_MASS as M
+from tests.conftest import PAPER_CONTACT_STIFFNESS as K
+
+STEP = 1e-4  # the reference case's step: the contact period at rest is 0.6 ms, about 6 steps
+
+
+def _hertz_energy(d):
+    return K * max(d, 0.0) ** 2.5 / 2.5
+
+
+def _advance(d0, rate0, accel_n, damping, n_steps, mass=M):
+    """Iterate the implicit normal step; returns penetration, rate and the booked dissipation."""
+    d, rate, dissipated = d0, rate0, 0.0
+    history = []
+    for _ in range(n_steps):
+        d1, _, extra = implicit_normal_step(d, rate, accel_n, STEP, mass, K, 1.5, damping)
+        dissipated += extra * (d1 - d)
+        rate = 2.0 * (d1 - d) / STEP - rate   # trapezoid: d1 = d + h (rate + rate1) / 2
+        d = d1
+        history.append((d, rate))
+    return d, rate, dissipated, np.array(history)
+
+
+@pytest.mark.parametrize("speed", [0.01, 0.1, 1.0])
+def test_elastic_contact_conserves_energy_and_rebounds_at_the_impact_speed(speed):
+    d, rate, _, history = _advance(0.0, speed, 0.0, 0.0, 400)
+    energy = 0.5 * M * history[:, 1] ** 2 + np.array([_hertz_energy(x) for x in history[:, 0]])
+    assert np.abs(energy - 0.5 * M * speed**2).max() <= 1e-9 * 0.5 * M * speed**2
+    assert d < 0.0 and rate == pytest.approx(-speed, rel=1e-9)  # separated, leaving at the impact speed
+
+
+def test_damping_work_is_booked_exactly():
+    alpha = 0.05
+    d, rate, dissipated, _ = _advance(0.0, 0.1, 0.0, 1.5 * alpha * K, 400)
+    assert d < 0.0 and 0.0 < -rate < 0.1
+    lost = 0.5 * M * 0.1**2 - 0.5 * M * rate**2
+    assert dissipated == pytest.approx(lost, rel=1e-9)
+
+
+def test_a_constant_load_settles_at_the_static_hertz_penetration():
+    push = 10.0   # N towards the body: a taut thread's pull on a node resting on the surface
+    d, rate, _, _ = _advance(0.0, 0.0, -push / M, 1.5 * 0.05 * K, 20000)
+    assert d == pytest.approx((push / K) ** (1 / 1.5), rel=1e-6)
+    assert abs(rate) < 1e-9
+
+
+def test_friction_stops_the_slip_but_never_reverses_it():
+    impulse = np.zeros(3)
+    normal = np.array([0.0, 0.0, 1.0])
+    # resting at the static penetration of a 10 N load, sliding at 1 mm/s along x
+    d0 = (10.0 / K) ** (1 / 1.5)
+    _, _, _, ex, _, ez, dissipated = contact_implicit_step(
+        d0, np.array([1e-3, 0.0, 0.0]), normal, np.array([0.0, 0.0, -10.0]), M, 1e12, STEP, K, 1.5, 0.0,
+        0.19, 0.152, 0.01, impulse)
+    assert -1e-3 <= ex < 0.0                        # slowed, at most to a stop
+    assert ez > 0.0 and dissipated >= 0.0
