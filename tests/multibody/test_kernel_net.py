@@ -73,3 +73,20 @@ def test_both_paths_record_the_same_net(both_paths):
     assert np.abs(fast["positions_lvlh"] - reference["positions_lvlh"]).max() < 2.5e-5
     assert np.abs(fast["velocities_lvlh"] - reference["velocities_lvlh"]).max() < 1e-3 * np.abs(
         reference["velocities_lvlh"]).max()
+
+
+def test_the_finite_state_check_sees_the_kernels_net(both_paths):
+    """Exudyn no longer holds the net on the kernel path: a NaN in the kernel's node velocities must
+    still fail the health check (multibody.health, the recorder's check at every sample and 1 ms)."""
+    from multibody.health import HealthWatch
+
+    system = both_paths["kernel"][0].system
+    watch = HealthWatch(cause="test")
+    assert watch.state(0.3, *system.state_arrays())
+    saved = system.kernel_net.qt[7]
+    system.kernel_net.qt[7] = np.nan
+    try:
+        assert not watch.state(0.3, *system.state_arrays())
+        assert "not finite" in str(watch.failure)
+    finally:
+        system.kernel_net.qt[7] = saved
