@@ -22,7 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from multibody.control.mu_approach import ApproachProblem, collocation_points, constraint_report, resimulate, solve
+from multibody.control.mu_approach import constraint_report, solve
+from multibody.control.mu_mesh import collocation_points, resimulate
+from multibody.control.mu_problem import ApproachProblem
 from multibody.control.mu_dynamics import IndependentMUs, RigidRodMUs, thrust_angles
 from riskassess import results
 from riskassess.approach_case import ApproachCase
