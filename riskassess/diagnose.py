@@ -26,8 +26,9 @@ from riskassess.diagnosis.fit import (CandidateFit, FitResult, Problem, first_un
                            step_error_sigma)
 from multibody.health import SimulationFailed
 from riskassess.diagnosis.hint import describe_terms, library, sparse_terms
+from riskassess.diagnosis.channels import CHANNELS
 from riskassess.diagnosis.measured import read_measured
-from riskassess.diagnosis.observation import CHANNELS, scenario_channels
+from riskassess.diagnosis.observation import scenario_channels
 from riskassess.diagnosis.residuals import analyse, describe
 from riskassess.diagnosis.selection import decide, gain_percent, score
 from riskassess.diagnosis.threads import single_threaded_blas

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from riskassess.diagnosis.observation import CHANNELS, QUATERNION
+from riskassess.diagnosis.channels import CHANNELS, QUATERNION
 from riskassess.case_inputs import read_text
 
 #: Fewest samples a record must have: the noise estimate and a held-out part need a few dozen.

@@ -7,7 +7,8 @@ import numpy as np
 
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.exudyn_model import ExudynScenario, simulate_exudyn
-from riskassess.diagnosis.plant import Plant, is_towing, plant_of
+from riskassess.diagnosis.plant import Plant, is_towing
+from riskassess.diagnosis.scenario import plant_of
 
 #: Default 1-sigma noise per channel group (channel units): a MEMS gyro at 10 Hz (2e-4 rad/s), a
 #: star tracker (~1e-3 per quaternion component, ~7 arcmin), an encoder (1e-3 rad), its rate
