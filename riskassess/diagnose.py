@@ -36,6 +36,7 @@ from riskassess import results
 from riskassess.case import read_toml
 from riskassess.diagnosis_case import load_diagnosis_case, toml_text
 from riskassess.outfolder import OutputFolder, claim, default_out, safe_name
+from riskassess.report.diagnosis import write_figures
 
 #: Worker processes fitting candidates in parallel (the issue's 2-core machine).
 WORKERS = 2
@@ -273,8 +274,6 @@ def _copy_towing_reference(out: Path, case_path: Path) -> list[str]:
 
 def _write(folder: OutputFolder, case_path: Path, answer, data: tuple, figures: bool = True) -> None:
     """The diagnosis files into the claimed ``folder``; the extended case only there."""
-    from riskassess.report.diagnosis import write_figures
-
     problem, predictions, chosen, before, after, extended = data
     out = folder.path
     files = ["diagnosis.json", "diagnosis.npz"]

@@ -19,6 +19,7 @@ from scipy.spatial.transform import Rotation
 
 from riskassess.diagnosis.channels import HINGE, OMEGA, QUATERNION, REL
 from riskassess.diagnosis.dynamics import axis_rotation, initial_state, radial_inertial
+from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.observation import lvlh_from_inertial
 from riskassess.diagnosis.plant import Plant
 from riskassess.diagnosis.scenario import plant_of
@@ -256,8 +257,6 @@ def simulate_case(case, times, step: float | None = None) -> dict:
     """Channels at ``times`` (s) of a case with every effect its ``[[effects]]`` lists (an extended
     case written by `riskassess diagnose`), by Exudyn: plant changes, loads and sensor effects in
     the order given."""
-    from riskassess.diagnosis.effects import CATALOG
-
     if case.kind == "towing":
         return _simulate_towing_case(case, times, CATALOG)
     plant = Plant.from_case(case)
