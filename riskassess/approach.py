@@ -22,8 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from multibody.control.mu_approach import ApproachProblem, collocation_points, constraint_report, resimulate, solve
+from multibody.control.mu_approach import constraint_report, solve
+from multibody.control.mu_mesh import collocation_points, resimulate
+from multibody.control.mu_problem import ApproachProblem
 from multibody.control.mu_dynamics import IndependentMUs, RigidRodMUs, thrust_angles
+from multibody.mu_replay import replay
 from riskassess import results
 from riskassess.approach_case import ApproachCase
 from riskassess.approach_plots import write_plots
@@ -130,8 +133,6 @@ def _unit_paths(problem, states):
 
 
 def _replay(case: ApproachCase, solution, resim) -> tuple[dict, dict]:
-    from multibody.mu_replay import replay
-
     r, problem = case.replay, solution.problem
     widths = problem.width_bounds
     side = r.side_length or (widths[1] if widths else case.model.length)

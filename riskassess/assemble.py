@@ -14,13 +14,13 @@ from scipy.spatial.transform import Rotation
 
 from multibody.assembly import (ContactLaw, ImpactAssembly, JointSpec, NetMount, RigidBodySpec, SolverSpec,
                                 subtree_bodies)
-from multibody.geometry import geometric_center_of_mass, shape_mesh, uniform_density_inertia
+from multibody.geometry import geometric_center_of_mass, uniform_density_inertia
 from multibody.hinge import hinge_frame_lvlh
 from multibody.net import flat_square_net, thread_node_mass
 from multibody.orbit import mean_motion
-from riskassess.case import Case, CircularOrbit
+from riskassess.case import Case, CircularOrbit, section_properties
+from riskassess.target_geometry import body_meshes_target_frame, target_points_lvlh, target_pose_lvlh
 from structures.criteria import Allowable
-from structures.sections import SECTIONS
 from structures.weak_location import WeakLocation
 
 
@@ -33,21 +33,6 @@ class ModelInputs:
     rest_coms: list
 
 
-def body_meshes_target_frame(case: Case, base: Path):
-    """Per body, its shapes as trimesh meshes in the target frame (m)."""
-    meshes = []
-    for body in case.target.bodies:
-        meshes.append([shape_mesh(**_shape_kwargs(s, base)) for s in body.shapes])
-    return meshes
-
-
-def _shape_kwargs(shape, base: Path) -> dict:
-    kwargs = shape.model_dump()
-    if shape.kind == "mesh":
-        kwargs["file"] = base / shape.file
-    return kwargs
-
-
 def mass_properties_target_frame(case: Case, meshes):
     """Per body: (CoM (m), inertia about CoM (kg m^2)), target frame; defaults from geometry."""
     props = []
@@ -58,24 +43,6 @@ def mass_properties_target_frame(case: Case, meshes):
                    else uniform_density_inertia(body_meshes, body.mass, com))
         props.append((com, inertia))
     return props
-
-
-def target_pose_lvlh(case: Case):
-    """Target-frame origin (m) and target->LVLH rotation matrix at t = 0."""
-    rot = Rotation.from_rotvec(case.target.attitude_rotation_vector).as_matrix()
-    return np.asarray(case.target.position_lvlh, float), rot
-
-
-def target_points_lvlh(case: Case, points_target) -> np.ndarray:
-    """Points given in the target frame ((3,) or (k, 3), m) at t = 0, in LVLH (m)."""
-    origin, rot = target_pose_lvlh(case)
-    return origin + np.asarray(points_target, float) @ rot.T
-
-
-def target_vertices_lvlh(case: Case, base: Path = Path(".")) -> np.ndarray:
-    """Vertices of every target shape at t = 0, LVLH (m)."""
-    return target_points_lvlh(case, np.vstack([m.vertices for body in body_meshes_target_frame(case, base)
-                                                for m in body]))
 
 
 def build_net(case: Case):
@@ -200,12 +167,6 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
         mean_motion=mean_motion(case.orbit.altitude) if isinstance(case.orbit, CircularOrbit) else 0.0,
         mount=mount, chaser=chaser_index)
     return ModelInputs(assembly, rest_att, rest_com)
-
-
-def section_properties(spec):
-    """Section properties from a case section (raises ValueError for impossible dimensions)."""
-    params = spec.model_dump()
-    return SECTIONS[params.pop("kind")](**params)
 
 
 def weak_locations(case: Case, assembly) -> list:

@@ -25,6 +25,8 @@ from pydantic import BaseModel, Field, ValidationError, field_validator, model_v
 from riskassess.case_inputs import (JSON_FILE_LIMIT, MESH_FILE_LIMIT, CaseError, CaseName, ItemName, RelativeFile,
                                     Strict, Text, decode_utf8, read_limited, read_toml, resolve_reference,
                                     unique_names)
+from riskassess.target_geometry import target_points_lvlh, target_vertices_lvlh
+from structures.sections import SECTIONS
 
 Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Positive = Annotated[float, Field(gt=0)]
@@ -387,6 +389,13 @@ Section = Annotated[Union[SolidRectangle, HollowRectangle, ThinWalledBox, Circul
                     Field(discriminator="kind")]
 
 
+def section_properties(spec):
+    """Section properties (:mod:`structures.sections`) from a case section table (raises ValueError
+    for impossible dimensions)."""
+    params = spec.model_dump()
+    return SECTIONS[params.pop("kind")](**params)
+
+
 class Material(Strict):
     modulus: Positive | None = Field(None, description="Young's modulus (Pa); informational, stresses do not need it.")
     ultimate_normal: ValueOrRange = Field(description="Ultimate normal stress (Pa), a value or [low, high].")
@@ -627,8 +636,6 @@ def _check_files(case: Case, base: Path) -> list[str]:
 
 
 def _check_sections(case: Case) -> list[str]:
-    from riskassess.assemble import section_properties
-
     problems = []
     for i, loc in enumerate(case.structures.weak_locations if case.structures else []):
         if loc.section is not None:
@@ -641,8 +648,6 @@ def _check_sections(case: Case) -> list[str]:
 
 def _check_reach(case: Case, base: Path) -> list[str]:
     """Reject a net that cannot reach the target before any simulation starts."""
-    from riskassess.assemble import target_points_lvlh, target_vertices_lvlh  # geometry needs the mesh loader
-
     try:
         points = target_vertices_lvlh(case, base)
     except Exception as exc:  # noqa: BLE001 - trimesh's many file parsers raise many types on a malformed file

@@ -191,7 +191,7 @@ def _cmd_perceive(args) -> int:
 
 def _cmd_tow(args) -> int:
     from riskassess.case import load_model
-    from riskassess.tow import tow_case
+    from riskassess.tow_stage import tow_case
     from riskassess.towing_case import TowingCase
 
     case = load_model(args.case, TowingCase)

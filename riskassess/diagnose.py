@@ -26,8 +26,9 @@ from riskassess.diagnosis.fit import (CandidateFit, FitResult, Problem, first_un
                            step_error_sigma)
 from multibody.health import SimulationFailed
 from riskassess.diagnosis.hint import describe_terms, library, sparse_terms
+from riskassess.diagnosis.channels import CHANNELS
 from riskassess.diagnosis.measured import read_measured
-from riskassess.diagnosis.observation import CHANNELS, scenario_channels
+from riskassess.diagnosis.observation import scenario_channels
 from riskassess.diagnosis.residuals import analyse, describe
 from riskassess.diagnosis.selection import decide, gain_percent, score
 from riskassess.diagnosis.threads import single_threaded_blas
@@ -35,6 +36,7 @@ from riskassess import results
 from riskassess.case import read_toml
 from riskassess.diagnosis_case import load_diagnosis_case, toml_text
 from riskassess.outfolder import OutputFolder, claim, default_out, safe_name
+from riskassess.report.diagnosis import write_figures
 
 #: Worker processes fitting candidates in parallel (the issue's 2-core machine).
 WORKERS = 2
@@ -272,8 +274,6 @@ def _copy_towing_reference(out: Path, case_path: Path) -> list[str]:
 
 def _write(folder: OutputFolder, case_path: Path, answer, data: tuple, figures: bool = True) -> None:
     """The diagnosis files into the claimed ``folder``; the extended case only there."""
-    from riskassess.report.diagnosis import write_figures
-
     problem, predictions, chosen, before, after, extended = data
     out = folder.path
     files = ["diagnosis.json", "diagnosis.npz"]

@@ -45,9 +45,10 @@ from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, 
 from perception.registration import DebrisTracker, known_shape_model
 from perception.shape import half_turn_symmetry_transforms, rotation_error
 from riskassess import results
-from riskassess.assemble import body_meshes_target_frame, model_inputs
+from riskassess.assemble import model_inputs
 from riskassess.case import Case, CaseError, load_case
 from riskassess.pipeline import begin_run_folder, run_recorded, write_simulation
+from riskassess.target_geometry import body_meshes_target_frame
 
 #: Scan points farther than this from the predicted debris surface are not registered to it (m):
 #: a frame's motion is predicted to ~1 cm; net threads sit decimetres to metres in front.

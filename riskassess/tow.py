@@ -1,25 +1,14 @@
-"""`riskassess tow`: the lower-order towing run of a towing case (Boonrath, Singh & Botta 2024).
+"""The lower-order towing model of a towing case (Boonrath, Singh & Botta 2024) and the figures
+every towing run reports.
 
 :func:`towing_model` turns the validated case (:mod:`riskassess.towing_case`) into a
 :class:`multibody.towing.TowingModel` for a given debris spin rate and sub-tether decision vector
-``s = [log10 k_ST, l_ST0, log10 c_ST, m_P/m_net]`` (eq. 22); :func:`tow_case` runs it in Exudyn
-and writes the run folder:
-
-============== ==============================================================
-file           content
-============== ==============================================================
-manifest.json  format of :mod:`riskassess.results`, stage ``tow``, case, status, files
-case.toml      the case file as given
-towing.json    tension peaks, tautness after engagement, separation, rates, step, wall time
-towing.npz     every series of :meth:`multibody.towing.TowResult.series`
-tow.png        main-tether tension, thrust, separation and angular rates
-============== ==============================================================
-
-``riskassess report DIR`` shows it in its towing section (:mod:`riskassess.report.towing`).
+``s = [log10 k_ST, l_ST0, log10 c_ST, m_P/m_net]`` (eq. 22); :func:`thrust_law` is the case's thrust
+law, shared with the full-net model (:mod:`riskassess.tow_fullnet`); :func:`run_figures` the figures
+of a lower-order or full-net run. The stage ``riskassess tow`` that runs them and writes the run
+folder is :mod:`riskassess.tow_stage`.
 """
 from __future__ import annotations
-
-from pathlib import Path
 
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
@@ -27,11 +16,7 @@ from scipy.optimize import brentq, minimize_scalar
 from multibody.control.attitude import quaternion_to_matrix, sampled_boundary_layer
 from multibody.control.mrac import mrac_initial_state, mrac_params, reference_steady_elongation
 from multibody.control.thrust import KINDS
-from multibody.towing import TowingModel, run_exudyn
-from riskassess import results
-from riskassess.case import load_model
-from riskassess.outfolder import claim
-from riskassess.pipeline import software_versions
+from multibody.towing import TowingModel
 from riskassess.towing_case import TowingCase
 
 #: Main-tether tension (N) from which the tether counts as engaged: before it the sub-tethers are still
@@ -161,47 +146,3 @@ def run_figures(case: TowingCase, series: dict, model) -> dict:
         "debris_final_rate_deg_s": float(np.rad2deg(np.linalg.norm(series["debris_omega_body"][-1]))),
         "step_s": model.step, "n_steps": model.n_steps, "simulated_s": model.end_time - model.start_time,
     }
-
-
-def summarize(case: TowingCase, result, s) -> dict:
-    """The numbers ``riskassess tow`` prints and writes to towing.json (SI): :func:`run_figures`, the
-    decision vector s and the sub-tethers' peak tension, wall time."""
-    series = result.series()
-    return {**run_figures(case, series, result.model), "decision_vector_s": [float(x) for x in s],
-            "sub_tether_peak_tension_N": float(series["sub_tether_tension"].max()),
-            "wall_time_s": result.wall_time, "steps_per_second": result.model.n_steps / result.wall_time}
-
-
-def tow_case(case_path: str | Path, out_dir: str | Path, case: TowingCase | None = None,
-             overwrite: bool = False) -> dict:
-    """Load the case (unless given), claim the output folder (:func:`riskassess.outfolder.claim`),
-    run the lower-order tow in Exudyn (or the full-net tow when ``simulation.model = "full-net"``,
-    :mod:`riskassess.tow_fullnet`), write the run folder; return the summary."""
-    case_path = Path(case_path)
-    case = case or load_model(case_path, TowingCase)
-    model = towing_model(case)
-    folder = claim(out_dir, case.name, "tow", overwrite, stage="tow", software=software_versions())
-    out = folder.path
-    with folder.recording():
-        results.atomic_write_bytes(out / "case.toml", case_path.read_bytes())
-        folder.add_files("case.toml")
-        if case.simulation.model == "full-net":
-            from riskassess.tow_fullnet import run_full_net
-
-            summary, series = run_full_net(case, out)
-            return _finish(case, folder, series, summary, ["towing.json", "towing.npz", "net.npz", "tow.png"])
-        result = run_exudyn(model)
-        summary = summarize(case, result, case_decision_vector(case))
-        results.atomic_write_npz(out / "towing.npz", result.series())
-        results.atomic_write_json(out / "towing.json", summary)
-        return _finish(case, folder, result.series(), summary, ["towing.json", "towing.npz", "tow.png"])
-
-
-def _finish(case, folder, series, summary, files) -> dict:
-    """Plot, mark the run folder complete with ``files``, return ``summary``."""
-    from riskassess.towing_plots import plot_tow
-
-    plot_tow(series, folder.path / "tow.png", case.name)
-    folder.add_files(*files)
-    folder.finish("complete")
-    return summary

@@ -20,6 +20,7 @@ from multibody.control.attitude import quaternion_to_matrix, sampled_boundary_la
 from multibody.net_towing import FullNetModel, run_exudyn
 from multibody.net_wrap import drape_and_close, towing_net, wrap_summary
 from riskassess import results
+from riskassess.tow import run_figures, thrust_law
 from riskassess.towing_case import TowingCase
 
 #: Height of the flat net above the cylinder before draping (m).
@@ -110,8 +111,6 @@ def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapp
     state at ``simulation.start_time`` (``wrapped`` = (net, x_body) of :func:`wrapped_net`, computed
     if not given) or, with ``full_net.start = "capture"``, from the net's ejection at t = 0
     (:func:`capture_start`; ``wrapped`` is not used)."""
-    from riskassess.tow import thrust_law
-
     fn, sim, ch, de = case.full_net, case.simulation, case.chaser, case.debris
     rate = de.spin_rate_deg_s if spin_rate_deg_s is None else spin_rate_deg_s
     if fn.start == "capture":
@@ -154,8 +153,6 @@ def momentum_residual(series: dict) -> float:
 def summarize_full_net(case: TowingCase, result, wrap: dict) -> dict:
     """The figures of every towing run (:func:`riskassess.tow.run_figures`) for a full-net run, plus
     the net's: wrapped-state shape, contact, closing-loop tension, momentum balance."""
-    from riskassess.tow import run_figures
-
     series = result.series()
     model = result.model
     return {

@@ -1,5 +1,5 @@
 """VTK export of a full-net tow folder (``riskassess export-vtk RUN_DIR`` on a ``riskassess tow`` run
-with ``simulation.model = "full-net"``), in the layout of :mod:`riskassess.vtk_export`.
+with ``simulation.model = "full-net"``), in the layout of :mod:`riskassess.vtk_export`, written by :mod:`riskassess.vtk_frames`.
 
 Written into ``RUN_DIR/vtk/``; all positions in the debris' LVLH frame at each frame's time (origin
 at the debris CoM; axes radial, along-track, orbit normal of the debris' inertial position and
@@ -32,15 +32,16 @@ import trimesh
 
 from riskassess.diagnosis.towing_plant import lvlh_to_eci
 from multibody.net import thread_tension_strain
+from riskassess.case import load_model
 from riskassess.results import MissingData, RunFolder
-from riskassess.vtk_export import VtkExport, export_frames, nearest_samples, surface_lvlh
+from riskassess.tow_fullnet import debris_geometry
+from riskassess.towing_case import TowingCase
+from riskassess.vtk_frames import VtkExport, export_frames, nearest_samples, surface_lvlh
 
 
 def body_meshes(case) -> list[trimesh.Trimesh]:
     """Chaser cube (side L_C) and debris cylinder (d_D, L_D, axis z_body, centre at the
     :func:`riskassess.tow_fullnet.debris_geometry` offset) in their body frames (m)."""
-    from riskassess.tow_fullnet import debris_geometry
-
     radius, half_length, z_centre = debris_geometry(case)
     cylinder = trimesh.creation.cylinder(radius=radius, height=2.0 * half_length, sections=48)
     cylinder.apply_translation([0.0, 0.0, z_centre])
@@ -51,9 +52,6 @@ class _TowFrames:
     """The tow folder's data per frame, checked once up front."""
 
     def __init__(self, run: RunFolder):
-        from riskassess.case import load_model
-        from riskassess.towing_case import TowingCase
-
         for name in ("net.npz", "towing.npz", "case.toml"):
             if not run.has(name):
                 raise MissingData(f"{run.path / name}: missing; VTK export of a tow folder needs a full-net run")
@@ -107,6 +105,6 @@ class _TowFrames:
 def export_tow_vtk(run_dir: str | Path, out: str | Path | None = None, every: int | None = None, progress=None,
                    overwrite: bool = False, max_frames: int | None = None) -> VtkExport:
     """Write the VTK files of a full-net tow folder (module docstring); returns where and how many
-    (``every``, ``max_frames``: :func:`riskassess.vtk_export.frame_stride`)."""
+    (``every``, ``max_frames``: :func:`riskassess.vtk_frames.frame_stride`)."""
     return export_frames(run_dir, out, every, progress, _TowFrames, ("net", "bodies", "tether"), "towing.pvd",
                          "positions in the debris' LVLH frame (m)", overwrite=overwrite, max_frames=max_frames)

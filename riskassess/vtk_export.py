@@ -31,7 +31,8 @@ file                        content
 
 One frame per kept net snapshot (the case's ``net_output_rate``): every ``every``-th one, or, by
 default, evenly strided so that the export stays within ``max_frames`` frames, or within
-:data:`VTK_BUDGET_BYTES` when neither is given (the size of the middle snapshot sets the stride).
+:data:`~riskassess.vtk_frames.VTK_BUDGET_BYTES` when neither is given (the size of the middle
+snapshot sets the stride).
 Body poses come from the time series sample nearest to the snapshot (at most half an output
 interval away; the same time when the output rate is a multiple of the net output rate, as in
 the shipped cases). Net point data ``contact_force_lvlh_N`` (N) is the contact force on each node,
@@ -42,57 +43,22 @@ tool made earlier for the same run (its ``manifest.json``, format ``riskassess-v
 run and lists the files); the run folder itself or any folder holding other files is refused
 (:class:`riskassess.outfolder.OutputRefused`). It is written into a hidden staging folder beside
 ``out`` and moved in at the end, so an interrupted export leaves the previous export intact; of
-a replaced export only the files its manifest lists are removed.
+a replaced export only the files its manifest lists are removed. The writer is
+:mod:`riskassess.vtk_frames`; a full-net tow folder is exported by :mod:`riskassess.tow_vtk`.
 """
 from __future__ import annotations
 
-import contextlib
 import json
-import os
-import tempfile
-from dataclasses import dataclass
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
 import meshio
 import numpy as np
 
 from multibody.net import thread_tension_strain
-from riskassess import outfolder
-from riskassess.results import MissingData, RunFolder, atomic_write_bytes, write_manifest
+from riskassess.results import MissingData, RunFolder
+from riskassess.tow_vtk import export_tow_vtk
+from riskassess.vtk_frames import VtkExport, export_frames, nearest_samples, surface_lvlh, surface_velocity_lvlh
 from riskassess.vtk_markers import joint_markers
-
-#: Format of the manifest that marks a folder as a VTK export of one run.
-VTK_FORMAT = "riskassess-vtk"
-#: Size an export aims to stay within when neither ``every`` nor ``max_frames`` is given (bytes):
-#: 20 MB keeps the reference run (1229 nodes, 376 snapshots) at every 3rd snapshot, 0.06 s apart.
-VTK_BUDGET_BYTES = 20_000_000
-
-
-@dataclass
-class VtkExport:
-    folder: Path
-    pvd: Path
-    n_frames: int
-    times: np.ndarray
-
-
-def surface_lvlh(vertices_body, body_to_lvlh, com_lvlh):
-    """Vertices (m) of a body surface in LVLH: r = R r_body + c. (n, 3) in, (n, 3) out."""
-    return np.asarray(vertices_body) @ np.asarray(body_to_lvlh).T + com_lvlh
-
-
-def surface_velocity_lvlh(vertices_body, body_to_lvlh, velocity_lvlh, omega_body):
-    """Velocity (m/s, LVLH) of body-fixed points: v = v_c + R (omega_body x r_body)."""
-    return np.cross(omega_body, np.asarray(vertices_body)) @ np.asarray(body_to_lvlh).T + velocity_lvlh
-
-
-def nearest_samples(sample_times, wanted_times) -> np.ndarray:
-    """Index of the sample nearest to each wanted time."""
-    idx = np.clip(np.searchsorted(sample_times, wanted_times), 1, len(sample_times) - 1)
-    earlier = np.abs(wanted_times - sample_times[idx - 1]) <= np.abs(sample_times[idx] - wanted_times)
-    return np.where(earlier, idx - 1, idx)
-
 
 def release_times_by_body(run: RunFolder, body_names) -> np.ndarray:
     """Per body the time (s) its piece is released; inf for bodies never released."""
@@ -204,144 +170,6 @@ class _Frames:
                                       "released": [np.concatenate(released)]})
 
 
-def pvd_text(entries: list[tuple[float, int, str, str]], comment: str = "") -> str:
-    """ParaView collection: (time s, part, name, file) per dataset."""
-    lines = ['<?xml version="1.0"?>', f"<!-- {comment} -->" if comment else "",
-             '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">', "  <Collection>"]
-    lines += [f'    <DataSet timestep="{t:.9g}" part="{part}" name={quoteattr(name)} file={quoteattr(file)}/>'
-              for t, part, name, file in entries]
-    lines += ["  </Collection>", "</VTKFile>", ""]
-    return "\n".join(line for line in lines if line)
-
-
-def vtm_text(blocks: list[tuple[str, str]]) -> str:
-    """A VTK multiblock file whose blocks are the given (name, file) pairs: ParaView shows the names."""
-    lines = ['<?xml version="1.0"?>', '<VTKFile type="vtkMultiBlockDataSet" version="1.0" byte_order="LittleEndian">',
-             "  <vtkMultiBlockDataSet>"]
-    lines += [f'    <DataSet index="{k}" name={quoteattr(name)} file={quoteattr(file)}/>'
-              for k, (name, file) in enumerate(blocks)]
-    lines += ["  </vtkMultiBlockDataSet>", "</VTKFile>", ""]
-    return "\n".join(lines)
-
-
-def write_collection(out: Path, frames, n_frames: int, pvd_name: str, comment: str, identity: dict,
-                     progress=None, extra=None, overwrite: bool = False) -> None:
-    """Write ``frames``, an iterable of (time (s), ((part name, meshio.Mesh), ...)) per frame, as
-    ``<part>_NNNN.vtu`` files, one ``frame_NNNN.vtm`` per frame naming its parts, and the ParaView
-    collection ``pvd_name`` of the frames into ``out``, with a manifest
-    ``identity`` (format, case, command, run) plus the files. ``out`` is checked first
-    (:func:`riskassess.outfolder.check`: new, empty, or this run's earlier export with ``overwrite``);
-    the files are staged beside it and moved in at the end, so an interrupted export leaves the
-    previous one intact; ``extra(staging)`` may add files before the collection is written."""
-    old = outfolder.check(out, identity, overwrite)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(dir=out.parent, prefix=f".{out.name}.partial-"))
-    try:
-        entries = []
-        for n, (t, parts) in enumerate(frames):
-            blocks = []
-            for name, mesh in parts:
-                file = f"{name}_{n:04d}.vtu"
-                meshio.write(staging / file, mesh, file_format="vtu", binary=True, compression="zlib")
-                blocks.append((name, file))
-            (staging / f"frame_{n:04d}.vtm").write_text(vtm_text(blocks))
-            entries.append((t, 0, "frame", f"frame_{n:04d}.vtm"))
-            if progress:
-                progress(n + 1, n_frames)
-        if extra:
-            extra(staging)
-        atomic_write_bytes(staging / pvd_name, pvd_text(entries, comment).encode())
-        write_manifest(staging, {**identity, "version": 1, "status": "complete",
-                                 "files": sorted(p.name for p in staging.iterdir())})
-        _move_in(staging, out, old)
-    except BaseException:
-        _remove_staging(staging)
-        raise
-
-
-def _move_in(staging: Path, out: Path, old: dict | None) -> None:
-    """Put the staged export at ``out``: renamed there when ``out`` does not exist; file by file
-    into an empty ``out`` (the user's folder stays); swapped with this run's earlier export
-    (``old``, its manifest), of which only the listed files are then removed."""
-    staging.chmod(0o755)
-    if not out.exists():
-        staging.rename(out)
-    elif old is None:                      # an empty folder, checked just before
-        names = sorted(p.name for p in staging.iterdir())
-        for name in sorted(names, key=lambda n: n == outfolder.MANIFEST):   # the manifest last
-            os.replace(staging / name, out / name)
-        staging.rmdir()
-    else:
-        previous = out.with_name(f".{out.name}.old-{staging.name.rsplit('-', 1)[-1]}")
-        out.rename(previous)
-        staging.rename(out)
-        outfolder.remove_own(previous, old)
-        with contextlib.suppress(OSError):   # something else appeared in it meanwhile: it stays
-            previous.rmdir()
-
-
-def _remove_staging(staging: Path) -> None:
-    """Remove the staging folder this export made (its files only, never a tree walk)."""
-    for path in staging.iterdir():
-        path.unlink(missing_ok=True)
-    staging.rmdir()
-
-
-def frame_bytes(frames, parts: tuple, f: int) -> int:
-    """Size (bytes) of snapshot ``f`` written as the export writes it (compressed VTU files)."""
-    with tempfile.TemporaryDirectory() as tmp:
-        for part in parts:
-            meshio.write(Path(tmp) / f"{part}.vtu", getattr(frames, f"{part}_mesh")(f), file_format="vtu",
-                         binary=True, compression="zlib")
-        return sum(p.stat().st_size for p in Path(tmp).iterdir())
-
-
-def frame_stride(n_snapshots: int, every: int | None, max_frames: int | None, bytes_per_frame=None,
-                 budget: int = VTK_BUDGET_BYTES) -> int:
-    """Snapshots to step: ``every`` when given; else the smallest stride that keeps at most
-    ``max_frames`` frames; else at most ``budget // bytes_per_frame()`` frames (at least 2)."""
-    if every is not None:
-        if every < 1:
-            raise ValueError(f"every must be >= 1 (frames to step); got {every}")
-        if max_frames is not None:
-            raise ValueError("give 'every' or 'max_frames', not both")
-        return every
-    if max_frames is None:
-        max_frames = max(2, budget // max(1, bytes_per_frame()))
-    elif max_frames < 1:
-        raise ValueError(f"max_frames must be >= 1; got {max_frames}")
-    return max(1, -(-n_snapshots // max_frames))
-
-
-def export_frames(run_dir: str | Path, out: str | Path | None, every: int | None, progress, frames_type, parts: tuple,
-                  pvd_name: str, comment: str, extra=None, overwrite: bool = False,
-                  max_frames: int | None = None) -> VtkExport:
-    """The front shared by the impact and the tow export: checks ``every``, reads the run folder into
-    ``frames_type(run)`` (which raises MissingData before anything is written), writes every stride-th
-    net snapshot's ``parts`` (each the ``<part>_mesh(f)`` of the frames; stride: :func:`frame_stride`)
-    with :func:`write_collection` into ``out`` (default ``RUN_DIR/vtk``; a folder directly inside the run
-    folder is registered as a product of the run) and returns where and how many. ``extra(frames,
-    staging)`` may add files."""
-    if every is not None and every < 1:
-        raise ValueError(f"every must be >= 1 (frames to step); got {every}")
-    run = RunFolder(run_dir)
-    out = Path(out) if out else run.path / "vtk"
-    identity = {"format": VTK_FORMAT, "case": run.manifest.get("case"), "command": "export-vtk",
-                "run": str(run.path.resolve())}
-    outfolder.check(out, identity, overwrite)   # refuse before reading the run's arrays
-    frames = frames_type(run)
-    n = len(frames.net["time"])
-    # sized on a mid-run snapshot: the flat net at t = 0 compresses far better than the wrapped one
-    stride = frame_stride(n, every, max_frames, lambda: frame_bytes(frames, parts, n // 2))
-    picked = np.arange(0, n, stride)
-    write_collection(out, ((float(frames.net["time"][f]), tuple((part, getattr(frames, f"{part}_mesh")(f)) for part in parts))
-                           for f in picked), len(picked), pvd_name, f"case {run.manifest.get('case')}: {comment}", identity,
-                     progress, None if extra is None else lambda staging: extra(frames, staging), overwrite)
-    if out.resolve().parent == run.path.resolve():
-        run.add_product(out.name)
-    return VtkExport(out, out / pvd_name, len(picked), frames.net["time"][picked])
-
-
 def _write_bodies_json(frames: _Frames, staging: Path) -> None:
     """``bodies.json``: body index -> name, mass (kg), release time of its piece (s, null if never)."""
     bodies = [{"index": k, "name": name, "mass_kg": float(m), "released_at_s": None if np.isinf(r) else float(r)}
@@ -359,10 +187,8 @@ def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int | 
                overwrite: bool = False, max_frames: int | None = None) -> VtkExport:
     """Write the VTK files of a run folder (see the module docstring); returns where and how many.
     ``every``: export every N-th snapshot; ``max_frames``: at most that many, evenly strided; neither:
-    within :data:`VTK_BUDGET_BYTES`."""
+    within :data:`~riskassess.vtk_frames.VTK_BUDGET_BYTES`."""
     if RunFolder(run_dir).stage == "tow":  # a full-net tow folder: its own layout
-        from riskassess.tow_vtk import export_tow_vtk
-
         return export_tow_vtk(run_dir, out, every, progress, overwrite, max_frames)
     return export_frames(run_dir, out, every, progress, _Frames, ("net", "bodies", "bullets", "body_frames", "joints"),
                          "impact.pvd", "positions LVLH (m); body_index -> bodies.json, joint_index -> joints.json",

@@ -1,4 +1,5 @@
-"""Mesh of the net-approach collocation (:mod:`multibody.control.mu_approach`) and the open-loop check of
+"""Mesh of the net-approach collocation (:mod:`multibody.control.mu_approach`; the problem and
+solution in :mod:`multibody.control.mu_problem`) and the open-loop check of
 its controls: interval widths, the Hermite-Simpson control interpolation (piecewise quadratic
 through node, midpoint, node), the independent SciPy re-simulation, the local error of each
 interval and the mesh refinement it drives.
@@ -13,15 +14,12 @@ Control*, Sec. 4.7).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from multibody.control.mu_dynamics import CONTROLS
-
-if TYPE_CHECKING:
-    from multibody.control.mu_approach import ApproachProblem, ApproachSolution
+from multibody.control.mu_problem import ApproachProblem, ApproachSolution
 
 NU = len(CONTROLS)
 

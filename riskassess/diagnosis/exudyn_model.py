@@ -17,9 +17,13 @@ from exudyn.itemInterface import (LoadForceVector, LoadTorqueVector, MarkerBodyR
                                   ObjectConnectorRigidBodySpringDamper)
 from scipy.spatial.transform import Rotation
 
+from riskassess.diagnosis.channels import HINGE, OMEGA, QUATERNION, REL
 from riskassess.diagnosis.dynamics import axis_rotation, initial_state, radial_inertial
-from riskassess.diagnosis.observation import HINGE, OMEGA, QUATERNION, REL, lvlh_from_inertial
+from riskassess.diagnosis.effects import CATALOG
+from riskassess.diagnosis.observation import lvlh_from_inertial
 from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.scenario import plant_of
+from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn
 from multibody.assembly import JointSpec, RigidBodySpec
 from multibody.hinge import add_penalty_joint, hinge_frame_lvlh
 from multibody.impact import add_rigid_bodies, explicit_settings
@@ -253,8 +257,6 @@ def simulate_case(case, times, step: float | None = None) -> dict:
     """Channels at ``times`` (s) of a case with every effect its ``[[effects]]`` lists (an extended
     case written by `riskassess diagnose`), by Exudyn: plant changes, loads and sensor effects in
     the order given."""
-    from riskassess.diagnosis.effects import CATALOG
-
     if case.kind == "towing":
         return _simulate_towing_case(case, times, CATALOG)
     plant = Plant.from_case(case)
@@ -279,9 +281,6 @@ def simulate_case(case, times, step: float | None = None) -> dict:
 
 def _simulate_towing_case(case, times, catalog) -> dict:
     """:func:`simulate_case` of a towing case: its one effect (an extended case has one) in Exudyn."""
-    from riskassess.diagnosis.plant import plant_of
-    from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn
-
     if len(case.effects) > 1:
         raise NotImplementedError("the towing scenario's Exudyn model takes one effect at a time; the case lists "
                                   f"{[e.id for e in case.effects]}")

@@ -24,10 +24,12 @@ from scipy.optimize import least_squares
 
 from riskassess.diagnosis.effects.base import Effect, Parameter
 from riskassess.diagnosis.model import max_step, predict
-from riskassess.diagnosis.observation import QUATERNION, scenario_channels
-from riskassess.diagnosis.plant import (NOMINAL_PARAMETERS, Plant, is_towing, nominal_parameter_names, nominal_vector, plant_of,
-                             prior_sigmas, with_nominal)
+from riskassess.diagnosis.channels import QUATERNION
+from riskassess.diagnosis.observation import scenario_channels
+from riskassess.diagnosis.plant import (NOMINAL_PARAMETERS, Plant, is_towing, nominal_parameter_names, nominal_vector,
+                                        prior_sigmas, with_nominal)
 from riskassess.diagnosis.residuals import aligned_quaternion
+from riskassess.diagnosis.scenario import plant_of
 
 #: Share of the training span fitted first (continuation).
 FIRST_SPAN = 0.35

@@ -14,8 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from riskassess.diagnosis.observation import CHANNELS, QUATERNION
+from riskassess.diagnosis.channels import CHANNELS, QUATERNION
 from riskassess.case_inputs import read_text
+from riskassess.results import atomic_write_bytes
 
 #: Fewest samples a record must have: the noise estimate and a held-out part need a few dozen.
 MIN_SAMPLES = 30
@@ -205,8 +206,6 @@ def _set_noise(measured: MeasuredData, given: dict) -> None:
 
 def write_measured(path, time, values: dict) -> None:
     """Write a measured-data CSV (``time`` then the channels), atomically."""
-    from riskassess.results import atomic_write_bytes
-
     names = list(values)
     lines = [",".join(["time"] + names)]
     for k, t in enumerate(time):

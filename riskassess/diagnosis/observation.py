@@ -3,24 +3,17 @@
 Channels (SI): ``omega_x..z`` inertial angular velocity of the main body, its own frame B
 (rad/s, a gyro); ``q_w..q_z`` attitude B->LVLH (unit quaternion, scalar first);
 ``hinge_angle`` (rad) and ``hinge_rate`` (rad/s); ``rel_x..z`` the target-frame origin
-relative to the chaser, LVLH (m); ``tether_tension`` (N, towing only).
+relative to the chaser, LVLH (m); ``tether_tension`` (N, towing only). Their names and units are
+in :mod:`riskassess.diagnosis.channels`.
 """
 from __future__ import annotations
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from riskassess.diagnosis.channels import HINGE, OMEGA, QUATERNION, REL, TENSION
 from riskassess.diagnosis.dynamics import environment, observe
 from riskassess.diagnosis.plant import Plant
-
-OMEGA = ("omega_x", "omega_y", "omega_z")
-QUATERNION = ("q_w", "q_x", "q_y", "q_z")
-HINGE = ("hinge_angle", "hinge_rate")
-REL = ("rel_x", "rel_y", "rel_z")
-TENSION = ("tether_tension",)
-CHANNELS = OMEGA + QUATERNION + HINGE + REL + TENSION
-UNITS = {**{c: "rad/s" for c in OMEGA}, **{c: "-" for c in QUATERNION}, "hinge_angle": "rad",
-         "hinge_rate": "rad/s", **{c: "m" for c in REL}, "tether_tension": "N"}
 
 
 def scenario_channels(plant: Plant) -> tuple[str, ...]:

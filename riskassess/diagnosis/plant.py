@@ -138,16 +138,6 @@ class Plant:
         return float(max(rates))
 
 
-def plant_of(case):
-    """The plant of a diagnosis case: :class:`Plant`, or :class:`riskassess.diagnosis.towing_plant.TowingPlant`
-    for the towing scenario."""
-    if case.kind == "towing":
-        from riskassess.diagnosis.towing_plant import TowingPlant
-
-        return TowingPlant.from_case(case)
-    return Plant.from_case(case)
-
-
 def is_towing(plant) -> bool:
     return getattr(plant, "kind", None) == "towing"
 

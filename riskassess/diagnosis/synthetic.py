@@ -7,7 +7,9 @@ import numpy as np
 
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.exudyn_model import ExudynScenario, simulate_exudyn
-from riskassess.diagnosis.plant import Plant, is_towing, plant_of
+from riskassess.diagnosis.plant import Plant, is_towing
+from riskassess.diagnosis.scenario import plant_of
+from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn
 
 #: Default 1-sigma noise per channel group (channel units): a MEMS gyro at 10 Hz (2e-4 rad/s), a
 #: star tracker (~1e-3 per quaternion component, ~7 arcmin), an encoder (1e-3 rad), its rate
@@ -36,7 +38,7 @@ def simulate_effect(case, times, effect_id: str | None = None, values=None) -> d
     plant = plant_of(case)
     simulate = simulate_exudyn
     if is_towing(plant):
-        from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn as simulate
+        simulate = simulate_towing_exudyn
     if effect_id is None:
         return simulate(plant, times)
     effect = CATALOG[effect_id]

@@ -22,13 +22,14 @@ import numpy as np
 from numba import njit
 from scipy.spatial.transform import Rotation
 
+from riskassess.diagnosis.channels import OMEGA, QUATERNION, REL, TENSION
 from riskassess.diagnosis.dynamics import quaternion_from_matrix
-from riskassess.diagnosis.observation import OMEGA, QUATERNION, REL, TENSION
 from riskassess.diagnosis.towing_dynamics import (EXTRA_STATES, diagnostics_size, initial_extra_states, integrate,
                                       no_towing_load)
 from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.towing import packed
 from multibody.towing_kernel import MT_TENSION
+from riskassess.tow import towing_model
 
 #: Nominal parameters of the towing scenario: name -> (size, unit), the fitted vector's order.
 TOWING_PARAMETERS = {"attitude": (3, "rad"), "angular_velocity": (3, "rad/s"), "position": (3, "m"),
@@ -155,8 +156,6 @@ class TowingPlant:
 
     def model(self, duration: float, step: float):
         """The :class:`multibody.towing.TowingModel` over ``duration`` (s) from the record's t = 0."""
-        from riskassess.tow import towing_model
-
         case = self.towing_case(step)
         return towing_model(case, step=step, end_time=case.simulation.start_time + duration)
 

@@ -11,7 +11,8 @@ import numpy as np
 
 from multibody.net import thread_tension_strain
 from riskassess.results import MissingData, RunFolder
-from riskassess.vtk_export import nearest_samples, release_times_by_body, surface_lvlh
+from riskassess.vtk_export import release_times_by_body
+from riskassess.vtk_frames import nearest_samples, surface_lvlh
 
 
 #: Percentile of the thread tension samples at the top of the colour scale (see Scene.tension_scale).

@@ -301,12 +301,12 @@ def test_huge_values_are_refused_with_the_key(tmp_path, shipped, old, new, expec
 
 
 def test_arithmetic_errors_in_section_checks_name_the_key(tmp_path, monkeypatch):
-    import riskassess.assemble
+    import riskassess.case
 
     def overflowing(section):
         raise OverflowError("math range error")
 
-    monkeypatch.setattr(riskassess.assemble, "section_properties", overflowing)
+    monkeypatch.setattr(riskassess.case, "section_properties", overflowing)
     message = _message(load_case, _case(tmp_path, IMPACT))
     assert f"{tmp_path / 'case.toml'}: structures.weak_locations[1].section: math range error" in message
 

@@ -1,4 +1,4 @@
-"""`riskassess tow` (riskassess/tow.py): the run folder, the tautness figures and the report section."""
+"""`riskassess tow` (riskassess/tow_stage.py, riskassess/tow.py): the run folder, the tautness figures and the report section."""
 import json
 
 import meshio
@@ -11,7 +11,8 @@ from riskassess.case import load_model
 from riskassess.report import write_report
 from riskassess.report.towing import towing_section
 from riskassess.results import RunFolder
-from riskassess.tow import tautness, tow_case
+from riskassess.tow import tautness
+from riskassess.tow_stage import tow_case
 from riskassess.towing_case import TowingCase
 
 CASE = "cases/zenit2_towing.toml"

@@ -240,7 +240,7 @@ def test_export_into_an_empty_folder_then_only_into_its_own(assessed, tmp_path, 
 
 
 def test_frame_stride_keeps_the_export_within_its_budget():
-    from riskassess.vtk_export import frame_stride
+    from riskassess.vtk_frames import frame_stride
 
     # 376 snapshots of 120 kB in 20 MB: at most 166 frames, so every 3rd snapshot (126 frames)
     assert frame_stride(376, None, None, lambda: 120_000, budget=20_000_000) == 3

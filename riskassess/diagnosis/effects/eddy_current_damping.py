@@ -18,7 +18,7 @@ from numba import njit
 
 from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_Q, X_W, quaternion_rows, tdot, tmtv, tmv
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.plant import plant_of
+from riskassess.diagnosis.scenario import plant_of
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
 from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import DEBRIS

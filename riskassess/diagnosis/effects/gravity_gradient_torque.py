@@ -20,7 +20,7 @@ from riskassess.diagnosis.effects.base import Effect, Parameter
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, W_INERTIA, body_position
 from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import CHASER, DEBRIS
-from riskassess.diagnosis.plant import plant_of
+from riskassess.diagnosis.scenario import plant_of
 
 
 @njit(cache=True)

@@ -17,7 +17,7 @@ from numba import njit
 
 from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_E, L_TM, X_E, X_W, cross
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.plant import plant_of
+from riskassess.diagnosis.scenario import plant_of
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, XE_DAMPER
 from multibody.towing_kernel import DEBRIS
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.observation import OMEGA, REL, UNITS
+from riskassess.diagnosis.channels import OMEGA, REL, UNITS
 
 #: Channels that may carry a bias, with a typical bias size (their units): a MEMS gyro's
 #: 1e-3 rad/s, an encoder's 0.01 rad, a relative-navigation 0.05 m, a load cell's 1 N.

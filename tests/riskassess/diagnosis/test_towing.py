@@ -22,7 +22,7 @@ from riskassess.diagnosis.effects.tether_viscoelasticity import branch_after, st
 from riskassess.diagnosis.effects.thrust_misalignment import misaligned_thrust, thrust_direction_eci
 from riskassess.diagnosis.measured import write_measured
 from riskassess.diagnosis.model import predict
-from riskassess.diagnosis.plant import plant_of
+from riskassess.diagnosis.scenario import plant_of
 from riskassess.diagnosis.synthetic import channel_noise, sample_times
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, last_diagnostics
 from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn

@@ -1,0 +1,16 @@
+"""The plant of a diagnosis case, picked by the case's ``kind``: the rigid or hinged tumbling
+debris (:mod:`riskassess.diagnosis.plant`) or the towed debris
+(:mod:`riskassess.diagnosis.towing_plant`). It sits above both plants, so neither imports the other.
+"""
+from __future__ import annotations
+
+from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.towing_plant import TowingPlant
+
+
+def plant_of(case):
+    """The plant of a diagnosis case: :class:`~riskassess.diagnosis.plant.Plant`, or
+    :class:`~riskassess.diagnosis.towing_plant.TowingPlant` for the towing scenario."""
+    if case.kind == "towing":
+        return TowingPlant.from_case(case)
+    return Plant.from_case(case)
