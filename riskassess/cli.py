@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import json
 import sys
 from pathlib import Path
@@ -202,7 +203,7 @@ def _cmd_tow(args) -> int:
         print(json.dumps(summary, indent=2))
     else:
         print(f"{case.name}: towed {summary['simulated_s']:g} s with thrust '{summary['thrust_kind']}', "
-              f"debris spin {summary['spin_rate_deg_s']:.2f} deg/s; main tether peak "
+              f"debris spin {math.radians(summary['spin_rate_deg_s']):.4f} rad/s; main tether peak "
               f"{summary['main_tether_peak_tension_N']:.1f} N, final {summary['main_tether_final_tension_N']:.1f} N, "
               f"slack while thrusting {summary['main_tether_slack_time_while_thrusting_s']:.2f} s; "
               f"{summary['wall_time_s']:.2f} s wall\nresults: {out}")

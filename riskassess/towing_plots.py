@@ -20,8 +20,8 @@ def _tow_panels(axes, s, label, style="-"):
     axes[0].plot(t, s["thrust"], style, color="0.5", lw=0.8, label=f"{label} thrust")
     axes[1].plot(t, np.linalg.norm(s["debris_com_inertial"] - s["chaser_com_inertial"], axis=1), style,
                  label=f"{label} chaser-debris".strip())
-    axes[2].plot(t, np.degrees(np.linalg.norm(s["chaser_omega_body"], axis=1)), style, label=f"{label} chaser")
-    axes[2].plot(t, np.degrees(np.linalg.norm(s["debris_omega_body"], axis=1)), style, label=f"{label} debris")
+    axes[2].plot(t, np.linalg.norm(s["chaser_omega_body"], axis=1), style, label=f"{label} chaser")
+    axes[2].plot(t, np.linalg.norm(s["debris_omega_body"], axis=1), style, label=f"{label} debris")
 
 
 def tow_figure(series: dict, title: str, others: dict | None = None):
@@ -35,7 +35,7 @@ def tow_figure(series: dict, title: str, others: dict | None = None):
     axes[0].set_ylabel("force (N)")
     axes[0].set_title(f"{plain(title)}: main-tether tension and thrust")
     axes[1].set_ylabel("|r_D/C| (m)")
-    axes[2].set_ylabel("|omega| (deg/s)")
+    axes[2].set_ylabel("|omega| (rad/s)")
     for ax in axes:
         legend(ax)
     return fig
@@ -69,7 +69,7 @@ def plot_fit(data: dict, fitted: dict, path: Path, title: str) -> None:
         axes[0].set_ylabel("force (N)")
         axes[0].set_title(plain(title))
         axes[1].set_ylabel("|r_D/C| (m)")
-        axes[2].set_ylabel("|omega| (deg/s)")
+        axes[2].set_ylabel("|omega| (rad/s)")
         for ax in axes:
             legend(ax)
         _save(fig, path)

@@ -4,6 +4,8 @@ A full-net run (``towing.json`` with ``model = "full-net"``) has no sub-tethers 
 vector s; it shows the net's figures instead."""
 from __future__ import annotations
 
+import math
+
 from riskassess.report.blocks import Figure, Note, Section, Table
 from riskassess.results import RunFolder
 
@@ -25,7 +27,7 @@ def _rows(summary: dict) -> list[list[str]]:
     mt, sep = summary["main_tether"], summary["separation_m"]
     return [
         ["thrust law", summary["thrust_kind"]],
-        ["debris spin rate (deg/s)", f"{summary['spin_rate_deg_s']:.2f}"],
+        ["debris spin rate (rad/s)", f"{math.radians(summary['spin_rate_deg_s']):.4f}"],
         *_model_rows(summary),
         ["main tether engaged at (s)", f"{mt['engaged_at_s']:.1f}"],
         ["smallest tension after engagement (N)", f"{mt['min_tension_after_engagement_N']:.3f}"],
@@ -35,8 +37,8 @@ def _rows(summary: dict) -> list[list[str]]:
         ["MRAC reference elongation / RMS error, last 100 s (m)",
          "-" if mt["target_elongation_m"] is None else f"{mt['target_elongation_m']:.4f} / {mt['rms_elongation_error_m']:.4f}"],
         ["chaser-debris distance min / max / final (m)", f"{sep['min']:.2f} / {sep['max']:.2f} / {sep['final']:.2f}"],
-        ["chaser peak rate (deg/s)", f"{summary['chaser_peak_rate_deg_s']:.2f}"],
-        ["debris final rate (deg/s)", f"{summary['debris_final_rate_deg_s']:.2f}"],
+        ["chaser peak rate (rad/s)", f"{math.radians(summary['chaser_peak_rate_deg_s']):.4f}"],
+        ["debris final rate (rad/s)", f"{math.radians(summary['debris_final_rate_deg_s']):.4f}"],
     ]
 
 
