@@ -115,6 +115,9 @@ class SolverSpec:
     # who integrates the net: "kernel" (the compiled kernel, inside the bodies' Verlet step;
     # multibody.kernel_net) or "exudyn" (one Exudyn node for the whole net, the reference path)
     net_integration: str = "kernel"
+    # resting contacts: a node's single contact whose normal speed is below this (m/s) takes one
+    # implicit step instead of the sub-cycle (multibody.contact_implicit); 0 turns it off (the default)
+    implicit_contact_speed: float = 0.0
 
     @property
     def n_steps(self) -> int:

@@ -19,7 +19,7 @@ from multibody.contact import (
     hertz_elastic_energy,
     signed_distance_to_mesh,
 )
-from multibody.contact_implicit import IMPLICIT_CONTACT_SPEED, contact_implicit_step
+from multibody.contact_implicit import contact_implicit_step
 
 
 @njit(cache=True)
@@ -111,8 +111,8 @@ def _substeps_to_resolve_contact(penetrations, relative_velocities, normals, bod
 def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
                        triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
                        shape_is_box, k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps,
-                       stage_weight, velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse,
-                       out_node_impulse, f_non_contact, v_start, work_node, candidates):
+                       stage_weight, implicit_speed, velocity_lag, lag_body, f_net, f_body, torque_lvlh,
+                       out_body_impulse, out_node_impulse, f_non_contact, v_start, work_node, candidates):
     """Add node-body contact kicks to ``f_net`` and their reactions to ``f_body``/``torque_lvlh``.
 
     ``f_net`` enters holding every non-contact force on the nodes. Returns the elastic
@@ -236,7 +236,7 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
             # is carried as a lag and released at the next evaluation.
             normal_speed = abs(c_rel[0, 0] * c_normal[0, 0] + c_rel[0, 1] * c_normal[0, 1]
                                + c_rel[0, 2] * c_normal[0, 2])
-            if n_substeps > 1 and k == 1 and normal_speed < IMPLICIT_CONTACT_SPEED:
+            if n_substeps > 1 and k == 1 and normal_speed < implicit_speed:
                 # a resting or slow single contact: one implicit step (multibody.contact_implicit)
                 mx, my, mz, ex, ey, ez, dissipated = contact_implicit_step(
                     c_pen[0], c_rel[0], c_normal[0], f_non_contact[i], net_mass[i], c_mass[0], step,

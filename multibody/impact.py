@@ -96,6 +96,7 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
         contact_substep=(assembly.solver.contact_substep
                          if assembly.solver.integrator == "VelocityVerlet" else np.inf),
         stage_weight=1.0 / INTEGRATORS[assembly.solver.integrator][1],
+        implicit_contact_speed=assembly.solver.implicit_contact_speed,
         **_mount_arrays(assembly.mount),
     )
 

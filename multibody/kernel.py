@@ -148,6 +148,7 @@ class KernelData:
     step: float                      # integrator step (s)
     contact_substep: float           # shortest contact sub-step (s); >= step disables sub-cycling
     stage_weight: float = 1.0        # 1 / force evaluations per integrator step
+    implicit_contact_speed: float = 0.0  # (m/s) below it a single contact takes the implicit step; 0: never
     # Net nodes mounted on a body (a chaser's net frame): one stiff spring-damper per mount
     mount_node: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # (k,) net node
     mount_body: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # (k,) body
@@ -201,7 +202,8 @@ class KernelData:
             self.shape_body, self.shape_triangle_range, self.shape_box_min, self.shape_box_max, self.shape_is_box,
             self.contact_stiffness, self.contact_exponent, self.contact_damping,
             self.mu_static, self.mu_kinetic, self.transition_speed,
-            self.mean_motion, self.step, n_sub, self.stage_weight, self.velocity_lag, self.lag_body,
+            self.mean_motion, self.step, n_sub, self.stage_weight, self.implicit_contact_speed,
+            self.velocity_lag, self.lag_body,
             self.mount_node, self.mount_body, self.mount_point_body, self.mount_stiffness, self.mount_damping,
             self.force, self.body_impulse, self.node_impulse, self.scalars, self.work, self.work_node,
             self.candidates)
@@ -215,7 +217,7 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
                                body_reference, body_mass_all, inverse_inertia, triangles, triangle_normals,
                                shape_body, shape_triangle_range, shape_box_min, shape_box_max, shape_is_box,
                                k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
-                               n_orbit, step, n_substeps, stage_weight, velocity_lag, lag_body,
+                               n_orbit, step, n_substeps, stage_weight, implicit_speed, velocity_lag, lag_body,
                                mount_node, mount_body, mount_point_body, k_mount, d_mount,
                                out_force, out_body_impulse, out_node_impulse, out_scalars, work, work_node,
                                candidates):
@@ -264,7 +266,7 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
     contact_energy, n_contacts, contact_dissipated = add_contact_forces(
         x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
         triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max, shape_is_box,
-        k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight,
+        k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight, implicit_speed,
         velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_node_impulse,
         work[2], work[3], work_node, candidates)
     for b in range(nb):

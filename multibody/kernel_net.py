@@ -56,8 +56,9 @@ KERNEL_FIELDS = (
     "bending_triples", "bending_stiffness", "body_reference", "body_mass", "body_inverse_inertia", "triangles",
     "triangle_normals", "shape_body", "shape_triangle_range", "shape_box_min", "shape_box_max", "shape_is_box",
     "contact_stiffness", "contact_exponent", "contact_damping", "mu_static", "mu_kinetic", "transition_speed",
-    "mean_motion", "step", "stage_weight", "velocity_lag", "lag_body", "mount_node", "mount_body",
-    "mount_point_body", "mount_stiffness", "mount_damping", "force", "body_impulse", "node_impulse", "scalars", "work", "work_node",
+    "mean_motion", "step", "stage_weight", "implicit_contact_speed", "velocity_lag", "lag_body", "mount_node",
+    "mount_body", "mount_point_body", "mount_stiffness", "mount_damping", "force", "body_impulse", "node_impulse",
+    "scalars", "work", "work_node",
     "candidates")
 STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "q_eval", "qt_eval")
 
@@ -100,7 +101,7 @@ def _forces(m, time, n_substeps):
         m.shape_body, m.shape_triangle_range, m.shape_box_min, m.shape_box_max, m.shape_is_box,
         m.contact_stiffness, m.contact_exponent, m.contact_damping,
         m.mu_static, m.mu_kinetic, m.transition_speed,
-        m.mean_motion, m.step, n_substeps, m.stage_weight, m.velocity_lag, m.lag_body,
+        m.mean_motion, m.step, n_substeps, m.stage_weight, m.implicit_contact_speed, m.velocity_lag, m.lag_body,
         m.mount_node, m.mount_body, m.mount_point_body, m.mount_stiffness, m.mount_damping,
         m.force, m.body_impulse, m.node_impulse, m.scalars, m.work, m.work_node, m.candidates)
 

@@ -5,10 +5,10 @@ the 2-core machine CI uses, quiet (load < 1), and a run on a loaded or slower ma
 longer. They only need to be right within a factor of a few: their job is to stop a mistyped
 ``end_time = 1e6`` (1e10 steps, years of wall time) before it starts, not to schedule work.
 
-* impact (``run``, ``assess``, ``perceive``, sweeps): 55 us per step for Exudyn's bodies, joints,
-  the hooks and the recorder plus 0.22 us per net node and step (the compiled kernel integrating
-  the net): the line through bench/bench_impact.py's 105 us per step for 15 x 15 (229 nodes) and
-  329 us for the 35 x 35 reference case (1229 nodes), at load ~2 (docs/model.md, "Speed");
+* impact (``run``, ``assess``, ``perceive``, sweeps): 60 us per step for Exudyn's bodies, joints,
+  the hooks and the recorder plus 0.33 us per net node and step (the compiled kernel integrating
+  the net): about the line through bench/bench_impact.py's 143 us per step for 15 x 15 (229 nodes)
+  and 481 us for the 35 x 35 reference case (1229 nodes), at load 1.3-1.6 (docs/model.md, "Speed");
 * lower-order tow: 15 us per step (0.97 s for 71 100 steps, docs/towing.md);
 * full-net tow: 0.11 us per net node and net sub-step (300 s of the 15 x 15 net, 229 nodes, with
   20 sub-steps of each 2 ms step: 6.9e8 node sub-steps in 75.7 s, docs/towing.md).
@@ -20,13 +20,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-IMPACT_US_PER_STEP = 55.0
-IMPACT_US_PER_NODE_STEP = 0.22
+IMPACT_US_PER_STEP = 60.0
+IMPACT_US_PER_NODE_STEP = 0.33
 TOW_US_PER_STEP = 15.0
 FULL_NET_US_PER_NODE_SUBSTEP = 0.11
 
 #: Work refused without ``--force``: one hour of estimated wall time (a full reference impact is
-#: about 25 s; a 60 s impact of the full net about 3.5 min) or 8 GB of recorded data.
+#: about 36 s; a 60 s impact of the full net about 5 min) or 8 GB of recorded data.
 LIMIT_WALL_S = 3600.0
 LIMIT_MEMORY_BYTES = 8e9
 #: Never started, even with ``--force``: beyond this the estimate itself says the run cannot finish.
