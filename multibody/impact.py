@@ -379,9 +379,9 @@ def solve_checked(mbs, settings, solver_type, watch: HealthWatch) -> None:
     if watch.failure is not None:
         raise watch.failure
     reached = mbs.systemData.GetTime()
-    check_solver_flag(bool(success), end_time, reached, watch.cause)
-    if reached < end_time - 0.5 * settings.timeIntegration.endTime / max(settings.timeIntegration.numberOfSteps, 1):
-        raise SimulationFailed(reached, f"the integrator stopped before the end time {end_time:g} s", watch.cause)
+    half_step = 0.5 * end_time / max(settings.timeIntegration.numberOfSteps, 1)
+    # a solver that reports success but stopped short failed all the same
+    check_solver_flag(bool(success) and reached >= end_time - half_step, end_time, reached, watch.cause)
 
 
 class ImpactSimulation:
