@@ -236,9 +236,10 @@ class RunResult:
     @property
     def debris_state(self) -> str | None:
         """'debris', 'no_debris' or 'indeterminate' (docs/structures.md, "Three answers");
-        None for a case without weak locations (no verdict was asked for)."""
+        None for a case without weak locations (no verdict was asked for); 'indeterminate' for a
+        case with weak locations whose verdict is missing (the structures stage failed)."""
         if self.verdict is None:
-            return None
+            return "indeterminate" if (self._folder.case.get("structures") or {}).get("weak_locations") else None
         return self.verdict.get("debris_state") or ("debris" if self.verdict["secondary_debris"] else "no_debris")
 
     @property

@@ -88,3 +88,18 @@ def test_first_run_announces_compilation_and_keeps_solver_notices_off_the_termin
 
 def test_kernels_are_reported_compiled_after_a_run(api_run):
     assert not ra.needs_compilation()
+
+
+def test_a_case_with_weak_locations_and_no_verdict_is_indeterminate(api_run, tmp_path):
+    """A run whose structures stage failed has a summary but no structures.json: the API must not
+    read the missing verdict as "no verdict asked for" (issue 20)."""
+    import shutil
+
+    folder = tmp_path / "run"
+    shutil.copytree(api_run.path, folder)
+    (folder / "structures.json").unlink()
+    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest["files"] = [f for f in manifest["files"] if not f.startswith("structures.")]
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    assert api_run.debris_state in ("debris", "no_debris", "indeterminate")
+    assert ra.open_run(folder).debris_state == "indeterminate"
