@@ -12,9 +12,9 @@ import sys
 import time
 from pathlib import Path
 
-from riskassess.approach import solve_case
-from riskassess.approach_case import ApproachCase
-from riskassess.case import load_model
+from riskassess.stages.approach import solve_case
+from riskassess.cases.approach import ApproachCase
+from riskassess.cases.impact import load_model
 
 
 def _relative(reference, key):

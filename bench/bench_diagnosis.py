@@ -37,8 +37,8 @@ def towing_truths(workers: int) -> None:
 
     from riskassess.diagnosis.measured import write_measured
     from riskassess.diagnosis.synthetic import noisy, sample_times, simulate_effect
-    from riskassess.diagnose import diagnose_case
-    from riskassess.diagnosis_case import load_diagnosis_case
+    from riskassess.stages.diagnose import diagnose_case
+    from riskassess.cases.diagnosis import load_diagnosis_case
 
     times = sample_times(300.0, 10.0)
     for k_m, tau, seed in TOWING_TRUTHS:
@@ -93,7 +93,7 @@ def main() -> None:
         towing_truths(args.workers)
         return
     tic = time.perf_counter()
-    from riskassess.diagnose import diagnose_case   # numba compiled code loads from its cache here
+    from riskassess.stages.diagnose import diagnose_case   # numba compiled code loads from its cache here
     print(f"import (compiled model from the numba cache): {time.perf_counter() - tic:.1f} s")
     if not all((ROOT / "cases" / "data" / data).is_file() for _, data in RUNS):
         sys.path.insert(0, str(ROOT / "cases" / "data"))

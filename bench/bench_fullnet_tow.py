@@ -21,11 +21,11 @@ import time
 import numpy as np
 
 from multibody.net_towing import run_exudyn
-from riskassess.case import load_model
-from riskassess.identify import rmse
-from riskassess.identify_fullnet import CHANNELS
-from riskassess.tow_fullnet import full_net_model, momentum_residual, wrapped_net
-from riskassess.towing_case import TowingCase
+from riskassess.cases.impact import load_model
+from riskassess.stages.identify import rmse
+from riskassess.stages.identify_fullnet import CHANNELS
+from riskassess.stages.tow_fullnet import full_net_model, momentum_residual, wrapped_net
+from riskassess.cases.towing import TowingCase
 
 CASE = os.path.join(os.path.dirname(__file__), "..", "cases", "zenit2_towing.toml")
 

@@ -22,9 +22,9 @@ import time
 
 import numpy as np
 
-from riskassess.case import load_model
-from riskassess.identify import benchmark, simulate
-from riskassess.towing_case import Optimizers, TowingCase
+from riskassess.cases.impact import load_model
+from riskassess.stages.identify import benchmark, simulate
+from riskassess.cases.towing import Optimizers, TowingCase
 
 
 def main():

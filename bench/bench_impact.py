@@ -31,9 +31,9 @@ from exudyn.itemInterface import (
 )
 
 from multibody.impact import ImpactSimulation, net_stable_step, solver_chatter_to_stderr
-from riskassess.assemble import model_inputs
-from riskassess.case import load_case
-from riskassess.summary import run_summary
+from riskassess.models.impact import model_inputs
+from riskassess.cases.impact import load_case
+from riskassess.products.summary import run_summary
 
 ROOT = Path(__file__).resolve().parents[1]
 

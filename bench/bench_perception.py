@@ -19,8 +19,8 @@ import tempfile
 import tomllib
 from pathlib import Path
 
-from riskassess.case import validate_case
-from riskassess.perceive import perceive_case
+from riskassess.cases.impact import validate_case
+from riskassess.stages.perceive import perceive_case
 
 
 def _fmt(values, digits=3):

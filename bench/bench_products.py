@@ -13,9 +13,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from riskassess.report.document import build_sections, render_html, render_pdf
-from riskassess.results import RunFolder
-from riskassess.vtk_export import export_vtk
+from riskassess.products.report.document import build_sections, render_html, render_pdf
+from riskassess.products.results import RunFolder
+from riskassess.products.vtk_export import export_vtk
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -28,7 +28,7 @@ def main() -> None:
     if len(sys.argv) > 1:
         run_dir = Path(sys.argv[1])
     else:
-        from riskassess.pipeline import run_case
+        from riskassess.stages.run import run_case
 
         run_dir = Path(tempfile.mkdtemp()) / "envisat"
         t0 = time.perf_counter()

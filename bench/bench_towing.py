@@ -17,10 +17,10 @@ import argparse
 import numpy as np
 
 from multibody.towing import run_exudyn, run_twin, stable_step
-from riskassess.case import load_model
-from riskassess.identify import COMPARED, compared_series, rmse
-from riskassess.tow import case_decision_vector, towing_model
-from riskassess.towing_case import TowingCase
+from riskassess.cases.impact import load_model
+from riskassess.stages.identify import COMPARED, compared_series, rmse
+from riskassess.stages.tow import case_decision_vector, towing_model
+from riskassess.cases.towing import TowingCase
 
 
 def compared(result) -> tuple:

@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 
 from multibody.impact import ImpactSimulation
-from riskassess.assemble import model_inputs
-from riskassess.case import load_case
-from riskassess.summary import contact_totals_debris
+from riskassess.models.impact import model_inputs
+from riskassess.cases.impact import load_case
+from riskassess.products.summary import contact_totals_debris
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,6 +1,6 @@
 """Plain descriptions of what goes into an impact simulation (SI units, named frames).
 
-These dataclasses are the interface between the case files (``riskassess.case``) and the
+These dataclasses are the interface between the case files (``riskassess.cases.impact``) and the
 Exudyn builders; tests build them directly for analytic set-ups.
 """
 from __future__ import annotations

@@ -43,7 +43,7 @@ from multibody.contact import _power, hollar_friction_coefficient
 #: Off by default (``SolverSpec.implicit_contact_speed = 0``, every contact sub-cycled): with this value
 #: the reference case's results held (docs/model.md, Speed), but in the perception scenario
 #: (cases/tang2023_debris_perception.toml, 3 s collision run) the net left the tumbling debris 0.2-0.4 s
-#: later, leaving 6-8 LiDAR frames of free flight where tests/riskassess/test_perceive.py needs 10 (the
+#: later, leaving 6-8 LiDAR frames of free flight where tests/riskassess/stages/test_perceive.py needs 10 (the
 #: sub-cycled run has 10-11: the margin is thin there too); not understood yet.
 #: Suggested value, when switched on: below this normal relative speed (m/s) at the start of the step,
 #: a node's single contact takes the implicit step. At 0.15 m/s the Hunt-Crossley restitution is 1 - (2/3) alpha v = 0.995 for the

@@ -23,11 +23,11 @@ from pathlib import Path
 import numpy as np
 
 from multibody.impact import kernels_compiled
-from riskassess.case import Case, CaseError, read_toml, validate_case
-from riskassess.case_kinds import case_kind
-from riskassess.outfolder import open_existing
-from riskassess.pipeline import run_case
-from riskassess.results import RunFolder, atomic_write_json
+from riskassess.cases.impact import Case, CaseError, read_toml, validate_case
+from riskassess.cases.kinds import case_kind
+from riskassess.products.outfolder import open_existing
+from riskassess.stages.run import run_case
+from riskassess.products.results import RunFolder, atomic_write_json
 from riskassess.sweep.spec import case_with
 
 __all__ = ["ImpactCase", "RunResult", "load_case", "run", "open_run", "report", "needs_compilation"]
@@ -42,7 +42,7 @@ class ImpactCase:
 
     Attributes of the validated case read through: ``case.simulation.end_time`` (s),
     ``case.launch.velocity`` (m/s), ``case.name``; the pydantic model itself is ``case.model``
-    (:class:`riskassess.case.Case`, docs/case-format.md).
+    (:class:`riskassess.cases.impact.Case`, docs/case-format.md).
 
     Parameters
     ----------
@@ -51,7 +51,7 @@ class ImpactCase:
         copy of it (``case.toml``) and of the validated case with the overrides (``case.json``).
     raw : dict
         The file as parsed, before the overrides.
-    model : riskassess.case.Case
+    model : riskassess.cases.impact.Case
         The validated case, overrides applied.
     overrides : dict
         Dotted case keys and their new values (SI), e.g. ``{"launch.velocity": 12.0}``.
@@ -84,7 +84,7 @@ class ImpactCase:
 
         Raises
         ------
-        riskassess.case.CaseError
+        riskassess.cases.impact.CaseError
             A key the case does not have, or a value out of its range (the message names both).
         """
         overrides = {**self.overrides, **dict(values)}
@@ -109,7 +109,7 @@ def load_case(path: str | Path) -> ImpactCase:
 
     Raises
     ------
-    riskassess.case.CaseError
+    riskassess.cases.impact.CaseError
         The file is not valid (every problem named, with the file), or is a case of another kind
         (towing, approach, diagnosis: run those with their own command).
     """
@@ -145,7 +145,7 @@ def run(case: ImpactCase | str | Path, out: str | Path, *, overwrite: bool = Fal
         ``progress(t)`` with the simulated time t (s) at every output sample.
     pending : sequence of str
         Product steps the caller makes next (``"report"``, ``"vtk"``): the folder's status stays
-        ``running`` until they are recorded (:func:`riskassess.outfolder.step_done`).
+        ``running`` until they are recorded (:func:`riskassess.products.outfolder.step_done`).
     command : str
         The command recorded in the manifest (``run`` or ``assess``).
 
@@ -158,7 +158,7 @@ def run(case: ImpactCase | str | Path, out: str | Path, *, overwrite: bool = Fal
     ------
     multibody.health.SimulationFailed
         The simulation failed its numerical health check; the folder says ``failed``.
-    riskassess.outfolder.OutputRefused
+    riskassess.products.outfolder.OutputRefused
         ``out`` holds something else.
     """
     case = case if isinstance(case, ImpactCase) else load_case(case)
@@ -175,7 +175,7 @@ def open_run(path: str | Path) -> RunResult:
 
     Raises
     ------
-    riskassess.results.MissingData
+    riskassess.products.results.MissingData
         The folder lacks its summary (not a finished impact run).
     ValueError
         Not a run folder of this tool (no readable manifest).
@@ -197,12 +197,12 @@ def report(run: RunResult | str | Path, pdf: bool = False, progress=None):
 
     Returns
     -------
-    riskassess.report.ReportOutput
+    riskassess.products.report.ReportOutput
         ``.html`` and ``.pdf`` paths, ``.sections`` (each says whether its data was missing).
     """
-    # Imported here, not at the top: riskassess.report selects matplotlib's headless backend on
+    # Imported here, not at the top: riskassess.products.report selects matplotlib's headless backend on
     # import, which would switch off a notebook's inline plots for anyone importing this module.
-    from riskassess.report import write_report
+    from riskassess.products.report import write_report
 
     folder = run.path if isinstance(run, RunResult) else Path(run)
     return write_report(folder, pdf=pdf, progress=progress)

@@ -12,10 +12,10 @@ from rich.text import Text
 
 from multibody.health import SimulationFailed
 from riskassess import __version__
-from riskassess.case import Case, CaseError, load_case
-from riskassess.case_kinds import KINDS as CASE_KINDS
-from riskassess.outfolder import OutputRefused, default_out, step_done
-from riskassess.results import MissingData, RunFolder
+from riskassess.cases.impact import Case, CaseError, load_case
+from riskassess.cases.kinds import KINDS as CASE_KINDS
+from riskassess.products.outfolder import OutputRefused, default_out, step_done
+from riskassess.products.results import MissingData, RunFolder
 
 #: Exit codes (docs/outputs.md): 0 done; 1 a product after a finished run failed; 2 invalid input or
 #: refused output; 3 perceive: not observable; 4 approach: constraints not met; 5 the simulation
@@ -66,7 +66,7 @@ def _announce_compilation(needed: bool) -> None:
 
 
 def impact_estimate_of(case: Case):
-    from riskassess.estimate import impact_estimate
+    from riskassess.stages.estimate import impact_estimate
 
     sim = case.simulation
     return impact_estimate(sim.end_time, sim.step, case.net.nodes_per_side ** 2 + 4, len(case.target.bodies) + 1,
@@ -74,8 +74,8 @@ def impact_estimate_of(case: Case):
 
 
 def _check_work(estimate, args) -> None:
-    """Say what the simulation will cost; refuse above the limits unless --force (riskassess.estimate)."""
-    from riskassess.estimate import check_budget
+    """Say what the simulation will cost; refuse above the limits unless --force (riskassess.stages.estimate)."""
+    from riskassess.stages.estimate import check_budget
 
     check_budget(estimate, getattr(args, "force", False))
     if not getattr(args, "json", False):
@@ -89,7 +89,7 @@ def _steps(args) -> list[str]:
 
 def _products(run_dir: Path, steps, quiet: bool = False, make=None) -> int:
     """Product steps (report, VTK export) from a finished run folder, each recorded in its manifest
-    (:func:`riskassess.outfolder.step_done`); a failure keeps the finished results: exit code 1
+    (:func:`riskassess.products.outfolder.step_done`); a failure keeps the finished results: exit code 1
     (2 when the step's output is refused)."""
     status = 0
     for step in steps:
@@ -132,7 +132,7 @@ def _make_report(run_dir: Path, pdf: bool = True, quiet: bool = False):
 
 def _make_vtk(run_dir: Path, out=None, every: int | None = None, quiet: bool = False, overwrite: bool = False,
               max_frames: int | None = None):
-    from riskassess.vtk_export import export_vtk
+    from riskassess.products.vtk_export import export_vtk
 
     with _progress_bar("VTK export", quiet) as bar:
         task = bar.add_task("frames", total=None)
@@ -168,7 +168,7 @@ def _cmd_assess(args) -> int:
 
 def _cmd_perceive(args) -> int:
     from riskassess.api import needs_compilation
-    from riskassess.perceive import perceive_case
+    from riskassess.stages.perceive import perceive_case
 
     case = load_case(args.case)
     _check_work(impact_estimate_of(case), args)
@@ -191,9 +191,9 @@ def _cmd_perceive(args) -> int:
 
 
 def _cmd_tow(args) -> int:
-    from riskassess.case import load_model
-    from riskassess.tow_stage import tow_case
-    from riskassess.towing_case import TowingCase
+    from riskassess.cases.impact import load_model
+    from riskassess.stages.tow_stage import tow_case
+    from riskassess.cases.towing import TowingCase
 
     case = load_model(args.case, TowingCase)
     _check_work(tow_estimate_of(case), args)
@@ -211,7 +211,7 @@ def _cmd_tow(args) -> int:
 
 
 def tow_estimate_of(case):
-    from riskassess.estimate import tow_estimate
+    from riskassess.stages.estimate import tow_estimate
 
     sim = case.simulation
     if sim.model == "full-net":
@@ -221,15 +221,15 @@ def tow_estimate_of(case):
 
 
 def _cmd_identify(args) -> int:
-    from riskassess.case import load_model
-    from riskassess.identify import benchmark_case
-    from riskassess.towing_case import TowingCase
+    from riskassess.cases.impact import load_model
+    from riskassess.stages.identify import benchmark_case
+    from riskassess.cases.towing import TowingCase
 
     case = load_model(args.case, TowingCase)
     choice = {k: v for k, v in (("cost", args.cost), ("searches", args.optimizers)) if v}
     case = case.model_copy(update={"identification": case.identification.model_copy(update=choice)})
     if not args.benchmark:
-        from riskassess.identify_fullnet import identify_full_net
+        from riskassess.stages.identify_fullnet import identify_full_net
 
         out = Path(args.out) if args.out else default_out(case.name, "_identify_fullnet")
         answer = identify_full_net(args.case, out, case, overwrite=args.overwrite)
@@ -251,7 +251,7 @@ def _cmd_identify(args) -> int:
 
 
 def print_perception(answer: dict, out: Path, console=None) -> None:
-    from riskassess.tables import perception_rows
+    from riskassess.products.tables import perception_rows
 
     console = console or _console()
     _print_table(console, f"{escape(answer['case'])}: debris mass and inertia from LiDAR and the net collision",
@@ -311,7 +311,7 @@ def _console():
 
 def print_verdict(verdict: dict, console=None) -> None:
     """The verdict table: location, criterion, peak demand, allowable, margin, fails?, released piece."""
-    from riskassess.tables import STATE_TEXT, VERDICT_COLUMNS, debris_line, piece_fate, verdict_rows
+    from riskassess.products.tables import STATE_TEXT, VERDICT_COLUMNS, debris_line, piece_fate, verdict_rows
 
     console = console or _console()
     marked = {"fails": Text("FAIL", style="red"), "indeterminate": Text("indeterminate", style="yellow")}
@@ -331,7 +331,7 @@ def print_verdict(verdict: dict, console=None) -> None:
 
 
 def print_summary(summary: dict, run_dir: Path, console=None) -> None:
-    from riskassess.tables import summary_rows
+    from riskassess.products.tables import summary_rows
 
     console = console or _console()
     _print_table(console, f"{escape(summary['case'])}: coupled net impact", ("quantity", "this run", "paper (decoupled)"),
@@ -340,7 +340,7 @@ def print_summary(summary: dict, run_dir: Path, console=None) -> None:
 
 
 def _cmd_diagnose(args) -> int:
-    from riskassess.diagnose import diagnose_case
+    from riskassess.stages.diagnose import diagnose_case
 
     noise = {}
     for item in args.noise:
@@ -375,9 +375,9 @@ def _cmd_diagnose(args) -> int:
 
 
 def _cmd_approach(args) -> int:
-    from riskassess.approach import approach_case
-    from riskassess.approach_case import ApproachCase
-    from riskassess.case import load_model
+    from riskassess.stages.approach import approach_case
+    from riskassess.cases.approach import ApproachCase
+    from riskassess.cases.impact import load_model
 
     case = load_model(args.case, ApproachCase)
     out = Path(args.out) if args.out else default_out(case.name)
@@ -480,7 +480,7 @@ def _cmd_sweep_status(args) -> int:
 
 
 def _cmd_validate(args) -> int:
-    from riskassess.case_kinds import load_any_case
+    from riskassess.cases.kinds import load_any_case
 
     kind, case = load_any_case(args.case)
     print(f"{args.case}: valid {kind} case '{case.name}'")
@@ -488,7 +488,7 @@ def _cmd_validate(args) -> int:
 
 
 def _cmd_schema(args) -> int:
-    from riskassess.case_kinds import case_schema
+    from riskassess.cases.kinds import case_schema
 
     print(json.dumps(case_schema(args.kind), indent=2))
     return 0

@@ -24,7 +24,7 @@ import numpy as np
 
 from riskassess.diagnosis.measured import write_measured
 from riskassess.diagnosis.synthetic import noisy, sample_times, simulate_effect
-from riskassess.diagnosis_case import load_diagnosis_case
+from riskassess.cases.diagnosis import load_diagnosis_case
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = (("diagnose_tumbling_rigid.toml", "tumbling_rigid_nutation.csv", "internal_energy_dissipation",

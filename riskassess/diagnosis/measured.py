@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from riskassess.diagnosis.channels import CHANNELS, QUATERNION
-from riskassess.case_inputs import read_text
-from riskassess.results import atomic_write_bytes
+from riskassess.cases.inputs import read_text
+from riskassess.products.results import atomic_write_bytes
 
 #: Fewest samples a record must have: the noise estimate and a held-out part need a few dozen.
 MIN_SAMPLES = 30

@@ -29,7 +29,7 @@ from riskassess.diagnosis.towing_dynamics import (EXTRA_STATES, diagnostics_size
 from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.towing import packed
 from multibody.towing_kernel import MT_TENSION
-from riskassess.tow import towing_model
+from riskassess.stages.tow import towing_model
 
 #: Nominal parameters of the towing scenario: name -> (size, unit), the fitted vector's order.
 TOWING_PARAMETERS = {"attitude": (3, "rad"), "angular_velocity": (3, "rad/s"), "position": (3, "m"),
@@ -56,7 +56,7 @@ class TowingPlant:
 
     Attributes
     ----------
-    case : TowingCase                 The lower-order model (riskassess/towing_case.py).
+    case : TowingCase                 The lower-order model (riskassess/cases/towing.py).
     fit_step : float                  Largest step of the fast model (s).
     attitude0 : (3, 3) float          D -> ECI at t = 0.
     omega0 : (3,) float               Debris angular velocity, D (rad/s).

@@ -21,10 +21,10 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 
-from riskassess import results
-from riskassess.report.document import render_document, render_pdf
-from riskassess.report.plotting import STYLE
-from riskassess.report.sweep import envelope_section, runs_section
+from riskassess.products import results
+from riskassess.products.report.document import render_document, render_pdf
+from riskassess.products.report.plotting import STYLE
+from riskassess.products.report.sweep import envelope_section, runs_section
 from riskassess.sweep.envelope import envelope, unknown_counts
 from riskassess.sweep.store import ResultStore, StoreError
 

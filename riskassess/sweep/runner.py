@@ -20,9 +20,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from multibody.health import SimulationFailed
-from riskassess.case import CaseError, validate_case
-from riskassess.outfolder import open_existing
-from riskassess.results import atomic_write_json
+from riskassess.cases.impact import CaseError, validate_case
+from riskassess.products.outfolder import open_existing
+from riskassess.products.results import atomic_write_json
 from riskassess.sweep.cluster_log import StderrToFile, distributed_logging_to
 from riskassess.sweep.records import debris_state_of
 from riskassess.sweep.spec import RunSpec, SweepSpecError, case_with
@@ -129,7 +129,7 @@ def simulate_run(case_path: str, case_text: str, overrides: dict, keep_dir: str 
     A simulation stopped by the numerical health checks raises :class:`RunFailed` of kind
     ``diverged``, with the check's message.
     """
-    from riskassess.pipeline import run_case  # the pipeline imports Exudyn: only on the worker
+    from riskassess.stages.run import run_case  # the pipeline imports Exudyn: only on the worker
 
     case = validate_case(case_with(tomllib.loads(case_text), overrides), case_path)
     out = Path(keep_dir) if keep_dir else Path(tempfile.mkdtemp(prefix="riskassess-sweep-"))

@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 
 from multibody.impact import ImpactSimulation
-from riskassess.assemble import model_inputs
-from riskassess.case import load_case
+from riskassess.models.impact import model_inputs
+from riskassess.cases.impact import load_case
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from multibody.impact import ImpactSimulation
-from riskassess.assemble import model_inputs
-from riskassess.case import validate_case
+from riskassess.models.impact import model_inputs
+from riskassess.cases.impact import validate_case
 
 CASE = Path(__file__).parents[2] / "cases" / "tang2023_debris_perception.toml"
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import riskassess.api as ra
-from riskassess.case import CaseError
+from riskassess.cases.impact import CaseError
 from riskassess.cli import COMPILING, main
 from tests.riskassess.conftest import CASES
 

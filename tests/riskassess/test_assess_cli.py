@@ -4,7 +4,7 @@ import json
 import numpy as np
 import pytest
 
-from riskassess.results import read_manifest
+from riskassess.products.results import read_manifest
 
 
 def test_verdict_written_and_consistent_with_the_loads(assessed):

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from riskassess.cli import main
-from riskassess.results import RunFolder, read_manifest
+from riskassess.products.results import RunFolder, read_manifest
 from structures.verdict import MAX_SAMPLE_INTERVAL_S, MIN_JUDGED_SAMPLES, evidence_gaps
 from tests.riskassess.conftest import CASES, shortened_case
 

@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from riskassess.case_kinds import KINDS, load_any_case
+from riskassess.cases.kinds import KINDS, load_any_case
 from riskassess.cli import main
 from tests.riskassess.conftest import CASES
 

@@ -153,13 +153,13 @@ def test_simulation_failed_is_recorded_as_diverged(short_case, tmp_path, monkeyp
     kind "diverged" with the check's message; a re-run does not retry it unless --retry-failed."""
     from dask.distributed import LocalCluster
 
-    import riskassess.pipeline
+    import riskassess.stages.run
     from multibody.health import SimulationFailed
 
     def diverging(*args, **kwargs):
         raise SimulationFailed(0.123, "state is not finite (entry 7)", "step too large; stable step ~ 2e-4 s")
 
-    monkeypatch.setattr(riskassess.pipeline, "run_case", diverging)
+    monkeypatch.setattr(riskassess.stages.run, "run_case", diverging)
     specs = run_specs([parse_vary("launch.velocity=12:12:1")])
     with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cluster, \
             ResultStore(tmp_path / "results.sqlite") as store:   # in-process worker: it sees the patched pipeline
@@ -178,14 +178,14 @@ def test_diverged_failure_survives_the_trip_from_a_worker_process(short_case, mo
     RunFailed("diverged", message), which does."""
     import pickle
 
-    import riskassess.pipeline
+    import riskassess.stages.run
     from multibody.health import SimulationFailed
     from riskassess.sweep.runner import RunFailed, failure_kind, failure_message
 
     def diverging(*args, **kwargs):
         raise SimulationFailed(0.5, "energy balance drift 0.3 > 0.05", "step too large")
 
-    monkeypatch.setattr(riskassess.pipeline, "run_case", diverging)
+    monkeypatch.setattr(riskassess.stages.run, "run_case", diverging)
     with pytest.raises(RunFailed) as caught:
         simulate_run(str(short_case), short_case.read_text(), {"launch.velocity": 12.0})
     travelled = pickle.loads(pickle.dumps(caught.value))

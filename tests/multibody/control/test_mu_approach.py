@@ -103,7 +103,7 @@ def test_mesh_refinement_splits_the_thrust_switches_until_the_replay_follows():
     # the quadratic control cannot follow them (local error ~1e-3 there, ~1e-9 elsewhere). The
     # refinement splits exactly the intervals over the tolerance into SPLIT each (the mesh still
     # sums to 1); afterwards every local error is within the tolerance and the open-loop replay
-    # ends within 5 cm of the debris (the stage's tolerance, riskassess.approach.MISS_TOLERANCE_M).
+    # ends within 5 cm of the debris (the stage's tolerance, riskassess.stages.approach.MISS_TOLERANCE_M).
     # Measured: unrefined local error 3.6e-3, replay miss 0.25 m; refined (102 intervals) 9.8e-6, 0.13 mm.
     problem = ma.ApproachProblem(RigidRodMUs(2.5, 22.0, 0.0014), np.array([30.0, 0, 30.0, 0, 0, 0]), "combined",
                                  np.zeros(2), 5.5, (0.0, 5.0), 60, final_at_rest=True, final_time_bounds=(0.1, 40.0),

@@ -5,8 +5,8 @@ from pathlib import Path
 
 import pytest
 
-from riskassess.diagnosis_case import DiagnosisCaseFile, diagnosis_case_from_dict
-from riskassess.case import read_toml
+from riskassess.cases.diagnosis import DiagnosisCaseFile, diagnosis_case_from_dict
+from riskassess.cases.impact import read_toml
 
 CASES = Path(__file__).parents[3] / "cases"
 TUMBLING_CASE = CASES / "diagnose_tumbling_rigid.toml"

@@ -20,9 +20,9 @@ from riskassess.diagnosis.model import predict
 from riskassess.diagnosis.plant import Plant
 from riskassess.diagnosis.synthetic import channel_noise, sample_times, simulate_constant_body_torque, simulate_effect
 from riskassess.cli import main
-from riskassess.diagnose import diagnose_case
-from riskassess.report.diagnosis import diagnosis_section
-from riskassess.results import RunFolder
+from riskassess.stages.diagnose import diagnose_case
+from riskassess.products.report.diagnosis import diagnosis_section
+from riskassess.products.results import RunFolder
 from tests.riskassess.diagnosis.conftest import HINGED_CASE, TUMBLING_CASE, case_with
 
 SEED = int(os.environ.get("DIAGNOSIS_SEED", "0"))

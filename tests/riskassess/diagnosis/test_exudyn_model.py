@@ -8,8 +8,8 @@ from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.exudyn_model import simulate_case, simulate_exudyn
 from riskassess.diagnosis.model import predict
 from riskassess.diagnosis.plant import Plant
-from riskassess.diagnosis_case import DiagnosisCaseFile, toml_text
-from riskassess.case import read_toml
+from riskassess.cases.diagnosis import DiagnosisCaseFile, toml_text
+from riskassess.cases.impact import read_toml
 from tests.riskassess.diagnosis.conftest import HINGED_CASE, TUMBLING_CASE, case_with
 
 TIMES = np.arange(0.0, 10.01, 0.1)

@@ -29,9 +29,9 @@ from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn
 from riskassess.diagnosis.towing_plant import lvlh_to_eci, simulate
 from multibody.towing import run_twin
 from multibody.towing_kernel import CHASER, THRUST
-from riskassess.case import read_toml
-from riskassess.diagnose import diagnose_case
-from riskassess.diagnosis_case import toml_text
+from riskassess.cases.impact import read_toml
+from riskassess.stages.diagnose import diagnose_case
+from riskassess.cases.diagnosis import toml_text
 from tests.riskassess.diagnosis.conftest import TOWING_CASE, case_with
 from tests.riskassess.diagnosis.test_diagnose import _check_named, draw_effect
 

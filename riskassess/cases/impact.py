@@ -1,0 +1,681 @@
+"""Case files: TOML, validated once on load into typed objects.
+
+Every quantity is SI (m, kg, s, N, rad); the field descriptions below state the unit and
+are the schema documentation (``riskassess schema`` prints them). Frames:
+
+* **LVLH**: chaser-centred, x radial, y along-track (flight direction), z cross-track.
+* **target frame**: the debris reference frame in which body geometry, centres of
+  mass, inertia and joints are given; its pose in LVLH at t = 0 is ``target.position_lvlh``
+  and ``target.attitude_rotation_vector`` (target->LVLH).
+
+:func:`load_case` raises :class:`CaseError` listing every problem as
+``file: key.path: message`` before any simulation starts.
+"""
+from __future__ import annotations
+
+import copy
+import json
+import re
+from pathlib import Path
+from typing import Annotated, Literal, Union, get_args
+
+import numpy as np
+from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
+
+from riskassess.cases.inputs import (JSON_FILE_LIMIT, MESH_FILE_LIMIT, CaseError, CaseName, ItemName, RelativeFile,
+                                    Strict, Text, decode_utf8, read_limited, read_toml, resolve_reference,
+                                    unique_names)
+from riskassess.cases.target_geometry import target_points_lvlh, target_vertices_lvlh
+from structures.sections import SECTIONS
+
+Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+Positive = Annotated[float, Field(gt=0)]
+NonNegative = Annotated[float, Field(ge=0)]
+
+
+def check_physical_inertia(j):
+    """The inertia tensor ``j`` (3, 3) (kg m^2) of a rigid body, or ValueError: it must be
+    symmetric, positive definite and obey the triangle inequality of principal moments."""
+    m = np.asarray(j, float)
+    if not np.allclose(m, m.T, rtol=1e-9, atol=1e-9 * np.abs(m).max()):
+        raise ValueError("inertia must be symmetric")
+    eig = np.linalg.eigvalsh(m)
+    if eig.min() <= 0:
+        raise ValueError(f"inertia must be positive definite (principal moments {eig.round(6).tolist()})")
+    if eig[0] + eig[1] < eig[2] * (1 - 1e-9):
+        raise ValueError(f"principal moments {eig.round(6).tolist()} violate the triangle inequality")
+    return j
+
+
+# ---------------------------------------------------------------------------- simulation
+class Simulation(Strict):
+    end_time: Positive = Field(description="Simulated time (s).")
+    step: Annotated[float, Field(gt=0, le=1e-2)] = Field(
+        1e-4, description="Fixed integrator step (s); see docs/model.md for the convergence study.")
+    integrator: Literal["VelocityVerlet", "RK44", "ExplicitMidpoint"] = Field(
+        "VelocityVerlet", description="Exudyn explicit integrator.")
+    output_rate: Positive = Field(1000.0, description="Time-series samples per second (Hz).")
+    net_output_rate: Positive = Field(50.0, description="Net snapshots per second (Hz), for VTK export.")
+    contact_substep: Positive = Field(
+        2e-6, description="Shortest sub-step of the contact impulse integration (s); each node's sub-step resolves "
+                          "its contact's period (0.02 rad per sub-step) and is never shorter; >= step turns "
+                          "sub-cycling off.")
+    net_integration: Literal["kernel", "exudyn"] = Field(
+        "kernel", description="Who integrates the net nodes: 'kernel' (the compiled force kernel, inside the "
+                              "bodies' VelocityVerlet step; fast) or 'exudyn' (one Exudyn node for the whole net, "
+                              "the reference path). Runge-Kutta integrators always use 'exudyn'.")
+
+    @model_validator(mode="after")
+    def _rates_fit_step(self):
+        if self.output_rate * self.step > 1.0 + 1e-9:
+            raise ValueError(f"output_rate must be <= 1/step = {1 / self.step:g} Hz. Got {self.output_rate:g} instead")
+        if self.end_time < self.step:
+            raise ValueError(f"end_time must be >= step ({self.step:g} s). Got {self.end_time:g} instead")
+        return self
+
+
+# ---------------------------------------------------------------------------- orbit
+class CircularOrbit(Strict):
+    kind: Literal["circular"]
+    altitude: Annotated[float, Field(ge=100e3, le=1e8)] = Field(
+        description="Altitude of the circular reference orbit above the equatorial radius (m); "
+                    "sets the Clohessy-Wiltshire mean motion.")
+
+
+class NoOrbit(Strict):
+    kind: Literal["none"]
+
+
+# ---------------------------------------------------------------------------- net
+class Thread(Strict):
+    diameter: Annotated[float, Field(gt=0, le=0.05)] = Field(
+        description="Thread diameter (m); node contact radius is half of it.")
+    density: Annotated[float, Field(gt=0, le=25000)] | None = Field(
+        None, description="Thread material density (kg/m^3); gives the node mass.")
+    modulus: Annotated[float, Field(gt=0, le=1e13)] | None = Field(
+        None, description="Young's modulus (Pa); stiffness = E A / l0.")
+    stiffness: Positive | None = Field(
+        None, description="Axial stiffness of one mesh-length thread (N/m), instead of modulus.")
+    damping: NonNegative = Field(description="Axial damping of a thread (N s/m).")
+    bending: bool = Field(False, description="Add thread bending stiffness (EI from modulus or bending_rigidity).")
+    bending_rigidity: Positive | None = Field(None, description="Thread bending rigidity EI (N m^2).")
+    breaking_load: Positive | None = Field(
+        None, description="Breaking load of one thread (N), e.g. the maker's minimum breaking strength of the "
+                          "line; the report compares every thread's peak tension with it. No default: without "
+                          "it the net's integrity is 'not assessed'.")
+
+    @model_validator(mode="after")
+    def _one_stiffness(self):
+        if (self.modulus is None) == (self.stiffness is None):
+            raise ValueError("give exactly one of 'modulus' (Pa) or 'stiffness' (N/m)")
+        if self.bending and self.modulus is None and self.bending_rigidity is None:
+            raise ValueError("'bending = true' needs 'modulus' or 'bending_rigidity'")
+        return self
+
+
+class Net(Strict):
+    side_length: Positive = Field(description="Side of the square net (m).")
+    nodes_per_side: Annotated[int, Field(ge=2, le=200)] = Field(description="Nodes along one side (-).")
+    thread: Thread
+    node_mass: Positive | None = Field(
+        None, description="Mass of one net node (kg); default: thread mass spread evenly over the nodes.")
+
+    @model_validator(mode="after")
+    def _mass_source(self):
+        if self.node_mass is None and self.thread.density is None:
+            raise ValueError("give 'node_mass' (kg) or 'thread.density' (kg/m^3)")
+        return self
+
+    @property
+    def mesh_size(self) -> float:
+        return self.side_length / (self.nodes_per_side - 1)
+
+
+class Bullets(Strict):
+    mass: Positive = Field(description="Mass of each of the four corner bullets (kg).")
+    radius: Annotated[float, Field(gt=0, le=1.0)] = Field(description="Bullet contact radius (m).")
+    tether_length: Positive | None = Field(
+        None, description="Thread from corner node to bullet (m); default one mesh size.")
+
+
+class Launch(Strict):
+    distance: Positive = Field(description="Distance from the net centre to the aim point along 'direction' (m).")
+    velocity: Annotated[float, Field(gt=0, le=500)] = Field(description="Net speed along 'direction' (m/s).")
+    direction: Vector3 = Field(description="Launch direction, LVLH (-), normalised on load.")
+    aim_point: Vector3 = Field([0.0, 0.0, 0.0], description="Aim point, target frame (m).")
+
+    @field_validator("direction")
+    @classmethod
+    def _nonzero(cls, v):
+        if np.linalg.norm(v) == 0:
+            raise ValueError("direction must be a non-zero vector")
+        return v
+
+
+class Contact(Strict):
+    stiffness: Positive = Field(description="Hertz stiffness k_n (N/m^exponent).")
+    exponent: Annotated[float, Field(ge=1.0, le=3.0)] = Field(1.5, description="Hertz exponent n (-).")
+    hunt_crossley_alpha: NonNegative = Field(
+        description="Hunt-Crossley factor alpha (s/m): d_n = 1.5 alpha k_n.")
+    mu_static: NonNegative = Field(description="Static friction coefficient (-).")
+    mu_kinetic: NonNegative = Field(description="Kinetic friction coefficient (-).")
+    transition_speed: Positive = Field(description="Static-to-kinetic transition slip speed V_t0 (m/s).")
+
+    @model_validator(mode="after")
+    def _friction_order(self):
+        if self.mu_kinetic > self.mu_static:
+            raise ValueError(f"mu_kinetic must be <= mu_static ({self.mu_static}). Got {self.mu_kinetic} instead")
+        return self
+
+
+# ---------------------------------------------------------------------------- target
+class Box(Strict):
+    kind: Literal["box"]
+    size: Annotated[list[Positive], Field(min_length=3, max_length=3)] = Field(description="Edge lengths (m).")
+    center: Vector3 = Field(description="Centre, target frame (m).")
+    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Box->target rotation (rad).")
+
+
+class Cylinder(Strict):
+    kind: Literal["cylinder"]
+    radius: Positive = Field(description="(m)")
+    length: Positive = Field(description="(m)")
+    axis: Vector3 = Field(description="Axis direction, target frame (-).")
+    center: Vector3 = Field(description="Centre, target frame (m).")
+
+
+class Sphere(Strict):
+    kind: Literal["sphere"]
+    radius: Positive = Field(description="(m)")
+    center: Vector3 = Field(description="Centre, target frame (m).")
+
+
+class Ellipsoid(Strict):
+    kind: Literal["ellipsoid"]
+    semi_axes: Annotated[list[Positive], Field(min_length=3, max_length=3)] = Field(
+        description="Semi-axes along the ellipsoid's own x, y, z (m).")
+    center: Vector3 = Field(description="Centre, target frame (m).")
+    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Ellipsoid->target rotation (rad).")
+
+
+class MeshFile(Strict):
+    kind: Literal["mesh"]
+    file: RelativeFile = Field(description="Closed triangle mesh (STL, OBJ, PLY...), path relative to the case file, "
+                                           "in its folder or below.")
+    scale: Positive = Field(1.0, description="Factor taking file units to metres (-).")
+    center: Vector3 = Field([0.0, 0.0, 0.0], description="Translation of the mesh, target frame (m).")
+    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Mesh->target rotation (rad).")
+
+
+Shape = Annotated[Union[Box, Cylinder, Sphere, Ellipsoid, MeshFile], Field(discriminator="kind")]
+
+
+class Body(Strict):
+    name: ItemName = Field(description="Body name; joints name it as parent or child.")
+    mass: Positive = Field(description="(kg)")
+    center_of_mass: Vector3 | None = Field(None, description="CoM, target frame (m); default: shapes' centroid.")
+    inertia: Annotated[list[Vector3], Field(min_length=3, max_length=3)] | None = Field(
+        None, description="Inertia about the CoM, target-frame axes (kg m^2); default: uniform density over the shapes.")
+    shapes: Annotated[list[Shape], Field(min_length=1)]
+    mass_properties_from: RelativeFile | None = Field(
+        None, description="perception.json written by 'riskassess perceive' (path relative to the case file, in its "
+                          "folder or below): mass, "
+                          "center_of_mass and inertia are taken from its estimates (then leave those three keys out).")
+
+    @field_validator("inertia")
+    @classmethod
+    def _physical_inertia(cls, j):
+        return j if j is None else check_physical_inertia(j)
+
+
+class Joint(Strict):
+    name: ItemName = Field(description="Joint name; weak locations name it.")
+    kind: Literal["revolute", "clamped"] = Field(description="Hinge with torsional spring-damper, or clamped.")
+    parent: str = Field(description="Name of the parent body.")
+    child: str = Field(description="Name of the child (appendage) body.")
+    position: Vector3 = Field(description="Joint point, target frame (m).")
+    axis: Vector3 = Field([0.0, 0.0, 1.0], description="Hinge axis h2, target frame (-).")
+    torsional_stiffness: NonNegative = Field(0.0, description="About the hinge axis (N m/rad).")
+    torsional_damping: NonNegative = Field(0.0, description="About the hinge axis (N m s/rad).")
+    initial_angle: float = Field(0.0, description="Initial hinge angle about h2 (rad).")
+    initial_rate: float = Field(0.0, description="Initial hinge rate about h2 (rad/s).")
+    penalty_translational: Positive | None = Field(
+        None, description="Penalty stiffness locking the joint point (N/m); default: tuned to the step.")
+    penalty_rotational: Positive | None = Field(
+        None, description="Penalty stiffness locking rotations (N m/rad); default: tuned to the step.")
+    penalty_damping_ratio: Annotated[float, Field(ge=0, le=1)] = Field(
+        0.05, description="Penalty damping, fraction of critical (-).")
+
+    @model_validator(mode="after")
+    def _revolute_fields(self):
+        if np.linalg.norm(self.axis) == 0:
+            raise ValueError("axis must be a non-zero vector")
+        if self.kind == "clamped" and (self.torsional_stiffness or self.initial_angle or self.initial_rate):
+            raise ValueError("a clamped joint takes no torsional_stiffness, initial_angle or initial_rate")
+        return self
+
+
+class Target(Strict):
+    position_lvlh: Vector3 = Field(description="Target-frame origin at t = 0, LVLH (m).")
+    attitude_rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Target->LVLH rotation at t = 0 (rad).")
+    velocity_lvlh: Vector3 = Field([0.0, 0.0, 0.0], description="Velocity of the target-frame origin, LVLH (m/s).")
+    angular_velocity: Vector3 = Field([0.0, 0.0, 0.0], description="Rigid tumble of the whole target, target frame (rad/s).")
+    bodies: Annotated[list[Body], Field(min_length=1)]
+    joints: list[Joint] = []
+
+    @field_validator("bodies", "joints")
+    @classmethod
+    def _unique(cls, items, info):
+        return unique_names(items, {"bodies": "body", "joints": "joint"}[info.field_name])
+
+    @model_validator(mode="after")
+    def _joint_tree(self):
+        names = [b.name for b in self.bodies]
+        children = []
+        for j in self.joints:
+            for role in ("parent", "child"):
+                if getattr(j, role) not in names:
+                    raise ValueError(f"joint '{j.name}': {role} '{getattr(j, role)}' is not a body; bodies are {names}")
+            if j.parent == j.child:
+                raise ValueError(f"joint '{j.name}' joins body '{j.parent}' to itself")
+            children.append(j.child)
+        if len(set(children)) != len(children):
+            raise ValueError("each body can be the child of at most one joint")
+        roots = [n for n in names if n not in children]
+        if len(roots) != 1:
+            raise ValueError(f"the joints must form one tree with a single root body. Roots found: {roots}")
+        return self
+
+
+# ---------------------------------------------------------------------------- chaser
+class Chaser(Strict):
+    """The chaser simulated as a rigid body carrying the net on rods (a "netted pocket",
+    Tang et al. 2023 Sec. 4.2.2): the net's rim nodes are mounted on it and the whole
+    assembly flies at the target with the launch velocity."""
+    mass: Positive = Field(description="Chaser mass (kg).")
+    principal_inertia: Annotated[list[Positive], Field(min_length=3, max_length=3)] = Field(
+        description="Principal moments of inertia about its CoM, axes parallel to LVLH at t = 0 (kg m^2).")
+    standoff: Positive = Field(description="Distance from the chaser CoM back to the net plane along the launch direction (m).")
+    mount_stiffness: Positive = Field(description="Stiffness of each rod holding a rim node (N/m).")
+    mount_damping: NonNegative = Field(0.0, description="Damping of each rod (N s/m).")
+
+
+# ---------------------------------------------------------------------------- perception
+class Lidar(Strict):
+    position_chaser: Vector3 = Field([0.0, 0.0, 0.0], description="Sensor origin relative to the chaser CoM, LVLH axes at t = 0 (m).")
+    boresight_lvlh: Vector3 = Field(description="Sensor boresight (+x of the sensor frame), LVLH at t = 0 (-).")
+    up_lvlh: Vector3 = Field([0.0, 0.0, 1.0], description="Sensor +z (elevation up), LVLH; made orthogonal to the boresight (-).")
+    fov_azimuth: Annotated[float, Field(gt=0, le=2 * np.pi)] = Field(description="Full horizontal field of view (rad).")
+    fov_elevation: Annotated[float, Field(gt=0, le=np.pi)] = Field(description="Full vertical field of view (rad).")
+    resolution_azimuth: Positive = Field(description="Angle between rays, horizontal (rad).")
+    resolution_elevation: Positive = Field(description="Angle between rays, vertical (rad).")
+    range_noise: NonNegative = Field(description="Range noise 1 sigma (m), constant over range.")
+    rate: Annotated[float, Field(gt=0, le=100)] = Field(description="Frames per second (Hz).")
+    max_range: Positive = Field(200.0, description="Longest range returned (m).")
+    pointing: Literal["target", "body"] = Field(
+        "target", description="'target': a pan-tilt mount turns the boresight to the debris' last registered "
+                              "position each frame (the chaser may spin after the collision); 'body': fixed to the "
+                              "chaser along boresight_lvlh.")
+
+    @model_validator(mode="after")
+    def _grid_size(self):
+        rays = (self.fov_azimuth / self.resolution_azimuth + 1) * (self.fov_elevation / self.resolution_elevation + 1)
+        if rays > 5e6:
+            raise ValueError(f"the ray grid has {rays:.3g} rays per frame; at most 5e6 are allowed "
+                             f"(coarsen the resolution or narrow the field of view)")
+        if abs(np.dot(self.boresight_lvlh, self.up_lvlh)) >= 0.999 * np.linalg.norm(self.boresight_lvlh) * np.linalg.norm(self.up_lvlh):
+            raise ValueError("up_lvlh must not be parallel to boresight_lvlh")
+        return self
+
+
+class Registration(Strict):
+    voxel: Positive = Field(0.03, description="Voxel size the scans are thinned to before ICP (m).")
+    model_frames: Annotated[int, Field(ge=1)] = Field(30, description="Frames merged into the debris model before it is frozen (-).")
+    max_correspondence: Positive = Field(0.1, description="ICP correspondence distance (m).")
+
+
+class Perception(Strict):
+    observation_time: Positive = Field(description="LiDAR tracking of the free tumble before the chaser moves in (s).")
+    hold_distance: Positive = Field(10.0, description="Chaser CoM to debris CoM while it observes, back along the launch direction (m).")
+    seed: Annotated[int, Field(ge=0)] = Field(0, description="Seed of the range noise (-).")
+    lidar: Lidar
+    registration: Registration = Registration()
+
+
+# ---------------------------------------------------------------------------- structures
+ValueOrRange = Union[Positive, Annotated[list[Positive], Field(min_length=2, max_length=2)]]
+#: A dimension of a cross-section (m): a cut through a spacecraft member. The widest rocket bodies in
+#: orbit are about 4-5 m across; 20 m bounds every member while the section formulas (fourth powers of
+#: the dimensions) stay far from float overflow.
+SectionLength = Annotated[float, Field(gt=0, le=20.0)]
+
+
+class SolidRectangle(Strict):
+    kind: Literal["solid_rectangle"]
+    width: SectionLength = Field(description="Extent along section axis 2 (m).")
+    height: SectionLength = Field(description="Extent along section axis 3 (m).")
+
+
+class HollowRectangle(Strict):
+    kind: Literal["hollow_rectangle"]
+    width: SectionLength = Field(description="Outer extent along section axis 2 (m).")
+    height: SectionLength = Field(description="Outer extent along section axis 3 (m).")
+    wall: SectionLength = Field(description="Uniform wall thickness (m).")
+
+
+class ThinWalledBox(Strict):
+    kind: Literal["thin_walled_box"]
+    width: SectionLength = Field(description="Midline extent along section axis 2 (m).")
+    height: SectionLength = Field(description="Midline extent along section axis 3 (m).")
+    flange_thickness: SectionLength = Field(description="Thickness of the two walls along axis 2 (m).")
+    web_thickness: SectionLength = Field(description="Thickness of the two walls along axis 3 (m).")
+
+
+class CircularTube(Strict):
+    kind: Literal["circular_tube"]
+    outer_diameter: SectionLength = Field(description="(m)")
+    wall: SectionLength = Field(description="Wall thickness (m); outer_diameter / 2 for a solid shaft.")
+
+
+class ISection(Strict):
+    kind: Literal["i_section"]
+    height: SectionLength = Field(description="Overall depth along section axis 3, the web direction (m).")
+    flange_width: SectionLength = Field(description="Flange extent along section axis 2 (m).")
+    flange_thickness: SectionLength = Field(description="(m)")
+    web_thickness: SectionLength = Field(description="(m)")
+
+
+Section = Annotated[Union[SolidRectangle, HollowRectangle, ThinWalledBox, CircularTube, ISection],
+                    Field(discriminator="kind")]
+
+
+def section_properties(spec):
+    """Section properties (:mod:`structures.sections`) from a case section table (raises ValueError
+    for impossible dimensions)."""
+    params = spec.model_dump()
+    return SECTIONS[params.pop("kind")](**params)
+
+
+class Material(Strict):
+    modulus: Positive | None = Field(None, description="Young's modulus (Pa); informational, stresses do not need it.")
+    ultimate_normal: ValueOrRange = Field(description="Ultimate normal stress (Pa), a value or [low, high].")
+    ultimate_shear: ValueOrRange = Field(description="Ultimate shear stress (Pa), a value or [low, high].")
+
+
+class WeakLocationSpec(Strict):
+    name: ItemName = Field(description="Weak-location name, used in the results.")
+    joint: str = Field(description="Joint whose reaction loads this location (its name in target.joints).")
+    offset: Vector3 = Field([0.0, 0.0, 0.0], description="Cut point minus joint point, target frame (m), on the child side.")
+    beam_axis: Vector3 = Field([1.0, 0.0, 0.0], description="Section axis 1 (along the member, normal to the cut), target frame (-).")
+    width_axis: Vector3 = Field([0.0, 1.0, 0.0], description="Section axis 2, target frame (-); made normal to beam_axis.")
+    section: Section | None = Field(None, description="Cross-section at the cut; needs 'material'.")
+    material: Material | None = None
+    allowable_moment: ValueOrRange | None = Field(
+        None, description="Allowable moment (N m), a value or [low, high], against the resultant of 'moment_axes'.")
+    moment_axes: list[Literal["h1", "h2", "h3"]] | None = Field(
+        None, description="Joint-frame moment components judged by allowable_moment; default: all but the hinge "
+                          "axis h2 of a revolute joint (carried by its spring), all three for a clamped joint.")
+    allowable_force: ValueOrRange | None = Field(None, description="Allowable resultant joint force (N), value or [low, high].")
+
+    @field_validator("allowable_moment", "allowable_force")
+    @classmethod
+    def _ordered_range(cls, v):
+        if isinstance(v, list) and v[0] > v[1]:
+            raise ValueError(f"a range is [low, high] with low <= high. Got {v} instead")
+        return v
+
+    @model_validator(mode="after")
+    def _criteria(self):
+        if (self.section is None) != (self.material is None):
+            raise ValueError("'section' and 'material' come together (stresses need both)")
+        if self.section is None and self.allowable_moment is None and self.allowable_force is None:
+            raise ValueError("give at least one criterion: section + material, allowable_moment or allowable_force")
+        b, w = np.asarray(self.beam_axis, float), np.asarray(self.width_axis, float)
+        if np.linalg.norm(b) == 0 or np.linalg.norm(np.cross(b, w)) < 1e-6 * np.linalg.norm(b) * np.linalg.norm(w):
+            raise ValueError("beam_axis must be non-zero and width_axis not parallel to it")
+        return self
+
+
+class Structures(Strict):
+    skip_initial: NonNegative = Field(
+        0.0, description="Loads before this time are not judged (s); the seed paper omits about 0.25 s of "
+                         "initial impact loads that have no time to propagate.")
+    release: Literal["low", "nominal", "high", "never"] = Field(
+        "low", description="Which value of a range allowable releases a failed joint during the run "
+                           "('low': conservative, most debris), or 'never' to judge without releasing.")
+    weak_locations: Annotated[list[WeakLocationSpec], Field(min_length=1)]
+
+    @field_validator("weak_locations")
+    @classmethod
+    def _unique(cls, items):
+        return unique_names(items, "weak location")
+
+
+class Case(Strict):
+    name: CaseName = Field(description="Case name; default output folder runs/<name>.")
+    description: Text = ""
+    simulation: Simulation
+    orbit: Annotated[Union[CircularOrbit, NoOrbit], Field(discriminator="kind")]
+    net: Net
+    bullets: Bullets
+    launch: Launch
+    contact: Contact
+    target: Target
+    structures: Structures | None = None
+    chaser: Chaser | None = None
+    perception: Perception | None = None
+
+    @model_validator(mode="after")
+    def _weak_location_joints(self):
+        if self.structures is None:
+            return self
+        joints = [j.name for j in self.target.joints]
+        for loc in self.structures.weak_locations:
+            if loc.joint not in joints:
+                raise ValueError(f"structures: weak location '{loc.name}': joint '{loc.joint}' is not in "
+                                 f"target.joints {joints}")
+        return self
+
+
+# ---------------------------------------------------------------------------- loading
+def _all_subclasses(model: type) -> list[type]:
+    return [sub for direct in model.__subclasses__() for sub in [direct, *_all_subclasses(direct)]]
+
+
+def _discriminator_tags() -> set:
+    """The ``kind`` values that tag the members of a discriminated union (orbit, shape and
+    section kinds): models whose ``kind`` admits exactly one value."""
+    kinds = [get_args(model.model_fields["kind"].annotation)
+             for model in _all_subclasses(Strict) if "kind" in model.model_fields]
+    return {values[0] for values in kinds if len(values) == 1}
+
+
+#: Tags pydantic puts in an error's location for the member of a plain union that failed
+#: (``allowable_moment.constrained-float``); they name types, not keys.
+_UNION_TAG = re.compile(r"constrained-\w+|(list|dict|nullable|function-\w+)\[.*\]")
+#: Longest rendering of a rejected value in a message (characters).
+MAX_SHOWN = 120
+
+
+def _format_location(loc) -> str:
+    parts, tag = [], False
+    for item in loc:
+        if isinstance(item, str) and _UNION_TAG.fullmatch(item):
+            continue
+        if isinstance(item, int):
+            parts[-1] = f"{parts[-1]}[{item}]" if parts else f"[{item}]"
+        elif item in _discriminator_tags() and not tag:
+            tag = True  # a discriminator tag adds nothing for the user (a key after it may share its name)
+            continue
+        else:
+            parts.append(str(item))
+        tag = False
+    return ".".join(parts) or "(top level)"
+
+
+def format_validation_error(path: Path, error: ValidationError) -> str:
+    """scikit-learn-style messages, one per problem: ``file: key.path: message. Got X instead.``"""
+    lines = []
+    for e in error.errors():
+        where = _format_location(e["loc"])
+        msg = e["msg"].removeprefix("Value error, ")
+        if e["type"] == "extra_forbidden":
+            msg = "unknown key (check spelling; see 'riskassess schema')"
+        elif "input" in e and e["type"] not in ("missing",) and not _is_table(e["input"]) \
+                and "Got " not in msg:
+            shown = repr(e["input"])
+            shown = shown if len(shown) <= MAX_SHOWN else shown[:MAX_SHOWN] + "..."
+            msg = f"{msg}. Got {shown} instead"
+        if where == "(top level)" and re.match(r"[\w.\[\]]+: ", msg):
+            where, msg = msg.split(": ", 1)   # a whole-case check that names its key itself
+        lines.append(f"{path}: {where}: {msg}")
+    return "\n".join(lines)
+
+
+def _is_table(value) -> bool:
+    """A table or a list of tables: too long to repeat in a message, which names its key instead."""
+    return isinstance(value, dict) or (isinstance(value, list) and any(isinstance(v, dict) for v in value))
+
+
+def load_model(path: str | Path, model: type[BaseModel]):
+    """Read the TOML file ``path`` into the pydantic ``model`` (a stage's own case schema, e.g.
+    towing or approach); raise :class:`CaseError` naming the file, every bad key and what is allowed."""
+    path = Path(path)
+    try:
+        return model.model_validate(read_toml(path))
+    except ValidationError as exc:
+        raise CaseError(format_validation_error(path, exc)) from None
+
+
+def load_case(path: str | Path) -> Case:
+    """Read and validate a net-impact case file; raise :class:`CaseError` naming every problem."""
+    return validate_case(read_toml(path), path)
+
+
+def validate_case(raw: dict, path: str | Path) -> Case:
+    """Validate the parsed content of the case file ``path`` (mesh paths are relative to it);
+    raise :class:`CaseError` naming every problem. Sweeps call it for every varied case."""
+    path = Path(path)
+    raw, problems = _with_perceived_mass_properties(raw, path.parent)
+    if problems:
+        raise CaseError("\n".join(f"{path}: {p}" for p in problems))
+    try:
+        case = Case.model_validate(raw)
+    except ValidationError as exc:
+        raise CaseError(format_validation_error(path, exc)) from None
+    problems = _check_files(case, path.parent) + _check_sections(case)
+    if not problems:
+        problems = _check_reach(case, path.parent)
+    if problems:
+        raise CaseError("\n".join(f"{path}: {p}" for p in problems))
+    return case
+
+
+#: perception.json keys -> body keys, for ``mass_properties_from``.
+PERCEIVED_KEYS = {"mass_kg": "mass", "center_of_mass_target_m": "center_of_mass", "inertia_target_kg_m2": "inertia"}
+
+
+def _with_perceived_mass_properties(raw: dict, base: Path) -> tuple[dict, list[str]]:
+    """Fill the mass properties of bodies that name a perception result; problems name the key.
+    Anything not shaped like a case (bodies not a list, a file name not a string) is left to the
+    schema, which names it."""
+    target = raw.get("target")
+    bodies = target.get("bodies") if isinstance(target, dict) else None
+    if not isinstance(bodies, list) or not any(_perceived_source(b) for b in bodies):
+        return raw, []
+    raw = copy.deepcopy(raw)
+    problems = []
+    for i, body in enumerate(raw["target"]["bodies"]):
+        source = _perceived_source(body)
+        if source:
+            problem = _fill_perceived(body, source, base)
+            if problem:
+                problems.append(f"target.bodies[{i}].mass_properties_from: {problem}")
+    return raw, problems
+
+
+def _perceived_source(body) -> str | None:
+    source = body.get("mass_properties_from") if isinstance(body, dict) else None
+    return source if isinstance(source, str) and source else None
+
+
+def _fill_perceived(body: dict, source: str, base: Path) -> str | None:
+    """Copy the estimates of the perception result ``source`` into ``body``; the problem, or None."""
+    given = [k for k in PERCEIVED_KEYS.values() if k in body]
+    if given:
+        return f"the mass properties come from '{source}'; remove {given} from this body"
+    try:
+        path = resolve_reference(base, source, JSON_FILE_LIMIT)
+        answer = json.loads(decode_utf8(read_limited(path, JSON_FILE_LIMIT), path, "perception.json"))
+    except ValueError as exc:   # JSONDecodeError is a ValueError
+        return f"perception result {exc}" if str(exc).startswith("'") else f"'{source}' is not a perception.json ({exc})"
+    except RecursionError:
+        return f"'{source}' is not a perception.json (nested too deeply)"
+    if not isinstance(answer, dict):
+        return f"'{source}' is not a perception.json (a JSON object is expected)"
+    missing = [k for k in PERCEIVED_KEYS if answer.get(k) is None]
+    if missing:
+        reason = answer.get("not_observable") or "keys missing"
+        return f"'{source}' has no estimate of {missing}: {reason}"
+    for source_key, body_key in PERCEIVED_KEYS.items():
+        body[body_key] = answer[source_key]
+    return None
+
+
+def _check_files(case: Case, base: Path) -> list[str]:
+    """Every mesh file is a regular file below the case's folder, at most MESH_FILE_LIMIT bytes."""
+    problems = []
+    for i, body in enumerate(case.target.bodies):
+        for k, shape in enumerate(body.shapes):
+            if isinstance(shape, MeshFile):
+                try:
+                    resolve_reference(base, shape.file, MESH_FILE_LIMIT)
+                except ValueError as exc:
+                    problems.append(f"target.bodies[{i}].shapes[{k}].file: mesh file {exc}")
+    return problems
+
+
+def _check_sections(case: Case) -> list[str]:
+    problems = []
+    for i, loc in enumerate(case.structures.weak_locations if case.structures else []):
+        if loc.section is not None:
+            try:
+                section_properties(loc.section)
+            except (ValueError, ArithmeticError) as exc:
+                problems.append(f"structures.weak_locations[{i}].section: {exc}")
+    return problems
+
+
+def _check_reach(case: Case, base: Path) -> list[str]:
+    """Reject a net that cannot reach the target before any simulation starts."""
+    try:
+        points = target_vertices_lvlh(case, base)
+    except Exception as exc:  # noqa: BLE001 - trimesh's many file parsers raise many types on a malformed file
+        return [f"target.bodies: a mesh file cannot be read as a triangle mesh ({type(exc).__name__}: {exc})"]
+    launch = case.launch
+    d = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
+    net_center = target_points_lvlh(case, launch.aim_point) - launch.distance * d
+    relative = points - net_center
+    along = relative @ d
+    lateral = np.linalg.norm(relative - np.outer(along, d), axis=1)
+    half_diagonal = case.net.side_length / np.sqrt(2.0)
+    problems = []
+    ahead = along > 0
+    if not ahead.any():
+        return ["launch.direction: the whole target is behind the net; the net flies away from it"]
+    if lateral[ahead].min() > half_diagonal:
+        problems.append(f"launch.direction: the net's path misses the target by "
+                        f"{lateral[ahead].min() - half_diagonal:.2f} m beyond its half-diagonal "
+                        f"{half_diagonal:.2f} m; it cannot reach")
+    gap = along.min()
+    first_step = launch.velocity * case.simulation.step
+    if 0 < gap <= first_step:
+        problems.append(f"launch.distance: the net would touch the target within the first step "
+                        f"({first_step:.2g} m of travel); start it farther than {launch.distance - gap + first_step:.3f} m")
+    if gap <= 0:
+        problems.append(f"launch.distance: the net plane starts {-gap:.2f} m inside the target; "
+                        f"increase distance to more than {launch.distance - gap:.2f} m")
+    elif gap > launch.velocity * case.simulation.end_time:
+        problems.append(f"launch.distance: the net needs {gap / launch.velocity:.2f} s to reach the target but "
+                        f"simulation.end_time is {case.simulation.end_time:g} s")
+    return problems

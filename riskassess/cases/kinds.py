@@ -1,0 +1,59 @@
+"""Which stage a case file is written for, its schema and its loader: one table for
+``riskassess validate``, ``riskassess schema --kind`` and the tests of the shipped cases.
+
+Each stage has its own case schema (see the modules below); the kind is told from the file's
+top-level tables, then the file is validated by that stage's schema, so the errors name the
+stage's keys.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from riskassess.cases.approach import ApproachCase
+from riskassess.cases.impact import Case, load_case, load_model, read_toml
+from riskassess.cases.diagnosis import DiagnosisCaseFile, load_diagnosis_case
+from riskassess.cases.towing import TowingCase
+
+#: Case kind -> (pydantic model of its file, loader of a file of that kind, command that runs it).
+KINDS = {
+    "impact": (Case, load_case, "run, assess, perceive, sweep"),
+    "towing": (TowingCase, lambda path: load_model(path, TowingCase), "tow, identify"),
+    "diagnosis": (DiagnosisCaseFile, load_diagnosis_case, "diagnose"),
+    "approach": (ApproachCase, lambda path: load_model(path, ApproachCase), "approach"),
+}
+
+
+def case_kind(raw: dict) -> str:
+    """'impact', 'approach', 'towing' or 'diagnosis' for the parsed TOML of a case file."""
+    if "kind" in raw:                          # diagnosis scenarios: top-level kind
+        return "diagnosis"
+    if "model" in raw and "objective" in raw:  # maneuverable-unit approach
+        return "approach"
+    if "main_tether" in raw or "sub_tethers" in raw:
+        return "towing"
+    return "impact"                            # net impact, assess and perceive
+
+
+def _known(kind: str) -> None:
+    if kind not in KINDS:
+        raise ValueError(f"unknown case kind '{kind}'; the kinds are: {', '.join(KINDS)}")
+
+
+def load_any_case(path: str | Path) -> tuple[str, object]:
+    """(kind, validated case) of any case file; :class:`~riskassess.cases.impact.CaseError` naming the
+    file and the keys when it is not valid for its kind."""
+    kind = case_kind(read_toml(path))
+    return kind, KINDS[kind][1](path)
+
+
+def case_schema(kind: str = "impact") -> dict:
+    """The JSON schema (draft 2020-12, pydantic's) of a case file of ``kind``: keys, units in the
+    descriptions, ranges, required keys; a diagnosis file is one of its scenario kinds (``kind``
+    discriminator). ``ValueError`` listing the kinds for an unknown one."""
+    _known(kind)
+    model, _, commands = KINDS[kind]
+    schema = model.model_json_schema()
+    schema.setdefault("title", model.__name__)
+    schema["description"] = (f"riskassess {kind} case file (TOML), for: {commands}. "
+                             + schema.get("description", "")).strip()
+    return schema

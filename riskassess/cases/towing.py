@@ -1,0 +1,265 @@
+"""Case schema of the towing stages (``riskassess tow``, ``riskassess identify``).
+
+Boonrath, Singh & Botta 2024: Table 1 (system parameters), Table 2 (initial conditions), Table 3
+(initial debris spin rates), Sec. 4.1 (thrust and attitude-control settings), eq. (24) (bounds of
+the identification). Every quantity is SI except where a key says otherwise (``_deg_s``); the
+inertial frame is Earth-centred; quaternions are scalar-first, body->inertial.
+Load with ``riskassess.cases.impact.load_model(path, TowingCase)``.
+"""
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from riskassess.cases.impact import NonNegative, Positive, Strict, Vector3
+from riskassess.cases.inputs import CaseName, Text
+
+Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
+PositiveVector3 = Annotated[list[Positive], Field(min_length=3, max_length=3)]
+DecisionVector = Annotated[list[float], Field(min_length=4, max_length=4)]
+
+
+class BodyState(Strict):
+    position_inertial: Vector3 = Field(description="CoM position from the Earth's centre, inertial (m).")
+    velocity_inertial: Vector3 = Field(description="CoM velocity, inertial (m/s).")
+    attitude_quaternion: Quaternion = Field(description="Body->inertial quaternion, scalar first (-); normalised on load.")
+
+    @model_validator(mode="after")
+    def _unit_quaternion(self):
+        if abs(np.linalg.norm(self.attitude_quaternion) - 1.0) > 1e-3:
+            raise ValueError(f"attitude_quaternion must have unit norm (within 1e-3). "
+                             f"Got norm {np.linalg.norm(self.attitude_quaternion):.6g} instead")
+        return self
+
+
+class TowChaser(BodyState):
+    mass: Positive = Field(description="m_C (kg), Table 1.")
+    side_length: Positive = Field(description="L_C, cube side (m), Table 1 (plots only).")
+    principal_inertia: PositiveVector3 = Field(description="Diagonal of J_C, body frame (kg m^2), Table 1.")
+    tether_attachment_body: Vector3 = Field(description="r_A/C, main-tether attachment, chaser frame (m), Table 1.")
+    angular_velocity_body: Vector3 = Field([0.0, 0.0, 0.0], description="Initial angular velocity, chaser frame (rad/s).")
+
+
+class TowDebris(BodyState):
+    nominal_mass: Positive = Field(description="m_D,nom (kg), Table 1; the lower-order debris carries "
+                                                "m_D,nom + m_net (1 - connection_mass_fraction).")
+    length: Positive = Field(description="L_D (m), Table 1 (plots only).")
+    diameter: Positive = Field(description="d_D (m), Table 1 (plots only).")
+    principal_inertia: PositiveVector3 = Field(description="Diagonal of J_D, body frame (kg m^2), Table 1.")
+    spin_axis_body: Vector3 = Field(description="Direction of the initial angular velocity, debris frame (-), Table 2.")
+    spin_rate_deg_s: NonNegative = Field(description="Initial spin rate of the 'tow' run (deg/s).")
+
+
+class MainTether(Strict):
+    stiffness: Positive = Field(description="k_MT (N/m), Table 1.")
+    damping: NonNegative = Field(description="c_MT (N s/m), Table 1.")
+    natural_length: Positive = Field(description="l_MT,0 (m), Table 1.")
+
+
+class SubTethers(Strict):
+    attachment_points_body: Annotated[list[Vector3], Field(min_length=1, max_length=16)] = Field(
+        description="r_i/D, sub-tether attachments, debris frame (m), Table 1.")
+    stiffness: Positive = Field(description="k_ST of each sub-tether (N/m); s1 = log10 k_ST.")
+    natural_length: Positive = Field(description="l_ST,0 (m); s2.")
+    damping: NonNegative = Field(description="c_ST (N s/m); s3 = log10 c_ST.")
+    connection_mass_fraction: Annotated[float, Field(gt=0, le=1)] = Field(
+        description="m_P / m_net (-); s4. The rest of the net mass goes to the debris.")
+    connection_point_start_inertial: Vector3 | None = Field(
+        None, description="Initial position of P (m, inertial), moving with the debris; default: on the line from the "
+                          "debris CoM to the main tether's chaser end where the farthest sub-tether is at its natural "
+                          "length. The full-net identification sets it to the net's central node at 25 s (Sec. 4.1).")
+
+
+class Thrust(Strict):
+    kind: Literal["ramp", "mrac1", "mrac2"] = Field(
+        "ramp", description="'ramp': open loop against the orbital velocity (paper after eq. 2); 'mrac1'/'mrac2': "
+                            "main-tether elongation control along the chaser's body z (MRAC paper eqs. 9-21).")
+    t_on: NonNegative = Field(description="Thruster on (s), Sec. 4.1.")
+    t_slope: Positive = Field(description="Ramp time from 0 to max_force (s), Sec. 4.1.")
+    max_force: Positive = Field(description="F_t,max, also the MRAC saturation u_max (N), Sec. 4.1.")
+
+
+class Mrac(Strict):
+    desired_elongation: Positive = Field(description="z_d (m).")
+    k_p: Positive = Field(description="Reference-model proportional gain K_P (N/m).")
+    k_d: Positive = Field(description="Reference-model derivative gain K_D (N s/m).")
+    lambda0: Positive = Field(description="MRAC-1 lambda_0 (1/s).")
+    k_s: NonNegative = Field(description="MRAC-1 sliding gain k_s (N s/m).")
+    gamma: NonNegative = Field(description="MRAC-1 adaptation rate gamma (-).")
+    xi_h: NonNegative = Field(description="MRAC-1 damping xi_h of the h adaptation (-).")
+    xi_a: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = Field(description="MRAC-1 diagonal of Xi_a (-).")
+    gamma_z: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = Field(description="MRAC-2 diagonal of Gamma_z (-).")
+    gamma_r: NonNegative = Field(description="MRAC-2 gamma_r (-).")
+    gamma_theta: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = Field(description="MRAC-2 diagonal of Gamma_theta (-).")
+    xi_2: NonNegative = Field(description="MRAC-2 e-modification gain xi_2 (-).")
+    q: Annotated[list[Positive], Field(min_length=2, max_length=2)] = Field(description="MRAC-2 diagonal of Q in eq. (21a) (-).")
+
+
+class AttitudeControl(Strict):
+    enabled: bool = Field(True, description="Sliding-mode attitude control of the chaser (eqs. 7-10).")
+    k_gain: Positive = Field(description="K (1/s), Sec. 4.1.")
+    gain: PositiveVector3 = Field(description="Diagonal of G (rad/s^2), Sec. 4.1.")
+    boundary_layer: Positive = Field(description="epsilon (rad/s), Sec. 4.1; widened to the sampled-loop value "
+                                                 "for the step (multibody.control.attitude.sampled_boundary_layer).")
+
+
+class TowSimulation(Strict):
+    start_time: NonNegative = Field(description="Time of the lower-order run's initial state (s); the paper starts "
+                                                "the lower-order runs at thrust-on, 25 s.")
+    end_time: Positive = Field(description="End of the run (s); 300 s in the paper.")
+    step: Annotated[float, Field(gt=0, le=0.05)] = Field(description="VelocityVerlet step (s); reduced automatically "
+                                                                    "below the connection point's stability limit.")
+    output_interval: Positive = Field(description="Time between samples, Delta t_save (s).")
+    mu: Positive = Field(3.986e14, description="Earth's gravitational parameter (m^3/s^2), Sec. 2.1.")
+    model: Literal["lower-order", "full-net"] = Field(
+        "lower-order", description="Model 'riskassess tow' runs: the lower-order model (Sec. 2.2) or the full net "
+                                   "wrapped around the debris ([full_net], Sec. 2.1; docs/towing.md).")
+
+    @model_validator(mode="after")
+    def _times(self):
+        if self.end_time <= self.start_time:
+            raise ValueError(f"end_time must be > start_time ({self.start_time:g} s). Got {self.end_time:g} instead")
+        if self.output_interval < self.step:
+            raise ValueError(f"output_interval must be >= step ({self.step:g} s). Got {self.output_interval:g} instead")
+        return self
+
+
+class Rates(Strict):
+    training_deg_s: Annotated[list[NonNegative], Field(min_length=1)] = Field(description="Table 3, training (deg/s).")
+    validation_deg_s: Annotated[list[NonNegative], Field(min_length=1)] = Field(description="Table 3, validation (deg/s).")
+
+
+class Optimizers(Strict):
+    swarm_size: Annotated[int, Field(ge=2)] = Field(40, description="PSO particles (-), Sec. 4.3.")
+    pso_generations: Annotated[int, Field(ge=1)] = Field(100, description="Largest number of PSO generations (-).")
+    pso_tolerance: Positive = Field(1e-6, description="PSO stops when the best cost improves by less than this, "
+                                                      "relative, over stall_generations (-).")
+    stall_generations: Annotated[int, Field(ge=1)] = Field(20, description="MaxStallIterations (-), Sec. 4.3.")
+    pattern_evaluations: Annotated[int, Field(ge=1)] = Field(2000, description="Largest number of pattern-search evaluations (-).")
+    pattern_tolerance: Positive = Field(1e-6, description="Pattern-search step tolerance, in units of each bound range (-).")
+    polish_evaluations: Annotated[int, Field(ge=0)] = Field(
+        0, description="Pattern-search evaluations polishing the PSO's best (0: none); reported as optimizer 'pso+pattern' (-).")
+    restart_evaluations: Annotated[int, Field(ge=10)] = Field(
+        1000, description="Evaluations of one pattern-search leg before it restarts from its best point (-).")
+    polish_delta: Annotated[float, Field(gt=0, le=0.5)] = Field(
+        0.02, description="Pattern-search step of the polish and of every restart, in units of each bound range (-).")
+    seed: Annotated[int, Field(ge=0)] = Field(0, description="Seed of the PSO (-).")
+
+
+class Identification(Strict):
+    cost: Literal["f1", "f2"] = Field("f1", description="f1: weighted RMSE of r_D/C and both angular velocities, "
+                                                        "eq. (18); f2: main-tether tension RMSE, eq. (20).")
+    weights: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = Field(
+        description="w1 (1/m) and w2 (s/rad) of eq. (18), Sec. 4.2.")
+    lower_bounds: DecisionVector = Field(description="Lower bounds of s = [log10 k_ST, l_ST0, log10 c_ST, m_P/m_net], eq. (24).")
+    upper_bounds: DecisionVector = Field(description="Upper bounds of s, eq. (24).")
+    initial_guess: DecisionVector = Field(description="Pattern-search start s_0, Sec. 4.3.")
+    benchmark_truth: DecisionVector = Field(description="s of the benchmark's data, Sec. 4.3.")
+    optimizers: Optimizers = Optimizers()
+    searches: Annotated[list[Literal["pso", "pattern"]], Field(min_length=1)] = Field(
+        ["pso", "pattern"], description="Optimizers 'riskassess identify' runs, in order: 'pso' (pymoo PSO; then the "
+                                        "pattern-search polish, reported as 'pso+pattern', if optimizers.polish_evaluations "
+                                        "> 0) and 'pattern' (pattern search from initial_guess); --optimizers overrides it.")
+    workers: Annotated[int, Field(ge=1)] = Field(2, description="Processes evaluating simulations in parallel (-).")
+    step: Annotated[float, Field(gt=0, le=0.05)] = Field(
+        0.02, description="Step of the identification's lower-order runs (s); the connection point is implicit, so it "
+                          "does not depend on s (docs/towing.md: step study).")
+
+    @model_validator(mode="after")
+    def _inside_bounds(self):
+        lo, hi = np.asarray(self.lower_bounds), np.asarray(self.upper_bounds)
+        if np.any(lo >= hi):
+            raise ValueError(f"lower_bounds must be < upper_bounds component-wise. Got {self.lower_bounds} and {self.upper_bounds}")
+        for key in ("initial_guess", "benchmark_truth"):
+            s = np.asarray(getattr(self, key))
+            if np.any(s < lo) or np.any(s > hi):
+                raise ValueError(f"{key} {getattr(self, key)} lies outside the bounds {self.lower_bounds} .. {self.upper_bounds}")
+        if lo[3] <= 0:
+            raise ValueError("the lower bound of s4 = m_P/m_net must be > 0 (a massless connection point is not physical)")
+        return self
+
+
+class FullNetContact(Strict):
+    stiffness: Positive = Field(description="Hertz k_n of node-debris contact (N/m^exponent).")
+    exponent: Annotated[float, Field(ge=1, le=2)] = Field(1.5, description="Hertz exponent n (-).")
+    hunt_crossley_alpha: NonNegative = Field(description="Hunt-Crossley alpha (s/m); d_n = 1.5 alpha k_n.")
+    mu_static: NonNegative = Field(description="Static friction coefficient (-), Hollar's law.")
+    mu_kinetic: NonNegative = Field(description="Kinetic friction coefficient (-).")
+    transition_speed: Positive = Field(description="Slip speed V_t0 where friction reaches mu_static (m/s).")
+
+
+class FullNet(Strict):
+    """The wrapped net of the full-net towing model (multibody/net_towing.py; docs/towing.md)."""
+
+    start: Literal["wrapped", "capture"] = Field(
+        "wrapped", description="'wrapped': prepared wrapped state at simulation.start_time; 'capture': the open net "
+                               "ejected from the chaser at t = 0 s towards the debris (Table 2 states), closed from "
+                               "closing_time on (Sec. 2.1, 4.1; docs/towing.md).")
+    launch_speed: Positive = Field(2.0, description="Capture start: speed of every net node relative to the chaser at "
+                                                    "t = 0, along r_D/C (m/s) [assumed: the authors' launch data are "
+                                                    "not available].")
+    launch_offset: NonNegative = Field(1.0, description="Capture start: distance of the flat net's centre ahead of the "
+                                                        "chaser's tether attachment along r_D/C at t = 0 (m).")
+    closing_duration: Positive = Field(5.0, description="Capture start: the closing loop is reeled in linearly from "
+                                                        "open to closed over this time from closing_time on (s).")
+    side_length: Positive = Field(description="Side of the square net (m); (nodes_per_side - 1) sections of l_net,0.")
+    nodes_per_side: Annotated[int, Field(ge=5, le=41)] = Field(description="Nodes along a side (-), odd so that a central node exists.")
+    corner_mass: Positive = Field(description="Each of the four corner masses (kg), part of net_mass.")
+    node_radius: Positive = Field(description="Contact radius of a net node (m).")
+    corner_radius: Positive = Field(description="Contact radius of a corner mass (m).")
+    thread_axial_rigidity: Positive = Field(description="EA of a thread (N); a section of length l gets EA/l (N/m).")
+    thread_damping: NonNegative = Field(description="Axial damping of a thread section (N s/m).")
+    closing_axial_rigidity: Positive = Field(description="EA of the closing thread (N).")
+    closed_fraction: Annotated[float, Field(gt=0, le=1)] = Field(
+        description="Natural length of the closed loop over its open length (-).")
+    closing_time: NonNegative = Field(15.0, description="Closing-mechanism activation; the main tether gets its "
+                                                        "stiffness and damping from then on (s), Sec. 2.1, 4.1.")
+    main_tether_slack: NonNegative = Field(0.0, description="How much shorter than l_MT,0 the main tether starts in "
+                                                            "the wrapped state (m); 0: at its natural length.")
+    step: Annotated[float, Field(gt=0, le=0.02)] = Field(description="VelocityVerlet step of chaser and debris (s).")
+    substeps: Annotated[int, Field(ge=1, le=1000)] = Field(description="Net sub-steps per step (-); the net's step is "
+                                                                      "step/substeps (docs/towing.md: step study).")
+    net_output_interval: Positive = Field(1.0, description="Time between net snapshots in net.npz (s).")
+    contact: FullNetContact
+    identification_end_time: Positive | None = Field(
+        None, description="End of the full-net and lower-order runs of 'riskassess identify' (s); default simulation.end_time.")
+    identification_training_runs: Annotated[int, Field(ge=1)] | None = Field(
+        None, description="Use only the first k training rates (-); default all.")
+    identification_validation_runs: Annotated[int, Field(ge=1)] | None = Field(
+        None, description="Use only the first k validation rates (-); default all.")
+
+    @model_validator(mode="after")
+    def _odd(self):
+        if self.nodes_per_side % 2 == 0:
+            raise ValueError(f"nodes_per_side must be odd (the main tether needs a central node). Got {self.nodes_per_side}")
+        return self
+
+
+class TowingCase(Strict):
+    name: CaseName = Field(description="Case name; default output folder runs/<name>.")
+    description: Text = ""
+    simulation: TowSimulation
+    chaser: TowChaser
+    debris: TowDebris
+    net_mass: Positive = Field(description="m_net, total net mass (kg), Sec. 4.1.")
+    main_tether: MainTether
+    sub_tethers: SubTethers
+    thrust: Thrust
+    mrac: Mrac | None = None
+    attitude_control: AttitudeControl
+    rates: Rates
+    identification: Identification
+    full_net: FullNet | None = None
+
+    @model_validator(mode="after")
+    def _mrac_given(self):
+        if self.thrust.kind != "ramp" and self.mrac is None:
+            raise ValueError(f"thrust.kind = '{self.thrust.kind}' needs an [mrac] section")
+        if self.simulation.model == "full-net" and self.full_net is None:
+            raise ValueError("simulation.model = 'full-net' needs a [full_net] section")
+        if self.full_net is not None and 4 * self.full_net.corner_mass >= self.net_mass:
+            raise ValueError(f"full_net.corner_mass must be < net_mass / 4 ({self.net_mass / 4:g} kg). "
+                             f"Got {self.full_net.corner_mass:g} instead")
+        return self

@@ -1,0 +1,203 @@
+"""Turn a validated :class:`~riskassess.cases.impact.Case` into the multibody model's inputs.
+
+Frames: shapes, centres of mass, inertia and joints come in the target frame; each body
+frame has its origin at the body CoM and axes parallel to the target frame, so a body's
+attitude at t = 0 is the target attitude (times the initial hinge rotation for a child).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from multibody.assembly import (ContactLaw, ImpactAssembly, JointSpec, NetMount, RigidBodySpec, SolverSpec,
+                                subtree_bodies)
+from multibody.geometry import geometric_center_of_mass, uniform_density_inertia
+from multibody.hinge import hinge_frame_lvlh
+from multibody.net import flat_square_net, thread_node_mass
+from multibody.orbit import mean_motion
+from riskassess.cases.impact import Case, CircularOrbit, section_properties
+from riskassess.cases.target_geometry import body_meshes_target_frame, target_points_lvlh, target_pose_lvlh
+from structures.criteria import Allowable
+from structures.weak_location import WeakLocation
+
+
+@dataclass
+class ModelInputs:
+    """An assembly plus the joint rest states (child attitude and CoM before initial hinge angles)."""
+
+    assembly: ImpactAssembly
+    rest_attitudes: list
+    rest_coms: list
+
+
+def mass_properties_target_frame(case: Case, meshes):
+    """Per body: (CoM (m), inertia about CoM (kg m^2)), target frame; defaults from geometry."""
+    props = []
+    for body, body_meshes in zip(case.target.bodies, meshes):
+        com = (np.asarray(body.center_of_mass, float) if body.center_of_mass is not None
+               else geometric_center_of_mass(body_meshes))
+        inertia = (np.asarray(body.inertia, float) if body.inertia is not None
+                   else uniform_density_inertia(body_meshes, body.mass, com))
+        props.append((com, inertia))
+    return props
+
+
+def build_net(case: Case):
+    """Net topology (LVLH) and initial node velocities for the case's launch."""
+    net, launch, bullets = case.net, case.launch, case.bullets
+    thread = net.thread
+    mesh = net.mesh_size
+    area = np.pi * thread.diameter**2 / 4.0
+    axial_rigidity = thread.stiffness * mesh if thread.stiffness is not None else thread.modulus * area
+    bending_rigidity = 0.0
+    if thread.bending:
+        bending_rigidity = (thread.bending_rigidity if thread.bending_rigidity is not None
+                            else thread.modulus * np.pi * thread.diameter**4 / 64.0)
+    node_mass = (net.node_mass if net.node_mass is not None
+                 else thread_node_mass(net.side_length, net.nodes_per_side, thread.diameter, thread.density))
+    direction = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
+    aim = target_points_lvlh(case, launch.aim_point)
+    topology = flat_square_net(
+        center=aim - launch.distance * direction, direction=direction,
+        side_length=net.side_length, nodes_per_side=net.nodes_per_side,
+        node_mass=node_mass, node_radius=thread.diameter / 2.0,
+        thread_axial_rigidity=axial_rigidity, thread_damping=thread.damping,
+        bullet_mass=bullets.mass, bullet_radius=bullets.radius,
+        bullet_tether_length=bullets.tether_length or mesh, bending_rigidity=bending_rigidity)
+    velocity = np.tile(launch.velocity * direction, (topology.n_nodes, 1))
+    return topology, velocity
+
+
+def build_bodies_and_joints(case: Case, base: Path):
+    """Rigid-body and joint specs in LVLH at t = 0, and the joints' rest states."""
+    target = case.target
+    meshes = body_meshes_target_frame(case, base)
+    props = mass_properties_target_frame(case, meshes)
+    origin, target_to_lvlh = target_pose_lvlh(case)
+    omega_lvlh = target_to_lvlh @ np.asarray(target.angular_velocity, float)
+    names = [b.name for b in target.bodies]
+
+    bodies = []
+    for body, body_meshes, (com_t, inertia) in zip(target.bodies, meshes, props):
+        com = origin + target_to_lvlh @ com_t
+        shifted = [m.copy().apply_translation(-com_t) for m in body_meshes]
+        bodies.append(RigidBodySpec(
+            name=body.name, mass=body.mass, inertia_body=inertia, com_lvlh=com,
+            body_to_lvlh=target_to_lvlh.copy(),
+            velocity_lvlh=np.asarray(target.velocity_lvlh, float) + np.cross(omega_lvlh, com - origin),
+            omega_body=np.asarray(target.angular_velocity, float), meshes_body=shifted))
+    rest_attitudes = [b.body_to_lvlh.copy() for b in bodies]
+    rest_coms = [b.com_lvlh.copy() for b in bodies]
+
+    joints = []
+    for j in target.joints:
+        parent, child = names.index(j.parent), names.index(j.child)
+        point = origin + target_to_lvlh @ np.asarray(j.position, float)
+        frame = hinge_frame_lvlh(target_to_lvlh @ np.asarray(j.axis, float), point, bodies[child].com_lvlh)
+        joints.append(JointSpec(
+            name=j.name, kind=j.kind, parent=parent, child=child, point_lvlh=point, hinge_to_lvlh=frame,
+            torsional_stiffness=j.torsional_stiffness, torsional_damping=j.torsional_damping,
+            penalty_translational=j.penalty_translational, penalty_rotational=j.penalty_rotational,
+            penalty_damping_ratio=j.penalty_damping_ratio))
+        if j.initial_angle or j.initial_rate:
+            _apply_initial_hinge_state(bodies, joints, len(joints) - 1, j.initial_angle, j.initial_rate)
+    return bodies, joints, rest_attitudes, rest_coms
+
+
+def _apply_initial_hinge_state(bodies, joints, index, angle, rate):
+    """Rotate the child subtree about the hinge axis by ``angle`` and give it ``rate`` (LVLH)."""
+    joint = joints[index]
+    axis = joint.hinge_to_lvlh[:, 1]
+    turn = Rotation.from_rotvec(angle * axis).as_matrix()
+    for k in subtree_bodies(joints, joint.child):
+        b = bodies[k]
+        arm = turn @ (b.com_lvlh - joint.point_lvlh)
+        b.com_lvlh = joint.point_lvlh + arm
+        b.body_to_lvlh = turn @ b.body_to_lvlh
+        b.velocity_lvlh = turn @ b.velocity_lvlh + rate * np.cross(axis, arm)
+        b.omega_body = b.omega_body + rate * (b.body_to_lvlh.T @ axis)
+
+
+def rim_nodes(nodes_per_side: int) -> np.ndarray:
+    """Indices of the square grid's perimeter nodes (row-major grid, see multibody.net)."""
+    i, j = np.divmod(np.arange(nodes_per_side**2), nodes_per_side)
+    return np.flatnonzero((i == 0) | (j == 0) | (i == nodes_per_side - 1) | (j == nodes_per_side - 1))
+
+
+def build_chaser(case: Case, net, index: int) -> tuple[RigidBodySpec, NetMount]:
+    """The chaser body behind the net plane, moving with the net, and the rods holding the rim
+    on it; ``index`` is the chaser's place in the assembly's body list."""
+    chaser, launch = case.chaser, case.launch
+    direction = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
+    n = case.net.nodes_per_side
+    net_center = net.positions[: n * n].mean(axis=0)
+    com = net_center - chaser.standoff * direction
+    body = RigidBodySpec(name="chaser", mass=chaser.mass, inertia_body=np.diag(chaser.principal_inertia),
+                         com_lvlh=com, velocity_lvlh=launch.velocity * direction)
+    rim = rim_nodes(n)
+    mount = NetMount(nodes=rim, body=index, points_body=net.positions[rim] - com,
+                     stiffness=chaser.mount_stiffness, damping=chaser.mount_damping)
+    return body, mount
+
+
+def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
+    """Everything :class:`multibody.impact.ImpactSimulation` needs for this case."""
+    net, velocity = build_net(case)
+    bodies, joints, rest_att, rest_com = build_bodies_and_joints(case, base)
+    mount = chaser_index = None
+    if case.chaser is not None:
+        chaser_index = len(bodies)
+        chaser, mount = build_chaser(case, net, chaser_index)
+        bodies.append(chaser)
+        rest_att.append(chaser.body_to_lvlh.copy())
+        rest_com.append(chaser.com_lvlh.copy())
+    law = case.contact
+    sim = case.simulation
+    assembly = ImpactAssembly(
+        net=net, net_velocity=velocity, bodies=bodies, joints=joints,
+        contact=ContactLaw(stiffness=law.stiffness, exponent=law.exponent,
+                           hunt_crossley_alpha=law.hunt_crossley_alpha, mu_static=law.mu_static,
+                           mu_kinetic=law.mu_kinetic, transition_speed=law.transition_speed),
+        solver=SolverSpec(end_time=sim.end_time, step=sim.step, integrator=sim.integrator,
+                          output_rate=sim.output_rate, net_output_rate=sim.net_output_rate,
+                          contact_substep=sim.contact_substep, net_integration=sim.net_integration),
+        mean_motion=mean_motion(case.orbit.altitude) if isinstance(case.orbit, CircularOrbit) else 0.0,
+        mount=mount, chaser=chaser_index)
+    return ModelInputs(assembly, rest_att, rest_com)
+
+
+def weak_locations(case: Case, assembly) -> list:
+    """The case's weak locations with axes and offsets in their joint frames (t = 0)."""
+    if case.structures is None:
+        return []
+    _, target_to_lvlh = target_pose_lvlh(case)
+    names = [j.name for j in assembly.joints]
+    out = []
+    for spec in case.structures.weak_locations:
+        k = names.index(spec.joint)
+        joint = assembly.joints[k]
+        target_to_joint = joint.hinge_to_lvlh.T @ target_to_lvlh
+        beam = np.asarray(spec.beam_axis, float)
+        beam /= np.linalg.norm(beam)
+        width = np.asarray(spec.width_axis, float)
+        width = width - (width @ beam) * beam
+        width /= np.linalg.norm(width)
+        section_to_target = np.column_stack([beam, width, np.cross(beam, width)])
+        if spec.moment_axes is not None:
+            axes = tuple(sorted({"h1": 0, "h2": 1, "h3": 2}[a] for a in spec.moment_axes))
+        else:
+            axes = (0, 2) if joint.kind == "revolute" else (0, 1, 2)
+        material = spec.material
+        out.append(WeakLocation(
+            name=spec.name, joint=k, section_to_joint=target_to_joint @ section_to_target,
+            offset_joint=target_to_joint @ np.asarray(spec.offset, float),
+            section=section_properties(spec.section) if spec.section is not None else None,
+            ultimate_normal=Allowable.of(material.ultimate_normal) if material else None,
+            ultimate_shear=Allowable.of(material.ultimate_shear) if material else None,
+            allowable_moment=Allowable.of(spec.allowable_moment) if spec.allowable_moment is not None else None,
+            allowable_force=Allowable.of(spec.allowable_force) if spec.allowable_force is not None else None,
+            moment_axes=axes))
+    return out

@@ -1,0 +1,153 @@
+"""Report sections of the structures stage: the verdict, loads against allowables, stresses
+against strengths (from structures.json and structures.npz of the run folder)."""
+from __future__ import annotations
+
+import numpy as np
+
+from riskassess.products.report.blocks import Figure, Note, Section, Table
+from riskassess.products.report.plotting import allowable_band, legend, mark_release, panels, plain, shade_not_judged
+from riskassess.products.results import RunFolder
+from riskassess.products.tables import STATE_TEXT, VERDICT_COLUMNS, format_margin, format_vector, verdict_rows
+
+NOT_ASSESSED = ("Not assessed: the case declares no weak locations. Add [[structures.weak_locations]] to the case "
+                "(docs/case-format.md) and run it again to get failure verdicts and released pieces.")
+
+
+def _not_assessed(run: RunFolder) -> bool:
+    """The case declares no weak locations, so the run has no structures results to miss."""
+    return not run.has("structures.json") and run.case.get("structures") is None
+
+
+def verdict_section(run: RunFolder) -> Section:
+    if _not_assessed(run):
+        return Section("verdict", "Verdict: secondary debris", [Note(NOT_ASSESSED, "warning")])
+    verdict = run.structures  # MissingData names the file when a case with weak locations lacks it
+    pieces = verdict["released_pieces"]
+    failing = [loc["name"] for loc in verdict["locations"] if loc["fails"]]
+    state = verdict.get("debris_state") or ("debris" if verdict["secondary_debris"] else "no_debris")
+    if state == "debris":
+        headline = Note(f"SECONDARY DEBRIS: {len(pieces)} piece(s) released"
+                        + (f"; failing locations: {', '.join(failing)}" if failing else ""), "alarm")
+    elif state == "indeterminate":
+        headline = Note("INDETERMINATE: the run gives no evidence for a verdict, so it cannot say that the capture "
+                        "is safe. " + "; ".join(verdict.get("indeterminate_reasons") or []), "alarm")
+    else:
+        headline = Note("No secondary debris: every weak location holds with its decisive allowable.", "info")
+    blocks = [headline]
+    if pieces:
+        blocks.append(Table(
+            ["piece (bodies)", "released at (s)", "by", "mass (kg)", "size (m)", "at end", "velocity rel. chaser "
+             "(m/s, LVLH)", "spin (rad/s)"],
+            [["+".join(p["bodies"]), f"{p['release_time_s']:.3f}", f"{p['location']} ({p['criterion']})",
+              f"{p['mass_kg']:.4g}", " x ".join(f"{e:.3g}" for e in p["size_m"]),
+              "inside the net" if p["inside_net_at_end"] else "OUTSIDE the net",
+              format_vector(p["velocity_relative_to_chaser_lvlh_m_s"]), f"{p['spin_rate_rad_s']:.3g}"]
+             for p in pieces], "Released pieces (size: oriented bounding box of the piece's shapes)"))
+    rows = verdict_rows(verdict)
+    columns = [c for c in VERDICT_COLUMNS if c != "released piece"]
+    blocks.append(Table(columns, [[STATE_TEXT[r["state"]] if c == "fails?" else r[c] for c in columns]
+                                  for r in rows],
+                        f"Weak locations: peak demand after {verdict['skip_initial_s']:g} s against the allowable; "
+                        f"range allowables decide at their '{verdict['release_policy']}' value. Margin of safety = "
+                        f"allowable / demand - 1.",
+                        alarm_rows={k for k, r in enumerate(rows) if r["state"] != "holds"}, css_class="verdict"))
+    blocks.append(Note("Likelihood: probability of failure with the allowable uniformly distributed over its "
+                       "range. For a released location it is a lower bound ('>='), because the joint carries "
+                       "nothing after its release."))
+    return Section("verdict", "Verdict: secondary debris", blocks)
+
+
+def _mpa(value) -> str:
+    """A stress (Pa) in MPa; '-' when the run judged none (indeterminate location)."""
+    return "-" if value is None else f"{value / 1e6:.4g}"
+
+
+def _margin(value) -> str:
+    return "-" if value is None else format_margin(value)
+
+
+def _locations_with(verdict: dict, criteria: set) -> list[dict]:
+    return [loc for loc in verdict["locations"] if criteria & set(loc["criteria"])]
+
+
+def while_joined(t, demand, loc: dict) -> np.ndarray:
+    """The demand (any unit) with NaN after the location's release: a released load path carries
+    nothing, and a plotted 0 would read as a measured zero load."""
+    demand = np.asarray(demand, float).copy()
+    if loc["released_at_s"] is not None:
+        demand[np.asarray(t) > loc["released_at_s"]] = np.nan   # the sample that broke it stays
+    return demand
+
+
+def _decorate(ax, verdict: dict, loc: dict, time_end: float) -> None:
+    shade_not_judged(ax, verdict["skip_initial_s"])
+    if loc["released_at_s"] is not None:
+        mark_release(ax, loc["released_at_s"])
+    ax.set_xlim(0.0, time_end)
+
+
+def joint_loads_section(run: RunFolder) -> Section:
+    """Moment and force demands of every weak location that has a moment or force allowable."""
+    title = "Hinge and joint loads against allowables"
+    if _not_assessed(run):
+        return Section("joint-loads", title, [Note(NOT_ASSESSED, "warning")])
+    verdict, series = run.structures, run.structures_series
+    t = series["time"]
+    units = {"moment": "N m", "force": "N"}
+    judged = [(loc, name) for loc in verdict["locations"] for name in units if name in loc["criteria"]]
+    if not judged:
+        return Section("joint-loads", title, [Note("No weak location has a moment or force allowable.")])
+    fig, axes = panels(len(judged), 1.9)
+    for ax, (loc, name) in zip(axes, judged):
+        c = loc["criteria"][name]
+        ax.plot(t, while_joined(t, run.key(series, f"{loc['name']}/{name}"), loc), color="k",
+                label=f"{name} demand")
+        allowable_band(ax, *c["allowable"], c["decisive_allowable"], 1.0, units[name])
+        _decorate(ax, verdict, loc, t[-1])
+        ax.set_ylabel(f"{name} ({units[name]})")
+        ax.set_title(plain(f"{loc['name']} (joint {loc['joint']})"))
+        legend(ax)
+    return Section("joint-loads", title, [Figure.from_matplotlib(
+        "fig-joint-loads", "Demand of each location with a moment or force allowable (the resultant of the "
+        "judged joint-frame components) against its allowable range; grey: initial transient not judged; the curve "
+        "ends where the location is released (red dotted).", fig)])
+
+
+def stresses_section(run: RunFolder) -> Section:
+    title = "Stresses against strengths"
+    if _not_assessed(run):
+        return Section("stresses", title, [Note(NOT_ASSESSED, "warning")])
+    verdict, series = run.structures, run.structures_series
+    t = series["time"]
+    locations = _locations_with(verdict, {"normal_stress", "shear_stress"})
+    if not locations:
+        return Section("stresses", title, [Note("No weak location has a cross-section and material.")])
+    fig, axes = panels(len(locations), 1.9)
+    colors = {"normal_stress": "tab:blue", "shear_stress": "tab:purple"}
+    rows = []
+    for ax, loc in zip(axes, locations):
+        floor = np.inf
+        for name, color in colors.items():
+            c = loc["criteria"][name]
+            demand = while_joined(t, run.key(series, f"{loc['name']}/{name}"), loc) / 1e6
+            ax.plot(t, np.maximum(demand, 1e-9), color=color, label=f"{name.replace('_', ' ')}")
+            ax.axhspan(c["allowable"][0] / 1e6, c["allowable"][1] / 1e6, color=color, alpha=0.12, lw=0)
+            ax.axhline(c["decisive_allowable"] / 1e6, color=color, ls="--", lw=1.0,
+                       label=f"{c['mode']} strength {c['decisive_allowable'] / 1e6:.4g} MPa")
+            floor = min(floor, c["allowable"][0] / 1e6 * 1e-4)
+        ax.set_yscale("log")
+        ax.set_ylim(bottom=floor)
+        _decorate(ax, verdict, loc, t[-1])
+        ax.set_ylabel("stress (MPa)")
+        ax.set_title(plain(f"{loc['name']} (joint {loc['joint']})"))
+        legend(ax)
+        normal, shear = loc["criteria"]["normal_stress"], loc["criteria"]["shear_stress"]
+        rows.append([loc["name"], _mpa(normal["peak"]), _mpa(shear["peak"]), _mpa(loc.get("peak_von_mises_stress_Pa")),
+                     f"{_margin(normal['margin_of_safety'])} / {_margin(shear['margin_of_safety'])}"])
+    return Section("stresses", title, [
+        Figure.from_matplotlib("fig-stresses", "Peak normal (axial + bending) and shear (torsion + transverse) "
+                               "stress at each section, log axis, against the material's ultimate strength "
+                               "(shaded: the given range; dashed: the decisive value).", fig),
+        Table(["location", "peak normal (MPa)", "peak shear (MPa)", "peak von Mises (MPa)",
+               "margin normal / shear"], rows, "Peak stresses after the initial transient"),
+    ])

@@ -1,0 +1,75 @@
+"""Figures of the towing stages (PNG, written atomically): a tow's time series and the
+identification's convergence and data-versus-fit comparison."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from riskassess.products.report.plotting import STYLE, legend, panels, plain, plt, write_png
+
+
+def _save(fig, path: Path) -> None:
+    write_png(fig, path, dpi=130)
+
+
+def _tow_panels(axes, s, label, style="-"):
+    label = plain(label)
+    t = s["time"]
+    axes[0].plot(t, s["main_tether_tension"], style, label=f"{label} main tether")
+    axes[0].plot(t, s["thrust"], style, color="0.5", lw=0.8, label=f"{label} thrust")
+    axes[1].plot(t, np.linalg.norm(s["debris_com_inertial"] - s["chaser_com_inertial"], axis=1), style,
+                 label=f"{label} chaser-debris".strip())
+    axes[2].plot(t, np.linalg.norm(s["chaser_omega_body"], axis=1), style, label=f"{label} chaser")
+    axes[2].plot(t, np.linalg.norm(s["debris_omega_body"], axis=1), style, label=f"{label} debris")
+
+
+def tow_figure(series: dict, title: str, others: dict | None = None):
+    """Main-tether tension and thrust, chaser-debris distance, angular rates against time;
+    ``others`` (label -> series) are drawn dashed on the same axes (e.g. thrust laws compared).
+    Call inside ``plt.rc_context(STYLE)``; returns the matplotlib figure."""
+    fig, axes = panels(3, 1.8)
+    _tow_panels(axes, series, "")
+    for label, other in (others or {}).items():
+        _tow_panels(axes, other, label, "--")
+    axes[0].set_ylabel("force (N)")
+    axes[0].set_title(f"{plain(title)}: main-tether tension and thrust")
+    axes[1].set_ylabel("|r_D/C| (m)")
+    axes[2].set_ylabel("|omega| (rad/s)")
+    for ax in axes:
+        legend(ax)
+    return fig
+
+
+def plot_tow(series: dict, path: Path, title: str, others: dict | None = None) -> None:
+    """:func:`tow_figure` written to ``path`` as PNG."""
+    with plt.rc_context(STYLE):
+        _save(tow_figure(series, title, others), path)
+
+
+def plot_convergence(histories: dict, path: Path, title: str) -> None:
+    """Best cost against evaluations for each optimizer run (label -> (evaluations, best cost))."""
+    with plt.rc_context(STYLE):
+        fig, (ax,) = panels(1, 2.6, sharex=False)
+        for label, (evaluations, best) in histories.items():
+            ax.semilogy(evaluations, best, label=plain(label))
+        ax.set_xlabel("cost evaluations (each: one simulation per spin rate)")
+        ax.set_ylabel("best cost")
+        ax.set_title(plain(title))
+        legend(ax)
+        _save(fig, path)
+
+
+def plot_fit(data: dict, fitted: dict, path: Path, title: str) -> None:
+    """One run's data (solid) against the identified model (dashed)."""
+    with plt.rc_context(STYLE):
+        fig, axes = panels(3, 1.8)
+        _tow_panels(axes, data, "data")
+        _tow_panels(axes, fitted, "identified", "--")
+        axes[0].set_ylabel("force (N)")
+        axes[0].set_title(plain(title))
+        axes[1].set_ylabel("|r_D/C| (m)")
+        axes[2].set_ylabel("|omega| (rad/s)")
+        for ax in axes:
+            legend(ax)
+        _save(fig, path)

@@ -1,0 +1,323 @@
+"""`riskassess identify`: sub-tether parameters of the lower-order towing model (Boonrath, Singh &
+Botta 2024, Sec. 3).
+
+Decision vector :math:`s = [\\log_{10} k_{ST}, l_{ST,0}, \\log_{10} c_{ST}, m_P/m_{net}]` (eq. 22) within
+the bounds of eq. (24). For each candidate, one lower-order run per spin rate of the data set
+(the compiled twin of the Exudyn model, :func:`multibody.towing.run_twin`) is compared with the
+data by
+
+* :func:`cost_f1`: :math:`\\sum_j w_1 RMSE_{r,j} + w_2 (RMSE_{\\omega_D,j} + RMSE_{\\omega_C,j})`, eqs. (17)-(19);
+* :func:`cost_f2`: :math:`\\sum_j RMSE_{T,j}` of the main-tether tension, eqs. (20)-(21).
+
+Two maintained optimizers of pymoo minimize it: particle swarm (:class:`pymoo.algorithms.soo.nonconvex.pso.PSO`,
+the paper's ``particleswarm``) and pattern search (:class:`pymoo.algorithms.soo.nonconvex.pattern.PatternSearch`,
+Hooke-Jeeves, in place of MATLAB's MADS ``patternsearch``). A population's runs are spread over
+worker processes (:class:`multiprocessing.Pool`; each worker holds the case and the data).
+
+The benchmark of Sec. 4.3 (:func:`benchmark`) takes as data the model's own runs with
+``identification.benchmark_truth`` at the training rates, so the minimum is known: cost 0 at s_true.
+"""
+from __future__ import annotations
+
+import multiprocessing
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pymoo.algorithms.soo.nonconvex.pattern import PatternSearch, calc_sign, exploration_move, pattern_move
+from pymoo.algorithms.soo.nonconvex.pso import PSO
+from pymoo.core.population import Population
+from pymoo.core.problem import Problem
+from pymoo.core.replacement import is_better
+from pymoo.core.termination import Termination
+from pymoo.optimize import minimize
+from pymoo.termination.collection import TerminationCollection
+from pymoo.termination.default import DefaultSingleObjectiveTermination
+from pymoo.termination.max_eval import MaximumFunctionCallTermination
+
+from multibody.towing import run_twin
+from multibody.towing_kernel import MT_TENSION
+from riskassess.products import results
+from riskassess.products.outfolder import OutputFolder, claim
+from riskassess.stages.tow import towing_model
+from riskassess.cases.towing import TowingCase
+
+#: The quantities the costs compare, from :meth:`multibody.towing.TowResult.series`.
+COMPARED = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
+
+
+def compared_series(result) -> dict:
+    """r_D/C (m, inertial), both angular velocities (rad/s, body frames) and the MT tension (N) of a run:
+    the entries of :meth:`multibody.towing.TowResult.series`, bit for bit, taken straight from the samples
+    (``series`` also forms two rotation matrices per sample, a fifth of an identification run's time)."""
+    m, q, v = result.model, result.q, result.v
+    return {"relative_position": (m.positions[2] + q[:, 9:12]) - (m.positions[1] + q[:, 3:6]),
+            "chaser_omega_body": v[:, 6:9], "debris_omega_body": v[:, 12:15],
+            "main_tether_tension": result.diag[:, MT_TENSION]}
+
+
+def rmse(model, data) -> float:
+    """:math:`\\sqrt{\\sum_g \\|x^L_g - x^H_g\\|^2 / N_t}` over the samples, eqs. (19), (21)."""
+    diff = (np.asarray(model) - np.asarray(data)).reshape(len(data), -1)
+    return float(np.sqrt(np.mean(np.sum(diff**2, axis=1))))
+
+
+def cost_f1(model: dict, data: dict, weights) -> float:
+    """One run's term of eq. (18): :math:`w_1 RMSE_r + w_2 (RMSE_{\\omega_D} + RMSE_{\\omega_C})`."""
+    return weights[0] * rmse(model["relative_position"], data["relative_position"]) + weights[1] * (
+        rmse(model["debris_omega_body"], data["debris_omega_body"])
+        + rmse(model["chaser_omega_body"], data["chaser_omega_body"]))
+
+
+def cost_f2(model: dict, data: dict, weights=None) -> float:
+    """One run's term of eq. (20): the RMSE of the main-tether tension."""
+    return rmse(model["main_tether_tension"], data["main_tether_tension"])
+
+
+COSTS = {"f1": cost_f1, "f2": cost_f2}
+
+
+def simulate(case: TowingCase, rate_deg_s: float, s, end_time=None) -> dict:
+    """The compared series of one lower-order run (twin, step ``identification.step``) at spin rate
+    ``rate_deg_s`` with sub-tethers ``s``."""
+    return compared_series(run_twin(towing_model(case, rate_deg_s, s, step=case.identification.step,
+                                                  end_time=end_time)))
+
+
+# ------------------------------------------------------------------ parallel evaluation
+_WORKER = {}
+
+
+def _init_worker(case, data, cost, weights, end_time):
+    _WORKER.update(case=case, data=data, cost=COSTS[cost], weights=weights, end_time=end_time)
+
+
+def _run_term(task) -> float:
+    """Cost term of one (candidate, rate index) pair, in a worker; a run that fails or diverges (a
+    non-finite cost: the twin's state went NaN) scores inf, so it is never the identified answer."""
+    s, j = task
+    w = _WORKER
+    rate = w["data"][j]["rate_deg_s"]
+    try:
+        term = w["cost"](simulate(w["case"], rate, s, w["end_time"]), w["data"][j], w["weights"])
+    except (ValueError, ZeroDivisionError, FloatingPointError):
+        return np.inf
+    return term if np.isfinite(term) else np.inf
+
+
+class TowingFit(Problem):
+    """pymoo problem: minimize ``cost`` of the lower-order runs against ``data`` over s in the bounds;
+    each population is evaluated as (candidates x rates) runs on ``pool``."""
+
+    def __init__(self, pool, n_runs, lower, upper):
+        super().__init__(n_var=4, n_obj=1, xl=np.asarray(lower, float), xu=np.asarray(upper, float))
+        self.pool, self.n_runs = pool, n_runs
+        self.evaluations, self.best = [], []
+
+    def _evaluate(self, x, out, *args, **kwargs):
+        tasks = [(np.array(s), j) for s in x for j in range(self.n_runs)]
+        terms = np.array(self.pool.map(_run_term, tasks, chunksize=max(1, len(tasks) // (4 * self.pool._processes))))
+        costs = terms.reshape(len(x), self.n_runs).sum(axis=1)
+        out["F"] = costs
+        for c in costs:
+            self.evaluations.append(len(self.evaluations) + 1)
+            self.best.append(min(c, self.best[-1]) if self.best else c)
+
+
+@dataclass
+class Identified:
+    """Result of one optimizer run: s (4,), cost, optimizer name, evaluations, wall time (s) and
+    the best cost after each evaluation."""
+
+    s: np.ndarray
+    cost: float
+    optimizer: str
+    evaluations: int
+    wall_s: float
+    history: list
+
+
+class SeededPatternSearch(PatternSearch):
+    """pymoo's Hooke-Jeeves (:class:`pymoo.algorithms.soo.nonconvex.pattern.PatternSearch`), unchanged
+    except that the random order of each exploration move is drawn from the algorithm's seeded generator:
+    pymoo 0.6.2 calls ``exploration_move`` without it, so every exploration drew a fresh unseeded order and
+    two runs from the same start could end at different points."""
+
+    def _next(self):
+        if not is_better(self._explr, self._center):
+            self.n_not_improved += 1
+            self._rho = self.init_rho**self.n_not_improved
+            self._explr = yield from exploration_move(self.problem, self._center, self._sign, self._delta, self._rho,
+                                                      random_state=self.random_state)
+        else:
+            self._direction = self._explr.X - self._center.X
+            self._center = self._explr
+            self._trial = yield pattern_move(self.problem, self._center, self._direction, self.step_size)
+            self._sign = calc_sign(self._direction)
+            self._explr = yield from exploration_move(self.problem, self._trial, self._sign, self._delta, self._rho,
+                                                      random_state=self.random_state)
+        self.pop = Population.create(self._center, self._explr)
+
+
+class StepTolerance(Termination):
+    """Ends a Hooke-Jeeves leg once its exploration step (:math:`\\rho\\,\\delta`) is below ``tolerance``
+    times every variable's bound range: smaller moves do not change s at the precision asked for."""
+
+    def __init__(self, tolerance):
+        super().__init__()
+        self.tolerance = tolerance
+
+    def _update(self, algorithm):
+        if getattr(algorithm, "_delta", None) is None:
+            return 0.0
+        lower, upper = algorithm.problem.bounds()
+        return float(np.all(algorithm._rho * algorithm._delta < self.tolerance * (upper - lower)))
+
+
+def _pattern_search(problem, x0, settings, first_delta, budget):
+    """Hooke-Jeeves (:class:`SeededPatternSearch`) from ``x0`` in legs of at most
+    ``settings.restart_evaluations`` evaluations, each restarted from the best point so far.
+
+    Hooke-Jeeves shrinks one step factor for all variables, so in this problem (the cost ~260x flatter
+    along s4 than along s1, docs/towing.md) the step along s4 is down to 1e-3 of its range while s1-s3 are
+    still being tuned, and s4 then crawls. Each restart therefore gives every variable its own first step
+    (a fraction of its bound range): a variable that travelled at least a tenth of its first step in the
+    last leg keeps that step (or the distance travelled, if larger, up to ``first_delta``); a settled one
+    gets the distance it travelled, at least a tenth of its step (at most tenfold smaller per leg).
+    A leg without improvement shrinks all steps tenfold. A leg ends when its step is below
+    ``settings.pattern_tolerance`` of every bound range (:class:`StepTolerance`) or after
+    ``settings.restart_evaluations``; the search stops after ``budget`` evaluations or when every first step
+    is below the tolerance. Returns (best s, best cost)."""
+    span = problem.xu - problem.xl
+    x, f, delta = np.asarray(x0, float), np.inf, np.full(problem.n_var, float(first_delta))
+    leg = 0
+    while len(problem.evaluations) < budget and delta.max() >= settings.pattern_tolerance:
+        n = min(settings.restart_evaluations, budget - len(problem.evaluations))
+        result = minimize(problem, SeededPatternSearch(x0=x, init_delta=delta), TerminationCollection(
+            StepTolerance(settings.pattern_tolerance), MaximumFunctionCallTermination(n)), seed=settings.seed + leg,
+            verbose=False)
+        leg += 1
+        cost, found = float(np.atleast_1d(result.F)[0]), np.asarray(result.X, float).ravel()
+        if cost < f:
+            moved = np.abs(found - x) / span
+            travelling = moved >= 0.1 * delta
+            delta = np.where(travelling, np.minimum(np.maximum(moved, delta), first_delta), np.maximum(moved, 0.1 * delta))
+            x, f = found, cost
+        else:
+            delta = 0.1 * delta
+    return x, f
+
+
+def identify(case: TowingCase, data: list[dict], optimizer: str, end_time=None, workers=None,
+             initial_guess=None) -> Identified:
+    """Minimize the case's cost (``identification.cost``) against ``data`` (one dict per run: the
+    compared series and ``rate_deg_s``) with ``optimizer``: 'pso' (pymoo PSO), 'pattern' (pattern
+    search with restarts from ``initial_guess`` or the case's s0, :func:`_pattern_search`) or 'polish'
+    (the same, with ``optimizers.polish_delta`` as first step and ``polish_evaluations`` as budget)."""
+    ident = case.identification
+    settings = ident.optimizers
+    x0 = ident.initial_guess if initial_guess is None else initial_guess
+    start = time.perf_counter()
+    with multiprocessing.get_context("fork").Pool(
+            workers or ident.workers, _init_worker, (case, data, ident.cost, ident.weights, end_time)) as pool:
+        problem = TowingFit(pool, len(data), ident.lower_bounds, ident.upper_bounds)
+        if optimizer == "pso":
+            result = minimize(problem, PSO(pop_size=settings.swarm_size), DefaultSingleObjectiveTermination(
+                ftol=settings.pso_tolerance, period=settings.stall_generations, n_max_gen=settings.pso_generations),
+                seed=settings.seed, verbose=False)
+            s, cost = np.asarray(result.X, float).ravel(), float(np.atleast_1d(result.F)[0])
+        elif optimizer == "pattern":
+            s, cost = _pattern_search(problem, x0, settings, 0.25, settings.pattern_evaluations)
+        else:
+            s, cost = _pattern_search(problem, x0, settings, settings.polish_delta, settings.polish_evaluations)
+    return Identified(s, cost, optimizer, len(problem.evaluations), time.perf_counter() - start, problem.best)
+
+
+def training_data(case: TowingCase, s, rates, end_time=None) -> list[dict]:
+    """Lower-order runs with sub-tethers ``s`` at ``rates`` (deg/s): the benchmark's data (Sec. 4.3)."""
+    return [{**simulate(case, rate, s, end_time), "rate_deg_s": rate} for rate in rates]
+
+
+def _entry(found: Identified, truth) -> dict:
+    return {"s": found.s.tolist(), "cost": found.cost, "optimizer": found.optimizer,
+            "relative_error": (np.abs(found.s - truth) / np.abs(truth)).tolist(),
+            "evaluations": found.evaluations, "wall_s": found.wall_s, "history": found.history}
+
+
+def run_optimizers(case: TowingCase, data: list[dict], optimizers=None, end_time=None, workers=None) -> dict:
+    """Each of ``optimizers`` (default ``identification.searches``: 'pso' and/or 'pattern') on ``data``
+    with :func:`identify`; with ``optimizers.polish_evaluations`` > 0 the PSO's best is polished by a
+    pattern search, reported as 'pso+pattern' (evaluations and wall time include the PSO's).
+    Returns {name: :class:`Identified`} in the order run."""
+    found = {}
+    for name in case.identification.searches if optimizers is None else optimizers:
+        found[name] = identify(case, data, name, end_time, workers)
+        if name == "pso" and case.identification.optimizers.polish_evaluations > 0:
+            swarm = found[name]
+            polish = identify(case, data, "polish", end_time, workers, initial_guess=swarm.s)
+            found["pso+pattern"] = Identified(polish.s, polish.cost, "pso+pattern", swarm.evaluations + polish.evaluations,
+                                              swarm.wall_s + polish.wall_s,
+                                              swarm.history + [min(swarm.cost, c) for c in polish.history])
+    return found
+
+
+def benchmark(case: TowingCase, optimizers=None, rates=None, end_time=None, workers=None) -> dict:
+    """Sec. 4.3: data from ``benchmark_truth`` at the training rates (same model and step as the
+    fit), identified by each optimizer (:func:`run_optimizers`). Returns per optimizer s, cost,
+    relative error against the truth, evaluations and wall time."""
+    truth = np.asarray(case.identification.benchmark_truth, float)
+    rates = case.rates.training_deg_s if rates is None else rates
+    start = time.perf_counter()
+    data = training_data(case, truth, rates, end_time)
+    out = {"truth": truth.tolist(), "cost_function": case.identification.cost, "rates_deg_s": list(rates),
+           "data_wall_s": time.perf_counter() - start, "runs": {}}
+    for name, found in run_optimizers(case, data, optimizers, end_time, workers).items():
+        out["runs"][name] = _entry(found, truth)
+    return out
+
+
+def benchmark_case(case_path, out_dir, case: TowingCase | None = None, end_time=None,
+                   overwrite: bool = False) -> dict:
+    """`riskassess identify CASE --benchmark`: run :func:`benchmark` and write ``identification.json``
+    (every run, history included), ``convergence.png`` and a manifest to ``out_dir`` (claimed by
+    :func:`riskassess.products.outfolder.claim`); returns the answer with the best run's ``s``, ``cost``,
+    ``optimizer`` and ``wall_s`` on top."""
+    from riskassess.cases.impact import load_model
+
+    case = case or load_model(case_path, TowingCase)
+    folder = claim_identify_folder(out_dir, case_path, case.name, overwrite)
+    with folder.recording():
+        answer = _benchmark_into(case, folder, end_time)
+    folder.finish("complete")
+    return answer
+
+
+def claim_identify_folder(out_dir, case_path, case_name: str, overwrite: bool) -> OutputFolder:
+    """Claim the folder of `riskassess identify` and copy the case into it; on ``overwrite`` the cached
+    full-net runs (``fullnet/``) stay when the folder's ``case.toml`` is byte-identical to the case file."""
+    out, case_path = Path(out_dir), Path(case_path)
+    same_case = (out / "case.toml").is_file() and (out / "case.toml").read_bytes() == case_path.read_bytes()
+    folder = claim(out, case_name, "identify", overwrite, stage="identify",
+                   keep=(lambda name: name.startswith("fullnet/")) if same_case else None)
+    with folder.recording():
+        results.atomic_write_bytes(folder.path / "case.toml", case_path.read_bytes())
+        folder.add_files("case.toml")
+    return folder
+
+
+def _benchmark_into(case: TowingCase, folder: OutputFolder, end_time) -> dict:
+    from riskassess.products.towing_plots import plot_convergence
+
+    out = folder.path
+    start = time.perf_counter()
+    answer = benchmark(case, end_time=end_time)
+    best = min(answer["runs"].values(), key=lambda r: r["cost"])
+    answer = {"case": case.name, "s": best["s"], "cost": best["cost"], "optimizer": best["optimizer"],
+              "wall_s": time.perf_counter() - start, **answer}
+    results.atomic_write_json(out / "identification.json", answer)
+    plot_convergence({name: (np.arange(1, len(r["history"]) + 1), np.maximum(r["history"], 1e-12))
+                      for name, r in answer["runs"].items()}, out / "convergence.png",
+                     f"{case.name}: Sec. 4.3 benchmark, cost {answer['cost_function']}")
+    folder.add_files("identification.json", "convergence.png")
+    return answer

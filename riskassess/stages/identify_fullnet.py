@@ -1,0 +1,150 @@
+"""`riskassess identify CASE` (without --benchmark): sub-tether identification against full-net runs
+(Boonrath, Singh & Botta 2024, Sec. 4.1, 4.4).
+
+1. Full-net runs (:mod:`riskassess.stages.tow_fullnet`, wrapped start) at the training and validation spin
+   rates of Table 3 (``full_net.identification_training_runs`` / ``_validation_runs`` take the first k),
+   in parallel worker processes, each cached in ``OUT/fullnet/rate_<deg_s>.npz`` (a re-run reuses them).
+2. The lower-order runs start from the full-net state at the start time, as the paper does (Sec. 4.1):
+   debris and chaser states, P at the net node the main tether holds. With the wrapped start the debris
+   has the case's Table 2 state, so this is the case with the chaser moved where the full-net run
+   starts it and ``sub_tethers.connection_point_start_inertial`` at the central node
+   (:func:`lower_order_case`); P's velocity is the debris' rigid motion there, as the node's.
+3. s is identified on the training runs by each optimizer of ``identification.searches`` (PSO, then the
+   pattern-search polish, and/or the pattern search; :func:`riskassess.stages.identify.run_optimizers`) on the
+   case's cost, f1 or f2 (eqs. 18, 20), and each identified model is compared with the training runs and
+   the unseen validation runs: RMSE per channel (r_D/C, omega_C, omega_D, T_MT, eqs. 19, 21) and both
+   costs, per run and summed (the paper's Tables 7, 8 and 10).
+"""
+from __future__ import annotations
+
+import multiprocessing
+import time
+from pathlib import Path
+
+import numpy as np
+
+from riskassess.products import results
+from riskassess.cases.impact import CaseError
+from riskassess.stages.identify import COSTS, claim_identify_folder, rmse, simulate
+from riskassess.products.outfolder import OutputFolder
+from riskassess.cases.towing import TowingCase
+
+CHANNELS = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
+
+
+def _run_full_net(task):
+    """One full-net run in a worker: (case, wrapped net, rate, end) -> compared series (+ start state)."""
+    from multibody.net_towing import run_exudyn
+    from riskassess.stages.tow_fullnet import full_net_model
+
+    case, wrapped, rate, end = task
+    model = full_net_model(case, rate, wrapped=wrapped, end_time=end)
+    result = run_exudyn(model)
+    s = result.series()
+    series = {"relative_position": s["debris_com_inertial"] - s["chaser_com_inertial"],
+              "chaser_omega_body": s["chaser_omega_body"], "debris_omega_body": s["debris_omega_body"],
+              "main_tether_tension": s["main_tether_tension"]}   # the channels of identify.compared_series
+    return {**series, "rate_deg_s": rate, "chaser_start_inertial": model.positions[0],
+            "node_start_inertial": model.node_positions[model.net.central], "wall_s": result.wall_time}
+
+
+def full_net_runs(case: TowingCase, rates, out: Path, end, workers, record=None) -> list[dict]:
+    """Full-net runs at ``rates`` (deg/s), read from ``out``'s cache where present (same end time);
+    ``record(relative path)`` is told of each new cache file (the output folder lists it)."""
+    from riskassess.stages.tow_fullnet import wrapped_net
+
+    cache = out / "fullnet"
+    cache.mkdir(parents=True, exist_ok=True)
+    path = {rate: cache / f"rate_{rate:.2f}_end_{end:g}.npz" for rate in rates}
+    missing = [rate for rate in rates if not path[rate].exists()]
+    if missing:
+        wrapped = wrapped_net(case)
+        with multiprocessing.get_context("fork").Pool(min(workers, len(missing))) as pool:
+            # each run cached as soon as it is done: an interrupted call keeps the finished ones
+            for run in pool.imap_unordered(_run_full_net, [(case, wrapped, r, end) for r in missing]):
+                results.atomic_write_npz(path[run["rate_deg_s"]], run)
+                if record:
+                    record(path[run["rate_deg_s"]].relative_to(out).as_posix())
+    return [{k: (float(v) if v.ndim == 0 else v) for k, v in np.load(path[rate]).items()} for rate in rates]
+
+
+def lower_order_case(case: TowingCase, run: dict) -> TowingCase:
+    """The case whose lower-order runs start from the full-net start state (module doc, item 2)."""
+    chaser = case.chaser.model_copy(update={"position_inertial": list(map(float, run["chaser_start_inertial"]))})
+    tethers = case.sub_tethers.model_copy(
+        update={"connection_point_start_inertial": list(map(float, run["node_start_inertial"]))})
+    return case.model_copy(update={"chaser": chaser, "sub_tethers": tethers})
+
+
+def comparison_rows(case: TowingCase, s, data: list[dict], end) -> list[dict]:
+    """Per run of ``data``: RMSE of each channel and both costs (eqs. 18-21) of the lower-order model with ``s``."""
+    rows = []
+    for run in data:
+        model = simulate(case, run["rate_deg_s"], s, end)
+        rows.append({"rate_deg_s": run["rate_deg_s"], **{f"rmse_{c}": rmse(model[c], run[c]) for c in CHANNELS},
+                     "f1": COSTS["f1"](model, run, case.identification.weights), "f2": COSTS["f2"](model, run)})
+    return rows
+
+
+def _totals(rows: list[dict]) -> dict:
+    """Sums of f1 and f2 over the runs (eqs. 18, 20) and the mean RMSE of each channel."""
+    return {"f1": sum(r["f1"] for r in rows), "f2": sum(r["f2"] for r in rows),
+            **{f"mean_rmse_{c}": float(np.mean([r[f"rmse_{c}"] for r in rows])) for c in CHANNELS}}
+
+
+def _entry(case: TowingCase, found, training: list[dict], validation: list[dict], end) -> dict:
+    """One optimizer's answer: s, its training cost and history, and the identified model against the
+    training and the unseen validation runs (per run and totals)."""
+    train_rows, valid_rows = comparison_rows(case, found.s, training, end), comparison_rows(case, found.s, validation, end)
+    return {"s": found.s.tolist(), "cost": found.cost, "optimizer": found.optimizer, "evaluations": found.evaluations,
+            "wall_s": found.wall_s, "history": found.history, "training_totals": _totals(train_rows),
+            "validation_totals": _totals(valid_rows), "training": train_rows, "validation": valid_rows}
+
+
+def identify_full_net(case_path, out_dir, case: TowingCase, optimizers=None, overwrite: bool = False) -> dict:
+    """Steps 1-3 of the module doc with ``optimizers`` (default ``identification.searches``) on the case's
+    cost; writes ``identification.json`` (every optimizer's run), ``convergence.png`` and a manifest to
+    ``out_dir`` (claimed by :func:`riskassess.products.outfolder.claim`; with ``overwrite`` the cached full-net runs
+    are kept when the folder's ``case.toml`` is the same file, byte for byte). Returns the answer with the
+    best run's ``s``, ``cost`` and ``optimizer`` on top."""
+    fn = case.full_net
+    if fn is None:
+        raise CaseError(f"{case_path}: identification against full-net runs needs a [full_net] section")
+    if fn.start == "capture":
+        raise CaseError(f"{case_path}: full_net.start = 'capture' is not supported by 'riskassess identify': its "
+                         f"lower-order runs would each need their own start state (the full-net state at "
+                         f"simulation.start_time, Sec. 4.1), which riskassess.stages.identify does not take; use 'wrapped'")
+    folder = claim_identify_folder(out_dir, case_path, case.name, overwrite)
+    with folder.recording():
+        answer = _identify(case, folder, optimizers)
+    folder.finish("complete")
+    return answer
+
+
+def _identify(case: TowingCase, folder: OutputFolder, optimizers) -> dict:
+    """Steps 1-3 into the claimed ``folder``; returns the answer."""
+    from riskassess.stages.identify import run_optimizers
+    from riskassess.products.towing_plots import plot_convergence
+
+    fn, out = case.full_net, folder.path
+    end = fn.identification_end_time or case.simulation.end_time
+    training = case.rates.training_deg_s[:fn.identification_training_runs]
+    validation = case.rates.validation_deg_s[:fn.identification_validation_runs]
+    start = time.perf_counter()
+    data = full_net_runs(case, list(training) + list(validation), out, end, case.identification.workers,
+                         record=folder.add_files)
+    data_wall = time.perf_counter() - start
+    lower = lower_order_case(case, data[0])
+    train, valid = data[:len(training)], data[len(training):]
+    runs = {name: _entry(lower, found, train, valid, end)
+            for name, found in run_optimizers(lower, train, optimizers, end_time=end).items()}
+    best = min(runs.values(), key=lambda r: r["cost"])
+    answer = {"case": case.name, "s": best["s"], "cost": best["cost"], "optimizer": best["optimizer"],
+              "cost_function": case.identification.cost, "wall_s": time.perf_counter() - start, "end_time_s": end,
+              "training_rates_deg_s": list(training), "validation_rates_deg_s": list(validation),
+              "full_net_runs_wall_s": data_wall, "runs": runs}
+    results.atomic_write_json(out / "identification.json", answer)
+    plot_convergence({name: (np.arange(1, len(r["history"]) + 1), np.asarray(r["history"])) for name, r in runs.items()},
+                     out / "convergence.png", f"{case.name}: against full-net runs, cost {case.identification.cost}")
+    folder.add_files("identification.json", "convergence.png")
+    return answer

@@ -1,0 +1,131 @@
+"""The risk pipeline: case file -> coupled simulation -> run folder.
+
+Later stages (structures, reports, VTK) read the run folder; nothing here re-runs them.
+"""
+from __future__ import annotations
+
+import platform
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from multibody.impact import ImpactSimulation
+from riskassess.products import results
+from riskassess.models.impact import model_inputs, weak_locations
+from riskassess.cases.impact import Case, load_case
+from riskassess.products.outfolder import OutputFolder, claim
+from riskassess.products.summary import run_summary
+from structures.release import ReleaseMonitor
+from structures.verdict import INDETERMINATE, demand_series, structures_verdict
+
+
+@dataclass
+class RunOutput:
+    run_dir: Path
+    summary: dict                  # as in summary.json
+    structures: dict | None = None  # as in structures.json, for a case with weak locations
+
+
+def software_versions() -> dict:
+    import exudyn
+    import numba
+    import trimesh
+
+    return {"python": platform.python_version(), "exudyn": exudyn.__version__, "numpy": np.__version__,
+            "numba": numba.__version__, "trimesh": trimesh.__version__}
+
+
+def prepare_simulation(case: Case, case_path: Path) -> ImpactSimulation:
+    """Build the Exudyn model; raises ``ValueError`` for model-level problems before running."""
+    inputs = model_inputs(case, case_path.parent)
+    return ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
+
+
+def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Case | None = None,
+             overwrite: bool = False, pending=(), command: str = "run") -> RunOutput:
+    """Load (unless ``case`` is the already validated file), claim the output folder
+    (:func:`riskassess.products.outfolder.claim`), simulate and write the run folder. ``pending``: product
+    steps (``report``, ``vtk``) the caller makes next; the status stays ``running`` until they end."""
+    case_path = Path(case_path)
+    case = case or load_case(case_path)
+    simulation = prepare_simulation(case, case_path)
+    folder = begin_run_folder(Path(out_dir), case_path, case, overwrite, command)
+    with folder.recording():
+        locations = weak_locations(case, simulation.assembly)
+        monitor = None
+        if locations and case.structures.release != "never":
+            monitor = ReleaseMonitor(locations, simulation.system, case.structures.skip_initial,
+                                     case.structures.release)
+        recorder = run_recorded(simulation, folder, progress=progress, monitor=monitor)
+        summary = write_simulation(folder, recorder, simulation, case)
+    verdict = None
+    if locations:
+        # A later stage that fails leaves the finished simulation results and says so.
+        try:
+            verdict = structures_verdict(
+                locations, recorder.series, simulation.assembly, monitor.events if monitor else [],
+                recorder.net["positions_lvlh"][-1], case.structures.skip_initial, case.structures.release)
+            results.atomic_write_npz(folder.path / "structures.npz", demand_series(locations, recorder.series))
+            results.atomic_write_json(folder.path / "structures.json", verdict)
+        except BaseException as exc:
+            folder.fail("structures_failed", exc)
+            raise
+        folder.add_files("structures.json", "structures.npz")
+    folder.finish("complete", pending)
+    return RunOutput(folder.path, summary, verdict)
+
+
+def run_recorded(simulation: ImpactSimulation, folder: OutputFolder, **run_options):
+    """``simulation.run(**run_options)``; when it stops (a failed health check, :mod:`multibody.health`,
+    or any error) the manifest also gets the verdict 'indeterminate' and the health record, and the
+    folder's recording marks it 'failed'."""
+    try:
+        return simulation.run(**run_options)
+    except BaseException:
+        folder.manifest.update(debris_state=INDETERMINATE, health=simulation.health.summary())
+        raise
+
+
+def begin_run_folder(out: Path, case_path: Path, case: Case, overwrite: bool = False,
+                     command: str = "run") -> OutputFolder:
+    """Claim the run folder and write the case into it; the manifest says 'running', so an
+    interrupted run is recognisable by later stages."""
+    folder = claim(out, case.name, command, overwrite, stage="impact", software=software_versions())
+    with folder.recording():
+        results.atomic_write_bytes(folder.path / "case.toml", case_path.read_bytes())
+        results.atomic_write_json(folder.path / "case.json", case.model_dump())
+        folder.add_files("case.toml", "case.json")
+    return folder
+
+
+def write_simulation(folder: OutputFolder, recorder, simulation: ImpactSimulation, case: Case) -> dict:
+    """Write the simulation's results and summary and list them in the manifest (the status stays
+    'running': the caller finishes the folder)."""
+    summary = run_summary(recorder, simulation.assembly, case.name)
+    write_simulation_results(folder.path, recorder, simulation)
+    results.atomic_write_json(folder.path / "summary.json", summary)
+    folder.add_files("summary.json", "timeseries.npz", "net.npz", "bodies.npz")
+    return summary
+
+
+def write_simulation_results(out: Path, recorder, simulation: ImpactSimulation) -> None:
+    assembly = simulation.assembly
+    series = dict(recorder.series)
+    series["body_names"] = np.array([b.name for b in assembly.bodies])
+    series["body_masses"] = np.array([b.mass for b in assembly.bodies])
+    series["joint_names"] = np.array([j.name for j in assembly.joints])
+    series["joint_kinds"] = np.array([j.kind for j in assembly.joints])
+    results.atomic_write_npz(out / "timeseries.npz", series)
+    net = assembly.net
+    results.atomic_write_npz(out / "net.npz", dict(
+        recorder.net, threads=net.threads, rest_lengths=net.rest_lengths, stiffness=net.stiffness,
+        damping=net.damping, masses=net.masses, radii=net.radii, n_bullets=net.n_bullets))
+    meshes = {}
+    for k, body in enumerate(assembly.bodies):
+        merged = trimesh.util.concatenate(body.meshes_body)
+        meshes[f"vertices_{k}"] = np.asarray(merged.vertices)
+        meshes[f"faces_{k}"] = np.asarray(merged.faces)
+    results.atomic_write_npz(out / "bodies.npz", meshes)
+

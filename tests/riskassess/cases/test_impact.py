@@ -1,0 +1,137 @@
+"""Case files are rejected with a message naming the file, the key and what is allowed."""
+from pathlib import Path
+
+import pytest
+
+from riskassess.cases.kinds import load_any_case
+from riskassess.cases.impact import CaseError, load_case
+
+CASES = Path(__file__).resolve().parents[3] / "cases"
+REFERENCE = (CASES / "envisat_net_impact.toml").read_text()
+
+
+def _load_modified(tmp_path, old, new):
+    assert old in REFERENCE, old
+    path = tmp_path / "bad.toml"
+    path.write_text(REFERENCE.replace(old, new, 1))
+    with pytest.raises(CaseError) as info:
+        load_case(path)
+    return str(info.value)
+
+
+def test_shipped_cases_are_valid():
+    # Every case file a user copies loads with its own stage's schema; the four kinds are all shipped.
+    kinds = {path.name: load_any_case(path)[0] for path in CASES.glob("*.toml")}
+    assert kinds["envisat_net_impact.toml"] == "impact" and kinds["zenit2_towing.toml"] == "towing"
+    assert kinds["approach_mu_min_time.toml"] == "approach"
+    assert kinds["diagnose_tumbling_rigid.toml"] == "diagnosis"
+
+
+def test_reference_case_matches_paper_tables():
+    case = load_case(CASES / "envisat_net_impact.toml")
+    # seed paper Table 1 / Table 2
+    assert case.net.side_length == 30.0 and case.net.nodes_per_side == 35
+    assert case.net.thread.stiffness == 62308.25 and case.net.thread.damping == 1.58
+    assert case.bullets.mass == 1.786 and case.launch.velocity == 20.0
+    assert case.contact.stiffness == 1.622e8 and case.contact.exponent == 1.5
+    assert (case.contact.mu_static, case.contact.mu_kinetic) == (0.19, 0.152)
+
+
+@pytest.mark.parametrize("old, new, expected", [
+    ('mass = 350.0', 'mass = -350.0', "target.bodies[1].mass: Input should be greater than 0. Got -350.0"),
+    ('stiffness = 62308.25', 'stiffness = 0.0', "net.thread.stiffness: Input should be greater than 0"),
+    ('velocity = 20.0', 'velocity = "20 m/s"', "launch.velocity: Input should be a valid number"),
+    ('side_length = 30.0', 'side_length = 30.0\nsidelength = 3', "net.sidelength: unknown key"),
+    ('diameter = 0.002', 'diameter = 2.0', "net.thread.diameter: Input should be less than or equal to 0.05"),
+    ('altitude = 770e3', 'altitude = 770', "orbit.altitude: Input should be greater than or equal to 100000"),
+    ('child = "solar_array"', 'child = "solar_panel"', "joint 'solar_array_hinge': child 'solar_panel' is not a body"),
+    ('torsional_stiffness = 5.0e4', 'torsional_stiffness = -1.0', "torsional_stiffness: Input should be greater than or equal to 0"),
+    ('stiffness = 1.622e8', 'stiffness = -1.622e8', "contact.stiffness: Input should be greater than 0"),
+])
+def test_bad_values_name_file_key_and_allowed_range(tmp_path, old, new, expected):
+    message = _load_modified(tmp_path, old, new)
+    assert str(tmp_path / "bad.toml") in message
+    assert expected in message
+
+
+def test_net_that_cannot_reach_is_rejected(tmp_path):
+    message = _load_modified(tmp_path, "aim_point = [0.0, 0.0, 7.0]", "aim_point = [40.0, 0.0, 7.0]")
+    assert "launch.direction" in message and "misses the target" in message
+    message = _load_modified(tmp_path, "distance = 3.0 ", "distance = 1000.0 ")
+    assert "launch.distance" in message and "end_time" in message
+    message = _load_modified(tmp_path, "distance = 3.0 ", "distance = 1.0 ")
+    assert "launch.distance" in message and "inside the target" in message
+
+
+def test_missing_mesh_file_is_named(tmp_path):
+    message = _load_modified(tmp_path, 'kind = "box"\nsize = [3.375, 3.75, 7.875]',
+                             'kind = "mesh"\nfile = "envisat_body.stl"')
+    assert "target.bodies[0].shapes[0]" in message
+
+
+def test_cli_reports_a_bad_case_before_running(tmp_path, capsys):
+    from riskassess.cli import main
+
+    path = tmp_path / "bad.toml"
+    path.write_text(REFERENCE.replace("mass = 1.786", "mass = -1.786", 1))
+    out = tmp_path / "run"
+    assert main(["run", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "bullets.mass: Input should be greater than 0. Got -1.786" in err
+    assert not out.exists(), "nothing is written for a case that does not validate"
+
+
+@pytest.mark.parametrize("old, new, expected", [
+    ('joint = "ka_band_hinge"', 'joint = "ka_hinge"',
+     "weak location 'ka_band_hinge': joint 'ka_hinge' is not in target.joints"),
+    ('outer_diameter = 0.1, wall = 0.002', 'outer_diameter = 0.1, wall = 0.2',
+     "structures.weak_locations[2].section: circular_tube: wall must be in (0, outer_diameter/2 = 0.05 m]"),
+    ('allowable_moment = [200.0, 1000.0]', 'allowable_moment = [1000.0, 200.0]',
+     "structures.weak_locations[0].allowable_moment: a range is [low, high] with low <= high"),
+    ('release = "low"', 'release = "sometimes"', "structures.release: Input should be 'low', 'nominal', 'high' or 'never'"),
+    ('material = { ultimate_normal = 570e6, ultimate_shear = 330e6 }', '',
+     "structures.weak_locations[1]: 'section' and 'material' come together"),
+])
+def test_bad_weak_locations_are_named(tmp_path, old, new, expected):
+    message = _load_modified(tmp_path, old, new)
+    assert expected in message
+
+
+def test_case_format_doc_is_current():
+    """docs/case-format.md is generated from the models; regenerate with python -m riskassess.cases.doc."""
+    from riskassess.cases.doc import render
+
+    assert (CASES.parent / "docs" / "case-format.md").read_text() == render()
+
+
+def test_every_numeric_input_states_its_unit():
+    """The report lists every input with its unit, read from the field descriptions: a numeric
+    field without a recognisable SI unit in its description would show a blank unit."""
+    import typing
+
+    from pydantic import BaseModel
+
+    from riskassess.cases import impact as c
+    from riskassess.cases.doc import field_unit
+
+    def numeric(annotation) -> bool:
+        if annotation in (int, float):
+            return True
+        return any(numeric(a) for a in typing.get_args(annotation) if a is not type(None))
+
+    models = [m for m in vars(c).values() if isinstance(m, type) and issubclass(m, BaseModel)
+              and m.__module__ == c.__name__]
+    unitless = [f"{m.__name__}.{name}" for m in models for name, field in m.model_fields.items()
+                if numeric(field.annotation) and name != "kind" and not field_unit(field)]
+    assert unitless == []
+
+
+def test_input_rows_of_the_reference_case_carry_units():
+    from riskassess.cases.doc import input_rows
+
+    rows = {key: (value, unit) for key, value, unit, _ in input_rows(load_case(CASES / "envisat_net_impact.toml"))}
+    assert rows["launch.velocity"] == ("20", "m/s")                  # [paper T1]
+    assert rows["contact.stiffness"] == ("1.622e+08", "N/m^exponent")  # [paper T2]
+    assert rows["target.bodies[solar_array].mass"] == ("350", "kg")
+    assert rows["target.joints[solar_array_hinge].torsional_stiffness"][1] == "N m/rad"
+    assert rows["target.bodies[main_body].shapes[0]"][0].startswith("box: size [")

@@ -1,0 +1,110 @@
+"""`riskassess perceive` end to end on a shortened Tang et al. (2023) scenario, and its
+"not observable" answers."""
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from riskassess.cases.impact import load_case
+from riskassess.cli import main
+
+CASE = Path(__file__).parents[3] / "cases" / "tang2023_debris_perception.toml"
+
+
+def _shortened(tmp_path, observation, end_time, **replace):
+    """The paper case with a shorter observation and collision run (and any key = value line
+    replaced), written next to the test's outputs."""
+    text = CASE.read_text()
+    text = re.sub(r"(?m)^observation_time = .*$", f"observation_time = {observation}", text)
+    text = re.sub(r"(?m)^end_time = .*$", f"end_time = {end_time}", text)
+    for key, value in replace.items():
+        text = re.sub(rf"(?m)^{key} = .*$", f"{key} = {value}", text)
+    path = tmp_path / "case.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def perceived(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("perceive")
+    case = _shortened(tmp, 15.0, 3.0)
+    return tmp, case
+
+
+def test_perceive_estimates_mass_and_inertia(perceived, capsys):
+    # 15 s of tumble and 3 s of collision run: the torque-free fit fixes the inertia ratios to
+    # ~0.1 %, the linear balance the mass to ~0.01 % (1 sigma ~0.2 kg: the CoM velocity from ~16
+    # free-flight frames). The angular balance has only ~1.7 s of free flight after the contact
+    # ends (~1.2 s), and its first frames, with the net still 0.1-0.5 m away, carry 3-4 deg
+    # errors that pass the outlier test: C errors of -2.2 % and -3.1 % were measured here with
+    # tracker versions that differ only in which frames pass (the stage's own 1-sigma 0.7 %
+    # does not cover that: docs/perception.md, Known limits); 12 s runs give 0.02-0.45 %
+    # (bench/bench_perception.py, 5 seeds). Bounds: mass 0.5 % (the issue's goal), moments 5 %.
+    tmp, case = perceived
+    assert main(["perceive", str(case), "--out", str(tmp / "run"), "--json"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    assert answer["not_observable"] is None
+    for key in ("mass_estimate", "inertia_estimate", "mass_error_percent", "inertia_error_percent",
+                "registration_ms_per_frame", "observation_time_s"):
+        assert answer[key] is not None, key
+    assert answer["mass_error_percent"] < 0.5
+    # the stated 1-sigma uncertainties cover the errors (4 sigma)
+    assert abs(answer["mass_kg"] - answer["true_mass_kg"]) < 4 * answer["mass_std_kg"] + 1e-9
+    assert answer["inertia_error_percent"] < 5.0
+    assert answer["center_of_mass_error_m"] < 0.005
+    assert 15.0 < answer["observation_time_s"] <= 18.0
+    manifest = json.loads((tmp / "run" / "manifest.json").read_text())
+    assert manifest["status"] == "complete" and "perception.json" in manifest["files"]
+
+
+def test_case_takes_mass_properties_from_a_perception_result(perceived):
+    tmp, case = perceived
+    answer = json.loads((tmp / "run" / "perception.json").read_text())
+    text = case.read_text()
+    text = re.sub(r"(?m)^mass = 1715.23.*$\n^center_of_mass = .*$\n^#.*$\n^inertia = .*$",
+                  'mass_properties_from = "run/perception.json"', text)
+    assert "mass_properties_from" in text
+    fed = tmp / "fed.toml"
+    fed.write_text(text)
+    body = load_case(fed).target.bodies[0]
+    assert body.mass == pytest.approx(answer["mass_kg"], rel=1e-12)
+    assert body.inertia == answer["inertia_target_kg_m2"]
+
+
+def test_a_debris_that_does_not_turn_is_not_observable(tmp_path, capsys):
+    case = _shortened(tmp_path, 3.0, 1.0, angular_velocity="[0.0, 0.0, 0.0]")
+    assert main(["perceive", str(case), "--out", str(tmp_path / "run"), "--json"]) == 3
+    answer = json.loads(capsys.readouterr().out)
+    assert "turn" in answer["not_observable"]
+    assert "mass_estimate" not in answer
+
+
+def test_an_empty_scan_is_not_observable(tmp_path, capsys):
+    # the debris sits 10 m away; a 5 m range returns nothing: no pose, no estimate
+    case = _shortened(tmp_path, 2.0, 1.0, rate="10.0\nmax_range = 5.0")
+    assert main(["perceive", str(case), "--out", str(tmp_path / "run"), "--json"]) == 3
+    answer = json.loads(capsys.readouterr().out)
+    assert "registered frames" in answer["not_observable"]
+
+
+def test_free_flight_starts_after_the_last_measured_contact():
+    """Frames without a debris pose (NaN gap) count as contact next to a touching frame, as
+    clear between clear frames (a registration failure far from the net)."""
+    import numpy as np
+
+    from perception.motion import NotObservable
+    from riskassess.stages.perceive import NetTrack, free_flight_start
+
+    nan = float("nan")
+    # Contact (gap <= 0.1 m) up to frame 3, a failed registration at frame 4 next to it (still
+    # contact for all we know), clear from 5 on, a failure between clear frames at 8 and the
+    # track lost in the last frames: free flight from the second frame after the last contact.
+    track = NetTrack(separation=[0.0, 0.01, nan, 0.05, nan, 0.4, 0.9, 1.5, nan, 2.6, nan, nan])
+    assert free_flight_start(track) == 6
+    # the failed frames right after the last touching frame count as touching
+    assert free_flight_start(NetTrack(separation=[0.3, 0.02, nan, nan, 0.5, 0.8, 1.0])) == 5
+    with pytest.raises(NotObservable, match="still touching"):
+        free_flight_start(NetTrack(separation=[0.5, 0.0, 0.05, nan]))
+    with pytest.raises(NotObservable, match="never came near"):
+        free_flight_start(NetTrack(separation=[0.5, 0.6, np.nan, 0.9]))

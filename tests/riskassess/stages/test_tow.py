@@ -1,0 +1,119 @@
+"""`riskassess tow` (riskassess/stages/tow_stage.py, riskassess/stages/tow.py): the run folder, the tautness figures and the report section."""
+import json
+
+import meshio
+import numpy as np
+import pytest
+
+from multibody.control.mrac import reference_steady_elongation
+from multibody.net import tension_only_kelvin_voigt
+from riskassess.cases.impact import load_model
+from riskassess.products.report import write_report
+from riskassess.products.report.towing import towing_section
+from riskassess.products.results import RunFolder
+from riskassess.stages.tow import tautness
+from riskassess.stages.tow_stage import tow_case
+from riskassess.cases.towing import TowingCase
+
+CASE = "cases/zenit2_towing.toml"
+
+
+@pytest.fixture(scope="module")
+def tow_folder(tmp_path_factory):
+    """The case's tow with MRAC-1, shortened to 45 s of towing (engagement at ~32 s, Exudyn ~1 s)."""
+    case = load_model(CASE, TowingCase)
+    case = case.model_copy(update=dict(simulation=case.simulation.model_copy(update=dict(end_time=70.0)),
+                                       thrust=case.thrust.model_copy(update=dict(kind="mrac1"))))
+    out = tmp_path_factory.mktemp("tow")
+    tow_case(CASE, out, case=case)
+    return out, case
+
+
+def test_folder_is_complete_and_tension_follows_the_tether_law(tow_folder):
+    out, case = tow_folder
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["status"] == "complete" and manifest["stage"] == "tow"
+    assert all((out / f).is_file() for f in manifest["files"])
+    summary = json.loads((out / "towing.json").read_text())
+    assert summary["thrust_kind"] == "mrac1" and summary["simulated_s"] == pytest.approx(45.0)
+    series = dict(np.load(out / "towing.npz"))
+    mt = case.main_tether
+    # the sampled tension is eq. (5a) of the sampled stretch and stretch rate, to round-off
+    expected = [tension_only_kelvin_voigt(z, r, mt.stiffness, mt.damping)
+                for z, r in zip(series["main_tether_elongation"], series["main_tether_elongation_rate"])]
+    np.testing.assert_allclose(series["main_tether_tension"], expected, rtol=1e-12, atol=1e-9)
+    # the MRAC laws keep the main tether taut once the sub-tethers pull (bench/bench_tow_control.py over
+    # the Table 3 rates: smallest tension after engagement 0.03-5 N, never slack)
+    assert summary["main_tether"]["slack_after_engagement_s"] == 0.0
+    assert summary["main_tether"]["min_tension_after_engagement_N"] > 0.0
+
+
+def test_tautness_counts_slack_after_engagement_only():
+    # hand-made series at 0.5 s: slack before engagement (ignored), 2 samples slack after it
+    t = np.arange(0.0, 5.0, 0.5)
+    tension = np.array([0.0, 0.0, 0.5, 2.0, 3.0, 0.0, 0.0, 4.0, 5.0, 6.0])
+    s = tautness({"time": t, "main_tether_tension": tension, "main_tether_elongation": tension / 100.0}, 0.05)
+    assert s["engaged_at_s"] == 1.5 and s["min_tension_after_engagement_N"] == 0.0
+    assert s["slack_after_engagement_s"] == pytest.approx(1.0)
+    assert s["rms_elongation_error_m"] == pytest.approx(np.sqrt(np.mean((tension / 100.0 - 0.05) ** 2)), rel=1e-12)
+
+
+def test_reference_steady_elongation_balances_pd_and_tether():
+    # eq. (13) at rest and taut: k_MT z = K_P (z_d - z) -> z = K_P z_d / (k_MT + K_P); exact arithmetic
+    assert reference_steady_elongation(3000.0, 1000.0, 0.04) == pytest.approx(0.01, rel=1e-15)
+
+
+def test_report_of_a_tow_folder_has_the_towing_section(tow_folder):
+    out, _ = tow_folder
+    section = towing_section(RunFolder(out))
+    assert section is not None and section.id == "towing" and section.figures
+    html = write_report(out, pdf=False).html.read_text()
+    assert '<section id="towing"' in html and "fig-towing" in html
+
+
+@pytest.fixture(scope="module")
+def full_net_tow_folder(tmp_path_factory):
+    """The case's full-net tow, shrunk: 7 x 7 net (same side, mass and threads), 2 s of towing."""
+    case = load_model(CASE, TowingCase)
+    case = case.model_copy(update=dict(simulation=case.simulation.model_copy(update=dict(end_time=27.0, model="full-net")),
+                                       full_net=case.full_net.model_copy(update=dict(nodes_per_side=7))))
+    out = tmp_path_factory.mktemp("tow_full_net")
+    tow_case(CASE, out, case=case)
+    return out, case
+
+
+def test_report_of_a_full_net_tow_folder_shows_the_net(full_net_tow_folder):
+    out, case = full_net_tow_folder
+    summary = json.loads((out / "towing.json").read_text())
+    assert summary["model"] == "full-net" and summary["simulated_s"] == pytest.approx(2.0)
+    # the momentum balance closes to Verlet's owed half kick of the external load (docs/towing.md):
+    # H/2 |F| with |F| <= gravity on chaser + debris + net (mu m / r^2, r >= 7.2e6 m) plus F_max
+    gravity = case.simulation.mu * (case.chaser.mass + case.debris.nominal_mass + case.net_mass) / 7.2e6**2
+    assert summary["net"]["momentum_residual_Ns"] <= summary["step_s"] / 2 * (gravity + case.thrust.max_force)
+    section = towing_section(RunFolder(out))
+    rows = dict(map(tuple, section.blocks[1].rows))
+    # 7 x 7 thread crossings plus the four corner masses (multibody.net_wrap.towing_net)
+    assert rows["net nodes / mean nodes in contact with the debris"].startswith("53 / ")
+    assert "sub-tether peak tension (N)" not in rows
+    html = write_report(out, pdf=False).html.read_text()
+    assert '<section id="towing"' in html and "Full-net towing run" in html
+
+
+def test_vtk_export_of_a_full_net_tow_folder(full_net_tow_folder):
+    from riskassess.products.vtk_export import export_vtk
+
+    out, case = full_net_tow_folder
+    result = export_vtk(out)
+    # one frame per net snapshot: 25, 26, 27 s (full_net.net_output_interval = 1 s)
+    assert result.n_frames == 3 and result.pvd.is_file()
+    np.testing.assert_allclose(result.times, [25.0, 26.0, 27.0])
+    net, bodies, tether = (meshio.read(result.folder / f"{name}_0002.vtu") for name in ("net", "bodies", "tether"))
+    assert len(net.points) == 53
+    # the tether starts at a net node (the central one) and ends |r_A/C| = 0.5 m from the chaser cube's
+    # centre (Table 1); both in the same LVLH frame, so to round-off of the LVLH rotation (1e-9 m at 20 m)
+    assert np.linalg.norm(net.points - tether.points[0], axis=1).min() < 1e-9
+    chaser = bodies.points[:8].mean(axis=0)            # trimesh box: 8 vertices around its centre
+    assert np.linalg.norm(tether.points[1] - chaser) == pytest.approx(0.5, abs=1e-9)
+    # slack threads carry no elastic tension, stretched ones k (l - l_0) > 0
+    strain, tension = net.cell_data["strain"][0], net.cell_data["elastic_tension_N"][0]
+    assert np.all(tension[strain <= 0] == 0.0) and np.all(tension[strain > 0] > 0.0)
