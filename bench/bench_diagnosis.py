@@ -35,10 +35,10 @@ def towing_truths(workers: int) -> None:
     standard deviations."""
     import numpy as np
 
-    from riskassess.diagnosis.measured import write_measured
+    from riskassess.products.measured import write_measured
     from riskassess.diagnosis.synthetic import noisy, sample_times, simulate_effect
     from riskassess.stages.diagnose import diagnose_case
-    from riskassess.cases.diagnosis import load_diagnosis_case
+    from riskassess.diagnosis.cases import load_diagnosis_case
 
     times = sample_times(300.0, 10.0)
     for k_m, tau, seed in TOWING_TRUTHS:

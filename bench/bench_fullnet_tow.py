@@ -24,7 +24,8 @@ from multibody.net_towing import run_exudyn
 from riskassess.cases.impact import load_model
 from riskassess.stages.identify import rmse
 from riskassess.stages.identify_fullnet import CHANNELS
-from riskassess.stages.tow_fullnet import full_net_model, momentum_residual, wrapped_net
+from riskassess.models.towing_fullnet import full_net_model, wrapped_net
+from riskassess.stages.tow_fullnet import momentum_residual
 from riskassess.cases.towing import TowingCase
 
 CASE = os.path.join(os.path.dirname(__file__), "..", "cases", "zenit2_towing.toml")

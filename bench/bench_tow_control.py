@@ -3,12 +3,12 @@
 
     python bench/bench_tow_control.py [--case cases/zenit2_towing.toml] [--rates training|validation|all]
 
-For every thrust law and spin rate prints (riskassess.stages.tow.tautness): the engagement time t_e (first
+For every thrust law and spin rate prints (riskassess.products.towing_figures.tautness): the engagement time t_e (first
 sample with main-tether tension > 1 N: before it the sub-tethers are still slack and only P hangs
 on the main tether),
 the smallest main-tether tension after t_e (> 0: taut), the slack time after t_e, the peak
 tension, the final elongation and its RMS error over the last 100 s against the MRAC reference
-model's steady elongation (riskassess.stages.tow.reference_elongation); then the worst over the rates per law.
+model's steady elongation (riskassess.products.towing_figures.reference_elongation); then the worst over the rates per law.
 """
 from __future__ import annotations
 
@@ -19,7 +19,8 @@ import numpy as np
 
 from multibody.towing import run_exudyn
 from riskassess.cases.impact import load_model
-from riskassess.stages.tow import reference_elongation, tautness, towing_model
+from riskassess.products.towing_figures import reference_elongation, tautness
+from riskassess.models.towing import towing_model
 from riskassess.cases.towing import TowingCase
 
 def main():

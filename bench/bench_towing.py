@@ -19,7 +19,7 @@ import numpy as np
 from multibody.towing import run_exudyn, run_twin, stable_step
 from riskassess.cases.impact import load_model
 from riskassess.stages.identify import COMPARED, compared_series, rmse
-from riskassess.stages.tow import case_decision_vector, towing_model
+from riskassess.models.towing import case_decision_vector, towing_model
 from riskassess.cases.towing import TowingCase
 
 

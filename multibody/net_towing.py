@@ -30,6 +30,7 @@ from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING
                                          body_gravity, chaser_actuation, net_forces)
 from multibody.net_wrap import TowingNet
 from multibody.towing import HEALTH_EVERY_STEPS, TowedBodies, tow_failure_cause
+from multibody.net_towing_kernel import D_SLIDING, D_THRUST, D_TORQUE
 
 #: Layout of the run state ``clock``: net time (s), external impulse (3, N s) since the start.
 CLOCK_TIME, CLOCK_IMPULSE, CLOCK_SIZE = 0, 1, 4
@@ -230,8 +231,6 @@ class NetTowResult:
     def series(self) -> dict:
         """The lower-order model's series names (:meth:`multibody.towing.TowResult.series`; the
         connection point is the central node), plus the net's own (SI; frames in the names)."""
-        from multibody.net_towing_kernel import D_SLIDING, D_THRUST, D_TORQUE
-
         m = self.model
         rot = np.array([[rotation_matrix_from_rotation_vector(self.q[k, b + 3:b + 6]) for b in (0, 6)]
                         for k in range(len(self.time))]).reshape(-1, 2, 3, 3)

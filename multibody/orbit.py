@@ -85,3 +85,13 @@ def two_body_specific_energy(r_inertial, v_inertial, mu):
     inertial frame; constant on a Keplerian orbit."""
     r = np.linalg.norm(r_inertial, axis=-1)
     return 0.5 * np.sum(np.asarray(v_inertial) ** 2, axis=-1) - mu / r
+
+
+def lvlh_to_eci(r_eci, v_eci) -> np.ndarray:
+    """(k, 3, 3) or (3, 3) rotation LVLH -> ECI (columns radial, along-track, orbit normal) from the
+    chaser's position (m) and velocity (m/s), ECI."""
+    r, v = np.asarray(r_eci, float), np.asarray(v_eci, float)
+    x = r / np.linalg.norm(r, axis=-1, keepdims=True)
+    z = np.cross(r, v)
+    z /= np.linalg.norm(z, axis=-1, keepdims=True)
+    return np.stack([x, np.cross(z, x), z], axis=-1)

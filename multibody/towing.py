@@ -27,6 +27,7 @@ from multibody.health import HealthWatch
 from multibody.impact import _object_state_index, checked_post_step, explicit_settings, solve_checked
 from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import N_COORDINATES, ST_TENSION, body_forces, pack, sampled_state, twin_run
+from multibody.towing_kernel import MT_ELONGATION, MT_ELONGATION_RATE, MT_TENSION, SLIDING, THRUST, TORQUE
 
 
 @dataclass
@@ -132,8 +133,6 @@ class TowResult:
 
     def series(self) -> dict:
         """Named time series (SI; frames in the names), see docs/towing.md."""
-        from multibody.towing_kernel import MT_ELONGATION, MT_ELONGATION_RATE, MT_TENSION, SLIDING, THRUST, TORQUE
-
         m = self.model
         rot = np.array([[rotation_matrix_from_rotation_vector(self.q[k, b + 3:b + 6]) for b in (3, 9)]
                         for k in range(len(self.time))]).reshape(-1, 2, 3, 3)

@@ -24,11 +24,12 @@ import numpy as np
 
 from multibody.impact import kernels_compiled
 from riskassess.cases.impact import Case, CaseError, read_toml, validate_case
-from riskassess.cases.kinds import case_kind
+from riskassess.stages.kinds import case_kind
 from riskassess.products.outfolder import open_existing
 from riskassess.stages.run import run_case
 from riskassess.products.results import RunFolder, atomic_write_json
 from riskassess.sweep.spec import case_with
+from riskassess.products.report import write_report
 
 __all__ = ["ImpactCase", "RunResult", "load_case", "run", "open_run", "report", "needs_compilation"]
 
@@ -202,8 +203,6 @@ def report(run: RunResult | str | Path, pdf: bool = False, progress=None):
     """
     # Imported here, not at the top: riskassess.products.report selects matplotlib's headless backend on
     # import, which would switch off a notebook's inline plots for anyone importing this module.
-    from riskassess.products.report import write_report
-
     folder = run.path if isinstance(run, RunResult) else Path(run)
     return write_report(folder, pdf=pdf, progress=progress)
 

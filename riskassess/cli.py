@@ -13,7 +13,7 @@ from rich.text import Text
 from multibody.health import SimulationFailed
 from riskassess import __version__
 from riskassess.cases.impact import Case, CaseError, load_case
-from riskassess.cases.kinds import KINDS as CASE_KINDS
+from riskassess.stages.kinds import KINDS as CASE_KINDS
 from riskassess.products.outfolder import OutputRefused, default_out, step_done
 from riskassess.products.results import MissingData, RunFolder
 
@@ -192,7 +192,7 @@ def _cmd_perceive(args) -> int:
 
 def _cmd_tow(args) -> int:
     from riskassess.cases.impact import load_model
-    from riskassess.stages.tow_stage import tow_case
+    from riskassess.stages.tow import tow_case
     from riskassess.cases.towing import TowingCase
 
     case = load_model(args.case, TowingCase)
@@ -398,7 +398,7 @@ def _cmd_sweep(args) -> int:
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
     from riskassess.sweep.cluster_log import CLUSTER_LOG
-    from riskassess.sweep.envelope import envelope_statement
+    from riskassess.products.envelope import envelope_statement
     from riskassess.sweep.products import (PRODUCTS, check_products, check_products_at, products_dir,
                                            write_sweep_products)
     from riskassess.sweep.runner import UNKNOWN_RUNS_EXIT, run_sweep, validate_runs
@@ -462,7 +462,7 @@ def _now() -> str:
 
 def _cmd_sweep_status(args) -> int:
     """Read-only: SQLite mode=ro, no lock, nothing written to the store or beside it."""
-    from riskassess.sweep.envelope import run_status
+    from riskassess.products.envelope import run_status
     from riskassess.sweep.store import ResultStore
 
     with ResultStore.open_readonly(args.store) as store:
@@ -480,7 +480,7 @@ def _cmd_sweep_status(args) -> int:
 
 
 def _cmd_validate(args) -> int:
-    from riskassess.cases.kinds import load_any_case
+    from riskassess.stages.kinds import load_any_case
 
     kind, case = load_any_case(args.case)
     print(f"{args.case}: valid {kind} case '{case.name}'")
@@ -488,7 +488,7 @@ def _cmd_validate(args) -> int:
 
 
 def _cmd_schema(args) -> int:
-    from riskassess.cases.kinds import case_schema
+    from riskassess.stages.kinds import case_schema
 
     print(json.dumps(case_schema(args.kind), indent=2))
     return 0

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from riskassess.diagnosis.measured import write_measured
+from riskassess.products.measured import write_measured
 from riskassess.diagnosis.synthetic import noisy, sample_times, simulate_effect
 from riskassess.cases.diagnosis import load_diagnosis_case
 

@@ -26,6 +26,7 @@ from pydantic import Field, PrivateAttr, RootModel, ValidationError, ValidationI
 from riskassess.cases.impact import (CaseError, NonNegative, Positive, Strict, Vector3, check_physical_inertia,
                              format_validation_error, load_model, read_toml)
 from riskassess.cases.inputs import CASE_FILE_LIMIT, CaseName, RelativeFile, Text, resolve_reference, unique_names
+from riskassess.cases.towing import TowingCase
 
 Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3)]
 
@@ -140,14 +141,23 @@ class _ScenarioBase(Strict):
         return unique_names(effects, "effect", "id")
 
     @model_validator(mode="after")
-    def _known_effects(self):
-        return _check_effects(self)
+    def _known_effects(self, info: ValidationInfo):
+        return _check_effects(self, info)
 
 
-def _check_effects(case):
-    """Every ``[[effects]]`` entry names a catalog effect that applies and gives its parameters."""
-    from riskassess.diagnosis.effects import CATALOG
+def _check_effects(case, info: ValidationInfo):
+    """Every ``[[effects]]`` entry names a catalog effect that applies and gives its parameters.
 
+    The catalog (effect id -> :class:`riskassess.diagnosis.effects.base.Effect`) comes in the
+    validation context (``effect_catalog``), given by the diagnosis package's loader
+    (:func:`riskassess.diagnosis.cases.load_diagnosis_case`): the schema sits below the effects and
+    does not import them. Effects without a catalog to check them against are refused."""
+    if not case.effects:
+        return case
+    CATALOG = (info.context or {}).get("effect_catalog")
+    if CATALOG is None:
+        raise ValueError("effects: no effect catalog to check them against (load the case with "
+                         "riskassess.diagnosis.cases.load_diagnosis_case)")
     for k, entry in enumerate(case.effects):
         if entry.id not in CATALOG:
             raise ValueError(f"effects[{k}].id: '{entry.id}' is not in the catalog {sorted(CATALOG)}")
@@ -219,8 +229,6 @@ class TowingDiagnosisCase(Strict):
 
     @model_validator(mode="after")
     def _load_towing(self, info: ValidationInfo):
-        from riskassess.cases.towing import TowingCase
-
         base = Path((info.context or {}).get("case_dir", "."))
         try:
             path = resolve_reference(base, self.towing, CASE_FILE_LIMIT)
@@ -230,7 +238,7 @@ class TowingDiagnosisCase(Strict):
             self._towing_case = load_model(path, TowingCase)
         except CaseError as exc:
             raise ValueError(f"towing: the towing case cannot be loaded: {exc}") from None
-        return _check_effects(self)
+        return _check_effects(self, info)
 
     @property
     def towing_case(self):
@@ -245,16 +253,19 @@ class DiagnosisCaseFile(RootModel):
     root: Annotated[DiagnosisCase, Field(discriminator="kind")]
 
 
-def diagnosis_case_from_dict(raw: dict, case_dir=".") -> DiagnosisCase:
-    """Validate parsed case content; file references (``towing``) are relative to ``case_dir``."""
-    return DiagnosisCaseFile.model_validate(raw, context={"case_dir": str(case_dir)}).root
+def diagnosis_case_from_dict(raw: dict, case_dir=".", effect_catalog=None) -> DiagnosisCase:
+    """Validate parsed case content; file references (``towing``) are relative to ``case_dir``;
+    ``[[effects]]`` are checked against ``effect_catalog`` (id -> effect; required when there are any)."""
+    context = {"case_dir": str(case_dir), "effect_catalog": effect_catalog}
+    return DiagnosisCaseFile.model_validate(raw, context=context).root
 
 
-def load_diagnosis_case(path) -> DiagnosisCase:
-    """Read and validate a diagnosis case; :class:`~riskassess.cases.impact.CaseError` names file and key."""
+def load_diagnosis_case(path, effect_catalog=None) -> DiagnosisCase:
+    """Read and validate a diagnosis case; :class:`~riskassess.cases.impact.CaseError` names file and key.
+    ``effect_catalog``: as in :func:`diagnosis_case_from_dict`."""
     path = Path(path)
     try:
-        return diagnosis_case_from_dict(read_toml(path), path.parent)
+        return diagnosis_case_from_dict(read_toml(path), path.parent, effect_catalog)
     except ValidationError as exc:
         raise CaseError(format_validation_error(path, exc)) from None
 

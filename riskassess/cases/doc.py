@@ -11,7 +11,7 @@ from pydantic import AfterValidator, BaseModel
 
 from riskassess.cases import impact as c
 from riskassess.cases import inputs as limits
-from riskassess.diagnosis.measured import MEASURED_FILE_LIMIT
+from riskassess.cases.inputs import MEASURED_FILE_LIMIT
 
 HEADER = """# Case file format
 

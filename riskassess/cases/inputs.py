@@ -27,6 +27,10 @@ MESH_FILE_LIMIT = 200_000_000
 #: Largest perception.json read by ``mass_properties_from`` (bytes); 'riskassess perceive' writes a
 #: few kB (estimates, their covariances and per-frame figures).
 JSON_FILE_LIMIT = 10_000_000
+#: Largest measured-data file read (bytes): 50 MB is about 250 000 rows of 20 channels at 10 significant
+#: digits, ten times the longest record the fit handles in minutes (every sample is simulated each
+#: evaluation); the shipped records are below 1 MB.
+MEASURED_FILE_LIMIT = 50_000_000
 #: Deepest nesting of tables and arrays in a case file: the shipped cases nest 5 deep
 #: (target.bodies[].shapes[].center[]); 32 leaves room and keeps the parser far from Python's
 #: recursion limit (tomllib recurses about three frames per level).

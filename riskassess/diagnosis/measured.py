@@ -15,8 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from riskassess.diagnosis.channels import CHANNELS, QUATERNION
-from riskassess.cases.inputs import read_text
-from riskassess.products.results import atomic_write_bytes
+from riskassess.cases.inputs import MEASURED_FILE_LIMIT, read_text
 
 #: Fewest samples a record must have: the noise estimate and a held-out part need a few dozen.
 MIN_SAMPLES = 30
@@ -26,10 +25,6 @@ DIFFERENCE_ORDERS = range(1, 9)
 #: Two successive orders within 5 % mean the signal no longer shows: a pure-noise estimate from
 #: 600 samples scatters by ~3 % (1 / sqrt(2 n)).
 PLATEAU = 1.05
-#: Largest measured-data file read (bytes): 50 MB is about 250 000 rows of 20 channels at 10 significant
-#: digits, ten times the longest record the fit handles in minutes (every sample is simulated each
-#: evaluation); the shipped records are below 1 MB.
-MEASURED_FILE_LIMIT = 50_000_000
 
 
 class MeasuredDataError(ValueError):
@@ -202,12 +197,3 @@ def _set_noise(measured: MeasuredData, given: dict) -> None:
         else:
             measured.noise[name] = difference_noise(column)
             measured.noise_source[name] = "estimated from successive differences"
-
-
-def write_measured(path, time, values: dict) -> None:
-    """Write a measured-data CSV (``time`` then the channels), atomically."""
-    names = list(values)
-    lines = [",".join(["time"] + names)]
-    for k, t in enumerate(time):
-        lines.append(",".join([f"{t:.6f}"] + [f"{values[c][k]:.9g}" for c in names]))
-    atomic_write_bytes(Path(path), ("\n".join(lines) + "\n").encode())

@@ -34,6 +34,7 @@ from multibody.connection_point import V_N, X_N
 from multibody.kernel import rotation_matrix_from_rotation_vector, verlet_evaluation_state
 from multibody.towing_kernel import (CHASER, DEBRIS, N_COORDINATES, ST_TENSION, W_ACCEL, W_ATTACH_CHASER, W_INERTIA,
                                      W_DIAG, W_MASSES, W_POINT, W_REFERENCE, W_STEP, W_TETHER, extra_forces, packed_forces, start_forces)
+from multibody.towing_kernel import W_N_ATTACH
 
 _VECTOR = types.float64[::1]
 #: numba signature of a towing law (see the module doc); laws are compiled eagerly with it so that one
@@ -132,8 +133,6 @@ def integrate(law, p, q, v, t0, n_steps, work, xe, record, out_q, out_v, out_dia
 
 def diagnostics_size(work) -> int:
     """Columns of the diagnostics rows of a packed model (main tether, thrust, torque, sliding, STs)."""
-    from multibody.towing_kernel import W_N_ATTACH
-
     return ST_TENSION + int(work[W_N_ATTACH])
 
 

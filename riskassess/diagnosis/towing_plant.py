@@ -29,7 +29,8 @@ from riskassess.diagnosis.towing_dynamics import (EXTRA_STATES, diagnostics_size
 from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.towing import packed
 from multibody.towing_kernel import MT_TENSION
-from riskassess.stages.tow import towing_model
+from multibody.orbit import lvlh_to_eci
+from riskassess.models.towing import towing_model
 
 #: Nominal parameters of the towing scenario: name -> (size, unit), the fitted vector's order.
 TOWING_PARAMETERS = {"attitude": (3, "rad"), "angular_velocity": (3, "rad/s"), "position": (3, "m"),
@@ -38,16 +39,6 @@ TOWING_PARAMETERS = {"attitude": (3, "rad"), "angular_velocity": (3, "rad/s"), "
 
 #: Every channel's value when a run diverges (channel units): far from any data, so the fit steps back.
 FAILED = 1e6
-
-
-def lvlh_to_eci(r_eci, v_eci) -> np.ndarray:
-    """(k, 3, 3) or (3, 3) rotation LVLH -> ECI (columns radial, along-track, orbit normal) from the
-    chaser's position (m) and velocity (m/s), ECI."""
-    r, v = np.asarray(r_eci, float), np.asarray(v_eci, float)
-    x = r / np.linalg.norm(r, axis=-1, keepdims=True)
-    z = np.cross(r, v)
-    z /= np.linalg.norm(z, axis=-1, keepdims=True)
-    return np.stack([x, np.cross(z, x), z], axis=-1)
 
 
 @dataclass(frozen=True)

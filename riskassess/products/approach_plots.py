@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from riskassess.products.report.plotting import legend, panels, plain, plt, write_png
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
+
+from riskassess.products.plotting import legend, panels, plain, write_png
 
 
 def trajectory_figure(answer: dict, arrays: dict):
     """MU paths (nodes and re-simulation), mouth segments every few nodes, the keep-out circle."""
-    fig, ax = plt.subplots(figsize=(6.7, 4.2), layout="constrained")
+    fig = Figure(figsize=(6.7, 4.2), layout="constrained")
+    ax = fig.subplots()
     paths, fine = arrays["unit_paths"], arrays["resim_unit_paths"]
     for k, color in enumerate(("tab:blue", "tab:orange")):
         ax.plot(fine[k, 0], fine[k, 1], color=color, lw=1.0, label=f"MU{k + 1} (re-simulated)")
@@ -18,7 +22,7 @@ def trajectory_figure(answer: dict, arrays: dict):
         ax.plot(paths[:, 0, j], paths[:, 1, j], color="0.6", lw=0.6)
     ax.plot(*paths[:, :, -1].T, color="k", lw=1.2, label="net mouth at t_f")
     center, radius = arrays["debris_center"], float(arrays["keep_out_radius"])
-    ax.add_patch(plt.Circle(center, radius, color="tab:red", alpha=0.2, lw=0, label="keep-out circle"))
+    ax.add_patch(Circle(center, radius, color="tab:red", alpha=0.2, lw=0, label="keep-out circle"))
     ax.plot(*center, "+", color="tab:red")
     if "replay_unit_positions" in arrays:
         edge = arrays["replay_mouth_edge"][-1]

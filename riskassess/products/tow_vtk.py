@@ -30,11 +30,11 @@ import meshio
 import numpy as np
 import trimesh
 
-from riskassess.diagnosis.towing_plant import lvlh_to_eci
+from multibody.orbit import lvlh_to_eci
 from multibody.net import thread_tension_strain
 from riskassess.cases.impact import load_model
 from riskassess.products.results import MissingData, RunFolder
-from riskassess.stages.tow_fullnet import debris_geometry
+from riskassess.models.towing_fullnet import debris_geometry
 from riskassess.cases.towing import TowingCase
 from riskassess.products.vtk_frames import VtkExport, export_frames, nearest_samples, surface_lvlh
 

@@ -6,7 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from riskassess.products.report.plotting import STYLE, legend, panels, plain, plt, write_png
+import matplotlib
+
+from riskassess.products.plotting import STYLE, legend, panels, plain, write_png
 
 
 def _save(fig, path: Path) -> None:
@@ -27,7 +29,7 @@ def _tow_panels(axes, s, label, style="-"):
 def tow_figure(series: dict, title: str, others: dict | None = None):
     """Main-tether tension and thrust, chaser-debris distance, angular rates against time;
     ``others`` (label -> series) are drawn dashed on the same axes (e.g. thrust laws compared).
-    Call inside ``plt.rc_context(STYLE)``; returns the matplotlib figure."""
+    Call inside ``matplotlib.rc_context(STYLE)``; returns the matplotlib figure."""
     fig, axes = panels(3, 1.8)
     _tow_panels(axes, series, "")
     for label, other in (others or {}).items():
@@ -43,13 +45,13 @@ def tow_figure(series: dict, title: str, others: dict | None = None):
 
 def plot_tow(series: dict, path: Path, title: str, others: dict | None = None) -> None:
     """:func:`tow_figure` written to ``path`` as PNG."""
-    with plt.rc_context(STYLE):
+    with matplotlib.rc_context(STYLE):
         _save(tow_figure(series, title, others), path)
 
 
 def plot_convergence(histories: dict, path: Path, title: str) -> None:
     """Best cost against evaluations for each optimizer run (label -> (evaluations, best cost))."""
-    with plt.rc_context(STYLE):
+    with matplotlib.rc_context(STYLE):
         fig, (ax,) = panels(1, 2.6, sharex=False)
         for label, (evaluations, best) in histories.items():
             ax.semilogy(evaluations, best, label=plain(label))
@@ -62,7 +64,7 @@ def plot_convergence(histories: dict, path: Path, title: str) -> None:
 
 def plot_fit(data: dict, fitted: dict, path: Path, title: str) -> None:
     """One run's data (solid) against the identified model (dashed)."""
-    with plt.rc_context(STYLE):
+    with matplotlib.rc_context(STYLE):
         fig, axes = panels(3, 1.8)
         _tow_panels(axes, data, "data")
         _tow_panels(axes, fitted, "identified", "--")

@@ -34,7 +34,8 @@ from riskassess.diagnosis.selection import decide, gain_percent, score
 from riskassess.diagnosis.threads import single_threaded_blas
 from riskassess.products import results
 from riskassess.cases.impact import read_toml
-from riskassess.cases.diagnosis import load_diagnosis_case, toml_text
+from riskassess.cases.diagnosis import toml_text
+from riskassess.diagnosis.cases import load_diagnosis_case
 from riskassess.products.outfolder import OutputFolder, claim, default_out, safe_name
 from riskassess.products.report.diagnosis import write_figures
 

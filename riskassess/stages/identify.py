@@ -40,8 +40,10 @@ from multibody.towing import run_twin
 from multibody.towing_kernel import MT_TENSION
 from riskassess.products import results
 from riskassess.products.outfolder import OutputFolder, claim
-from riskassess.stages.tow import towing_model
+from riskassess.models.towing import towing_model
 from riskassess.cases.towing import TowingCase
+from riskassess.cases.impact import load_model
+from riskassess.products.towing_plots import plot_convergence
 
 #: The quantities the costs compare, from :meth:`multibody.towing.TowResult.series`.
 COMPARED = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
@@ -283,8 +285,6 @@ def benchmark_case(case_path, out_dir, case: TowingCase | None = None, end_time=
     (every run, history included), ``convergence.png`` and a manifest to ``out_dir`` (claimed by
     :func:`riskassess.products.outfolder.claim`); returns the answer with the best run's ``s``, ``cost``,
     ``optimizer`` and ``wall_s`` on top."""
-    from riskassess.cases.impact import load_model
-
     case = case or load_model(case_path, TowingCase)
     folder = claim_identify_folder(out_dir, case_path, case.name, overwrite)
     with folder.recording():
@@ -307,8 +307,6 @@ def claim_identify_folder(out_dir, case_path, case_name: str, overwrite: bool) -
 
 
 def _benchmark_into(case: TowingCase, folder: OutputFolder, end_time) -> dict:
-    from riskassess.products.towing_plots import plot_convergence
-
     out = folder.path
     start = time.perf_counter()
     answer = benchmark(case, end_time=end_time)

@@ -28,15 +28,17 @@ from riskassess.cases.impact import CaseError
 from riskassess.stages.identify import COSTS, claim_identify_folder, rmse, simulate
 from riskassess.products.outfolder import OutputFolder
 from riskassess.cases.towing import TowingCase
+from multibody.net_towing import run_exudyn
+from riskassess.models.towing_fullnet import full_net_model
+from riskassess.models.towing_fullnet import wrapped_net
+from riskassess.stages.identify import run_optimizers
+from riskassess.products.towing_plots import plot_convergence
 
 CHANNELS = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
 
 
 def _run_full_net(task):
     """One full-net run in a worker: (case, wrapped net, rate, end) -> compared series (+ start state)."""
-    from multibody.net_towing import run_exudyn
-    from riskassess.stages.tow_fullnet import full_net_model
-
     case, wrapped, rate, end = task
     model = full_net_model(case, rate, wrapped=wrapped, end_time=end)
     result = run_exudyn(model)
@@ -51,8 +53,6 @@ def _run_full_net(task):
 def full_net_runs(case: TowingCase, rates, out: Path, end, workers, record=None) -> list[dict]:
     """Full-net runs at ``rates`` (deg/s), read from ``out``'s cache where present (same end time);
     ``record(relative path)`` is told of each new cache file (the output folder lists it)."""
-    from riskassess.stages.tow_fullnet import wrapped_net
-
     cache = out / "fullnet"
     cache.mkdir(parents=True, exist_ok=True)
     path = {rate: cache / f"rate_{rate:.2f}_end_{end:g}.npz" for rate in rates}
@@ -123,9 +123,6 @@ def identify_full_net(case_path, out_dir, case: TowingCase, optimizers=None, ove
 
 def _identify(case: TowingCase, folder: OutputFolder, optimizers) -> dict:
     """Steps 1-3 into the claimed ``folder``; returns the answer."""
-    from riskassess.stages.identify import run_optimizers
-    from riskassess.products.towing_plots import plot_convergence
-
     fn, out = case.full_net, folder.path
     end = fn.identification_end_time or case.simulation.end_time
     training = case.rates.training_deg_s[:fn.identification_training_runs]

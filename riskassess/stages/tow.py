@@ -1,148 +1,71 @@
-"""The lower-order towing model of a towing case (Boonrath, Singh & Botta 2024) and the figures
-every towing run reports.
+"""`riskassess tow`: the towing run of a towing case, lower-order (:func:`riskassess.models.towing.towing_model`)
+or full-net (:mod:`riskassess.stages.tow_fullnet`, ``simulation.model = "full-net"``). :func:`tow_case` runs
+it in Exudyn and writes the run folder:
 
-:func:`towing_model` turns the validated case (:mod:`riskassess.cases.towing`) into a
-:class:`multibody.towing.TowingModel` for a given debris spin rate and sub-tether decision vector
-``s = [log10 k_ST, l_ST0, log10 c_ST, m_P/m_net]`` (eq. 22); :func:`thrust_law` is the case's thrust
-law, shared with the full-net model (:mod:`riskassess.stages.tow_fullnet`); :func:`run_figures` the figures
-of a lower-order or full-net run. The stage ``riskassess tow`` that runs them and writes the run
-folder is :mod:`riskassess.stages.tow_stage`.
+============== ==============================================================
+file           content
+============== ==============================================================
+manifest.json  format of :mod:`riskassess.products.results`, stage ``tow``, case, status, files
+case.toml      the case file as given
+towing.json    tension peaks, tautness after engagement, separation, rates, step, wall time
+towing.npz     every series of :meth:`multibody.towing.TowResult.series`
+tow.png        main-tether tension, thrust, separation and angular rates
+============== ==============================================================
+
+``riskassess report DIR`` shows it in its towing section (:mod:`riskassess.products.report.towing`).
 """
 from __future__ import annotations
 
-import numpy as np
-from scipy.optimize import brentq, minimize_scalar
+from pathlib import Path
 
-from multibody.control.attitude import quaternion_to_matrix, sampled_boundary_layer
-from multibody.control.mrac import mrac_initial_state, mrac_params, reference_steady_elongation
-from multibody.control.thrust import KINDS
-from multibody.towing import TowingModel
+from multibody.towing import run_exudyn
+from riskassess.products import results
+from riskassess.cases.impact import load_model
+from riskassess.products.outfolder import claim
+from riskassess.stages.run import software_versions
+from riskassess.models.towing import case_decision_vector, towing_model
+from riskassess.products.towing_figures import run_figures
+from riskassess.stages.tow_fullnet import run_full_net
 from riskassess.cases.towing import TowingCase
-
-#: Main-tether tension (N) from which the tether counts as engaged: before it the sub-tethers are still
-#: slack and only the connection point hangs on the main tether.
-ENGAGED_N = 1.0
+from riskassess.products.towing_plots import plot_tow
 
 
-def case_decision_vector(case: TowingCase) -> np.ndarray:
-    """The case's own sub-tether parameters as s (eq. 22)."""
-    st = case.sub_tethers
-    return np.array([np.log10(st.stiffness), st.natural_length, np.log10(max(st.damping, 1e-300)),
-                     st.connection_mass_fraction])
+def summarize(case: TowingCase, result, s) -> dict:
+    """The numbers ``riskassess tow`` prints and writes to towing.json (SI):
+    :func:`~riskassess.products.towing_figures.run_figures`, the decision vector s and the sub-tethers' peak tension,
+    wall time."""
+    series = result.series()
+    return {**run_figures(case, series, result.model), "decision_vector_s": [float(x) for x in s],
+            "sub_tether_peak_tension_N": float(series["sub_tether_tension"].max()),
+            "wall_time_s": result.wall_time, "steps_per_second": result.model.n_steps / result.wall_time}
 
 
-def connection_point_start(debris_com, debris_to_inertial, attach_body, toward, rest_length) -> np.ndarray:
-    """Initial connection point (m, inertial): on the line from the debris CoM towards ``toward``
-    (the main tether's chaser end), where the farthest sub-tether attachment is exactly
-    ``rest_length`` away (all sub-tethers just slack or taut); the point nearest to all
-    attachments when ``rest_length`` cannot reach them."""
-    axis = (toward - debris_com) / np.linalg.norm(toward - debris_com)
-    points = debris_com + attach_body @ debris_to_inertial.T
-
-    def reach(d):
-        return np.linalg.norm(debris_com + d * axis - points, axis=1).max() - rest_length
-
-    span = np.linalg.norm(toward - debris_com)
-    nearest = minimize_scalar(reach, bounds=(0.0, span), method="bounded").x
-    if reach(nearest) >= 0.0:
-        return debris_com + nearest * axis
-    return debris_com + brentq(reach, nearest, span, xtol=1e-12) * axis
-
-
-def thrust_law(case: TowingCase, tether, z0, z_rate0):
-    """The case's thrust law: (kind code, parameters, initial state) for elongation z0 (m), rate z_rate0 (m/s)."""
-    kind = KINDS[case.thrust.kind]
-    th = case.thrust
-    if kind == 0:
-        return kind, np.array([th.t_on, th.t_slope, th.max_force]), np.zeros(1)
-    m = case.mrac
-    params = mrac_params(kind, th.t_on, th.max_force, case.chaser.mass, tether[0], tether[1], m.desired_elongation,
-                         m.k_p, m.k_d, lambda0=m.lambda0, k_s=m.k_s, gamma=m.gamma, xi_h=m.xi_h, xi_a=m.xi_a,
-                         gamma_z=m.gamma_z, gamma_r=m.gamma_r, gamma_theta=m.gamma_theta, xi_2=m.xi_2, q=np.diag(m.q))
-    return kind, params, mrac_initial_state(kind, params, z0, z_rate0)
+def tow_case(case_path: str | Path, out_dir: str | Path, case: TowingCase | None = None,
+             overwrite: bool = False) -> dict:
+    """Load the case (unless given), claim the output folder (:func:`riskassess.products.outfolder.claim`),
+    run the lower-order tow in Exudyn (or the full-net tow when ``simulation.model = "full-net"``,
+    :mod:`riskassess.stages.tow_fullnet`), write the run folder; return the summary."""
+    case_path = Path(case_path)
+    case = case or load_model(case_path, TowingCase)
+    model = towing_model(case)
+    folder = claim(out_dir, case.name, "tow", overwrite, stage="tow", software=software_versions())
+    out = folder.path
+    with folder.recording():
+        results.atomic_write_bytes(out / "case.toml", case_path.read_bytes())
+        folder.add_files("case.toml")
+        if case.simulation.model == "full-net":
+            summary, series = run_full_net(case, out)
+            return _finish(case, folder, series, summary, ["towing.json", "towing.npz", "net.npz", "tow.png"])
+        result = run_exudyn(model)
+        summary = summarize(case, result, case_decision_vector(case))
+        results.atomic_write_npz(out / "towing.npz", result.series())
+        results.atomic_write_json(out / "towing.json", summary)
+        return _finish(case, folder, result.series(), summary, ["towing.json", "towing.npz", "tow.png"])
 
 
-def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None, step: float | None = None,
-                 end_time: float | None = None) -> TowingModel:
-    """The lower-order model of ``case`` with the debris spinning at ``spin_rate_deg_s`` (default: the
-    case's) and sub-tethers ``s`` (default: the case's). The step is the case's (or ``step``),
-    reduced to a divisor of the output interval. The connection point is implicit
-    (:mod:`multibody.connection_point`), so the step does not depend on ``s``."""
-    s = case_decision_vector(case) if s is None else np.asarray(s, float)
-    sim, ch, de = case.simulation, case.chaser, case.debris
-    mt = case.main_tether
-    tether = np.array([mt.stiffness, mt.damping, mt.natural_length, 10.0 ** s[0], 10.0 ** s[2], s[1]])
-    masses = np.array([case.net_mass * s[3], ch.mass, de.nominal_mass + case.net_mass * (1.0 - s[3])])
-    rot = np.array([quaternion_to_matrix(np.asarray(b.attitude_quaternion, float)) for b in (ch, de)])
-    com = np.array([ch.position_inertial, de.position_inertial], float)
-    attach_debris = np.asarray(case.sub_tethers.attachment_points_body, float)
-    rate = np.deg2rad(de.spin_rate_deg_s if spin_rate_deg_s is None else spin_rate_deg_s)
-    omega = np.array([ch.angular_velocity_body, rate * np.asarray(de.spin_axis_body) / np.linalg.norm(de.spin_axis_body)])
-    a_point = com[0] + rot[0] @ np.asarray(ch.tether_attachment_body, float)
-    p0 = connection_point_start(com[1], rot[1], attach_debris, a_point, s[1])
-    if case.sub_tethers.connection_point_start_inertial is not None:
-        p0 = np.asarray(case.sub_tethers.connection_point_start_inertial, float)
-    v_p0 = np.asarray(de.velocity_inertial) + rot[1] @ np.cross(omega[1], rot[1].T @ (p0 - com[1]))
-    z0 = np.linalg.norm(p0 - a_point) - mt.natural_length
-    kind, params, state = thrust_law(case, tether, z0, 0.0)
-    model = TowingModel(
-        masses=masses, inertia_body=np.array([np.diag(ch.principal_inertia), np.diag(de.principal_inertia)], float),
-        attach_chaser_body=np.asarray(ch.tether_attachment_body, float), attach_debris_body=attach_debris,
-        tether=tether, mu=sim.mu, attitude=np.zeros(8), thrust_kind=kind, thrust_along_body_z=kind != 0,
-        thrust_params=params, thrust_state=state,
-        positions=np.array([p0, com[0], com[1]]), velocities=np.array([v_p0, ch.velocity_inertial, de.velocity_inertial], float),
-        body_to_inertial=rot, omega_body=omega, start_time=sim.start_time,
-        end_time=sim.end_time if end_time is None else end_time, step=sim.step if step is None else step,
-        output_interval=sim.output_interval)
-    model.step = sim.output_interval / np.ceil(sim.output_interval / model.step - 1e-9)
-    ac = case.attitude_control
-    model.attitude = np.r_[float(ac.enabled), ac.k_gain, ac.gain,
-                           sampled_boundary_layer(ac.boundary_layer, np.asarray(ac.gain, float), model.step)]
-    return model
-
-
-def reference_elongation(case: TowingCase) -> float | None:
-    """Where the MRAC laws steer the elongation (m): the steady state of their reference model
-    (:func:`multibody.control.mrac.reference_steady_elongation`); None without an [mrac] section."""
-    if case.mrac is None:
-        return None
-    return reference_steady_elongation(case.main_tether.stiffness, case.mrac.k_p, case.mrac.desired_elongation)
-
-
-def tautness(series: dict, target_elongation: float | None) -> dict:
-    """Main-tether figures after engagement (first sample with tension > :data:`ENGAGED_N`): smallest
-    tension and slack time (taut: > 0 N and 0 s), peak tension, final elongation and its RMS error
-    against ``target_elongation`` over the last 100 s (None without a target) (SI)."""
-    t, tension, z = series["time"], series["main_tether_tension"], series["main_tether_elongation"]
-    engaged = np.nonzero(tension > ENGAGED_N)[0]
-    k = engaged[0] if len(engaged) else len(t) - 1
-    dt = np.diff(t, prepend=t[0])
-    late = t >= t[-1] - 100.0
-    return {"engaged_at_s": float(t[k]), "min_tension_after_engagement_N": float(tension[k:].min()),
-            "slack_after_engagement_s": float(np.sum(dt[k:][tension[k:] <= 0.0])),
-            "peak_tension_N": float(tension.max()), "final_elongation_m": float(z[-1]),
-            "target_elongation_m": target_elongation,
-            "rms_elongation_error_m": None if target_elongation is None else
-            float(np.sqrt(np.mean((z[late] - target_elongation) ** 2)))}
-
-
-def run_figures(case: TowingCase, series: dict, model) -> dict:
-    """The figures every towing run reports, lower-order or full-net (SI): main-tether peak, final
-    tension, slack while thrusting and :func:`tautness`; separation; chaser peak and debris final
-    rate; step and step count. ``model`` is the run's model (``omega_body``, ``step``, times)."""
-    t, tension = series["time"], series["main_tether_tension"]
-    dt = np.diff(t, prepend=t[0])
-    separation = np.linalg.norm(series["debris_com_inertial"] - series["chaser_com_inertial"], axis=1)
-    return {
-        "case": case.name, "thrust_kind": case.thrust.kind,
-        "spin_rate_deg_s": float(np.rad2deg(np.linalg.norm(model.omega_body[1]))),
-        "main_tether_peak_tension_N": float(tension.max()),
-        "main_tether_final_tension_N": float(tension[-1]),
-        "main_tether_slack_time_while_thrusting_s": float(np.sum(dt[(series["thrust"] != 0.0) & (tension <= 0.0)])),
-        "main_tether": tautness(series, reference_elongation(case)),
-        "separation_m": {"initial": float(separation[0]), "min": float(separation.min()),
-                         "max": float(separation.max()), "final": float(separation[-1])},
-        "chaser_peak_rate_deg_s": float(np.rad2deg(np.linalg.norm(series["chaser_omega_body"], axis=1).max())),
-        "debris_final_rate_deg_s": float(np.rad2deg(np.linalg.norm(series["debris_omega_body"][-1]))),
-        "step_s": model.step, "n_steps": model.n_steps, "simulated_s": model.end_time - model.start_time,
-    }
+def _finish(case, folder, series, summary, files) -> dict:
+    """Plot, mark the run folder complete with ``files``, return ``summary``."""
+    plot_tow(series, folder.path / "tow.png", case.name)
+    folder.add_files(*files)
+    folder.finish("complete")
+    return summary

@@ -1,146 +1,18 @@
-"""Full-net towing runs of a towing case (``simulation.model = "full-net"``; Boonrath, Singh & Botta
-2024, Sec. 2.1, 4.1): the case's ``[full_net]`` table turned into a
-:class:`multibody.net_towing.FullNetModel` started from the prepared wrapped state or from the net's
-ejection (``full_net.start = "capture"``, :func:`capture_start`), and the run folder of
-``riskassess tow`` for it (the lower-order files plus ``net.npz``).
-
-Wrapped start (docs/towing.md): at ``simulation.start_time`` the debris has the Table 2 state and
-spins at the given rate about ``debris.spin_axis_body``; the net (draped and closed around it by
-:func:`multibody.net_wrap.drape_and_close`, the same shape for every rate) turns with it; the chaser
-keeps its Table 2 velocity and attitude but sits on the line from the central node towards its
-Table 2 attachment point, the main tether at its natural length minus ``full_net.main_tether_slack``.
-"""
+"""Full-net towing runs (``simulation.model = "full-net"``): the model of
+:mod:`riskassess.models.towing_fullnet` run by Exudyn, its figures and the run folder of
+``riskassess tow`` for it (the lower-order files plus ``net.npz``)."""
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
 
-from multibody.control.attitude import quaternion_to_matrix, sampled_boundary_layer
-from multibody.net_towing import FullNetModel, run_exudyn
-from multibody.net_wrap import drape_and_close, towing_net, wrap_summary
+from multibody.net_towing import run_exudyn
+from multibody.net_wrap import wrap_summary
 from riskassess.products import results
-from riskassess.stages.tow import run_figures, thrust_law
+from riskassess.models.towing_fullnet import debris_geometry, full_net_model, wrapped_net
+from riskassess.products.towing_figures import run_figures
 from riskassess.cases.towing import TowingCase
-
-#: Height of the flat net above the cylinder before draping (m).
-DROP_HEIGHT = 0.3
-
-
-def debris_geometry(case: TowingCase) -> np.ndarray:
-    """Cylinder [radius, half length, axial centre z_body] (m): d_D and L_D of Table 1; the geometric
-    centre sits where the sub-tether attachments' axial asymmetry puts it (Table 1: z = -5.717 and
-    5.283 for L_D = 11 m give -0.217 m: the CoM is 0.217 m towards +z_body, Sec. 4.1)."""
-    z = np.asarray(case.sub_tethers.attachment_points_body, float)[:, 2]
-    return np.array([case.debris.diameter / 2.0, case.debris.length / 2.0, 0.5 * (z.min() + z.max())])
-
-
-def contact_law(case: TowingCase) -> np.ndarray:
-    c = case.full_net.contact
-    return np.array([c.stiffness, c.exponent, 1.5 * c.hunt_crossley_alpha * c.stiffness, c.mu_static, c.mu_kinetic,
-                     c.transition_speed])
-
-
-def _bodies(case: TowingCase):
-    ch, de = case.chaser, case.debris
-    rot = np.array([quaternion_to_matrix(np.asarray(b.attitude_quaternion, float)) for b in (ch, de)])
-    com = np.array([ch.position_inertial, de.position_inertial], float)
-    return rot, com
-
-
-def wrapped_net(case: TowingCase):
-    """The net and its wrapped node positions (n, 3) (m, debris frame): built flat on the cylinder's
-    side that faces the chaser's attachment point, draped and closed. Returns (TowingNet, x_body)."""
-    fn = case.full_net
-    geometry = debris_geometry(case)
-    rot, com = _bodies(case)
-    a_point = com[0] + rot[0] @ np.asarray(case.chaser.tether_attachment_body, float)
-    up = rot[1].T @ (a_point - com[1])
-    up[2] = 0.0
-    up /= np.linalg.norm(up)
-    center = up * (geometry[0] + DROP_HEIGHT) + np.array([0.0, 0.0, geometry[2]])
-    net = towing_net(fn.side_length, fn.nodes_per_side, case.net_mass, fn.corner_mass, fn.node_radius, fn.corner_radius,
-                     fn.thread_axial_rigidity, fn.thread_damping, fn.closing_axial_rigidity, fn.closed_fraction, center,
-                     -up)
-    x_body = drape_and_close(net, geometry, contact_law(case), up)
-    top = net.topology
-    top.rest_lengths[-len(net.closing_rest_closed):] = net.closing_rest_closed  # the loop stays closed
-    top.stiffness[-len(net.closing_rest_closed):] = net.closing_stiffness(net.closing_rest_closed)
-    return net, x_body
-
-
-def wrapped_start(case: TowingCase, net, x_body, spin_rate_deg_s: float):
-    """Initial state of the wrapped start (module doc): node positions and velocities (n, 3)
-    (m, m/s, inertial), chaser CoM (m, inertial), debris angular velocity (rad/s, body)."""
-    rot, com = _bodies(case)
-    de = case.debris
-    omega = np.deg2rad(spin_rate_deg_s) * np.asarray(de.spin_axis_body, float) / np.linalg.norm(de.spin_axis_body)
-    nodes = com[1] + x_body @ rot[1].T
-    velocities = np.asarray(de.velocity_inertial, float) + np.cross(omega, x_body) @ rot[1].T
-    arm = rot[0] @ np.asarray(case.chaser.tether_attachment_body, float)
-    node = nodes[net.central]
-    direction = (com[0] + arm - node) / np.linalg.norm(com[0] + arm - node)
-    chaser = node + (case.main_tether.natural_length - case.full_net.main_tether_slack) * direction - arm
-    return nodes, velocities, chaser, omega
-
-
-def capture_start(case: TowingCase, spin_rate_deg_s: float):
-    """Initial state of the capture start at t = 0 (Sec. 2.1, 4.1): chaser and debris at their
-    Table 2 states (v_D/C = 0), the debris spinning about ``debris.spin_axis_body``; the open net
-    flat, normal to r_D/C (the unit vector from the chaser's tether attachment to the debris CoM),
-    centred ``full_net.launch_offset`` ahead of the attachment, every node moving at the chaser's
-    velocity plus ``full_net.launch_speed`` along r_D/C. Returns (TowingNet, node positions (n, 3)
-    (m, inertial), node velocities (n, 3) (m/s, inertial), chaser CoM (m, inertial), debris angular
-    velocity (rad/s, body))."""
-    fn, de = case.full_net, case.debris
-    rot, com = _bodies(case)
-    a_point = com[0] + rot[0] @ np.asarray(case.chaser.tether_attachment_body, float)
-    direction = (com[1] - a_point) / np.linalg.norm(com[1] - a_point)
-    net = towing_net(fn.side_length, fn.nodes_per_side, case.net_mass, fn.corner_mass, fn.node_radius, fn.corner_radius,
-                     fn.thread_axial_rigidity, fn.thread_damping, fn.closing_axial_rigidity, fn.closed_fraction,
-                     a_point + fn.launch_offset * direction, direction)
-    nodes = net.topology.positions.copy()
-    velocities = np.tile(np.asarray(case.chaser.velocity_inertial, float) + fn.launch_speed * direction, (len(nodes), 1))
-    omega = np.deg2rad(spin_rate_deg_s) * np.asarray(de.spin_axis_body, float) / np.linalg.norm(de.spin_axis_body)
-    return net, nodes, velocities, com[0], omega
-
-
-def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapped=None, end_time=None, step=None,
-                   substeps=None) -> FullNetModel:
-    """The full-net model of ``case`` at ``spin_rate_deg_s`` (default: the case's): from the wrapped
-    state at ``simulation.start_time`` (``wrapped`` = (net, x_body) of :func:`wrapped_net`, computed
-    if not given) or, with ``full_net.start = "capture"``, from the net's ejection at t = 0
-    (:func:`capture_start`; ``wrapped`` is not used)."""
-    fn, sim, ch, de = case.full_net, case.simulation, case.chaser, case.debris
-    rate = de.spin_rate_deg_s if spin_rate_deg_s is None else spin_rate_deg_s
-    if fn.start == "capture":
-        net, nodes, velocities, chaser, omega = capture_start(case, rate)
-        start, closing_duration = 0.0, fn.closing_duration
-    else:
-        net, x_body = wrapped if wrapped is not None else wrapped_net(case)
-        nodes, velocities, chaser, omega = wrapped_start(case, net, x_body, rate)
-        start, closing_duration = sim.start_time, None
-    rot, com = _bodies(case)
-    mt = case.main_tether
-    tether = np.array([mt.stiffness, mt.damping, mt.natural_length])
-    a_point = chaser + rot[0] @ np.asarray(ch.tether_attachment_body, float)
-    kind, params, state = thrust_law(case, tether, np.linalg.norm(nodes[net.central] - a_point) - mt.natural_length, 0.0)
-    h = fn.step if step is None else step
-    h = sim.output_interval / np.ceil(sim.output_interval / h - 1e-9)
-    ac = case.attitude_control
-    return FullNetModel(
-        net=net, node_positions=nodes, node_velocities=velocities, masses=np.array([ch.mass, de.nominal_mass]),
-        inertia_body=np.array([np.diag(ch.principal_inertia), np.diag(de.principal_inertia)], float),
-        attach_chaser_body=np.asarray(ch.tether_attachment_body, float), main_tether=tether,
-        geometry=debris_geometry(case), contact_law=contact_law(case), mu=sim.mu,
-        attitude=np.r_[float(ac.enabled), ac.k_gain, ac.gain,
-                       sampled_boundary_layer(ac.boundary_layer, np.asarray(ac.gain, float), h)],
-        thrust_kind=kind, thrust_along_body_z=kind != 0, thrust_params=params, thrust_state=state,
-        positions=np.array([chaser, com[1]]), velocities=np.array([ch.velocity_inertial, de.velocity_inertial], float),
-        body_to_inertial=rot, omega_body=np.array([ch.angular_velocity_body, omega], float),
-        start_time=start, end_time=sim.end_time if end_time is None else end_time, step=h,
-        substeps=fn.substeps if substeps is None else substeps, output_interval=sim.output_interval,
-        net_output_interval=fn.net_output_interval, closing_time=fn.closing_time, closing_duration=closing_duration)
 
 
 def momentum_residual(series: dict) -> float:
@@ -151,7 +23,7 @@ def momentum_residual(series: dict) -> float:
 
 
 def summarize_full_net(case: TowingCase, result, wrap: dict) -> dict:
-    """The figures of every towing run (:func:`riskassess.stages.tow.run_figures`) for a full-net run, plus
+    """The figures of every towing run (:func:`riskassess.products.towing_figures.run_figures`) for a full-net run, plus
     the net's: wrapped-state shape, contact, closing-loop tension, momentum balance."""
     series = result.series()
     model = result.model

@@ -19,13 +19,13 @@ import hashlib
 import json
 from pathlib import Path
 
-import matplotlib.pyplot as plt
+import matplotlib
 
 from riskassess.products import results
 from riskassess.products.report.document import render_document, render_pdf
-from riskassess.products.report.plotting import STYLE
+from riskassess.products.plotting import STYLE
 from riskassess.products.report.sweep import envelope_section, runs_section
-from riskassess.sweep.envelope import envelope, unknown_counts
+from riskassess.products.envelope import envelope, unknown_counts
 from riskassess.sweep.store import ResultStore, StoreError
 
 #: The store file name whose products go beside it (the default layout).
@@ -95,7 +95,7 @@ def write_sweep_products(store: ResultStore, confidence: float = 0.95, reliabili
     # allow_nan=False: the envelope never holds a NaN (a "nan" limit was issue 20's false safe)
     write_product(store, "envelope.json", (json.dumps(env, indent=2, allow_nan=False) + "\n").encode())
     varied = [a.split(" ", 1)[1].split("=")[0] for a in info.get("arguments", []) if a.startswith("--vary ")]
-    with plt.rc_context(STYLE):
+    with matplotlib.rc_context(STYLE):
         sections = [envelope_section(rows, env, [k for k in varied if k != env["key"]]), runs_section(rows)]
     counts = unknown_counts(rows)
     problems = [f"{n} runs {what}" for what, n in counts.items() if n]

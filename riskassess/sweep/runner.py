@@ -24,7 +24,7 @@ from riskassess.cases.impact import CaseError, validate_case
 from riskassess.products.outfolder import open_existing
 from riskassess.products.results import atomic_write_json
 from riskassess.sweep.cluster_log import StderrToFile, distributed_logging_to
-from riskassess.sweep.records import debris_state_of
+from riskassess.products.sweep_records import debris_state_of
 from riskassess.sweep.spec import RunSpec, SweepSpecError, case_with
 from riskassess.sweep.store import ResultStore
 from structures.verdict import INDETERMINATE

@@ -38,7 +38,7 @@ import sqlite3
 import urllib.parse
 from pathlib import Path
 
-from riskassess.sweep.records import debris_state_of
+from riskassess.products.sweep_records import debris_state_of
 
 #: SQLite header ``application_id`` of a results store: "RSKA" in ASCII.
 APPLICATION_ID = 0x52534B41

@@ -3,7 +3,7 @@ import json
 
 import pytest
 
-from riskassess.cases.kinds import KINDS, load_any_case
+from riskassess.stages.kinds import KINDS, load_any_case
 from riskassess.cli import main
 from tests.riskassess.conftest import CASES
 

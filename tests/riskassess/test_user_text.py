@@ -10,7 +10,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
 
 from riskassess.cli import main  # noqa: E402
-from riskassess.products.report.plotting import plain  # noqa: E402
+from riskassess.products.plotting import plain  # noqa: E402
 from tests.riskassess.conftest import shortened_case  # noqa: E402
 
 #: Names that broke the tool: rich closing tag without opening (MarkupError after the run), a link,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from riskassess.products.report.blocks import Figure, Note, Section, Table
 from riskassess.products.results import RunFolder
+from riskassess.products.approach_plots import controls_figure, trajectory_figure
 
 
 def _rows(answer: dict) -> list[list[str]]:
@@ -32,8 +33,6 @@ def _reference_rows(reference: dict) -> list[list[str]]:
 def approach_section(run: RunFolder) -> Section | None:
     if not run.has("approach.json"):
         return None
-    from riskassess.products.approach_plots import controls_figure, trajectory_figure  # it imports the report package
-
     answer, arrays = run.json("approach.json"), run.arrays("approach.npz")
     verdict = "satisfied" if answer["constraints_satisfied"] else "NOT satisfied"
     blocks = [Note(f"{answer['objective']} ({answer['kind']}): constraints {verdict} on the re-simulation.",

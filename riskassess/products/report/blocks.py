@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import base64
 from dataclasses import dataclass, field
+from riskassess.products.plotting import png_bytes
 
 #: Resolution of embedded figures (dots per inch): sharp on screen and in print at 17 cm width.
 FIGURE_DPI = 150
@@ -27,8 +28,6 @@ class Figure:
     @classmethod
     def from_matplotlib(cls, id: str, caption: str, fig) -> Figure:
         """Render and close a matplotlib figure."""
-        from riskassess.products.report.plotting import png_bytes
-
         return cls(id, caption, base64.b64encode(png_bytes(fig, FIGURE_DPI)).decode("ascii"))
 
 

@@ -7,7 +7,7 @@ import base64
 import numpy as np
 
 from riskassess.products.report.blocks import FIGURE_DPI, Figure, Note, Section, Table
-from riskassess.products.report.plotting import WIDTH_IN, legend, mark_release, panels
+from riskassess.products.plotting import WIDTH_IN, legend, mark_release, panels
 from riskassess.products.results import RunFolder
 from riskassess.products.view.products import ANIMATION, VIEWER
 from riskassess.products.view.render import snapshots_png

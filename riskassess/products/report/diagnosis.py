@@ -5,11 +5,14 @@ The same figure builders write the stage's PNG files and the report's embedded f
 """
 from __future__ import annotations
 
+import matplotlib
+
 
 import numpy as np
 
 from riskassess.products.report.blocks import Figure, Note, Section, Table
-from riskassess.products.report.plotting import STYLE, legend, panels, plain, write_png
+from riskassess.products.plotting import STYLE, legend, panels, plain, write_png
+from riskassess.diagnosis.residuals import spectrum
 
 #: Channels shown in the time-series figures: the ones with the largest residual before.
 SHOWN_CHANNELS = 6
@@ -57,8 +60,6 @@ def residuals_figure(answer: dict, arrays: dict):
 
 def spectrum_figure(answer: dict, arrays: dict):
     """Welch PSD of the worst channel's normalized residual, before and after."""
-    from riskassess.diagnosis.residuals import spectrum
-
     worst = _shown(answer, arrays)[0]
     fig, (ax,) = panels(1, 2.2)
     t = arrays["time"]
@@ -108,10 +109,8 @@ def _figures(answer: dict, arrays: dict):
 
 def write_figures(out, answer: dict, arrays: dict) -> list[str]:
     """Write the PNG figures into ``out`` atomically; returns their names."""
-    import matplotlib.pyplot as plt
-
     names = []
-    with plt.rc_context(STYLE):
+    with matplotlib.rc_context(STYLE):
         for name, _, _, fig in _figures(answer, arrays):
             write_png(fig, out / name, dpi=150)
             names.append(name)

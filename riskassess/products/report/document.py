@@ -12,6 +12,8 @@ Adding a stage's section is adding one module and one line here.
 """
 from __future__ import annotations
 
+import matplotlib
+
 import datetime
 from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
@@ -28,7 +30,7 @@ from riskassess.products.report.diagnosis import diagnosis_section
 from riskassess.products.report.impact import contact_section, debris_motion_section, energy_section, hinge_section
 from riskassess.products.report.inputs import appendix_inputs_section, case_section, run_facts_section
 from riskassess.products.report.perception import perception_section
-from riskassess.products.report.plotting import STYLE
+from riskassess.products.plotting import STYLE
 from riskassess.products.report.structures import joint_loads_section, stresses_section, verdict_section
 from riskassess.products.report.towing import towing_section
 from riskassess.products.results import MissingData, RunFolder
@@ -75,14 +77,12 @@ def tool_version() -> str:
 
 def build_sections(run: RunFolder, progress=None) -> list[Section]:
     """Every applicable section; a section whose data is missing says what is missing."""
-    import matplotlib.pyplot as plt
-
     sections = []
     for k, (section_id, title, build) in enumerate(SECTIONS):
         if progress:
             progress(k, len(SECTIONS), title)
         try:
-            with plt.rc_context(STYLE):
+            with matplotlib.rc_context(STYLE):
                 section = build(run)
         except MissingData as exc:
             # a folder of another stage (approach, tow) has no impact results to miss

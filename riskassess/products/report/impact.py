@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.products.report.blocks import Figure, Note, Section, Table
-from riskassess.products.report.plotting import COMPONENT_COLORS, legend, mark_release, panels, plain
+from riskassess.products.plotting import COMPONENT_COLORS, legend, mark_release, panels, plain
 from riskassess.products.results import RunFolder
 from riskassess.products.summary import contact_totals_debris
 from riskassess.products.tables import format_vector

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.products.report.blocks import Figure, Note, Section, Table
-from riskassess.products.report.plotting import legend, panels
+from riskassess.products.plotting import legend, panels
 from riskassess.products.results import RunFolder
 from riskassess.products.tables import perception_rows
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.products.report.blocks import Figure, Note, Section, Table
-from riskassess.products.report.plotting import allowable_band, legend, mark_release, panels, plain, shade_not_judged
+from riskassess.products.plotting import allowable_band, legend, mark_release, panels, plain, shade_not_judged
 from riskassess.products.results import RunFolder
 from riskassess.products.tables import STATE_TEXT, VERDICT_COLUMNS, format_margin, format_vector, verdict_rows
 

@@ -7,8 +7,8 @@ import numpy as np
 
 from riskassess.cases.doc import key_unit
 from riskassess.products.report.blocks import Figure, Note, Section, Table
-from riskassess.products.report.plotting import legend, panels, plain
-from riskassess.sweep.envelope import UNKNOWN, envelope, envelope_statement, is_probabilistic, run_status
+from riskassess.products.plotting import legend, panels, plain
+from riskassess.products.envelope import UNKNOWN, envelope, envelope_statement, is_probabilistic, run_status
 from structures.verdict import DEBRIS, NO_DEBRIS
 
 #: How the runs table shows a run's outcome.

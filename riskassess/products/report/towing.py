@@ -8,6 +8,7 @@ import math
 
 from riskassess.products.report.blocks import Figure, Note, Section, Table
 from riskassess.products.results import RunFolder
+from riskassess.products.towing_plots import tow_figure
 
 TITLE = "Towing: main tether and tethered bodies"
 
@@ -57,8 +58,6 @@ def towing_section(run: RunFolder) -> Section | None:
     """None unless the folder holds a tow run (``towing.json``)."""
     if not run.has("towing.json"):
         return None
-    from riskassess.products.towing_plots import tow_figure
-
     summary = run.json("towing.json")
     series = run.arrays("towing.npz")
     mt = summary["main_tether"]

@@ -16,14 +16,13 @@ import io
 from pathlib import Path
 
 import matplotlib
+from matplotlib.animation import PillowWriter
+from matplotlib.cm import ScalarMappable
+from matplotlib.colors import LightSource, Normalize
+from matplotlib.figure import Figure
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-matplotlib.use("Agg")  # headless
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.animation import PillowWriter  # noqa: E402
-from matplotlib.colors import LightSource, Normalize  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
-
-from riskassess.products.view.scene import Instant, Scene, decimation  # noqa: E402
+from riskassess.products.view.scene import Instant, Scene, decimation
 
 TENSION_CMAP = "plasma"
 BODY_COLOR = "#c8c8c8"
@@ -65,7 +64,7 @@ def draw_frame(ax, scene: Scene, f: int, norm: Normalize) -> list:
             scene.body_vertices(f, k)[faces], facecolors=color, edgecolors=color, linewidths=0.2, shade=True,
             lightsource=light)))
     x = scene.positions[f]
-    colors = plt.get_cmap(TENSION_CMAP)(norm(scene.tension[f]))
+    colors = matplotlib.colormaps[TENSION_CMAP](norm(scene.tension[f]))
     artists.append(ax.add_collection3d(Line3DCollection(x[scene.threads], colors=colors, linewidths=1.1)))
     bullets = x[len(x) - scene.n_bullets:]
     artists.append(ax.scatter(*bullets.T, s=6, color="k", depthshade=False))
@@ -73,7 +72,7 @@ def draw_frame(ax, scene: Scene, f: int, norm: Normalize) -> list:
 
 
 def _colorbar(fig, norm: Normalize, axes) -> None:
-    bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=TENSION_CMAP), ax=axes, orientation="horizontal",
+    bar = fig.colorbar(ScalarMappable(norm=norm, cmap=TENSION_CMAP), ax=axes, orientation="horizontal",
                        fraction=0.035, pad=0.03, aspect=40, shrink=0.6, extend="max")
     bar.set_label("thread tension (N)", size=7)
     bar.ax.tick_params(labelsize=6)
@@ -90,7 +89,7 @@ def snapshots_png(scene: Scene, instants: list[Instant], width_in: float, dpi: f
     norm = tension_norm(scene)
     cols = min(2, len(instants))
     rows = -(-len(instants) // cols)
-    fig = plt.figure(figsize=(width_in, rows * 0.5 * width_in * 0.95 + 0.6), layout="constrained")
+    fig = Figure(figsize=(width_in, rows * 0.5 * width_in * 0.95 + 0.6), layout="constrained")
     axes = []
     for n, instant in enumerate(instants):
         ax = _axes(fig.add_subplot(rows, cols, n + 1, projection="3d"), scene)
@@ -100,7 +99,6 @@ def snapshots_png(scene: Scene, instants: list[Instant], width_in: float, dpi: f
     _colorbar(fig, norm, axes)
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=dpi)
-    plt.close(fig)
     return buffer.getvalue()
 
 
@@ -110,7 +108,7 @@ def write_animation(scene: Scene, path: Path, max_frames: int = 30, size_in: flo
     the first and last included); returns the number of frames written."""
     frames = decimation(scene.n_frames, max_frames)
     norm = tension_norm(scene)
-    fig = plt.figure(figsize=(size_in, size_in + 0.5), layout="constrained")
+    fig = Figure(figsize=(size_in, size_in + 0.5), layout="constrained")
     ax = _axes(fig.add_subplot(projection="3d"), scene)
     _colorbar(fig, norm, [ax])
     ax.set_title(_title(scene, int(frames[-1]), "capture"), fontsize=7)
@@ -124,5 +122,4 @@ def write_animation(scene: Scene, path: Path, max_frames: int = 30, size_in: flo
             writer.grab_frame()
             for artist in artists:
                 artist.remove()
-    plt.close(fig)
     return len(frames)

@@ -23,8 +23,8 @@ from hypothesis import strategies as st
 from riskassess.cases.approach import ApproachCase
 from riskassess.cases.impact import CaseError, load_case, load_model
 from riskassess.cases.inputs import read_toml
-from riskassess.cases.kinds import load_any_case
-from riskassess.cases.diagnosis import load_diagnosis_case
+from riskassess.stages.kinds import load_any_case
+from riskassess.diagnosis.cases import load_diagnosis_case
 from riskassess.cases.towing import TowingCase
 
 CASES = Path(__file__).resolve().parents[3] / "cases"

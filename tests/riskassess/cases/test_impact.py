@@ -3,7 +3,7 @@ from pathlib import Path
 
 import pytest
 
-from riskassess.cases.kinds import load_any_case
+from riskassess.stages.kinds import load_any_case
 from riskassess.cases.impact import CaseError, load_case
 
 CASES = Path(__file__).resolve().parents[3] / "cases"

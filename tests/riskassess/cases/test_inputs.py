@@ -10,14 +10,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from riskassess.diagnosis.measured import MEASURED_FILE_LIMIT, MeasuredDataError, read_measured, write_measured
+from riskassess.cases.inputs import MEASURED_FILE_LIMIT
+from riskassess.diagnosis.measured import MeasuredDataError, read_measured
+from riskassess.products.measured import write_measured
 from riskassess.cases.approach import ApproachCase
 from riskassess.cases.impact import CaseError, load_case, load_model
 from riskassess.cases.inputs import (CASE_FILE_LIMIT, CASE_NAME_PATTERN, ITEM_NAME_PATTERN, JSON_FILE_LIMIT,
                                     MAX_NESTING, MESH_FILE_LIMIT, read_toml)
-from riskassess.cases.kinds import load_any_case
+from riskassess.stages.kinds import load_any_case
 from riskassess.cli import main
-from riskassess.cases.diagnosis import load_diagnosis_case
+from riskassess.diagnosis.cases import load_diagnosis_case
 from riskassess.cases.towing import TowingCase
 
 CASES = Path(__file__).resolve().parents[3] / "cases"

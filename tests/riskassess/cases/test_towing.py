@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from riskassess.cases.impact import CaseError, load_model
-from riskassess.stages.tow import case_decision_vector, towing_model
+from riskassess.models.towing import case_decision_vector, towing_model
 from riskassess.cases.towing import TowingCase
 
 CASE = "cases/zenit2_towing.toml"

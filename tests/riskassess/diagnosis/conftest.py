@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from riskassess.cases.diagnosis import DiagnosisCaseFile, diagnosis_case_from_dict
+from riskassess.diagnosis.cases import diagnosis_case_from_dict
 from riskassess.cases.impact import read_toml
 
 CASES = Path(__file__).parents[3] / "cases"
@@ -19,9 +19,7 @@ def case_with(path: Path, **changes):
     raw = read_toml(path)
     for key, value in changes.items():
         raw[key] = {**raw.get(key, {}), **value} if isinstance(value, dict) and key != "orbit" else value
-    if raw.get("kind") == "towing":       # its towing case is named relative to the case file
-        return diagnosis_case_from_dict(raw, path.parent)
-    return DiagnosisCaseFile.model_validate(raw).root
+    return diagnosis_case_from_dict(raw, path.parent)   # a towing case names its file relative to it
 
 
 @pytest.fixture

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from riskassess.diagnosis.effects import CATALOG
-from riskassess.diagnosis.measured import write_measured
+from riskassess.products.measured import write_measured
 from riskassess.diagnosis.model import predict
 from riskassess.diagnosis.plant import Plant
 from riskassess.diagnosis.synthetic import channel_noise, sample_times, simulate_constant_body_torque, simulate_effect

@@ -8,7 +8,8 @@ from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.exudyn_model import simulate_case, simulate_exudyn
 from riskassess.diagnosis.model import predict
 from riskassess.diagnosis.plant import Plant
-from riskassess.cases.diagnosis import DiagnosisCaseFile, toml_text
+from riskassess.cases.diagnosis import toml_text
+from riskassess.diagnosis.cases import load_diagnosis_case
 from riskassess.cases.impact import read_toml
 from tests.riskassess.diagnosis.conftest import HINGED_CASE, TUMBLING_CASE, case_with
 
@@ -56,7 +57,7 @@ def test_extended_case_loads_and_simulates_in_exudyn(tmp_path):
     raw["effects"] = [{"id": "hinge_stiffness_hardening", "parameters": {"cubic_stiffness": 200.0}}]
     path = tmp_path / "extended.toml"
     path.write_text(toml_text(raw))
-    case = DiagnosisCaseFile.model_validate(read_toml(path)).root
+    case = load_diagnosis_case(path)
     out = simulate_case(case, TIMES[:51])
     plant = Plant.from_case(case)
     fast = predict(plant, TIMES[:51], CATALOG["hinge_stiffness_hardening"], [200.0], ["cubic_stiffness"])

@@ -4,7 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from riskassess.diagnosis.measured import MeasuredDataError, difference_noise, read_measured, write_measured
+from riskassess.diagnosis.measured import MeasuredDataError, difference_noise, read_measured
+from riskassess.products.measured import write_measured
 
 
 def _write(path, text):

@@ -20,13 +20,14 @@ from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.effects.base import Effect
 from riskassess.diagnosis.effects.tether_viscoelasticity import branch_after, step_gain
 from riskassess.diagnosis.effects.thrust_misalignment import misaligned_thrust, thrust_direction_eci
-from riskassess.diagnosis.measured import write_measured
+from riskassess.products.measured import write_measured
 from riskassess.diagnosis.model import predict
 from riskassess.diagnosis.scenario import plant_of
 from riskassess.diagnosis.synthetic import channel_noise, sample_times
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, last_diagnostics
 from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn
-from riskassess.diagnosis.towing_plant import lvlh_to_eci, simulate
+from multibody.orbit import lvlh_to_eci
+from riskassess.diagnosis.towing_plant import simulate
 from multibody.towing import run_twin
 from multibody.towing_kernel import CHASER, THRUST
 from riskassess.cases.impact import read_toml

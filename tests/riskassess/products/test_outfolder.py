@@ -234,17 +234,17 @@ def test_report_never_overwrites_a_file_it_did_not_write(tmp_path, small_case, c
 def test_a_failed_product_is_recorded_and_the_results_stay(tmp_path, small_case, monkeypatch, capsys):
     """Issue 20 item 4: `run --report --vtk` is 'running' until its last product; a product that fails
     leaves 'products_failed' (exit code 1) with readable results, and a retry of the step clears it."""
-    import riskassess.products.report
+    import riskassess.api
 
     out = tmp_path / "run"
     statuses = []
-    real = riskassess.products.report.write_report
+    real = riskassess.api.write_report
 
     def full_disk(run_dir, **kwargs):
         statuses.append(_manifest(Path(run_dir))["status"])
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(riskassess.products.report, "write_report", full_disk)
+    monkeypatch.setattr(riskassess.api, "write_report", full_disk)
     assert main(["run", str(small_case), "--out", str(out), "--report", "--vtk", "--json"]) == 1
     assert statuses == ["running"]
     manifest = _manifest(out)
@@ -252,7 +252,7 @@ def test_a_failed_product_is_recorded_and_the_results_stay(tmp_path, small_case,
     assert "No space left" in manifest["product_errors"]["report"] and manifest["products"] == ["vtk"]
     assert "retry this step alone with 'riskassess report" in capsys.readouterr().err
     assert RunFolder(out).summary["case"] == "envisat_small"   # the results stay readable
-    monkeypatch.setattr(riskassess.products.report, "write_report", real)
+    monkeypatch.setattr(riskassess.api, "write_report", real)
     assert main(["report", str(out), "--no-pdf"]) == 0
     manifest = _manifest(out)
     assert manifest["status"] == "complete" and "product_errors" not in manifest

@@ -11,7 +11,7 @@ from pypdf import PdfReader
 
 from riskassess.cli import main
 from riskassess.products.report import SECTIONS, write_report
-from riskassess.products.report.plotting import WIDTH_IN
+from riskassess.products.plotting import WIDTH_IN
 from riskassess.products.report.blocks import FIGURE_DPI
 
 FIGURES = {"capture": ["fig-capture"], "net-integrity": ["fig-net-tension"], "contact": ["fig-contact"], "debris-motion": ["fig-debris-motion"], "hinges": ["fig-hinge-angle"],

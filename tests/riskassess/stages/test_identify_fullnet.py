@@ -9,7 +9,7 @@ from riskassess.products import results
 from riskassess.cases.impact import CaseError, load_model
 from riskassess.stages.identify import claim_identify_folder, simulate
 from riskassess.stages.identify_fullnet import comparison_rows, full_net_runs, identify_full_net, lower_order_case
-from riskassess.stages.tow import towing_model
+from riskassess.models.towing import towing_model
 from riskassess.cases.towing import TowingCase
 
 CASE = "cases/zenit2_towing.toml"

@@ -11,8 +11,8 @@ from riskassess.cases.impact import load_model
 from riskassess.products.report import write_report
 from riskassess.products.report.towing import towing_section
 from riskassess.products.results import RunFolder
-from riskassess.stages.tow import tautness
-from riskassess.stages.tow_stage import tow_case
+from riskassess.products.towing_figures import tautness
+from riskassess.stages.tow import tow_case
 from riskassess.cases.towing import TowingCase
 
 CASE = "cases/zenit2_towing.toml"

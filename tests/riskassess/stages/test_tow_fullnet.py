@@ -6,7 +6,7 @@ import pytest
 from multibody.control.attitude import quaternion_to_matrix
 from multibody.net_towing import NetTowState, run_exudyn
 from riskassess.cases.impact import load_model
-from riskassess.stages.tow_fullnet import capture_start, full_net_model
+from riskassess.models.towing_fullnet import capture_start, full_net_model
 from riskassess.cases.towing import TowingCase
 
 CASE = "cases/zenit2_towing.toml"

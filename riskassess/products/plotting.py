@@ -1,18 +1,18 @@
 """Shared look of the report's figures: sizes, fonts, time axes, allowable bands, release marks.
 
-Section builders run inside ``matplotlib.pyplot.rc_context(STYLE)`` (see :mod:`.document`).
+Section builders run inside ``matplotlib.rc_context(STYLE)`` (see :mod:`.report.document`). Figures are
+:class:`matplotlib.figure.Figure` objects rendered by Agg on save, never pyplot figures: writing a
+product neither needs a display nor changes the backend of the user's session (a notebook keeps
+its inline plots).
 """
 from __future__ import annotations
 
 import io
 from pathlib import Path
 
-import matplotlib
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")  # reports are written headless
-import matplotlib.pyplot as plt  # noqa: E402
-
-from riskassess.products.results import atomic_write_bytes  # noqa: E402
+from riskassess.products.results import atomic_write_bytes
 
 #: Figure width fits an A4 page with 2 cm margins (17 cm); fonts stay readable at that size.
 WIDTH_IN = 6.7
@@ -35,22 +35,21 @@ def plain(text) -> str:
 
 
 def png_bytes(fig, dpi: float) -> bytes:
-    """Render a matplotlib figure as PNG at ``dpi`` (dots per inch) and close it."""
+    """Render a matplotlib figure as PNG at ``dpi`` (dots per inch)."""
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=dpi)
-    plt.close(fig)
     return buffer.getvalue()
 
 
 def write_png(fig, path, dpi: float) -> None:
-    """Render a figure as PNG, close it, and write it to ``path`` atomically (a reader never sees half a file)."""
+    """Render a figure as PNG and write it to ``path`` atomically (a reader never sees half a file)."""
     atomic_write_bytes(Path(path), png_bytes(fig, dpi))
 
 
 def panels(n: int, height_in: float = 2.0, sharex: bool = True):
     """A figure of ``n`` stacked panels sharing the time axis; returns (fig, list of axes)."""
-    fig, axes = plt.subplots(n, 1, figsize=(WIDTH_IN, 0.5 + height_in * n), sharex=sharex, squeeze=False,
-                             layout="constrained")
+    fig = Figure(figsize=(WIDTH_IN, 0.5 + height_in * n), layout="constrained")
+    axes = fig.subplots(n, 1, sharex=sharex, squeeze=False)
     axes[-1, 0].set_xlabel("time (s)")
     return fig, list(axes[:, 0])
 

@@ -11,7 +11,8 @@ from pathlib import Path
 
 from riskassess.cases.approach import ApproachCase
 from riskassess.cases.impact import Case, load_case, load_model, read_toml
-from riskassess.cases.diagnosis import DiagnosisCaseFile, load_diagnosis_case
+from riskassess.cases.diagnosis import DiagnosisCaseFile
+from riskassess.diagnosis.cases import load_diagnosis_case
 from riskassess.cases.towing import TowingCase
 
 #: Case kind -> (pydantic model of its file, loader of a file of that kind, command that runs it).

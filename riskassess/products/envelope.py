@@ -29,7 +29,7 @@ from collections import defaultdict
 import numpy as np
 from scipy.stats import beta
 
-from riskassess.sweep.records import debris_state_of
+from riskassess.products.sweep_records import debris_state_of
 from structures.verdict import DEBRIS, NO_DEBRIS
 
 DEFAULT_KEY = "launch.velocity"
@@ -59,7 +59,7 @@ def envelope_key(rows: list[dict]) -> str | None:
 def run_status(row: dict) -> str:
     """``debris``, ``no_debris``, ``indeterminate``, ``failed``, ``pending``, or ``unassessed``
     (done, in a case without weak locations: no verdict to count). A "no debris" record whose
-    evidence is not finite is ``indeterminate`` (:func:`~riskassess.sweep.records.debris_state_of`)."""
+    evidence is not finite is ``indeterminate`` (:func:`~riskassess.products.sweep_records.debris_state_of`)."""
     if row["state"] != "done":
         return row["state"]
     record = dict(row["result"] or {})

@@ -1,0 +1,18 @@
+"""Diagnosis case files checked against the effect catalog: the schema
+(:mod:`riskassess.cases.diagnosis`) validates the file, this layer hands it the catalog
+(:data:`riskassess.diagnosis.effects.CATALOG`) so ``[[effects]]`` entries are checked too."""
+from __future__ import annotations
+
+from riskassess.cases import diagnosis as schema
+from riskassess.diagnosis.effects import CATALOG
+
+
+def load_diagnosis_case(path) -> schema.DiagnosisCase:
+    """Read and validate a diagnosis case file, its ``[[effects]]`` against the catalog;
+    :class:`~riskassess.cases.impact.CaseError` names the file and the key."""
+    return schema.load_diagnosis_case(path, CATALOG)
+
+
+def diagnosis_case_from_dict(raw: dict, case_dir=".") -> schema.DiagnosisCase:
+    """:func:`riskassess.cases.diagnosis.diagnosis_case_from_dict` with the effect catalog."""
+    return schema.diagnosis_case_from_dict(raw, case_dir, CATALOG)

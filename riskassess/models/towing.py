@@ -1,0 +1,94 @@
+"""The lower-order towing model of a towing case (Boonrath, Singh & Botta 2024).
+
+:func:`towing_model` turns the validated case (:mod:`riskassess.cases.towing`) into a
+:class:`multibody.towing.TowingModel` for a given debris spin rate and sub-tether decision vector
+``s = [log10 k_ST, l_ST0, log10 c_ST, m_P/m_net]`` (eq. 22); :func:`thrust_law` is the case's thrust
+law, shared with the full-net model (:mod:`riskassess.models.towing_fullnet`). The stage
+``riskassess tow`` that runs them and writes the run folder is :mod:`riskassess.stages.tow`.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+from multibody.control.attitude import quaternion_to_matrix, sampled_boundary_layer
+from multibody.control.mrac import mrac_initial_state, mrac_params
+from multibody.control.thrust import KINDS
+from multibody.towing import TowingModel
+from riskassess.cases.towing import TowingCase
+
+def case_decision_vector(case: TowingCase) -> np.ndarray:
+    """The case's own sub-tether parameters as s (eq. 22)."""
+    st = case.sub_tethers
+    return np.array([np.log10(st.stiffness), st.natural_length, np.log10(max(st.damping, 1e-300)),
+                     st.connection_mass_fraction])
+
+
+def connection_point_start(debris_com, debris_to_inertial, attach_body, toward, rest_length) -> np.ndarray:
+    """Initial connection point (m, inertial): on the line from the debris CoM towards ``toward``
+    (the main tether's chaser end), where the farthest sub-tether attachment is exactly
+    ``rest_length`` away (all sub-tethers just slack or taut); the point nearest to all
+    attachments when ``rest_length`` cannot reach them."""
+    axis = (toward - debris_com) / np.linalg.norm(toward - debris_com)
+    points = debris_com + attach_body @ debris_to_inertial.T
+
+    def reach(d):
+        return np.linalg.norm(debris_com + d * axis - points, axis=1).max() - rest_length
+
+    span = np.linalg.norm(toward - debris_com)
+    nearest = minimize_scalar(reach, bounds=(0.0, span), method="bounded").x
+    if reach(nearest) >= 0.0:
+        return debris_com + nearest * axis
+    return debris_com + brentq(reach, nearest, span, xtol=1e-12) * axis
+
+
+def thrust_law(case: TowingCase, tether, z0, z_rate0):
+    """The case's thrust law: (kind code, parameters, initial state) for elongation z0 (m), rate z_rate0 (m/s)."""
+    kind = KINDS[case.thrust.kind]
+    th = case.thrust
+    if kind == 0:
+        return kind, np.array([th.t_on, th.t_slope, th.max_force]), np.zeros(1)
+    m = case.mrac
+    params = mrac_params(kind, th.t_on, th.max_force, case.chaser.mass, tether[0], tether[1], m.desired_elongation,
+                         m.k_p, m.k_d, lambda0=m.lambda0, k_s=m.k_s, gamma=m.gamma, xi_h=m.xi_h, xi_a=m.xi_a,
+                         gamma_z=m.gamma_z, gamma_r=m.gamma_r, gamma_theta=m.gamma_theta, xi_2=m.xi_2, q=np.diag(m.q))
+    return kind, params, mrac_initial_state(kind, params, z0, z_rate0)
+
+
+def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None, step: float | None = None,
+                 end_time: float | None = None) -> TowingModel:
+    """The lower-order model of ``case`` with the debris spinning at ``spin_rate_deg_s`` (default: the
+    case's) and sub-tethers ``s`` (default: the case's). The step is the case's (or ``step``),
+    reduced to a divisor of the output interval. The connection point is implicit
+    (:mod:`multibody.connection_point`), so the step does not depend on ``s``."""
+    s = case_decision_vector(case) if s is None else np.asarray(s, float)
+    sim, ch, de = case.simulation, case.chaser, case.debris
+    mt = case.main_tether
+    tether = np.array([mt.stiffness, mt.damping, mt.natural_length, 10.0 ** s[0], 10.0 ** s[2], s[1]])
+    masses = np.array([case.net_mass * s[3], ch.mass, de.nominal_mass + case.net_mass * (1.0 - s[3])])
+    rot = np.array([quaternion_to_matrix(np.asarray(b.attitude_quaternion, float)) for b in (ch, de)])
+    com = np.array([ch.position_inertial, de.position_inertial], float)
+    attach_debris = np.asarray(case.sub_tethers.attachment_points_body, float)
+    rate = np.deg2rad(de.spin_rate_deg_s if spin_rate_deg_s is None else spin_rate_deg_s)
+    omega = np.array([ch.angular_velocity_body, rate * np.asarray(de.spin_axis_body) / np.linalg.norm(de.spin_axis_body)])
+    a_point = com[0] + rot[0] @ np.asarray(ch.tether_attachment_body, float)
+    p0 = connection_point_start(com[1], rot[1], attach_debris, a_point, s[1])
+    if case.sub_tethers.connection_point_start_inertial is not None:
+        p0 = np.asarray(case.sub_tethers.connection_point_start_inertial, float)
+    v_p0 = np.asarray(de.velocity_inertial) + rot[1] @ np.cross(omega[1], rot[1].T @ (p0 - com[1]))
+    z0 = np.linalg.norm(p0 - a_point) - mt.natural_length
+    kind, params, state = thrust_law(case, tether, z0, 0.0)
+    model = TowingModel(
+        masses=masses, inertia_body=np.array([np.diag(ch.principal_inertia), np.diag(de.principal_inertia)], float),
+        attach_chaser_body=np.asarray(ch.tether_attachment_body, float), attach_debris_body=attach_debris,
+        tether=tether, mu=sim.mu, attitude=np.zeros(8), thrust_kind=kind, thrust_along_body_z=kind != 0,
+        thrust_params=params, thrust_state=state,
+        positions=np.array([p0, com[0], com[1]]), velocities=np.array([v_p0, ch.velocity_inertial, de.velocity_inertial], float),
+        body_to_inertial=rot, omega_body=omega, start_time=sim.start_time,
+        end_time=sim.end_time if end_time is None else end_time, step=sim.step if step is None else step,
+        output_interval=sim.output_interval)
+    model.step = sim.output_interval / np.ceil(sim.output_interval / model.step - 1e-9)
+    ac = case.attitude_control
+    model.attitude = np.r_[float(ac.enabled), ac.k_gain, ac.gain,
+                           sampled_boundary_layer(ac.boundary_layer, np.asarray(ac.gain, float), model.step)]
+    return model
