@@ -13,7 +13,7 @@ from typing import Annotated, Literal, Union
 from pydantic import Field, model_validator
 
 from riskassess.cases.impact import NonNegative, Positive, Strict
-from riskassess.cases.inputs import CaseName, Text
+from riskassess.cases.inputs import KIND_NOTE, CaseName, Text
 
 Vector2 = Annotated[list[float], Field(min_length=2, max_length=2)]
 
@@ -135,6 +135,7 @@ Objective = Annotated[Union[MinFuel, MinTime, Combined], Field(discriminator="ki
 
 
 class ApproachCase(Strict):
+    kind: Literal["approach"] = Field("approach", description=KIND_NOTE)
     name: CaseName = Field(description="Case name; default output folder runs/<name>.")
     description: Text = Field("", description="What the case is.")
     model: Model

@@ -18,7 +18,7 @@ dynamics is LVLH at t = 0. Time 0 is the epoch of the initial state; measured ti
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Literal, Optional, Union
+from typing import Annotated, Literal, Optional, Union, get_args
 
 import numpy as np
 from pydantic import Field, PrivateAttr, RootModel, ValidationError, ValidationInfo, field_validator, model_validator
@@ -249,15 +249,46 @@ class TowingDiagnosisCase(Strict):
 DiagnosisCase = Union[TumblingRigidCase, HingedAppendageCase, TowingDiagnosisCase]
 
 
+#: The scenario kinds, as a file names them in ``scenario`` (or, written before case kinds, in ``kind``).
+SCENARIOS = tuple(get_args(model.model_fields["kind"].annotation)[0] for model in get_args(DiagnosisCase))
+
+
 class DiagnosisCaseFile(RootModel):
     root: Annotated[DiagnosisCase, Field(discriminator="kind")]
+
+    @classmethod
+    def model_json_schema(cls, *args, **kwargs) -> dict:
+        """The schema of the file as written today: ``kind = "diagnosis"`` and the scenario in
+        ``scenario`` (the models discriminate on ``kind``, see :func:`scenario_form`)."""
+        schema = super().model_json_schema(*args, **kwargs)
+        for ref in schema["oneOf"]:
+            model = schema["$defs"][ref["$ref"].rsplit("/", 1)[1]]
+            scenario = model["properties"].pop("kind")
+            model["properties"] = {"kind": {"const": "diagnosis", "title": "Kind", "type": "string"},
+                                   "scenario": {**scenario, "title": "Scenario"}, **model["properties"]}
+            model["required"] = ["kind", "scenario"] + [k for k in model["required"] if k != "kind"]
+        schema["discriminator"]["propertyName"] = "scenario"
+        return schema
+
+
+def scenario_form(raw: dict) -> dict:
+    """The file's content with its scenario as the ``kind`` the scenario models discriminate on: a
+    file says ``kind = "diagnosis"`` and ``scenario = "towing"``; files written before case kinds
+    were explicit say ``kind = "towing"`` (the scenario) and are read as they are."""
+    if raw.get("kind") != "diagnosis":
+        return raw
+    raw = dict(raw)
+    del raw["kind"]
+    if "scenario" in raw:
+        raw["kind"] = raw.pop("scenario")
+    return raw
 
 
 def diagnosis_case_from_dict(raw: dict, case_dir=".", effect_catalog=None) -> DiagnosisCase:
     """Validate parsed case content; file references (``towing``) are relative to ``case_dir``;
     ``[[effects]]`` are checked against ``effect_catalog`` (id -> effect; required when there are any)."""
     context = {"case_dir": str(case_dir), "effect_catalog": effect_catalog}
-    return DiagnosisCaseFile.model_validate(raw, context=context).root
+    return DiagnosisCaseFile.model_validate(scenario_form(raw), context=context).root
 
 
 def load_diagnosis_case(path, effect_catalog=None) -> DiagnosisCase:

@@ -25,6 +25,15 @@ that cannot reach the target are rejected on load, each error naming the file an
 This page is generated from `riskassess/cases/impact.py` (`python -m riskassess.cases.doc`).
 """
 
+KINDS = """## Case kinds
+
+Every case file starts with its kind: `kind = "impact"` (run, assess, perceive, sweep), `"towing"` (tow,
+identify), `"approach"` or `"diagnosis"`; a diagnosis file adds its scenario: `scenario = "tumbling_rigid"`,
+`"hinged_appendage"` or `"towing"` (docs/diagnosis.md). Files written before the kind was explicit (no
+`kind`; a diagnosis file with its scenario in `kind`) are read as before: the kind is told from their tables.
+An unknown kind is refused with the list of kinds.
+"""
+
 REFUSED = f"""## What the checker refuses
 
 Every case kind (impact, towing, diagnosis, approach; `riskassess validate` takes any of them) is checked
@@ -176,7 +185,7 @@ def model_table(model: type[BaseModel]) -> str:
 
 
 def render() -> str:
-    parts = [HEADER, REFUSED]
+    parts = [HEADER, KINDS, REFUSED]
     for title, model in SECTIONS:
         parts.append(f"## {title}\n\n{model_table(model)}\n")
     return "\n".join(parts)

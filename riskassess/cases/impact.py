@@ -22,8 +22,8 @@ from typing import Annotated, Literal, Union, get_args
 import numpy as np
 from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
 
-from riskassess.cases.inputs import (JSON_FILE_LIMIT, MESH_FILE_LIMIT, CaseError, CaseName, ItemName, RelativeFile,
-                                    Strict, Text, decode_utf8, read_limited, read_toml, resolve_reference,
+from riskassess.cases.inputs import (JSON_FILE_LIMIT, KIND_NOTE, MESH_FILE_LIMIT, CaseError, CaseName, ItemName,
+                                    RelativeFile, Strict, Text, decode_utf8, read_limited, read_toml, resolve_reference,
                                     unique_names)
 from riskassess.cases.target_geometry import target_points_lvlh, target_vertices_lvlh
 from structures.sections import SECTIONS
@@ -452,6 +452,7 @@ class Structures(Strict):
 
 
 class Case(Strict):
+    kind: Literal["impact"] = Field("impact", description=KIND_NOTE)
     name: CaseName = Field(description="Case name; default output folder runs/<name>.")
     description: Text = ""
     simulation: Simulation

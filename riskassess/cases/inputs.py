@@ -50,6 +50,11 @@ ITEM_NAME_PATTERN = r"[A-Za-z][A-Za-z0-9._-]{0,63}"
 MAX_TEXT = 10_000
 
 
+#: Description of every schema's top-level ``kind``.
+KIND_NOTE = ("The case kind: impact, towing, approach or diagnosis (docs/case-format.md); files written before "
+             "it was explicit may leave it out.")
+
+
 class CaseError(ValueError):
     """A case file that cannot be used; the message names the file, the key and what is allowed."""
 

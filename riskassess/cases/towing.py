@@ -14,7 +14,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from riskassess.cases.impact import NonNegative, Positive, Strict, Vector3
-from riskassess.cases.inputs import CaseName, Text
+from riskassess.cases.inputs import KIND_NOTE, CaseName, Text
 
 Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
 PositiveVector3 = Annotated[list[Positive], Field(min_length=3, max_length=3)]
@@ -238,6 +238,7 @@ class FullNet(Strict):
 
 
 class TowingCase(Strict):
+    kind: Literal["towing"] = Field("towing", description=KIND_NOTE)
     name: CaseName = Field(description="Case name; default output folder runs/<name>.")
     description: Text = ""
     simulation: TowSimulation

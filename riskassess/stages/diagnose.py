@@ -34,7 +34,7 @@ from riskassess.diagnosis.selection import decide, gain_percent, score
 from riskassess.diagnosis.threads import single_threaded_blas
 from riskassess.products import results
 from riskassess.cases.impact import read_toml
-from riskassess.cases.diagnosis import toml_text
+from riskassess.cases.diagnosis import scenario_form, toml_text
 from riskassess.diagnosis.cases import load_diagnosis_case
 from riskassess.products.outfolder import OutputFolder, claim, default_out, safe_name
 from riskassess.products.report.diagnosis import write_figures
@@ -130,10 +130,11 @@ def extended_case(case_path: Path, problem: Problem, fit: FitResult) -> str:
     from scipy.spatial.transform import Rotation
 
     raw = read_toml(case_path)
+    scenario = scenario_form(raw).get("kind")
     nominal = _parameters(fit, nominal=True)
     initial = raw.setdefault("initial", {})
     value = {n: p["value"] for n, p in nominal.items()}
-    if raw.get("kind") == "towing":
+    if scenario == "towing":
         _towing_initial(raw, case_path, value)
     elif "attitude_x" in value:
         delta = Rotation.from_rotvec([value[f"attitude_{a}"] for a in "xyz"])
@@ -143,7 +144,7 @@ def extended_case(case_path: Path, problem: Problem, fit: FitResult) -> str:
         if f"{key}_x" in value:
             initial[field] = [value[f"{key}_{a}"] for a in "xyz"]
     header_note = ""
-    if raw.get("kind") == "towing":
+    if scenario == "towing":
         header_note = ("# The towing case is referenced relative to this file, as in the input case; the output\n"
                        "# folder holds a copy of it beside this file.\n")
     for key, field in (("hinge_angle", "initial_angle"), ("hinge_rate", "initial_rate"),
@@ -265,7 +266,7 @@ def _copy_towing_reference(out: Path, case_path: Path) -> list[str]:
     """Copy a towing diagnosis case's towing case into ``out`` at the same relative path, so that
     ``case.toml`` and the extended case there load; the copied names (none for other kinds)."""
     raw = read_toml(case_path)
-    if raw.get("kind") != "towing":
+    if scenario_form(raw).get("kind") != "towing":
         return []
     name = raw["towing"]        # validated on load: relative, in the case's folder or below
     (out / name).parent.mkdir(parents=True, exist_ok=True)

@@ -10,8 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from riskassess.cases.approach import ApproachCase
-from riskassess.cases.impact import Case, load_case, load_model, read_toml
-from riskassess.cases.diagnosis import DiagnosisCaseFile
+from riskassess.cases.impact import Case, CaseError, load_case, load_model, read_toml
+from riskassess.cases.diagnosis import SCENARIOS, DiagnosisCaseFile
 from riskassess.diagnosis.cases import load_diagnosis_case
 from riskassess.cases.towing import TowingCase
 
@@ -25,9 +25,29 @@ KINDS = {
 
 
 def case_kind(raw: dict) -> str:
-    """'impact', 'approach', 'towing' or 'diagnosis' for the parsed TOML of a case file."""
-    if "kind" in raw:                          # diagnosis scenarios: top-level kind
-        return "diagnosis"
+    """'impact', 'approach', 'towing' or 'diagnosis' for the parsed TOML of a case file: its
+    top-level ``kind``. Files written before the kind was explicit are told by their tables
+    (a diagnosis file then names its scenario in ``kind``)."""
+    kind = raw.get("kind")
+    if kind is not None and not isinstance(kind, str):
+        raise ValueError(f"kind: a text is expected (one of {', '.join(KINDS)}); got {type(kind).__name__}")
+    if kind in KINDS and not (kind == "towing" and _legacy_diagnosis(raw)):
+        return kind
+    if kind is not None:
+        if kind in SCENARIOS:
+            return "diagnosis"
+        raise ValueError(f"kind: '{kind}' is not a case kind; the kinds are: {', '.join(KINDS)} "
+                         f"(a diagnosis file: kind = \"diagnosis\" and scenario = one of {', '.join(SCENARIOS)})")
+    return _kind_from_tables(raw)
+
+
+def _legacy_diagnosis(raw: dict) -> bool:
+    """A diagnosis file of the towing scenario written before case kinds (``kind = "towing"``,
+    naming its towing case in ``towing``) rather than a towing case (its tethers are tables)."""
+    return isinstance(raw.get("towing"), str) and "main_tether" not in raw and "sub_tethers" not in raw
+
+
+def _kind_from_tables(raw: dict) -> str:
     if "model" in raw and "objective" in raw:  # maneuverable-unit approach
         return "approach"
     if "main_tether" in raw or "sub_tethers" in raw:
@@ -43,7 +63,12 @@ def _known(kind: str) -> None:
 def load_any_case(path: str | Path) -> tuple[str, object]:
     """(kind, validated case) of any case file; :class:`~riskassess.cases.impact.CaseError` naming the
     file and the keys when it is not valid for its kind."""
-    kind = case_kind(read_toml(path))
+    try:
+        kind = case_kind(read_toml(path))
+    except CaseError:
+        raise
+    except ValueError as exc:
+        raise CaseError(f"{path}: {exc}") from None
     return kind, KINDS[kind][1](path)
 
 

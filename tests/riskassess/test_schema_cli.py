@@ -20,12 +20,13 @@ def test_schema_of_every_kind(kind, capsys):
     assert main(["schema", "--kind", kind]) == 0
     schema = json.loads(capsys.readouterr().out)
     assert kind in schema["description"]
-    if kind == "diagnosis":   # one of the scenario kinds, told by the 'kind' key
-        assert schema["discriminator"]["propertyName"] == "kind"
+    if kind == "diagnosis":   # kind = "diagnosis", one of the scenarios told by the 'scenario' key
+        assert schema["discriminator"]["propertyName"] == "scenario"
         assert {"tumbling_rigid", "hinged_appendage"} <= set(schema["discriminator"]["mapping"])
         for ref in schema["discriminator"]["mapping"].values():
             variant = schema["$defs"][ref.rsplit("/", 1)[-1]]
-            assert {"kind", "name"} <= set(variant["required"])
+            assert {"kind", "scenario", "name"} <= set(variant["required"])
+            assert variant["properties"]["kind"]["const"] == "diagnosis"
     else:
         assert REQUIRED[kind] <= set(schema["required"])
         assert schema["additionalProperties"] is False   # unknown keys are refused
