@@ -27,10 +27,11 @@ from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING, ACC_CONTACT_F, ACC_CONTACTS,
                                          ACC_DEBRIS_F, ACC_DEBRIS_T, ACC_EXTERNAL, ACC_SIZE, ACC_TENSION, D_CLOSING,
                                          D_CONTACT_F, D_CONTACTS, D_ELONGATION, D_RATE, D_SIZE, D_TENSION, advance_net,
-                                         body_gravity, chaser_actuation, net_forces)
+                                         chaser_actuation, net_forces)
 from multibody.net_wrap import TowingNet
 from multibody.towing import HEALTH_EVERY_STEPS, TowedBodies, tow_failure_cause
 from multibody.net_towing_kernel import D_SLIDING, D_THRUST, D_TORQUE
+from multibody.orbit import add_body_gravity
 
 #: Layout of the run state ``clock``: net time (s), external impulse (3, N s) since the start.
 CLOCK_TIME, CLOCK_IMPULSE, CLOCK_SIZE = 0, 1, 4
@@ -141,8 +142,8 @@ def step_forces(q, v, t, advance, x, xv, lag, clock, masses, radii, threads, res
     chaser_actuation(t, z, rate, u, rot_c, bodies[0, 0:3], bodies[0, 6:9], bodies[0, 9:12], inertia[0], attitude,
                      thrust_kind, along_z, thrust_params, thrust_state, step, advance, chaser, diag)
     debris = force[6:12]
-    body_gravity(bodies[0, 0:3], body_masses[0], mu, chaser)
-    body_gravity(bodies[1, 0:3], body_masses[1], mu, debris)
+    add_body_gravity(chaser, 0, bodies[0, 0], bodies[0, 1], bodies[0, 2], body_masses[0], mu)
+    add_body_gravity(debris, 0, bodies[1, 0], bodies[1, 1], bodies[1, 2], body_masses[1], mu)
     if advance:
         clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3] += h_step * (chaser[0:3] - before) + h_step * (
             debris[0:3] - scale * acc[ACC_DEBRIS_F:ACC_DEBRIS_F + 3])

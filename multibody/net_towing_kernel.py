@@ -309,14 +309,3 @@ def chaser_actuation(t, elongation, rate, u_inertial, rot_c, com_c, vel_c, omega
         force[3:6] += torque
         diag[D_TORQUE:D_TORQUE + 3] = torque
         diag[D_SLIDING:D_SLIDING + 3] = s
-
-
-@njit(cache=True)
-def body_gravity(com, mass, mu, force):
-    """Eq. (1) on a body at ``com`` (absolute, m) into ``force[0:3]`` (N); ``mu`` = 0: none."""
-    if mu == 0.0:
-        return
-    gx, gy, gz = two_body_acceleration_xyz(com[0], com[1], com[2], mu)
-    force[0] += mass * gx
-    force[1] += mass * gy
-    force[2] += mass * gz

@@ -95,3 +95,16 @@ def lvlh_to_eci(r_eci, v_eci) -> np.ndarray:
     z = np.cross(r, v)
     z /= np.linalg.norm(z, axis=-1, keepdims=True)
     return np.stack([x, np.cross(z, x), z], axis=-1)
+
+
+@njit(cache=True, inline="always")
+def add_body_gravity(out_force, base, x, y, z, mass, mu):
+    """Two-body gravity (Boonrath et al. 2024, eq. 1) on a body of ``mass`` (kg) whose CoM is at
+    (x, y, z) (m, inertial) added to ``out_force[base:base + 3]`` (N, inertial); ``mu`` = 0 turns
+    gravity off (tests away from any orbit)."""
+    if mu == 0.0:
+        return
+    gx, gy, gz = two_body_acceleration_xyz(x, y, z, mu)
+    out_force[base] += mass * gx
+    out_force[base + 1] += mass * gy
+    out_force[base + 2] += mass * gz

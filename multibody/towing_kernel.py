@@ -30,7 +30,7 @@ from multibody.control.thrust import thrust_command
 from multibody.connection_point import STATE_SIZE, TIME, V_N, X_N, advance_point, initial_point_state
 from multibody.kernel import rotation_matrix_from_rotation_vector, verlet_evaluation_state
 from multibody.net import tension_only_kelvin_voigt
-from multibody.orbit import two_body_acceleration_xyz
+from multibody.orbit import add_body_gravity
 
 N_COORDINATES = 15
 P, CHASER, DEBRIS = 0, 3, 9
@@ -86,17 +86,6 @@ def _tether_to_body(x, v, rot, base, com, point_body, k, c, rest, out_force):
     return tension, length - rest, rate, dx, dy, dz
 
 
-@njit(cache=True, inline="always")
-def _add_gravity(out_force, x, y, z, mass, mu, base):
-    """Eq. (1) on the body at ``base``; ``mu`` = 0 turns gravity off (tests away from any orbit)."""
-    if mu == 0.0:
-        return
-    gx, gy, gz = two_body_acceleration_xyz(x, y, z, mu)
-    out_force[base] += mass * gx
-    out_force[base + 1] += mass * gy
-    out_force[base + 2] += mass * gz
-
-
 @njit(cache=True)
 def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, attach_debris, tether, mu,
                   attitude, thrust_kind, thrust_along_body_z, thrust_params, thrust_state, step, advance,
@@ -127,9 +116,9 @@ def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, att
     for i in range(attach_debris.shape[0]):
         out_diag[ST_TENSION + i] = _tether_to_body(x, v, rot_d, DEBRIS, com_d, attach_debris[i],
                                                    tether[K_ST], tether[C_ST], tether[L_ST], out_force)[0]
-    _add_gravity(out_force, x[0], x[1], x[2], masses[0], mu, 0)
-    _add_gravity(out_force, com_c[0], com_c[1], com_c[2], masses[1], mu, CHASER)
-    _add_gravity(out_force, com_d[0], com_d[1], com_d[2], masses[2], mu, DEBRIS)
+    add_body_gravity(out_force, 0, x[0], x[1], x[2], masses[0], mu)
+    add_body_gravity(out_force, CHASER, com_c[0], com_c[1], com_c[2], masses[1], mu)
+    add_body_gravity(out_force, DEBRIS, com_d[0], com_d[1], com_d[2], masses[2], mu)
 
     magnitude = thrust_command(thrust_kind, t, z, z_rate, thrust_params, thrust_state, step, advance)
     out_diag[THRUST] = magnitude

@@ -13,50 +13,7 @@ import numpy as np
 from numba import njit
 
 from multibody.linalg3 import cross3, dot3, matvec3
-
-
-@njit(cache=True)
-def quaternion_from_matrix(body_to_inertial):
-    """Scalar-first unit quaternion of a body->inertial rotation matrix (Shepperd's method).
-
-    Inverse of paper eq. (6); the sign is chosen with a non-negative scalar part.
-    """
-    out = np.empty(4)
-    out[0], out[1], out[2], out[3] = _quaternion_from_matrix(body_to_inertial)
-    return out
-
-
-@njit(cache=True, inline="always")
-def _quaternion_from_matrix(a):
-    """:func:`quaternion_from_matrix` as a tuple (no allocation: the attitude controller runs every step)."""
-    trace = a[0, 0] + a[1, 1] + a[2, 2]
-    if trace > max(a[0, 0], a[1, 1], a[2, 2]):
-        s = 2.0 * math.sqrt(1.0 + trace)
-        q = 0.25 * s, (a[2, 1] - a[1, 2]) / s, (a[0, 2] - a[2, 0]) / s, (a[1, 0] - a[0, 1]) / s
-    elif a[0, 0] >= a[1, 1] and a[0, 0] >= a[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + a[0, 0] - a[1, 1] - a[2, 2])
-        q = (a[2, 1] - a[1, 2]) / s, 0.25 * s, (a[0, 1] + a[1, 0]) / s, (a[0, 2] + a[2, 0]) / s
-    elif a[1, 1] >= a[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + a[1, 1] - a[0, 0] - a[2, 2])
-        q = (a[0, 2] - a[2, 0]) / s, (a[0, 1] + a[1, 0]) / s, 0.25 * s, (a[1, 2] + a[2, 1]) / s
-    else:
-        s = 2.0 * math.sqrt(1.0 + a[2, 2] - a[0, 0] - a[1, 1])
-        q = (a[1, 0] - a[0, 1]) / s, (a[0, 2] + a[2, 0]) / s, (a[1, 2] + a[2, 1]) / s, 0.25 * s
-    if q[0] < 0.0:
-        q = -q[0], -q[1], -q[2], -q[3]
-    norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-    return q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm
-
-
-@njit(cache=True)
-def quaternion_to_matrix(q):
-    """Body->inertial rotation matrix of a scalar-first quaternion, paper eq. (6)."""
-    q = q / math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-    q1, q2, q3, q4 = q[0], q[1], q[2], q[3]
-    return np.array([
-        [q1 * q1 + q2 * q2 - q3 * q3 - q4 * q4, 2.0 * (q2 * q3 - q1 * q4), 2.0 * (q2 * q4 + q1 * q3)],
-        [2.0 * (q2 * q3 + q1 * q4), q1 * q1 - q2 * q2 + q3 * q3 - q4 * q4, 2.0 * (q4 * q3 - q1 * q2)],
-        [2.0 * (q2 * q4 - q3 * q1), 2.0 * (q3 * q4 + q1 * q2), q1 * q1 - q2 * q2 - q3 * q3 + q4 * q4]])
+from multibody.rotations import quaternion_from_matrix_tuple
 
 
 @njit(cache=True)
@@ -171,8 +128,8 @@ def sliding_mode_torque(body_to_inertial, omega_body, desired_to_inertial, inert
     width : (3,) float
         Boundary-layer width per axis (rad/s), see :func:`sampled_boundary_layer`.
     """
-    q = _quaternion_from_matrix(body_to_inertial)
-    qd = _quaternion_from_matrix(desired_to_inertial)
+    q = quaternion_from_matrix_tuple(body_to_inertial)
+    qd = quaternion_from_matrix_tuple(desired_to_inertial)
     sign = 1.0 if qd[0] * q[0] + qd[1] * q[1] + qd[2] * q[2] + qd[3] * q[3] >= 0.0 else -1.0
     error = _kinematics_transpose_times(qd, q)
     feedforward = _kinematics_transpose_times(qd, _kinematics_times(q, omega_body))

@@ -36,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, types
 
+from multibody.rotations import quaternion_from_matrix, quaternion_to_matrix
 from riskassess.diagnosis.plant import Plant
 
 _VECTOR = types.float64[::1]
@@ -88,40 +89,6 @@ def initial_state(plant: Plant) -> np.ndarray:
 
 # ------------------------------------------------------------------------------ kinematics
 @njit(cache=True)
-def cross(a, b):
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-@njit(cache=True)
-def quaternion_matrix(q):
-    """Rotation matrix of a unit quaternion [w, x, y, z]."""
-    w, x, y, z = q[0], q[1], q[2], q[3]
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
-@njit(cache=True)
-def quaternion_from_matrix(m):
-    """Unit quaternion [w, x, y, z] (w >= 0) of a rotation matrix (Shepperd's method)."""
-    trace = m[0, 0] + m[1, 1] + m[2, 2]
-    q = np.empty(4)
-    if trace > max(m[0, 0], m[1, 1], m[2, 2]):
-        r = np.sqrt(1.0 + trace)
-        q[0], q[1], q[2], q[3] = 0.5 * r, (m[2, 1] - m[1, 2]) / (2 * r), (m[0, 2] - m[2, 0]) / (2 * r), \
-            (m[1, 0] - m[0, 1]) / (2 * r)
-    else:
-        i = 0 if m[0, 0] >= m[1, 1] and m[0, 0] >= m[2, 2] else (1 if m[1, 1] >= m[2, 2] else 2)
-        j, k = (i + 1) % 3, (i + 2) % 3
-        r = np.sqrt(1.0 + m[i, i] - m[j, j] - m[k, k])
-        q[1 + i] = 0.5 * r
-        q[1 + j] = (m[j, i] + m[i, j]) / (2 * r)
-        q[1 + k] = (m[k, i] + m[i, k]) / (2 * r)
-        q[0] = (m[k, j] - m[j, k]) / (2 * r)
-    return q if q[0] >= 0 else -q
-
-
-@njit(cache=True)
 def observe(states, times, env, origin_main):
     """Channels (k, 12) from states: omega_B (3), quaternion B->LVLH(t) (4), tracked point in LVLH
     (3), hinge angle and rate; see :mod:`riskassess.diagnosis.observation`."""
@@ -136,7 +103,7 @@ def observe(states, times, env, origin_main):
         offset = origin_main.copy()
         if env[E_HINGED] != 0.0:
             offset -= share * appendage_state(env, x[X_TH])[1]
-        p = x[X_R:X_R + 3] + quaternion_matrix(x[0:4]) @ offset
+        p = x[X_R:X_R + 3] + quaternion_to_matrix(x[0:4]) @ offset
         cn, sn = np.cos(n * times[k]), np.sin(n * times[k])
         out[k, 7], out[k, 8], out[k, 9] = cn * p[0] + sn * p[1], -sn * p[0] + cn * p[1], p[2]
         out[k, 0:3] = x[X_W:X_W + 3]
@@ -373,7 +340,7 @@ def angular_momentum_inertial(plant: Plant, states) -> np.ndarray:
     env = environment(plant)
     out = []
     for x in np.atleast_2d(states):
-        rot = quaternion_matrix(x[X_Q:X_Q + 4])
+        rot = quaternion_to_matrix(x[X_Q:X_Q + 4])
         w = x[X_W:X_W + 3]
         h = plant.inertia_main @ w
         if plant.hinged:

@@ -23,13 +23,13 @@ from numba import njit
 from scipy.spatial.transform import Rotation
 
 from riskassess.diagnosis.channels import OMEGA, QUATERNION, REL, TENSION
-from riskassess.diagnosis.dynamics import quaternion_from_matrix
 from riskassess.diagnosis.towing_dynamics import (EXTRA_STATES, diagnostics_size, initial_extra_states, integrate,
                                       no_towing_load)
 from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.towing import packed
 from multibody.towing_kernel import MT_TENSION
 from multibody.orbit import lvlh_to_eci
+from multibody.rotations import quaternion_from_matrix
 from riskassess.models.towing import towing_model
 
 #: Nominal parameters of the towing scenario: name -> (size, unit), the fitted vector's order.

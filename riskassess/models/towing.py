@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from multibody.control.attitude import quaternion_to_matrix, sampled_boundary_layer
+from multibody.control.attitude import sampled_boundary_layer
+from multibody.rotations import quaternion_to_matrix
 from multibody.control.mrac import mrac_initial_state, mrac_params
 from multibody.control.thrust import KINDS
 from multibody.towing import TowingModel

@@ -15,7 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from multibody.control.attitude import quaternion_to_matrix, sampled_boundary_layer
+from multibody.control.attitude import sampled_boundary_layer
+from multibody.rotations import quaternion_to_matrix
 from multibody.net_towing import FullNetModel
 from multibody.net_wrap import drape_and_close, towing_net
 from riskassess.models.towing import thrust_law

@@ -15,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_E, L_TM, X_E, X_W, cross
+from multibody.linalg3 import cross3
+from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_E, L_TM, X_E, X_W
 from riskassess.diagnosis.effects.base import Effect, Parameter
 from riskassess.diagnosis.scenario import plant_of
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, XE_DAMPER
@@ -34,7 +35,7 @@ def law(t, x, p, env, load):
     wd = x[X_E:X_E + 3]
     torque = damper_torque(w, wd, p[0], p[1])
     load[L_TM:L_TM + 3] += torque
-    load[L_E:L_E + 3] += -torque / p[0] - cross(w, wd) if p[0] > 0 else -cross(w, wd)
+    load[L_E:L_E + 3] += -torque / p[0] - cross3(w, wd) if p[0] > 0 else -cross3(w, wd)
 
 
 @njit(TOWING_LAW_SIGNATURE, cache=True)
@@ -46,7 +47,7 @@ def towing_law(t, q, v, p, work, xe, h, load):
     torque = damper_torque(w, wd, p[0], p[1])
     load[DEBRIS + 3:DEBRIS + 6] += torque
     if h > 0.0 and p[0] > 0.0:
-        xe[XE_DAMPER:XE_DAMPER + 3] += h * (-torque / p[0] - cross(w, wd))
+        xe[XE_DAMPER:XE_DAMPER + 3] += h * (-torque / p[0] - cross3(w, wd))
 
 
 class InternalEnergyDissipation(Effect):

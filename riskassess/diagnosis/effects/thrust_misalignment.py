@@ -21,7 +21,8 @@ import math
 import numpy as np
 from numba import njit
 
-from riskassess.diagnosis.dynamics import axis_rotation, cross
+from multibody.linalg3 import cross3
+from riskassess.diagnosis.dynamics import axis_rotation
 from riskassess.diagnosis.effects.base import Effect, Parameter
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, last_diagnostics
 from multibody.kernel import rotation_matrix_from_rotation_vector
@@ -33,7 +34,7 @@ def misaligned_thrust(thrust, direction_body, nozzle_body, tilt_x, tilt_y):
     """Thrust force (N) and torque about the CoM (N m), tug body frame, for tilts (rad) about x and y."""
     tilt = axis_rotation(np.array([0.0, 1.0, 0.0]), tilt_y) @ axis_rotation(np.array([1.0, 0.0, 0.0]), tilt_x)
     force = thrust * (tilt @ direction_body)
-    return force, cross(nozzle_body, force)
+    return force, cross3(nozzle_body, force)
 
 
 @njit(cache=True)

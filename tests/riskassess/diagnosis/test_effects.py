@@ -4,10 +4,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from riskassess.diagnosis.dynamics import X_E, X_W, angular_momentum_inertial, environment, initial_state, integrate, quaternion_matrix
+from riskassess.diagnosis.dynamics import X_E, X_W, angular_momentum_inertial, environment, initial_state, integrate
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.effects.gravity_gradient_torque import gravity_gradient
 from riskassess.diagnosis.model import max_step
+from multibody.rotations import quaternion_to_matrix
 from riskassess.diagnosis.plant import Plant
 from tests.riskassess.diagnosis.conftest import HINGED_CASE, TOWING_CASE, TUMBLING_CASE, case_with
 
@@ -54,7 +55,7 @@ def test_nutation_damper_keeps_total_momentum_and_dissipates_energy():
     case = case_with(TUMBLING_CASE, orbit={"kind": "none"})
     damper_inertia = 20.0
     plant, states = _run(case, "internal_energy_dissipation", [damper_inertia, 20.0])
-    rot = [quaternion_matrix(x[:4]) for x in states]
+    rot = [quaternion_to_matrix(x[:4]) for x in states]
     total = angular_momentum_inertial(plant, states) + damper_inertia * np.array(
         [r @ x[X_E:X_E + 3] for r, x in zip(rot, states)])
     energy = np.array([0.5 * x[X_W:X_W + 3] @ plant.inertia_main @ x[X_W:X_W + 3]
