@@ -13,6 +13,7 @@ from rich.text import Text
 from multibody.health import SimulationFailed
 from riskassess import __version__
 from riskassess.cases.impact import Case, CaseError, load_case
+from riskassess.cases.towing import SEARCHES
 from riskassess.stages.kinds import KINDS as CASE_KINDS
 from riskassess.products.outfolder import OutputRefused, default_out, step_done
 from riskassess.products.results import MissingData, RunFolder
@@ -529,7 +530,7 @@ def build_parser() -> argparse.ArgumentParser:
                           "print s, cost, optimizer, wall_s and every run as JSON", "runs/<case name>_identify")
     ident.add_argument("--benchmark", action="store_true", help="Sec. 4.3 benchmark: data from the model itself "
                        "with identification.benchmark_truth at the training rates")
-    ident.add_argument("--optimizers", nargs="+", choices=["pso", "pattern"], help="optimizers to run, in order "
+    ident.add_argument("--optimizers", nargs="+", choices=SEARCHES, help="optimizers to run, in order "
                        "(default identification.searches); 'pso' is followed by the pattern-search polish")
     ident.add_argument("--cost", choices=["f1", "f2"], help="cost function (default identification.cost): f1 weighted "
                        "RMSE of r_D/C and both angular velocities (eq. 18), f2 main-tether tension RMSE (eq. 20)")

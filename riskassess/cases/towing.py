@@ -8,7 +8,7 @@ Load with ``riskassess.cases.impact.load_model(path, TowingCase)``.
 """
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Literal, get_args
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -131,6 +131,12 @@ class Rates(Strict):
     validation_deg_s: Annotated[list[NonNegative], Field(min_length=1)] = Field(description="Table 3, validation (deg/s).")
 
 
+#: The optimizers a case or ``riskassess identify --optimizers`` may name (plug-ins of
+#: :mod:`riskassess.stages.optimizers`; the tests check each is there).
+Search = Literal["pso", "pattern"]
+SEARCHES = get_args(Search)
+
+
 class Optimizers(Strict):
     swarm_size: Annotated[int, Field(ge=2)] = Field(40, description="PSO particles (-), Sec. 4.3.")
     pso_generations: Annotated[int, Field(ge=1)] = Field(100, description="Largest number of PSO generations (-).")
@@ -158,7 +164,7 @@ class Identification(Strict):
     initial_guess: DecisionVector = Field(description="Pattern-search start s_0, Sec. 4.3.")
     benchmark_truth: DecisionVector = Field(description="s of the benchmark's data, Sec. 4.3.")
     optimizers: Optimizers = Optimizers()
-    searches: Annotated[list[Literal["pso", "pattern"]], Field(min_length=1)] = Field(
+    searches: Annotated[list[Search], Field(min_length=1)] = Field(
         ["pso", "pattern"], description="Optimizers 'riskassess identify' runs, in order: 'pso' (pymoo PSO; then the "
                                         "pattern-search polish, reported as 'pso+pattern', if optimizers.polish_evaluations "
                                         "> 0) and 'pattern' (pattern search from initial_guess); --optimizers overrides it.")

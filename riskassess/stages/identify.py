@@ -25,16 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from pymoo.algorithms.soo.nonconvex.pattern import PatternSearch, calc_sign, exploration_move, pattern_move
-from pymoo.algorithms.soo.nonconvex.pso import PSO
-from pymoo.core.population import Population
 from pymoo.core.problem import Problem
-from pymoo.core.replacement import is_better
-from pymoo.core.termination import Termination
-from pymoo.optimize import minimize
-from pymoo.termination.collection import TerminationCollection
-from pymoo.termination.default import DefaultSingleObjectiveTermination
-from pymoo.termination.max_eval import MaximumFunctionCallTermination
 
 from multibody.towing import run_twin
 from multibody.towing_kernel import MT_TENSION
@@ -44,6 +35,7 @@ from riskassess.models.towing import towing_model
 from riskassess.cases.towing import TowingCase
 from riskassess.cases.impact import load_model
 from riskassess.products.towing_plots import plot_convergence
+from riskassess.stages.optimizers import optimizer_search
 
 #: The quantities the costs compare, from :meth:`multibody.towing.TowResult.series`.
 COMPARED = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
@@ -140,83 +132,13 @@ class Identified:
     history: list
 
 
-class SeededPatternSearch(PatternSearch):
-    """pymoo's Hooke-Jeeves (:class:`pymoo.algorithms.soo.nonconvex.pattern.PatternSearch`), unchanged
-    except that the random order of each exploration move is drawn from the algorithm's seeded generator:
-    pymoo 0.6.2 calls ``exploration_move`` without it, so every exploration drew a fresh unseeded order and
-    two runs from the same start could end at different points."""
-
-    def _next(self):
-        if not is_better(self._explr, self._center):
-            self.n_not_improved += 1
-            self._rho = self.init_rho**self.n_not_improved
-            self._explr = yield from exploration_move(self.problem, self._center, self._sign, self._delta, self._rho,
-                                                      random_state=self.random_state)
-        else:
-            self._direction = self._explr.X - self._center.X
-            self._center = self._explr
-            self._trial = yield pattern_move(self.problem, self._center, self._direction, self.step_size)
-            self._sign = calc_sign(self._direction)
-            self._explr = yield from exploration_move(self.problem, self._trial, self._sign, self._delta, self._rho,
-                                                      random_state=self.random_state)
-        self.pop = Population.create(self._center, self._explr)
-
-
-class StepTolerance(Termination):
-    """Ends a Hooke-Jeeves leg once its exploration step (:math:`\\rho\\,\\delta`) is below ``tolerance``
-    times every variable's bound range: smaller moves do not change s at the precision asked for."""
-
-    def __init__(self, tolerance):
-        super().__init__()
-        self.tolerance = tolerance
-
-    def _update(self, algorithm):
-        if getattr(algorithm, "_delta", None) is None:
-            return 0.0
-        lower, upper = algorithm.problem.bounds()
-        return float(np.all(algorithm._rho * algorithm._delta < self.tolerance * (upper - lower)))
-
-
-def _pattern_search(problem, x0, settings, first_delta, budget):
-    """Hooke-Jeeves (:class:`SeededPatternSearch`) from ``x0`` in legs of at most
-    ``settings.restart_evaluations`` evaluations, each restarted from the best point so far.
-
-    Hooke-Jeeves shrinks one step factor for all variables, so in this problem (the cost ~260x flatter
-    along s4 than along s1, docs/towing.md) the step along s4 is down to 1e-3 of its range while s1-s3 are
-    still being tuned, and s4 then crawls. Each restart therefore gives every variable its own first step
-    (a fraction of its bound range): a variable that travelled at least a tenth of its first step in the
-    last leg keeps that step (or the distance travelled, if larger, up to ``first_delta``); a settled one
-    gets the distance it travelled, at least a tenth of its step (at most tenfold smaller per leg).
-    A leg without improvement shrinks all steps tenfold. A leg ends when its step is below
-    ``settings.pattern_tolerance`` of every bound range (:class:`StepTolerance`) or after
-    ``settings.restart_evaluations``; the search stops after ``budget`` evaluations or when every first step
-    is below the tolerance. Returns (best s, best cost)."""
-    span = problem.xu - problem.xl
-    x, f, delta = np.asarray(x0, float), np.inf, np.full(problem.n_var, float(first_delta))
-    leg = 0
-    while len(problem.evaluations) < budget and delta.max() >= settings.pattern_tolerance:
-        n = min(settings.restart_evaluations, budget - len(problem.evaluations))
-        result = minimize(problem, SeededPatternSearch(x0=x, init_delta=delta), TerminationCollection(
-            StepTolerance(settings.pattern_tolerance), MaximumFunctionCallTermination(n)), seed=settings.seed + leg,
-            verbose=False)
-        leg += 1
-        cost, found = float(np.atleast_1d(result.F)[0]), np.asarray(result.X, float).ravel()
-        if cost < f:
-            moved = np.abs(found - x) / span
-            travelling = moved >= 0.1 * delta
-            delta = np.where(travelling, np.minimum(np.maximum(moved, delta), first_delta), np.maximum(moved, 0.1 * delta))
-            x, f = found, cost
-        else:
-            delta = 0.1 * delta
-    return x, f
-
-
 def identify(case: TowingCase, data: list[dict], optimizer: str, end_time=None, workers=None,
              initial_guess=None) -> Identified:
     """Minimize the case's cost (``identification.cost``) against ``data`` (one dict per run: the
-    compared series and ``rate_deg_s``) with ``optimizer``: 'pso' (pymoo PSO), 'pattern' (pattern
-    search with restarts from ``initial_guess`` or the case's s0, :func:`_pattern_search`) or 'polish'
-    (the same, with ``optimizers.polish_delta`` as first step and ``polish_evaluations`` as budget)."""
+    compared series and ``rate_deg_s``) with ``optimizer``, a name of
+    :data:`riskassess.stages.optimizers.OPTIMIZERS` ('pso', 'pattern', 'polish'; one file each), from
+    ``initial_guess`` (default the case's s0). ``ValueError`` listing the known names for another."""
+    search = optimizer_search(optimizer)        # an unknown name fails here, before any run
     ident = case.identification
     settings = ident.optimizers
     x0 = ident.initial_guess if initial_guess is None else initial_guess
@@ -224,15 +146,7 @@ def identify(case: TowingCase, data: list[dict], optimizer: str, end_time=None, 
     with multiprocessing.get_context("fork").Pool(
             workers or ident.workers, _init_worker, (case, data, ident.cost, ident.weights, end_time)) as pool:
         problem = TowingFit(pool, len(data), ident.lower_bounds, ident.upper_bounds)
-        if optimizer == "pso":
-            result = minimize(problem, PSO(pop_size=settings.swarm_size), DefaultSingleObjectiveTermination(
-                ftol=settings.pso_tolerance, period=settings.stall_generations, n_max_gen=settings.pso_generations),
-                seed=settings.seed, verbose=False)
-            s, cost = np.asarray(result.X, float).ravel(), float(np.atleast_1d(result.F)[0])
-        elif optimizer == "pattern":
-            s, cost = _pattern_search(problem, x0, settings, 0.25, settings.pattern_evaluations)
-        else:
-            s, cost = _pattern_search(problem, x0, settings, settings.polish_delta, settings.polish_evaluations)
+        s, cost = search(problem, x0, settings)
     return Identified(s, cost, optimizer, len(problem.evaluations), time.perf_counter() - start, problem.best)
 
 

@@ -5,7 +5,8 @@ import pytest
 from pymoo.core.problem import Problem
 
 from riskassess.cases.impact import load_model
-from riskassess.stages.identify import _pattern_search, cost_f1, cost_f2, identify, training_data
+from riskassess.stages.identify import cost_f1, cost_f2, identify, training_data
+from riskassess.stages.optimizers.pattern import restarted_pattern_search
 from riskassess.cases.towing import Optimizers, TowingCase
 
 CASE = "cases/zenit2_towing.toml"
@@ -53,7 +54,7 @@ class ValleyCone(Problem):
 def test_pattern_search_finds_the_apex_of_a_flat_valley_reproducibly():
     apex = [2.0, 7.0, 2.0, 0.73]
     settings = Optimizers(restart_evaluations=100, pattern_tolerance=1e-6, seed=3)
-    found = [_pattern_search(ValleyCone(apex), [1.0, 6.0, 3.0, 0.25], settings, 0.25, 3000) for _ in range(2)]
+    found = [restarted_pattern_search(ValleyCone(apex), [1.0, 6.0, 3.0, 0.25], settings, 0.25, 3000) for _ in range(2)]
     # The apex is exact (no simulation): the search is limited only by its step tolerance, 1e-6 of each
     # bound range, so 1e-5 relative on every component is a loose bound that still fails for a search
     # that stalls in the valley or leaves s4 where it started (0.25).
@@ -126,3 +127,14 @@ def test_a_diverged_twin_run_scores_inf(monkeypatch):
     monkeypatch.setattr(identify, "simulate", lambda *args: nan_run)
     identify._init_worker(None, [{"rate_deg_s": 1.0, "main_tether_tension": np.ones(5)}], "f2", None, None)
     assert identify._run_term((np.ones(4), 0)) == np.inf
+
+
+def test_optimizers_are_plug_ins_found_by_name_and_an_unknown_one_is_refused():
+    """Issue 21: one file per optimizer; the case schema's and the CLI's names are the registry's."""
+    from riskassess.cases.towing import SEARCHES
+    from riskassess.stages.optimizers import OPTIMIZERS, optimizer_search
+
+    assert set(OPTIMIZERS) == {"pso", "pattern", "polish"}
+    assert set(SEARCHES) <= set(OPTIMIZERS)
+    with pytest.raises(ValueError, match="unknown optimizer 'mads'; the optimizers are: pattern, polish, pso"):
+        optimizer_search("mads")
