@@ -35,12 +35,11 @@ from scipy.spatial.transform import Rotation
 
 from multibody.free_motion import free_motion
 from multibody.impact import ImpactSimulation
-from perception.euler_poinsot import TorqueFreeFit, normalized_inertia_linear, principal_frame
+from perception.free_flight import FreeMotion, fit_free_motion, normalized_energy_and_momentum
 from perception.lidar import LidarSpec, cast, sensor_to_platform
-from perception.momentum import (mass_from_linear_momentum, point_masses_momentum, rigid_body_momentum,
-                                 smallest_moment_from_angular_momentum)
-from perception.motion import (NotObservable, attitude_sqrt_information, center_of_mass_line, isotropic_attitude_weights,
-                               rates_from_attitudes)
+from perception.momentum import point_masses_momentum, rigid_body_momentum
+from perception.momentum_balance import momentum_step
+from perception.motion import NotObservable
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
 from perception.registration import DebrisTracker, known_shape_model
 from perception.shape import half_turn_symmetry_transforms, rotation_error
@@ -57,8 +56,6 @@ DEBRIS_GATE = 0.3
 NET_GATE = 0.1
 #: The debris flies free once no tracked net thread comes closer to its surface than this (m).
 SEPARATION = 0.1
-#: Fewest registered free-flight frames after the collision for the momentum step.
-MIN_FRAMES_AFTER = 10
 
 
 def _pose(rotation, translation) -> np.ndarray:
@@ -211,63 +208,9 @@ def _register(tracker, frames, t, phase, points, sensor_world, true_rot, true_co
 
 
 # ------------------------------------------------------------------------------ estimation
-@dataclass
-class FreeMotion:
-    """Fits of one free-flight stretch: CoM line, torque-free motion, spin momentum per C."""
-
-    times: np.ndarray
-    line: object
-    fit: TorqueFreeFit
-    spin_per_c: np.ndarray
-    spin_per_c_cov: np.ndarray
-
-
 def _good(tracker, select) -> np.ndarray:
     ok = np.array([a.ok for a in tracker.alignments])
     return np.flatnonzero(ok & select)
-
-
-#: A frame whose weighted attitude residual |W e|^2, over the median frame's, exceeds this is
-#: dropped and the fit redone. It removes poses that passed the check but are wrong (during and
-#: right after the collision) and frames still touched by the net. The errors are far from
-#: isotropic (mostly about a near-symmetry axis), so the bound is that of one dominant axis:
-#: chi^2 with 1 dof, 0.1 % tail over median = 10.83 / 0.455.
-OUTLIER_OVER_MEDIAN = 23.8
-
-
-def fit_free_motion(tracker, indices, times, com_body=None, moments=None, principal_to_body=None) -> FreeMotion:
-    """CoM line and torque-free fit through the registered frames ``indices``; inertia shape
-    estimated (before the collision) or known (after). Frames the fitted motion does not explain
-    (weighted residual above :data:`OUTLIER_OVER_MEDIAN` times the median) are dropped and the fit redone."""
-    indices = np.asarray(indices)
-    for _ in range(5):
-        motion, chi2 = _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_to_body)
-        keep = chi2 <= OUTLIER_OVER_MEDIAN * np.median(chi2)
-        if keep.all():
-            break
-        indices = indices[keep]
-    return motion
-
-
-def _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_to_body):
-    if len(indices) < MIN_FRAMES_AFTER:
-        raise NotObservable(f"only {len(indices)} registered frames of free flight; at least {MIN_FRAMES_AFTER} "
-                            "are needed")
-    poses = np.array([tracker.alignments[i].body_to_world for i in indices])
-    t = np.asarray(times)[indices]
-    line = center_of_mass_line(t, poses[:, :3, :3], poses[:, :3, 3], com_body)
-    attitudes = Rotation.from_matrix(poses[:, :3, :3])
-    omega, omega_dot = rates_from_attitudes(t, attitudes)
-    weights = isotropic_attitude_weights(attitude_sqrt_information([tracker.alignments[i].information for i in indices]))
-    if moments is None:
-        moments0, axes0 = principal_frame(normalized_inertia_linear(omega, omega_dot))
-        fit = TorqueFreeFit().fit(t, attitudes, weights, omega[0], moments0, axes0)
-    else:
-        fit = TorqueFreeFit(moments, principal_to_body).fit(t, attitudes, weights, omega[0])
-    error = (attitudes.inv() * fit.predict_body_to_world(t)).as_rotvec()
-    chi2 = np.sum(np.einsum("kij,kj->ki", weights, error) ** 2, axis=1)
-    h, h_cov = fit.spin_momentum_per_c()
-    return FreeMotion(t, line, fit, h, h_cov), chi2
 
 
 # ------------------------------------------------------------------------------ phase 2
@@ -384,24 +327,6 @@ def _touching_through_failures(separation) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------ momentum step
-def _skew(v) -> np.ndarray:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-
-
-def _line_covariances(line) -> tuple[np.ndarray, np.ndarray]:
-    """Covariances (3, 3) of the fitted CoM position at time0 and of the CoM velocity."""
-    c = line.covariance
-    return (c[3:6, 3:6], c[6:9, 6:9]) if c.shape[0] == 9 else (c[:3, :3], c[3:6, 3:6])
-
-
-def _orbital_per_mass(line, origin) -> tuple[np.ndarray, np.ndarray]:
-    """(p - O) x v of a CoM line (constant along it) and its covariance, first order."""
-    p = line.position0_world - origin
-    v = line.velocity_world
-    cov_p, cov_v = _line_covariances(line)
-    return np.cross(p, v), _skew(v) @ cov_p @ _skew(v).T + _skew(p) @ cov_v @ _skew(p).T
-
-
 def others_momentum_after(assembly, recorder, track, frame_times, origin):
     """Chaser (navigation) + net (tracked nodes) linear and angular momentum about ``origin`` at
     each free-flight frame: (k, 3), (k, 3)."""
@@ -432,39 +357,9 @@ def others_momentum_before(assembly, origin):
     return p_c + p_n, l_c + l_n
 
 
-def _mean_and_covariance_of_mean(samples) -> tuple[np.ndarray, np.ndarray]:
-    samples = np.asarray(samples)
-    return samples.mean(axis=0), np.cov(samples.T) / len(samples)
-
-
-def momentum_step(before: FreeMotion, after: FreeMotion, others_before, others_after, origin) -> dict:
-    """Mass and C from the two balances (see :mod:`perception.momentum`), every angular momentum
-    about ``origin`` (3,) (m, world)."""
-    p_before, l_before = others_before
-    p_after, cov_p_after = _mean_and_covariance_of_mean(others_after[0])
-    l_after, cov_l_after = _mean_and_covariance_of_mean(others_after[1])
-    cov_v = _line_covariances(before.line)[1] + _line_covariances(after.line)[1]
-    mass = mass_from_linear_momentum(after.line.velocity_world - before.line.velocity_world,
-                                     p_after - p_before, cov_v, cov_p_after)
-    orbital0, cov0 = _orbital_per_mass(before.line, origin)
-    orbital1, cov1 = _orbital_per_mass(after.line, origin)
-    c = smallest_moment_from_angular_momentum(
-        after.spin_per_c - before.spin_per_c, orbital1 - orbital0, mass.value, l_after - l_before,
-        before.spin_per_c_cov + after.spin_per_c_cov, cov0 + cov1, mass.sigma, cov_l_after)
-    return {"mass": mass, "c": c}
-
-
 # ------------------------------------------------------------------------------ the stage
 def _percent(estimate, truth):
     return (np.asarray(estimate, float) / np.asarray(truth, float) - 1.0) * 100.0
-
-
-def normalized_energy_and_momentum(motion: FreeMotion) -> dict:
-    """D = 2E/C, F = L^2/C^2 and the angular momentum direction (world) of a torque-free fit
-    (Tang et al. 2023, eqs. 20-22)."""
-    moments, omega = motion.fit.moments_, motion.fit.omega0_principal_
-    h = motion.spin_per_c
-    return {"D": float(moments @ omega**2), "F": float(h @ h), "direction_world": h / np.linalg.norm(h)}
 
 
 def estimates(scene: Scene, before: FreeMotion, after: FreeMotion | None, step: dict | None,
