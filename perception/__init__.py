@@ -1,2 +1,3 @@
-"""Perception (issue 6, not built yet): synthetic LiDAR, Open3D registration, mass and inertia
-estimation from the debris motion and the net collision. Nothing here yet."""
+"""Perception: synthetic LiDAR scans, Open3D registration of the debris and tracking of the net,
+and the debris' centre of mass, inertia ratios, mass and principal moments estimated from its free
+motion and the momentum balance of the net collision (Tang et al. 2023)."""

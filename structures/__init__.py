@@ -1,2 +1,3 @@
-"""Structures (issue 3, not built yet): stresses at weak joints from the recorded joint loads,
-failure verdicts and released secondary debris. Nothing here yet."""
+"""Structures: weak locations and their sections, stresses from the recorded joint loads, allowables
+and failure criteria, the verdict with its evidence rules (debris / no_debris / indeterminate), the
+pieces a failed joint releases, and the net threads' tension check."""
