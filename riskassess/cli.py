@@ -326,6 +326,9 @@ def print_verdict(verdict: dict, console=None) -> None:
         console.print(f"released {escape('+'.join(p['bodies']))}: {escape(piece_fate(p))}")
     if verdict["released_pieces"]:
         console.print("likelihoods of released locations are lower bounds: their loads after release are not known")
+    for loc in verdict["locations"]:
+        if loc.get("condition"):            # folders written before the condition sentence lack it
+            console.print(escape(loc["condition"]), overflow="fold")
     line = escape(debris_line(verdict))
     colour = {"debris": "red", "indeterminate": "yellow"}.get(verdict.get("debris_state"))
     console.print(f"[{colour}]{line}[/{colour}]" if colour else line)

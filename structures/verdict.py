@@ -73,9 +73,10 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
     released_at = {e.location: e for e in events}
     gaps = evidence_gaps(time, series["contact_force_lvlh"][:, list(assembly.debris_indices)], skip_until)
     rows = []
+    judged_at = policy if policy != "never" else "low"     # without release, range allowables judge low
     for loc in locations:
         result = assess(loc, time, series["joint_force_joint"][:, loc.joint], series["joint_moment_joint"][:, loc.joint],
-                        skip_until, policy if policy != "never" else "low")
+                        skip_until, judged_at)
         result["joint"] = assembly.joints[loc.joint].name
         event = released_at.get(loc.name)
         result["released_at_s"] = event.time if event else None
@@ -83,6 +84,7 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
         # covers the loads up to the release: a lower bound of what the intact joint would see.
         result["likelihood_is_lower_bound"] = event is not None
         result["state"], result["indeterminate_reason"] = location_state(result, gaps)
+        result["condition"] = condition_sentence(result, judged_at)
         rows.append(result)
     pieces = released_pieces(events, assembly, series, net_positions_final)
     states = [r["state"] for r in rows]
@@ -95,6 +97,55 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
     return {"skip_initial_s": skip_until, "release_policy": policy, "locations": rows, "released_pieces": pieces,
             "debris_state": answer, "secondary_debris": {DEBRIS: True, NO_DEBRIS: False}.get(answer),
             "indeterminate_reasons": sorted({r["indeterminate_reason"] for r in rows if r["indeterminate_reason"]})}
+
+
+def _quantity(value: float, unit: str) -> str:
+    """A demand or allowable as people read it: stresses in MPa, loads in their SI unit."""
+    if unit == "Pa":
+        return f"{value / 1e6:.4g} MPa"
+    return f"{value:.4g} {unit}"
+
+
+def _decisive_criterion(result: dict):
+    """(name, criterion) that decides the location: the judged one with the largest likelihood of
+    failure, ties broken by the smallest margin; None when nothing was judged."""
+    judged = [(n, c) for n, c in result["criteria"].items() if c["peak"] is not None]
+    if not judged:
+        return None
+    return max(judged, key=lambda nc: (nc[1]["likelihood"], -nc[1]["margin_of_safety"]))
+
+
+def condition_sentence(result: dict, policy: str) -> str:
+    """One sentence that states a location's deterministic result and the condition it rests on, so
+    that "fails" and a small likelihood cannot be read as a contradiction: the run judges a range
+    allowable at the release policy's value, the likelihood is P(allowable < peak) over the range.
+
+    Example: "solar_array_hinge breaks if its hinge moment allowable is below 223 N m (the peak,
+    at 0.41 s): P >= 3 % for an allowable uniform over 200-1000 N m; this run judges at the low
+    end (200 N m): fails." ``>=`` marks a released location (its loads after release are unknown).
+    """
+    name = result["name"]
+    if result["state"] == "indeterminate":
+        return f"{name}: indeterminate ({result['indeterminate_reason']}); no condition can be stated."
+    decisive = _decisive_criterion(result)
+    if decisive is None:
+        return f"{name}: nothing judged; no condition can be stated."
+    criterion, c = decisive
+    unit, low, high = c["unit"], *c["allowable"]
+    peak = _quantity(c["peak"], unit)
+    when = f"the peak, at {c['peak_time_s']:.3g} s" + (", up to its release" if result["released_at_s"] is not None
+                                                       else "")
+    verb = "fails" if result["state"] == "fails" else "holds"
+    if high > low:
+        bound = ">=" if result["released_at_s"] is not None else "="
+        span = _quantity(high, unit).split(" ", 1)
+        scale = 1e6 if unit == "Pa" else 1.0
+        return (f"{name} breaks if its {criterion.replace('_', ' ')} allowable is below {peak} ({when}): "
+                f"P {bound} {c['likelihood']:.0%} for an allowable uniform over {low / scale:.4g}-{span[0]} {span[1]}; "
+                f"this run judges at the {policy} end "
+                f"({_quantity(c['decisive_allowable'], unit)}): {verb}.")
+    return (f"{name} {verb}: its {criterion.replace('_', ' ')} reached {peak} ({when}) against an allowable of "
+            f"{_quantity(low, unit)} (margin {c['margin_of_safety']:+.2f}).")
 
 
 def demand_series(locations: list[WeakLocation], series: dict) -> dict:

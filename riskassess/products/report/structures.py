@@ -51,6 +51,9 @@ def verdict_section(run: RunFolder) -> Section:
                         f"range allowables decide at their '{verdict['release_policy']}' value. Margin of safety = "
                         f"allowable / demand - 1.",
                         alarm_rows={k for k, r in enumerate(rows) if r["state"] != "holds"}, css_class="verdict"))
+    conditions = [loc["condition"] for loc in verdict["locations"] if loc.get("condition")]
+    if conditions:
+        blocks.append(Note("What each verdict rests on: " + " ".join(conditions)))
     blocks.append(Note("Likelihood: probability of failure with the allowable uniformly distributed over its "
                        "range. For a released location it is a lower bound ('>='), because the joint carries "
                        "nothing after its release."))

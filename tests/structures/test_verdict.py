@@ -1,0 +1,41 @@
+"""The condition sentence of a location's verdict (structures/verdict.py): the deterministic result
+and the condition it rests on, in one sentence (issue 23: "FAIL" beside "likelihood >= 3 %")."""
+from structures.verdict import condition_sentence
+
+
+def _result(peak, allowable, state, released_at=None, unit="N m", policy_value=None):
+    low, high = allowable
+    likelihood = min(max((peak - low) / (high - low), 0.0), 1.0) if high > low else float(peak >= low)
+    return {"name": "solar_array_hinge", "state": state, "released_at_s": released_at, "indeterminate_reason": None,
+            "criteria": {"hinge_moment": {"peak": peak, "peak_time_s": 0.41, "unit": unit, "allowable": [low, high],
+                                          "likelihood": likelihood, "margin_of_safety": (policy_value or low) / peak - 1,
+                                          "decisive_allowable": policy_value or low}}}
+
+
+def test_a_released_range_location_states_its_threshold_probability_and_policy():
+    # the issue's case: released at 223 N m against 200-1000 N m judged at the low end;
+    # P(allowable < 223) = (223 - 200) / 800 = 2.9 % -> "3 %", a lower bound since the joint let go
+    text = condition_sentence(_result(223.0, (200.0, 1000.0), "fails", released_at=0.41), "low")
+    assert text == ("solar_array_hinge breaks if its hinge moment allowable is below 223 N m (the peak, at 0.41 s, "
+                    "up to its release): P >= 3% for an allowable uniform over 200-1000 N m; this run judges at "
+                    "the low end (200 N m): fails.")
+
+
+def test_a_holding_single_value_location_states_its_margin():
+    text = condition_sentence(_result(30e6, (50e6, 50e6), "holds", unit="Pa"), "low")
+    # margin = 50 / 30 - 1 = +0.67
+    assert text == ("solar_array_hinge holds: its hinge moment reached 30 MPa (the peak, at 0.41 s) against an "
+                    "allowable of 50 MPa (margin +0.67).")
+
+
+def test_an_indeterminate_location_states_no_condition():
+    result = _result(10.0, (200.0, 1000.0), "indeterminate")
+    result["indeterminate_reason"] = "no net contact on the debris after skip_initial"
+    assert "indeterminate (no net contact" in condition_sentence(result, "low")
+
+
+def test_a_range_stress_location_reads_in_mpa_with_an_equal_sign():
+    # P(allowable < 165 MPa) for 950-3500 MPa is 0: the peak is below the range
+    text = condition_sentence(_result(164.8e6, (950e6, 3500e6), "holds", unit="Pa"), "low")
+    assert "below 164.8 MPa" in text and "P = 0% for an allowable uniform over 950-3500 MPa" in text
+    assert text.endswith("this run judges at the low end (950 MPa): holds.")
