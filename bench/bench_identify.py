@@ -4,7 +4,7 @@ the whole 275 s tow; identified by pymoo's PSO (then polished by the pattern sea
 pattern search from the paper's s0 = [1, 6, 3, 0.25]. Simulations run on ``identification.workers``
 processes.
 
-    python bench/bench_identify.py [--optimizers pso pattern] [--swarm N] [--generations N]
+    python bench/bench_identify.py [--optimizers pso pattern mads] [--swarm N] [--generations N]
                                    [--polish N] [--pattern N] [--restart N] [--tolerance X]
                                    [--truth S1 S2 S3 S4]
 
@@ -30,10 +30,11 @@ from riskassess.cases.towing import Optimizers, TowingCase
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--case", default="cases/zenit2_towing.toml")
-    parser.add_argument("--optimizers", nargs="+", default=["pso", "pattern"], choices=["pso", "pattern"])
+    parser.add_argument("--optimizers", nargs="+", default=["pso", "pattern"], choices=["pso", "pattern", "mads"])
     for flag, key, kind in (("--swarm", "swarm_size", int), ("--generations", "pso_generations", int),
                             ("--polish", "polish_evaluations", int), ("--pattern", "pattern_evaluations", int),
-                            ("--restart", "restart_evaluations", int), ("--tolerance", "pattern_tolerance", float)):
+                            ("--restart", "restart_evaluations", int), ("--tolerance", "pattern_tolerance", float),
+                            ("--mads", "mads_evaluations", int)):
         parser.add_argument(flag, dest=key, type=kind, default=None)
     parser.add_argument("--truth", type=float, nargs=4, default=None,
                         help="s of the data instead of the case's benchmark_truth (a robustness check off the paper's s)")

@@ -133,7 +133,7 @@ class Rates(Strict):
 
 #: The optimizers a case or ``riskassess identify --optimizers`` may name (plug-ins of
 #: :mod:`riskassess.stages.optimizers`; the tests check each is there).
-Search = Literal["pso", "pattern"]
+Search = Literal["pso", "pattern", "mads"]
 SEARCHES = get_args(Search)
 
 
@@ -151,7 +151,13 @@ class Optimizers(Strict):
         1000, description="Evaluations of one pattern-search leg before it restarts from its best point (-).")
     polish_delta: Annotated[float, Field(gt=0, le=0.5)] = Field(
         0.02, description="Pattern-search step of the polish and of every restart, in units of each bound range (-).")
-    seed: Annotated[int, Field(ge=0)] = Field(0, description="Seed of the PSO (-).")
+    seed: Annotated[int, Field(ge=0)] = Field(0, description="Seed of the PSO and of MADS (-).")
+    mads_iterations: Annotated[int, Field(ge=1)] = Field(
+        250, description="Largest number of MADS iterations (NOMAD MAX_ITERATIONS), Sec. 4.3: 250 (-).")
+    mads_mesh_tolerance: Positive = Field(
+        1e-6, description="MADS stops when its mesh size falls below this (NOMAD MIN_MESH_SIZE), Sec. 4.3: 1e-6 (-).")
+    mads_evaluations: Annotated[int, Field(ge=1)] = Field(
+        2000, description="Largest number of MADS evaluations (NOMAD MAX_BB_EVAL) (-).")
 
 
 class Identification(Strict):
