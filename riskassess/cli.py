@@ -164,7 +164,42 @@ def _cmd_assess(args) -> int:
     if case.structures is None:
         raise CaseError(f"{args.case}: structures: missing; 'assess' needs [[structures.weak_locations]] "
                         f"(see docs/case-format.md)")
+    if args.monte_carlo:
+        return _assess_monte_carlo(args, case)
+    if args.uncertain:
+        raise ValueError("--uncertain needs --monte-carlo N (the number of samples)")
     return _cmd_run(args)
+
+
+def _assess_monte_carlo(args, case) -> int:
+    """``assess --monte-carlo N``: N runs of the case with the ``--uncertain`` inputs drawn, on the sweep
+    runner and its store (resumable: a re-run finds the finished runs), and P(secondary debris)."""
+    from riskassess.products.envelope import debris_probability, probability_statement
+    from riskassess.sweep.store import ResultStore
+
+    if not args.uncertain:
+        raise ValueError("--monte-carlo needs at least one --uncertain KEY=DIST(...): without one every run "
+                         "would be the same")
+    if args.out or args.report or args.vtk:
+        raise ValueError("--monte-carlo writes a results store (--store), not a run folder: --out, --report and "
+                         "--vtk do not apply (use 'riskassess sweep' options --keep-runs for run folders)")
+    store = args.store or str(Path("sweeps") / f"{case.name}-monte-carlo" / "results.sqlite")
+    sweep_args = argparse.Namespace(
+        case=args.case, vary=[], uncertain=args.uncertain, monte_carlo=args.monte_carlo, seed=args.seed,
+        scheduler=None, workers=args.workers, store=store, retry_failed=False, keep_runs=None,
+        confidence=args.confidence, reliability=0.9, no_pdf=True, json=args.json, force=args.force)
+    store_path, outcome, env = _sweep(sweep_args)
+    with ResultStore.open_readonly(store_path) as results:
+        p = debris_probability(results.rows(), args.confidence)
+    statement = probability_statement(p, args.uncertain)
+    if args.json:
+        print(json.dumps({"store": str(store_path), "runs": outcome.total, "wall_s": outcome.wall_s,
+                          "p_secondary_debris": p, "condition": statement}, indent=2))
+    else:
+        print(f"monte carlo: {outcome.total} runs ({outcome.skipped} already in the store, {outcome.done} done now, "
+              f"{outcome.failed} failed) in {outcome.wall_s:.1f} s; store {store_path}")
+        print(statement)
+    return _sweep_exit(env)
 
 
 def _cmd_perceive(args) -> int:
@@ -399,13 +434,39 @@ def _cmd_approach(args) -> int:
 
 
 def _cmd_sweep(args) -> int:
+    from riskassess.products.envelope import envelope_statement
+    from riskassess.sweep.products import products_dir
+
+    store_path, outcome, env = _sweep(args)
+    if args.json:
+        print(json.dumps({"store": str(store_path), "total": outcome.total, "skipped": outcome.skipped,
+                          "done": outcome.done, "failed": outcome.failed, "indeterminate": outcome.indeterminate,
+                          "wall_s": outcome.wall_s, "envelope": env, "statement": envelope_statement(env)}, indent=2))
+    else:
+        print(f"sweep: {outcome.total} runs ({outcome.skipped} already in the store, {outcome.done} done now "
+              f"({outcome.indeterminate} of them indeterminate), {outcome.failed} failed) in {outcome.wall_s:.1f} s; "
+              f"store {store_path}")
+        print(envelope_statement(env))
+        print(f"report: {products_dir(store_path) / 'report.html'}")
+    return _sweep_exit(env)
+
+
+def _sweep_exit(env: dict) -> int:
+    """Failed, indeterminate or pending runs: the envelope holds runs it cannot count as safe."""
+    from riskassess.sweep.runner import UNKNOWN_RUNS_EXIT
+
+    return UNKNOWN_RUNS_EXIT if env["failed_runs"] + env["indeterminate_runs"] + env["pending_runs"] else 0
+
+
+def _sweep(args):
+    """Run the sweep of ``args`` (every option checked before any work) into its store and write its
+    products; returns (store path, outcome, envelope)."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
     from riskassess.sweep.cluster_log import CLUSTER_LOG
-    from riskassess.products.envelope import envelope_statement
     from riskassess.sweep.products import (PRODUCTS, check_products, check_products_at, products_dir,
                                            write_sweep_products)
-    from riskassess.sweep.runner import UNKNOWN_RUNS_EXIT, run_sweep, validate_runs
+    from riskassess.sweep.runner import run_sweep, validate_runs
     from riskassess.sweep.spec import check_options, check_sweep, parse_uncertain, parse_vary, run_specs
     from riskassess.sweep.store import ResultStore, default_store_path
 
@@ -444,18 +505,7 @@ def _cmd_sweep(args) -> int:
         env = write_sweep_products(store, args.confidence, args.reliability, pdf=not args.no_pdf)
     finally:
         store.close()   # releases the writer lock
-    if args.json:
-        print(json.dumps({"store": str(store.path), "total": outcome.total, "skipped": outcome.skipped,
-                          "done": outcome.done, "failed": outcome.failed, "indeterminate": outcome.indeterminate,
-                          "wall_s": outcome.wall_s, "envelope": env, "statement": envelope_statement(env)}, indent=2))
-    else:
-        print(f"sweep: {outcome.total} runs ({outcome.skipped} already in the store, {outcome.done} done now "
-              f"({outcome.indeterminate} of them indeterminate), {outcome.failed} failed) in {outcome.wall_s:.1f} s; "
-              f"store {store.path}")
-        print(envelope_statement(env))
-        print(f"report: {products_dir(store.path) / 'report.html'}")
-    # failed, indeterminate or pending runs: the envelope holds runs it cannot count as safe
-    return UNKNOWN_RUNS_EXIT if env["failed_runs"] + env["indeterminate_runs"] + env["pending_runs"] else 0
+    return store.path, outcome, env
 
 
 def _now() -> str:
@@ -504,10 +554,20 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     _simulation_command(sub, "run", _cmd_run, "simulate a case and write a run folder", "case file (TOML)",
                         "print the run summary as JSON")
-    _simulation_command(sub, "assess", _cmd_assess,
-                        "simulate a case with weak locations and print the structural verdict",
-                        "case file (TOML) with [[structures.weak_locations]]",
-                        "print the run summary (with the verdict) as JSON")
+    assess = _simulation_command(sub, "assess", _cmd_assess,
+                                 "simulate a case with weak locations and print the structural verdict",
+                                 "case file (TOML) with [[structures.weak_locations]]",
+                                 "print the run summary (with the verdict) as JSON")
+    assess.add_argument("--monte-carlo", type=int, default=0, metavar="N",
+                        help="P(secondary debris) from N runs with the --uncertain inputs drawn (on the sweep runner)")
+    assess.add_argument("--uncertain", action="append", default=[], metavar="KEY=DIST(...)",
+                        help="an uncertain input, as for 'sweep' (e.g. contact.mu_kinetic=uniform(0.1,0.3))")
+    assess.add_argument("--seed", type=int, default=0, help="random seed of the Monte Carlo draws (default 0)")
+    assess.add_argument("--workers", type=int, default=2, help="Monte Carlo worker processes (default 2)")
+    assess.add_argument("--store", help="Monte Carlo results store (default sweeps/<case name>-monte-carlo/"
+                                        "results.sqlite); a re-run resumes it")
+    assess.add_argument("--confidence", type=float, default=0.95,
+                        help="confidence of the interval of P(secondary debris) (default 0.95)")
     _simulation_command(sub, "perceive", _cmd_perceive,
                         "track the tumbling debris by LiDAR, simulate the net collision, estimate mass and inertia",
                         "case file (TOML) with [perception] and [chaser]",
@@ -613,13 +673,14 @@ def _case_command(sub, name, func, help_text, case_help, json_help, out_default=
     return parser
 
 
-def _simulation_command(sub, name, func, help_text, case_help, json_help) -> None:
-    """A command that simulates a case into a run folder (run, assess, perceive)."""
+def _simulation_command(sub, name, func, help_text, case_help, json_help):
+    """A command that simulates a case into a run folder (run, assess, perceive); returns its parser."""
     parser = _case_command(sub, name, func, help_text, case_help, json_help)
     parser.add_argument("--report", action="store_true", help="also write report.html and report.pdf")
     parser.add_argument("--vtk", action="store_true", help="also export VTK files (RUN_DIR/vtk/impact.pvd)")
     parser.add_argument("--force", action="store_true", help="run even when the estimated work is above the limit "
                                                              "(1 h wall or 8 GB recorded; docs/outputs.md)")
+    return parser
 
 
 def main(argv=None) -> int:

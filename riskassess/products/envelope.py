@@ -46,6 +46,49 @@ def no_debris_lower_bound(n: int, k: int, confidence: float) -> float:
     return float(beta.ppf(1.0 - confidence, n - k, k + 1))
 
 
+def clopper_pearson(k: int, n: int, confidence: float) -> tuple[float, float]:
+    """Two-sided Clopper-Pearson interval of a binomial probability from k events in n trials
+    (exact: it covers the true probability with at least ``confidence`` for every n)."""
+    alpha = 1.0 - confidence
+    low = 0.0 if k == 0 else float(beta.ppf(alpha / 2.0, k, n - k + 1))
+    high = 1.0 if k == n else float(beta.ppf(1.0 - alpha / 2.0, k + 1, n - k))
+    return low, high
+
+
+def debris_probability(rows: list[dict], confidence: float = 0.95) -> dict:
+    """P(secondary debris) of a Monte Carlo from its runs' records, with its interval.
+
+    The estimate is k / (k + m) over the runs with a verdict (k with debris, m without). Runs that
+    say nothing (failed, indeterminate, pending: u of them) are never counted as safe: the
+    interval is Clopper-Pearson's, its lower end with every unknown run taken as debris-free and its
+    upper end with every unknown run taken as debris, so it holds whatever the unknown runs would
+    have shown. None where no run has a verdict."""
+    status = [run_status(r) for r in rows]
+    k, m = status.count("debris"), status.count("no_debris")
+    unknown = sum(status.count(s) for s in UNKNOWN)
+    n = k + m + unknown
+    if n == 0:
+        return {"estimate": None, "interval": None, "confidence": confidence, "runs": 0, "debris_runs": 0,
+                "no_debris_runs": 0, "unknown_runs": 0}
+    low = clopper_pearson(k, n, confidence)[0]
+    high = clopper_pearson(k + unknown, n, confidence)[1]
+    return {"estimate": k / (k + m) if k + m else None, "interval": [low, high], "confidence": confidence,
+            "runs": n, "debris_runs": k, "no_debris_runs": m, "unknown_runs": unknown}
+
+
+def probability_statement(p: dict, inputs: list[str]) -> str:
+    """One sentence: P(secondary debris), its interval, over what."""
+    if p["estimate"] is None and p["interval"] is None:
+        return "No Monte Carlo run has finished: no probability of secondary debris."
+    low, high = p["interval"]
+    estimate = "unknown (no run has a verdict)" if p["estimate"] is None else f"{p['estimate']:.0%}"
+    text = (f"P(secondary debris) = {estimate}, {p['confidence']:.0%} interval {low:.0%}-{high:.0%}, from "
+            f"{p['runs']} runs ({p['debris_runs']} with debris, {p['no_debris_runs']} without")
+    if p["unknown_runs"]:
+        text += f", {p['unknown_runs']} unknown: the interval holds whatever they would show"
+    return text + ")" + (f" over {'; '.join(inputs)}." if inputs else ".")
+
+
 def runs_needed(confidence: float, reliability: float) -> int:
     """Debris-free runs per value needed to state P(no debris) >= reliability at that confidence."""
     return math.ceil(math.log(1.0 - confidence) / math.log(reliability))

@@ -191,3 +191,37 @@ def test_diverged_failure_survives_the_trip_from_a_worker_process(short_case, mo
     travelled = pickle.loads(pickle.dumps(caught.value))
     assert failure_kind(travelled) == "diverged"
     assert failure_message(travelled) == "SimulationFailed: simulation failed at t = 0.5 s: energy balance drift 0.3 > 0.05; step too large"
+
+
+def test_assess_monte_carlo_probability_has_the_known_answer(tmp_path, capsys):
+    """Issue 23 item 2 against a known answer. With release off the dynamics do not depend on the
+    hinge allowable, so the solar-array location fails exactly when its sampled allowable is at most
+    the deterministic peak D of one run: P(debris) = P(allowable <= D) = 1/2 for an allowable
+    uniform over [D/2, 3D/2], and every run's verdict is known from its sample."""
+    from tests.riskassess.conftest import shortened_case
+
+    case = tmp_path / "small_never.toml"
+    text = shortened_case(0.6)
+    assert 'release = "low"' in text
+    case.write_text(text.replace('release = "low"', 'release = "never"', 1))
+    assert main(["assess", str(case), "--out", str(tmp_path / "one"), "--json"]) in (0, 1)
+    capsys.readouterr()
+    verdict = json.loads((tmp_path / "one" / "structures.json").read_text())
+    hinge = next(loc for loc in verdict["locations"] if loc["name"] == "solar_array_hinge_panel")
+    peak = hinge["criteria"]["moment"]["peak"]
+    others_hold = all(loc["state"] == "holds" for loc in verdict["locations"] if loc is not hinge)
+    assert others_hold and peak > 0
+    key = "structures.weak_locations[solar_array_hinge_panel].allowable_moment"
+    store = tmp_path / "mc.sqlite"
+    code = main(["assess", str(case), "--monte-carlo", "8", "--uncertain", f"{key}=uniform({peak / 2},{1.5 * peak})",
+                 "--store", str(store), "--seed", "1", "--json"])
+    answer = json.loads(capsys.readouterr().out)
+    assert code == 0
+    with ResultStore.open_readonly(store) as results:
+        expected = sum(r["overrides"][key] <= peak for r in results.rows())
+    p = answer["p_secondary_debris"]
+    assert (p["runs"], p["debris_runs"], p["unknown_runs"]) == (8, expected, 0)
+    assert p["estimate"] == expected / 8
+    low, high = p["interval"]
+    assert low <= 0.5 <= high                  # the true P; Clopper-Pearson covers it with >= 95 %
+    assert "P(secondary debris) = " in answer["condition"] and key in answer["condition"]

@@ -216,3 +216,30 @@ def test_sampled_validation_still_finds_a_bad_value():
     specs = run_specs([parse_vary("launch.velocity=-1:20:30"), parse_vary("contact.mu_kinetic=0.1:0.2:10")])
     with pytest.raises(SweepSpecError, match=r"of \d+ validated sweep runs give an invalid case \(\d+ of 300 runs"):
         validate_runs(str(CASES / "envisat_small.toml"), text, specs)
+
+
+def test_clopper_pearson_matches_its_closed_forms():
+    """Clopper-Pearson ends: for k = 0 the upper end is 1 - (alpha/2)^(1/n), for k = n the lower end
+    is (alpha/2)^(1/n) (the binomial tail equations solved by hand)."""
+    from riskassess.products.envelope import clopper_pearson
+
+    low, high = clopper_pearson(0, 20, 0.95)
+    assert low == 0.0 and abs(high - (1.0 - 0.025 ** (1 / 20))) < 1e-12
+    low, high = clopper_pearson(20, 20, 0.95)
+    assert high == 1.0 and abs(low - 0.025 ** (1 / 20)) < 1e-12
+    # k = 3 of 20: the textbook interval 3.2 %-37.9 % (e.g. R's binom.test(3, 20))
+    low, high = clopper_pearson(3, 20, 0.95)
+    assert abs(low - 0.0321) < 5e-4 and abs(high - 0.3789) < 5e-4
+
+
+def test_debris_probability_never_counts_unknown_runs_as_safe():
+    from riskassess.products.envelope import clopper_pearson, debris_probability
+
+    rows = ([{"state": "done", "result": {"debris_state": "debris"}}] * 3
+            + [{"state": "done", "result": {"debris_state": "no_debris"}}] * 15
+            + [{"state": "failed", "result": None}] * 2)
+    p = debris_probability(rows, 0.95)
+    assert (p["runs"], p["debris_runs"], p["no_debris_runs"], p["unknown_runs"]) == (20, 3, 15, 2)
+    assert p["estimate"] == 3 / 18
+    # lower end: the 2 unknown runs debris-free (3 of 20); upper end: both with debris (5 of 20)
+    assert p["interval"] == [clopper_pearson(3, 20, 0.95)[0], clopper_pearson(5, 20, 0.95)[1]]
