@@ -95,6 +95,10 @@ class Mrac(Strict):
     gamma_theta: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = Field(description="MRAC-2 diagonal of Gamma_theta (-).")
     xi_2: NonNegative = Field(description="MRAC-2 e-modification gain xi_2 (-).")
     q: Annotated[list[Positive], Field(min_length=2, max_length=2)] = Field(description="MRAC-2 diagonal of Q in eq. (21a) (-).")
+    settle_at_desired: bool = Field(
+        False, description="Command the reference model (eq. 13) with z_d (k_MT + K_P) / K_P so that it settles at "
+                          "desired_elongation; false: the paper's command z_d, with which it settles at "
+                          "K_P z_d / (k_MT + K_P) (eq. 13 has no integral action).")
 
 
 class AttitudeControl(Strict):

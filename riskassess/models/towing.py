@@ -50,10 +50,18 @@ def thrust_law(case: TowingCase, tether, z0, z_rate0):
     if kind == 0:
         return kind, np.array([th.t_on, th.t_slope, th.max_force]), np.zeros(1)
     m = case.mrac
-    params = mrac_params(kind, th.t_on, th.max_force, case.chaser.mass, tether[0], tether[1], m.desired_elongation,
+    params = mrac_params(kind, th.t_on, th.max_force, case.chaser.mass, tether[0], tether[1], reference_command(case),
                          m.k_p, m.k_d, lambda0=m.lambda0, k_s=m.k_s, gamma=m.gamma, xi_h=m.xi_h, xi_a=m.xi_a,
                          gamma_z=m.gamma_z, gamma_r=m.gamma_r, gamma_theta=m.gamma_theta, xi_2=m.xi_2, q=np.diag(m.q))
     return kind, params, mrac_initial_state(kind, params, z0, z_rate0)
+
+
+def reference_command(case: TowingCase) -> float:
+    """The elongation command z_d of the MRAC reference model (eq. 13) (m): ``mrac.desired_elongation``
+    itself, or, with ``mrac.settle_at_desired``, z_d (k_MT + K_P) / K_P, the command whose static
+    balance :math:`k_{MT} z_m = K_P (z_d - z_m)` puts the reference at the desired elongation."""
+    m, k_mt = case.mrac, case.main_tether.stiffness
+    return m.desired_elongation * (k_mt + m.k_p) / m.k_p if m.settle_at_desired else m.desired_elongation
 
 
 def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None, step: float | None = None,

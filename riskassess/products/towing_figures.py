@@ -6,6 +6,7 @@ import numpy as np
 
 from multibody.control.mrac import reference_steady_elongation
 from riskassess.cases.towing import TowingCase
+from riskassess.models.towing import reference_command
 
 #: Main-tether tension (N) from which the tether counts as engaged: before it the sub-tethers are still
 #: slack and only the connection point hangs on the main tether.
@@ -17,7 +18,7 @@ def reference_elongation(case: TowingCase) -> float | None:
     (:func:`multibody.control.mrac.reference_steady_elongation`); None without an [mrac] section."""
     if case.mrac is None:
         return None
-    return reference_steady_elongation(case.main_tether.stiffness, case.mrac.k_p, case.mrac.desired_elongation)
+    return reference_steady_elongation(case.main_tether.stiffness, case.mrac.k_p, reference_command(case))
 
 
 def tautness(series: dict, target_elongation: float | None) -> dict:

@@ -117,3 +117,20 @@ def test_vtk_export_of_a_full_net_tow_folder(full_net_tow_folder):
     # slack threads carry no elastic tension, stretched ones k (l - l_0) > 0
     strain, tension = net.cell_data["strain"][0], net.cell_data["elastic_tension_N"][0]
     assert np.all(tension[strain <= 0] == 0.0) and np.all(tension[strain > 0] > 0.0)
+
+
+def test_the_reference_model_settles_at_the_desired_elongation_when_asked():
+    """Eq. (13) has no integral action: commanded with z_d its static balance k_MT z_m = K_P (z_d - z_m)
+    gives z_m = K_P z_d / (k_MT + K_P); mrac.settle_at_desired commands z_d (k_MT + K_P) / K_P instead,
+    so z_m = z_d exactly (the balance solved by hand)."""
+    from riskassess.cases.impact import load_model
+    from riskassess.cases.towing import TowingCase
+    from riskassess.models.towing import reference_command
+    from riskassess.products.towing_figures import reference_elongation
+
+    case = load_model("cases/zenit2_towing.toml", TowingCase)
+    k, kp, zd = case.main_tether.stiffness, case.mrac.k_p, case.mrac.desired_elongation
+    assert reference_command(case) == zd and abs(reference_elongation(case) - kp * zd / (k + kp)) < 1e-15
+    settled = case.model_copy(update=dict(mrac=case.mrac.model_copy(update=dict(settle_at_desired=True))))
+    assert abs(reference_command(settled) - zd * (k + kp) / kp) < 1e-15
+    assert abs(reference_elongation(settled) - zd) < 1e-15
