@@ -88,8 +88,20 @@ def two_body_specific_energy(r_inertial, v_inertial, mu):
 
 
 def lvlh_to_eci(r_eci, v_eci) -> np.ndarray:
-    """(k, 3, 3) or (3, 3) rotation LVLH -> ECI (columns radial, along-track, orbit normal) from the
-    chaser's position (m) and velocity (m/s), ECI."""
+    """Rotation LVLH -> ECI of a spacecraft's orbit frame.
+
+    Parameters
+    ----------
+    r_eci : (3,) or (k, 3) float array
+        Position (m, ECI).
+    v_eci : (3,) or (k, 3) float array
+        Velocity (m/s, ECI).
+
+    Returns
+    -------
+    (3, 3) or (k, 3, 3) float array
+        Matrices whose columns are the LVLH axes in ECI: radial, along-track, orbit normal.
+    """
     r, v = np.asarray(r_eci, float), np.asarray(v_eci, float)
     x = r / np.linalg.norm(r, axis=-1, keepdims=True)
     z = np.cross(r, v)
@@ -99,9 +111,21 @@ def lvlh_to_eci(r_eci, v_eci) -> np.ndarray:
 
 @njit(cache=True, inline="always")
 def add_body_gravity(out_force, base, x, y, z, mass, mu):
-    """Two-body gravity (Boonrath et al. 2024, eq. 1) on a body of ``mass`` (kg) whose CoM is at
-    (x, y, z) (m, inertial) added to ``out_force[base:base + 3]`` (N, inertial); ``mu`` = 0 turns
-    gravity off (tests away from any orbit)."""
+    """Two-body gravity (Boonrath et al. 2024, eq. 1) on a body, added to a force vector.
+
+    Parameters
+    ----------
+    out_force : (n,) float array
+        Generalized forces (N, inertial); the body's three force components start at ``base``.
+    base : int
+        Index of the body's x force component in ``out_force``.
+    x, y, z : float
+        The body's CoM (m, inertial, from the Earth's centre).
+    mass : float
+        The body's mass (kg).
+    mu : float
+        Gravitational parameter (m^3/s^2); 0 turns gravity off (tests away from any orbit).
+    """
     if mu == 0.0:
         return
     gx, gy, gz = two_body_acceleration_xyz(x, y, z, mu)

@@ -18,6 +18,16 @@ def quaternion_from_matrix(body_to_inertial):
     """Scalar-first unit quaternion of a body->inertial rotation matrix (Shepperd's method).
 
     Inverse of paper eq. (6); the sign is chosen with a non-negative scalar part.
+
+    Parameters
+    ----------
+    body_to_inertial : (3, 3) float array
+        Rotation matrix whose columns are the body axes in inertial (or LVLH) components.
+
+    Returns
+    -------
+    (4,) float array
+        Unit quaternion [q0, q1, q2, q3], scalar first, q0 >= 0.
     """
     out = np.empty(4)
     out[0], out[1], out[2], out[3] = quaternion_from_matrix_tuple(body_to_inertial)
@@ -48,7 +58,19 @@ def quaternion_from_matrix_tuple(a):
 
 @njit(cache=True)
 def quaternion_to_matrix(q):
-    """Body->inertial rotation matrix of a scalar-first quaternion, paper eq. (6)."""
+    """Body->inertial rotation matrix of a scalar-first quaternion, paper eq. (6).
+
+    Parameters
+    ----------
+    q : (4,) float array
+        Quaternion [q0, q1, q2, q3], scalar first; normalised here (an integrator's drift off the
+        unit sphere does not skew the matrix).
+
+    Returns
+    -------
+    (3, 3) float array
+        Orthonormal matrix mapping body components to inertial (or LVLH) components.
+    """
     q = q / math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
     q1, q2, q3, q4 = q[0], q[1], q[2], q[3]
     return np.array([

@@ -39,7 +39,26 @@ OUTLIER_OVER_MEDIAN = 23.8
 def fit_free_motion(tracker, indices, times, com_body=None, moments=None, principal_to_body=None) -> FreeMotion:
     """CoM line and torque-free fit through the registered frames ``indices``; inertia shape
     estimated (before the collision) or known (after). Frames the fitted motion does not explain
-    (weighted residual above :data:`OUTLIER_OVER_MEDIAN` times the median) are dropped and the fit redone."""
+    (weighted residual above :data:`OUTLIER_OVER_MEDIAN` times the median) are dropped and the fit redone.
+
+    Parameters
+    ----------
+    tracker : perception.registration.DebrisTracker
+        The tracker whose ``alignments`` hold each frame's body -> world pose and information matrix.
+    indices : sequence of int
+        Frames of the free-flight stretch.
+    times : (n,) float array
+        Time of every frame (s).
+    com_body : (3,) float array, optional
+        The CoM in the body (model) frame (m) when known; fitted otherwise.
+    moments, principal_to_body : (3,) and (3, 3) float arrays, optional
+        Normalized principal moments (-) and principal -> body rotation when known (after the
+        collision); estimated from the rates otherwise.
+
+    Returns
+    -------
+    FreeMotion
+    """
     indices = np.asarray(indices)
     for _ in range(5):
         motion, chi2 = _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_to_body)

@@ -34,8 +34,26 @@ def _mean_and_covariance_of_mean(samples) -> tuple[np.ndarray, np.ndarray]:
 
 
 def momentum_step(before: FreeMotion, after: FreeMotion, others_before, others_after, origin) -> dict:
-    """Mass and C from the two balances (see :mod:`perception.momentum`), every angular momentum
-    about ``origin`` (3,) (m, world)."""
+    """Mass and smallest principal moment C from the two momentum balances of the collision
+    (see :mod:`perception.momentum`).
+
+    Parameters
+    ----------
+    before, after : FreeMotion
+        Free-flight fits of the debris before and after the collision (world frame).
+    others_before : tuple of two (3,) float arrays
+        Linear (kg m/s) and angular (kg m^2/s, about ``origin``) momentum of the chaser and net before,
+        world components.
+    others_after : tuple of two (k, 3) float arrays
+        The same at each of the k free-flight frames after the collision.
+    origin : (3,) float array
+        Point the angular momenta are taken about (m, world).
+
+    Returns
+    -------
+    dict
+        ``mass`` and ``c``: estimates with their standard deviations (:mod:`perception.momentum`).
+    """
     p_before, l_before = others_before
     p_after, cov_p_after = _mean_and_covariance_of_mean(others_after[0])
     l_after, cov_l_after = _mean_and_covariance_of_mean(others_after[1])

@@ -123,6 +123,19 @@ def condition_sentence(result: dict, policy: str) -> str:
     Example: "solar_array_hinge breaks if its hinge moment allowable is below 223 N m (the peak,
     at 0.41 s): P >= 3 % for an allowable uniform over 200-1000 N m; this run judges at the low
     end (200 N m): fails." ``>=`` marks a released location (its loads after release are unknown).
+
+    Parameters
+    ----------
+    result : dict
+        One location's verdict (:func:`structures.weak_location.assess` with ``state``,
+        ``indeterminate_reason`` and ``released_at_s`` added): criteria with peak (SI), time (s),
+        allowable range, likelihood and margin.
+    policy : str
+        The release policy's end of a range allowable that decided the run: "low", "nominal", "high".
+
+    Returns
+    -------
+    str
     """
     name = result["name"]
     if result["state"] == "indeterminate":

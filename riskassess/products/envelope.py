@@ -48,7 +48,20 @@ def no_debris_lower_bound(n: int, k: int, confidence: float) -> float:
 
 def clopper_pearson(k: int, n: int, confidence: float) -> tuple[float, float]:
     """Two-sided Clopper-Pearson interval of a binomial probability from k events in n trials
-    (exact: it covers the true probability with at least ``confidence`` for every n)."""
+    (exact: it covers the true probability with at least ``confidence`` for every n).
+
+    Parameters
+    ----------
+    k, n : int
+        Events and trials, 0 <= k <= n, n >= 1.
+    confidence : float
+        Two-sided confidence, in (0, 1).
+
+    Returns
+    -------
+    (float, float)
+        Lower and upper end of the interval.
+    """
     alpha = 1.0 - confidence
     low = 0.0 if k == 0 else float(beta.ppf(alpha / 2.0, k, n - k + 1))
     high = 1.0 if k == n else float(beta.ppf(1.0 - alpha / 2.0, k + 1, n - k))
