@@ -19,7 +19,8 @@ import time
 from pathlib import Path
 
 from riskassess.sweep.runner import run_sweep
-from riskassess.sweep.spec import parse_uncertain, run_specs
+from riskassess.cases.uncertain import parse_uncertain
+from riskassess.sweep.spec import run_specs
 from riskassess.sweep.store import ResultStore
 
 ROOT = Path(__file__).resolve().parents[1]

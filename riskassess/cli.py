@@ -171,27 +171,37 @@ def _cmd_assess(args) -> int:
     return _cmd_run(args)
 
 
+def _uncertain_inputs(case, given: list[str]) -> list[str]:
+    """The case's ``[monte_carlo] uncertain`` inputs, with ``--uncertain`` ones added or replacing the same key."""
+    from riskassess.cases.uncertain import parse_uncertain
+
+    by_key = {parse_uncertain(text)[0]: text for text in (case.monte_carlo.uncertain if case.monte_carlo else [])}
+    by_key.update({parse_uncertain(text)[0]: text for text in given})
+    return list(by_key.values())
+
+
 def _assess_monte_carlo(args, case) -> int:
     """``assess --monte-carlo N``: N runs of the case with the ``--uncertain`` inputs drawn, on the sweep
     runner and its store (resumable: a re-run finds the finished runs), and P(secondary debris)."""
     from riskassess.products.envelope import debris_probability, probability_statement
     from riskassess.sweep.store import ResultStore
 
-    if not args.uncertain:
-        raise ValueError("--monte-carlo needs at least one --uncertain KEY=DIST(...): without one every run "
-                         "would be the same")
+    uncertain = _uncertain_inputs(case, args.uncertain)
+    if not uncertain:
+        raise ValueError("--monte-carlo needs at least one uncertain input ([monte_carlo] uncertain in the case, or "
+                         "--uncertain KEY=DIST(...)): without one every run would be the same")
     if args.out or args.report or args.vtk:
         raise ValueError("--monte-carlo writes a results store (--store), not a run folder: --out, --report and "
                          "--vtk do not apply (use 'riskassess sweep' options --keep-runs for run folders)")
     store = args.store or str(Path("sweeps") / f"{case.name}-monte-carlo" / "results.sqlite")
     sweep_args = argparse.Namespace(
-        case=args.case, vary=[], uncertain=args.uncertain, monte_carlo=args.monte_carlo, seed=args.seed,
+        case=args.case, vary=[], uncertain=uncertain, monte_carlo=args.monte_carlo, seed=args.seed,
         scheduler=None, workers=args.workers, store=store, retry_failed=False, keep_runs=None,
         confidence=args.confidence, reliability=0.9, no_pdf=True, json=args.json, force=args.force)
     store_path, outcome, env = _sweep(sweep_args)
     with ResultStore.open_readonly(store_path) as results:
         p = debris_probability(results.rows(), args.confidence)
-    statement = probability_statement(p, args.uncertain)
+    statement = probability_statement(p, uncertain)
     if args.json:
         print(json.dumps({"store": str(store_path), "runs": outcome.total, "wall_s": outcome.wall_s,
                           "p_secondary_debris": p, "condition": statement}, indent=2))
@@ -467,7 +477,8 @@ def _sweep(args):
     from riskassess.sweep.products import (PRODUCTS, check_products, check_products_at, products_dir,
                                            write_sweep_products)
     from riskassess.sweep.runner import run_sweep, validate_runs
-    from riskassess.sweep.spec import check_options, check_sweep, parse_uncertain, parse_vary, run_specs
+    from riskassess.cases.uncertain import parse_uncertain
+    from riskassess.sweep.spec import check_options, check_sweep, parse_vary, run_specs
     from riskassess.sweep.store import ResultStore, default_store_path
 
     # every option checked before any work

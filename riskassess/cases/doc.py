@@ -76,6 +76,7 @@ SECTIONS = [
     ("[[target.joints]]", c.Joint), ("[chaser] (optional)", c.Chaser),
     ("[perception] (optional; for riskassess perceive)", c.Perception), ("[perception.lidar]", c.Lidar),
     ("[perception.registration]", c.Registration), ("[structures] (optional)", c.Structures),
+    ("[monte_carlo] (optional; for riskassess assess --monte-carlo)", c.MonteCarlo),
     ("[[structures.weak_locations]]", c.WeakLocationSpec), ("material", c.Material),
     ('section: kind = "solid_rectangle"', c.SolidRectangle), ('section: kind = "hollow_rectangle"', c.HollowRectangle),
     ('section: kind = "thin_walled_box"', c.ThinWalledBox), ('section: kind = "circular_tube"', c.CircularTube),

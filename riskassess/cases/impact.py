@@ -26,6 +26,7 @@ from riskassess.cases.inputs import (JSON_FILE_LIMIT, KIND_NOTE, MESH_FILE_LIMIT
                                     RelativeFile, Strict, Text, decode_utf8, read_limited, read_toml, resolve_reference,
                                     unique_names)
 from riskassess.cases.target_geometry import target_points_lvlh, target_vertices_lvlh
+from riskassess.cases.uncertain import parse_uncertain
 from structures.sections import SECTIONS
 
 Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
@@ -451,6 +452,22 @@ class Structures(Strict):
         return unique_names(items, "weak location")
 
 
+class MonteCarlo(Strict):
+    uncertain: Annotated[list[Text], Field(min_length=1)] = Field(
+        description="Uncertain inputs of 'riskassess assess --monte-carlo N', each KEY=DIST(params) with DIST one "
+                    "of uniform(low,high), normal(mean,std), lognormal(median,sigma_log), triangular(low,mode,high), "
+                    "in the key's SI unit (e.g. \"contact.mu_kinetic=uniform(0.1,0.19)\"); --uncertain on the "
+                    "command line adds to them and replaces one of the same key.")
+
+    @field_validator("uncertain")
+    @classmethod
+    def _grammar(cls, items):
+        keys = [parse_uncertain(text)[0] for text in items]   # ValueError naming the entry
+        if len(set(keys)) != len(keys):
+            raise ValueError("each key appears once")
+        return items
+
+
 class Case(Strict):
     kind: Literal["impact"] = Field("impact", description=KIND_NOTE)
     name: CaseName = Field(description="Case name; default output folder runs/<name>.")
@@ -465,6 +482,7 @@ class Case(Strict):
     structures: Structures | None = None
     chaser: Chaser | None = None
     perception: Perception | None = None
+    monte_carlo: MonteCarlo | None = None
 
     @model_validator(mode="after")
     def _weak_location_joints(self):

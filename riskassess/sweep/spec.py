@@ -20,33 +20,16 @@ import math
 import re
 from dataclasses import dataclass
 
+from riskassess.cases.uncertain import DISTRIBUTIONS, KEY_TOKEN, SweepSpecError, check_key, split_key
+
 import numpy as np
 
-#: name -> (parameter names, sampler(rng, n, *params)); all parameters in the key's SI unit.
-DISTRIBUTIONS = {
-    "uniform": (("low", "high"), lambda rng, n, a, b: rng.uniform(a, b, n)),
-    "normal": (("mean", "std"), lambda rng, n, m, s: rng.normal(m, s, n)),
-    "lognormal": (("median", "sigma_log"), lambda rng, n, med, s: med * np.exp(rng.normal(0.0, s, n))),
-    "triangular": (("low", "mode", "high"), lambda rng, n, a, c, b: rng.triangular(a, c, b, n)),
-}
-#: name -> check(params) -> problem or None: the parameter ranges each distribution accepts.
-DISTRIBUTION_CHECKS = {
-    "uniform": lambda a, b: None if a < b else "low < high",
-    "normal": lambda m, s: None if s >= 0 else "std >= 0",
-    "lognormal": lambda med, s: None if med > 0 and s >= 0 else "median > 0 and sigma_log >= 0",
-    "triangular": lambda a, c, b: None if a <= c <= b and a < b else "low <= mode <= high and low < high",
-}
 #: Runs of one sweep above which ``--force`` is needed: 100 000 runs of the smallest case
 #: (about 25 s each, docs/sweeps.md) are some 300 core-days, more than anyone asks by accident.
 MAX_RUNS = 100_000
 #: Runs of one sweep even with ``--force``: every run is a spec in memory and a row in the
 #: store (about 1 kB each), so 10 million is about 10 GB.
 HARD_MAX_RUNS = 10_000_000
-_TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[[^\]]+\])*)")
-
-
-class SweepSpecError(ValueError):
-    """A --vary or --uncertain argument that cannot be used; the message says what is allowed."""
 
 
 @dataclass(frozen=True)
@@ -73,50 +56,16 @@ def parse_vary(text: str) -> tuple[str, np.ndarray]:
     if n > HARD_MAX_RUNS:
         raise SweepSpecError(f"--vary {text!r}: N must be <= {HARD_MAX_RUNS} (the most runs of one sweep). "
                              f"Got {n} instead.")
-    _check_key(key, "--vary", text)
+    check_key(key, "--vary", text)
     return key, np.linspace(start, stop, n)
-
-
-def parse_uncertain(text: str) -> tuple[str, str, tuple]:
-    """'KEY=DIST(a,b)' -> (key, distribution name, parameters)."""
-    key, _, spec = text.partition("=")
-    match = re.fullmatch(r"\s*([a-z]+)\s*\(([^)]*)\)\s*", spec)
-    allowed = ", ".join(f"{name}({', '.join(p)})" for name, (p, _) in DISTRIBUTIONS.items())
-    if not match or match.group(1) not in DISTRIBUTIONS:
-        raise SweepSpecError(f"--uncertain {text!r}: expected KEY=DIST(...) with DIST one of {allowed}")
-    name = match.group(1)
-    try:
-        params = tuple(float(v) for v in match.group(2).split(","))
-    except ValueError:
-        raise SweepSpecError(f"--uncertain {text!r}: parameters must be numbers") from None
-    if len(params) != len(DISTRIBUTIONS[name][0]):
-        raise SweepSpecError(f"--uncertain {text!r}: {name} takes {len(DISTRIBUTIONS[name][0])} parameters "
-                             f"({', '.join(DISTRIBUTIONS[name][0])}); got {len(params)}")
-    if not all(math.isfinite(p) for p in params):
-        raise SweepSpecError(f"--uncertain {text!r}: parameters must be finite numbers")
-    problem = DISTRIBUTION_CHECKS[name](*params)
-    if problem:
-        raise SweepSpecError(f"--uncertain {text!r}: {name}({', '.join(DISTRIBUTIONS[name][0])}) needs {problem}")
-    _check_key(key, "--uncertain", text)
-    return key, name, params
-
-
-def _check_key(key: str, option: str, text: str) -> None:
-    if not key or not all(_TOKEN.fullmatch(part) for part in _split_key(key)):
-        raise SweepSpecError(f"{option} {text!r}: '{key}' is not a case key like launch.velocity or "
-                             f"target.joints[solar_array_hinge].torsional_damping")
-
-
-def _split_key(key: str) -> list[str]:
-    return re.findall(r"[^.\[]+(?:\[[^\]]+\])*", key)
 
 
 def set_key(raw: dict, key: str, value) -> None:
     """Set ``key`` in the parsed case file ``raw`` (in place); ``KeyError`` naming what is missing."""
     node = raw
-    parts = _split_key(key)
+    parts = split_key(key)
     for depth, part in enumerate(parts):
-        name, selectors = _TOKEN.fullmatch(part).groups()
+        name, selectors = KEY_TOKEN.fullmatch(part).groups()
         selectors = re.findall(r"\[([^\]]+)\]", selectors)
         last = depth == len(parts) - 1
         if not isinstance(node, dict) or name not in node:

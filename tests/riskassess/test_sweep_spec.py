@@ -8,7 +8,8 @@ import pytest
 from riskassess.cli import main
 from riskassess.products.envelope import envelope, envelope_statement, no_debris_lower_bound, runs_needed
 from riskassess.sweep.runner import VALIDATE_ALL_UP_TO, validate_runs, validation_sample
-from riskassess.sweep.spec import (SweepSpecError, case_with, parse_uncertain, parse_vary, run_id, run_specs)
+from riskassess.cases.uncertain import parse_uncertain
+from riskassess.sweep.spec import SweepSpecError, case_with, parse_vary, run_id, run_specs
 from tests.riskassess.conftest import CASES
 
 SMALL = tomllib.loads((CASES / "envisat_small.toml").read_text())

@@ -135,3 +135,20 @@ def test_input_rows_of_the_reference_case_carry_units():
     assert rows["target.bodies[solar_array].mass"] == ("350", "kg")
     assert rows["target.joints[solar_array_hinge].torsional_stiffness"][1] == "N m/rad"
     assert rows["target.bodies[main_body].shapes[0]"][0].startswith("box: size [")
+
+
+def test_monte_carlo_table_is_checked_on_load(tmp_path):
+    """[monte_carlo] uncertain: the KEY=DIST(params) grammar of --uncertain, checked when the case loads
+    (before any run), each key once."""
+    text = (CASES / "envisat_small.toml").read_text()
+    good = text + '\n[monte_carlo]\nuncertain = ["contact.mu_kinetic=uniform(0.1,0.19)"]\n'
+    path = tmp_path / "mc.toml"
+    path.write_text(good)
+    assert load_case(path).monte_carlo.uncertain == ["contact.mu_kinetic=uniform(0.1,0.19)"]
+    for entry, message in (('"contact.mu_kinetic=gauss(0.1,0.2)"', "DIST one of uniform(low, high)"),
+                           ('"contact.mu_kinetic=uniform(0.2,0.1)"', "needs low < high"),
+                           ('"a=uniform(0,1)", "a=uniform(0,2)"', "each key appears once")):
+        path.write_text(text + f"\n[monte_carlo]\nuncertain = [{entry}]\n")
+        with pytest.raises(CaseError) as err:
+            load_case(path)
+        assert "monte_carlo.uncertain" in str(err.value) and message in str(err.value)
