@@ -183,7 +183,7 @@ def _uncertain_inputs(case, given: list[str]) -> list[str]:
 def _assess_monte_carlo(args, case) -> int:
     """``assess --monte-carlo N``: N runs of the case with the ``--uncertain`` inputs drawn, on the sweep
     runner and its store (resumable: a re-run finds the finished runs), and P(secondary debris)."""
-    from riskassess.products.envelope import debris_probability, probability_statement
+    from riskassess.products.envelope import debris_probability, probability_statement, utilization_sensitivity
     from riskassess.sweep.store import ResultStore
 
     uncertain = _uncertain_inputs(case, args.uncertain)
@@ -200,11 +200,13 @@ def _assess_monte_carlo(args, case) -> int:
         confidence=args.confidence, reliability=0.9, no_pdf=True, json=args.json, force=args.force)
     store_path, outcome, env = _sweep(sweep_args)
     with ResultStore.open_readonly(store_path) as results:
-        p = debris_probability(results.rows(), args.confidence)
+        rows = results.rows()
+    p = debris_probability(rows, args.confidence)
     statement = probability_statement(p, uncertain)
     if args.json:
         print(json.dumps({"store": str(store_path), "runs": outcome.total, "wall_s": outcome.wall_s,
-                          "p_secondary_debris": p, "condition": statement}, indent=2))
+                          "p_secondary_debris": p, "condition": statement,
+                          "utilization_sensitivity": utilization_sensitivity(rows)}, indent=2))
     else:
         print(f"monte carlo: {outcome.total} runs ({outcome.skipped} already in the store, {outcome.done} done now, "
               f"{outcome.failed} failed) in {outcome.wall_s:.1f} s; store {store_path}")

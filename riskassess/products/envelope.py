@@ -27,7 +27,7 @@ import math
 from collections import defaultdict
 
 import numpy as np
-from scipy.stats import beta
+from scipy.stats import beta, spearmanr
 
 from riskassess.products.sweep_records import debris_state_of
 from structures.verdict import DEBRIS, NO_DEBRIS
@@ -87,6 +87,28 @@ def debris_probability(rows: list[dict], confidence: float = 0.95) -> dict:
     high = clopper_pearson(k + unknown, n, confidence)[1]
     return {"estimate": k / (k + m) if k + m else None, "interval": [low, high], "confidence": confidence,
             "runs": n, "debris_runs": k, "no_debris_runs": m, "unknown_runs": unknown}
+
+
+def utilization_sensitivity(rows: list[dict]) -> dict:
+    """Sensitivity of each weak location's utilization (peak over decisive allowable) to each
+    varied or uncertain input: Spearman's rank correlation over the finished runs with a finite
+    utilization (monotone effects count, whatever their shape; -1 to 1, None with fewer than 3
+    runs or a constant input). Returns {location: {input key: rho}}."""
+    done = [r for r in rows if r["state"] == "done" and r["result"] and r["result"].get("locations")]
+    keys = list(rows[0]["overrides"]) if rows else []
+    locations = sorted({name for r in done for name in r["result"]["locations"]})
+    out = {}
+    for name in locations:
+        out[name] = {}
+        for key in keys:
+            pairs = [(r["overrides"][key], r["result"]["locations"].get(name, {}).get("utilization")) for r in done]
+            pairs = [(x, u) for x, u in pairs if u is not None and math.isfinite(u)]
+            x, u = (np.array(v, float) for v in zip(*pairs)) if pairs else (np.array([]), np.array([]))
+            if len(x) < 3 or np.ptp(x) == 0.0 or np.ptp(u) == 0.0:
+                out[name][key] = None
+                continue
+            out[name][key] = float(spearmanr(x, u).statistic)
+    return out
 
 
 def probability_statement(p: dict, inputs: list[str]) -> str:

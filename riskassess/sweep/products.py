@@ -24,7 +24,7 @@ import matplotlib
 from riskassess.products import results
 from riskassess.products.report.document import render_document, render_pdf
 from riskassess.products.plotting import STYLE
-from riskassess.products.report.sweep import envelope_section, runs_section
+from riskassess.products.report.sweep import envelope_section, runs_section, sensitivity_section
 from riskassess.products.envelope import envelope, unknown_counts
 from riskassess.sweep.store import ResultStore, StoreError
 
@@ -96,7 +96,9 @@ def write_sweep_products(store: ResultStore, confidence: float = 0.95, reliabili
     write_product(store, "envelope.json", (json.dumps(env, indent=2, allow_nan=False) + "\n").encode())
     varied = [a.split(" ", 1)[1].split("=")[0] for a in info.get("arguments", []) if a.startswith("--vary ")]
     with matplotlib.rc_context(STYLE):
-        sections = [envelope_section(rows, env, [k for k in varied if k != env["key"]]), runs_section(rows)]
+        sensitivity = sensitivity_section(rows)
+        sections = [envelope_section(rows, env, [k for k in varied if k != env["key"]]),
+                    *([sensitivity] if sensitivity else []), runs_section(rows)]
     counts = unknown_counts(rows)
     problems = [f"{n} runs {what}" for what, n in counts.items() if n]
     html = render_document(f"Sweep: {Path(info.get('case_path', '?')).name}",

@@ -244,3 +244,21 @@ def test_debris_probability_never_counts_unknown_runs_as_safe():
     assert p["estimate"] == 3 / 18
     # lower end: the 2 unknown runs debris-free (3 of 20); upper end: both with debris (5 of 20)
     assert p["interval"] == [clopper_pearson(3, 20, 0.95)[0], clopper_pearson(5, 20, 0.95)[1]]
+
+
+def test_utilization_sensitivity_is_the_rank_correlation_with_each_input():
+    """Spearman's rho: 1 for a utilization that grows monotonically (here cubically) with an input,
+    -1 for one that falls with it, None for a constant input; failed runs left out."""
+    from riskassess.products.envelope import utilization_sensitivity
+
+    rng = np.random.default_rng(0)
+    rows = []
+    for x, y in zip(rng.uniform(10, 20, 12), rng.uniform(0.1, 0.2, 12)):
+        rows.append({"state": "done", "overrides": {"launch.velocity": x, "contact.mu_kinetic": y, "c": 1.0},
+                     "result": {"locations": {"hinge": {"utilization": (x / 10) ** 3},
+                                              "dish": {"utilization": 1.0 / y}}}})
+    rows.append({"state": "failed", "overrides": {"launch.velocity": 99.0, "contact.mu_kinetic": 0.5, "c": 1.0},
+                 "result": None})
+    s = utilization_sensitivity(rows)
+    assert s["hinge"]["launch.velocity"] == pytest.approx(1.0) and s["dish"]["contact.mu_kinetic"] == pytest.approx(-1.0)
+    assert abs(s["hinge"]["contact.mu_kinetic"]) < 0.7 and s["hinge"]["c"] is None

@@ -4,11 +4,13 @@ from __future__ import annotations
 from collections import defaultdict
 
 import numpy as np
+from matplotlib.figure import Figure as MplFigure
 
 from riskassess.cases.doc import key_unit
 from riskassess.products.report.blocks import Figure, Note, Section, Table
-from riskassess.products.plotting import legend, panels, plain
-from riskassess.products.envelope import UNKNOWN, envelope, envelope_statement, is_probabilistic, run_status
+from riskassess.products.plotting import WIDTH_IN, legend, panels, plain
+from riskassess.products.envelope import (UNKNOWN, envelope, envelope_statement, is_probabilistic, run_status,
+                                          utilization_sensitivity)
 from structures.verdict import DEBRIS, NO_DEBRIS
 
 #: How the runs table shows a run's outcome.
@@ -101,6 +103,37 @@ def envelope_section(rows: list[dict], env: dict, other_keys=()) -> Section:
                            f"the runs table; --retry-failed re-runs failed runs, a re-run finishes pending ones).",
                            "warning"))
     return Section("envelope", "Safe impact envelope", blocks)
+
+
+def tornado_figure(sensitivity: dict) -> Figure:
+    """One panel per weak location: the rank correlation of its utilization with each input, largest
+    magnitude on top (a tornado plot)."""
+    names = list(sensitivity)
+    keys = list(next(iter(sensitivity.values())))
+    fig = MplFigure(figsize=(WIDTH_IN, 0.7 + len(names) * (0.35 + 0.28 * len(keys))), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(len(names), 1, sharex=True))
+    for ax, name in zip(axes, names):
+        rho = {k: v for k, v in sensitivity[name].items() if v is not None}
+        order = sorted(rho, key=lambda k: abs(rho[k]))
+        ax.barh([plain(k) for k in order], [rho[k] for k in order],
+                color=["tab:red" if rho[k] > 0 else "tab:blue" for k in order])
+        ax.axvline(0.0, color="k", lw=0.8)
+        ax.set_title(plain(name), loc="left")
+        if not rho:
+            ax.text(0.5, 0.5, "no finite utilization, or a constant input", ha="center", transform=ax.transAxes)
+    axes[-1].set_xlim(-1.05, 1.05)
+    axes[-1].set_xlabel("Spearman rank correlation of the utilization with the input (-)")
+    return Figure.from_matplotlib("fig-sensitivity", "Sensitivity of each weak location's utilization (peak demand "
+                                  "over decisive allowable) to each varied or uncertain input: rank correlation over the "
+                                  "finished runs (red: the demand grows with the input).", fig)
+
+
+def sensitivity_section(rows: list[dict]) -> Section | None:
+    """The tornado plot of :func:`tornado_figure`, for a sweep with at least 3 finished runs."""
+    sensitivity = utilization_sensitivity(rows)
+    if not sensitivity or not any(v is not None for s in sensitivity.values() for v in s.values()):
+        return None
+    return Section("sensitivity", "Sensitivity of the utilization to the inputs", [tornado_figure(sensitivity)])
 
 
 def _number(value) -> str:
