@@ -23,8 +23,9 @@ from typing import Annotated, Literal, Optional, Union, get_args
 import numpy as np
 from pydantic import Field, PrivateAttr, RootModel, ValidationError, ValidationInfo, field_validator, model_validator
 
-from riskassess.cases.impact import (CaseError, NonNegative, Positive, Strict, Vector3, check_physical_inertia,
-                             format_validation_error, load_model, read_toml)
+from riskassess.cases import impact
+from riskassess.cases.impact import (CaseError, NonNegative, NoOrbit, Positive, Strict, Vector3, check_physical_inertia,
+                                    format_validation_error, load_model, read_toml)
 from riskassess.cases.inputs import CASE_FILE_LIMIT, CaseName, RelativeFile, Text, resolve_reference, unique_names
 from riskassess.cases.towing import TowingCase
 
@@ -82,17 +83,13 @@ class InitialState(Strict):
                                                                 "bodies) relative to the chaser at t = 0, LVLH (m/s).")
 
 
-class CircularOrbit(Strict):
-    kind: Literal["circular"]
-    altitude: Annotated[float, Field(ge=100e3, le=1e8)] = Field(description="Circular orbit altitude above the "
-                                                                            "equatorial radius (m).")
+class CircularOrbit(impact.CircularOrbit):
+    """The impact case's circular orbit, placed in inertial space (the diagnosis models gravity
+    gradient and J2, which depend on where the orbit lies)."""
+
     inclination: Annotated[float, Field(ge=0, le=np.pi)] = Field(0.0, description="Orbit inclination (rad).")
     argument_of_latitude: float = Field(0.0, description="Chaser's argument of latitude at t = 0 (rad), from the "
                                                          "ascending node (right ascension of the node 0).")
-
-
-class NoOrbit(Strict):
-    kind: Literal["none"]
 
 
 Orbit = Annotated[Union[CircularOrbit, NoOrbit], Field(discriminator="kind")]
