@@ -78,9 +78,7 @@ SECTIONS = [
     ("[perception.registration]", c.Registration), ("[structures] (optional)", c.Structures),
     ("[monte_carlo] (optional; for riskassess assess --monte-carlo)", c.MonteCarlo),
     ("[[structures.weak_locations]]", c.WeakLocationSpec), ("material", c.Material),
-    ('section: kind = "solid_rectangle"', c.SolidRectangle), ('section: kind = "hollow_rectangle"', c.HollowRectangle),
-    ('section: kind = "thin_walled_box"', c.ThinWalledBox), ('section: kind = "circular_tube"', c.CircularTube),
-    ('section: kind = "i_section"', c.ISection),
+    *((f'section: kind = "{name}"', model) for name, model in c.SECTION_MODELS.items()),
 ]
 
 
@@ -143,8 +141,7 @@ def _compact_model(model: BaseModel) -> str:
 
 
 #: Nested models shown as one line each in input tables (they are details of their parent).
-COMPACT = (c.Box, c.Cylinder, c.Sphere, c.MeshFile, c.SolidRectangle, c.HollowRectangle, c.ThinWalledBox,
-           c.CircularTube, c.ISection, c.Material)
+COMPACT = (c.Box, c.Cylinder, c.Sphere, c.MeshFile, *c.SECTION_MODELS.values(), c.Material)
 
 
 def input_rows(model: BaseModel, prefix: str = "") -> list[tuple[str, str, str, str]]:

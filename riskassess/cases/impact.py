@@ -20,13 +20,14 @@ from pathlib import Path
 from typing import Annotated, Literal, Union, get_args
 
 import numpy as np
-from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, Field, ValidationError, create_model, field_validator, model_validator
 
 from riskassess.cases.inputs import (JSON_FILE_LIMIT, KIND_NOTE, MESH_FILE_LIMIT, CaseError, CaseName, ItemName,
                                     RelativeFile, Strict, Text, decode_utf8, read_limited, read_toml, resolve_reference,
                                     unique_names)
 from riskassess.cases.target_geometry import target_points_lvlh, target_vertices_lvlh
 from riskassess.cases.uncertain import parse_uncertain
+from structures.section_shapes import SHAPES
 from structures.sections import SECTIONS
 
 Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
@@ -351,43 +352,18 @@ ValueOrRange = Union[Positive, Annotated[list[Positive], Field(min_length=2, max
 SectionLength = Annotated[float, Field(gt=0, le=20.0)]
 
 
-class SolidRectangle(Strict):
-    kind: Literal["solid_rectangle"]
-    width: SectionLength = Field(description="Extent along section axis 2 (m).")
-    height: SectionLength = Field(description="Extent along section axis 3 (m).")
+def _section_model(shape) -> type[Strict]:
+    """The case schema of one cross-section shape (:mod:`structures.section_shapes`): its ``kind`` and
+    its dimensions, each a :data:`SectionLength` described as the shape describes it."""
+    fields = {"kind": (Literal[shape.NAME], ...)}
+    fields.update({name: (SectionLength, Field(description=text)) for name, text in shape.DIMENSIONS.items()})
+    class_name = "".join(part.capitalize() for part in shape.NAME.split("_"))
+    return create_model(class_name, __base__=Strict, __module__=__name__, **fields)
 
 
-class HollowRectangle(Strict):
-    kind: Literal["hollow_rectangle"]
-    width: SectionLength = Field(description="Outer extent along section axis 2 (m).")
-    height: SectionLength = Field(description="Outer extent along section axis 3 (m).")
-    wall: SectionLength = Field(description="Uniform wall thickness (m).")
-
-
-class ThinWalledBox(Strict):
-    kind: Literal["thin_walled_box"]
-    width: SectionLength = Field(description="Midline extent along section axis 2 (m).")
-    height: SectionLength = Field(description="Midline extent along section axis 3 (m).")
-    flange_thickness: SectionLength = Field(description="Thickness of the two walls along axis 2 (m).")
-    web_thickness: SectionLength = Field(description="Thickness of the two walls along axis 3 (m).")
-
-
-class CircularTube(Strict):
-    kind: Literal["circular_tube"]
-    outer_diameter: SectionLength = Field(description="(m)")
-    wall: SectionLength = Field(description="Wall thickness (m); outer_diameter / 2 for a solid shaft.")
-
-
-class ISection(Strict):
-    kind: Literal["i_section"]
-    height: SectionLength = Field(description="Overall depth along section axis 3, the web direction (m).")
-    flange_width: SectionLength = Field(description="Flange extent along section axis 2 (m).")
-    flange_thickness: SectionLength = Field(description="(m)")
-    web_thickness: SectionLength = Field(description="(m)")
-
-
-Section = Annotated[Union[SolidRectangle, HollowRectangle, ThinWalledBox, CircularTube, ISection],
-                    Field(discriminator="kind")]
+#: Section kind -> its schema, one per shape file of structures/section_shapes.
+SECTION_MODELS = {name: _section_model(shape) for name, shape in SHAPES.items()}
+Section = Annotated[Union[tuple(SECTION_MODELS.values())], Field(discriminator="kind")]
 
 
 def section_properties(spec):

@@ -3,8 +3,12 @@ import math
 
 import pytest
 
-from structures.sections import circular_tube, hollow_rectangle, i_section, section_stresses, solid_rectangle, \
-    thin_walled_box
+from structures.section_shapes.circular_tube import circular_tube
+from structures.section_shapes.hollow_rectangle import hollow_rectangle
+from structures.section_shapes.i_section import i_section
+from structures.section_shapes.solid_rectangle import solid_rectangle
+from structures.section_shapes.thin_walled_box import thin_walled_box
+from structures.sections import section_stresses
 
 
 def test_solid_rectangle_cantilever_root_stresses():
@@ -80,3 +84,15 @@ def test_i_section_against_hand_calculation():
     assert s.second_moment_2 + fillets * arm**2 == pytest.approx(1943e-8, rel=0.01)
     # web shear ~ V / (h_w t_w) within 20 % (the classical estimate of the mean web shear)
     assert s.shear_per_force3 == pytest.approx(1 / ((h - 2 * tf) * tw), rel=0.2)
+
+
+
+def test_section_shapes_are_plug_ins_found_by_name():
+    """Issue 21: one file per shape; the case schema's section kinds are the registry's."""
+    from riskassess.cases.impact import SECTION_MODELS
+    from structures.section_shapes import SHAPES
+
+    assert set(SHAPES) == {"solid_rectangle", "hollow_rectangle", "thin_walled_box", "circular_tube", "i_section"}
+    assert set(SECTION_MODELS) == set(SHAPES)
+    for name, shape in SHAPES.items():
+        assert list(SECTION_MODELS[name].model_fields) == ["kind", *shape.DIMENSIONS]
