@@ -66,7 +66,10 @@ def main() -> None:
     parser.add_argument("--end-time", type=float, default=None)
     args = parser.parse_args()
     base_dir = Path(args.case).resolve().parent
-    text = Path(args.case).read_text().replace('release = "low"', 'release = "never"', 1)
+    text = Path(args.case).read_text()
+    if 'release = "low"' not in text:      # otherwise the peaks would be cut at each joint's release
+        raise SystemExit(f"{args.case}: expected release = \"low\" in [structures] to switch it off")
+    text = text.replace('release = "low"', 'release = "never"', 1)
     if args.end_time:
         text = re.sub(r"^end_time = [0-9.e]+", f"end_time = {args.end_time:g}", text, count=1, flags=re.M)
     variants = {"baseline": (text, hinge.PENALTY_STEP_FACTOR), "step/2": (_variant(text, "step/2"), hinge.PENALTY_STEP_FACTOR),

@@ -99,11 +99,21 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
             "indeterminate_reasons": sorted({r["indeterminate_reason"] for r in rows if r["indeterminate_reason"]})}
 
 
+def _display_unit(unit: str) -> tuple[float, str]:
+    """(divisor, unit) people read a quantity in: stresses in MPa, loads in their SI unit."""
+    return (1e6, "MPa") if unit == "Pa" else (1.0, unit)
+
+
 def _quantity(value: float, unit: str) -> str:
-    """A demand or allowable as people read it: stresses in MPa, loads in their SI unit."""
-    if unit == "Pa":
-        return f"{value / 1e6:.4g} MPa"
-    return f"{value:.4g} {unit}"
+    """A demand or allowable (SI ``unit``) as people read it."""
+    scale, shown = _display_unit(unit)
+    return f"{value / scale:.4g} {shown}"
+
+
+def _span(low: float, high: float, unit: str) -> str:
+    """A range allowable (SI ``unit``) as people read it: "200-1000 N m", "950-3500 MPa"."""
+    scale, shown = _display_unit(unit)
+    return f"{low / scale:.4g}-{high / scale:.4g} {shown}"
 
 
 def _decisive_criterion(result: dict):
@@ -151,10 +161,8 @@ def condition_sentence(result: dict, policy: str) -> str:
     verb = "fails" if result["state"] == "fails" else "holds"
     if high > low:
         bound = ">=" if result["released_at_s"] is not None else "="
-        span = _quantity(high, unit).split(" ", 1)
-        scale = 1e6 if unit == "Pa" else 1.0
         return (f"{name} breaks if its {criterion.replace('_', ' ')} allowable is below {peak} ({when}): "
-                f"P {bound} {c['likelihood']:.0%} for an allowable uniform over {low / scale:.4g}-{span[0]} {span[1]}; "
+                f"P {bound} {c['likelihood']:.0%} for an allowable uniform over {_span(low, high, unit)}; "
                 f"this run judges at the {policy} end "
                 f"({_quantity(c['decisive_allowable'], unit)}): {verb}.")
     return (f"{name} {verb}: its {criterion.replace('_', ' ')} reached {peak} ({when}) against an allowable of "
