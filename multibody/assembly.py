@@ -60,6 +60,9 @@ class JointSpec:
                                       None: automatic, tuned to the step (multibody.hinge).
     penalty_rotational : float or None      Penalty stiffness on locked rotations (N m/rad).
     penalty_damping_ratio : float     Damping of the penalty springs, fraction of critical (-).
+    first_mode_hz : float or None     The structure's own first mode on this joint (Hz): the
+                                      penalty springs not given explicitly are set from it instead
+                                      of from the step (multibody.hinge.joint_stiffness_joint_frame).
     """
 
     name: str
@@ -73,6 +76,7 @@ class JointSpec:
     penalty_translational: float | None = None
     penalty_rotational: float | None = None
     penalty_damping_ratio: float = 0.05
+    first_mode_hz: float | None = None
 
 
 def subtree_bodies(joints: list[JointSpec], root: int, cut_joints=()) -> list[int]:

@@ -122,7 +122,30 @@ def _criterion_verdict(name, allowable, time, demand, judged, skip_until, policy
     peak = float(demand[k])
     return {**out, "peak": peak, "peak_time_s": float(time[k]),
             "margin_of_safety": allowable.margin_of_safety(peak, policy), "fails": bool(peak >= threshold),
-            "likelihood": allowable.likelihood_of_failure(peak)}
+            "likelihood": allowable.likelihood_of_failure(peak), **history_around_peak(time, demand, k)}
+
+
+#: Half-width of the demand history kept around a reported peak (s): a few periods of the
+#: slowest joint modes that ring after a strike (tens of Hz), so a reader sees whether the peak is
+#: a single-sample spike or a sustained load.
+PEAK_HISTORY_HALF_WIDTH_S = 0.025
+#: Most samples kept in that window (denser output is thinned, the peak sample always kept).
+PEAK_HISTORY_SAMPLES = 101
+
+
+def history_around_peak(time, demand, k: int) -> dict:
+    """The demand around its peak sample ``k``: ``peak_history`` {"time_s", "demand"} over
+    +-:data:`PEAK_HISTORY_HALF_WIDTH_S`, and ``peak_width_s``, how long the demand stays at or above
+    half the peak around it (a spike of one sample gives one sample interval)."""
+    window = np.flatnonzero(np.abs(time - time[k]) <= PEAK_HISTORY_HALF_WIDTH_S)
+    thin = max(1, -(-window.size // PEAK_HISTORY_SAMPLES))
+    kept = np.union1d(window[(window - k) % thin == 0], [k])
+    above = np.abs(demand) >= 0.5 * abs(demand[k])
+    start = k - int(np.argmin(above[k::-1])) if not above[:k + 1].all() else 0
+    stop = k + int(np.argmin(above[k:])) if not above[k:].all() else len(time)
+    interval = float(np.median(np.diff(time))) if len(time) > 1 else 0.0
+    return {"peak_width_s": float(max(stop - start - 1, 1) * interval),
+            "peak_history": {"time_s": time[kept].tolist(), "demand": np.asarray(demand)[kept].tolist()}}
 
 
 def exceeds_now(location: WeakLocation, force_joint, moment_joint, policy="low"):

@@ -246,7 +246,11 @@ class Joint(Strict):
     penalty_rotational: Positive | None = Field(
         None, description="Penalty stiffness locking rotations (N m/rad); default: tuned to the step.")
     penalty_damping_ratio: Annotated[float, Field(ge=0, le=1)] = Field(
-        0.05, description="Penalty damping, fraction of critical (-).")
+        0.05, description="Penalty damping, fraction of critical (-); with first_mode_hz, the structure's damping.")
+    first_mode_hz: Positive | None = Field(
+        None, description="The structure's own first mode on this joint (Hz), from its FE model or a test: the "
+                          "penalty springs not given explicitly then carry the structure's compliance instead of a "
+                          "stiffness tuned to the step (needs at least 20 steps per period).")
 
     @model_validator(mode="after")
     def _revolute_fields(self):

@@ -101,7 +101,7 @@ def build_bodies_and_joints(case: Case, base: Path):
             name=j.name, kind=j.kind, parent=parent, child=child, point_lvlh=point, hinge_to_lvlh=frame,
             torsional_stiffness=j.torsional_stiffness, torsional_damping=j.torsional_damping,
             penalty_translational=j.penalty_translational, penalty_rotational=j.penalty_rotational,
-            penalty_damping_ratio=j.penalty_damping_ratio))
+            penalty_damping_ratio=j.penalty_damping_ratio, first_mode_hz=j.first_mode_hz))
         if j.initial_angle or j.initial_rate:
             _apply_initial_hinge_state(bodies, joints, len(joints) - 1, j.initial_angle, j.initial_rate)
     return bodies, joints, rest_attitudes, rest_coms

@@ -71,3 +71,59 @@ def test_free_hinged_two_body_ring_down_frequency():
     # hinge moment about h2 is the spring moment -k * angle, read from the joint reaction
     moment = rec.series["joint_moment_joint"][:, 0, 1]
     assert np.abs(moment + K_HINGE * angle).max() < 0.01 * K_HINGE * 0.01
+
+
+def clamped_assembly(angle0, first_mode_hz, step):
+    """The same pair with the array clamped; its rotational penalties carry a structural mode."""
+    assembly, rest_att, rest_com = ring_down_assembly(angle0)
+    joint = assembly.joints[0]
+    joint.kind, joint.torsional_stiffness, joint.first_mode_hz = "clamped", 0.0, first_mode_hz
+    # the joint point held much stiffer than the rotation (mode at 0.5 / step), so the pair turns
+    # about a pinned point as the analytic reference assumes
+    joint.penalty_translational = M1 * M2 / (M1 + M2) * (0.5 / step) ** 2
+    assembly.solver.step = step
+    return assembly, rest_att, rest_com
+
+
+def measured_frequency(t, angle) -> float:
+    crossings = np.flatnonzero(np.sign(angle[:-1]) != np.sign(angle[1:]))
+    times = t[crossings] - angle[crossings] * (t[crossings + 1] - t[crossings]) / (angle[crossings + 1] - angle[crossings])
+    return 2.0 * np.pi / (2.0 * np.mean(np.diff(times)))
+
+
+def test_structural_first_mode_sets_the_clamp_compliance_not_the_step():
+    """A clamp with ``first_mode_hz``: the pair rings at f, whatever the step, and at the
+    free-free frequency of its stiffness (the null-space reference above)."""
+    from multibody.hinge import joint_stiffness_joint_frame
+    f = 2.0                                                   # Hz
+    measured = []
+    for step in (1e-3, 5e-4):
+        assembly, rest_att, rest_com = clamped_assembly(0.002, f, step)
+        joint, (main, array) = assembly.joints[0], assembly.bodies
+        k = joint_stiffness_joint_frame(joint, main, array, step)
+        assembly.solver.end_time = 3.0
+        rec = ImpactSimulation(assembly, rest_att, rest_com).run()
+        measured.append(measured_frequency(rec.series["time"], rec.series["joint_rotation_joint"][:, 0, 1]))
+    global K_HINGE
+    saved, K_HINGE = K_HINGE, k[4]
+    try:
+        exact = analytic_frequency()
+    finally:
+        K_HINGE = saved
+    # 1 %: the pinned point's own compliance (its mode ~40x faster: (1/40)^2) and Verlet's phase
+    # error ((omega h)^2 / 24 < 1e-5) are far below it
+    assert measured[0] == pytest.approx(exact, rel=0.01)
+    # the step no longer moves the joint: halving it changes the frequency by < 0.1 %
+    assert measured[1] == pytest.approx(measured[0], rel=1e-3)
+    # the tuning is exact for one axis with the others rigid (coupled_mode_inertia_joint_frame):
+    # the reference, which pins the point rigidly, rings at f up to the array's initial turn of
+    # 2 mrad, which the tuning sees and the planar reference does not (O(angle^2) ~ 1e-6)
+    assert exact == pytest.approx(2 * np.pi * f, rel=1e-5)
+    assert measured[0] == pytest.approx(2 * np.pi * f, rel=0.01)
+
+
+def test_structural_first_mode_must_be_resolved_by_the_step():
+    from multibody.hinge import joint_stiffness_joint_frame
+    assembly, _, _ = clamped_assembly(0.0, 600.0, 1e-4)     # 16.7 steps per period < 20
+    with pytest.raises(ValueError, match="first_mode_hz = 600 Hz has fewer than 20 steps"):
+        joint_stiffness_joint_frame(assembly.joints[0], *assembly.bodies, 1e-4)
