@@ -130,7 +130,7 @@ def condition_sentence(result: dict, policy: str) -> str:
     that "fails" and a small likelihood cannot be read as a contradiction: the run judges a range
     allowable at the release policy's value, the likelihood is P(allowable < peak) over the range.
 
-    Example: "solar_array_hinge breaks if its hinge moment allowable is below 223 N m (the peak,
+    Example: "solar_array_hinge breaks if its hinge moment allowable is below 223 N m (this run's peak,
     at 0.41 s): P >= 3 % for an allowable uniform over 200-1000 N m; this run judges at the low
     end (200 N m): fails." ``>=`` marks a released location (its loads after release are unknown).
 
@@ -156,7 +156,7 @@ def condition_sentence(result: dict, policy: str) -> str:
     criterion, c = decisive
     unit, low, high = c["unit"], *c["allowable"]
     peak = _quantity(c["peak"], unit)
-    when = f"the peak, at {c['peak_time_s']:.3g} s" + (", up to its release" if result["released_at_s"] is not None
+    when = f"this run's peak, at {c['peak_time_s']:.3g} s" + (", up to its release" if result["released_at_s"] is not None
                                                        else "")
     verb = "fails" if result["state"] == "fails" else "holds"
     if high > low:

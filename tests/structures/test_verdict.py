@@ -16,7 +16,7 @@ def test_a_released_range_location_states_its_threshold_probability_and_policy()
     # the case: released at 223 N m against 200-1000 N m judged at the low end;
     # P(allowable < 223) = (223 - 200) / 800 = 2.9 % -> "3 %", a lower bound since the joint let go
     text = condition_sentence(_result(223.0, (200.0, 1000.0), "fails", released_at=0.41), "low")
-    assert text == ("solar_array_hinge breaks if its hinge moment allowable is below 223 N m (the peak, at 0.41 s, "
+    assert text == ("solar_array_hinge breaks if its hinge moment allowable is below 223 N m (this run's peak, at 0.41 s, "
                     "up to its release): P >= 3% for an allowable uniform over 200-1000 N m; this run judges at "
                     "the low end (200 N m): fails.")
 
@@ -24,7 +24,7 @@ def test_a_released_range_location_states_its_threshold_probability_and_policy()
 def test_a_holding_single_value_location_states_its_margin():
     text = condition_sentence(_result(30e6, (50e6, 50e6), "holds", unit="Pa"), "low")
     # margin = 50 / 30 - 1 = +0.67
-    assert text == ("solar_array_hinge holds: its hinge moment reached 30 MPa (the peak, at 0.41 s) against an "
+    assert text == ("solar_array_hinge holds: its hinge moment reached 30 MPa (this run's peak, at 0.41 s) against an "
                     "allowable of 50 MPa (margin +0.67).")
 
 
