@@ -6,11 +6,15 @@ Exudyn builders; tests build them directly for analytic set-ups.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import trimesh
 
 from multibody.net import NetTopology
+
+if TYPE_CHECKING:       # annotation only: the loads module needs Exudyn, these descriptions do not
+    from multibody.recorded_loads import RecordedBodyLoads
 
 
 @dataclass
@@ -166,6 +170,9 @@ class ImpactAssembly:
     mean_motion: float = 0.0        # (rad/s), 0 without orbit
     mount: NetMount | None = None
     chaser: int | None = None
+    #: recorded contact loads applied to the bodies (the sequential method's second step,
+    #: :mod:`multibody.recorded_loads`); None in a coupled run
+    body_loads: RecordedBodyLoads | None = None
 
     @property
     def debris_indices(self) -> list[int]:

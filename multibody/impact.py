@@ -23,6 +23,7 @@ from multibody.hinge import add_penalty_joint
 from multibody.jit_cache import all_compiled_on_disk
 from multibody.kernel import KernelData, coupled_generalized_forces, verlet_evaluation_state
 from multibody.kernel_net import KernelNet, kernel_net_start, kernel_net_step
+from multibody.recorded_loads import add_recorded_loads
 from multibody.recorder import Recorder
 from multibody.solver_output import solver_chatter_captured
 
@@ -200,6 +201,8 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
         to_child.append(rest_attitudes[joint.child].T @ joint.hinge_to_lvlh)
         p_parent.append(parent.body_to_lvlh.T @ (joint.point_lvlh - parent.com_lvlh))
         p_child.append(rest_attitudes[joint.child].T @ (joint.point_lvlh - rest_coms[joint.child]))
+    if assembly.body_loads is not None:
+        add_recorded_loads(mbs, body_objects, assembly.body_loads, assembly.solver.step)
     mbs.Assemble()
     state_index = _object_state_index(mbs, generic_nodes, [3 * n_exudyn] * bool(n_exudyn) + [6] * len(body_nodes))
     kernel_net = None
@@ -341,6 +344,8 @@ def initial_kinetic_energy(assembly: ImpactAssembly) -> float:
     for b in assembly.bodies:
         omega = np.asarray(b.omega_body, float)
         energy += 0.5 * b.mass * float(np.dot(b.velocity_lvlh, b.velocity_lvlh)) + 0.5 * omega @ b.inertia_body @ omega
+    if assembly.body_loads is not None:     # driven by recorded loads: the recording run's reference
+        energy = max(energy, assembly.body_loads.reference_energy)
     return energy
 
 

@@ -48,6 +48,7 @@ from multibody.kernel import (
     THREAD_DISSIPATED,
     THREAD_ELASTIC,
 )
+from multibody.recorded_loads import applied_work
 from multibody.recorder_kernel import body_sample, net_sums
 
 #: Longest simulated time between two finite-state checks when the output rate is lower (s):
@@ -70,6 +71,8 @@ class Recorder:
         self.health = health or HealthWatch(cause="")
         self.joint_active = np.ones(len(assembly.joints), bool)
         self._released_energy = 0.0
+        self._applied_work = 0.0        # J, by recorded loads (sequential method), since t = 0
+        self._previous_body_state = None
         solver = assembly.solver
         self.step = solver.step
         self.output_interval = 1.0 / solver.output_rate
@@ -226,12 +229,24 @@ class Recorder:
         }
         if self.assembly.chaser is not None:
             e["chaser_kinetic"] = summary[9]
+        if self.assembly.body_loads is not None:
+            e["applied_loads_work"] = -self._work_of_applied_loads(t, w["com"], w["vel"], w["omega"])
         e["total"] = sum(e.values())
         for key, value in e.items():
             row["energy_" + key] = value
         row["momentum_linear_lvlh"] = net[2:5] + w["summary"][10:13]
         row["momentum_angular_lvlh"] = net[5:8] + w["summary"][13:16]
         return row
+
+    def _work_of_applied_loads(self, t, com_lvlh, velocity_lvlh, omega_body) -> float:
+        """Work (J) done by the recorded loads since t = 0: the energy they bring in, which the
+        balance subtracts so that it stays closed."""
+        if self._previous_body_state is not None:
+            t0, com0, velocity0, omega0 = self._previous_body_state
+            self._applied_work += applied_work(self.assembly.body_loads, self.step, t0, t, com0, com_lvlh, velocity0,
+                                               omega0, omega_body)
+        self._previous_body_state = (t, com_lvlh.copy(), velocity_lvlh.copy(), omega_body.copy())
+        return self._applied_work
 
     def _store(self, row):
         """Write a row into the preallocated series (allocated at the first sample, from its shapes)."""
