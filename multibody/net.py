@@ -50,6 +50,16 @@ class NetTopology:
         return len(self.masses)
 
 
+def single_node_net(position_lvlh, mass: float, radius: float) -> NetTopology:
+    """A "net" of one free node and no threads (m, kg, m): where a model needs a net and has none
+    (the sequential method's driven debris, analytic tests)."""
+    return NetTopology(
+        positions=np.atleast_2d(np.asarray(position_lvlh, float)), masses=np.array([float(mass)]),
+        radii=np.array([float(radius)]), threads=np.zeros((0, 2), np.int64), rest_lengths=np.zeros(0),
+        stiffness=np.zeros(0), damping=np.zeros(0), bending_triples=np.zeros((0, 3), np.int64),
+        bending_stiffness=np.zeros(0), nodes_per_side=1, n_bullets=0)
+
+
 def square_grid_threads(nodes_per_side: int) -> np.ndarray:
     """Thread node pairs of a square mesh, row-major node numbering: (2 N (N-1), 2) int."""
     idx = np.arange(nodes_per_side**2).reshape(nodes_per_side, nodes_per_side)

@@ -6,7 +6,7 @@ import pytest
 import trimesh
 
 from multibody.assembly import ContactLaw, ImpactAssembly, RigidBodySpec, SolverSpec
-from multibody.net import NetTopology, flat_square_net
+from multibody.net import NetTopology, flat_square_net, single_node_net
 
 #: Seed paper Table 1/2 values used by several tests.
 KEVLAR_NODE_MASS = 0.0077      # kg, 35 x 35 Kevlar net node (paper Sec. 3.1, thread mass spread)
@@ -15,10 +15,7 @@ PAPER_CONTACT_STIFFNESS = 1.622e8  # N/m^1.5, paper Table 2
 
 def single_node(position, velocity, mass=KEVLAR_NODE_MASS, radius=0.001) -> NetTopology:
     """A 'net' of one free node: no threads."""
-    return NetTopology(
-        positions=np.atleast_2d(np.asarray(position, float)), masses=np.array([mass]), radii=np.array([radius]),
-        threads=np.zeros((0, 2), np.int64), rest_lengths=np.zeros(0), stiffness=np.zeros(0), damping=np.zeros(0),
-        bending_triples=np.zeros((0, 3), np.int64), bending_stiffness=np.zeros(0), nodes_per_side=1, n_bullets=0)
+    return single_node_net(position, mass, radius)
 
 
 def wall_body(center=(0.0, 1.0, 0.0), size=2.0, mass=1e12) -> RigidBodySpec:

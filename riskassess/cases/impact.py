@@ -66,6 +66,10 @@ class Simulation(Strict):
         "kernel", description="Who integrates the net nodes: 'kernel' (the compiled force kernel, inside the "
                               "bodies' VelocityVerlet step; fast) or 'exudyn' (one Exudyn node for the whole net, "
                               "the reference path). Runge-Kutta integrators always use 'exudyn'.")
+    coupling: Literal["coupled", "sequential"] = Field(
+        "coupled", description="'coupled': net and debris in one system (the tool's model); 'sequential': the seed "
+                               "paper's method, the net against the debris held fixed, then the recorded contact "
+                               "force and moment histories applied to the free debris (docs/model.md).")
 
     @model_validator(mode="after")
     def _rates_fit_step(self):
@@ -473,6 +477,13 @@ class Case(Strict):
             if loc.joint not in joints:
                 raise ValueError(f"structures: weak location '{loc.name}': joint '{loc.joint}' is not in "
                                  f"target.joints {joints}")
+        return self
+
+    @model_validator(mode="after")
+    def _sequential_without_chaser(self):
+        if self.simulation.coupling == "sequential" and self.chaser is not None:
+            raise ValueError("simulation.coupling = 'sequential' (the seed paper's method, the net launched free "
+                             "against a fixed target) takes no [chaser]; remove it or use coupling = 'coupled'")
         return self
 
 

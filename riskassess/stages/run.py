@@ -14,9 +14,10 @@ import trimesh
 from multibody.impact import ImpactSimulation
 from riskassess.products import results
 from riskassess.models.impact import model_inputs, weak_locations
+from riskassess.models.impact_sequential import applied_contact_series, driven_inputs, recorded_loads, wall_inputs
 from riskassess.cases.impact import Case, load_case
 from riskassess.products.outfolder import OutputFolder, claim
-from riskassess.products.summary import run_summary
+from riskassess.products.summary import run_summary, sequential_summary
 from structures.release import ReleaseMonitor
 from structures.verdict import INDETERMINATE, demand_series, structures_verdict
 
@@ -37,9 +38,12 @@ def software_versions() -> dict:
             "numba": numba.__version__, "trimesh": trimesh.__version__}
 
 
-def prepare_simulation(case: Case, case_path: Path) -> ImpactSimulation:
-    """Build the Exudyn model; raises ``ValueError`` for model-level problems before running."""
+def prepare_simulation(case: Case, case_path: Path, wall: bool = False) -> ImpactSimulation:
+    """Build the Exudyn model (with ``wall``, the sequential method's first step: the target held
+    fixed); raises ``ValueError`` for model-level problems before running."""
     inputs = model_inputs(case, case_path.parent)
+    if wall:
+        inputs = wall_inputs(inputs)
     return ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
 
 
@@ -47,26 +51,42 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
              overwrite: bool = False, pending=(), command: str = "run") -> RunOutput:
     """Load (unless ``case`` is the already validated file), claim the output folder
     (:func:`riskassess.products.outfolder.claim`), simulate and write the run folder. ``pending``: product
-    steps (``report``, ``vtk``) the caller makes next; the status stays ``running`` until they end."""
+    steps (``report``, ``vtk``) the caller makes next; the status stays ``running`` until they end.
+    A sequential case (``simulation.coupling``) runs the net against the fixed target first and
+    judges the free debris under the recorded loads (:mod:`riskassess.models.impact_sequential`)."""
     case_path = Path(case_path)
     case = case or load_case(case_path)
-    simulation = prepare_simulation(case, case_path)
+    sequential = case.simulation.coupling == "sequential"
+    simulation = prepare_simulation(case, case_path, wall=sequential)
     folder = begin_run_folder(Path(out_dir), case_path, case, overwrite, command)
     with folder.recording():
+        if sequential:
+            wall_recorder = run_recorded(simulation, folder, progress=_first_half(progress, case))
+            wall = simulation
+            loads = recorded_loads(wall_recorder.series, wall.health.reference_energy)
+            inputs = driven_inputs(model_inputs(case, case_path.parent), loads)
+            simulation = ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
         locations = weak_locations(case, simulation.assembly)
         monitor = None
         if locations and case.structures.release != "never":
             monitor = ReleaseMonitor(locations, simulation.system, case.structures.skip_initial,
                                      case.structures.release)
-        recorder = run_recorded(simulation, folder, progress=progress, monitor=monitor)
-        summary = write_simulation(folder, recorder, simulation, case)
+        recorder = run_recorded(simulation, folder, progress=_second_half(progress, case) if sequential else progress,
+                                monitor=monitor)
+        if sequential:
+            recorder.series = applied_contact_series(recorder.series, loads)
+            summary = write_sequential(folder, wall_recorder, wall, recorder, simulation, case, case_path)
+            net_positions_final = wall_recorder.net["positions_lvlh"][-1]
+        else:
+            summary = write_simulation(folder, recorder, simulation, case)
+            net_positions_final = recorder.net["positions_lvlh"][-1]
     verdict = None
     if locations:
         # A later stage that fails leaves the finished simulation results and says so.
         try:
             verdict = structures_verdict(
                 locations, recorder.series, simulation.assembly, monitor.events if monitor else [],
-                recorder.net["positions_lvlh"][-1], case.structures.skip_initial, case.structures.release)
+                net_positions_final, case.structures.skip_initial, case.structures.release)
             results.atomic_write_npz(folder.path / "structures.npz", demand_series(locations, recorder.series))
             results.atomic_write_json(folder.path / "structures.json", verdict)
         except BaseException as exc:
@@ -75,6 +95,16 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
         folder.add_files("structures.json", "structures.npz")
     folder.finish("complete", pending)
     return RunOutput(folder.path, summary, verdict)
+
+
+def _first_half(progress, case: Case):
+    """Progress of a sequential run's first step (the wall run) on the 0..end_time scale of the whole."""
+    return None if progress is None else (lambda t: progress(0.5 * t))
+
+
+def _second_half(progress, case: Case):
+    end = case.simulation.end_time
+    return None if progress is None else (lambda t: progress(0.5 * end + 0.5 * t))
 
 
 def run_recorded(simulation: ImpactSimulation, folder: OutputFolder, **run_options):
@@ -110,7 +140,23 @@ def write_simulation(folder: OutputFolder, recorder, simulation: ImpactSimulatio
     return summary
 
 
-def write_simulation_results(out: Path, recorder, simulation: ImpactSimulation) -> None:
+def write_sequential(folder: OutputFolder, wall_recorder, wall: ImpactSimulation, recorder,
+                     simulation: ImpactSimulation, case: Case, case_path: Path) -> dict:
+    """Write a sequential run: the driven debris' series (``timeseries.npz``), the net of the wall
+    run (``net.npz``) and the wall run's own series (``wall_timeseries.npz``: the loads recorded on
+    the fixed target, the net's energies), and the summary of both."""
+    coupled = model_inputs(case, case_path.parent).assembly
+    summary = sequential_summary(wall_recorder, wall.assembly, recorder, simulation.assembly, coupled, case.name)
+    write_net_and_bodies(folder.path, wall_recorder, wall)
+    results.atomic_write_npz(folder.path / "wall_timeseries.npz", dict(wall_recorder.series))
+    write_series(folder.path, recorder, simulation)
+    results.atomic_write_json(folder.path / "summary.json", summary)
+    folder.add_files("summary.json", "timeseries.npz", "net.npz", "bodies.npz", "wall_timeseries.npz")
+    return summary
+
+
+def write_series(out: Path, recorder, simulation: ImpactSimulation) -> None:
+    """``timeseries.npz``: the recorder's series with the body and joint names."""
     assembly = simulation.assembly
     series = dict(recorder.series)
     series["body_names"] = np.array([b.name for b in assembly.bodies])
@@ -118,6 +164,16 @@ def write_simulation_results(out: Path, recorder, simulation: ImpactSimulation) 
     series["joint_names"] = np.array([j.name for j in assembly.joints])
     series["joint_kinds"] = np.array([j.kind for j in assembly.joints])
     results.atomic_write_npz(out / "timeseries.npz", series)
+
+
+def write_simulation_results(out: Path, recorder, simulation: ImpactSimulation) -> None:
+    write_series(out, recorder, simulation)
+    write_net_and_bodies(out, recorder, simulation)
+
+
+def write_net_and_bodies(out: Path, recorder, simulation: ImpactSimulation) -> None:
+    """``net.npz`` (the recorder's net snapshots and the net's arrays) and ``bodies.npz`` (meshes)."""
+    assembly = simulation.assembly
     net = assembly.net
     results.atomic_write_npz(out / "net.npz", dict(
         recorder.net, threads=net.threads, rest_lengths=net.rest_lengths, stiffness=net.stiffness,
