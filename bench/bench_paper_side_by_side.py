@@ -46,6 +46,9 @@ PAPER = [
     ("ASAR mount shear stress (kPa)", 2.78, "kPa", "2.78 kPa from 750 N shear [Sec. 3.4, ref. 18]"),
     ("Ka-band dish root shear stress within 1 s (MPa)", 50.0, "MPa", ">= 50 MPa (the low shear limit is reached "
                                                                    "within 1 s) [Sec. 3.4, Fig. 14]"),
+    ("ASAR mount axial stress N/A, the paper's reading (kPa)", 8.55, "kPa",
+     "8.55 kPa = 2000 N / (1.5 m x 0.156 m): axial only [Sec. 3.4]"),
+    ("ASAR mount transverse shear stress (kPa)", 2.78, "kPa", "2.78 kPa from 750 N [Sec. 3.4]"),
     ("main body roll rate at the end (deg/s)", 1.75, "deg/s", "+1.75 deg/s for the single-body model; larger "
                                                               "with the array, no number [Sec. 3.3.2]"),
 ]
@@ -97,7 +100,9 @@ def figures(run: Path) -> dict:
         PAPER[8][0]: 1e-3 * locations["asar_mount"]["criteria"]["normal_stress"]["peak"],
         PAPER[9][0]: 1e-3 * locations["asar_mount"]["criteria"]["shear_stress"]["peak"],
         PAPER[10][0]: 1e-6 * peak_within("ka_band_dish_root", "shear_stress", 1.0),
-        PAPER[11][0]: float(np.degrees(s["body_omega_body"][-1, 0, 0])),
+        PAPER[11][0]: 1e-3 * peak_within("asar_mount", "axial_stress", ts[-1]),
+        PAPER[12][0]: 1e-3 * peak_within("asar_mount", "transverse_shear_stress", ts[-1]),
+        PAPER[13][0]: float(np.degrees(s["body_omega_body"][-1, 0, 0])),
         "hinge moment h1 / h3 RMS after 0.25 s (N m)": (
             float(np.sqrt(np.mean(s["joint_moment_joint"][judged, hinge, 0] ** 2))),
             float(np.sqrt(np.mean(s["joint_moment_joint"][judged, hinge, 2] ** 2)))),
