@@ -108,6 +108,9 @@ def summary_rows(summary: dict) -> list[tuple[str, str, str]]:
     dv = summary["debris_velocity_change_final_third_mean_lvlh_m_s"]
     est = summary["momentum_exchange_estimate_lvlh_m_s"]
     rows = [
+        ("coupling", "sequential (the paper's method: net on the fixed target, then the recorded loads on the "
+                     "free debris)" if summary.get("coupling") == "sequential" else "coupled (net and debris in one "
+                                                                                     "system)", "sequential"),
         ("peak contact force (N)", f"{f['value']:.4g} at {f['time_s']:.3f} s", f"{ref['peak_contact_force_N']:.3g}"),
         ("peak contact moment (N m)", f"{m['value']:.4g} at {m['time_s']:.3f} s", f"{ref['peak_contact_moment_Nm']:.3g}"),
         ("debris along-track velocity change, mean of last third (m/s)", f"{dv[1]:.4f} (estimate {est[1]:.4f})",
