@@ -30,7 +30,8 @@ from exudyn.itemInterface import (
     ObjectMassPoint,
 )
 
-from multibody.impact import ImpactSimulation, net_stable_step, solver_chatter_to_stderr
+from multibody.impact import ImpactSimulation, net_stable_step
+from multibody.solver_output import solver_chatter_captured
 from riskassess.models.impact import model_inputs
 from riskassess.cases.impact import load_case
 from riskassess.products.summary import run_summary
@@ -94,7 +95,7 @@ def plain_exudyn_net(net, step: float, n_steps: int) -> float:
     s.solution.file.write = False
     s.solution.sensors.active = False
     start = time.perf_counter()
-    with solver_chatter_to_stderr():
+    with solver_chatter_captured():
         exu.SolveDynamic(mbs, s, solverType=exu.DynamicSolverType.VelocityVerlet)
     return (time.perf_counter() - start) / n_steps
 
