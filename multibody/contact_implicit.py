@@ -157,6 +157,46 @@ def _lower_bracket(d0, free, rate0, accel_n, step, reduced_mass, stiffness, expo
     return lo
 
 
+#: Bisection steps of the friction impulse: 2^-50 of its bracket, round-off.
+FRICTION_BISECTIONS = 50
+
+
+@njit(cache=True)
+def friction_impulse(free_mid_slip, free_end_slip, normal_impulse, reduced_mass, mu_static, mu_kinetic,
+                     transition_speed):
+    """Friction impulse (N s) over one step, consistent with the slip it leaves.
+
+    The Hollar coefficient is read at the step's mean slip *with* the friction acting: the impulse
+    j slows the slip linearly over the step, so its mean is ``free_mid_slip - j / (2 m)``, and
+    j = mu(mean slip) N h solves for it (bisection: a root exists between 0 and the impulse that
+    stops the slip). Reading mu at the slip without friction overstated it in the regularised
+    range (slip below ``transition_speed``), which made resting contacts stick: the net stayed on a
+    tumbling target 0.3 s longer than the sub-cycle's (docs/model.md, "Contact"). Friction may stop
+    the slip within the step but never reverses it.
+
+    Parameters
+    ----------
+    free_mid_slip, free_end_slip : float   Slip speed without friction at mid-step and end (m/s).
+    normal_impulse : float                 Normal contact impulse over the step, N h (N s).
+    reduced_mass : float                   Node-body reduced mass (kg).
+    """
+    stop = reduced_mass * max(free_end_slip, 0.0)
+    if stop <= 0.0:
+        return 0.0
+    mean_slip = max(free_mid_slip - 0.5 * stop / reduced_mass, 0.0)
+    if stop <= hollar_friction_coefficient(mean_slip, mu_static, mu_kinetic, transition_speed) * normal_impulse:
+        return stop            # friction enough to stop the slip within the step
+    lo, hi = 0.0, stop
+    for _ in range(FRICTION_BISECTIONS):
+        j = 0.5 * (lo + hi)
+        mean_slip = max(free_mid_slip - 0.5 * j / reduced_mass, 0.0)
+        if j < hollar_friction_coefficient(mean_slip, mu_static, mu_kinetic, transition_speed) * normal_impulse:
+            lo = j
+        else:
+            hi = j
+    return 0.5 * (lo + hi)
+
+
 @njit(cache=True)
 def contact_implicit_step(penetration, relative_velocity, normal, external_force, node_mass, body_mass, step,
                           stiffness, exponent, damping, mu_static, mu_kinetic, transition_speed, impulse):
@@ -205,9 +245,7 @@ def contact_implicit_step(penetration, relative_velocity, normal, external_force
             ux, uy, uz = mx / slip, my / slip, mz / slip
             start = gx * ux + gy * uy + gz * uz
             end_free = start + tx * ux + ty * uy + tz * uz
-            mu = hollar_friction_coefficient(slip, mu_static, mu_kinetic, transition_speed)
-            # friction may stop the slip within the step but never reverse it (impulse, N s)
-            j_t = min(mu * force * step, reduced_mass * max(end_free, 0.0))
+            j_t = friction_impulse(slip, end_free, force * step, reduced_mass, mu_static, mu_kinetic, transition_speed)
             jx -= j_t * ux
             jy -= j_t * uy
             jz -= j_t * uz
