@@ -66,6 +66,10 @@ class Simulation(Strict):
         "kernel", description="Who integrates the net nodes: 'kernel' (the compiled force kernel, inside the "
                               "bodies' VelocityVerlet step; fast) or 'exudyn' (one Exudyn node for the whole net, "
                               "the reference path). Runge-Kutta integrators always use 'exudyn'.")
+    implicit_contact_speed: Annotated[float, Field(ge=0, le=1.0)] = Field(
+        0.15, description="A node's single contact approaching or separating slower than this (m/s) takes one "
+                          "implicit step instead of the explicit sub-cycle (docs/model.md, 'Contact'); 0 sub-cycles "
+                          "every contact (the reference path, about 2.4 times slower).")
     coupling: Literal["coupled", "sequential"] = Field(
         "coupled", description="'coupled': net and debris in one system (the tool's model); 'sequential': the seed "
                                "paper's method, the net against the debris held fixed, then the recorded contact "

@@ -163,7 +163,8 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
                            mu_kinetic=law.mu_kinetic, transition_speed=law.transition_speed),
         solver=SolverSpec(end_time=sim.end_time, step=sim.step, integrator=sim.integrator,
                           output_rate=sim.output_rate, net_output_rate=sim.net_output_rate,
-                          contact_substep=sim.contact_substep, net_integration=sim.net_integration),
+                          contact_substep=sim.contact_substep, net_integration=sim.net_integration,
+                          implicit_contact_speed=sim.implicit_contact_speed),
         mean_motion=mean_motion(case.orbit.altitude) if isinstance(case.orbit, CircularOrbit) else 0.0,
         mount=mount, chaser=chaser_index)
     return ModelInputs(assembly, rest_att, rest_com)
