@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from riskassess.diagnosis.effects import CATALOG
+from riskassess.diagnosis.forward import make_pairs, pair_candidates, selection_steps
 from riskassess.diagnosis.fit import (CandidateFit, FitResult, Problem, first_unpredicted_time, prediction,
                            step_error_sigma)
 from multibody.health import SimulationFailed
@@ -216,17 +217,34 @@ def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, 
     not_applicable = {k: v for k, v in not_applicable.items() if v}
     fitted = [k for k in CATALOG if k not in not_applicable and (candidates is None or k in candidates)]
     fits = fit_candidates(problem, fitted, workers, progress)
-    predictions = {k: prediction(problem, CATALOG.get(k), f, problem.time) for k, f in fits.items()}
+    effects = dict(CATALOG)
+    predictions = {k: prediction(problem, effects.get(k), f, problem.time) for k, f in fits.items()}
     fits, predictions, diverged = _without_diverged(problem, fits, predictions)
-    step_errors = {k: step_error_sigma(problem, CATALOG.get(k), f, predictions[k]) for k, f in fits.items()}
+    step_errors = {k: step_error_sigma(problem, effects.get(k), f, predictions[k]) for k, f in fits.items()}
     scores = score(problem, predictions, step_errors)
     decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms, problem)
+    if decision["cause"] == "unexplained":
+        # two effects at once? (riskassess.diagnosis.forward)
+        pairs = make_pairs(pair_candidates(fits, effects, case.diagnosis.decisive_delta_bic), fits, effects, problem)
+        for pair in pairs:
+            effects[pair.id] = pair
+            fits[pair.id] = CandidateFit(problem, pair).fit(fits["nominal"])
+            predictions[pair.id] = prediction(problem, pair, fits[pair.id], problem.time)
+        if pairs:
+            fits, predictions, more = _without_diverged(problem, fits, predictions)
+            diverged.update(more)
+            step_errors.update({p.id: step_error_sigma(problem, p, fits[p.id], predictions[p.id]) for p in pairs
+                                if p.id in fits})
+            scores = score(problem, predictions, step_errors)
+            decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms, problem)
     chosen = decision["model"]
     before = analyse(problem.time, predictions["nominal"], problem.values, problem.noise)
     after = analyse(problem.time, predictions[chosen], problem.values, problem.noise)
     rmse_before, rmse_after, gain = _gain(scores, chosen)
     answer = {
         "case": case.name, "scenario": case.kind, "measured": str(measured_path), "cause": decision["cause"],
+        "effects": decision["cause"].split("+") if decision["cause"] not in ("none", "unexplained") else [],
+        "selection_steps": selection_steps(fits, scores, chosen),
         "confidence": decision["confidence"], "statement": decision["reason"], "model": chosen,
         "parameters": _parameters(fits[chosen], nominal=False) if chosen != "nominal" else {},
         "nominal_parameters": _parameters(fits[chosen], nominal=True),
@@ -251,8 +269,9 @@ def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, 
     case_as_given = prediction(problem, None, _unfitted(problem), problem.time)
     answer["rmse_case_as_given"] = {c: v["rmse"] for c, v in score(problem, {"case": case_as_given})["case"]["holdout"].items()}
     answer["extended_case"] = None
+    # a pair's extended case is not written: one [[effects]] entry per effect is not built yet
     extended = extended_case(case_path, problem, fits[chosen]) if chosen != "nominal" and \
-        decision["cause"] == chosen else None
+        decision["cause"] == chosen and "+" not in chosen else None
     answer["wall_s"] = time.perf_counter() - wall
     return answer, (problem, predictions, chosen, before, after, extended)
 
