@@ -10,7 +10,7 @@ from riskassess.diagnosis.exudyn_model import ExudynScenario
 from riskassess.diagnosis.model import predict
 from riskassess.diagnosis.plant import Plant
 from riskassess.diagnosis.synthetic import channel_noise, sample_times
-from tests.riskassess.diagnosis.conftest import HINGED_CASE, TUMBLING_CASE
+from tests.riskassess.diagnosis.conftest import HINGED_CASE, TUMBLING_CASE, case_with
 from tests.riskassess.diagnosis.test_diagnose import DURATION, _diagnose
 
 
@@ -42,7 +42,6 @@ def test_discrepancy_torque_is_its_legendre_series(tumbling_rocket_body):
 def test_out_of_catalog_effects_get_no_confident_catalog_cause(tmp_path, family, case_path, request):
     """A torque fixed in inertial space (a solar-pressure-like load) and a quadratic hinge damping are
     in no catalog entry: 20 sigma of departure, default noise."""
-    from tests.riskassess.diagnosis.conftest import case_with
     case = case_with(case_path)
     plant = Plant.from_case(case)
     rng = np.random.default_rng(7)
