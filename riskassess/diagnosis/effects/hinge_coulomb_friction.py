@@ -119,11 +119,72 @@ class HingeCoulombFriction(Effect):
     def law_parameters(self, plant, values):
         return np.array([float(values[0]), *stick_gains(plant), stick_rate(plant)])
 
-    def stiffness_rate(self, plant, specs):
+    def parameter_free_stiffness_rate(self, plant):
         return stick_rate(plant) + plant.damping / plant.effective_hinge_inertia()
+
+    def stiffness_rate(self, plant, specs):
+        return self.parameter_free_stiffness_rate(plant)
 
     def add_to_exudyn(self, builder, values, names):
         builder.add_hinge_torque(_StickAnchor(float(values[0]), builder.plant))
 
 
 EFFECT = HingeCoulombFriction()
+
+
+# ------------------------------------------------------------------ references for the stick-slip check
+def analytic_turning_points(theta0, stiffness, inertia, torque):
+    """Turning points of the analytic Coulomb ring-down J theta'' = -k theta - T sign(theta') released
+    from rest at ``theta0`` (rad), up to and including the one where it sticks: each half cycle is a
+    harmonic half period pi/omega about the centre +-T/k, so theta_n = (-1)^n (theta0 - 2 n T/k) at
+    t_n = n pi/omega, until |k theta_n| <= T.
+
+    Parameters
+    ----------
+    theta0 : float
+        Release angle (rad), at rest.
+    stiffness, inertia, torque : float
+        k (N m/rad), J (kg m^2) and the Coulomb torque T (N m).
+
+    Returns
+    -------
+    times, angles : ndarray, shape (n,)
+        Times (s) and hinge angles (rad) of the turning points; the last is the stop.
+    """
+    omega = np.sqrt(stiffness / inertia)
+    times, angles = [], []
+    n = 1
+    while True:
+        times.append(n * np.pi / omega)
+        angles.append((-1) ** n * (theta0 - 2 * n * torque / stiffness))
+        if abs(stiffness * angles[-1]) <= torque:
+            return np.array(times), np.array(angles)
+        n += 1
+
+
+def turning_points(times, angle):
+    """Sampled turning points of a swing: local maxima of |angle| (``times`` (s) and ``angle`` (rad),
+    shape (k,)); returns their times (s) and angles (rad)."""
+    a = np.abs(angle)
+    k = np.nonzero((a[1:-1] >= a[:-2]) & (a[1:-1] > a[2:]))[0] + 1
+    return times[k], angle[k]
+
+
+class ElastoPlasticFriction:
+    """An independent stiction law for the record (not the catalog's): the elasto-plastic bristle model
+    (Dahl / Dupont et al. 2002, without presliding creep): the friction is a stiff damped spring to an
+    anchor that is dragged along once the spring's torque reaches T, so the hinge sticks wherever the
+    held torque stays below T. Stateful hinge-torque user function of the Exudyn builder
+    (``ExudynScenario.add_hinge_torque``); used to make records the catalog's law did not make
+    (tests/riskassess/diagnosis/test_stiction.py, bench/bench_stick_slip.py)."""
+
+    def __init__(self, torque, inertia, anchor, bristle_frequency=15.0):
+        self.torque, self.anchor = torque, anchor
+        self.stiffness = inertia * bristle_frequency ** 2                    # N m/rad
+        self.damping = 2 * 0.7 * inertia * bristle_frequency                  # N m s/rad
+
+    def __call__(self, t, angle, rate):
+        reach = self.torque / self.stiffness
+        self.anchor = min(max(self.anchor, angle - reach), angle + reach)
+        held = self.stiffness * (angle - self.anchor) + self.damping * rate
+        return -min(max(held, -self.torque), self.torque)

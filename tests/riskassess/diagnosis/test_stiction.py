@@ -14,6 +14,8 @@ import numpy as np
 import pytest
 
 from riskassess.diagnosis.effects import CATALOG
+from riskassess.diagnosis.effects.hinge_coulomb_friction import (ElastoPlasticFriction, analytic_turning_points,
+                                                             turning_points)
 from riskassess.diagnosis.exudyn_model import ExudynScenario, simulate_exudyn
 from riskassess.diagnosis.model import predict
 from riskassess.diagnosis.plant import Plant
@@ -37,26 +39,6 @@ def one_dof_panel():
     case = case_with(HINGED_CASE, main_body={"mass": 1e8, "inertia": [[1e11, 0, 0], [0, 1e11, 0], [0, 0, 1e11]]},
                      hinge={"torsional_damping": 0.0}, initial={"angular_velocity": [0.0, 0.0, 0.0]})
     return Plant.from_case(case)
-
-
-def analytic_turning_points(theta0, stiffness, inertia, torque):
-    """(times (s), angles (rad)) of the turning points of the Coulomb ring-down up to the stop."""
-    omega = np.sqrt(stiffness / inertia)
-    times, angles = [], []
-    n = 1
-    while True:
-        times.append(n * np.pi / omega)
-        angles.append((-1) ** n * (theta0 - 2 * n * torque / stiffness))
-        if abs(stiffness * angles[-1]) <= torque:
-            return np.array(times), np.array(angles)
-        n += 1
-
-
-def turning_points(times, angle):
-    """Sampled extrema of |angle| (local maxima), i.e. the turning points of the swing."""
-    a = np.abs(angle)
-    k = np.nonzero((a[1:-1] >= a[:-2]) & (a[1:-1] > a[2:]))[0] + 1
-    return times[k], angle[k]
 
 
 @pytest.mark.parametrize("path", ["compiled", "exudyn"])
@@ -101,24 +83,6 @@ def test_stuck_hinge_breaks_away_when_the_held_torque_exceeds_the_limit():
     slides = predict(plant, times, FRICTION, [20.0], ["friction_torque"])["hinge_angle"]
     assert abs(slides[-1] - (2 * 20.0 / 60.0 - 0.4)) < 0.02 * 2 * 20.0 / 60.0, slides[-1]
     assert np.ptp(slides[times > 15.0]) < 1e-5     # a half period is pi/omega = 8.2 s
-
-
-class ElastoPlasticFriction:
-    """An independent stiction law for the record (not the catalog's): the elasto-plastic bristle model
-    (Dahl / Dupont et al. 2002, without presliding creep): the friction is a stiff damped spring to an
-    anchor that is dragged along once the spring's torque reaches T, so the hinge sticks wherever the
-    held torque stays below T. Stateful hinge-torque user function of the Exudyn builder."""
-
-    def __init__(self, torque, inertia, anchor, bristle_frequency=15.0):
-        self.torque, self.anchor = torque, anchor
-        self.stiffness = inertia * bristle_frequency ** 2                    # N m/rad
-        self.damping = 2 * 0.7 * inertia * bristle_frequency                  # N m s/rad
-
-    def __call__(self, t, angle, rate):
-        reach = self.torque / self.stiffness
-        self.anchor = min(max(self.anchor, angle - reach), angle + reach)
-        held = self.stiffness * (angle - self.anchor) + self.damping * rate
-        return -min(max(held, -self.torque), self.torque)
 
 
 def test_diagnose_names_friction_of_a_hinge_that_sticks(tmp_path):
