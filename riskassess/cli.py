@@ -410,6 +410,10 @@ def _cmd_diagnose(args) -> int:
     else:
         confidence = "" if answer["confidence"] is None else f" (confidence {answer['confidence']:.3f})"
         print(f"{answer['case']}: cause = {answer['cause']}{confidence}\n{answer['statement']}")
+        if len(answer["selection_steps"]) > 1:
+            for k, step in enumerate(answer["selection_steps"], 1):
+                print(f"  step {k}: + {step['added']}: BIC lower by {step['delta_bic_over_previous']:.1f}, residual "
+                      f"{step['train_rms_sigma']:.2f} / {step['holdout_rms_sigma']:.2f} sigma (training / held-out)")
         for name, p in answer["parameters"].items():
             print(f"  {name} = {p['value']:.4g} +- {p['std']:.2g} {p['unit']}")
         print("held-out RMSE before -> after (gain %): " + ", ".join(

@@ -50,6 +50,9 @@ class Effect:
     scenarios: tuple[str, ...] = ("tumbling_rigid", "hinged_appendage")
     #: It is seen only if one of these channels is measured.
     channels: tuple[str, ...] = ()
+    #: Whether its laws use the models' extra-state slot (the fast model's X_E, the towing model's
+    #: effect states): two such effects cannot be fitted together (riskassess.diagnosis.composite).
+    extra_state: bool = False
     #: numba load law of the fast model (``no_load``: none).
     law = staticmethod(no_load)
     #: numba load law of the towing model (:mod:`riskassess.diagnosis.towing_dynamics`; ``no_towing_load``: none).

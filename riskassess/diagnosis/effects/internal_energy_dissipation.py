@@ -52,6 +52,7 @@ def towing_law(t, q, v, p, work, xe, h, load):
 
 class InternalEnergyDissipation(Effect):
     id = "internal_energy_dissipation"
+    extra_state = True
     title = "nutation damping by internal energy dissipation (spherical viscous damper)"
     channels = ("omega_x", "omega_y", "omega_z", "q_w")
     scenarios = ("tumbling_rigid", "hinged_appendage", "towing")

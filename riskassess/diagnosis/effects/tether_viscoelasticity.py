@@ -73,6 +73,7 @@ def towing_law(t, q, v, p, work, xe, h, load):
 
 class TetherViscoelasticity(Effect):
     id = "tether_viscoelasticity"
+    extra_state = True
     title = "viscoelastic main tether (standard linear solid: a relaxing Maxwell branch)"
     scenarios = ("towing",)
     channels = ("tether_tension", "rel_x", "rel_y", "rel_z", "omega_x", "omega_y", "omega_z", "q_w")

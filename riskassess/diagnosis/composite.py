@@ -1,0 +1,132 @@
+"""Two catalog effects at once: the model that forward selection fits when one effect is not enough.
+
+:class:`EffectPair` implements the :class:`~riskassess.diagnosis.effects.base.Effect` interface by
+applying both effects: parameters concatenated (the first effect's, then the second's), plant
+modifications, sample times and sensor models chained, and the two numba load laws called in turn
+by one compiled law (:func:`paired_law`), so the pair runs in the same fast model, towing model and
+Exudyn builder as a single effect. Two effects that both carry extra states (the fast model has one
+slot for them) cannot be paired (:func:`can_pair`).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from riskassess.diagnosis.dynamics import LAW_SIGNATURE
+from riskassess.diagnosis.effects.base import Effect, Parameter
+from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
+
+_COMPILED: dict = {}     # (law, law, split) -> compiled pair law: each pair compiles once per process
+
+
+def can_pair(first: Effect, second: Effect) -> bool:
+    """Whether the two effects can be fitted together (different effects, not both with extra states)."""
+    return first.id != second.id and not (first.extra_state and second.extra_state)
+
+
+def paired_law(law_a, law_b, split: int, towing: bool = False):
+    """One compiled load law that calls ``law_a`` with ``p[:split]`` and ``law_b`` with ``p[split:]``
+    (the fast model's signature, or the towing model's with ``towing``)."""
+    key = (law_a, law_b, split, towing)
+    if key not in _COMPILED:
+        if towing:
+            @njit(TOWING_LAW_SIGNATURE)
+            def law(t, x, v, p, env, state, step, load):
+                law_a(t, x, v, np.ascontiguousarray(p[:split]), env, state, step, load)
+                law_b(t, x, v, np.ascontiguousarray(p[split:]), env, state, step, load)
+        else:
+            @njit(LAW_SIGNATURE)
+            def law(t, x, p, env, load):
+                law_a(t, x, np.ascontiguousarray(p[:split]), env, load)
+                law_b(t, x, np.ascontiguousarray(p[split:]), env, load)
+        _COMPILED[key] = law
+    return _COMPILED[key]
+
+
+class EffectPair(Effect):
+    """``first`` and ``second`` together, for one case (parameter counts and law layouts are fixed
+    by the case's plant and channels)."""
+
+    linear = False
+    extra_state = False
+
+    def __init__(self, first: Effect, second: Effect, case, channels, plant, start_values=(None, None)):
+        self.first, self.second = first, second
+        self.id = f"{first.id}+{second.id}"
+        self.title = f"{first.title}, and {second.title}"
+        self.scenarios = tuple(s for s in first.scenarios if s in second.scenarios)
+        self.extra_state = first.extra_state or second.extra_state
+        self._specs = (first.parameter_specs(case, channels), second.parameter_specs(case, channels))
+        self._start_values = start_values
+        self.n_first = len(self._specs[0])
+        self._plant = plant
+
+    @property
+    def law(self):
+        """The fast model's pair law (compiled on first use: ~1 s)."""
+        split = len(self.first.law_parameters(self._plant, _null(self._specs[0])))
+        return paired_law(self.first.law, self.second.law, split)
+
+    @property
+    def towing_law(self):
+        split = len(self.first.towing_law_parameters(self._plant, _null(self._specs[0])))
+        return paired_law(self.first.towing_law, self.second.towing_law, split, towing=True)
+
+    def _split(self, values):
+        values = np.asarray(values, float)
+        return values[:self.n_first], values[self.n_first:]
+
+    def parameter_specs(self, case, channels=None) -> list[Parameter]:
+        """Both effects' parameters; a name the two share is prefixed with its effect's id."""
+        a, b = self._specs
+        shared = {p.name for p in a} & {p.name for p in b}
+        rename = [lambda p, e=e: p if p.name not in shared else Parameter(f"{e.id}.{p.name}", p.unit, p.description,
+                                                                           p.typical, p.lower, p.upper, p.log)
+                  for e in (self.first, self.second)]
+        return [rename[0](p) for p in a] + [rename[1](p) for p in b]
+
+    def not_applicable(self, case, channels):
+        return self.first.not_applicable(case, channels) or self.second.not_applicable(case, channels)
+
+    def law_parameters(self, plant, values):
+        a, b = self._split(values)
+        return np.r_[self.first.law_parameters(plant, a), self.second.law_parameters(plant, b)]
+
+    def towing_law_parameters(self, plant, values):
+        a, b = self._split(values)
+        return np.r_[self.first.towing_law_parameters(plant, a), self.second.towing_law_parameters(plant, b)]
+
+    def modify_plant(self, plant, values):
+        a, b = self._split(values)
+        return self.second.modify_plant(self.first.modify_plant(plant, a), b)
+
+    def sample_times(self, times, values):
+        a, b = self._split(values)
+        return self.second.sample_times(self.first.sample_times(times, a), b)
+
+    def measure(self, outputs, values, names):
+        a, b = self._split(values)
+        names = list(names)
+        return self.second.measure(self.first.measure(outputs, a, names[:self.n_first]), b, names[self.n_first:])
+
+    def starts(self, specs):
+        """Each effect's own starts, and its fitted values from its single fit when known (forward
+        selection's step 1): the pair starts where each effect alone ended."""
+        a_specs, b_specs = specs[:self.n_first], specs[self.n_first:]
+        firsts = [v for v in (self._start_values[0],) if v is not None] + self.first.starts(a_specs)
+        seconds = [v for v in (self._start_values[1],) if v is not None] + self.second.starts(b_specs)
+        return [np.r_[a, b] for a in firsts[:2] for b in seconds[:2]]
+
+    def stiffness_rate(self, plant, specs):
+        return max(self.first.stiffness_rate(plant, specs[:self.n_first]),
+                   self.second.stiffness_rate(plant, specs[self.n_first:]))
+
+    def add_to_exudyn(self, builder, values, names):
+        a, b = self._split(values)
+        names = list(names)
+        self.first.add_to_exudyn(builder, a, names[:self.n_first])
+        self.second.add_to_exudyn(builder, b, names[self.n_first:])
+
+
+def _null(specs) -> np.ndarray:
+    return np.clip(np.zeros(len(specs)), [p.lower for p in specs], [p.upper for p in specs])
