@@ -121,6 +121,9 @@ class EffectPair(Effect):
         return max(self.first.stiffness_rate(plant, specs[:self.n_first]),
                    self.second.stiffness_rate(plant, specs[self.n_first:]))
 
+    def parameter_free_stiffness_rate(self, plant):
+        return max(self.first.parameter_free_stiffness_rate(plant), self.second.parameter_free_stiffness_rate(plant))
+
     def add_to_exudyn(self, builder, values, names):
         a, b = self._split(values)
         names = list(names)

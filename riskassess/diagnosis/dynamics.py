@@ -24,12 +24,13 @@ Clohessy-Wiltshire equation (seed paper eq. (9)) written in non-rotating axes.
 
 State x (``STATE_SIZE``): quaternion B->I [w, x, y, z], omega_B (rad/s), hinge angle (rad),
 hinge rate (rad/s), system CoM rho_I (m), its velocity (m/s), three extra states for effects
-(a nutation damper's rate, B (rad/s)).
+(a nutation damper's rate, B (rad/s)), and the hinge friction's stick anchor (rad; the angle a
+sticking hinge is held at, :mod:`riskassess.diagnosis.effects.hinge_coulomb_friction`).
 
 Effect laws are numba functions ``law(t, x, p, env, load)`` that ADD to ``load``
 (``LOAD_SIZE``): torque on the main body (B, N m), torque on the appendage (B, N m), hinge
-torque on the appendage about the axis (N m), force on the system CoM (I, N) and the rates of
-the extra states. ``env`` holds the plant's constants (layout ``ENV_*``).
+torque on the appendage about the axis (N m), force on the system CoM (I, N), the rates of
+the extra states and the stick anchor's rate (rad/s). ``env`` holds the plant's constants (layout ``ENV_*``).
 """
 from __future__ import annotations
 
@@ -46,11 +47,11 @@ LAW_SIGNATURE = types.void(types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR)
 _LAW = types.FunctionType(LAW_SIGNATURE)
 
 # state layout
-X_Q, X_W, X_TH, X_THD, X_R, X_V, X_E = 0, 4, 7, 8, 9, 12, 15
-STATE_SIZE = 18
+X_Q, X_W, X_TH, X_THD, X_R, X_V, X_E, X_ANCHOR = 0, 4, 7, 8, 9, 12, 15, 18
+STATE_SIZE = 19
 # load layout
-L_TM, L_TA, L_TH, L_F, L_E = 0, 3, 6, 7, 10
-LOAD_SIZE = 13
+L_TM, L_TA, L_TH, L_F, L_E, L_ANCHOR = 0, 3, 6, 7, 10, 13
+LOAD_SIZE = 14
 # env layout
 E_N, E_INC, E_U0, E_RADIUS, E_MM, E_MA, E_JM, E_JA, E_AXIS, E_HINGE, E_S0, E_K, E_C, E_HINGED = (
     0, 1, 2, 3, 4, 5, 6, 15, 24, 27, 30, 33, 34, 35)
@@ -84,6 +85,7 @@ def initial_state(plant: Plant) -> np.ndarray:
     x[X_R:X_R + 3] = rho
     x[X_V:X_V + 3] = plant.velocity0 + np.cross([0.0, 0.0, plant.mean_motion], rho)
     x[X_E:X_E + 3] = plant.omega0
+    x[X_ANCHOR] = plant.hinge_angle0
     return x
 
 
@@ -301,6 +303,7 @@ def derivative(t, x, law, p, env):
         dx[X_R + i] = x[X_V + i]
         dx[X_V + i] = tidal[i] + load[L_F + i] / mass
         dx[X_E + i] = load[L_E + i]
+    dx[X_ANCHOR] = load[L_ANCHOR]
     return dx
 
 

@@ -35,7 +35,7 @@ def predict(plant: Plant, times, effect: Effect | None = None, values=(), names=
     else:
         plant = effect.modify_plant(plant, values)
         law, p, sample_times = effect.law, effect.law_parameters(plant, values), effect.sample_times(times, values)
-    step = step or max_step(plant)
+    step = step or max_step(plant, effect.parameter_free_stiffness_rate(plant) if effect is not None else 0.0)
     states = integrate(law, np.ascontiguousarray(p if p.size else np.zeros(1), float), environment(plant),
                        initial_state(plant), np.ascontiguousarray(sample_times, float), step)
     out = outputs(plant, sample_times, states)

@@ -96,6 +96,11 @@ class Effect:
         1.5 / rate (RK4 is stable up to 2.78 / rate)."""
         return 0.0
 
+    def parameter_free_stiffness_rate(self, plant: Plant) -> float:
+        """Decay rate (1/s) the law adds whatever its parameters (a stick law's hold, for example);
+        :func:`riskassess.diagnosis.model.predict` keeps its default RK4 step below 1.5 / rate."""
+        return 0.0
+
     def add_to_exudyn(self, builder, values: np.ndarray, names) -> None:
         """Apply the effect to an Exudyn scenario builder before it is assembled."""
 
