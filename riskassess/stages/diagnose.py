@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from riskassess.diagnosis.composite import EffectPair
 from riskassess.diagnosis.discrepancy import DISCREPANCY_ID, Discrepancy, none_of_these
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.forward import make_pairs, pair_candidates, selection_steps
@@ -127,8 +128,19 @@ def _hint(problem: Problem, analysis: dict, nominal_prediction: dict) -> dict:
     return {"channel": worst, "terms": kept, "statement": describe_terms(worst, kept)}
 
 
-def extended_case(case_path: Path, problem: Problem, fit: FitResult) -> str:
-    """The input case with the named effect and its fitted parameters (and the fitted nominal values)."""
+def effect_entries(fit: FitResult, effect) -> list[dict]:
+    """The ``[[effects]]`` entries of a fitted model: one for a single effect, one per effect for a
+    pair (:class:`~riskassess.diagnosis.composite.EffectPair`; a name the two shared loses its prefix)."""
+    values = {n: p["value"] for n, p in _parameters(fit, nominal=False).items()}
+    if not isinstance(effect, EffectPair):
+        return [{"id": fit.id, "parameters": values}]
+    names = list(values)
+    parts = ((effect.first.id, names[:effect.n_first]), (effect.second.id, names[effect.n_first:]))
+    return [{"id": eid, "parameters": {n.removeprefix(f"{eid}."): values[n] for n in part}} for eid, part in parts]
+
+
+def extended_case(case_path: Path, problem: Problem, fit: FitResult, effect=None) -> str:
+    """The input case with the named effect(s) and fitted parameters (and the fitted nominal values)."""
     from scipy.spatial.transform import Rotation
 
     raw = read_toml(case_path)
@@ -153,9 +165,11 @@ def extended_case(case_path: Path, problem: Problem, fit: FitResult) -> str:
                        ("torsional_stiffness", "torsional_stiffness"), ("torsional_damping", "torsional_damping")):
         if key in value:
             raw["hinge"][field] = value[key]
-    effect = {n: p["value"] for n, p in _parameters(fit, nominal=False).items()}
-    raw["effects"] = [e for e in raw.get("effects", []) if e.get("id") != fit.id] + [{"id": fit.id, "parameters": effect}]
-    header = (f"# Extended by 'riskassess diagnose' from {case_path.name}: effect '{fit.id}' added with its fitted\n"
+    entries = effect_entries(fit, effect)
+    ids = {e["id"] for e in entries}
+    raw["effects"] = [e for e in raw.get("effects", []) if e.get("id") not in ids] + entries
+    named = " and ".join(f"'{e['id']}'" for e in entries)
+    header = (f"# Extended by 'riskassess diagnose' from {case_path.name}: effect {named} added with fitted\n"
               f"# parameters; the initial state and hinge values are the fitted nominal ones.\n") + header_note
     return header + toml_text(raw) + "\n"
 
@@ -278,9 +292,8 @@ def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, 
     case_as_given = prediction(problem, None, _unfitted(problem), problem.time)
     answer["rmse_case_as_given"] = {c: v["rmse"] for c, v in score(problem, {"case": case_as_given})["case"]["holdout"].items()}
     answer["extended_case"] = None
-    # a pair's extended case is not written: one [[effects]] entry per effect is not built yet
-    extended = extended_case(case_path, problem, fits[chosen]) if chosen != "nominal" and \
-        decision["cause"] == chosen and "+" not in chosen else None
+    extended = extended_case(case_path, problem, fits[chosen], effects.get(chosen)) if chosen != "nominal" and \
+        decision["cause"] == chosen else None
     answer["wall_s"] = time.perf_counter() - wall
     return answer, (problem, predictions, chosen, before, after, extended)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from riskassess.diagnosis.cases import load_diagnosis_case
 from riskassess.diagnosis.composite import EffectPair, can_pair
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.exudyn_model import simulate_exudyn
@@ -64,6 +65,10 @@ def test_two_hidden_effects_are_both_named(tmp_path, panel_on_hinge, first, seco
     # each step is decisive (the case's delta BIC 10) and the pair leaves noise (1.25 sigma)
     assert all(s["delta_bic_over_previous"] > 10.0 for s in steps)
     assert steps[-1]["train_rms_sigma"] < 1.25 and steps[-1]["holdout_rms_sigma"] < 1.25
+    # the extended case lists both effects with their fitted parameters, and loads
+    extended = load_diagnosis_case(answer["extended_case"])
+    assert [e.id for e in extended.effects] == [first, second]
+    assert set(extended.effects[0].parameters) | set(extended.effects[1].parameters) == set(truth)
     for name, true in truth.items():
         fitted = answer["parameters"][name]
         # within 4 sigma of its own uncertainty or 10 % (the Exudyn data vs the compiled fit model;
