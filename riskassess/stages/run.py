@@ -38,12 +38,9 @@ def software_versions() -> dict:
             "numba": numba.__version__, "trimesh": trimesh.__version__}
 
 
-def prepare_simulation(case: Case, case_path: Path, wall: bool = False) -> ImpactSimulation:
-    """Build the Exudyn model (with ``wall``, the sequential method's first step: the target held
-    fixed); raises ``ValueError`` for model-level problems before running."""
-    inputs = model_inputs(case, case_path.parent)
-    if wall:
-        inputs = wall_inputs(inputs)
+def _simulation(inputs) -> ImpactSimulation:
+    """The Exudyn model of ``inputs`` (:class:`riskassess.models.impact.ModelInputs`); raises
+    ``ValueError`` for model-level problems before running."""
     return ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
 
 
@@ -57,25 +54,25 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
     case_path = Path(case_path)
     case = case or load_case(case_path)
     sequential = case.simulation.coupling == "sequential"
-    simulation = prepare_simulation(case, case_path, wall=sequential)
+    inputs = model_inputs(case, case_path.parent)       # model-level problems raise before the folder is claimed
+    simulation = _simulation(wall_inputs(inputs) if sequential else inputs)
     folder = begin_run_folder(Path(out_dir), case_path, case, overwrite, command)
     with folder.recording():
         if sequential:
-            wall_recorder = run_recorded(simulation, folder, progress=_first_half(progress, case))
+            wall_recorder = run_recorded(simulation, folder, progress=_scaled(progress, 0.0))
             wall = simulation
             loads = recorded_loads(wall_recorder.series, wall.health.reference_energy)
-            inputs = driven_inputs(model_inputs(case, case_path.parent), loads)
-            simulation = ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
+            simulation = _simulation(driven_inputs(inputs, loads))
         locations = weak_locations(case, simulation.assembly)
         monitor = None
         if locations and case.structures.release != "never":
             monitor = ReleaseMonitor(locations, simulation.system, case.structures.skip_initial,
                                      case.structures.release)
-        recorder = run_recorded(simulation, folder, progress=_second_half(progress, case) if sequential else progress,
-                                monitor=monitor)
+        driven_progress = _scaled(progress, 0.5 * case.simulation.end_time) if sequential else progress
+        recorder = run_recorded(simulation, folder, progress=driven_progress, monitor=monitor)
         if sequential:
             recorder.series = applied_contact_series(recorder.series, loads)
-            summary = write_sequential(folder, wall_recorder, wall, recorder, simulation, case, case_path)
+            summary = write_sequential(folder, wall_recorder, wall, recorder, simulation, inputs.assembly, case)
             net_positions_final = wall_recorder.net["positions_lvlh"][-1]
         else:
             summary = write_simulation(folder, recorder, simulation, case)
@@ -97,14 +94,10 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
     return RunOutput(folder.path, summary, verdict)
 
 
-def _first_half(progress, case: Case):
-    """Progress of a sequential run's first step (the wall run) on the 0..end_time scale of the whole."""
-    return None if progress is None else (lambda t: progress(0.5 * t))
-
-
-def _second_half(progress, case: Case):
-    end = case.simulation.end_time
-    return None if progress is None else (lambda t: progress(0.5 * end + 0.5 * t))
+def _scaled(progress, offset: float):
+    """Progress of one step of a sequential run (wall run: ``offset`` 0, driven run: half the end
+    time) on the 0..end_time scale of the whole: each step is half of it."""
+    return None if progress is None else (lambda t: progress(offset + 0.5 * t))
 
 
 def run_recorded(simulation: ImpactSimulation, folder: OutputFolder, **run_options):
@@ -141,11 +134,11 @@ def write_simulation(folder: OutputFolder, recorder, simulation: ImpactSimulatio
 
 
 def write_sequential(folder: OutputFolder, wall_recorder, wall: ImpactSimulation, recorder,
-                     simulation: ImpactSimulation, case: Case, case_path: Path) -> dict:
+                     simulation: ImpactSimulation, coupled, case: Case) -> dict:
     """Write a sequential run: the driven debris' series (``timeseries.npz``), the net of the wall
     run (``net.npz``) and the wall run's own series (``wall_timeseries.npz``: the loads recorded on
-    the fixed target, the net's energies), and the summary of both."""
-    coupled = model_inputs(case, case_path.parent).assembly
+    the fixed target, the net's energies), and the summary of both; ``coupled``: the case's own
+    assembly (its net gives the momentum-exchange estimate)."""
     summary = sequential_summary(wall_recorder, wall.assembly, recorder, simulation.assembly, coupled, case.name)
     write_net_and_bodies(folder.path, wall_recorder, wall)
     results.atomic_write_npz(folder.path / "wall_timeseries.npz", dict(wall_recorder.series))
