@@ -37,12 +37,17 @@ class RecordedBodyLoads:
         """Index of the interval holding ``t`` (s); the last one past the end (then the load is 0)."""
         return int(np.searchsorted(self.time, t - 1e-9 * (self.time[1] - self.time[0] if len(self.time) > 1 else 1.0)))
 
-    def at(self, t: float, body: int) -> tuple[np.ndarray, np.ndarray]:
-        """(force LVLH (N), moment body frame (N m)) on ``body`` at ``t``; zero outside the record."""
+    def held(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """((nb, 3) forces LVLH (N), (nb, 3) moments body frame (N m)) held at ``t``; zero outside the record."""
         k = self.interval(t)
         if t <= 0.0 or k >= len(self.time):
-            return np.zeros(3), np.zeros(3)
-        return self.force_lvlh[k, body], self.moment_body[k, body]
+            return np.zeros_like(self.force_lvlh[0]), np.zeros_like(self.moment_body[0])
+        return self.force_lvlh[k], self.moment_body[k]
+
+    def at(self, t: float, body: int) -> tuple[np.ndarray, np.ndarray]:
+        """(force LVLH (N), moment body frame (N m)) on ``body`` at ``t``; zero outside the record."""
+        force, moment = self.held(t)
+        return force[body], moment[body]
 
 
 def applied_work(loads: RecordedBodyLoads, step: float, t0: float, t1: float, com_start_lvlh, com_end_lvlh,
@@ -60,13 +65,7 @@ def applied_work(loads: RecordedBodyLoads, step: float, t0: float, t1: float, co
     velocity_start_lvlh : (nb, 3) float               Body CoM velocities at t0 (m/s), LVLH.
     omega_start_body, omega_end_body : (nb, 3) float  Body rates at t0 and t1 (rad/s), body frames.
     """
-    def held(time):
-        k = loads.interval(time)
-        if time <= 0.0 or k >= len(loads.time):
-            return np.zeros_like(loads.force_lvlh[0]), np.zeros_like(loads.moment_body[0])
-        return loads.force_lvlh[k], loads.moment_body[k]
-
-    (force, moment), (force_before, moment_before) = held(t1), held(t0)
+    (force, moment), (force_before, moment_before) = loads.held(t1), loads.held(t0)
     displacement = np.asarray(com_end_lvlh) - np.asarray(com_start_lvlh)
     omega0 = np.asarray(omega_start_body)
     mean_rate = 0.5 * (omega0 + np.asarray(omega_end_body))
