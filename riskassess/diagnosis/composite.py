@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from riskassess.diagnosis.dynamics import LAW_SIGNATURE
-from riskassess.diagnosis.effects.base import Effect, Parameter
+from riskassess.diagnosis.effects.base import Effect, Parameter, switched_off
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
 
 _COMPILED: dict = {}     # (law, law, split) -> compiled pair law: each pair compiles once per process
@@ -64,12 +64,12 @@ class EffectPair(Effect):
     @property
     def law(self):
         """The fast model's pair law (compiled on first use: ~1 s)."""
-        split = len(self.first.law_parameters(self._plant, _null(self._specs[0])))
+        split = len(self.first.law_parameters(self._plant, switched_off(self._specs[0])))
         return paired_law(self.first.law, self.second.law, split)
 
     @property
     def towing_law(self):
-        split = len(self.first.towing_law_parameters(self._plant, _null(self._specs[0])))
+        split = len(self.first.towing_law_parameters(self._plant, switched_off(self._specs[0])))
         return paired_law(self.first.towing_law, self.second.towing_law, split, towing=True)
 
     def _split(self, values):
@@ -130,6 +130,3 @@ class EffectPair(Effect):
         self.first.add_to_exudyn(builder, a, names[:self.n_first])
         self.second.add_to_exudyn(builder, b, names[self.n_first:])
 
-
-def _null(specs) -> np.ndarray:
-    return np.clip(np.zeros(len(specs)), [p.lower for p in specs], [p.upper for p in specs])

@@ -94,8 +94,7 @@ class Discrepancy(Effect):
         t0, t1 = self.t0, self.t1
 
         def series(t, coefficients):
-            s = 2.0 * (t - t0) / (t1 - t0) - 1.0
-            return coefficients[0] + coefficients[1] * s + coefficients[2] * (1.5 * s * s - 0.5)
+            return float(np.dot(_legendre(t, t0, t1), coefficients))
 
         body = values[:3 * TERMS].reshape(3, TERMS)
         builder.add_body_torque(lambda t, k, rot, omega: np.array([series(t, c) for c in body]) if k == 0

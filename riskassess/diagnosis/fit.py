@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from riskassess.diagnosis.effects.base import Effect, Parameter
+from riskassess.diagnosis.effects.base import Effect, Parameter, switched_off
 from riskassess.diagnosis.model import max_step, predict
 from riskassess.diagnosis.channels import QUATERNION
 from riskassess.diagnosis.observation import scenario_channels
@@ -213,7 +213,7 @@ class CandidateFit:
 
     def null(self) -> np.ndarray:
         """The effect's parameters at zero, clipped into their bounds (SI): the effect switched off."""
-        return np.clip(np.zeros(len(self.specs)), [p.lower for p in self.specs], [p.upper for p in self.specs])
+        return switched_off(self.specs)
 
     # -- model ---------------------------------------------------------------------------
     def predict(self, z, times) -> dict:

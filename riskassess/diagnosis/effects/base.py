@@ -39,6 +39,11 @@ class Parameter:
     log: bool = False
 
 
+def switched_off(specs: list[Parameter]) -> np.ndarray:
+    """The parameters at zero, clipped into their bounds (SI): the effect switched off."""
+    return np.clip(np.zeros(len(specs)), [p.lower for p in specs], [p.upper for p in specs])
+
+
 class Effect:
     """Base class; subclasses set the class attributes and override what they change."""
 
