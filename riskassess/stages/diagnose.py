@@ -233,10 +233,9 @@ def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, 
     fitted = [k for k in CATALOG if k not in not_applicable and (candidates is None or k in candidates)]
     fits = fit_candidates(problem, fitted, workers, progress)
     effects = dict(CATALOG)
-    predictions = {k: prediction(problem, effects.get(k), f, problem.time) for k, f in fits.items()}
-    fits, predictions, diverged = _without_diverged(problem, fits, predictions)
-    step_errors = {k: step_error_sigma(problem, effects.get(k), f, predictions[k]) for k, f in fits.items()}
-    scores = score(problem, predictions, step_errors)
+    predictions, step_errors, diverged = {}, {}, {}
+    fits, predictions, scores = _predicted_and_scored(problem, fits, effects, predictions, step_errors, diverged,
+                                                      list(fits))
     decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms, problem)
     if decision["cause"] == "unexplained":
         # two effects at once? (riskassess.diagnosis.forward)
@@ -244,13 +243,9 @@ def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, 
         for pair in pairs:
             effects[pair.id] = pair
             fits[pair.id] = CandidateFit(problem, pair).fit(fits["nominal"])
-            predictions[pair.id] = prediction(problem, pair, fits[pair.id], problem.time)
         if pairs:
-            fits, predictions, more = _without_diverged(problem, fits, predictions)
-            diverged.update(more)
-            step_errors.update({p.id: step_error_sigma(problem, p, fits[p.id], predictions[p.id]) for p in pairs
-                                if p.id in fits})
-            scores = score(problem, predictions, step_errors)
+            fits, predictions, scores = _predicted_and_scored(problem, fits, effects, predictions, step_errors,
+                                                              diverged, [p.id for p in pairs])
             decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms, problem)
     alternative = _none_of_these_fit(problem, fits)
     if alternative is not None:
@@ -296,6 +291,19 @@ def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, 
         decision["cause"] == chosen else None
     answer["wall_s"] = time.perf_counter() - wall
     return answer, (problem, predictions, chosen, before, after, extended)
+
+
+def _predicted_and_scored(problem: Problem, fits: dict, effects: dict, predictions: dict, step_errors: dict,
+                          diverged: dict, new: list[str]):
+    """Predict the models ``new`` (into ``predictions``), drop every model whose prediction diverges
+    (into ``diverged``), add the kept new ones' step errors (into ``step_errors``) and score all;
+    returns (fits, predictions, scores)."""
+    for k in new:
+        predictions[k] = prediction(problem, effects.get(k), fits[k], problem.time)
+    fits, predictions, more = _without_diverged(problem, fits, predictions)
+    diverged.update(more)
+    step_errors.update({k: step_error_sigma(problem, effects.get(k), fits[k], predictions[k]) for k in new if k in fits})
+    return fits, predictions, score(problem, predictions, step_errors)
 
 
 def _none_of_these_fit(problem: Problem, fits: dict) -> FitResult | None:
