@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from riskassess.products.summary import contact_totals_debris
 from riskassess.stages.run import run_case
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -71,10 +72,7 @@ def figures(run: Path) -> dict:
     verdict = json.loads((run / "structures.json").read_text())
     loads = np.load(run / "wall_timeseries.npz") if (run / "wall_timeseries.npz").exists() else s
     t = loads["time"]
-    force = loads["contact_force_lvlh"][:, :, :].sum(axis=1)
-    com = loads["debris_com_lvlh"]
-    arms = loads["body_com_lvlh"] - com[:, None, :]
-    moment = (loads["contact_moment_lvlh"] + np.cross(arms, loads["contact_force_lvlh"])).sum(axis=1)
+    force, moment = contact_totals_debris(loads)
     first = t <= 0.5
     late = t >= 0.8 * t[-1]      # after wrapping (6-7.5 s of the 7.5 s run)
     joints = list(s["joint_names"])

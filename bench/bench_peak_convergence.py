@@ -128,10 +128,10 @@ def main() -> None:
 
 def report(results: dict, replicas: int) -> None:
     """Per window, location and criterion: baseline median [range], each variant's median change."""
-    def medians(variant):
-        runs = [results[(variant, r)] for r in range(replicas) if not isinstance(results[(variant, r)], str)]
-        return runs
-    base = medians("baseline")
+    def finished(variant):
+        """The replicas of ``variant`` that ran (a failed one holds its message)."""
+        return [results[(variant, r)] for r in range(replicas) if not isinstance(results[(variant, r)], str)]
+    base = finished("baseline")
     names = [v for v in VARIANTS if v != "baseline"]
     unconverged = total = 0
     for window in base[0][next(iter(base[0]))]:
@@ -143,7 +143,7 @@ def report(results: dict, replicas: int) -> None:
             med = np.median(values)
             cells = []
             for n in names:
-                runs = medians(n)
+                runs = finished(n)
                 if not runs:
                     cells.append(f"{'failed':>12s}")
                     continue

@@ -111,9 +111,9 @@ def joint_stiffness_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: 
     ``first_mode_hz``, at that frequency: the joint then carries the structure's compliance,
     and its loads no longer follow the step (docs/structures.md, "Are the judged peaks
     converged?"). A structural mode is tuned exactly on each axis alone
-    (:func:`coupled_mode_inertia_joint_frame`); the automatic penalty on the reduced mass, which
-    puts its modes up to ~2x faster (a margin the 1 / step check leaves). Given values must stay below the explicit
-    stability limit, and a structural mode must be resolved by at least
+    (:func:`coupled_mode_inertia_joint_frame`); the automatic penalty is tuned on the reduced mass,
+    which puts its modes up to ~2x faster than asked (a margin the 1 / step check leaves). Given
+    values must stay below the explicit stability limit, and a structural mode must be resolved by at least
     ``STRUCTURAL_STEPS_PER_PERIOD`` steps; otherwise a ``ValueError`` names the joint.
     """
     inertia = effective_mass_joint_frame(joint, parent, child)
