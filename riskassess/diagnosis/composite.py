@@ -48,7 +48,6 @@ class EffectPair(Effect):
     by the case's plant and channels)."""
 
     linear = False
-    extra_state = False
 
     def __init__(self, first: Effect, second: Effect, case, channels, plant, start_values=(None, None)):
         self.first, self.second = first, second
