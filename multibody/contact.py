@@ -71,6 +71,19 @@ def hollar_friction_coefficient(slip_speed, mu_static, mu_kinetic, transition_sp
     return mu
 
 
+@njit(cache=True)
+def hollar_friction_coefficient_and_slope(slip_speed, mu_static, mu_kinetic, transition_speed):
+    """:func:`hollar_friction_coefficient` (-) and its derivative with respect to the slip speed (s/m),
+    for Newton iterations on friction laws; the slope is one-sided (from above) at the transition."""
+    ratio = slip_speed / transition_speed
+    denominator = 1.0 + ratio * ratio
+    mu = mu_kinetic + 2.0 * (mu_static - mu_kinetic) / denominator
+    mu_slope = -4.0 * (mu_static - mu_kinetic) * ratio / (denominator * denominator)  # d mu / d ratio
+    if ratio < 1.0:
+        return ratio * mu, (mu + ratio * mu_slope) / transition_speed
+    return mu, mu_slope / transition_speed
+
+
 @njit(cache=True, inline="always")
 def _dot(ax, ay, az, bx, by, bz):
     return ax * bx + ay * by + az * bz

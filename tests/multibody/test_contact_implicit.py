@@ -87,3 +87,36 @@ def test_friction_creep_under_a_tangential_pull_is_the_regularised_law_s():
         v = v + np.array(mean[3:6]) + external / M * STEP
     # 0.5 %: the step's trapezoid on a creep that settles; measured 0.05 % off
     assert v[0] == pytest.approx(x * vt, rel=5e-3)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_friction_impulse_solves_its_consistency_equation_to_round_off(seed):
+    """friction_impulse's j satisfies j = mu(s - j / (2 m)) N (Hollar, paper eq. 7, read at the step's
+    mean slip) or stops the slip, and equals the unique root a bracketing solver finds where the
+    residual is monotonic. Inputs span slips of 0.1 to 100 times the transition speed and normal
+    impulses from feather touches to ones that stop the slip. Tolerance 1e-12 of the stopping
+    impulse: the solver stops at 4e-16 of it, Brent's method here at 1e-15."""
+    from scipy.optimize import brentq
+
+    from multibody.contact import hollar_friction_coefficient as mu
+    from multibody.contact_implicit import friction_impulse
+
+    rng = np.random.default_rng(seed)
+    mus, muk, vt = 0.19, 0.152, 0.01
+    for _ in range(500):
+        mass = 10 ** rng.uniform(-3, 0)
+        slip = vt * 10 ** rng.uniform(-1, 2)
+        end = slip * rng.uniform(0.5, 1.5)
+        normal = mass * slip * 10 ** rng.uniform(-2, 2) / mus
+        j = friction_impulse(slip, end, normal, mass, mus, muk, vt)
+        stop = mass * end
+        assert 0.0 <= j <= stop
+        if j == stop:
+            assert stop <= mu(max(slip - 0.5 * end, 0.0), mus, muk, vt) * normal
+            continue
+        def residual(x):
+            return x - mu(max(slip - 0.5 * x / mass, 0.0), mus, muk, vt) * normal
+        assert abs(residual(j)) <= 1e-12 * stop
+        grid = np.linspace(0.0, stop, 200)
+        if np.all(np.diff([residual(x) for x in grid]) > 0.0):   # a single root: the same one
+            assert j == pytest.approx(brentq(residual, 0.0, stop, xtol=1e-15 * stop), abs=1e-12 * stop)
