@@ -26,6 +26,7 @@ class FreeMotion:
     fit: TorqueFreeFit
     spin_per_c: np.ndarray
     spin_per_c_cov: np.ndarray
+    attitude_residual_deg: float = float("nan")   # RMS turn between registered and fitted attitudes (deg)
 
 
 #: A frame whose weighted attitude residual |W e|^2, over the median frame's, exceeds this is
@@ -87,7 +88,8 @@ def _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_
     error = (attitudes.inv() * fit.predict_body_to_world(t)).as_rotvec()
     chi2 = np.sum(np.einsum("kij,kj->ki", weights, error) ** 2, axis=1)
     h, h_cov = fit.spin_momentum_per_c()
-    return FreeMotion(t, line, fit, h, h_cov), chi2
+    residual = float(np.degrees(np.sqrt(np.mean(np.sum(error**2, axis=1)))))
+    return FreeMotion(t, line, fit, h, h_cov, residual), chi2
 
 
 def normalized_energy_and_momentum(motion: FreeMotion) -> dict:

@@ -352,6 +352,10 @@ class Perception(Strict):
     observation_time: Positive = Field(description="LiDAR tracking of the free tumble before the chaser moves in (s).")
     hold_distance: Positive = Field(10.0, description="Chaser CoM to debris CoM while it observes, back along the launch direction (m).")
     seed: Annotated[int, Field(ge=0)] = Field(0, description="Seed of the range noise (-).")
+    model: Literal["known", "none"] = Field(
+        "known", description="'known': each scan is registered to the debris mesh of [target] (a catalogued "
+                             "shape); 'none': no mesh, scan-to-map registration to a map built from the scans "
+                             "(perception/scan_to_map.py); the body frame is then the first scan's.")
     lidar: Lidar
     registration: Registration = Registration()
 
@@ -629,7 +633,9 @@ def _fill_perceived(body: dict, source: str, base: Path) -> str | None:
         return f"'{source}' is not a perception.json (a JSON object is expected)"
     missing = [k for k in PERCEIVED_KEYS if answer.get(k) is None]
     if missing:
-        reason = answer.get("not_observable") or "keys missing"
+        reason = answer.get("not_observable") or (
+            "estimated without the debris mesh (perception.model = 'none'): the CoM and inertia are in the first "
+            "scan's frame, not the target frame" if answer.get("perception_model") == "none" else "keys missing")
         return f"'{source}' has no estimate of {missing}: {reason}"
     for source_key, body_key in PERCEIVED_KEYS.items():
         body[body_key] = answer[source_key]

@@ -42,6 +42,7 @@ from perception.momentum_balance import momentum_step
 from perception.motion import NotObservable
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
 from perception.registration import DebrisTracker, known_shape_model
+from perception.scan_to_map import alignments as map_alignments, track_scans
 from perception.shape import half_turn_symmetry_transforms, rotation_error
 from riskassess.products import results
 from riskassess.models.impact import model_inputs
@@ -52,6 +53,17 @@ from riskassess.cases.target_geometry import body_meshes_target_frame
 #: Scan points farther than this from the predicted debris surface are not registered to it (m):
 #: a frame's motion is predicted to ~1 cm; net threads sit decimetres to metres in front.
 DEBRIS_GATE = 0.3
+#: A model-free track (``perception.model = 'none'``) is used only when the torque-free fit explains
+#: its attitudes to this RMS (deg). Tracks of a featured body fit to ~0.4 deg (each frame good to
+#: ~1 deg, mostly a constant turn of the map); on the paper's smooth ellipsoid the map slides about
+#: the near-symmetry axis and the fit leaves 12 deg (10 s) (tests/perception/test_scan_to_map.py,
+#: docs/perception.md).
+MAX_MODEL_FREE_RESIDUAL_DEG = 5.0
+#: ... and when the fit determines the inertia ratios to this relative 1-sigma (-). A track that slid
+#: smoothly (the paper's ellipsoid over 5 s: 2.6 deg from the fit, 19 deg from the truth) passes the
+#: residual test but leaves the ratios undetermined (1-sigma 120 %, the fit at its bound of 2);
+#: a featured body's 10 s track gives 0.4-0.5 %.
+MAX_MODEL_FREE_RATIO_SIGMA = 0.05
 #: Returns closer than this to a predicted net thread are taken as net, not debris (m).
 NET_GATE = 0.1
 #: The debris flies free once no tracked net thread comes closer to its surface than this (m).
@@ -195,15 +207,64 @@ def observe_tumble(scene: Scene, tracker: DebrisTracker, frames: Frames, symmetr
             states["body_omega_body"][-1, 0])
 
 
-def _register(tracker, frames, t, phase, points, sensor_world, true_rot, true_com, symmetries):
-    """Register a scan (a tiny one is recorded as failed by the tracker) and score it."""
+def observe_tumble_model_free(scene: Scene, frames: Frames, rng, progress=None):
+    """Free tumble before the run in, scanned from the hold point (boresight fixed: no pose to aim
+    at before the track exists), every scan registered to a map built from the scans
+    (:func:`perception.scan_to_map.track_scans`). Returns the debris state at time 0 as
+    :func:`observe_tumble`, the tracker for the collision phase (the map as its frozen model) and the
+    target -> B transform (4, 4) of the truth, for the error figures only."""
+    p = scene.case.perception
+    debris = scene.debris
+    count = int(round(p.observation_time * scene.spec.rate))
+    sample_times = np.arange(count + 1) / scene.spec.rate
+    states = free_motion([debris], [], sample_times)
+    chaser_com = debris.com_lvlh - p.hold_distance * scene.direction
+    com_target = scene.truth["com_target"]
+    sensor_world, sensor_to_world = scene.sensor_pose(chaser_com, np.eye(3))
+    scans, origins = [], []
+    for k, t in enumerate(sample_times - p.observation_time):
+        rot, com = states["body_to_lvlh"][k, 0], states["body_com_lvlh"][k, 0]
+        origins.append(com - rot @ com_target)
+        tic = time.perf_counter()
+        points, _ = _scan_world(scene, [(scene.debris_vertices_world(rot, origins[-1]), scene.mesh_target.faces)],
+                                sensor_world, sensor_to_world, t, rng)
+        frames.cast_seconds.append(time.perf_counter() - tic)
+        scans.append(points)
+        frames.time.append(t)
+        frames.phase.append(0)
+        frames.n_points.append(len(points))
+        frames.true_target_to_world.append(rot)
+        frames.true_com_world.append(com)
+        if progress:
+            progress("observation", k + 1, count + 1)
+    reg = p.registration
+    track = track_scans(scans, reg.voxel, reg.max_correspondence)
+    tracker = DebrisTracker(reg.voxel, reg.max_correspondence, reg.model_frames, track.map_points, track.map_normals,
+                            seed=p.seed)
+    tracker.alignments = map_alignments(track, frames.time)
+    target_to_body = np.eye(4)
+    if track.ok.any():
+        first = int(np.flatnonzero(track.ok)[0])
+        target_to_body = track.world_to_body[first] @ _pose(frames.true_target_to_world[first], origins[first])
+    for alignment, true_rot in zip(tracker.alignments, frames.true_target_to_world):
+        frames.rotation_error.append(rotation_error(alignment.body_to_world[:3, :3], true_rot @ target_to_body[:3, :3].T,
+                                                    [np.eye(3)]) if alignment.ok else np.nan)
+    state = (states["body_com_lvlh"][-1, 0], states["body_to_lvlh"][-1, 0], states["body_velocity_lvlh"][-1, 0],
+             states["body_omega_body"][-1, 0])
+    return state, tracker, target_to_body
+
+
+def _register(tracker, frames, t, phase, points, sensor_world, true_rot, true_com, symmetries, target_to_body=np.eye(3)):
+    """Register a scan (a tiny one is recorded as failed by the tracker) and score it against the
+    true attitude (target -> world ``true_rot``; ``target_to_body`` (3, 3) the truth's rotation into
+    the tracker's frame B: identity when B is the target frame)."""
     alignment = tracker.update(t, points, sensor_world)
     frames.time.append(t)
     frames.phase.append(phase)
     frames.n_points.append(len(points))
     frames.true_target_to_world.append(true_rot)
     frames.true_com_world.append(true_com)
-    frames.rotation_error.append(rotation_error(alignment.body_to_world[:3, :3], true_rot, symmetries)
+    frames.rotation_error.append(rotation_error(alignment.body_to_world[:3, :3], true_rot @ target_to_body.T, symmetries)
                                  if alignment.ok else np.nan)
 
 
@@ -236,9 +297,11 @@ class NetTrack:
     true_positions: list = field(default_factory=list)
 
 
-def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembly, progress=None) -> NetTrack:
+def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembly, progress=None,
+                      target_to_body=np.eye(4)) -> NetTrack:
     """Scan debris and net from the chaser through the collision run; register the debris, fit
-    the net's nodes, measure the gap between them."""
+    the net's nodes, measure the gap between them. ``target_to_body`` (4, 4): the truth's
+    transform into the tracker's frame B, for the error figures."""
     series, net_snapshots = recorder.series, recorder.net
     net = assembly.net
     chaser, mount = assembly.chaser, assembly.mount
@@ -270,7 +333,7 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         predicted = carried_by_chaser(estimate, start_pose, chaser_pose)
         on_net = nearest_segments(points, predicted, net.threads)[2] < NET_GATE if len(points) else np.zeros(0, bool)
         _register(tracker, frames, t, 1, _crop_to_predicted(tracker, points[~on_net]), sensor_world, rot, com,
-                  symmetries)
+                  symmetries, target_to_body[:3, :3])
         # The net's nodes are fitted to the returns the debris does not explain, the rim held at
         # the rod tips.
         alignment = tracker.alignments[-1]
@@ -363,12 +426,16 @@ def _percent(estimate, truth):
 
 
 def estimates(scene: Scene, before: FreeMotion, after: FreeMotion | None, step: dict | None,
-              state_at_zero) -> dict:
+              state_at_zero, target_to_body=np.eye(4)) -> dict:
     """The perception answer: estimates with 1-sigma uncertainties and, since the case knows the
-    truth, their errors."""
+    truth, their errors. ``target_to_body`` (4, 4): the truth's transform into the tracker's frame B
+    (identity with the known mesh; with ``perception.model = 'none'`` B is the first scan's frame and
+    the frame-dependent estimates are named ``..._first_scan_...``)."""
     fit = before.fit
     com_body = before.line.com_body
     truth = scene.truth
+    frame = "target" if scene.case.perception.model == "known" else "first_scan"
+    com_truth_body = target_to_body[:3, :3] @ truth["com_target"] + target_to_body[:3, 3]
     true_moments = np.linalg.eigvalsh(truth["inertia_target"])[::-1]
     true_ratios = true_moments / true_moments[-1]
     _, rotation_true, _, omega_true = state_at_zero
@@ -377,13 +444,13 @@ def estimates(scene: Scene, before: FreeMotion, after: FreeMotion | None, step: 
     normalized = normalized_energy_and_momentum(before)
     true_l = rotation_true @ (j_true @ omega_true)
     out = {
-        "center_of_mass_target_m": com_body.tolist(),
+        f"center_of_mass_{frame}_m": com_body.tolist(),
         "center_of_mass_std_m": np.sqrt(np.diag(before.line.covariance)[:3]).tolist(),
-        "center_of_mass_error_m": float(np.linalg.norm(com_body - truth["com_target"])),
+        "center_of_mass_error_m": float(np.linalg.norm(com_body - com_truth_body)),
         "inertia_ratios": fit.moments_[:2].tolist(),
         "inertia_ratios_std": fit.moments_std_.tolist(),
         "inertia_ratio_error_percent": _percent(fit.moments_[:2], true_ratios[:2]).tolist(),
-        "principal_axes_target": fit.principal_to_body_.tolist(),
+        f"principal_axes_{frame}": fit.principal_to_body_.tolist(),
         "normalized_kinetic_energy_D_rad2_s2": normalized["D"],
         "normalized_kinetic_energy_error_percent": float(_percent(normalized["D"], omega_true @ j_true @ omega_true / c_true)),
         "normalized_angular_momentum_F_rad2_s2": normalized["F"],
@@ -410,7 +477,7 @@ def estimates(scene: Scene, before: FreeMotion, after: FreeMotion | None, step: 
         "mass_error_signed_percent": float(_percent(mass.value, truth["mass"])),
         "principal_moments_kg_m2": moments.tolist(), "principal_moments_std_kg_m2": moments_std.tolist(),
         "principal_moments_error_percent": _percent(moments, true_moments).tolist(),
-        "inertia_target_kg_m2": (axes @ np.diag(moments) @ axes.T).tolist(),
+        f"inertia_{frame}_kg_m2": (axes @ np.diag(moments) @ axes.T).tolist(),
         "kinetic_energy_rotational_J": energy,
         "angular_momentum_world_N_m_s": (c.value * before.spin_per_c).tolist(),
         "linear_balance_misfit_N_s": mass.misfit, "angular_balance_misfit_N_m_s": c.misfit,
@@ -458,24 +525,47 @@ def perceive_case(case_path, out_dir, progress=None, case: Case | None = None, o
         return _perceive(case, scene, folder, progress, pending)
 
 
+def _check_model_free_track(before: FreeMotion) -> None:
+    """Raise NotObservable when a model-free track does not pin the tumble down: attitudes not
+    explained by a torque-free motion, or inertia ratios left undetermined by it."""
+    ratio_sigma = float(np.max(before.fit.moments_std_ / before.fit.moments_[:2]))
+    if before.attitude_residual_deg <= MAX_MODEL_FREE_RESIDUAL_DEG and ratio_sigma <= MAX_MODEL_FREE_RATIO_SIGMA:
+        return
+    raise NotObservable(
+        f"the model-free track does not determine the tumble (attitudes {before.attitude_residual_deg:.1f} deg rms "
+        f"from the torque-free fit, at most {MAX_MODEL_FREE_RESIDUAL_DEG}; inertia ratios 1-sigma "
+        f"{100 * ratio_sigma:.1f} %, at most {100 * MAX_MODEL_FREE_RATIO_SIGMA:.0f} %): the shape has too few features "
+        "for scan-to-map registration without its mesh; use perception.model = 'known'")
+
+
 def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
     """The stage's body (module docstring) into the claimed ``folder``."""
     p = case.perception
     rng = np.random.default_rng(p.seed)
-    symmetry_transforms = half_turn_symmetry_transforms(scene.mesh_target, 0.5 * p.registration.voxel)
-    tracker = DebrisTracker(p.registration.voxel, p.registration.max_correspondence, p.registration.model_frames,
-                            *known_shape_model(scene.mesh_target, p.registration.voxel, p.seed),
-                            symmetries_body=symmetry_transforms, seed=p.seed)
-    symmetries = [transform[:3, :3] for transform in symmetry_transforms]
     frames = Frames()
     wall = time.perf_counter()
+    target_to_body = np.eye(4)
     # Open3D's RANSAC warnings go to stdout, which --json keeps for the answer.
     with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
-        state_at_zero = observe_tumble(scene, tracker, frames, symmetries, rng, progress)
-    answer = {"case": case.name, "observation_time_s": p.observation_time, "not_observable": None}
+        if p.model == "known":
+            symmetry_transforms = half_turn_symmetry_transforms(scene.mesh_target, 0.5 * p.registration.voxel)
+            tracker = DebrisTracker(p.registration.voxel, p.registration.max_correspondence, p.registration.model_frames,
+                                    *known_shape_model(scene.mesh_target, p.registration.voxel, p.seed),
+                                    symmetries_body=symmetry_transforms, seed=p.seed)
+            symmetries = [transform[:3, :3] for transform in symmetry_transforms]
+            state_at_zero = observe_tumble(scene, tracker, frames, symmetries, rng, progress)
+        else:
+            # No mesh: no known symmetries either (the map's are not those of a catalogued shape).
+            symmetries = [np.eye(3)]
+            state_at_zero, tracker, target_to_body = observe_tumble_model_free(scene, frames, rng, progress)
+    answer = {"case": case.name, "perception_model": p.model, "body_frame": "target" if p.model == "known" else
+              "first_scan", "observation_time_s": p.observation_time, "not_observable": None}
     before = after = step = None
     try:
         before = fit_free_motion(tracker, _good(tracker, np.array(frames.phase) == 0), frames.time)
+        answer["attitude_fit_residual_deg"] = before.attitude_residual_deg
+        if p.model == "none":
+            _check_model_free_track(before)
     except NotObservable as exc:
         # Nothing to scale by the collision: stop before simulating it.
         answer["not_observable"] = f"before the collision: {exc}"
@@ -489,7 +579,7 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
     write_simulation(folder, recorder, simulation, collision)
     assembly = simulation.assembly
     with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
-        track = observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembly, progress)
+        track = observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembly, progress, target_to_body)
     times = np.array(frames.time)
     try:
         start_time = track.times[free_flight_start(track)]
@@ -502,7 +592,7 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
         answer["observation_time_s"] = float(p.observation_time + after.times[-1])
     except NotObservable as exc:
         answer["not_observable"] = f"after the collision: {exc}"
-    answer.update(estimates(scene, before, after, step, state_at_zero))
+    answer.update(estimates(scene, before, after, step, state_at_zero, target_to_body))
     return _conclude(folder, answer, tracker, frames, track, assembly, wall, pending)
 
 

@@ -152,3 +152,12 @@ def test_monte_carlo_table_is_checked_on_load(tmp_path):
         with pytest.raises(CaseError) as err:
             load_case(path)
         assert "monte_carlo.uncertain" in str(err.value) and message in str(err.value)
+
+
+def test_perception_model_is_known_by_default_and_checked(tmp_path):
+    perception = CASES / "tang2023_debris_perception.toml"
+    assert load_case(perception).perception.model == "known"
+    path = tmp_path / "case.toml"
+    path.write_text(perception.read_text().replace("seed = 0", 'seed = 0\nmodel = "mesh"', 1))
+    with pytest.raises(CaseError, match=r"case.toml: perception.model: Input should be 'known' or 'none'"):
+        load_case(path)
