@@ -155,9 +155,9 @@ def register_with_motion_prior(scan_world, map_points, map_normals, predicted_wo
                                prior_sigma, tree=None) -> np.ndarray:
     """Point-to-plane ICP (Tukey kernel) of a thinned scan to the map, regularized towards the
     pose predicted from the motion: the Gauss-Newton steps minimize
-    ``sum w r^2 / s^2 + d^T P d`` with r the point-to-plane residuals (scatter s, a third of the
-    coarse correspondence distance's Tukey cut-off), d the pose's difference from the prediction
-    and P = diag(1 / prior_sigma^2).
+    ``sum w r^2 / s^2 + d^T P d`` with r the point-to-plane residuals (Tukey weights w, cut-off
+    half the level's correspondence distance, scatter s a third of that cut-off), d the pose's
+    difference from the prediction and P = diag(1 / prior_sigma^2).
 
     Why: on a smooth near-spheroid the turn about the near-symmetry axis barely changes the fit
     of a partial view (the paper's ellipsoid: a 7 deg error fitted as well as the truth), so

@@ -18,8 +18,13 @@ Timeline (time 0 = the chaser starts its run in):
    chaser's own navigation (taken exact) and the net's tracked nodes close the linear and
    angular momentum balances, which give the mass and the smallest principal moment C.
 
+With ``perception.model = "none"`` the observation is tracked without the debris mesh
+(:mod:`perception.scan_to_map`: scan-to-map registration, the first scan's frame as body frame),
+the map then serves as the collision phase's model; the fits are the same.
+
 The estimators see only the scans, the chaser's navigation and the design of the chaser and
-net; the simulated truth is used for the error figures alone.
+net; the simulated truth is used for the error figures alone (and the mesh, with model "none",
+only to make the scans).
 """
 from __future__ import annotations
 
