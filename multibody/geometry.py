@@ -64,22 +64,48 @@ def uniform_density_inertia(meshes, mass, com):
 
     Overlapping shapes count twice; keep the shapes of one body disjoint when the
     inertia is to come from geometry.
+
+    Parameters
+    ----------
+    meshes : list of trimesh.Trimesh
+        Closed shapes of one body, vertices in the target frame (m).
+    mass : float
+        The body's mass (kg).
+    com : (3,) float
+        Reference point of the tensor (the body's CoM), target frame (m).
+
+    Returns
+    -------
+    (3, 3) float
+        Inertia tensor about ``com``, axes of the target frame (kg m^2).
     """
     volume = sum(m.volume for m in meshes)
-    inertia = np.zeros((3, 3))
+    inertia_target = np.zeros((3, 3))
     for m in meshes:
         share = mass * m.volume / volume
-        j_own = m.moment_inertia * share / m.volume  # trimesh uses unit density
-        d = np.asarray(m.center_mass) - np.asarray(com)
-        inertia += j_own + share * (d @ d * np.eye(3) - np.outer(d, d))
-    return inertia
+        j_own_target = m.moment_inertia * share / m.volume  # trimesh uses unit density
+        offset_target = np.asarray(m.center_mass) - np.asarray(com)
+        inertia_target += j_own_target + share * (offset_target @ offset_target * np.eye(3)
+                                                  - np.outer(offset_target, offset_target))
+    return inertia_target
 
 
 def geometric_center_of_mass(meshes):
-    """Volume-weighted centroid of the meshes, target frame (m)."""
+    """Volume-weighted centroid of the meshes, target frame (m).
+
+    Parameters
+    ----------
+    meshes : list of trimesh.Trimesh
+        Closed shapes of one body, vertices in the target frame (m).
+
+    Returns
+    -------
+    (3,) float
+        Centroid of the shapes' joint volume, target frame (m).
+    """
     volumes = np.array([m.volume for m in meshes])
-    centers = np.array([m.center_mass for m in meshes])
-    return volumes @ centers / volumes.sum()
+    centers_target = np.array([m.center_mass for m in meshes])
+    return volumes @ centers_target / volumes.sum()
 
 
 @dataclass(frozen=True)

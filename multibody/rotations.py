@@ -36,7 +36,18 @@ def quaternion_from_matrix(body_to_inertial):
 
 @njit(cache=True, inline="always")
 def quaternion_from_matrix_tuple(a):
-    """:func:`quaternion_from_matrix` as a tuple (no allocation: the attitude controller runs every step)."""
+    """:func:`quaternion_from_matrix` as a tuple (no allocation: the attitude controller runs every step).
+
+    Parameters
+    ----------
+    a : (3, 3) float array
+        Rotation matrix body->inertial (or body->LVLH): columns are the body axes.
+
+    Returns
+    -------
+    tuple of 4 float
+        Unit quaternion (q0, q1, q2, q3), scalar first, q0 >= 0.
+    """
     trace = a[0, 0] + a[1, 1] + a[2, 2]
     if trace > max(a[0, 0], a[1, 1], a[2, 2]):
         s = 2.0 * math.sqrt(1.0 + trace)
