@@ -118,8 +118,8 @@ class Recorder:
         self._joint_arrays = (np.array([j.parent for j in joints], np.int64), np.array([j.child for j in joints], np.int64),
                               np.array(system.joint_to_parent, float).reshape(nj, 3, 3),
                               np.array(system.joint_to_child, float).reshape(nj, 3, 3),
-                              np.array(system.joint_point_parent, float).reshape(nj, 3),
-                              np.array(system.joint_point_child, float).reshape(nj, 3),
+                              np.array(system.joint_point_parent_body, float).reshape(nj, 3),
+                              np.array(system.joint_point_child_body, float).reshape(nj, 3),
                               np.array(self._joint_stiffness, float).reshape(nj, 6))
         self._work = {name: np.zeros(shape) for name, shape in (
             ("com", (nb, 3)), ("vel", (nb, 3)), ("rot", (nb, 3, 3)), ("omega", (nb, 3)), ("force", (nb, 3)),
