@@ -119,19 +119,19 @@ def flag_candidates(x_lvlh, reach, body_to_lvlh, com_lvlh, shape_body, box_min, 
     x0, x1, x2 = xs[0], xs[1], xs[2]
     for s in range(shape_body.shape[0]):
         b = shape_body[s]
-        r = body_to_lvlh[b]
+        body_to_lvlh_b = body_to_lvlh[b]
         # box centre in LVLH, half sizes in the body frame
         mx, my, mz = (0.5 * (box_min[s, 0] + box_max[s, 0]), 0.5 * (box_min[s, 1] + box_max[s, 1]),
                       0.5 * (box_min[s, 2] + box_max[s, 2]))
-        cx = com_lvlh[b, 0] + r[0, 0] * mx + r[0, 1] * my + r[0, 2] * mz
-        cy = com_lvlh[b, 1] + r[1, 0] * mx + r[1, 1] * my + r[1, 2] * mz
-        cz = com_lvlh[b, 2] + r[2, 0] * mx + r[2, 1] * my + r[2, 2] * mz
+        cx = com_lvlh[b, 0] + body_to_lvlh_b[0, 0] * mx + body_to_lvlh_b[0, 1] * my + body_to_lvlh_b[0, 2] * mz
+        cy = com_lvlh[b, 1] + body_to_lvlh_b[1, 0] * mx + body_to_lvlh_b[1, 1] * my + body_to_lvlh_b[1, 2] * mz
+        cz = com_lvlh[b, 2] + body_to_lvlh_b[2, 0] * mx + body_to_lvlh_b[2, 1] * my + body_to_lvlh_b[2, 2] * mz
         hx = 0.5 * (box_max[s, 0] - box_min[s, 0]) + shape_reach[s]
         hy = 0.5 * (box_max[s, 1] - box_min[s, 1]) + shape_reach[s]
         hz = 0.5 * (box_max[s, 2] - box_min[s, 2]) + shape_reach[s]
-        r00, r01, r02 = r[0, 0], r[0, 1], r[0, 2]
-        r10, r11, r12 = r[1, 0], r[1, 1], r[1, 2]
-        r20, r21, r22 = r[2, 0], r[2, 1], r[2, 2]
+        r00, r01, r02 = body_to_lvlh_b[0, 0], body_to_lvlh_b[0, 1], body_to_lvlh_b[0, 2]
+        r10, r11, r12 = body_to_lvlh_b[1, 0], body_to_lvlh_b[1, 1], body_to_lvlh_b[1, 2]
+        r20, r21, r22 = body_to_lvlh_b[2, 0], body_to_lvlh_b[2, 1], body_to_lvlh_b[2, 2]
         row = flags[s]
         for i in range(n):
             dx, dy, dz = x0[i] - cx, x1[i] - cy, x2[i] - cz

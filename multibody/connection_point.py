@@ -63,11 +63,13 @@ def point_force(x_inertial, v_inertial, points_inertial, point_velocities_inerti
         dx = x_inertial[0] - points_inertial[i, 0]
         dy = x_inertial[1] - points_inertial[i, 1]
         dz = x_inertial[2] - points_inertial[i, 2]
-        rel = (v_inertial[0] - point_velocities_inertial[i, 0], v_inertial[1] - point_velocities_inertial[i, 1],
-               v_inertial[2] - point_velocities_inertial[i, 2])
+        rel_velocity_inertial = (v_inertial[0] - point_velocities_inertial[i, 0],
+                                 v_inertial[1] - point_velocities_inertial[i, 1],
+                                 v_inertial[2] - point_velocities_inertial[i, 2])
         length = math.sqrt(dx * dx + dy * dy + dz * dz)
         u_inertial = (dx / length, dy / length, dz / length)  # tuples, not arrays: no allocation in the Newton loop
-        rate = rel[0] * u_inertial[0] + rel[1] * u_inertial[1] + rel[2] * u_inertial[2]
+        rate = (rel_velocity_inertial[0] * u_inertial[0] + rel_velocity_inertial[1] * u_inertial[1]
+                + rel_velocity_inertial[2] * u_inertial[2])
         tension = tension_only_kelvin_voigt(length - rest[i], rate, stiffness[i], damping[i])
         if tension <= 0.0:
             continue
@@ -75,21 +77,22 @@ def point_force(x_inertial, v_inertial, points_inertial, point_velocities_inerti
         for a in range(3):
             force_inertial[a] -= tension * u_inertial[a]
             for b in range(3):
-                jac_x[a, b] -= u_inertial[a] * (k * u_inertial[b] + c * (rel[b] - rate * u_inertial[b]) / length) + (
-                    tension * ((1.0 if a == b else 0.0) - u_inertial[a] * u_inertial[b]) / length)
+                jac_x[a, b] -= (u_inertial[a] * (k * u_inertial[b]
+                                                 + c * (rel_velocity_inertial[b] - rate * u_inertial[b]) / length)
+                                + tension * ((1.0 if a == b else 0.0) - u_inertial[a] * u_inertial[b]) / length)
                 jac_v[a, b] -= c * u_inertial[a] * u_inertial[b]
 
 
 @njit(cache=True)
-def implicit_point_step(x_hat, v_hat, beta, mass, reference_inertial, mu, points_inertial, point_velocities_inertial,
-                        stiffness, damping, rest, v_guess, external_inertial):
+def implicit_point_step(x_hat_inertial, v_hat_inertial, beta, mass, reference_inertial, mu, points_inertial,
+                        point_velocities_inertial, stiffness, damping, rest, v_guess_inertial, external_inertial):
     """Solve :math:`m(v - \\hat v) = \\beta (F(\\hat x + \\beta v, v) + m g(\\hat x + \\beta v))` for P's new
     velocity (Newton, the tether Jacobians of :func:`point_force`; the gravity gradient, 1e-6 1/s^2,
     is left out of the Newton matrix only).
 
     Parameters
     ----------
-    x_hat, v_hat : (3,) float
+    x_hat_inertial, v_hat_inertial : (3,) float
         BDF2 (or backward-Euler) predictors of P's displacement (m) and velocity (m/s), inertial frame.
     beta : float
         Step factor (s): 2h/3 for BDF2, h for backward Euler.
@@ -101,7 +104,7 @@ def implicit_point_step(x_hat, v_hat, beta, mass, reference_inertial, mu, points
         Gravitational parameter (m^3/s^2); 0 turns gravity off.
     points_inertial, point_velocities_inertial, stiffness, damping, rest
         The tethers, as in :func:`point_force`.
-    v_guess : (3,) float
+    v_guess_inertial : (3,) float
         Newton's starting velocity (m/s), inertial frame.
     external_inertial : (3,) float
         Further force on P held over the step (N), inertial frame.
@@ -113,10 +116,10 @@ def implicit_point_step(x_hat, v_hat, beta, mass, reference_inertial, mu, points
     """
     force_inertial, jac_x, jac_v = np.empty(3), np.empty((3, 3)), np.empty((3, 3))
     matrix, residual = np.empty((3, 3)), np.empty(3)
-    v_inertial, x_inertial = v_guess.copy(), np.empty(3)
+    v_inertial, x_inertial = v_guess_inertial.copy(), np.empty(3)
     for _ in range(MAX_ITERATIONS):
         for a in range(3):
-            x_inertial[a] = x_hat[a] + beta * v_inertial[a]
+            x_inertial[a] = x_hat_inertial[a] + beta * v_inertial[a]
         point_force(x_inertial, v_inertial, points_inertial, point_velocities_inertial, stiffness, damping, rest,
                     force_inertial, jac_x, jac_v)
         for a in range(3):
@@ -129,15 +132,15 @@ def implicit_point_step(x_hat, v_hat, beta, mass, reference_inertial, mu, points
             force_inertial[1] += mass * gy
             force_inertial[2] += mass * gz
         for a in range(3):
-            residual[a] = beta * force_inertial[a] - mass * (v_inertial[a] - v_hat[a])
+            residual[a] = beta * force_inertial[a] - mass * (v_inertial[a] - v_hat_inertial[a])
             for b in range(3):
                 matrix[a, b] = (1.0 if a == b else 0.0) * mass - beta * jac_v[a, b] - beta * beta * jac_x[a, b]
-        dv = solve3(matrix, residual)
-        v_inertial += dv
+        dv_inertial = solve3(matrix, residual)
+        v_inertial += dv_inertial
         speed = math.sqrt(v_inertial[0] ** 2 + v_inertial[1] ** 2 + v_inertial[2] ** 2)
-        if math.sqrt(dv[0] ** 2 + dv[1] ** 2 + dv[2] ** 2) <= TOLERANCE * (1.0 + speed):
+        if math.sqrt(dv_inertial[0] ** 2 + dv_inertial[1] ** 2 + dv_inertial[2] ** 2) <= TOLERANCE * (1.0 + speed):
             break
-    return x_hat + beta * v_inertial, v_inertial
+    return x_hat_inertial + beta * v_inertial, v_inertial
 
 
 #: Layout of P's integrator state (one float array): x_n, v_n, x_{n-1}, v_{n-1}, t_n, history flag.
@@ -187,18 +190,18 @@ def advance_point(state, t, step, mass, reference_inertial, mu, points_inertial,
     h = t - state[TIME]
     if h <= 0.5 * step:
         return
-    x_n, v_n = state[X_N:X_N + 3].copy(), state[V_N:V_N + 3].copy()
+    x_n_inertial, v_n_inertial = state[X_N:X_N + 3].copy(), state[V_N:V_N + 3].copy()
     if state[HISTORY] > 0.0 and abs(h - step) <= 1e-9 * step:
         beta = 2.0 * h / 3.0
-        x_hat, v_hat = np.empty(3), np.empty(3)
+        x_hat_inertial, v_hat_inertial = np.empty(3), np.empty(3)
         for a in range(3):
-            x_hat[a] = (4.0 * x_n[a] - state[X_PREVIOUS + a]) / 3.0
-            v_hat[a] = (4.0 * v_n[a] - state[V_PREVIOUS + a]) / 3.0
+            x_hat_inertial[a] = (4.0 * x_n_inertial[a] - state[X_PREVIOUS + a]) / 3.0
+            v_hat_inertial[a] = (4.0 * v_n_inertial[a] - state[V_PREVIOUS + a]) / 3.0
     else:
-        beta, x_hat, v_hat = h, x_n, v_n
-    x_inertial, v_inertial = implicit_point_step(x_hat, v_hat, beta, mass, reference_inertial, mu, points_inertial,
-                                                 point_velocities_inertial, stiffness, damping, rest, v_n,
-                                                 external_inertial)
-    state[X_PREVIOUS:X_PREVIOUS + 3], state[V_PREVIOUS:V_PREVIOUS + 3] = x_n, v_n
+        beta, x_hat_inertial, v_hat_inertial = h, x_n_inertial, v_n_inertial
+    x_inertial, v_inertial = implicit_point_step(x_hat_inertial, v_hat_inertial, beta, mass, reference_inertial, mu,
+                                                 points_inertial, point_velocities_inertial, stiffness, damping, rest,
+                                                 v_n_inertial, external_inertial)
+    state[X_PREVIOUS:X_PREVIOUS + 3], state[V_PREVIOUS:V_PREVIOUS + 3] = x_n_inertial, v_n_inertial
     state[X_N:X_N + 3], state[V_N:V_N + 3] = x_inertial, v_inertial
     state[TIME], state[HISTORY] = t, 1.0

@@ -99,10 +99,10 @@ def replay_net(side_length, nodes_per_side, net_mass, axial_rigidity, damping, s
     return replace(net, positions=positions_world), np.arange(n) * n
 
 
-def _unit_body(name, mass, position, velocity):
+def _unit_body(name, mass, position_world, velocity_world):
     inertia = 0.4 * mass * MU_RADIUS**2 * np.eye(3)
-    return RigidBodySpec(name=name, mass=mass, inertia_body=inertia, com_lvlh=np.r_[position, 0.0],
-                         velocity_lvlh=np.r_[velocity, 0.0])
+    return RigidBodySpec(name=name, mass=mass, inertia_body=inertia, com_lvlh=np.r_[position_world, 0.0],
+                         velocity_lvlh=np.r_[velocity_world, 0.0])
 
 
 class _TrackingLoad:

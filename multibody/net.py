@@ -135,11 +135,11 @@ def in_plane_axes(direction):
     e1, e2 : (3,) float
         Unit vectors, same frame; (e1, e2, direction) is right-handed.
     """
-    d = np.asarray(direction, float) / np.linalg.norm(direction)
-    seed = np.array([1.0, 0.0, 0.0]) if abs(d[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
-    e1 = seed - (seed @ d) * d
+    direction_unit = np.asarray(direction, float) / np.linalg.norm(direction)
+    seed_axis = np.array([1.0, 0.0, 0.0]) if abs(direction_unit[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
+    e1 = seed_axis - (seed_axis @ direction_unit) * direction_unit
     e1 /= np.linalg.norm(e1)
-    return e1, np.cross(d, e1)
+    return e1, np.cross(direction_unit, e1)
 
 
 def flat_square_net(center, direction, side_length, nodes_per_side, node_mass, node_radius,

@@ -171,15 +171,15 @@ def lvlh_to_eci(r_eci, v_eci) -> np.ndarray:
 
 
 @njit(cache=True, inline="always")
-def add_body_gravity(out_force, base, x, y, z, mass, mu):
+def add_body_gravity(out_force_inertial, base, x, y, z, mass, mu):
     """Two-body gravity (Boonrath et al. 2024, eq. 1) on a body, added to a force vector.
 
     Parameters
     ----------
-    out_force : (n,) float array
+    out_force_inertial : (n,) float array
         Generalized forces (N, inertial); the body's three force components start at ``base``.
     base : int
-        Index of the body's x force component in ``out_force``.
+        Index of the body's x force component in ``out_force_inertial``.
     x, y, z : float
         The body's CoM (m, inertial, from the Earth's centre).
     mass : float
@@ -190,6 +190,6 @@ def add_body_gravity(out_force, base, x, y, z, mass, mu):
     if mu == 0.0:
         return
     gx, gy, gz = two_body_acceleration_xyz(x, y, z, mu)
-    out_force[base] += mass * gx
-    out_force[base + 1] += mass * gy
-    out_force[base + 2] += mass * gz
+    out_force_inertial[base] += mass * gx
+    out_force_inertial[base + 1] += mass * gy
+    out_force_inertial[base + 2] += mass * gz

@@ -65,10 +65,11 @@ def desired_attitude(u_main_tether_inertial, r_chaser_inertial):
     r_chaser_inertial : (3,) float
         Chaser CoM from the Earth's centre (m), inertial.
     """
-    u, r = u_main_tether_inertial, r_chaser_inertial
-    u_norm, r_norm = math.sqrt(dot3(u, u)), math.sqrt(dot3(r, r))
-    ez_inertial = -u[0] / u_norm, -u[1] / u_norm, -u[2] / u_norm  # tuples: this runs every step of a tow
-    radial_inertial = r[0] / r_norm, r[1] / r_norm, r[2] / r_norm
+    u_inertial, r_inertial = u_main_tether_inertial, r_chaser_inertial
+    u_norm, r_norm = math.sqrt(dot3(u_inertial, u_inertial)), math.sqrt(dot3(r_inertial, r_inertial))
+    # tuples: this runs every step of a tow
+    ez_inertial = -u_inertial[0] / u_norm, -u_inertial[1] / u_norm, -u_inertial[2] / u_norm
+    radial_inertial = r_inertial[0] / r_norm, r_inertial[1] / r_norm, r_inertial[2] / r_norm
     ex_inertial = _cross(ez_inertial, radial_inertial)
     ex_norm = math.sqrt(dot3(ex_inertial, ex_inertial))
     ex_inertial = ex_inertial[0] / ex_norm, ex_inertial[1] / ex_norm, ex_inertial[2] / ex_norm
