@@ -96,7 +96,7 @@ def flag_candidates(x_lvlh, reach, body_to_lvlh, com_lvlh, shape_body, box_min, 
     x_lvlh : (n, 3) float
         Net node positions, LVLH (m).
     reach : (n,) float
-        Distance each node can travel within the step (m).
+        Each node's contact radius plus the distance it can travel within the step (m).
     body_to_lvlh : (nb, 3, 3) float
         Body attitudes (columns: body axes in LVLH).
     com_lvlh : (nb, 3) float

@@ -179,7 +179,7 @@ def advance_point(state, t, step, mass, reference_inertial, mu, points_inertial,
     state : (STATE_SIZE,) float
         P's integrator state (:func:`initial_point_state`), updated in place.
     t : float
-        Time to advance to (s); nothing happens unless it is at least half a step past the state's.
+        Time to advance to (s); nothing happens unless it is more than half a step past the state's.
     step : float
         The integrator's step (s).
     mass, reference_inertial, mu, points_inertial, point_velocities_inertial, stiffness, damping, rest

@@ -29,7 +29,7 @@ def kinematics_matrix(q):
     Returns
     -------
     (4, 3) float
-        Q(q), mapping a body-frame angular velocity (rad/s) to the quaternion rate (1/s).
+        Q(q); half of it times the body-frame angular velocity (rad/s) is the quaternion rate (1/s).
     """
     return np.array([[-q[1], -q[2], -q[3]],
                      [q[0], -q[3], q[2]],
