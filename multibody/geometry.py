@@ -30,6 +30,8 @@ def shape_mesh(kind: str, *, size=None, radius=None, length=None, axis=None, cen
     center : (3,) float     Shape centre, target frame (m).
     rotation_vector : (3,) float  Shape->target rotation for boxes, ellipsoids and meshes (rad).
     file : path             Mesh file (any format trimesh reads), vertices in m before ``scale``.
+    scale : float           Factor applied to the mesh file's vertices (-).
+    sections : int          Facets around a cylinder's circumference.
     """
     if kind == "box":
         mesh = trimesh.creation.box(extents=size)

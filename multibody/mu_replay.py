@@ -135,6 +135,7 @@ def replay(t_plan, unit_paths, unit_masses, net_spec: dict, debris, keep_out_rad
     debris : (2,) float              Debris centre (m), world.
     keep_out_radius : float          (m), for the report only.
     step : float                     Explicit step (s).
+    output_rate : float              Samples per second of the result (Hz).
     """
     splines = _reference(t_plan, unit_paths)
     net, mouth_nodes = replay_net(net_spec["side_length"], net_spec["nodes_per_side"], net_spec["net_mass"],

@@ -37,6 +37,7 @@ def mrac_params(kind, t_on, u_max, chaser_mass, k_mt, c_mt, z_d, k_p, k_d, **gai
 
     Parameters
     ----------
+    kind : {1, 2}       MRAC-1 or MRAC-2.
     t_on : float        Time the controller starts (s); thrust is 0 before.
     u_max : float       Thrust saturation (N).
     chaser_mass : float :math:`m_C` (kg), :math:`b = 1/m_C`.
