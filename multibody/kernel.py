@@ -163,7 +163,7 @@ class KernelData:
     scalars: np.ndarray = field(init=False)
     work: np.ndarray = field(init=False)          # (4, n, 3) work space: positions, forces, non-contact forces, start velocities
     work_node: np.ndarray = field(init=False)     # (4, n) work space: speed, acceleration bound, reach; 1 / mass
-    candidates: np.ndarray = field(init=False)    # (ns, n) uint8 work space: node near shape
+    candidates: np.ndarray = field(init=False)    # (ns + 1, n) uint8 work space: node near shape; last row: near any
 
     def __post_init__(self):
         n = len(self.net_mass)
@@ -171,7 +171,7 @@ class KernelData:
         self.work = np.zeros((4, n, 3))
         self.work_node = np.zeros((4, n))
         self.work_node[3] = 1.0 / np.asarray(self.net_mass, float)  # constant: a product is cheaper than a division
-        self.candidates = np.zeros((len(self.shape_body), n), np.uint8)
+        self.candidates = np.zeros((len(self.shape_body) + 1, n), np.uint8)
         self.force = np.zeros(3 * n + 6 * nb)
         self.body_impulse = np.zeros((nb, 6))
         self.node_impulse = np.zeros((n, 3))
