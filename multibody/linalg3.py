@@ -88,7 +88,18 @@ def mattvec3(m, x):
 
 @njit(cache=True, inline="always")
 def matmat3(a, b):
-    """a b for (3, 3) matrices."""
+    """a b for (3, 3) matrices.
+
+    Parameters
+    ----------
+    a, b : (3, 3) float
+        Typically rotations b: x->y and a: y->z (columns: source axes in target components).
+
+    Returns
+    -------
+    (3, 3) float
+        a b, the rotation x->z.
+    """
     out = np.empty((3, 3))
     for i in range(3):
         for k in range(3):
@@ -98,7 +109,18 @@ def matmat3(a, b):
 
 @njit(cache=True, inline="always")
 def mattmat3(a, b):
-    """a^T b for (3, 3) matrices."""
+    """a^T b for (3, 3) matrices.
+
+    Parameters
+    ----------
+    a, b : (3, 3) float
+        Typically rotations a: y->z and b: x->z (columns: source axes in target components).
+
+    Returns
+    -------
+    (3, 3) float
+        a^T b, the rotation x->y.
+    """
     out = np.empty((3, 3))
     for i in range(3):
         for k in range(3):
