@@ -108,17 +108,40 @@ def _substeps_to_resolve_contact(penetrations, relative_velocities, normals, bod
 
 
 @njit(cache=True)
-def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
-                       triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max,
-                       shape_is_box, k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps,
-                       stage_weight, implicit_speed, velocity_lag, lag_body, f_net, f_body, torque_lvlh,
-                       out_body_impulse, out_node_impulse, f_non_contact, v_start, work_node, candidates):
+def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, f_net, f_body,
+                       torque_lvlh):
     """Add node-body contact kicks to ``f_net`` and their reactions to ``f_body``/``torque_lvlh``.
 
-    ``f_net`` enters holding every non-contact force on the nodes. Returns the elastic
-    contact energy (J), the number of penetrating contacts at this evaluation and the energy
-    dissipated by contact over the step (J, weighted by ``stage_weight``).
+    Parameters
+    ----------
+    x, v : (n, 3) float
+        Node positions (m) and velocities (m/s) at the evaluation state, LVLH.
+    net, states, bodies, shapes, law : NetArrays, BodyStates, BodyArrays, ShapeArrays, ContactLaw
+        (:mod:`multibody.kernel`).
+    step : float
+        Integrator step (s).
+    n_substeps : int
+        Contact sub-steps per step (1: plain force evaluation).
+    stage_weight : float
+        Weight of the accumulated impulses and energies (1 / force evaluations per step).
+    buffers : KernelBuffers
+        Impulse accumulators, the carried velocity lag and work space (:mod:`multibody.kernel`).
+    f_net : (n, 3) float
+        Enters holding every non-contact force on the nodes (N, LVLH); the contact forces are added.
+    f_body, torque_lvlh : (nb, 3) float
+        The reactions are added: force (N) and torque about the CoM (N m), LVLH.
 
+    Returns
+    -------
+    contact_energy : float
+        Elastic contact energy (J) at this evaluation.
+    n_contacts : int
+        Penetrating contacts at this evaluation.
+    dissipated : float
+        Energy dissipated by contact over the step (J, weighted by ``stage_weight``).
+
+    Notes
+    -----
     With sub-cycling (Verlet only), the node's state at the evaluation time is the
     solver's position and its mid-step velocity ``v`` (Verlet evaluates the force before
     its second half kick) plus the half kick of the non-contact force and the lag carried
@@ -127,6 +150,18 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
     acts as a negative damping of about ``k step / 2`` per thread (3 N s/m at 1e-4 s
     against the threads' own 1.6 N s/m) and pumped energy into nodes held on a surface.
     """
+    net_mass, net_radius = net.mass, net.radius
+    rots, coms, vels, omegas = states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh, states.omega_lvlh
+    body_mass_all, inverse_inertia = bodies.mass, bodies.inverse_inertia_body
+    triangles, triangle_normals, shape_body = shapes.triangles_body, shapes.normals_body, shapes.body
+    shape_triangle_range, shape_box_min, shape_box_max = shapes.triangle_range, shapes.box_min_body, shapes.box_max_body
+    shape_is_box = shapes.is_box
+    k_contact, exponent, d_contact = law.stiffness, law.exponent, law.damping
+    mu_s, mu_k, v_transition, implicit_speed = law.mu_static, law.mu_kinetic, law.transition_speed, law.implicit_speed
+    velocity_lag, lag_body, work_node, candidates = (buffers.velocity_lag, buffers.lag_body, buffers.work_node,
+                                                     buffers.candidates)
+    out_body_impulse, out_node_impulse = buffers.body_impulse_lvlh, buffers.node_impulse_lvlh
+    f_non_contact, v_start = buffers.work[2], buffers.work[3]
     n = net_mass.shape[0]
     contact_energy = 0.0
     n_contacts = 0

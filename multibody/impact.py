@@ -21,7 +21,17 @@ from multibody.geometry import contact_shapes_body_frame
 from multibody.health import HealthWatch, SimulationFailed, check_solver_flag
 from multibody.hinge import add_penalty_joint
 from multibody.jit_cache import all_compiled_on_disk
-from multibody.kernel import KernelData, coupled_generalized_forces, verlet_evaluation_state
+from multibody.kernel import (
+    BodyArrays,
+    ContactLaw,
+    KernelData,
+    Mounts,
+    NetArrays,
+    ShapeArrays,
+    coupled_generalized_forces,
+    no_mounts,
+    verlet_evaluation_state,
+)
 from multibody.kernel_net import KernelNet, kernel_net_start, kernel_net_step
 from multibody.recorded_loads import add_recorded_loads
 from multibody.recorder import Recorder
@@ -73,7 +83,7 @@ class BuiltSystem:
             return self.kernel_net.positions(), self.kernel_net.velocities()
         n = self.kernel.n_nodes
         i = self.mbs.GetNodeODE2Index(self.net_node) if self.net_node is not None else 0
-        return (self.kernel.net_reference + np.asarray(q[i:i + 3 * n]).reshape(n, 3),
+        return (self.kernel.net.reference_lvlh + np.asarray(q[i:i + 3 * n]).reshape(n, 3),
                 np.asarray(qt[i:i + 3 * n]).reshape(n, 3))
 
     def state_arrays(self) -> tuple:
@@ -103,39 +113,41 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
     net, law = assembly.net, assembly.contact
     shapes = contact_shapes_body_frame([b.meshes_body for b in assembly.bodies],
                                        np.zeros((len(assembly.bodies), 3)))
-    return KernelData(
-        net_reference=np.ascontiguousarray(net.positions, float),
-        net_mass=np.asarray(net.masses, float), net_radius=np.asarray(net.radii, float),
-        threads=net.threads, rest_lengths=net.rest_lengths,
+    net_arrays = NetArrays(
+        reference_lvlh=np.ascontiguousarray(net.positions, float), mass=np.asarray(net.masses, float),
+        radius=np.asarray(net.radii, float), threads=net.threads, rest_lengths=net.rest_lengths,
         thread_stiffness=net.stiffness, thread_damping=net.damping,
-        bending_triples=net.bending_triples, bending_stiffness=net.bending_stiffness,
-        body_reference=np.array([b.com_lvlh for b in assembly.bodies], float).reshape(-1, 3),
-        body_mass=np.array([b.mass for b in assembly.bodies], float),
-        body_inverse_inertia=np.array([np.linalg.inv(b.inertia_body) for b in assembly.bodies]).reshape(-1, 3, 3),
-        triangles=shapes.triangles_body, triangle_normals=shapes.normals_body,
-        shape_body=shapes.shape_body, shape_triangle_range=shapes.triangle_range,
-        shape_box_min=shapes.box_min_body, shape_box_max=shapes.box_max_body,
-        shape_is_box=box_shape_flags(shapes.triangles_body, shapes.triangle_range, shapes.box_min_body,
-                                     shapes.box_max_body),
-        contact_stiffness=law.stiffness, contact_exponent=law.exponent, contact_damping=law.damping,
-        mu_static=law.mu_static, mu_kinetic=law.mu_kinetic, transition_speed=law.transition_speed,
-        mean_motion=assembly.mean_motion, step=assembly.solver.step,
+        bending_triples=net.bending_triples, bending_stiffness=net.bending_stiffness)
+    bodies = BodyArrays(
+        reference_com_lvlh=np.array([b.com_lvlh for b in assembly.bodies], float).reshape(-1, 3),
+        mass=np.array([b.mass for b in assembly.bodies], float),
+        inverse_inertia_body=np.array([np.linalg.inv(b.inertia_body) for b in assembly.bodies]).reshape(-1, 3, 3))
+    shape_arrays = ShapeArrays(
+        triangles_body=shapes.triangles_body, normals_body=shapes.normals_body, body=shapes.shape_body,
+        triangle_range=shapes.triangle_range, box_min_body=shapes.box_min_body, box_max_body=shapes.box_max_body,
+        is_box=box_shape_flags(shapes.triangles_body, shapes.triangle_range, shapes.box_min_body,
+                               shapes.box_max_body))
+    contact_law = ContactLaw(
+        stiffness=float(law.stiffness), exponent=float(law.exponent), damping=float(law.damping),
+        mu_static=float(law.mu_static), mu_kinetic=float(law.mu_kinetic), transition_speed=float(law.transition_speed),
+        implicit_speed=float(assembly.solver.implicit_contact_speed))
+    return KernelData(
+        net=net_arrays, bodies=bodies, shapes=shape_arrays, law=contact_law,
+        mean_motion=float(assembly.mean_motion), step=float(assembly.solver.step),
         # Sub-cycling assumes Verlet's kick-drift use of the force (see contact.py).
-        contact_substep=(assembly.solver.contact_substep
+        contact_substep=(float(assembly.solver.contact_substep)
                          if assembly.solver.integrator == "VelocityVerlet" else np.inf),
         stage_weight=1.0 / INTEGRATORS[assembly.solver.integrator][1],
-        implicit_contact_speed=assembly.solver.implicit_contact_speed,
-        **_mount_arrays(assembly.mount),
+        mounts=_mounts(assembly.mount),
     )
 
 
-def _mount_arrays(mount) -> dict:
+def _mounts(mount) -> Mounts:
     if mount is None:
-        return {}
-    return dict(mount_node=np.asarray(mount.nodes, np.int64),
-                mount_body=np.full(len(mount.nodes), mount.body, np.int64),
-                mount_point_body=np.ascontiguousarray(mount.points_body, float),
-                mount_stiffness=float(mount.stiffness), mount_damping=float(mount.damping))
+        return no_mounts()
+    return Mounts(node=np.asarray(mount.nodes, np.int64), body=np.full(len(mount.nodes), mount.body, np.int64),
+                  point_body=np.ascontiguousarray(mount.points_body, float),
+                  stiffness=float(mount.stiffness), damping=float(mount.damping))
 
 
 def _inertia6(inertia):

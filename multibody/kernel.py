@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -53,82 +54,145 @@ def verlet_evaluation_state(q, qt, qtt, step, n_net_coordinates, n_bodies):
     return q_next, v_half
 
 
+class NetArrays(NamedTuple):
+    """The net's nodes, threads and bending triples (SI units; n nodes, m threads, k triples)."""
+
+    reference_lvlh: np.ndarray     # (n, 3) reference node positions, LVLH (m)
+    mass: np.ndarray               # (n,) node masses (kg)
+    radius: np.ndarray             # (n,) node contact radii (m)
+    threads: np.ndarray            # (m, 2) int64 node pairs
+    rest_lengths: np.ndarray       # (m,) (m)
+    thread_stiffness: np.ndarray   # (m,) (N/m)
+    thread_damping: np.ndarray     # (m,) (N s/m)
+    bending_triples: np.ndarray    # (k, 3) int64 node triples (end, middle, end)
+    bending_stiffness: np.ndarray  # (k,) (N m/rad)
+
+
+class BodyArrays(NamedTuple):
+    """The rigid bodies' constants (nb bodies)."""
+
+    reference_com_lvlh: np.ndarray     # (nb, 3) reference CoM positions, LVLH (m)
+    mass: np.ndarray                   # (nb,) (kg)
+    inverse_inertia_body: np.ndarray   # (nb, 3, 3) inverse inertia about the CoM, body frame (1/(kg m^2))
+
+
+class ShapeArrays(NamedTuple):
+    """The bodies' closed contact shapes (ns shapes of T triangles in all), each a slice of the triangle
+    arrays in its body's frame (origin at the body CoM). Signed distances are taken per shape, so shapes
+    of one body may overlap."""
+
+    triangles_body: np.ndarray     # (T, 3, 3) corners, body frame of the owning body (m)
+    normals_body: np.ndarray       # (T, 3) outward unit normals, body frame
+    body: np.ndarray               # (ns,) int64 body owning each shape
+    triangle_range: np.ndarray     # (ns, 2) int64 triangle slice of each shape
+    box_min_body: np.ndarray       # (ns, 3) body-frame bounding box of each shape (m)
+    box_max_body: np.ndarray       # (ns, 3) (m)
+    is_box: np.ndarray             # (ns,) int64, 1: the shape is its bounding box (multibody.broad_phase)
+
+
+class ContactLaw(NamedTuple):
+    """Hunt-Crossley normal force and Hollar friction (seed paper eqs. (6), (7)), and the contact's
+    integration switch."""
+
+    stiffness: float           # k_n (N/m^n)
+    exponent: float            # n (-)
+    damping: float             # d_n = 1.5 alpha k_n (N s/m^(n+1))
+    mu_static: float           # (-)
+    mu_kinetic: float          # (-)
+    transition_speed: float    # Hollar's V_t (m/s)
+    implicit_speed: float      # below this normal speed (m/s) a single contact takes the implicit step; 0: never
+
+
+class Mounts(NamedTuple):
+    """Net nodes mounted on a body (a chaser's net frame): one stiff spring-damper per mount (k mounts)."""
+
+    node: np.ndarray           # (k,) int64 net node
+    body: np.ndarray           # (k,) int64 body
+    point_body: np.ndarray     # (k, 3) mount point, body frame (m)
+    stiffness: float           # (N/m)
+    damping: float             # (N s/m)
+
+
+def no_mounts() -> Mounts:
+    """:class:`Mounts` with none."""
+    return Mounts(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, 3)), 0.0, 0.0)
+
+
+class KernelBuffers(NamedTuple):
+    """What the kernel writes: the force vector, accumulated impulses and energies, the contact lag it
+    carries from step to step, and work space (so nothing is allocated per node)."""
+
+    force: np.ndarray              # (3 n + 6 nb,) generalized forces (module doc)
+    body_impulse_lvlh: np.ndarray  # (nb, 6) accumulated contact impulse (N s) and angular impulse about the CoM (N m s), LVLH
+    node_impulse_lvlh: np.ndarray  # (n, 3) accumulated contact impulse on each net node (N s), LVLH
+    velocity_lag: np.ndarray       # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s), LVLH
+    lag_body: np.ndarray           # (n,) int64 body of the node's last contact, -1 for none
+    scalars: np.ndarray            # (N_SCALARS,) energies (J) and contact count, indices above
+    work: np.ndarray               # (4, n, 3) positions, forces, non-contact forces, start velocities
+    work_node: np.ndarray          # (4, n) speed, acceleration bound, reach; 1 / mass
+    candidates: np.ndarray         # (ns + 1, n) uint8 node near shape; last row: near any
+
+
+def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffers:
+    """Zeroed :class:`KernelBuffers` for ``net`` and ``n_bodies`` bodies with ``n_shapes`` contact shapes."""
+    n = len(net.mass)
+    work_node = np.zeros((4, n))
+    work_node[3] = 1.0 / np.asarray(net.mass, float)  # constant: a product is cheaper than a division
+    return KernelBuffers(force=np.zeros(3 * n + 6 * n_bodies), body_impulse_lvlh=np.zeros((n_bodies, 6)),
+                         node_impulse_lvlh=np.zeros((n, 3)), velocity_lag=np.zeros((n, 3)),
+                         lag_body=np.full(n, -1, dtype=np.int64), scalars=np.zeros(N_SCALARS),
+                         work=np.zeros((4, n, 3)), work_node=work_node,
+                         candidates=np.zeros((n_shapes + 1, n), np.uint8))
+
+
+class BodyStates(NamedTuple):
+    """The bodies' state at a force evaluation (nb bodies), from :func:`body_states`."""
+
+    body_to_lvlh: np.ndarray   # (nb, 3, 3) attitude
+    com_lvlh: np.ndarray       # (nb, 3) CoM (m)
+    velocity_lvlh: np.ndarray  # (nb, 3) CoM velocity (m/s)
+    omega_lvlh: np.ndarray     # (nb, 3) angular velocity (rad/s)
+
+
 @dataclass
 class KernelData:
-    """Everything the kernel needs, as contiguous arrays (SI units).
+    """Everything the kernel needs, grouped (SI units; frames in the groups' field names).
 
-    Body geometry is a list of closed contact shapes (one per primitive or mesh file),
-    each a slice of the triangle arrays in its body's frame (origin at the body CoM).
-    Signed distances are taken per shape, so shapes of one body may overlap.
+    Parameters
+    ----------
+    net, bodies, shapes, law, mounts
+        :class:`NetArrays`, :class:`BodyArrays`, :class:`ShapeArrays`, :class:`ContactLaw`, :class:`Mounts`.
+    mean_motion : float
+        Orbit mean motion (rad/s) of the Clohessy-Wiltshire terms; 0 without orbit.
+    step : float
+        Integrator step (s).
+    contact_substep : float
+        Shortest contact sub-step (s); >= ``step`` (or inf) disables sub-cycling.
+    stage_weight : float
+        1 / force evaluations per integrator step.
     """
 
-    net_reference: np.ndarray        # (n, 3) reference node positions, LVLH (m)
-    net_mass: np.ndarray             # (n,) (kg)
-    net_radius: np.ndarray           # (n,) (m)
-    threads: np.ndarray              # (m, 2) int
-    rest_lengths: np.ndarray         # (m,) (m)
-    thread_stiffness: np.ndarray     # (m,) (N/m)
-    thread_damping: np.ndarray       # (m,) (N s/m)
-    bending_triples: np.ndarray      # (b, 3) int
-    bending_stiffness: np.ndarray    # (b,) (N m/rad)
-    body_reference: np.ndarray       # (nb, 3) reference CoM positions, LVLH (m)
-    body_mass: np.ndarray            # (nb,) (kg)
-    body_inverse_inertia: np.ndarray # (nb, 3, 3) inverse inertia about the CoM, body frame (1/(kg m^2))
-    triangles: np.ndarray            # (T, 3, 3) corners, body frame of the owning body (m)
-    triangle_normals: np.ndarray     # (T, 3) outward normals, body frame
-    shape_body: np.ndarray           # (ns,) int, body owning each contact shape
-    shape_triangle_range: np.ndarray # (ns, 2) int, triangle slice of each shape
-    shape_box_min: np.ndarray        # (ns, 3) body-frame bounding box of each shape (m)
-    shape_box_max: np.ndarray        # (ns, 3)
-    shape_is_box: np.ndarray         # (ns,) int, 1: the shape is its bounding box (multibody.broad_phase)
-    contact_stiffness: float         # k_n (N/m^n)
-    contact_exponent: float          # n (-)
-    contact_damping: float           # d_n = 1.5 alpha k_n
-    mu_static: float
-    mu_kinetic: float
-    transition_speed: float          # (m/s)
-    mean_motion: float               # (rad/s); 0 without orbit
-    step: float                      # integrator step (s)
-    contact_substep: float           # shortest contact sub-step (s); >= step disables sub-cycling
-    stage_weight: float = 1.0        # 1 / force evaluations per integrator step
-    implicit_contact_speed: float = 0.0  # (m/s) below it a single contact takes the implicit step; 0: never
-    # Net nodes mounted on a body (a chaser's net frame): one stiff spring-damper per mount
-    mount_node: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # (k,) net node
-    mount_body: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # (k,) body
-    mount_point_body: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # (k, 3) body frame (m)
-    mount_stiffness: float = 0.0     # (N/m)
-    mount_damping: float = 0.0       # (N s/m)
-    force: np.ndarray = field(init=False)
-    body_impulse: np.ndarray = field(init=False)   # (nb, 6) accumulated contact impulse and angular impulse about CoM, LVLH
-    node_impulse: np.ndarray = field(init=False)   # (n, 3) accumulated contact impulse on each net node (N s), LVLH
-    velocity_lag: np.ndarray = field(init=False)   # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s)
-    lag_body: np.ndarray = field(init=False)       # (n,) body of the node's last contact, -1 for none
-    scalars: np.ndarray = field(init=False)
-    work: np.ndarray = field(init=False)          # (4, n, 3) work space: positions, forces, non-contact forces, start velocities
-    work_node: np.ndarray = field(init=False)     # (4, n) work space: speed, acceleration bound, reach; 1 / mass
-    candidates: np.ndarray = field(init=False)    # (ns + 1, n) uint8 work space: node near shape; last row: near any
+    net: NetArrays
+    bodies: BodyArrays
+    shapes: ShapeArrays
+    law: ContactLaw
+    mean_motion: float
+    step: float
+    contact_substep: float
+    stage_weight: float = 1.0
+    mounts: Mounts = field(default_factory=no_mounts)
+    buffers: KernelBuffers = field(init=False)
 
     def __post_init__(self):
-        n = len(self.net_mass)
-        nb = len(self.body_mass)
-        self.work = np.zeros((4, n, 3))
-        self.work_node = np.zeros((4, n))
-        self.work_node[3] = 1.0 / np.asarray(self.net_mass, float)  # constant: a product is cheaper than a division
-        self.candidates = np.zeros((len(self.shape_body) + 1, n), np.uint8)
-        self.force = np.zeros(3 * n + 6 * nb)
-        self.body_impulse = np.zeros((nb, 6))
-        self.node_impulse = np.zeros((n, 3))
-        self.scalars = np.zeros(N_SCALARS)
-        self.velocity_lag = np.zeros((n, 3))
-        self.lag_body = np.full(n, -1, dtype=np.int64)
+        self.buffers = kernel_buffers(self.net, self.n_bodies, len(self.shapes.body))
 
     @property
     def n_nodes(self) -> int:
-        return len(self.net_mass)
+        return len(self.net.mass)
 
     @property
     def n_bodies(self) -> int:
-        return len(self.body_mass)
+        return len(self.bodies.mass)
 
     def evaluate(self, q, qt, time=1.0):
         """Generalized forces for coordinates ``q`` and velocities ``qt`` ((3n + 6nb,) each).
@@ -137,45 +201,38 @@ class KernelData:
         a half kick only) the contact is evaluated without sub-cycling.
         """
         n_sub = max(1, int(math.ceil(self.step / self.contact_substep - 1e-9))) if time > 0.0 else 1
-        coupled_generalized_forces(
-            q, qt, self.net_reference, self.net_mass, self.net_radius,
-            self.threads, self.rest_lengths, self.thread_stiffness, self.thread_damping,
-            self.bending_triples, self.bending_stiffness,
-            self.body_reference, self.body_mass, self.body_inverse_inertia, self.triangles, self.triangle_normals,
-            self.shape_body, self.shape_triangle_range, self.shape_box_min, self.shape_box_max, self.shape_is_box,
-            self.contact_stiffness, self.contact_exponent, self.contact_damping,
-            self.mu_static, self.mu_kinetic, self.transition_speed,
-            self.mean_motion, self.step, n_sub, self.stage_weight, self.implicit_contact_speed,
-            self.velocity_lag, self.lag_body,
-            self.mount_node, self.mount_body, self.mount_point_body, self.mount_stiffness, self.mount_damping,
-            self.force, self.body_impulse, self.node_impulse, self.scalars, self.work, self.work_node,
-            self.candidates)
-        return self.force
+        return coupled_generalized_forces(q, qt, self.net, self.bodies, self.shapes, self.law, self.mounts,
+                                          self.mean_motion, self.step, n_sub, self.stage_weight, self.buffers)
 
 
 @njit(cache=True)
-def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
-                               threads, rest_lengths, thread_stiffness, thread_damping,
-                               bending_triples, bending_stiffness,
-                               body_reference, body_mass_all, inverse_inertia, triangles, triangle_normals,
-                               shape_body, shape_triangle_range, shape_box_min, shape_box_max, shape_is_box,
-                               k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
-                               n_orbit, step, n_substeps, stage_weight, implicit_speed, velocity_lag, lag_body,
-                               mount_node, mount_body, mount_point_body, k_mount, d_mount,
-                               out_force, out_body_impulse, out_node_impulse, out_scalars, work, work_node,
-                               candidates):
-    """Fill ``out_force`` with the generalized forces of the coupled system (see module doc).
+def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit, step, n_substeps, stage_weight,
+                               buffers):
+    """Fill ``buffers.force`` with the generalized forces of the coupled system (see module doc); returns it.
 
-    Also accumulates, per body, the contact impulse (N s) and angular impulse about the
-    CoM (N m s) in LVLH into ``out_body_impulse``, per net node the contact impulse (N s, LVLH)
-    into ``out_node_impulse``, the dissipated energies into
-    ``out_scalars`` and sets the current elastic energies there. Accumulations are
-    weighted by ``stage_weight`` (1 / force evaluations per step: exact for
-    VelocityVerlet's single evaluation, an average for Runge-Kutta stages). ``work``,
-    ``work_node``, ``candidates``: work space (:class:`KernelData`), so nothing is allocated per node.
+    Parameters
+    ----------
+    q, qt : (3 n + 6 nb,) float
+        Coordinates and velocities in the module doc's layout.
+    net, bodies, shapes, law, mounts : NetArrays, BodyArrays, ShapeArrays, ContactLaw, Mounts
+    n_orbit : float
+        Mean motion (rad/s) of the Clohessy-Wiltshire terms; 0 without orbit.
+    step : float
+        Integrator step (s).
+    n_substeps : int
+        Contact sub-steps per step (1: none).
+    stage_weight : float
+        1 / force evaluations per step: accumulations are weighted by it (exact for VelocityVerlet's
+        single evaluation, an average for Runge-Kutta stages).
+    buffers : KernelBuffers
+        Also accumulates, per body, the contact impulse (N s) and angular impulse about the CoM
+        (N m s) in LVLH, per net node the contact impulse (N s, LVLH), the dissipated energies, and
+        sets the current elastic energies (``scalars``).
     """
+    out_force, out_scalars, work = buffers.force, buffers.scalars, buffers.work
+    net_reference, net_mass = net.reference_lvlh, net.mass
     n = net_mass.shape[0]
-    nb = body_mass_all.shape[0]
+    nb = bodies.mass.shape[0]
     x, f_net = work[0], work[1]
     for i in range(n):
         for d in range(3):
@@ -183,9 +240,10 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
             f_net[i, d] = 0.0
     v = qt[: 3 * n].reshape(n, 3)
 
-    elastic, power = add_thread_forces(x, v, threads, rest_lengths, thread_stiffness, thread_damping, f_net)
+    elastic, power = add_thread_forces(x, v, net.threads, net.rest_lengths, net.thread_stiffness,
+                                       net.thread_damping, f_net)
     out_scalars[THREAD_ELASTIC] = elastic
-    out_scalars[BENDING_ELASTIC] = add_bending_forces(x, bending_triples, bending_stiffness, f_net)
+    out_scalars[BENDING_ELASTIC] = add_bending_forces(x, net.bending_triples, net.bending_stiffness, f_net)
     out_scalars[THREAD_DISSIPATED] += power * step * stage_weight
 
     if n_orbit != 0.0:
@@ -195,23 +253,19 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
             f_net[i, 1] += net_mass[i] * ay
             f_net[i, 2] += net_mass[i] * az
 
-    rots, coms, vels, omegas = body_states(q, qt, n, body_reference)
+    states = body_states(q, qt, n, bodies.reference_com_lvlh)
+    rots, coms, vels = states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh
     f_body = np.zeros((nb, 3))
     if n_orbit != 0.0:
         for b in range(nb):
-            f_body[b] += body_mass_all[b] * clohessy_wiltshire_acceleration(coms[b], vels[b], n_orbit)
+            f_body[b] += bodies.mass[b] * clohessy_wiltshire_acceleration(coms[b], vels[b], n_orbit)
     torque_lvlh = np.zeros((nb, 3))
-    mount_elastic, mount_power = add_mount_forces(x, v, coms, vels, rots, omegas, mount_node, mount_body,
-                                                  mount_point_body, k_mount, d_mount, f_net, f_body, torque_lvlh)
+    mount_elastic, mount_power = add_mount_forces(x, v, states, mounts, f_net, f_body, torque_lvlh)
     # Mounts are the rods that hold the net's rim on the chaser: booked with the threads.
     out_scalars[THREAD_ELASTIC] += mount_elastic
     out_scalars[THREAD_DISSIPATED] += mount_power * step * stage_weight
     contact_energy, n_contacts, contact_dissipated = add_contact_forces(
-        x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
-        triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max, shape_is_box,
-        k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight, implicit_speed,
-        velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_node_impulse,
-        work[2], work[3], work_node, candidates)
+        x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, f_net, f_body, torque_lvlh)
     for b in range(nb):
         base = 3 * n + 6 * b
         out_force[base:base + 3] = f_body[b]
@@ -228,20 +282,22 @@ def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
 
 
 @njit(cache=True)
-def add_mount_forces(x, v, coms, vels, rots, omegas, mount_node, mount_body, mount_point_body, k, d,
-                     f_net, f_body, torque_lvlh):
-    """Spring-dampers (k, d) from mounted net nodes to their points on a body, all LVLH.
+def add_mount_forces(x, v, states, mounts, f_net, f_body, torque_lvlh):
+    """Spring-dampers from mounted net nodes to their points on a body, all LVLH.
 
-    The node's force and the body's reaction act on the same line, through the mount point,
-    so linear and angular momentum are exchanged exactly. Returns the elastic energy (J)
-    and the dissipated power (W).
+    ``x``, ``v`` (n, 3): node positions (m) and velocities (m/s); ``states``: :class:`BodyStates`;
+    ``mounts``: :class:`Mounts`. The node's force and the body's reaction act on the same line, through
+    the mount point, so linear and angular momentum are exchanged exactly. Returns the elastic energy
+    (J) and the dissipated power (W).
     """
+    k, d = mounts.stiffness, mounts.damping
+    rots, coms, vels, omegas = states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh, states.omega_lvlh
     elastic = 0.0
     power = 0.0
-    for m in range(mount_node.shape[0]):
-        i = mount_node[m]
-        b = mount_body[m]
-        arm = rots[b] @ mount_point_body[m]
+    for m in range(mounts.node.shape[0]):
+        i = mounts.node[m]
+        b = mounts.body[m]
+        arm = rots[b] @ mounts.point_body[m]
         gap = x[i] - (coms[b] + arm)
         rate = v[i] - (vels[b] + np.cross(omegas[b], arm))
         f = -k * gap - d * rate
@@ -254,19 +310,20 @@ def add_mount_forces(x, v, coms, vels, rots, omegas, mount_node, mount_body, mou
 
 
 @njit(cache=True)
-def body_states(q, qt, n_nodes, body_reference):
-    """Per body: attitude body->LVLH, CoM (m), CoM velocity (m/s), angular velocity (rad/s), LVLH."""
-    nb = body_reference.shape[0]
+def body_states(q, qt, n_nodes, reference_com_lvlh):
+    """:class:`BodyStates` (attitude body->LVLH, CoM (m), CoM velocity (m/s), angular velocity (rad/s),
+    LVLH) from the coordinates ``q``, ``qt`` in the module doc's layout."""
+    nb = reference_com_lvlh.shape[0]
     rots = np.empty((nb, 3, 3))
     coms = np.empty((nb, 3))
     vels = np.empty((nb, 3))
     omegas = np.empty((nb, 3))
     for b in range(nb):
         base = 3 * n_nodes + 6 * b
-        coms[b] = body_reference[b] + q[base:base + 3]
+        coms[b] = reference_com_lvlh[b] + q[base:base + 3]
         vels[b] = qt[base:base + 3]
         rots[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
         # in scalars: numba sends small matrix products to BLAS, microseconds a call
         for r in range(3):
             omegas[b, r] = rots[b, r, 0] * qt[base + 3] + rots[b, r, 1] * qt[base + 4] + rots[b, r, 2] * qt[base + 5]
-    return rots, coms, vels, omegas
+    return BodyStates(rots, coms, vels, omegas)

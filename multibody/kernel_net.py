@@ -23,8 +23,8 @@ Layout of the net state: ``q`` (3 n,) node displacement from the reference posit
 ``qt`` (3 n,) velocity (m/s), ``qtt`` (3 n,) acceleration (m/s^2), all LVLH, node-major.
 
 Speed: the whole pre-step is one compiled call (:func:`kernel_net_step`) on a numba structref
-(:class:`NetStepModel`) that holds the kernel's arrays and the net's state: a call with the kernel's
-40 arrays as arguments costs 5-10 us in numba's dispatcher alone, a structref about 2 us.
+(:class:`NetStepModel`) that holds the kernel's groups of arrays and the net's state: a call with the
+kernel's 40 arrays as arguments cost 5-10 us in numba's dispatcher alone, a structref about 2 us.
 """
 from __future__ import annotations
 
@@ -48,18 +48,10 @@ class NetStepModelType(types.StructRef):
         return tuple((name, types.unliteral(typ)) for name, typ in fields)
 
 
-#: Fields of :class:`NetStepModel`: the arrays and constants of :class:`multibody.kernel.KernelData`
-#: (same names, same buffers: what the kernel accumulates there, the recorder reads there), then
-#: the net's state and the work vectors of this module.
-KERNEL_FIELDS = (
-    "net_reference", "net_mass", "net_radius", "threads", "rest_lengths", "thread_stiffness", "thread_damping",
-    "bending_triples", "bending_stiffness", "body_reference", "body_mass", "body_inverse_inertia", "triangles",
-    "triangle_normals", "shape_body", "shape_triangle_range", "shape_box_min", "shape_box_max", "shape_is_box",
-    "contact_stiffness", "contact_exponent", "contact_damping", "mu_static", "mu_kinetic", "transition_speed",
-    "mean_motion", "step", "stage_weight", "implicit_contact_speed", "velocity_lag", "lag_body", "mount_node",
-    "mount_body", "mount_point_body", "mount_stiffness", "mount_damping", "force", "body_impulse", "node_impulse",
-    "scalars", "work", "work_node",
-    "candidates")
+#: Fields of :class:`NetStepModel`: the groups and constants of :class:`multibody.kernel.KernelData`
+#: (same names, same buffers: what the kernel accumulates there, the recorder reads there), then the
+#: net's state and the work vectors of this module.
+KERNEL_FIELDS = ("net", "bodies", "shapes", "law", "mounts", "mean_motion", "step", "stage_weight", "buffers")
 STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "q_eval", "qt_eval")
 
 
@@ -84,7 +76,7 @@ def net_step_model(kernel: KernelData, net_velocity) -> tuple:
     n_substeps = max(1, int(np.ceil(kernel.step / kernel.contact_substep - 1e-9))) if np.isfinite(
         kernel.contact_substep) else 1
     values = [getattr(kernel, name) for name in KERNEL_FIELDS]
-    values = [float(v) if isinstance(v, (float, np.floating)) else v for v in values]
+    values = [float(v) if isinstance(v, (float, np.floating, int)) else v for v in values]
     state = [n_substeps, np.zeros(3 * n), np.ascontiguousarray(net_velocity, float).reshape(3 * n).copy(),
              np.zeros(3 * n), np.zeros(3 * n + 6 * nb), np.zeros(3 * n + 6 * nb)]
     return NetStepModel(*values, *state), state[1], state[2]
@@ -93,17 +85,8 @@ def net_step_model(kernel: KernelData, net_velocity) -> tuple:
 @njit(cache=True)
 def _forces(m, time, n_substeps):
     """The kernel at (m.q_eval, m.qt_eval): :meth:`multibody.kernel.KernelData.evaluate` on the structref."""
-    return coupled_generalized_forces(
-        m.q_eval, m.qt_eval, m.net_reference, m.net_mass, m.net_radius,
-        m.threads, m.rest_lengths, m.thread_stiffness, m.thread_damping,
-        m.bending_triples, m.bending_stiffness,
-        m.body_reference, m.body_mass, m.body_inverse_inertia, m.triangles, m.triangle_normals,
-        m.shape_body, m.shape_triangle_range, m.shape_box_min, m.shape_box_max, m.shape_is_box,
-        m.contact_stiffness, m.contact_exponent, m.contact_damping,
-        m.mu_static, m.mu_kinetic, m.transition_speed,
-        m.mean_motion, m.step, n_substeps, m.stage_weight, m.implicit_contact_speed, m.velocity_lag, m.lag_body,
-        m.mount_node, m.mount_body, m.mount_point_body, m.mount_stiffness, m.mount_damping,
-        m.force, m.body_impulse, m.node_impulse, m.scalars, m.work, m.work_node, m.candidates)
+    return coupled_generalized_forces(m.q_eval, m.qt_eval, m.net, m.bodies, m.shapes, m.law, m.mounts,
+                                      m.mean_motion, m.step, n_substeps, m.stage_weight, m.buffers)
 
 
 @njit(cache=True)
@@ -118,7 +101,7 @@ def kernel_net_start(m, q_bodies, qt_bodies):
     m.qt_eval[n3:] = qt_bodies
     force = _forces(m, 0.0, 1)
     for k in range(n3):
-        m.qtt[k] = force[k] / m.net_mass[k // 3]
+        m.qtt[k] = force[k] / m.net.mass[k // 3]
     return force[n3:].copy()
 
 
@@ -145,7 +128,7 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
     q_eval[n3:] = q_next
     qt_eval[n3:] = v_half_bodies
     force = _forces(m, time, m.n_substeps if time > 0.0 else 1)
-    inverse_mass = m.work_node[3]  # (n,) 1 / node mass (multibody.kernel.KernelData)
+    inverse_mass = m.buffers.work_node[3]  # (n,) 1 / node mass (multibody.kernel.KernelBuffers)
     for i in range(n3 // 3):
         for d in range(3):
             k = 3 * i + d
@@ -196,7 +179,7 @@ class KernelNet:
 
     def positions(self) -> np.ndarray:
         """(n, 3) node positions (m), LVLH, at the end of the last step."""
-        return self.kernel.net_reference + self.q.reshape(-1, 3)
+        return self.kernel.net.reference_lvlh + self.q.reshape(-1, 3)
 
     def velocities(self) -> np.ndarray:
         """(n, 3) node velocities (m/s), LVLH, at the end of the last step (a view)."""

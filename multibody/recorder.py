@@ -190,7 +190,7 @@ class Recorder:
 
     def _node_contact_force(self, t):
         """Contact force on each net node (N, LVLH), averaged since the previous net snapshot."""
-        impulse_lvlh = self.system.kernel.node_impulse
+        impulse_lvlh = self.system.kernel.buffers.node_impulse_lvlh
         interval = t - self._last_net_time
         force_lvlh = impulse_lvlh / interval if interval > 0.0 else np.zeros_like(impulse_lvlh)
         impulse_lvlh[:] = 0.0
@@ -212,7 +212,8 @@ class Recorder:
         interval = t - self._last_output_time
         self._last_output_time = t
         body_sample(q, qt, self._body_index, self._body_reference_lvlh, self._body_mass, self._inertia_body,
-                    self.system.kernel.body_impulse, interval, *self._joint_arrays, self.joint_active.astype(float),
+                    self.system.kernel.buffers.body_impulse_lvlh, interval, *self._joint_arrays,
+                    self.joint_active.astype(float),
                     self.assembly.mean_motion, self._debris_mask, self._chaser, w["com"], w["vel"], w["rot"],
                     w["omega"], w["force"], w["moment"], w["force_body"], w["moment_body"], w["totals"],
                     w["joint_rotation"], w["joint_rate"], w["joint_energy"], w["summary"])
@@ -229,7 +230,7 @@ class Recorder:
                 moments_joint[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)
         self._joint_energies = w["joint_energy"]
         summary = w["summary"].tolist()
-        scalars = self.system.kernel.scalars.tolist()
+        scalars = self.system.kernel.buffers.scalars.tolist()
         row = {"time": t,
                "contact_force_lvlh": w["force"], "contact_moment_lvlh": w["moment"],
                "contact_force_body": w["force_body"], "contact_moment_body": w["moment_body"],
