@@ -166,14 +166,8 @@ def add_contact_forces(x, v, net_mass, net_radius, rots, coms, vels, omegas, bod
     work_recoil = np.empty((n_shapes, 3))
     work_forces = np.empty((n_shapes, 3))
     for i in range(n):
-        if lag_body[i] < 0:
-            near = False
-            for s in range(n_shapes):
-                if candidates[s, i]:
-                    near = True
-                    break
-            if not near:
-                continue  # far from every shape and nothing carried: no contact work for this node
+        if lag_body[i] < 0 and not candidates[n_shapes, i]:
+            continue  # far from every shape and nothing carried: no contact work for this node
         # the node's non-contact force and its velocity at the evaluation time (see the doc above)
         for d in range(3):
             f_non_contact[i, d] = f_net[i, d]

@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import exudyn as exu
 from exudyn.itemInterface import MarkerBodyRigid, ObjectConnectorRigidBodySpringDamper
-from scipy.spatial.transform import Rotation
 
 from multibody.assembly import JointSpec, RigidBodySpec
+from multibody.rotations import rotation_vector_from_matrix
 
 
 def hinge_frame_lvlh(axis_lvlh, point_lvlh, child_com_lvlh) -> np.ndarray:
@@ -177,22 +177,10 @@ def add_penalty_joint(mbs, joint: JointSpec, bodies: list[RigidBodySpec], body_o
         useIntrinsicFormulation=True))
 
 
-def rotation_vector_from_matrix(rot) -> np.ndarray:
-    """Rotation vector (rad) of a rotation matrix (log map); accurate away from 180 degrees."""
-    cos_angle = np.clip((np.trace(rot) - 1.0) / 2.0, -1.0, 1.0)
-    angle = np.arccos(cos_angle)
-    axis_sin = 0.5 * np.array([rot[2, 1] - rot[1, 2], rot[0, 2] - rot[2, 0], rot[1, 0] - rot[0, 1]])
-    if angle < 1e-6:
-        return axis_sin
-    if np.pi - angle < 1e-6:
-        return Rotation.from_matrix(rot).as_rotvec()
-    return axis_sin * angle / np.sin(angle)
-
-
 def relative_rotation_vector_joint_frame(parent_to_lvlh, child_to_lvlh, joint_to_parent, joint_to_child):
     """Rotation vector (rad) of the child's joint frame relative to the parent's, joint frame.
 
     Component 1 is the hinge angle about h2 for a revolute joint.
     """
     relative = (parent_to_lvlh @ joint_to_parent).T @ (child_to_lvlh @ joint_to_child)
-    return rotation_vector_from_matrix(relative)
+    return rotation_vector_from_matrix(np.ascontiguousarray(relative, float))

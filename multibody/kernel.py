@@ -32,68 +32,11 @@ from multibody.orbit import (
     clohessy_wiltshire_acceleration,
     clohessy_wiltshire_acceleration_xyz,
 )
+from multibody.rotations import compose_rotation_vectors, rotation_matrix_from_rotation_vector
 
 #: Indices into the kernel's scalar output buffer.
 THREAD_ELASTIC, BENDING_ELASTIC, CONTACT_ELASTIC, THREAD_DISSIPATED, CONTACT_DISSIPATED, N_CONTACTS = range(6)
 N_SCALARS = 6
-
-
-@njit(cache=True)
-def rotation_matrix_from_rotation_vector(rv):
-    """Body->LVLH rotation matrix from a rotation vector (rad); Rodrigues' formula
-    :math:`I + \\frac{\\sin\\theta}{\\theta}K + \\frac{1-\\cos\\theta}{\\theta^2}K^2`, written out in
-    scalars (numba sends 3x3 products to BLAS, ~1 us a call)."""
-    x, y, z = rv[0], rv[1], rv[2]
-    angle2 = x * x + y * y + z * z
-    if angle2 < 1e-16:
-        a, b = 1.0, 0.5
-    else:
-        angle = math.sqrt(angle2)
-        a, b = math.sin(angle) / angle, (1.0 - math.cos(angle)) / angle2
-    out = np.empty((3, 3))
-    # K^2 = r r^T - |r|^2 I
-    out[0, 0] = 1.0 + b * (x * x - angle2)
-    out[1, 1] = 1.0 + b * (y * y - angle2)
-    out[2, 2] = 1.0 + b * (z * z - angle2)
-    out[0, 1] = -a * z + b * x * y
-    out[1, 0] = a * z + b * x * y
-    out[0, 2] = a * y + b * x * z
-    out[2, 0] = -a * y + b * x * z
-    out[1, 2] = -a * x + b * y * z
-    out[2, 1] = a * x + b * y * z
-    return out
-
-
-@njit(cache=True)
-def _quaternion_from_rotation_vector(rv):
-    angle = math.sqrt(rv[0] * rv[0] + rv[1] * rv[1] + rv[2] * rv[2])
-    if angle < 1e-8:
-        return 1.0 - angle * angle / 8.0, 0.5 * rv[0], 0.5 * rv[1], 0.5 * rv[2]
-    s = math.sin(0.5 * angle) / angle
-    return math.cos(0.5 * angle), s * rv[0], s * rv[1], s * rv[2]
-
-
-@njit(cache=True)
-def compose_rotation_vectors(rv, increment_body):
-    """Rotation vector of R(rv) R(increment_body): a rotation by ``increment_body`` (rad, body
-    frame) after ``rv``; the Lie-group update Exudyn applies to rotation-vector nodes.
-    Returns the equivalent rotation vector with angle at most pi."""
-    w0, x0, y0, z0 = _quaternion_from_rotation_vector(rv)
-    w1, x1, y1, z1 = _quaternion_from_rotation_vector(increment_body)
-    w = w0 * w1 - x0 * x1 - y0 * y1 - z0 * z1
-    x = w0 * x1 + x0 * w1 + y0 * z1 - z0 * y1
-    y = w0 * y1 - x0 * z1 + y0 * w1 + z0 * x1
-    z = w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1
-    if w < 0.0:
-        w, x, y, z = -w, -x, -y, -z
-    sine = math.sqrt(x * x + y * y + z * z)
-    out = np.empty(3)
-    if sine < 1e-12:
-        out[0], out[1], out[2] = 2.0 * x, 2.0 * y, 2.0 * z
-        return out
-    angle = 2.0 * math.atan2(sine, w)
-    out[0], out[1], out[2] = angle * x / sine, angle * y / sine, angle * z / sine
-    return out
 
 
 @njit(cache=True)
@@ -163,7 +106,7 @@ class KernelData:
     scalars: np.ndarray = field(init=False)
     work: np.ndarray = field(init=False)          # (4, n, 3) work space: positions, forces, non-contact forces, start velocities
     work_node: np.ndarray = field(init=False)     # (4, n) work space: speed, acceleration bound, reach; 1 / mass
-    candidates: np.ndarray = field(init=False)    # (ns, n) uint8 work space: node near shape
+    candidates: np.ndarray = field(init=False)    # (ns + 1, n) uint8 work space: node near shape; last row: near any
 
     def __post_init__(self):
         n = len(self.net_mass)
@@ -171,7 +114,7 @@ class KernelData:
         self.work = np.zeros((4, n, 3))
         self.work_node = np.zeros((4, n))
         self.work_node[3] = 1.0 / np.asarray(self.net_mass, float)  # constant: a product is cheaper than a division
-        self.candidates = np.zeros((len(self.shape_body), n), np.uint8)
+        self.candidates = np.zeros((len(self.shape_body) + 1, n), np.uint8)
         self.force = np.zeros(3 * n + 6 * nb)
         self.body_impulse = np.zeros((nb, 6))
         self.node_impulse = np.zeros((n, 3))

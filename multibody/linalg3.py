@@ -41,6 +41,26 @@ def mattvec3(m, x):
     return out
 
 
+@njit(cache=True, inline="always")
+def matmat3(a, b):
+    """a b for (3, 3) matrices."""
+    out = np.empty((3, 3))
+    for i in range(3):
+        for k in range(3):
+            out[i, k] = a[i, 0] * b[0, k] + a[i, 1] * b[1, k] + a[i, 2] * b[2, k]
+    return out
+
+
+@njit(cache=True, inline="always")
+def mattmat3(a, b):
+    """a^T b for (3, 3) matrices."""
+    out = np.empty((3, 3))
+    for i in range(3):
+        for k in range(3):
+            out[i, k] = a[0, i] * b[0, k] + a[1, i] * b[1, k] + a[2, i] * b[2, k]
+    return out
+
+
 @njit(cache=True)
 def solve3(a, b):
     """x with a x = b for a (3, 3) matrix (Cramer's rule; a must be regular)."""

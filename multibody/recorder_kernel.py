@@ -6,12 +6,11 @@ each. Same definitions as before; frames in the names, SI units.
 """
 from __future__ import annotations
 
-import math
 
-import numpy as np
 from numba import njit
 
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.linalg3 import matmat3, mattmat3, mattvec3, matvec3
+from multibody.rotations import rotation_matrix_from_rotation_vector, rotation_vector_from_matrix_into
 
 
 @njit(cache=True)
@@ -32,59 +31,6 @@ def net_sums(x, v, masses, n_orbit, out):
         out[5] += x[i, 1] * pz - x[i, 2] * py
         out[6] += x[i, 2] * px - x[i, 0] * pz
         out[7] += x[i, 0] * py - x[i, 1] * px
-
-
-@njit(cache=True)
-def rotation_vector_from_matrix(r, out):
-    """Rotation vector (rad) of the rotation matrix ``r`` into ``out`` (3,), through the quaternion
-    (Shepperd 1978), accurate at every angle up to pi."""
-    trace = r[0, 0] + r[1, 1] + r[2, 2]
-    if trace >= max(r[0, 0], r[1, 1], r[2, 2]):
-        w = 0.5 * math.sqrt(max(1.0 + trace, 0.0))
-        x, y, z = (r[2, 1] - r[1, 2]) / (4 * w), (r[0, 2] - r[2, 0]) / (4 * w), (r[1, 0] - r[0, 1]) / (4 * w)
-    elif r[0, 0] >= r[1, 1] and r[0, 0] >= r[2, 2]:
-        x = 0.5 * math.sqrt(max(1.0 + r[0, 0] - r[1, 1] - r[2, 2], 0.0))
-        w, y, z = (r[2, 1] - r[1, 2]) / (4 * x), (r[0, 1] + r[1, 0]) / (4 * x), (r[0, 2] + r[2, 0]) / (4 * x)
-    elif r[1, 1] >= r[2, 2]:
-        y = 0.5 * math.sqrt(max(1.0 - r[0, 0] + r[1, 1] - r[2, 2], 0.0))
-        w, x, z = (r[0, 2] - r[2, 0]) / (4 * y), (r[0, 1] + r[1, 0]) / (4 * y), (r[1, 2] + r[2, 1]) / (4 * y)
-    else:
-        z = 0.5 * math.sqrt(max(1.0 - r[0, 0] - r[1, 1] + r[2, 2], 0.0))
-        w, x, y = (r[1, 0] - r[0, 1]) / (4 * z), (r[0, 2] + r[2, 0]) / (4 * z), (r[1, 2] + r[2, 1]) / (4 * z)
-    if w < 0.0:
-        w, x, y, z = -w, -x, -y, -z
-    sine = math.sqrt(x * x + y * y + z * z)
-    scale = 2.0 * math.atan2(sine, w) / sine if sine > 1e-300 else 2.0
-    out[0], out[1], out[2] = scale * x, scale * y, scale * z
-
-
-@njit(cache=True)
-def _mat_t_vec(r, a, out):
-    """out = r^T a for (3, 3) r and (3,) a, in scalars."""
-    for i in range(3):
-        out[i] = r[0, i] * a[0] + r[1, i] * a[1] + r[2, i] * a[2]
-
-
-@njit(cache=True)
-def _mat_vec(r, a):
-    """r a for (3, 3) r and (3,) a, in scalars (numba sends small products to BLAS, ~1 us a call)."""
-    out = np.empty(3)
-    for i in range(3):
-        out[i] = r[i, 0] * a[0] + r[i, 1] * a[1] + r[i, 2] * a[2]
-    return out
-
-
-@njit(cache=True)
-def _mat_mat(a, b, transpose_a):
-    """a b (or a^T b) for (3, 3) matrices, in scalars."""
-    out = np.empty((3, 3))
-    for i in range(3):
-        for k in range(3):
-            s = 0.0
-            for j in range(3):
-                s += (a[j, i] if transpose_a else a[i, j]) * b[j, k]
-            out[i, k] = s
-    return out
 
 
 @njit(cache=True)
@@ -130,16 +76,16 @@ def body_sample(q, qt, body_index, body_reference, body_mass, inertia, impulse, 
         for d in range(3):
             force_lvlh[b, d] = impulse[b, d] / interval if interval > 0.0 else 0.0
             moment_lvlh[b, d] = impulse[b, 3 + d] / interval if interval > 0.0 else 0.0
-        _mat_t_vec(rot[b], force_lvlh[b], force_body[b])
-        _mat_t_vec(rot[b], moment_lvlh[b], moment_body[b])
+        force_body[b] = mattvec3(rot[b], force_lvlh[b])
+        moment_body[b] = mattvec3(rot[b], moment_lvlh[b])
         for d in range(6):
             impulse[b, d] = 0.0
         m = body_mass[b]
-        spin = _mat_vec(inertia[b], omega[b])  # body frame
+        spin = matvec3(inertia[b], omega[b])  # body frame
         body_totals[b, 0] = 0.5 * m * (vel[b, 0] ** 2 + vel[b, 1] ** 2 + vel[b, 2] ** 2)
         body_totals[b, 1] = 0.5 * (omega[b, 0] * spin[0] + omega[b, 1] * spin[1] + omega[b, 2] * spin[2])
         body_totals[b, 2] = m * 0.5 * n_orbit * n_orbit * (com[b, 2] ** 2 - 3.0 * com[b, 0] ** 2)
-        spin_lvlh = _mat_vec(rot[b], spin)
+        spin_lvlh = matvec3(rot[b], spin)
         for d in range(3):
             body_totals[b, 3 + d] = m * vel[b, d]
         body_totals[b, 6] = m * (com[b, 1] * vel[b, 2] - com[b, 2] * vel[b, 1]) + spin_lvlh[0]
@@ -147,14 +93,13 @@ def body_sample(q, qt, body_index, body_reference, body_mass, inertia, impulse, 
         body_totals[b, 8] = m * (com[b, 0] * vel[b, 1] - com[b, 1] * vel[b, 0]) + spin_lvlh[2]
     for j in range(joint_parent.shape[0]):
         p, c = joint_parent[j], joint_child[j]
-        frame = _mat_mat(rot[p], to_parent[j], False)  # joint frame (parent side) in LVLH
-        relative = _mat_mat(frame, _mat_mat(rot[c], to_child[j], False), True)
-        rotation_vector_from_matrix(relative, joint_rotation[j])
-        w = _mat_vec(rot[c], omega[c]) - _mat_vec(rot[p], omega[p])
-        _mat_t_vec(frame, w, joint_rate[j])
-        offset = _mat_vec(rot[c], point_child[j]) + com[c] - _mat_vec(rot[p], point_parent[j]) - com[p]
-        offset_joint = np.empty(3)
-        _mat_t_vec(frame, offset, offset_joint)
+        frame = matmat3(rot[p], to_parent[j])  # joint frame (parent side) in LVLH
+        relative = mattmat3(frame, matmat3(rot[c], to_child[j]))
+        rotation_vector_from_matrix_into(relative, joint_rotation[j])
+        w = matvec3(rot[c], omega[c]) - matvec3(rot[p], omega[p])
+        joint_rate[j] = mattvec3(frame, w)
+        offset = matvec3(rot[c], point_child[j]) + com[c] - matvec3(rot[p], point_parent[j]) - com[p]
+        offset_joint = mattvec3(frame, offset)
         energy = 0.0
         for d in range(3):
             energy += joint_stiffness[j, d] * offset_joint[d] ** 2 + joint_stiffness[j, 3 + d] * joint_rotation[j, d] ** 2
