@@ -49,7 +49,13 @@ from multibody.kernel import (
     THREAD_ELASTIC,
 )
 from multibody.recorded_loads import applied_work
-from multibody.recorder_kernel import body_sample, net_sums
+from multibody.recorder_kernel import (
+    SampledBodies,
+    SampledJoints,
+    body_sample,
+    body_sample_buffers,
+    net_sums,
+)
 
 #: Longest simulated time between two finite-state checks when the output rate is lower (s):
 #: a NaN spreads through the coupled state within a few steps and stays, so 1 ms loses nothing.
@@ -107,25 +113,23 @@ class Recorder:
         self._n_net = 0
         bodies, joints = assembly.bodies, assembly.joints
         nb, nj = len(bodies), len(joints)
-        self._body_index = np.array(self._body_index, np.int64)
-        self._body_reference_lvlh = np.array([b.com_lvlh for b in bodies], float).reshape(nb, 3)
-        self._body_mass = np.array([b.mass for b in bodies], float)
-        self._inertia_body = np.array([b.inertia_body for b in bodies], float).reshape(nb, 3, 3)
+        self._bodies = SampledBodies(
+            index=np.array(self._body_index, np.int64),
+            reference_com_lvlh=np.array([b.com_lvlh for b in bodies], float).reshape(nb, 3),
+            mass=np.array([b.mass for b in bodies], float),
+            inertia_body=np.array([b.inertia_body for b in bodies], float).reshape(nb, 3, 3),
+            debris_mask=np.isin(np.arange(nb), np.array(assembly.debris_indices, np.int64)).astype(np.int64),
+            chaser=-1 if assembly.chaser is None else int(assembly.chaser))
         self._net_masses = np.asarray(assembly.net.masses, float)
-        self._debris = np.array(assembly.debris_indices, np.int64)
-        self._debris_mask = np.isin(np.arange(nb), self._debris).astype(np.int64)
-        self._chaser = -1 if assembly.chaser is None else int(assembly.chaser)
-        self._joint_arrays = (np.array([j.parent for j in joints], np.int64), np.array([j.child for j in joints], np.int64),
-                              np.array(system.joint_to_parent, float).reshape(nj, 3, 3),
-                              np.array(system.joint_to_child, float).reshape(nj, 3, 3),
-                              np.array(system.joint_point_parent_body, float).reshape(nj, 3),
-                              np.array(system.joint_point_child_body, float).reshape(nj, 3),
-                              np.array(self._joint_stiffness, float).reshape(nj, 6))
-        self._work = {name: np.zeros(shape) for name, shape in (
-            ("com", (nb, 3)), ("vel", (nb, 3)), ("rot", (nb, 3, 3)), ("omega", (nb, 3)), ("force", (nb, 3)),
-            ("moment", (nb, 3)), ("force_body", (nb, 3)), ("moment_body", (nb, 3)), ("totals", (nb, 9)),
-            ("joint_rotation", (nj, 3)), ("joint_rate", (nj, 3)), ("joint_energy", (nj,)), ("net", (8,)),
-            ("summary", (17,)))}
+        self._joints = SampledJoints(
+            parent=np.array([j.parent for j in joints], np.int64), child=np.array([j.child for j in joints], np.int64),
+            joint_to_parent=np.array(system.joint_to_parent, float).reshape(nj, 3, 3),
+            joint_to_child=np.array(system.joint_to_child, float).reshape(nj, 3, 3),
+            point_parent=np.array(system.joint_point_parent_body, float).reshape(nj, 3),
+            point_child=np.array(system.joint_point_child_body, float).reshape(nj, 3),
+            stiffness=np.array(self._joint_stiffness, float).reshape(nj, 6))
+        self._body_out = body_sample_buffers(nb, nj)
+        self._net_totals = np.zeros(8)
 
     # -- Exudyn hook -----------------------------------------------------------------
     def post_step(self, mbs, t):
@@ -208,16 +212,12 @@ class Recorder:
 
     def _compute_row(self, t, q, qt, x_lvlh, v_lvlh) -> dict:
         """One sample's values (see the module doc), from the compiled sums of multibody.recorder_kernel."""
-        w = self._work
+        w = self._body_out
         interval = t - self._last_output_time
         self._last_output_time = t
-        body_sample(q, qt, self._body_index, self._body_reference_lvlh, self._body_mass, self._inertia_body,
-                    self.system.kernel.buffers.body_impulse_lvlh, interval, *self._joint_arrays,
-                    self.joint_active.astype(float),
-                    self.assembly.mean_motion, self._debris_mask, self._chaser, w["com"], w["vel"], w["rot"],
-                    w["omega"], w["force"], w["moment"], w["force_body"], w["moment_body"], w["totals"],
-                    w["joint_rotation"], w["joint_rate"], w["joint_energy"], w["summary"])
-        net = w["net"]
+        body_sample(q, qt, self._bodies, self._joints, self.joint_active.astype(float),
+                    self.system.kernel.buffers.body_impulse_lvlh, interval, self.assembly.mean_motion, w)
+        net = self._net_totals
         net_sums(x_lvlh, v_lvlh, self._net_masses, self.assembly.mean_motion, net)
         mbs = self.system.mbs
         nj = len(self.system.joint_objects)
@@ -228,15 +228,15 @@ class Recorder:
                 # reversed sign; the parent's load on the child is its negative.
                 forces_joint[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)
                 moments_joint[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)
-        self._joint_energies = w["joint_energy"]
-        summary = w["summary"].tolist()
+        self._joint_energies = w.joint_energy
+        summary = w.summary.tolist()
         scalars = self.system.kernel.buffers.scalars.tolist()
         row = {"time": t,
-               "contact_force_lvlh": w["force"], "contact_moment_lvlh": w["moment"],
-               "contact_force_body": w["force_body"], "contact_moment_body": w["moment_body"],
-               "body_com_lvlh": w["com"], "body_velocity_lvlh": w["vel"], "body_omega_body": w["omega"],
-               "body_to_lvlh": w["rot"], "debris_com_lvlh": summary[0:3], "debris_velocity_lvlh": summary[3:6],
-               "joint_rotation_joint": w["joint_rotation"], "joint_rate_joint": w["joint_rate"],
+               "contact_force_lvlh": w.force_lvlh, "contact_moment_lvlh": w.moment_lvlh,
+               "contact_force_body": w.force_body, "contact_moment_body": w.moment_body,
+               "body_com_lvlh": w.com_lvlh, "body_velocity_lvlh": w.velocity_lvlh, "body_omega_body": w.omega_body,
+               "body_to_lvlh": w.body_to_lvlh, "debris_com_lvlh": summary[0:3], "debris_velocity_lvlh": summary[3:6],
+               "joint_rotation_joint": w.joint_rotation, "joint_rate_joint": w.joint_rate,
                "joint_force_joint": -forces_joint, "joint_moment_joint": -moments_joint}
         e = {
             "net_kinetic": net[0],
@@ -254,12 +254,12 @@ class Recorder:
         if self.assembly.chaser is not None:
             e["chaser_kinetic"] = summary[9]
         if self.assembly.body_loads is not None:
-            e["applied_loads_work"] = -self._work_of_applied_loads(t, w["com"], w["vel"], w["omega"])
+            e["applied_loads_work"] = -self._work_of_applied_loads(t, w.com_lvlh, w.velocity_lvlh, w.omega_body)
         e["total"] = sum(e.values())
         for key, value in e.items():
             row["energy_" + key] = value
-        row["momentum_linear_lvlh"] = net[2:5] + w["summary"][10:13]
-        row["momentum_angular_lvlh"] = net[5:8] + w["summary"][13:16]
+        row["momentum_linear_lvlh"] = net[2:5] + w.summary[10:13]
+        row["momentum_angular_lvlh"] = net[5:8] + w.summary[13:16]
         return row
 
     def _work_of_applied_loads(self, t, com_lvlh, velocity_lvlh, omega_body) -> float:
