@@ -586,7 +586,8 @@ def no_load(t, x, p, env, load):
         Time (s) from the record's t = 0.
     x : (STATE_SIZE,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
     p : (j,) float
         Not used.
     env : (ENV_SIZE,) float

@@ -76,7 +76,8 @@ def law(t, x, p, env, load):
         Time (s) from the record's t = 0.
     x : (STATE_SIZE,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
     p : (3,) float
         [c (N m s), field azimuth (rad), field elevation (rad)], I.
     env : (ENV_SIZE,) float
@@ -104,8 +105,8 @@ def towing_law(t, q, v, p, work, xe, h, load):
         :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
         (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
     p : (12,) float
-        c (N m s), field azimuth and elevation (rad) in I (the chaser's LVLH at the record's t = 0), I -> ECI
-        rotation (9, row-major, -).
+        c (N m s), field azimuth and elevation (rad) in I (the chaser's LVLH at the record's t = 0), I
+        -> ECI rotation (9, row-major, -).
     work : (w,) float
         Packed towing model (:func:`multibody.towing.packed`).
     xe : (EXTRA_STATES,) float
@@ -113,7 +114,8 @@ def towing_law(t, q, v, p, work, xe, h, load):
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float
-        Generalized forces, kernel layout, added to in place: the torque on the debris (N m, debris body frame).
+        Generalized forces, kernel layout, added to in place: the torque on the debris (N m, debris body
+        frame).
     """
     b_eci = tmv(p[3:12], field_direction(p[1], p[2]))
     rot = rotation_matrix_from_rotation_vector(q[DEBRIS + 3:DEBRIS + 6])

@@ -57,13 +57,15 @@ def law(t, x, p, env, load):
         Time (s) from the record's t = 0.
     x : (STATE_SIZE,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
     p : (1,) float
         [n (rad/s)], the mean motion the torque sees.
     env : (ENV_SIZE,) float
         Plant constants, layout ``E_*``.
     load : (LOAD_SIZE,) float
-        Loads, layout ``L_*``, added to in place: torques on the main body (``L_TM``) and the appendage (``L_TA``), B (N m).
+        Loads, layout ``L_*``, added to in place: torques on the main body (``L_TM``) and the appendage
+        (``L_TA``), B (N m).
     """
     n = env[E_N]
     r_b = tmtv(quaternion_rows(x[X_Q:X_Q + 4]), (np.cos(n * t), np.sin(n * t), 0.0))
@@ -99,7 +101,8 @@ def towing_law(t, q, v, p, work, xe, h, load):
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float
-        Generalized forces, kernel layout, added to in place: torques on chaser and debris (N m, their body frames).
+        Generalized forces, kernel layout, added to in place: torques on chaser and debris (N m, their
+        body frames).
     """
     for b, base in enumerate((CHASER, DEBRIS)):
         r = body_position(work, q, base)

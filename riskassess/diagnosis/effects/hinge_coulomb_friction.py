@@ -163,13 +163,16 @@ def law(t, x, p, env, load):
         Time (s) from the record's t = 0.
     x : (STATE_SIZE,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
     p : (4,) float
-        [T_c (N m), c_s (N m s/rad), k_s (N m/rad), anchor follow rate (1/s)] (:meth:`HingeCoulombFriction.law_parameters`).
+        [T_c (N m), c_s (N m s/rad), k_s (N m/rad), anchor follow rate (1/s)]
+        (:meth:`HingeCoulombFriction.law_parameters`).
     env : (ENV_SIZE,) float
         Plant constants, layout ``E_*``.
     load : (LOAD_SIZE,) float
-        Loads, layout ``L_*``, added to in place: the hinge torque (``L_TH``, N m, about the axis) and the anchor's rate (``L_ANCHOR``, rad/s).
+        Loads, layout ``L_*``, added to in place: the hinge torque (``L_TH``, N m, about the axis) and
+        the anchor's rate (``L_ANCHOR``, rad/s).
     """
     hold = holding_torque(x[X_TH], x[X_THD], x[X_ANCHOR], env[E_K], p[1], p[2])
     load[L_TH] += friction_torque(hold, p[0])

@@ -56,7 +56,8 @@ def law(t, x, p, env, load):
         Time (s) from the record's t = 0.
     x : (STATE_SIZE,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
     p : (2,) float
         [J_d (kg m^2), T_d (s)].
     env : (ENV_SIZE,) float
@@ -91,11 +92,13 @@ def towing_law(t, q, v, p, work, xe, h, load):
     work : (w,) float
         Packed towing model (:func:`multibody.towing.packed`).
     xe : (EXTRA_STATES,) float
-        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); ``XE_DAMPER``, the rotor's angular velocity (rad/s, debris frame), advanced in place.
+        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); ``XE_DAMPER``,
+        the rotor's angular velocity (rad/s, debris frame), advanced in place.
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float
-        Generalized forces, kernel layout, added to in place: the torque on the debris (N m, debris body frame).
+        Generalized forces, kernel layout, added to in place: the torque on the debris (N m, debris body
+        frame).
     """
     w = v[DEBRIS + 3:DEBRIS + 6]
     wd = xe[XE_DAMPER:XE_DAMPER + 3]

@@ -113,7 +113,8 @@ def law(t, x, p, env, load):
         Time (s) from the record's t = 0.
     x : (STATE_SIZE,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
     p : (1,) float
         [J2 (-)].
     env : (ENV_SIZE,) float
@@ -147,7 +148,8 @@ def towing_law(t, q, v, p, work, xe, h, load):
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float
-        Generalized forces, kernel layout, added to in place: forces on P, the chaser and the debris (N, ECI).
+        Generalized forces, kernel layout, added to in place: forces on P, the chaser and the debris (N,
+        ECI).
     """
     point, _ = point_position(work)
     for b, base in enumerate((0, CHASER, DEBRIS)):

@@ -104,12 +104,13 @@ def towing_law(t, q, v, p, work, xe, h, load):
     work : (w,) float
         Packed towing model (:func:`multibody.towing.packed`).
     xe : (EXTRA_STATES,) float
-        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); ``XE_MAXWELL`` (N) and ``XE_ELONGATION`` (m), advanced in place.
+        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); ``XE_MAXWELL``
+        (N) and ``XE_ELONGATION`` (m), advanced in place.
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float
-        Generalized forces, kernel layout, added to in place: none (the branch acts through the main tether's stiffness and
-        rest length in ``work``).
+        Generalized forces, kernel layout, added to in place: none (the branch acts through the main
+        tether's stiffness and rest length in ``work``).
     """
     if h <= 0.0:
         return

@@ -101,8 +101,8 @@ def towing_law(t, q, v, p, work, xe, h, load):
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float
-        Generalized forces, kernel layout, added to in place: the force change on the chaser (N, ECI) and the torque
-        (N m, chaser body frame; 0 with the thrust line through the CoM).
+        Generalized forces, kernel layout, added to in place: the force change on the chaser (N, ECI)
+        and the torque (N m, chaser body frame; 0 with the thrust line through the CoM).
     """
     thrust = last_diagnostics(work)[THRUST]
     if thrust == 0.0:
