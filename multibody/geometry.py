@@ -30,6 +30,8 @@ def shape_mesh(kind: str, *, size=None, radius=None, length=None, axis=None, cen
     center : (3,) float     Shape centre, target frame (m).
     rotation_vector : (3,) float  Shape->target rotation for boxes, ellipsoids and meshes (rad).
     file : path             Mesh file (any format trimesh reads), vertices in m before ``scale``.
+    scale : float           Factor applied to the mesh file's vertices (-).
+    sections : int          Facets around a cylinder's circumference.
     """
     if kind == "box":
         mesh = trimesh.creation.box(extents=size)
@@ -59,39 +61,65 @@ def _align_z_to(axis) -> np.ndarray:
     return trimesh.geometry.align_vectors([0, 0, 1], np.asarray(axis, float) / np.linalg.norm(axis))
 
 
-def uniform_density_inertia(meshes, mass, com):
-    """Inertia tensor (kg m^2) about ``com`` of ``mass`` spread evenly over the meshes' volume.
+def uniform_density_inertia(meshes, mass, com_target):
+    """Inertia tensor (kg m^2) about ``com_target`` of ``mass`` spread evenly over the meshes' volume.
 
     Overlapping shapes count twice; keep the shapes of one body disjoint when the
     inertia is to come from geometry.
+
+    Parameters
+    ----------
+    meshes : list of trimesh.Trimesh
+        Closed shapes of one body, vertices in the target frame (m).
+    mass : float
+        The body's mass (kg).
+    com_target : (3,) float
+        Reference point of the tensor (the body's CoM), target frame (m).
+
+    Returns
+    -------
+    (3, 3) float
+        Inertia tensor about ``com_target``, axes of the target frame (kg m^2).
     """
     volume = sum(m.volume for m in meshes)
-    inertia = np.zeros((3, 3))
+    inertia_target = np.zeros((3, 3))
     for m in meshes:
         share = mass * m.volume / volume
-        j_own = m.moment_inertia * share / m.volume  # trimesh uses unit density
-        d = np.asarray(m.center_mass) - np.asarray(com)
-        inertia += j_own + share * (d @ d * np.eye(3) - np.outer(d, d))
-    return inertia
+        j_own_target = m.moment_inertia * share / m.volume  # trimesh uses unit density
+        offset_target = np.asarray(m.center_mass) - np.asarray(com_target)
+        inertia_target += j_own_target + share * (offset_target @ offset_target * np.eye(3)
+                                                  - np.outer(offset_target, offset_target))
+    return inertia_target
 
 
 def geometric_center_of_mass(meshes):
-    """Volume-weighted centroid of the meshes, target frame (m)."""
+    """Volume-weighted centroid of the meshes, target frame (m).
+
+    Parameters
+    ----------
+    meshes : list of trimesh.Trimesh
+        Closed shapes of one body, vertices in the target frame (m).
+
+    Returns
+    -------
+    (3,) float
+        Centroid of the shapes' joint volume, target frame (m).
+    """
     volumes = np.array([m.volume for m in meshes])
-    centers = np.array([m.center_mass for m in meshes])
-    return volumes @ centers / volumes.sum()
+    centers_target = np.array([m.center_mass for m in meshes])
+    return volumes @ centers_target / volumes.sum()
 
 
 @dataclass(frozen=True)
 class ContactShapes:
     """Triangle soup of all contact shapes of all bodies, in body frames (see kernel)."""
 
-    triangles: np.ndarray       # (T, 3, 3) m
-    normals: np.ndarray         # (T, 3)
+    triangles_body: np.ndarray       # (T, 3, 3) m
+    normals_body: np.ndarray         # (T, 3)
     shape_body: np.ndarray      # (ns,) int
     triangle_range: np.ndarray  # (ns, 2) int
-    box_min: np.ndarray         # (ns, 3) m
-    box_max: np.ndarray         # (ns, 3) m
+    box_min_body: np.ndarray         # (ns, 3) m
+    box_max_body: np.ndarray         # (ns, 3) m
 
 
 def contact_shapes_body_frame(meshes_per_body, com_per_body) -> ContactShapes:
@@ -104,25 +132,25 @@ def contact_shapes_body_frame(meshes_per_body, com_per_body) -> ContactShapes:
     com_per_body : (nb, 3) float
         Body CoM, target frame (m). Body axes are parallel to the target frame.
     """
-    triangles, normals, owner, ranges, lo, hi = [], [], [], [], [], []
+    triangles_body, normals_body, owner, ranges, lo_body, hi_body = [], [], [], [], [], []
     start = 0
     for b, meshes in enumerate(meshes_per_body):
         for mesh in meshes:
-            tri = np.asarray(mesh.triangles) - np.asarray(com_per_body[b])
-            triangles.append(tri)
-            normals.append(np.asarray(mesh.face_normals))
+            tri_body = np.asarray(mesh.triangles) - np.asarray(com_per_body[b])
+            triangles_body.append(tri_body)
+            normals_body.append(np.asarray(mesh.face_normals))
             owner.append(b)
-            ranges.append((start, start + len(tri)))
-            lo.append(tri.reshape(-1, 3).min(axis=0))
-            hi.append(tri.reshape(-1, 3).max(axis=0))
-            start += len(tri)
-    if not triangles:  # bodies without contact shapes
+            ranges.append((start, start + len(tri_body)))
+            lo_body.append(tri_body.reshape(-1, 3).min(axis=0))
+            hi_body.append(tri_body.reshape(-1, 3).max(axis=0))
+            start += len(tri_body)
+    if not triangles_body:  # bodies without contact shapes
         return ContactShapes(np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros(0, np.int64),
                              np.zeros((0, 2), np.int64), np.zeros((0, 3)), np.zeros((0, 3)))
     return ContactShapes(
-        triangles=np.ascontiguousarray(np.concatenate(triangles)),
-        normals=np.ascontiguousarray(np.concatenate(normals)),
+        triangles_body=np.ascontiguousarray(np.concatenate(triangles_body)),
+        normals_body=np.ascontiguousarray(np.concatenate(normals_body)),
         shape_body=np.asarray(owner, np.int64),
         triangle_range=np.asarray(ranges, np.int64),
-        box_min=np.asarray(lo), box_max=np.asarray(hi),
+        box_min_body=np.asarray(lo_body), box_max_body=np.asarray(hi_body),
     )

@@ -7,6 +7,9 @@ each. Same definitions as before; frames in the names, SI units.
 from __future__ import annotations
 
 
+from typing import NamedTuple
+
+import numpy as np
 from numba import njit
 
 from multibody.linalg3 import matmat3, mattmat3, mattvec3, matvec3
@@ -33,38 +36,89 @@ def net_sums(x, v, masses, n_orbit, out):
         out[7] += x[i, 0] * py - x[i, 1] * px
 
 
+class SampledBodies(NamedTuple):
+    """The bodies' constants a sample needs (nb bodies)."""
+
+    index: np.ndarray                 # (nb,) int64 where body b's coordinates start in Exudyn's vectors
+    reference_com_lvlh: np.ndarray    # (nb, 3) reference CoM (m), LVLH
+    mass: np.ndarray                  # (nb,) (kg)
+    inertia_body: np.ndarray          # (nb, 3, 3) about the CoM, body frame (kg m^2)
+    debris_mask: np.ndarray           # (nb,) int64, 1 for debris bodies
+    chaser: int                       # the chaser's index, -1 for none
+
+
+class SampledJoints(NamedTuple):
+    """The joints' constants a sample needs (nj joints)."""
+
+    parent: np.ndarray                # (nj,) int64 parent body
+    child: np.ndarray                 # (nj,) int64 child body
+    joint_to_parent: np.ndarray       # (nj, 3, 3) joint frame in the parent's body frame
+    joint_to_child: np.ndarray        # (nj, 3, 3) joint frame in the child's body frame (unrotated)
+    point_parent: np.ndarray          # (nj, 3) joint point, parent body frame (m)
+    point_child: np.ndarray           # (nj, 3) joint point, child body frame (m)
+    stiffness: np.ndarray             # (nj, 6) penalty (N/m) and torsion (N m/rad) diagonals, joint frame
+
+
+class BodySample(NamedTuple):
+    """One sample's body and joint values, written by :func:`body_sample` (preallocated)."""
+
+    com_lvlh: np.ndarray              # (nb, 3) CoM (m)
+    velocity_lvlh: np.ndarray         # (nb, 3) CoM velocity (m/s)
+    body_to_lvlh: np.ndarray          # (nb, 3, 3) attitude
+    omega_body: np.ndarray            # (nb, 3) angular velocity (rad/s), body frame
+    force_lvlh: np.ndarray            # (nb, 3) mean contact force since the last sample (N)
+    moment_lvlh: np.ndarray           # (nb, 3) its moment about the CoM (N m)
+    force_body: np.ndarray            # (nb, 3) the same, body frame
+    moment_body: np.ndarray           # (nb, 3)
+    body_totals: np.ndarray           # (nb, 9) translational and rotational kinetic energy (J), CW potential (J),
+    #                                   linear momentum (3, kg m/s), angular momentum about the LVLH origin (3, kg m^2/s)
+    joint_rotation: np.ndarray        # (nj, 3) relative rotation vector (rad), joint frame
+    joint_rate: np.ndarray            # (nj, 3) relative rate (rad/s), joint frame
+    joint_energy: np.ndarray          # (nj,) elastic energy of the penalty spring (J)
+    summary: np.ndarray               # (17,) debris CoM (3, m) and CoM velocity (3, m/s), LVLH; debris translational
+    #                                   and rotational kinetic energy (J); CW potential of all bodies (J); the chaser's
+    #                                   kinetic energy (J); linear (3) and angular (3) momentum of all bodies (as
+    #                                   body_totals); joint elastic energy (J)
+
+
+def body_sample_buffers(n_bodies: int, n_joints: int) -> BodySample:
+    """Zeroed :class:`BodySample` arrays."""
+    nb, nj = n_bodies, n_joints
+    return BodySample(np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3, 3)), np.zeros((nb, 3)),
+                      np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 9)),
+                      np.zeros((nj, 3)), np.zeros((nj, 3)), np.zeros(nj), np.zeros(17))
+
+
 @njit(cache=True)
-def body_sample(q, qt, body_index, body_reference, body_mass, inertia, impulse, interval,
-                joint_parent, joint_child, to_parent, to_child, point_parent, point_child, joint_stiffness, active,
-                n_orbit, debris_mask, chaser, com, vel, rot, omega, force_lvlh, moment_lvlh, force_body, moment_body,
-                body_totals, joint_rotation, joint_rate, joint_energy, summary):
-    """Body and joint states of one sample, into the output arrays (all preallocated).
+def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
+    """Body and joint states of one sample, into ``out`` (preallocated).
 
     Parameters
     ----------
-    q, qt : (N,) float        Exudyn's coordinates and velocities; body ``b`` starts at ``body_index[b]``
-                              (CoM displacement (m), rotation vector (rad); CoM velocity (m/s), omega (rad/s, body)).
-    body_reference : (nb, 3)  Reference CoM (m), LVLH.
-    inertia : (nb, 3, 3)      About the CoM, body frame (kg m^2).
-    impulse : (nb, 6)         Contact impulse and angular impulse about the CoM since the last sample (N s, N m s),
-                              LVLH; zeroed here.
-    interval : float          Time since the last sample (s); 0 gives zero contact force.
-    joint_* , to_*, point_*   Per joint: parent, child, joint frame in each body frame (3, 3), joint point in
-                              each body frame (m); ``joint_stiffness`` (nj, 6) penalty/torsion diagonals,
-                              ``active`` (nj,) 1.0 or 0.0 (released).
-    com, vel, omega : (nb, 3); rot : (nb, 3, 3)    Body states (omega in the body frame).
-    n_orbit : float           Mean motion (rad/s) of the Clohessy-Wiltshire potential; 0 without orbit.
-    debris_mask : (nb,) int   1 for debris bodies; ``chaser`` (int) the chaser's index or -1.
-    force_lvlh, moment_lvlh, force_body, moment_body : (nb, 3)   Mean contact force (N), moment about the CoM (N m).
-    body_totals : (nb, 9)     Per body: translational and rotational kinetic energy (J), CW potential (J),
-                              linear momentum (3, kg m/s), angular momentum about the LVLH origin (3, kg m^2/s).
-    joint_rotation, joint_rate : (nj, 3)   Relative rotation vector (rad) and rate (rad/s), joint frame.
-    joint_energy : (nj,)      Elastic energy of the penalty spring (J).
-    summary : (17,)           Debris CoM (3, m) and CoM velocity (3, m/s), LVLH; debris translational and
-                              rotational kinetic energy (J); CW potential of all bodies (J); the chaser's
-                              kinetic energy (J); linear (3) and angular (3) momentum of all bodies (as
-                              ``body_totals``); joint elastic energy (J).
+    q, qt : (N,) float
+        Exudyn's coordinates and velocities; body ``b`` starts at ``bodies.index[b]`` (CoM displacement
+        (m), rotation vector (rad); CoM velocity (m/s), omega (rad/s, body frame)).
+    bodies : SampledBodies
+    joints : SampledJoints
+    active : (nj,) float
+        1.0 for a joint in place, 0.0 once released.
+    impulse : (nb, 6) float
+        Contact impulse and angular impulse about the CoM since the last sample (N s, N m s), LVLH;
+        zeroed here.
+    interval : float
+        Time since the last sample (s); 0 gives zero contact force.
+    n_orbit : float
+        Mean motion (rad/s) of the Clohessy-Wiltshire potential; 0 without orbit.
+    out : BodySample
     """
+    body_reference, body_mass, inertia = bodies.reference_com_lvlh, bodies.mass, bodies.inertia_body
+    body_index, debris_mask, chaser = bodies.index, bodies.debris_mask, bodies.chaser
+    joint_parent, joint_child, to_parent, to_child = joints.parent, joints.child, joints.joint_to_parent, joints.joint_to_child
+    point_parent, point_child, joint_stiffness = joints.point_parent, joints.point_child, joints.stiffness
+    com, vel, rot, omega = out.com_lvlh, out.velocity_lvlh, out.body_to_lvlh, out.omega_body
+    force_lvlh, moment_lvlh, force_body, moment_body = out.force_lvlh, out.moment_lvlh, out.force_body, out.moment_body
+    body_totals, joint_rotation, joint_rate = out.body_totals, out.joint_rotation, out.joint_rate
+    joint_energy, summary = out.joint_energy, out.summary
     nb = body_mass.shape[0]
     for b in range(nb):
         i = body_index[b]
