@@ -177,7 +177,7 @@ def extended_case(case_path: Path, problem: Problem, fit: FitResult, effect=None
     case_path : Path
         The diagnosis case file.
     problem : riskassess.diagnosis.fit.Problem
-        The diagnosis problem (its plant's initial attitude, target -> LVLH, composes a fitted
+        The diagnosis problem (its plant's initial attitude, main body -> inertial, composes a fitted
         attitude change).
     fit : FitResult
         The chosen model's fit: initial state (rad, rad/s, m, m/s), hinge values and effect parameters, SI.
