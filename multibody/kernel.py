@@ -45,7 +45,24 @@ def verlet_evaluation_state(q, qt, qtt, step, n_net_coordinates, n_bodies):
     """The state at which Exudyn's VelocityVerlet evaluates the forces of the step that starts
     at (q, qt, qtt): mid-step velocity qt + step/2 qtt and end position q + step * that;
     rigid-body rotation vectors are advanced by the Lie-group composition with the
-    mid-step angular velocity (body frame), as Exudyn does. Layout as in the module doc."""
+    mid-step angular velocity (body frame), as Exudyn does.
+
+    Parameters
+    ----------
+    q, qt, qtt : (N,) float
+        Coordinates, velocities and accelerations at the step's start, in the module doc's layout.
+    step : float
+        (s).
+    n_net_coordinates : int
+        Net coordinates ahead of the bodies' (3 n; 0 when the kernel holds the net).
+    n_bodies : int
+        Rigid bodies after them (6 coordinates each).
+
+    Returns
+    -------
+    q_next, v_half : (N,) float
+        The evaluation state: end positions (rotation vectors composed) and mid-step velocities.
+    """
     v_half = qt + (0.5 * step) * qtt
     q_next = q + step * v_half
     for b in range(n_bodies):
@@ -134,7 +151,13 @@ class KernelBuffers(NamedTuple):
 
 
 def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffers:
-    """Zeroed :class:`KernelBuffers` for ``net`` and ``n_bodies`` bodies with ``n_shapes`` contact shapes."""
+    """Zeroed :class:`KernelBuffers` for ``net`` and ``n_bodies`` bodies with ``n_shapes`` contact shapes.
+
+    Parameters
+    ----------
+    net : NetArrays
+    n_bodies, n_shapes : int
+    """
     n = len(net.mass)
     work_node = np.zeros((4, n))
     work_node[3] = 1.0 / np.asarray(net.mass, float)  # constant: a product is cheaper than a division
@@ -195,10 +218,15 @@ class KernelData:
         return len(self.bodies.mass)
 
     def evaluate(self, q, qt, time=1.0):
-        """Generalized forces for coordinates ``q`` and velocities ``qt`` ((3n + 6nb,) each).
+        """Generalized forces (3 n + 6 nb,) at coordinates ``q`` and velocities ``qt`` (module doc).
 
-        At ``time`` 0 (the solver's initial-acceleration evaluation, which Verlet applies as
-        a half kick only) the contact is evaluated without sub-cycling.
+        Parameters
+        ----------
+        q, qt : (3 n + 6 nb,) float
+            Coordinates and velocities in the module doc's layout.
+        time : float
+            Time of the evaluation (s). At 0 (the solver's initial-acceleration evaluation, which
+            Verlet applies as a half kick only) the contact is evaluated without sub-cycling.
         """
         n_sub = max(1, int(math.ceil(self.step / self.contact_substep - 1e-9))) if time > 0.0 else 1
         return coupled_generalized_forces(q, qt, self.net, self.bodies, self.shapes, self.law, self.mounts,
@@ -288,10 +316,20 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
 def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torque_lvlh):
     """Spring-dampers from mounted net nodes to their points on a body, all LVLH.
 
-    ``x``, ``v`` (n, 3): node positions (m) and velocities (m/s); ``states``: :class:`BodyStates`;
-    ``mounts``: :class:`Mounts`. The node's force and the body's reaction act on the same line, through
-    the mount point, so linear and angular momentum are exchanged exactly. Returns the elastic energy
-    (J) and the dissipated power (W).
+    The node's force and the body's reaction act on the same line, through the mount point, so linear
+    and angular momentum are exchanged exactly. Returns the elastic energy (J) and the dissipated
+    power (W).
+
+    Parameters
+    ----------
+    x, v : (n, 3) float
+        Node positions (m) and velocities (m/s), LVLH.
+    states : BodyStates
+    mounts : Mounts
+    net_force_lvlh : (n, 3) float
+        Node force accumulator (N), LVLH.
+    body_force_lvlh, torque_lvlh : (nb, 3) float
+        Body force (N) and torque about the CoM (N m) accumulators, LVLH.
     """
     k, d = mounts.stiffness, mounts.damping
     body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
@@ -316,7 +354,17 @@ def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torq
 @njit(cache=True)
 def body_states(q, qt, n_nodes, reference_com_lvlh):
     """:class:`BodyStates` (attitude body->LVLH, CoM (m), CoM velocity (m/s), angular velocity (rad/s),
-    LVLH) from the coordinates ``q``, ``qt`` in the module doc's layout."""
+    LVLH) from the coordinates in the module doc's layout.
+
+    Parameters
+    ----------
+    q, qt : (3 n + 6 nb,) float
+        Coordinates and velocities (module doc).
+    n_nodes : int
+        Net nodes ahead of the bodies (0 when the kernel holds the net).
+    reference_com_lvlh : (nb, 3) float
+        Reference CoM positions (m), LVLH.
+    """
     nb = reference_com_lvlh.shape[0]
     body_to_lvlh = np.empty((nb, 3, 3))
     com_lvlh = np.empty((nb, 3))
