@@ -15,7 +15,7 @@ DEBRIS_STATES = (DEBRIS, NO_DEBRIS, INDETERMINATE)
 
 
 #: A verdict needs at least this many judged samples (after ``skip_initial``): a peak read from
-#: fewer is not a load history (the reproducer of issue 20: end_time below skip_initial, or an
+#: fewer is not a load history (a run whose end_time was below skip_initial, or an
 #: output rate of 1e-300 Hz, judged nothing and said "pass").
 MIN_JUDGED_SAMPLES = 10
 #: Longest sample interval a verdict accepts (s). Joint loads are sampled, not averaged, so a
