@@ -39,19 +39,20 @@ def _effective_mass_along_normal(rot, inverse_inertia_body, mass, ax, ay, az, nx
 
 
 @njit(cache=True)
-def _apply_contact_pair(i, b, fx, fy, fz, coms, weight, x, f_net, f_body, torque_lvlh, out_body_impulse,
+def _apply_contact_pair(i, b, fx, fy, fz, com_lvlh, weight, x, net_force_lvlh, body_force_lvlh, torque_lvlh,
+                        out_body_impulse,
                         out_node_impulse):
     """Force (fx, fy, fz) on node ``i`` and its reaction on body ``b`` on the same line of action; the
     impulses (times ``weight``) accumulate per body and per node."""
-    f_net[i, 0] += fx
-    f_net[i, 1] += fy
-    f_net[i, 2] += fz
-    f_body[b, 0] -= fx
-    f_body[b, 1] -= fy
-    f_body[b, 2] -= fz
-    ax = x[i, 0] - coms[b, 0]
-    ay = x[i, 1] - coms[b, 1]
-    az = x[i, 2] - coms[b, 2]
+    net_force_lvlh[i, 0] += fx
+    net_force_lvlh[i, 1] += fy
+    net_force_lvlh[i, 2] += fz
+    body_force_lvlh[b, 0] -= fx
+    body_force_lvlh[b, 1] -= fy
+    body_force_lvlh[b, 2] -= fz
+    ax = x[i, 0] - com_lvlh[b, 0]
+    ay = x[i, 1] - com_lvlh[b, 1]
+    az = x[i, 2] - com_lvlh[b, 2]
     # moment of the reaction -f about the body CoM: a x (-f)
     mx = -(ay * fz - az * fy)
     my = -(az * fx - ax * fz)
@@ -108,9 +109,10 @@ def _substeps_to_resolve_contact(penetrations, relative_velocities, normals, bod
 
 
 @njit(cache=True)
-def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, f_net, f_body,
+def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, net_force_lvlh,
+                       body_force_lvlh,
                        torque_lvlh):
-    """Add node-body contact kicks to ``f_net`` and their reactions to ``f_body``/``torque_lvlh``.
+    """Add node-body contact kicks to ``net_force_lvlh`` and their reactions to ``body_force_lvlh``/``torque_lvlh``.
 
     Parameters
     ----------
@@ -126,9 +128,9 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
         Weight of the accumulated impulses and energies (1 / force evaluations per step).
     buffers : KernelBuffers
         Impulse accumulators, the carried velocity lag and work space (:mod:`multibody.kernel`).
-    f_net : (n, 3) float
+    net_force_lvlh : (n, 3) float
         Enters holding every non-contact force on the nodes (N, LVLH); the contact forces are added.
-    f_body, torque_lvlh : (nb, 3) float
+    body_force_lvlh, torque_lvlh : (nb, 3) float
         The reactions are added: force (N) and torque about the CoM (N m), LVLH.
 
     Returns
@@ -151,7 +153,8 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
     against the threads' own 1.6 N s/m) and pumped energy into nodes held on a surface.
     """
     net_mass, net_radius = net.mass, net.radius
-    rots, coms, vels, omegas = states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh, states.omega_lvlh
+    body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
+    velocity_lvlh, omega_lvlh = states.velocity_lvlh, states.omega_lvlh
     body_mass_all, inverse_inertia = bodies.mass, bodies.inverse_inertia_body
     triangles, triangle_normals, shape_body = shapes.triangles_body, shapes.normals_body, shapes.body
     shape_triangle_range, shape_box_min, shape_box_max = shapes.triangle_range, shapes.box_min_body, shapes.box_max_body
@@ -161,7 +164,7 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
     velocity_lag, lag_body, work_node, candidates = (buffers.velocity_lag, buffers.lag_body, buffers.work_node,
                                                      buffers.candidates)
     out_body_impulse, out_node_impulse = buffers.body_impulse_lvlh, buffers.node_impulse_lvlh
-    f_non_contact, v_start = buffers.work[2], buffers.work[3]
+    non_contact_force_lvlh, start_velocity_lvlh = buffers.work[2], buffers.work[3]
     n = net_mass.shape[0]
     contact_energy = 0.0
     n_contacts = 0
@@ -176,19 +179,21 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
         speed_bound = 0.0
         push_bound = 0.0
         for d in range(3):
-            speed_bound += abs(v[i, d] + velocity_lag[i, d] + half_kick * f_net[i, d] * inverse_mass)
-            push_bound += abs(f_net[i, d])
+            speed_bound += abs(v[i, d] + velocity_lag[i, d] + half_kick * net_force_lvlh[i, d] * inverse_mass)
+            push_bound += abs(net_force_lvlh[i, d])
         reach[i] = 1.001 * (net_radius[i] + step * speed_bound + 0.5 * step * step * push_bound * inverse_mass)
     n_shapes = shape_body.shape[0]
     shape_speed = np.empty(n_shapes)
     for s in range(n_shapes):
         b = shape_body[s]
         lo, hi = shape_box_min[s], shape_box_max[s]
-        extent = math.sqrt(max(lo[0] * lo[0] + lo[1] * lo[1] + lo[2] * lo[2], hi[0] * hi[0] + hi[1] * hi[1] + hi[2] * hi[2]))
-        shape_speed[s] = (math.sqrt(vels[b, 0] ** 2 + vels[b, 1] ** 2 + vels[b, 2] ** 2)
-                          + math.sqrt(omegas[b, 0] ** 2 + omegas[b, 1] ** 2 + omegas[b, 2] ** 2) * extent)
+        extent = math.sqrt(max(lo[0] * lo[0] + lo[1] * lo[1] + lo[2] * lo[2],
+                               hi[0] * hi[0] + hi[1] * hi[1] + hi[2] * hi[2]))
+        shape_speed[s] = (math.sqrt(velocity_lvlh[b, 0] ** 2 + velocity_lvlh[b, 1] ** 2 + velocity_lvlh[b, 2] ** 2)
+                          + math.sqrt(omega_lvlh[b, 0] ** 2 + omega_lvlh[b, 1] ** 2 + omega_lvlh[b, 2] ** 2) * extent)
     # bounding-sphere pass (multibody.broad_phase); the box test below stays the exact filter
-    flag_candidates(x, reach, rots, coms, shape_body, shape_box_min, shape_box_max, step * shape_speed, candidates)
+    flag_candidates(x, reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max, step * shape_speed,
+                    candidates)
     # per-node contact lists and sub-cycle work space, reused
     c_body = np.empty(n_shapes, np.int64)
     c_pen = np.empty(n_shapes)
@@ -205,10 +210,12 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
             continue  # far from every shape and nothing carried: no contact work for this node
         # the node's non-contact force and its velocity at the evaluation time (see the doc above)
         for d in range(3):
-            f_non_contact[i, d] = f_net[i, d]
-            v_start[i, d] = v[i, d] + velocity_lag[i, d] + half_kick * f_net[i, d] / net_mass[i]
-        speed[i] = math.sqrt(v_start[i, 0] ** 2 + v_start[i, 1] ** 2 + v_start[i, 2] ** 2)
-        push[i] = math.sqrt(f_net[i, 0] ** 2 + f_net[i, 1] ** 2 + f_net[i, 2] ** 2) / net_mass[i]
+            non_contact_force_lvlh[i, d] = net_force_lvlh[i, d]
+            start_velocity_lvlh[i, d] = v[i, d] + velocity_lag[i, d] + half_kick * net_force_lvlh[i, d] / net_mass[i]
+        speed[i] = math.sqrt(start_velocity_lvlh[i, 0] ** 2 + start_velocity_lvlh[i, 1] ** 2
+                             + start_velocity_lvlh[i, 2] ** 2)
+        push[i] = math.sqrt(net_force_lvlh[i, 0] ** 2 + net_force_lvlh[i, 1] ** 2
+                            + net_force_lvlh[i, 2] ** 2) / net_mass[i]
         k = 0
         for s in range(n_shapes):
             if not candidates[s, i]:
@@ -216,12 +223,12 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
             b = shape_body[s]
             # Broad phase in scalars: node in the body frame against the shape's box, grown by
             # the node radius and the distance the pair can close within one step.
-            ax = x[i, 0] - coms[b, 0]
-            ay = x[i, 1] - coms[b, 1]
-            az = x[i, 2] - coms[b, 2]
-            px = rots[b, 0, 0] * ax + rots[b, 1, 0] * ay + rots[b, 2, 0] * az
-            py = rots[b, 0, 1] * ax + rots[b, 1, 1] * ay + rots[b, 2, 1] * az
-            pz = rots[b, 0, 2] * ax + rots[b, 1, 2] * ay + rots[b, 2, 2] * az
+            ax = x[i, 0] - com_lvlh[b, 0]
+            ay = x[i, 1] - com_lvlh[b, 1]
+            az = x[i, 2] - com_lvlh[b, 2]
+            px = body_to_lvlh[b, 0, 0] * ax + body_to_lvlh[b, 1, 0] * ay + body_to_lvlh[b, 2, 0] * az
+            py = body_to_lvlh[b, 0, 1] * ax + body_to_lvlh[b, 1, 1] * ay + body_to_lvlh[b, 2, 1] * az
+            pz = body_to_lvlh[b, 0, 2] * ax + body_to_lvlh[b, 1, 2] * ay + body_to_lvlh[b, 2, 2] * az
             margin = net_radius[i] + step * (speed[i] + shape_speed[s]) + 0.5 * step * step * push[i]
             if (px < shape_box_min[s, 0] - margin or px > shape_box_max[s, 0] + margin
                     or py < shape_box_min[s, 1] - margin or py > shape_box_max[s, 1] + margin
@@ -233,24 +240,26 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
                 distance, nbx, nby, nbz = signed_distance_to_mesh(
                     px, py, pz, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
             penetration = net_radius[i] - distance
-            nx = rots[b, 0, 0] * nbx + rots[b, 0, 1] * nby + rots[b, 0, 2] * nbz
-            ny = rots[b, 1, 0] * nbx + rots[b, 1, 1] * nby + rots[b, 1, 2] * nbz
-            nz = rots[b, 2, 0] * nbx + rots[b, 2, 1] * nby + rots[b, 2, 2] * nbz
-            wx, wy, wz = omegas[b, 0], omegas[b, 1], omegas[b, 2]
-            rx = v_start[i, 0] - vels[b, 0] - (wy * az - wz * ay)
-            ry = v_start[i, 1] - vels[b, 1] - (wz * ax - wx * az)
-            rz = v_start[i, 2] - vels[b, 2] - (wx * ay - wy * ax)
+            nx = body_to_lvlh[b, 0, 0] * nbx + body_to_lvlh[b, 0, 1] * nby + body_to_lvlh[b, 0, 2] * nbz
+            ny = body_to_lvlh[b, 1, 0] * nbx + body_to_lvlh[b, 1, 1] * nby + body_to_lvlh[b, 1, 2] * nbz
+            nz = body_to_lvlh[b, 2, 0] * nbx + body_to_lvlh[b, 2, 1] * nby + body_to_lvlh[b, 2, 2] * nbz
+            wx, wy, wz = omega_lvlh[b, 0], omega_lvlh[b, 1], omega_lvlh[b, 2]
+            rx = start_velocity_lvlh[i, 0] - velocity_lvlh[b, 0] - (wy * az - wz * ay)
+            ry = start_velocity_lvlh[i, 1] - velocity_lvlh[b, 1] - (wz * ax - wx * az)
+            rz = start_velocity_lvlh[i, 2] - velocity_lvlh[b, 2] - (wx * ay - wy * ax)
             # Touches within the step if the gap closes under the current velocity and the
             # non-contact force (a taut thread can pull a node 0.6 mm in 1e-4 s; missing that
             # lets it sink unresisted for a step and come back out with the Hertz energy).
-            pull = (f_non_contact[i, 0] * nx + f_non_contact[i, 1] * ny + f_non_contact[i, 2] * nz) / net_mass[i]
-            if penetration - (rx * nx + ry * ny + rz * nz) * step - 0.5 * pull * step * step <= 0.0 and penetration <= 0.0:
+            pull = (non_contact_force_lvlh[i, 0] * nx + non_contact_force_lvlh[i, 1] * ny
+                    + non_contact_force_lvlh[i, 2] * nz) / net_mass[i]
+            closing = (rx * nx + ry * ny + rz * nz) * step
+            if penetration - closing - 0.5 * pull * step * step <= 0.0 and penetration <= 0.0:
                 continue
             c_body[k] = b
             c_pen[k] = penetration
             c_normal[k, 0], c_normal[k, 1], c_normal[k, 2] = nx, ny, nz
             c_rel[k, 0], c_rel[k, 1], c_rel[k, 2] = rx, ry, rz
-            c_mass[k] = _effective_mass_along_normal(rots[b], inverse_inertia[b], body_mass_all[b],
+            c_mass[k] = _effective_mass_along_normal(body_to_lvlh[b], inverse_inertia[b], body_mass_all[b],
                                                      ax, ay, az, nx, ny, nz)
             k += 1
             if penetration > 0.0:
@@ -268,16 +277,17 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
             if n_substeps > 1 and k == 1 and normal_speed < implicit_speed:
                 # a resting or slow single contact: one implicit step (multibody.contact_implicit)
                 mx, my, mz, ex, ey, ez, dissipated = contact_implicit_step(
-                    c_pen[0], c_rel[0], c_normal[0], f_non_contact[i], net_mass[i], c_mass[0], step,
+                    c_pen[0], c_rel[0], c_normal[0], non_contact_force_lvlh[i], net_mass[i], c_mass[0], step,
                     k_contact, exponent, d_contact, mu_s, mu_k, v_transition, impulses[0])
             else:
                 n_node = n_substeps
                 if n_substeps > 1:
                     n_node = min(n_substeps, _substeps_to_resolve_contact(
-                        c_pen, c_rel, c_normal, c_mass, k, f_non_contact[i], net_mass[i], step,
+                        c_pen, c_rel, c_normal, c_mass, k, non_contact_force_lvlh[i], net_mass[i], step,
                         k_contact, exponent, d_contact))
                 mx, my, mz, ex, ey, ez, dissipated = contact_over_step(
-                    c_pen[:k], c_rel[:k], c_normal[:k], f_non_contact[i], net_mass[i], c_mass[:k], step, n_node,
+                    c_pen[:k], c_rel[:k], c_normal[:k], non_contact_force_lvlh[i], net_mass[i], c_mass[:k], step,
+                    n_node,
                     k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
                     impulses, work_delta, work_recoil, work_forces)
             scale = net_mass[i] / step
@@ -290,7 +300,8 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
             for c in range(k):
                 weight = impulse_norm[c] / total if total > 0.0 else 1.0 / k
                 _apply_contact_pair(i, c_body[c], weight * scale * mx, weight * scale * my, weight * scale * mz,
-                                    coms, step * stage_weight, x, f_net, f_body, torque_lvlh, out_body_impulse,
+                                    com_lvlh, step * stage_weight, x, net_force_lvlh, body_force_lvlh, torque_lvlh,
+                                    out_body_impulse,
                                     out_node_impulse)
             lag_x, lag_y, lag_z = ex - mx, ey - my, ez - mz
             dissipated_total += dissipated * stage_weight
@@ -299,8 +310,8 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
         if b >= 0:
             scale = net_mass[i] / step
             _apply_contact_pair(i, b, scale * velocity_lag[i, 0], scale * velocity_lag[i, 1],
-                                scale * velocity_lag[i, 2], coms, step * stage_weight, x,
-                                f_net, f_body, torque_lvlh, out_body_impulse, out_node_impulse)
+                                scale * velocity_lag[i, 2], com_lvlh, step * stage_weight, x,
+                                net_force_lvlh, body_force_lvlh, torque_lvlh, out_body_impulse, out_node_impulse)
         lag_body[i] = c_body[strongest] if k > 0 else -1
         velocity_lag[i, 0] = lag_x
         velocity_lag[i, 1] = lag_y

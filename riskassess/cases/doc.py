@@ -91,7 +91,18 @@ def _is_unit(text: str) -> bool:
 
 
 def field_unit(field) -> str:
-    """The SI unit a field's description states in parentheses, e.g. 'N m/rad'; '' if none."""
+    """The SI unit a field's description states in parentheses, e.g. 'N m/rad'; '' if none.
+
+    Parameters
+    ----------
+    field : pydantic.fields.FieldInfo
+        A case-model field; its ``description`` is searched.
+
+    Returns
+    -------
+    str
+        The first parenthesised group built only of :data:`UNIT_SYMBOLS`, or ''.
+    """
     for group in re.findall(r"\(([^()]*)\)", field.description or ""):
         if _is_unit(group):
             return group
@@ -106,7 +117,19 @@ def _models_in(annotation) -> list[type[BaseModel]]:
 
 
 def key_unit(key: str) -> str:
-    """The unit of a case key such as 'launch.velocity' or 'target.joints[hinge].torsional_damping'."""
+    """The unit of a case key such as 'launch.velocity' or 'target.joints[hinge].torsional_damping'.
+
+    Parameters
+    ----------
+    key : str
+        Dotted path into an impact case (:class:`~riskassess.cases.impact.Case`); list selectors
+        ``[...]`` are ignored.
+
+    Returns
+    -------
+    str
+        The SI unit of the field (:func:`field_unit`); '' for an unknown key or a field without unit.
+    """
     models, field = [c.Case], None
     for part in re.sub(r"\[[^\]]*\]", "", key).split("."):
         field = next((m.model_fields[part] for m in models if part in m.model_fields), None)
@@ -148,6 +171,18 @@ def input_rows(model: BaseModel, prefix: str = "") -> list[tuple[str, str, str, 
 
     List items are keyed by their ``name`` where they have one (``target.bodies[solar_array]``);
     shapes, sections and materials are one row each.
+
+    Parameters
+    ----------
+    model : pydantic.BaseModel
+        A validated case or one of its tables.
+    prefix : str
+        Key path of ``model`` in the case, ending in '.' (``""`` for the case itself).
+
+    Returns
+    -------
+    list of (str, str, str, str)
+        Key path, formatted value, SI unit ('' if none) and the field's description.
     """
     rows = []
     for name, field in type(model).model_fields.items():
@@ -170,6 +205,18 @@ def input_rows(model: BaseModel, prefix: str = "") -> list[tuple[str, str, str, 
 
 
 def model_table(model: type[BaseModel]) -> str:
+    """The keys of one case model as a Markdown table (key, required, default, meaning with limits).
+
+    Parameters
+    ----------
+    model : type of pydantic.BaseModel
+        A case-model class; its ``kind`` field is left out.
+
+    Returns
+    -------
+    str
+        Markdown table, one row per field.
+    """
     rows = ["| key | required | default | meaning |", "|---|---|---|---|"]
     for name, field in model.model_fields.items():
         if name == "kind":

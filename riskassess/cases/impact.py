@@ -38,7 +38,18 @@ NonNegative = Annotated[float, Field(ge=0)]
 
 def check_physical_inertia(j):
     """The inertia tensor ``j`` (3, 3) (kg m^2) of a rigid body, or ValueError: it must be
-    symmetric, positive definite and obey the triangle inequality of principal moments."""
+    symmetric, positive definite and obey the triangle inequality of principal moments.
+
+    Parameters
+    ----------
+    j : (3, 3) float or nested list
+        Inertia about the CoM (kg m^2), in whatever frame the case gives it.
+
+    Returns
+    -------
+    (3, 3) float or nested list
+        ``j`` unchanged (usable as a validator).
+    """
     m = np.asarray(j, float)
     if not np.allclose(m, m.T, rtol=1e-9, atol=1e-9 * np.abs(m).max()):
         raise ValueError("inertia must be symmetric")
@@ -367,7 +378,17 @@ Section = Annotated[Union[tuple(SECTION_MODELS.values())], Field(discriminator="
 
 def section_properties(spec):
     """Section properties (:mod:`structures.sections`) from a case section table (raises ValueError
-    for impossible dimensions)."""
+    for impossible dimensions).
+
+    Parameters
+    ----------
+    spec : Section
+        A validated ``section`` table: ``kind`` and the shape's dimensions (m).
+
+    Returns
+    -------
+    structures.section_base.SectionProperties
+    """
     params = spec.model_dump()
     return SECTIONS[params.pop("kind")](**params)
 
@@ -515,7 +536,20 @@ def _format_location(loc) -> str:
 
 
 def format_validation_error(path: Path, error: ValidationError) -> str:
-    """scikit-learn-style messages, one per problem: ``file: key.path: message. Got X instead.``"""
+    """scikit-learn-style messages, one per problem: ``file: key.path: message. Got X instead.``
+
+    Parameters
+    ----------
+    path : Path
+        The case file, named in every line.
+    error : pydantic.ValidationError
+        The validation error of that file's content.
+
+    Returns
+    -------
+    str
+        One line per problem.
+    """
     lines = []
     for e in error.errors():
         where = _format_location(e["loc"])
@@ -540,7 +574,20 @@ def _is_table(value) -> bool:
 
 def load_model(path: str | Path, model: type[BaseModel]):
     """Read the TOML file ``path`` into the pydantic ``model`` (a stage's own case schema, e.g.
-    towing or approach); raise :class:`CaseError` naming the file, every bad key and what is allowed."""
+    towing or approach); raise :class:`CaseError` naming the file, every bad key and what is allowed.
+
+    Parameters
+    ----------
+    path : str or Path
+        The case file (TOML).
+    model : type of pydantic.BaseModel
+        The schema to validate against.
+
+    Returns
+    -------
+    pydantic.BaseModel
+        An instance of ``model``.
+    """
     path = Path(path)
     try:
         return model.model_validate(read_toml(path))
@@ -549,13 +596,36 @@ def load_model(path: str | Path, model: type[BaseModel]):
 
 
 def load_case(path: str | Path) -> Case:
-    """Read and validate a net-impact case file; raise :class:`CaseError` naming every problem."""
+    """Read and validate a net-impact case file; raise :class:`CaseError` naming every problem.
+
+    Parameters
+    ----------
+    path : str or Path
+        The case file (TOML); mesh and perception files it names are relative to its folder.
+
+    Returns
+    -------
+    Case
+    """
     return validate_case(read_toml(path), path)
 
 
 def validate_case(raw: dict, path: str | Path) -> Case:
     """Validate the parsed content of the case file ``path`` (mesh paths are relative to it);
-    raise :class:`CaseError` naming every problem. Sweeps call it for every varied case."""
+    raise :class:`CaseError` naming every problem. Sweeps call it for every varied case.
+
+    Parameters
+    ----------
+    raw : dict
+        Parsed TOML content (not modified).
+    path : str or Path
+        The file the content belongs to: named in errors, its folder resolves referenced files.
+
+    Returns
+    -------
+    Case
+        The validated case (files, sections and the net's reach checked).
+    """
     path = Path(path)
     raw, problems = _with_perceived_mass_properties(raw, path.parent)
     if problems:
