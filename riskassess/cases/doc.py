@@ -71,8 +71,7 @@ SECTIONS = [
     ("[simulation]", c.Simulation), ('[orbit] kind = "circular"', c.CircularOrbit), ('[orbit] kind = "none"', c.NoOrbit),
     ("[net]", c.Net), ("[net.thread]", c.Thread), ("[bullets]", c.Bullets), ("[launch]", c.Launch),
     ("[contact]", c.Contact), ("[target]", c.Target), ("[[target.bodies]]", c.Body),
-    ('shapes: kind = "box"', c.Box), ('shapes: kind = "cylinder"', c.Cylinder), ('shapes: kind = "sphere"', c.Sphere),
-    ('shapes: kind = "ellipsoid"', c.Ellipsoid), ('shapes: kind = "mesh"', c.MeshFile),
+    *((f'shapes: kind = "{name}"', model) for name, model in c.SHAPE_MODELS.items()),
     ("[[target.joints]]", c.Joint), ("[chaser] (optional)", c.Chaser),
     ("[perception] (optional; for riskassess perceive)", c.Perception), ("[perception.lidar]", c.Lidar),
     ("[perception.registration]", c.Registration), ("[structures] (optional)", c.Structures),
@@ -164,7 +163,7 @@ def _compact_model(model: BaseModel) -> str:
 
 
 #: Nested models shown as one line each in input tables (they are details of their parent).
-COMPACT = (c.Box, c.Cylinder, c.Sphere, c.MeshFile, *c.SECTION_MODELS.values(), c.Material)
+COMPACT = (*c.SHAPE_MODELS.values(), *c.SECTION_MODELS.values(), c.Material)
 
 
 def input_rows(model: BaseModel, prefix: str = "") -> list[tuple[str, str, str, str]]:

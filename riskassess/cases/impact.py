@@ -22,6 +22,7 @@ from typing import Annotated, Literal, Union, get_args
 import numpy as np
 from pydantic import BaseModel, Field, ValidationError, create_model, field_validator, model_validator
 
+from multibody.shapes import SHAPES as CONTACT_SHAPES
 from riskassess.cases.inputs import (JSON_FILE_LIMIT, KIND_NOTE, MESH_FILE_LIMIT, CaseError, CaseName, ItemName,
                                     RelativeFile, Strict, Text, decode_utf8, read_limited, read_toml, resolve_reference,
                                     unique_names)
@@ -190,45 +191,32 @@ class Contact(Strict):
 
 
 # ---------------------------------------------------------------------------- target
-class Box(Strict):
-    kind: Literal["box"]
-    size: Annotated[list[Positive], Field(min_length=3, max_length=3)] = Field(description="Edge lengths (m).")
-    center: Vector3 = Field(description="Centre, target frame (m).")
-    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Box->target rotation (rad).")
+#: Kind of value of a contact shape's key (:data:`multibody.shape_base.VALUES`) -> its checked type.
+SHAPE_VALUE_TYPES = {
+    "positive": Positive,
+    "positive_vector3": Annotated[list[Positive], Field(min_length=3, max_length=3)],
+    "vector3": Vector3,
+    "file": RelativeFile,
+}
 
 
-class Cylinder(Strict):
-    kind: Literal["cylinder"]
-    radius: Positive = Field(description="(m)")
-    length: Positive = Field(description="(m)")
-    axis: Vector3 = Field(description="Axis direction, target frame (-).")
-    center: Vector3 = Field(description="Centre, target frame (m).")
+def _model_class_name(kind: str) -> str:
+    return "".join(part.capitalize() for part in kind.split("_"))
 
 
-class Sphere(Strict):
-    kind: Literal["sphere"]
-    radius: Positive = Field(description="(m)")
-    center: Vector3 = Field(description="Centre, target frame (m).")
+def _shape_model(shape) -> type[Strict]:
+    """The case schema of one contact shape (:mod:`multibody.shapes`): its ``kind`` and its keys,
+    each checked as its kind of value and described as the shape describes it."""
+    fields = {"kind": (Literal[shape.NAME], ...)}
+    for key in shape.KEYS:
+        default = ... if key.default is None else (list(key.default) if isinstance(key.default, tuple) else key.default)
+        fields[key.name] = (SHAPE_VALUE_TYPES[key.value], Field(default, description=key.description))
+    return create_model(_model_class_name(shape.NAME), __base__=Strict, __module__=__name__, **fields)
 
 
-class Ellipsoid(Strict):
-    kind: Literal["ellipsoid"]
-    semi_axes: Annotated[list[Positive], Field(min_length=3, max_length=3)] = Field(
-        description="Semi-axes along the ellipsoid's own x, y, z (m).")
-    center: Vector3 = Field(description="Centre, target frame (m).")
-    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Ellipsoid->target rotation (rad).")
-
-
-class MeshFile(Strict):
-    kind: Literal["mesh"]
-    file: RelativeFile = Field(description="Closed triangle mesh (STL, OBJ, PLY...), path relative to the case file, "
-                                           "in its folder or below.")
-    scale: Positive = Field(1.0, description="Factor taking file units to metres (-).")
-    center: Vector3 = Field([0.0, 0.0, 0.0], description="Translation of the mesh, target frame (m).")
-    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Mesh->target rotation (rad).")
-
-
-Shape = Annotated[Union[Box, Cylinder, Sphere, Ellipsoid, MeshFile], Field(discriminator="kind")]
+#: Shape kind -> its schema, one per shape file of multibody/shapes.
+SHAPE_MODELS = {name: _shape_model(shape) for name, shape in CONTACT_SHAPES.items()}
+Shape = Annotated[Union[tuple(SHAPE_MODELS.values())], Field(discriminator="kind")]
 
 
 class Body(Strict):
@@ -380,8 +368,7 @@ def _section_model(shape) -> type[Strict]:
     its dimensions, each a :data:`SectionLength` described as the shape describes it."""
     fields = {"kind": (Literal[shape.NAME], ...)}
     fields.update({name: (SectionLength, Field(description=text)) for name, text in shape.DIMENSIONS.items()})
-    class_name = "".join(part.capitalize() for part in shape.NAME.split("_"))
-    return create_model(class_name, __base__=Strict, __module__=__name__, **fields)
+    return create_model(_model_class_name(shape.NAME), __base__=Strict, __module__=__name__, **fields)
 
 
 #: Section kind -> its schema, one per shape file of structures/section_shapes.
@@ -707,15 +694,16 @@ def _fill_perceived(body: dict, source: str, base: Path) -> str | None:
 
 
 def _check_files(case: Case, base: Path) -> list[str]:
-    """Every mesh file is a regular file below the case's folder, at most MESH_FILE_LIMIT bytes."""
+    """Every mesh file a shape names (its keys of kind "file") is a regular file below the case's
+    folder, at most MESH_FILE_LIMIT bytes."""
     problems = []
     for i, body in enumerate(case.target.bodies):
         for k, shape in enumerate(body.shapes):
-            if isinstance(shape, MeshFile):
+            for key in (key.name for key in CONTACT_SHAPES[shape.kind].KEYS if key.value == "file"):
                 try:
-                    resolve_reference(base, shape.file, MESH_FILE_LIMIT)
+                    resolve_reference(base, getattr(shape, key), MESH_FILE_LIMIT)
                 except ValueError as exc:
-                    problems.append(f"target.bodies[{i}].shapes[{k}].file: mesh file {exc}")
+                    problems.append(f"target.bodies[{i}].shapes[{k}].{key}: mesh file {exc}")
     return problems
 
 

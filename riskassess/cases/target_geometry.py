@@ -12,6 +12,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from multibody.geometry import shape_mesh
+from multibody.shapes import SHAPES
 
 
 def body_meshes_target_frame(case, base: Path):
@@ -36,9 +37,11 @@ def body_meshes_target_frame(case, base: Path):
 
 
 def _shape_kwargs(shape, base: Path) -> dict:
+    """The keys of a case shape for :func:`multibody.geometry.shape_mesh`; files relative to ``base``."""
     kwargs = shape.model_dump()
-    if shape.kind == "mesh":
-        kwargs["file"] = base / shape.file
+    for key in SHAPES[shape.kind].KEYS:
+        if key.value == "file":
+            kwargs[key.name] = base / kwargs[key.name]
     return kwargs
 
 
