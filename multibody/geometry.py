@@ -7,58 +7,24 @@ file); :func:`contact_shapes_body_frame` moves the triangles into a body frame
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import trimesh
-from scipy.spatial.transform import Rotation
+
+from multibody.shapes import shape_plugin
 
 
-def shape_mesh(kind: str, *, size=None, radius=None, length=None, axis=None, center=(0, 0, 0),
-               rotation_vector=(0, 0, 0), file=None, scale=1.0, sections=32, semi_axes=None,
-               subdivisions=3) -> trimesh.Trimesh:
-    """Closed triangle mesh of one shape, target frame (m).
+def shape_mesh(kind: str, **keys) -> trimesh.Trimesh:
+    """Closed triangle mesh of one shape, target frame (m): the plug-in of :mod:`multibody.shapes`
+    named ``kind`` (one file each); an unknown kind is a ValueError listing the known ones.
 
     Parameters
     ----------
-    kind : {"box", "cylinder", "sphere", "ellipsoid", "mesh"}
-    size : (3,) float       Box edge lengths (m), box frame.
-    radius, length : float  Cylinder or sphere radius (m); cylinder length (m).
-    axis : (3,) float       Cylinder axis, target frame.
-    semi_axes : (3,) float  Ellipsoid semi-axes along its own x, y, z (m) before ``rotation_vector``.
-    subdivisions : int      Icosphere refinement of the ellipsoid (3: 1280 triangles).
-    center : (3,) float     Shape centre, target frame (m).
-    rotation_vector : (3,) float  Shape->target rotation for boxes, ellipsoids and meshes (rad).
-    file : path             Mesh file (any format trimesh reads), vertices in m before ``scale``.
-    scale : float           Factor applied to the mesh file's vertices (-).
-    sections : int          Facets around a cylinder's circumference.
+    kind : str   The shape's ``NAME`` ("box", "cylinder", "ellipsoid", "mesh", "sphere", ...).
+    **keys       Its keys (SI, target frame), as its ``KEYS`` name them, e.g. ``size`` (3,) (m) and
+                 ``center`` (3,) (m) of a box; see the shape file's ``mesh_target_frame``.
     """
-    if kind == "box":
-        mesh = trimesh.creation.box(extents=size)
-    elif kind == "cylinder":
-        mesh = trimesh.creation.cylinder(radius=radius, height=length, sections=sections)
-        mesh.apply_transform(_align_z_to(axis))
-    elif kind == "sphere":
-        mesh = trimesh.creation.icosphere(subdivisions=2, radius=radius)
-    elif kind == "ellipsoid":
-        mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
-        mesh.apply_scale(np.asarray(semi_axes, float))
-    elif kind == "mesh":
-        mesh = trimesh.load_mesh(Path(file), force="mesh")
-        mesh.apply_scale(scale)
-    else:
-        raise ValueError(f"unknown shape kind {kind!r}")
-    if kind in ("box", "ellipsoid", "mesh"):
-        transform = np.eye(4)
-        transform[:3, :3] = Rotation.from_rotvec(rotation_vector).as_matrix()
-        mesh.apply_transform(transform)
-    mesh.apply_translation(center)
-    return mesh
-
-
-def _align_z_to(axis) -> np.ndarray:
-    """4x4 rotation taking the z axis onto ``axis``."""
-    return trimesh.geometry.align_vectors([0, 0, 1], np.asarray(axis, float) / np.linalg.norm(axis))
+    return shape_plugin(kind).mesh_target_frame(**keys)
 
 
 def uniform_density_inertia(meshes, mass, com_target):
