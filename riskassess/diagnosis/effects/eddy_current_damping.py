@@ -20,7 +20,7 @@ from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_Q, X_W, quatern
 from riskassess.diagnosis.effects.base import Effect, Parameter
 from riskassess.diagnosis.scenario import plant_of
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import DEBRIS
 
 

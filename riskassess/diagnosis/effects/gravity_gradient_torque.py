@@ -18,7 +18,7 @@ from riskassess.diagnosis.dynamics import (LAW_SIGNATURE, E_AXIS, E_HINGED, E_JA
                                 quaternion_rows, radial_inertial, sandwich, tcross, tmtv, tmv)
 from riskassess.diagnosis.effects.base import Effect, Parameter
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, W_INERTIA, body_position
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import CHASER, DEBRIS
 from riskassess.diagnosis.scenario import plant_of
 

@@ -25,7 +25,7 @@ from multibody.linalg3 import cross3
 from riskassess.diagnosis.dynamics import axis_rotation
 from riskassess.diagnosis.effects.base import Effect, Parameter
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, last_diagnostics
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import CHASER, THRUST, W_ALONG_Z
 
 
