@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -32,6 +33,7 @@ from multibody.orbit import (
     clohessy_wiltshire_acceleration,
     clohessy_wiltshire_acceleration_xyz,
 )
+from multibody.rotations import compose_rotation_vectors, rotation_matrix_from_rotation_vector
 
 #: Indices into the kernel's scalar output buffer.
 THREAD_ELASTIC, BENDING_ELASTIC, CONTACT_ELASTIC, THREAD_DISSIPATED, CONTACT_DISSIPATED, N_CONTACTS = range(6)
@@ -39,69 +41,28 @@ N_SCALARS = 6
 
 
 @njit(cache=True)
-def rotation_matrix_from_rotation_vector(rv):
-    """Body->LVLH rotation matrix from a rotation vector (rad); Rodrigues' formula
-    :math:`I + \\frac{\\sin\\theta}{\\theta}K + \\frac{1-\\cos\\theta}{\\theta^2}K^2`, written out in
-    scalars (numba sends 3x3 products to BLAS, ~1 us a call)."""
-    x, y, z = rv[0], rv[1], rv[2]
-    angle2 = x * x + y * y + z * z
-    if angle2 < 1e-16:
-        a, b = 1.0, 0.5
-    else:
-        angle = math.sqrt(angle2)
-        a, b = math.sin(angle) / angle, (1.0 - math.cos(angle)) / angle2
-    out = np.empty((3, 3))
-    # K^2 = r r^T - |r|^2 I
-    out[0, 0] = 1.0 + b * (x * x - angle2)
-    out[1, 1] = 1.0 + b * (y * y - angle2)
-    out[2, 2] = 1.0 + b * (z * z - angle2)
-    out[0, 1] = -a * z + b * x * y
-    out[1, 0] = a * z + b * x * y
-    out[0, 2] = a * y + b * x * z
-    out[2, 0] = -a * y + b * x * z
-    out[1, 2] = -a * x + b * y * z
-    out[2, 1] = a * x + b * y * z
-    return out
-
-
-@njit(cache=True)
-def _quaternion_from_rotation_vector(rv):
-    angle = math.sqrt(rv[0] * rv[0] + rv[1] * rv[1] + rv[2] * rv[2])
-    if angle < 1e-8:
-        return 1.0 - angle * angle / 8.0, 0.5 * rv[0], 0.5 * rv[1], 0.5 * rv[2]
-    s = math.sin(0.5 * angle) / angle
-    return math.cos(0.5 * angle), s * rv[0], s * rv[1], s * rv[2]
-
-
-@njit(cache=True)
-def compose_rotation_vectors(rv, increment_body):
-    """Rotation vector of R(rv) R(increment_body): a rotation by ``increment_body`` (rad, body
-    frame) after ``rv``; the Lie-group update Exudyn applies to rotation-vector nodes.
-    Returns the equivalent rotation vector with angle at most pi."""
-    w0, x0, y0, z0 = _quaternion_from_rotation_vector(rv)
-    w1, x1, y1, z1 = _quaternion_from_rotation_vector(increment_body)
-    w = w0 * w1 - x0 * x1 - y0 * y1 - z0 * z1
-    x = w0 * x1 + x0 * w1 + y0 * z1 - z0 * y1
-    y = w0 * y1 - x0 * z1 + y0 * w1 + z0 * x1
-    z = w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1
-    if w < 0.0:
-        w, x, y, z = -w, -x, -y, -z
-    sine = math.sqrt(x * x + y * y + z * z)
-    out = np.empty(3)
-    if sine < 1e-12:
-        out[0], out[1], out[2] = 2.0 * x, 2.0 * y, 2.0 * z
-        return out
-    angle = 2.0 * math.atan2(sine, w)
-    out[0], out[1], out[2] = angle * x / sine, angle * y / sine, angle * z / sine
-    return out
-
-
-@njit(cache=True)
 def verlet_evaluation_state(q, qt, qtt, step, n_net_coordinates, n_bodies):
     """The state at which Exudyn's VelocityVerlet evaluates the forces of the step that starts
     at (q, qt, qtt): mid-step velocity qt + step/2 qtt and end position q + step * that;
     rigid-body rotation vectors are advanced by the Lie-group composition with the
-    mid-step angular velocity (body frame), as Exudyn does. Layout as in the module doc."""
+    mid-step angular velocity (body frame), as Exudyn does.
+
+    Parameters
+    ----------
+    q, qt, qtt : (N,) float
+        Coordinates, velocities and accelerations at the step's start, in the module doc's layout.
+    step : float
+        (s).
+    n_net_coordinates : int
+        Net coordinates ahead of the bodies' (3 n; 0 when the kernel holds the net).
+    n_bodies : int
+        Rigid bodies after them (6 coordinates each).
+
+    Returns
+    -------
+    q_next, v_half : (N,) float
+        The evaluation state: end positions (rotation vectors composed) and mid-step velocities.
+    """
     v_half = qt + (0.5 * step) * qtt
     q_next = q + step * v_half
     for b in range(n_bodies):
@@ -110,200 +71,280 @@ def verlet_evaluation_state(q, qt, qtt, step, n_net_coordinates, n_bodies):
     return q_next, v_half
 
 
+class NetArrays(NamedTuple):
+    """The net's nodes, threads and bending triples (SI units; n nodes, m threads, k triples)."""
+
+    reference_lvlh: np.ndarray     # (n, 3) reference node positions, LVLH (m)
+    mass: np.ndarray               # (n,) node masses (kg)
+    radius: np.ndarray             # (n,) node contact radii (m)
+    threads: np.ndarray            # (m, 2) int64 node pairs
+    rest_lengths: np.ndarray       # (m,) (m)
+    thread_stiffness: np.ndarray   # (m,) (N/m)
+    thread_damping: np.ndarray     # (m,) (N s/m)
+    bending_triples: np.ndarray    # (k, 3) int64 node triples (end, middle, end)
+    bending_stiffness: np.ndarray  # (k,) (N m/rad)
+
+
+class BodyArrays(NamedTuple):
+    """The rigid bodies' constants (nb bodies)."""
+
+    reference_com_lvlh: np.ndarray     # (nb, 3) reference CoM positions, LVLH (m)
+    mass: np.ndarray                   # (nb,) (kg)
+    inverse_inertia_body: np.ndarray   # (nb, 3, 3) inverse inertia about the CoM, body frame (1/(kg m^2))
+
+
+class ShapeArrays(NamedTuple):
+    """The bodies' closed contact shapes (ns shapes of T triangles in all), each a slice of the triangle
+    arrays in its body's frame (origin at the body CoM). Signed distances are taken per shape, so shapes
+    of one body may overlap."""
+
+    triangles_body: np.ndarray     # (T, 3, 3) corners, body frame of the owning body (m)
+    normals_body: np.ndarray       # (T, 3) outward unit normals, body frame
+    body: np.ndarray               # (ns,) int64 body owning each shape
+    triangle_range: np.ndarray     # (ns, 2) int64 triangle slice of each shape
+    box_min_body: np.ndarray       # (ns, 3) body-frame bounding box of each shape (m)
+    box_max_body: np.ndarray       # (ns, 3) (m)
+    is_box: np.ndarray             # (ns,) int64, 1: the shape is its bounding box (multibody.broad_phase)
+
+
+class ContactLaw(NamedTuple):
+    """Hunt-Crossley normal force and Hollar friction (seed paper eqs. (6), (7)), and the contact's
+    integration switch."""
+
+    stiffness: float           # k_n (N/m^n)
+    exponent: float            # n (-)
+    damping: float             # d_n = 1.5 alpha k_n (N s/m^(n+1))
+    mu_static: float           # (-)
+    mu_kinetic: float          # (-)
+    transition_speed: float    # Hollar's V_t (m/s)
+    implicit_speed: float      # below this normal speed (m/s) a single contact takes the implicit step; 0: never
+
+
+class Mounts(NamedTuple):
+    """Net nodes mounted on a body (a chaser's net frame): one stiff spring-damper per mount (k mounts)."""
+
+    node: np.ndarray           # (k,) int64 net node
+    body: np.ndarray           # (k,) int64 body
+    point_body: np.ndarray     # (k, 3) mount point, body frame (m)
+    stiffness: float           # (N/m)
+    damping: float             # (N s/m)
+
+
+def no_mounts() -> Mounts:
+    """:class:`Mounts` with none."""
+    return Mounts(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, 3)), 0.0, 0.0)
+
+
+class KernelBuffers(NamedTuple):
+    """What the kernel writes: the force vector, accumulated impulses and energies, the contact lag it
+    carries from step to step, and work space (so nothing is allocated per node)."""
+
+    force: np.ndarray              # (3 n + 6 nb,) generalized forces (module doc)
+    body_impulse_lvlh: np.ndarray  # (nb, 6) accumulated contact impulse (N s), angular impulse about CoM (N m s), LVLH
+    node_impulse_lvlh: np.ndarray  # (n, 3) accumulated contact impulse on each net node (N s), LVLH
+    velocity_lag: np.ndarray       # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s), LVLH
+    lag_body: np.ndarray           # (n,) int64 body of the node's last contact, -1 for none
+    scalars: np.ndarray            # (N_SCALARS,) energies (J) and contact count, indices above
+    work: np.ndarray               # (4, n, 3) positions, forces, non-contact forces, start velocities
+    work_node: np.ndarray          # (4, n) speed, acceleration bound, reach; 1 / mass
+    candidates: np.ndarray         # (ns + 1, n) uint8 node near shape; last row: near any
+
+
+def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffers:
+    """Zeroed :class:`KernelBuffers` for ``net`` and ``n_bodies`` bodies with ``n_shapes`` contact shapes.
+
+    Parameters
+    ----------
+    net : NetArrays
+    n_bodies, n_shapes : int
+    """
+    n = len(net.mass)
+    work_node = np.zeros((4, n))
+    work_node[3] = 1.0 / np.asarray(net.mass, float)  # constant: a product is cheaper than a division
+    return KernelBuffers(force=np.zeros(3 * n + 6 * n_bodies), body_impulse_lvlh=np.zeros((n_bodies, 6)),
+                         node_impulse_lvlh=np.zeros((n, 3)), velocity_lag=np.zeros((n, 3)),
+                         lag_body=np.full(n, -1, dtype=np.int64), scalars=np.zeros(N_SCALARS),
+                         work=np.zeros((4, n, 3)), work_node=work_node,
+                         candidates=np.zeros((n_shapes + 1, n), np.uint8))
+
+
+class BodyStates(NamedTuple):
+    """The bodies' state at a force evaluation (nb bodies), from :func:`body_states`."""
+
+    body_to_lvlh: np.ndarray   # (nb, 3, 3) attitude
+    com_lvlh: np.ndarray       # (nb, 3) CoM (m)
+    velocity_lvlh: np.ndarray  # (nb, 3) CoM velocity (m/s)
+    omega_lvlh: np.ndarray     # (nb, 3) angular velocity (rad/s)
+
+
 @dataclass
 class KernelData:
-    """Everything the kernel needs, as contiguous arrays (SI units).
+    """Everything the kernel needs, grouped (SI units; frames in the groups' field names).
 
-    Body geometry is a list of closed contact shapes (one per primitive or mesh file),
-    each a slice of the triangle arrays in its body's frame (origin at the body CoM).
-    Signed distances are taken per shape, so shapes of one body may overlap.
+    Parameters
+    ----------
+    net, bodies, shapes, law, mounts
+        :class:`NetArrays`, :class:`BodyArrays`, :class:`ShapeArrays`, :class:`ContactLaw`, :class:`Mounts`.
+    mean_motion : float
+        Orbit mean motion (rad/s) of the Clohessy-Wiltshire terms; 0 without orbit.
+    step : float
+        Integrator step (s).
+    contact_substep : float
+        Shortest contact sub-step (s); >= ``step`` (or inf) disables sub-cycling.
+    stage_weight : float
+        1 / force evaluations per integrator step.
     """
 
-    net_reference: np.ndarray        # (n, 3) reference node positions, LVLH (m)
-    net_mass: np.ndarray             # (n,) (kg)
-    net_radius: np.ndarray           # (n,) (m)
-    threads: np.ndarray              # (m, 2) int
-    rest_lengths: np.ndarray         # (m,) (m)
-    thread_stiffness: np.ndarray     # (m,) (N/m)
-    thread_damping: np.ndarray       # (m,) (N s/m)
-    bending_triples: np.ndarray      # (b, 3) int
-    bending_stiffness: np.ndarray    # (b,) (N m/rad)
-    body_reference: np.ndarray       # (nb, 3) reference CoM positions, LVLH (m)
-    body_mass: np.ndarray            # (nb,) (kg)
-    body_inverse_inertia: np.ndarray # (nb, 3, 3) inverse inertia about the CoM, body frame (1/(kg m^2))
-    triangles: np.ndarray            # (T, 3, 3) corners, body frame of the owning body (m)
-    triangle_normals: np.ndarray     # (T, 3) outward normals, body frame
-    shape_body: np.ndarray           # (ns,) int, body owning each contact shape
-    shape_triangle_range: np.ndarray # (ns, 2) int, triangle slice of each shape
-    shape_box_min: np.ndarray        # (ns, 3) body-frame bounding box of each shape (m)
-    shape_box_max: np.ndarray        # (ns, 3)
-    shape_is_box: np.ndarray         # (ns,) int, 1: the shape is its bounding box (multibody.broad_phase)
-    contact_stiffness: float         # k_n (N/m^n)
-    contact_exponent: float          # n (-)
-    contact_damping: float           # d_n = 1.5 alpha k_n
-    mu_static: float
-    mu_kinetic: float
-    transition_speed: float          # (m/s)
-    mean_motion: float               # (rad/s); 0 without orbit
-    step: float                      # integrator step (s)
-    contact_substep: float           # shortest contact sub-step (s); >= step disables sub-cycling
-    stage_weight: float = 1.0        # 1 / force evaluations per integrator step
-    implicit_contact_speed: float = 0.0  # (m/s) below it a single contact takes the implicit step; 0: never
-    # Net nodes mounted on a body (a chaser's net frame): one stiff spring-damper per mount
-    mount_node: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # (k,) net node
-    mount_body: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))   # (k,) body
-    mount_point_body: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # (k, 3) body frame (m)
-    mount_stiffness: float = 0.0     # (N/m)
-    mount_damping: float = 0.0       # (N s/m)
-    force: np.ndarray = field(init=False)
-    body_impulse: np.ndarray = field(init=False)   # (nb, 6) accumulated contact impulse and angular impulse about CoM, LVLH
-    node_impulse: np.ndarray = field(init=False)   # (n, 3) accumulated contact impulse on each net node (N s), LVLH
-    velocity_lag: np.ndarray = field(init=False)   # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s)
-    lag_body: np.ndarray = field(init=False)       # (n,) body of the node's last contact, -1 for none
-    scalars: np.ndarray = field(init=False)
-    work: np.ndarray = field(init=False)          # (4, n, 3) work space: positions, forces, non-contact forces, start velocities
-    work_node: np.ndarray = field(init=False)     # (4, n) work space: speed, acceleration bound, reach; 1 / mass
-    candidates: np.ndarray = field(init=False)    # (ns, n) uint8 work space: node near shape
+    net: NetArrays
+    bodies: BodyArrays
+    shapes: ShapeArrays
+    law: ContactLaw
+    mean_motion: float
+    step: float
+    contact_substep: float
+    stage_weight: float = 1.0
+    mounts: Mounts = field(default_factory=no_mounts)
+    buffers: KernelBuffers = field(init=False)
 
     def __post_init__(self):
-        n = len(self.net_mass)
-        nb = len(self.body_mass)
-        self.work = np.zeros((4, n, 3))
-        self.work_node = np.zeros((4, n))
-        self.work_node[3] = 1.0 / np.asarray(self.net_mass, float)  # constant: a product is cheaper than a division
-        self.candidates = np.zeros((len(self.shape_body), n), np.uint8)
-        self.force = np.zeros(3 * n + 6 * nb)
-        self.body_impulse = np.zeros((nb, 6))
-        self.node_impulse = np.zeros((n, 3))
-        self.scalars = np.zeros(N_SCALARS)
-        self.velocity_lag = np.zeros((n, 3))
-        self.lag_body = np.full(n, -1, dtype=np.int64)
+        self.buffers = kernel_buffers(self.net, self.n_bodies, len(self.shapes.body))
 
     @property
     def n_nodes(self) -> int:
-        return len(self.net_mass)
+        return len(self.net.mass)
 
     @property
     def n_bodies(self) -> int:
-        return len(self.body_mass)
+        return len(self.bodies.mass)
 
     def evaluate(self, q, qt, time=1.0):
-        """Generalized forces for coordinates ``q`` and velocities ``qt`` ((3n + 6nb,) each).
+        """Generalized forces (3 n + 6 nb,) at coordinates ``q`` and velocities ``qt`` (module doc).
 
-        At ``time`` 0 (the solver's initial-acceleration evaluation, which Verlet applies as
-        a half kick only) the contact is evaluated without sub-cycling.
+        Parameters
+        ----------
+        q, qt : (3 n + 6 nb,) float
+            Coordinates and velocities in the module doc's layout.
+        time : float
+            Time of the evaluation (s). At 0 (the solver's initial-acceleration evaluation, which
+            Verlet applies as a half kick only) the contact is evaluated without sub-cycling.
         """
         n_sub = max(1, int(math.ceil(self.step / self.contact_substep - 1e-9))) if time > 0.0 else 1
-        coupled_generalized_forces(
-            q, qt, self.net_reference, self.net_mass, self.net_radius,
-            self.threads, self.rest_lengths, self.thread_stiffness, self.thread_damping,
-            self.bending_triples, self.bending_stiffness,
-            self.body_reference, self.body_mass, self.body_inverse_inertia, self.triangles, self.triangle_normals,
-            self.shape_body, self.shape_triangle_range, self.shape_box_min, self.shape_box_max, self.shape_is_box,
-            self.contact_stiffness, self.contact_exponent, self.contact_damping,
-            self.mu_static, self.mu_kinetic, self.transition_speed,
-            self.mean_motion, self.step, n_sub, self.stage_weight, self.implicit_contact_speed,
-            self.velocity_lag, self.lag_body,
-            self.mount_node, self.mount_body, self.mount_point_body, self.mount_stiffness, self.mount_damping,
-            self.force, self.body_impulse, self.node_impulse, self.scalars, self.work, self.work_node,
-            self.candidates)
-        return self.force
+        return coupled_generalized_forces(q, qt, self.net, self.bodies, self.shapes, self.law, self.mounts,
+                                          self.mean_motion, self.step, n_sub, self.stage_weight, self.buffers)
 
 
 @njit(cache=True)
-def coupled_generalized_forces(q, qt, net_reference, net_mass, net_radius,
-                               threads, rest_lengths, thread_stiffness, thread_damping,
-                               bending_triples, bending_stiffness,
-                               body_reference, body_mass_all, inverse_inertia, triangles, triangle_normals,
-                               shape_body, shape_triangle_range, shape_box_min, shape_box_max, shape_is_box,
-                               k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
-                               n_orbit, step, n_substeps, stage_weight, implicit_speed, velocity_lag, lag_body,
-                               mount_node, mount_body, mount_point_body, k_mount, d_mount,
-                               out_force, out_body_impulse, out_node_impulse, out_scalars, work, work_node,
-                               candidates):
-    """Fill ``out_force`` with the generalized forces of the coupled system (see module doc).
+def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit, step, n_substeps, stage_weight,
+                               buffers):
+    """Fill ``buffers.force`` with the generalized forces of the coupled system (see module doc); returns it.
 
-    Also accumulates, per body, the contact impulse (N s) and angular impulse about the
-    CoM (N m s) in LVLH into ``out_body_impulse``, per net node the contact impulse (N s, LVLH)
-    into ``out_node_impulse``, the dissipated energies into
-    ``out_scalars`` and sets the current elastic energies there. Accumulations are
-    weighted by ``stage_weight`` (1 / force evaluations per step: exact for
-    VelocityVerlet's single evaluation, an average for Runge-Kutta stages). ``work``,
-    ``work_node``, ``candidates``: work space (:class:`KernelData`), so nothing is allocated per node.
+    Parameters
+    ----------
+    q, qt : (3 n + 6 nb,) float
+        Coordinates and velocities in the module doc's layout.
+    net, bodies, shapes, law, mounts : NetArrays, BodyArrays, ShapeArrays, ContactLaw, Mounts
+    n_orbit : float
+        Mean motion (rad/s) of the Clohessy-Wiltshire terms; 0 without orbit.
+    step : float
+        Integrator step (s).
+    n_substeps : int
+        Contact sub-steps per step (1: none).
+    stage_weight : float
+        1 / force evaluations per step: accumulations are weighted by it (exact for VelocityVerlet's
+        single evaluation, an average for Runge-Kutta stages).
+    buffers : KernelBuffers
+        Also accumulates, per body, the contact impulse (N s) and angular impulse about the CoM
+        (N m s) in LVLH, per net node the contact impulse (N s, LVLH), the dissipated energies, and
+        sets the current elastic energies (``scalars``).
     """
+    out_force, out_scalars, work = buffers.force, buffers.scalars, buffers.work
+    net_reference, net_mass = net.reference_lvlh, net.mass
     n = net_mass.shape[0]
-    nb = body_mass_all.shape[0]
-    x, f_net = work[0], work[1]
+    nb = bodies.mass.shape[0]
+    x, net_force_lvlh = work[0], work[1]
     for i in range(n):
         for d in range(3):
             x[i, d] = net_reference[i, d] + q[3 * i + d]
-            f_net[i, d] = 0.0
+            net_force_lvlh[i, d] = 0.0
     v = qt[: 3 * n].reshape(n, 3)
 
-    elastic, power = add_thread_forces(x, v, threads, rest_lengths, thread_stiffness, thread_damping, f_net)
+    elastic, power = add_thread_forces(x, v, net.threads, net.rest_lengths, net.thread_stiffness,
+                                       net.thread_damping, net_force_lvlh)
     out_scalars[THREAD_ELASTIC] = elastic
-    out_scalars[BENDING_ELASTIC] = add_bending_forces(x, bending_triples, bending_stiffness, f_net)
+    out_scalars[BENDING_ELASTIC] = add_bending_forces(x, net.bending_triples, net.bending_stiffness, net_force_lvlh)
     out_scalars[THREAD_DISSIPATED] += power * step * stage_weight
 
     if n_orbit != 0.0:
         for i in range(n):
             ax, ay, az = clohessy_wiltshire_acceleration_xyz(x[i, 0], x[i, 2], v[i, 0], v[i, 1], n_orbit)
-            f_net[i, 0] += net_mass[i] * ax
-            f_net[i, 1] += net_mass[i] * ay
-            f_net[i, 2] += net_mass[i] * az
+            net_force_lvlh[i, 0] += net_mass[i] * ax
+            net_force_lvlh[i, 1] += net_mass[i] * ay
+            net_force_lvlh[i, 2] += net_mass[i] * az
 
-    rots, coms, vels, omegas = body_states(q, qt, n, body_reference)
-    f_body = np.zeros((nb, 3))
+    states = body_states(q, qt, n, bodies.reference_com_lvlh)
+    body_to_lvlh, com_lvlh, velocity_lvlh = states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh
+    body_force_lvlh = np.zeros((nb, 3))
     if n_orbit != 0.0:
         for b in range(nb):
-            f_body[b] += body_mass_all[b] * clohessy_wiltshire_acceleration(coms[b], vels[b], n_orbit)
+            body_force_lvlh[b] += bodies.mass[b] * clohessy_wiltshire_acceleration(com_lvlh[b], velocity_lvlh[b],
+                                                                                   n_orbit)
     torque_lvlh = np.zeros((nb, 3))
-    mount_elastic, mount_power = add_mount_forces(x, v, coms, vels, rots, omegas, mount_node, mount_body,
-                                                  mount_point_body, k_mount, d_mount, f_net, f_body, torque_lvlh)
+    mount_elastic, mount_power = add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torque_lvlh)
     # Mounts are the rods that hold the net's rim on the chaser: booked with the threads.
     out_scalars[THREAD_ELASTIC] += mount_elastic
     out_scalars[THREAD_DISSIPATED] += mount_power * step * stage_weight
     contact_energy, n_contacts, contact_dissipated = add_contact_forces(
-        x, v, net_mass, net_radius, rots, coms, vels, omegas, body_mass_all, inverse_inertia,
-        triangles, triangle_normals, shape_body, shape_triangle_range, shape_box_min, shape_box_max, shape_is_box,
-        k_contact, exponent, d_contact, mu_s, mu_k, v_transition, step, n_substeps, stage_weight, implicit_speed,
-        velocity_lag, lag_body, f_net, f_body, torque_lvlh, out_body_impulse, out_node_impulse,
-        work[2], work[3], work_node, candidates)
+        x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, net_force_lvlh,
+        body_force_lvlh, torque_lvlh)
     for b in range(nb):
         base = 3 * n + 6 * b
-        out_force[base:base + 3] = f_body[b]
+        out_force[base:base + 3] = body_force_lvlh[b]
         for r in range(3):  # body-frame torque R^T t, in scalars (no BLAS call)
-            out_force[base + 3 + r] = (rots[b, 0, r] * torque_lvlh[b, 0] + rots[b, 1, r] * torque_lvlh[b, 1]
-                                       + rots[b, 2, r] * torque_lvlh[b, 2])
+            out_force[base + 3 + r] = (body_to_lvlh[b, 0, r] * torque_lvlh[b, 0]
+                                       + body_to_lvlh[b, 1, r] * torque_lvlh[b, 1]
+                                       + body_to_lvlh[b, 2, r] * torque_lvlh[b, 2])
     out_scalars[CONTACT_ELASTIC] = contact_energy
     out_scalars[N_CONTACTS] = n_contacts
     out_scalars[CONTACT_DISSIPATED] += contact_dissipated
     for i in range(n):
         for d in range(3):
-            out_force[3 * i + d] = f_net[i, d]
+            out_force[3 * i + d] = net_force_lvlh[i, d]
     return out_force
 
 
 @njit(cache=True)
-def add_mount_forces(x, v, coms, vels, rots, omegas, mount_node, mount_body, mount_point_body, k, d,
-                     f_net, f_body, torque_lvlh):
-    """Spring-dampers (k, d) from mounted net nodes to their points on a body, all LVLH.
+def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torque_lvlh):
+    """Spring-dampers from mounted net nodes to their points on a body, all LVLH.
 
-    The node's force and the body's reaction act on the same line, through the mount point,
-    so linear and angular momentum are exchanged exactly. Returns the elastic energy (J)
-    and the dissipated power (W).
+    The node's force and the body's reaction act on the same line, through the mount point, so linear
+    and angular momentum are exchanged exactly. Returns the elastic energy (J) and the dissipated
+    power (W).
+
+    Parameters
+    ----------
+    x, v : (n, 3) float
+        Node positions (m) and velocities (m/s), LVLH.
+    states : BodyStates
+    mounts : Mounts
+    net_force_lvlh : (n, 3) float
+        Node force accumulator (N), LVLH.
+    body_force_lvlh, torque_lvlh : (nb, 3) float
+        Body force (N) and torque about the CoM (N m) accumulators, LVLH.
     """
+    k, d = mounts.stiffness, mounts.damping
+    body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
+    velocity_lvlh, omega_lvlh = states.velocity_lvlh, states.omega_lvlh
     elastic = 0.0
     power = 0.0
-    for m in range(mount_node.shape[0]):
-        i = mount_node[m]
-        b = mount_body[m]
-        arm = rots[b] @ mount_point_body[m]
-        gap = x[i] - (coms[b] + arm)
-        rate = v[i] - (vels[b] + np.cross(omegas[b], arm))
+    for m in range(mounts.node.shape[0]):
+        i = mounts.node[m]
+        b = mounts.body[m]
+        arm = body_to_lvlh[b] @ mounts.point_body[m]
+        gap = x[i] - (com_lvlh[b] + arm)
+        rate = v[i] - (velocity_lvlh[b] + np.cross(omega_lvlh[b], arm))
         f = -k * gap - d * rate
-        f_net[i] += f
-        f_body[b] -= f
+        net_force_lvlh[i] += f
+        body_force_lvlh[b] -= f
         torque_lvlh[b] -= np.cross(arm, f)
         elastic += 0.5 * k * (gap @ gap)
         power += d * (rate @ rate)
@@ -311,19 +352,31 @@ def add_mount_forces(x, v, coms, vels, rots, omegas, mount_node, mount_body, mou
 
 
 @njit(cache=True)
-def body_states(q, qt, n_nodes, body_reference):
-    """Per body: attitude body->LVLH, CoM (m), CoM velocity (m/s), angular velocity (rad/s), LVLH."""
-    nb = body_reference.shape[0]
-    rots = np.empty((nb, 3, 3))
-    coms = np.empty((nb, 3))
-    vels = np.empty((nb, 3))
-    omegas = np.empty((nb, 3))
+def body_states(q, qt, n_nodes, reference_com_lvlh):
+    """:class:`BodyStates` (attitude body->LVLH, CoM (m), CoM velocity (m/s), angular velocity (rad/s),
+    LVLH) from the coordinates in the module doc's layout.
+
+    Parameters
+    ----------
+    q, qt : (3 n + 6 nb,) float
+        Coordinates and velocities (module doc).
+    n_nodes : int
+        Net nodes ahead of the bodies (0 when the kernel holds the net).
+    reference_com_lvlh : (nb, 3) float
+        Reference CoM positions (m), LVLH.
+    """
+    nb = reference_com_lvlh.shape[0]
+    body_to_lvlh = np.empty((nb, 3, 3))
+    com_lvlh = np.empty((nb, 3))
+    velocity_lvlh = np.empty((nb, 3))
+    omega_lvlh = np.empty((nb, 3))
     for b in range(nb):
         base = 3 * n_nodes + 6 * b
-        coms[b] = body_reference[b] + q[base:base + 3]
-        vels[b] = qt[base:base + 3]
-        rots[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
+        com_lvlh[b] = reference_com_lvlh[b] + q[base:base + 3]
+        velocity_lvlh[b] = qt[base:base + 3]
+        body_to_lvlh[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
         # in scalars: numba sends small matrix products to BLAS, microseconds a call
         for r in range(3):
-            omegas[b, r] = rots[b, r, 0] * qt[base + 3] + rots[b, r, 1] * qt[base + 4] + rots[b, r, 2] * qt[base + 5]
-    return rots, coms, vels, omegas
+            omega_lvlh[b, r] = (body_to_lvlh[b, r, 0] * qt[base + 3] + body_to_lvlh[b, r, 1] * qt[base + 4]
+                                + body_to_lvlh[b, r, 2] * qt[base + 5])
+    return BodyStates(body_to_lvlh, com_lvlh, velocity_lvlh, omega_lvlh)

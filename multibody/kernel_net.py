@@ -23,8 +23,8 @@ Layout of the net state: ``q`` (3 n,) node displacement from the reference posit
 ``qt`` (3 n,) velocity (m/s), ``qtt`` (3 n,) acceleration (m/s^2), all LVLH, node-major.
 
 Speed: the whole pre-step is one compiled call (:func:`kernel_net_step`) on a numba structref
-(:class:`NetStepModel`) that holds the kernel's arrays and the net's state: a call with the kernel's
-40 arrays as arguments costs 5-10 us in numba's dispatcher alone, a structref about 2 us.
+(:class:`NetStepModel`) that holds the kernel's groups of arrays and the net's state: a call with the
+kernel's 40 arrays as arguments cost 5-10 us in numba's dispatcher alone, a structref about 2 us.
 """
 from __future__ import annotations
 
@@ -45,21 +45,19 @@ class NetStepModelType(types.StructRef):
     """Numba type of :class:`NetStepModel`."""
 
     def preprocess_fields(self, fields):
+        """Field types without literal values (numba's structref hook), so one compilation serves every case.
+
+        Parameters
+        ----------
+        fields : tuple of (str, numba type)
+        """
         return tuple((name, types.unliteral(typ)) for name, typ in fields)
 
 
-#: Fields of :class:`NetStepModel`: the arrays and constants of :class:`multibody.kernel.KernelData`
-#: (same names, same buffers: what the kernel accumulates there, the recorder reads there), then
-#: the net's state and the work vectors of this module.
-KERNEL_FIELDS = (
-    "net_reference", "net_mass", "net_radius", "threads", "rest_lengths", "thread_stiffness", "thread_damping",
-    "bending_triples", "bending_stiffness", "body_reference", "body_mass", "body_inverse_inertia", "triangles",
-    "triangle_normals", "shape_body", "shape_triangle_range", "shape_box_min", "shape_box_max", "shape_is_box",
-    "contact_stiffness", "contact_exponent", "contact_damping", "mu_static", "mu_kinetic", "transition_speed",
-    "mean_motion", "step", "stage_weight", "implicit_contact_speed", "velocity_lag", "lag_body", "mount_node",
-    "mount_body", "mount_point_body", "mount_stiffness", "mount_damping", "force", "body_impulse", "node_impulse",
-    "scalars", "work", "work_node",
-    "candidates")
+#: Fields of :class:`NetStepModel`: the groups and constants of :class:`multibody.kernel.KernelData`
+#: (same names, same buffers: what the kernel accumulates there, the recorder reads there), then the
+#: net's state and the work vectors of this module.
+KERNEL_FIELDS = ("net", "bodies", "shapes", "law", "mounts", "mean_motion", "step", "stage_weight", "buffers")
 STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "q_eval", "qt_eval")
 
 
@@ -77,14 +75,20 @@ structref.define_proxy(NetStepModel, NetStepModelType, KERNEL_FIELDS + STATE_FIE
 
 
 def net_step_model(kernel: KernelData, net_velocity) -> tuple:
-    """The structref for ``kernel`` with the net in its reference position, moving at ``net_velocity``
-    ((n, 3) m/s, LVLH); returns it and its ``q``, ``qt`` arrays (a structref proxy has no Python
-    attributes: its fields are read in compiled code)."""
+    """The structref for ``kernel`` with the net in its reference position; returns it and its ``q``,
+    ``qt`` arrays (a structref proxy has no Python attributes: its fields are read in compiled code).
+
+    Parameters
+    ----------
+    kernel : KernelData
+    net_velocity : (n, 3) float
+        Initial node velocities (m/s), LVLH.
+    """
     n, nb = kernel.n_nodes, kernel.n_bodies
     n_substeps = max(1, int(np.ceil(kernel.step / kernel.contact_substep - 1e-9))) if np.isfinite(
         kernel.contact_substep) else 1
     values = [getattr(kernel, name) for name in KERNEL_FIELDS]
-    values = [float(v) if isinstance(v, (float, np.floating)) else v for v in values]
+    values = [float(v) if isinstance(v, (float, np.floating, int)) else v for v in values]
     state = [n_substeps, np.zeros(3 * n), np.ascontiguousarray(net_velocity, float).reshape(3 * n).copy(),
              np.zeros(3 * n), np.zeros(3 * n + 6 * nb), np.zeros(3 * n + 6 * nb)]
     return NetStepModel(*values, *state), state[1], state[2]
@@ -93,24 +97,22 @@ def net_step_model(kernel: KernelData, net_velocity) -> tuple:
 @njit(cache=True)
 def _forces(m, time, n_substeps):
     """The kernel at (m.q_eval, m.qt_eval): :meth:`multibody.kernel.KernelData.evaluate` on the structref."""
-    return coupled_generalized_forces(
-        m.q_eval, m.qt_eval, m.net_reference, m.net_mass, m.net_radius,
-        m.threads, m.rest_lengths, m.thread_stiffness, m.thread_damping,
-        m.bending_triples, m.bending_stiffness,
-        m.body_reference, m.body_mass, m.body_inverse_inertia, m.triangles, m.triangle_normals,
-        m.shape_body, m.shape_triangle_range, m.shape_box_min, m.shape_box_max, m.shape_is_box,
-        m.contact_stiffness, m.contact_exponent, m.contact_damping,
-        m.mu_static, m.mu_kinetic, m.transition_speed,
-        m.mean_motion, m.step, n_substeps, m.stage_weight, m.implicit_contact_speed, m.velocity_lag, m.lag_body,
-        m.mount_node, m.mount_body, m.mount_point_body, m.mount_stiffness, m.mount_damping,
-        m.force, m.body_impulse, m.node_impulse, m.scalars, m.work, m.work_node, m.candidates)
+    return coupled_generalized_forces(m.q_eval, m.qt_eval, m.net, m.bodies, m.shapes, m.law, m.mounts,
+                                      m.mean_motion, m.step, n_substeps, m.stage_weight, m.buffers)
 
 
 @njit(cache=True)
 def kernel_net_start(m, q_bodies, qt_bodies):
     """The forces at the initial state (the solver's initial acceleration; no sub-cycling, as
     :meth:`~multibody.kernel.KernelData.evaluate` at time 0): sets the net's acceleration and
-    returns the bodies' generalized forces (6 nb,)."""
+    returns the bodies' generalized forces (6 nb,).
+
+    Parameters
+    ----------
+    m : NetStepModel
+    q_bodies, qt_bodies : (6 nb,) float
+        The bodies' initial coordinates and velocities (Exudyn's layout, :mod:`multibody.kernel`).
+    """
     n3 = m.q.shape[0]
     m.q_eval[:n3] = m.q
     m.qt_eval[:n3] = m.qt
@@ -118,7 +120,7 @@ def kernel_net_start(m, q_bodies, qt_bodies):
     m.qt_eval[n3:] = qt_bodies
     force = _forces(m, 0.0, 1)
     for k in range(n3):
-        m.qtt[k] = force[k] / m.net_mass[k // 3]
+        m.qtt[k] = force[k] / m.net.mass[k // 3]
     return force[n3:].copy()
 
 
@@ -127,29 +129,38 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
     """One VelocityVerlet step of the net inside the bodies' step (module doc); returns the bodies'
     generalized forces (6 nb,) at the evaluation state, for Exudyn's coupled object.
 
-    ``q_bodies``, ``qt_bodies``, ``qtt_bodies`` (6 nb,): the bodies' coordinates, velocities and
-    accelerations at the start of the step (Exudyn's layout, multibody.kernel); ``time`` (s) the
-    time of the evaluation state (the step's end)."""
-    n3 = m.q.shape[0]
+    Parameters
+    ----------
+    m : NetStepModel
+    q_bodies, qt_bodies, qtt_bodies : (6 nb,) float
+        The bodies' coordinates, velocities and accelerations at the start of the step (Exudyn's
+        layout, :mod:`multibody.kernel`).
+    time : float
+        Time of the evaluation state, the step's end (s); 0 evaluates without sub-cycling.
+    """
+    # the structref's arrays as locals: a field read inside a loop is not hoisted (stores through the
+    # other arrays may alias it), which cost about 5 ns per coordinate, 18 us a step for the reference net
+    q, qt, qtt, q_eval, qt_eval = m.q, m.qt, m.qtt, m.q_eval, m.qt_eval
+    n3 = q.shape[0]
     nb = q_bodies.shape[0] // 6
     step = m.step
     half = 0.5 * step
     for k in range(n3):
-        v_half = m.qt[k] + half * m.qtt[k]
-        m.qt_eval[k] = v_half
-        m.q_eval[k] = m.q[k] + step * v_half
+        v_half = qt[k] + half * qtt[k]
+        qt_eval[k] = v_half
+        q_eval[k] = q[k] + step * v_half
     q_next, v_half_bodies = verlet_evaluation_state(q_bodies, qt_bodies, qtt_bodies, step, 0, nb)
-    m.q_eval[n3:] = q_next
-    m.qt_eval[n3:] = v_half_bodies
+    q_eval[n3:] = q_next
+    qt_eval[n3:] = v_half_bodies
     force = _forces(m, time, m.n_substeps if time > 0.0 else 1)
-    inverse_mass = m.work_node[3]  # (n,) 1 / node mass (multibody.kernel.KernelData)
+    inverse_mass = m.buffers.work_node[3]  # (n,) 1 / node mass (multibody.kernel.KernelBuffers)
     for i in range(n3 // 3):
         for d in range(3):
             k = 3 * i + d
             a = force[k] * inverse_mass[i]
-            m.qtt[k] = a
-            m.qt[k] = m.qt_eval[k] + half * a
-            m.q[k] = m.q_eval[k]
+            qtt[k] = a
+            qt[k] = qt_eval[k] + half * a
+            q[k] = q_eval[k]
     return force[n3:].copy()
 
 
@@ -193,7 +204,7 @@ class KernelNet:
 
     def positions(self) -> np.ndarray:
         """(n, 3) node positions (m), LVLH, at the end of the last step."""
-        return self.kernel.net_reference + self.q.reshape(-1, 3)
+        return self.kernel.net.reference_lvlh + self.q.reshape(-1, 3)
 
     def velocities(self) -> np.ndarray:
         """(n, 3) node velocities (m/s), LVLH, at the end of the last step (a view)."""

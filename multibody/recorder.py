@@ -49,7 +49,13 @@ from multibody.kernel import (
     THREAD_ELASTIC,
 )
 from multibody.recorded_loads import applied_work
-from multibody.recorder_kernel import body_sample, net_sums
+from multibody.recorder_kernel import (
+    SampledBodies,
+    SampledJoints,
+    body_sample,
+    body_sample_buffers,
+    net_sums,
+)
 
 #: Longest simulated time between two finite-state checks when the output rate is lower (s):
 #: a NaN spreads through the coupled state within a few steps and stays, so 1 ms loses nothing.
@@ -107,28 +113,40 @@ class Recorder:
         self._n_net = 0
         bodies, joints = assembly.bodies, assembly.joints
         nb, nj = len(bodies), len(joints)
-        self._body_index = np.array(self._body_index, np.int64)
-        self._body_reference = np.array([b.com_lvlh for b in bodies], float).reshape(nb, 3)
-        self._body_mass = np.array([b.mass for b in bodies], float)
-        self._inertia = np.array([b.inertia_body for b in bodies], float).reshape(nb, 3, 3)
+        self._bodies = SampledBodies(
+            index=np.array(self._body_index, np.int64),
+            reference_com_lvlh=np.array([b.com_lvlh for b in bodies], float).reshape(nb, 3),
+            mass=np.array([b.mass for b in bodies], float),
+            inertia_body=np.array([b.inertia_body for b in bodies], float).reshape(nb, 3, 3),
+            debris_mask=np.isin(np.arange(nb), np.array(assembly.debris_indices, np.int64)).astype(np.int64),
+            chaser=-1 if assembly.chaser is None else int(assembly.chaser))
         self._net_masses = np.asarray(assembly.net.masses, float)
-        self._debris = np.array(assembly.debris_indices, np.int64)
-        self._debris_mask = np.isin(np.arange(nb), self._debris).astype(np.int64)
-        self._chaser = -1 if assembly.chaser is None else int(assembly.chaser)
-        self._joint_arrays = (np.array([j.parent for j in joints], np.int64), np.array([j.child for j in joints], np.int64),
-                              np.array(system.joint_to_parent, float).reshape(nj, 3, 3),
-                              np.array(system.joint_to_child, float).reshape(nj, 3, 3),
-                              np.array(system.joint_point_parent, float).reshape(nj, 3),
-                              np.array(system.joint_point_child, float).reshape(nj, 3),
-                              np.array(self._joint_stiffness, float).reshape(nj, 6))
-        self._work = {name: np.zeros(shape) for name, shape in (
-            ("com", (nb, 3)), ("vel", (nb, 3)), ("rot", (nb, 3, 3)), ("omega", (nb, 3)), ("force", (nb, 3)),
-            ("moment", (nb, 3)), ("force_body", (nb, 3)), ("moment_body", (nb, 3)), ("totals", (nb, 9)),
-            ("joint_rotation", (nj, 3)), ("joint_rate", (nj, 3)), ("joint_energy", (nj,)), ("net", (8,)),
-            ("summary", (17,)))}
+        self._joints = SampledJoints(
+            parent=np.array([j.parent for j in joints], np.int64), child=np.array([j.child for j in joints], np.int64),
+            joint_to_parent=np.array(system.joint_to_parent, float).reshape(nj, 3, 3),
+            joint_to_child=np.array(system.joint_to_child, float).reshape(nj, 3, 3),
+            point_parent=np.array(system.joint_point_parent_body, float).reshape(nj, 3),
+            point_child=np.array(system.joint_point_child_body, float).reshape(nj, 3),
+            stiffness=np.array(self._joint_stiffness, float).reshape(nj, 6))
+        self._body_out = body_sample_buffers(nb, nj)
+        self._net_totals = np.zeros(8)
 
     # -- Exudyn hook -----------------------------------------------------------------
     def post_step(self, mbs, t):
+        """Exudyn post-step function: sample at the output times, check the state in between.
+
+        Parameters
+        ----------
+        mbs : exudyn.MainSystem
+            The running system.
+        t : float
+            Time at the end of the step (s).
+
+        Returns
+        -------
+        bool
+            False stops the solver (a failed health check).
+        """
         half = 0.5 * self.step
         self._steps += 1
         if t >= self._next_output - half or t >= self._end_time - half:
@@ -142,12 +160,21 @@ class Recorder:
 
     # -- sampling --------------------------------------------------------------------
     def sample(self, t):
+        """Record one row of the time series at ``t`` (and a net snapshot when one is due).
+
+        Nothing is recorded from a non-finite state or past a failed energy check (the run stops).
+
+        Parameters
+        ----------
+        t : float
+            Current simulated time (s).
+        """
         arrays = self.system.state_arrays()
         q, qt = arrays[:2]
         if not self.health.state(t, *arrays):
             return  # nothing recorded from a lost state; the run stops at this step
-        x, v = self.system.net_state(q, qt)
-        row = self._compute_row(t, q, qt, x, v)
+        x_lvlh, v_lvlh = self.system.net_state(q, qt)
+        row = self._compute_row(t, q, qt, x_lvlh, v_lvlh)
         if not self.health.energy(t, row["energy_total"]):
             return
         self._store(row)
@@ -156,8 +183,8 @@ class Recorder:
         if t == 0.0 or t >= self._next_net - 0.5 * self.step:
             k = self._n_net
             self._net_time[k] = t
-            self._net_positions[k] = x
-            self._net_velocities[k] = v
+            self._net_positions[k] = x_lvlh
+            self._net_velocities[k] = v_lvlh
             self._net_contact_force[k] = self._node_contact_force(t)
             self._n_net += 1
             if t > 0.0:
@@ -167,12 +194,12 @@ class Recorder:
 
     def _node_contact_force(self, t):
         """Contact force on each net node (N, LVLH), averaged since the previous net snapshot."""
-        impulse = self.system.kernel.node_impulse
+        impulse_lvlh = self.system.kernel.buffers.node_impulse_lvlh
         interval = t - self._last_net_time
-        force = impulse / interval if interval > 0.0 else np.zeros_like(impulse)
-        impulse[:] = 0.0
+        force_lvlh = impulse_lvlh / interval if interval > 0.0 else np.zeros_like(impulse_lvlh)
+        impulse_lvlh[:] = 0.0
         self._last_net_time = t
-        return force
+        return force_lvlh
 
     def _check_monitor(self, t, row):
         before = len(self.monitor.events)
@@ -183,37 +210,34 @@ class Recorder:
             self.joint_active[event.joint] = False
             self._released_energy += event.stored_energy
 
-    def _compute_row(self, t, q, qt, x, v) -> dict:
+    def _compute_row(self, t, q, qt, x_lvlh, v_lvlh) -> dict:
         """One sample's values (see the module doc), from the compiled sums of multibody.recorder_kernel."""
-        w = self._work
+        w = self._body_out
         interval = t - self._last_output_time
         self._last_output_time = t
-        body_sample(q, qt, self._body_index, self._body_reference, self._body_mass, self._inertia,
-                    self.system.kernel.body_impulse, interval, *self._joint_arrays, self.joint_active.astype(float),
-                    self.assembly.mean_motion, self._debris_mask, self._chaser, w["com"], w["vel"], w["rot"],
-                    w["omega"], w["force"], w["moment"], w["force_body"], w["moment_body"], w["totals"],
-                    w["joint_rotation"], w["joint_rate"], w["joint_energy"], w["summary"])
-        net = w["net"]
-        net_sums(x, v, self._net_masses, self.assembly.mean_motion, net)
+        body_sample(q, qt, self._bodies, self._joints, self.joint_active.astype(float),
+                    self.system.kernel.buffers.body_impulse_lvlh, interval, self.assembly.mean_motion, w)
+        net = self._net_totals
+        net_sums(x_lvlh, v_lvlh, self._net_masses, self.assembly.mean_motion, net)
         mbs = self.system.mbs
         nj = len(self.system.joint_objects)
-        forces, moments = np.zeros((nj, 3)), np.zeros((nj, 3))
+        forces_joint, moments_joint = np.zeros((nj, 3)), np.zeros((nj, 3))
         for j, obj in enumerate(self.system.joint_objects):
             if self.joint_active[j]:
                 # Exudyn's connector force is the spring force acting on marker 1 (child) with
                 # reversed sign; the parent's load on the child is its negative.
-                forces[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)
-                moments[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)
-        self._joint_energies = w["joint_energy"]
-        summary = w["summary"].tolist()
-        scalars = self.system.kernel.scalars.tolist()
+                forces_joint[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)
+                moments_joint[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)
+        self._joint_energies = w.joint_energy
+        summary = w.summary.tolist()
+        scalars = self.system.kernel.buffers.scalars.tolist()
         row = {"time": t,
-               "contact_force_lvlh": w["force"], "contact_moment_lvlh": w["moment"],
-               "contact_force_body": w["force_body"], "contact_moment_body": w["moment_body"],
-               "body_com_lvlh": w["com"], "body_velocity_lvlh": w["vel"], "body_omega_body": w["omega"],
-               "body_to_lvlh": w["rot"], "debris_com_lvlh": summary[0:3], "debris_velocity_lvlh": summary[3:6],
-               "joint_rotation_joint": w["joint_rotation"], "joint_rate_joint": w["joint_rate"],
-               "joint_force_joint": -forces, "joint_moment_joint": -moments}
+               "contact_force_lvlh": w.force_lvlh, "contact_moment_lvlh": w.moment_lvlh,
+               "contact_force_body": w.force_body, "contact_moment_body": w.moment_body,
+               "body_com_lvlh": w.com_lvlh, "body_velocity_lvlh": w.velocity_lvlh, "body_omega_body": w.omega_body,
+               "body_to_lvlh": w.body_to_lvlh, "debris_com_lvlh": summary[0:3], "debris_velocity_lvlh": summary[3:6],
+               "joint_rotation_joint": w.joint_rotation, "joint_rate_joint": w.joint_rate,
+               "joint_force_joint": -forces_joint, "joint_moment_joint": -moments_joint}
         e = {
             "net_kinetic": net[0],
             "net_elastic": scalars[THREAD_ELASTIC],
@@ -230,21 +254,21 @@ class Recorder:
         if self.assembly.chaser is not None:
             e["chaser_kinetic"] = summary[9]
         if self.assembly.body_loads is not None:
-            e["applied_loads_work"] = -self._work_of_applied_loads(t, w["com"], w["vel"], w["omega"])
+            e["applied_loads_work"] = -self._work_of_applied_loads(t, w.com_lvlh, w.velocity_lvlh, w.omega_body)
         e["total"] = sum(e.values())
         for key, value in e.items():
             row["energy_" + key] = value
-        row["momentum_linear_lvlh"] = net[2:5] + w["summary"][10:13]
-        row["momentum_angular_lvlh"] = net[5:8] + w["summary"][13:16]
+        row["momentum_linear_lvlh"] = net[2:5] + w.summary[10:13]
+        row["momentum_angular_lvlh"] = net[5:8] + w.summary[13:16]
         return row
 
     def _work_of_applied_loads(self, t, com_lvlh, velocity_lvlh, omega_body) -> float:
         """Work (J) done by the recorded loads since t = 0: the energy they bring in, which the
         balance subtracts so that it stays closed."""
         if self._previous_body_state is not None:
-            t0, com0, velocity0, omega0 = self._previous_body_state
-            self._applied_work += applied_work(self.assembly.body_loads, self.step, t0, t, com0, com_lvlh, velocity0,
-                                               omega0, omega_body)
+            t0, com0_lvlh, velocity0_lvlh, omega0_body = self._previous_body_state
+            self._applied_work += applied_work(self.assembly.body_loads, self.step, t0, t, com0_lvlh, com_lvlh,
+                                               velocity0_lvlh, omega0_body, omega_body)
         self._previous_body_state = (t, com_lvlh.copy(), velocity_lvlh.copy(), omega_body.copy())
         return self._applied_work
 
@@ -258,6 +282,13 @@ class Recorder:
         self._n_rows += 1
 
     def finish(self, wall_time):
+        """Trim the preallocated arrays to the samples taken into :attr:`series` and :attr:`net`.
+
+        Parameters
+        ----------
+        wall_time : float
+            Wall-clock duration of the run (s).
+        """
         self.wall_time = wall_time
         self.series = {key: value[:self._n_rows].copy() for key, value in self._series.items()}
         self.net = {"time": self._net_time[:self._n_net].copy(), "positions_lvlh": self._net_positions[:self._n_net].copy(),

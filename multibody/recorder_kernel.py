@@ -6,19 +6,33 @@ each. Same definitions as before; frames in the names, SI units.
 """
 from __future__ import annotations
 
-import math
+
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.linalg3 import matmat3, mattmat3, mattvec3, matvec3
+from multibody.rotations import rotation_matrix_from_rotation_vector, rotation_vector_from_matrix_into
 
 
 @njit(cache=True)
 def net_sums(x, v, masses, n_orbit, out):
     """Net totals into ``out`` (8,): kinetic energy (J), Clohessy-Wiltshire potential
     :math:`\\sum m\\,\\tfrac12 n^2 (z^2 - 3x^2)` (J), linear momentum (3, kg m/s) and angular momentum
-    about the LVLH origin (3, kg m^2/s). ``x``, ``v`` (n, 3) positions (m) and velocities (m/s), LVLH."""
+    about the LVLH origin (3, kg m^2/s).
+
+    Parameters
+    ----------
+    x, v : (n, 3) float
+        Node positions (m) and velocities (m/s), LVLH.
+    masses : (n,) float
+        Node masses (kg).
+    n_orbit : float
+        Mean motion (rad/s); 0 without orbit.
+    out : (8,) float
+        Output.
+    """
     for k in range(8):
         out[k] = 0.0
     for i in range(masses.shape[0]):
@@ -34,91 +48,94 @@ def net_sums(x, v, masses, n_orbit, out):
         out[7] += x[i, 0] * py - x[i, 1] * px
 
 
-@njit(cache=True)
-def rotation_vector_from_matrix(r, out):
-    """Rotation vector (rad) of the rotation matrix ``r`` into ``out`` (3,), through the quaternion
-    (Shepperd 1978), accurate at every angle up to pi."""
-    trace = r[0, 0] + r[1, 1] + r[2, 2]
-    if trace >= max(r[0, 0], r[1, 1], r[2, 2]):
-        w = 0.5 * math.sqrt(max(1.0 + trace, 0.0))
-        x, y, z = (r[2, 1] - r[1, 2]) / (4 * w), (r[0, 2] - r[2, 0]) / (4 * w), (r[1, 0] - r[0, 1]) / (4 * w)
-    elif r[0, 0] >= r[1, 1] and r[0, 0] >= r[2, 2]:
-        x = 0.5 * math.sqrt(max(1.0 + r[0, 0] - r[1, 1] - r[2, 2], 0.0))
-        w, y, z = (r[2, 1] - r[1, 2]) / (4 * x), (r[0, 1] + r[1, 0]) / (4 * x), (r[0, 2] + r[2, 0]) / (4 * x)
-    elif r[1, 1] >= r[2, 2]:
-        y = 0.5 * math.sqrt(max(1.0 - r[0, 0] + r[1, 1] - r[2, 2], 0.0))
-        w, x, z = (r[0, 2] - r[2, 0]) / (4 * y), (r[0, 1] + r[1, 0]) / (4 * y), (r[1, 2] + r[2, 1]) / (4 * y)
-    else:
-        z = 0.5 * math.sqrt(max(1.0 - r[0, 0] - r[1, 1] + r[2, 2], 0.0))
-        w, x, y = (r[1, 0] - r[0, 1]) / (4 * z), (r[0, 2] + r[2, 0]) / (4 * z), (r[1, 2] + r[2, 1]) / (4 * z)
-    if w < 0.0:
-        w, x, y, z = -w, -x, -y, -z
-    sine = math.sqrt(x * x + y * y + z * z)
-    scale = 2.0 * math.atan2(sine, w) / sine if sine > 1e-300 else 2.0
-    out[0], out[1], out[2] = scale * x, scale * y, scale * z
+class SampledBodies(NamedTuple):
+    """The bodies' constants a sample needs (nb bodies)."""
+
+    index: np.ndarray                 # (nb,) int64 where body b's coordinates start in Exudyn's vectors
+    reference_com_lvlh: np.ndarray    # (nb, 3) reference CoM (m), LVLH
+    mass: np.ndarray                  # (nb,) (kg)
+    inertia_body: np.ndarray          # (nb, 3, 3) about the CoM, body frame (kg m^2)
+    debris_mask: np.ndarray           # (nb,) int64, 1 for debris bodies
+    chaser: int                       # the chaser's index, -1 for none
 
 
-@njit(cache=True)
-def _mat_t_vec(r, a, out):
-    """out = r^T a for (3, 3) r and (3,) a, in scalars."""
-    for i in range(3):
-        out[i] = r[0, i] * a[0] + r[1, i] * a[1] + r[2, i] * a[2]
+class SampledJoints(NamedTuple):
+    """The joints' constants a sample needs (nj joints)."""
+
+    parent: np.ndarray                # (nj,) int64 parent body
+    child: np.ndarray                 # (nj,) int64 child body
+    joint_to_parent: np.ndarray       # (nj, 3, 3) joint frame in the parent's body frame
+    joint_to_child: np.ndarray        # (nj, 3, 3) joint frame in the child's body frame (unrotated)
+    point_parent: np.ndarray          # (nj, 3) joint point, parent body frame (m)
+    point_child: np.ndarray           # (nj, 3) joint point, child body frame (m)
+    stiffness: np.ndarray             # (nj, 6) penalty (N/m) and torsion (N m/rad) diagonals, joint frame
 
 
-@njit(cache=True)
-def _mat_vec(r, a):
-    """r a for (3, 3) r and (3,) a, in scalars (numba sends small products to BLAS, ~1 us a call)."""
-    out = np.empty(3)
-    for i in range(3):
-        out[i] = r[i, 0] * a[0] + r[i, 1] * a[1] + r[i, 2] * a[2]
-    return out
+class BodySample(NamedTuple):
+    """One sample's body and joint values, written by :func:`body_sample` (preallocated)."""
+
+    com_lvlh: np.ndarray              # (nb, 3) CoM (m)
+    velocity_lvlh: np.ndarray         # (nb, 3) CoM velocity (m/s)
+    body_to_lvlh: np.ndarray          # (nb, 3, 3) attitude
+    omega_body: np.ndarray            # (nb, 3) angular velocity (rad/s), body frame
+    force_lvlh: np.ndarray            # (nb, 3) mean contact force since the last sample (N)
+    moment_lvlh: np.ndarray           # (nb, 3) its moment about the CoM (N m)
+    force_body: np.ndarray            # (nb, 3) the same, body frame
+    moment_body: np.ndarray           # (nb, 3)
+    body_totals: np.ndarray           # (nb, 9) translational and rotational kinetic energy (J), CW potential (J),
+    #                                   linear momentum (3, kg m/s), angular momentum about the LVLH origin (3, kg m^2/s)
+    joint_rotation: np.ndarray        # (nj, 3) relative rotation vector (rad), joint frame
+    joint_rate: np.ndarray            # (nj, 3) relative rate (rad/s), joint frame
+    joint_energy: np.ndarray          # (nj,) elastic energy of the penalty spring (J)
+    summary: np.ndarray               # (17,) debris CoM (3, m) and CoM velocity (3, m/s), LVLH; debris translational
+    #                                   and rotational kinetic energy (J); CW potential of all bodies (J); the chaser's
+    #                                   kinetic energy (J); linear (3) and angular (3) momentum of all bodies (as
+    #                                   body_totals); joint elastic energy (J)
 
 
-@njit(cache=True)
-def _mat_mat(a, b, transpose_a):
-    """a b (or a^T b) for (3, 3) matrices, in scalars."""
-    out = np.empty((3, 3))
-    for i in range(3):
-        for k in range(3):
-            s = 0.0
-            for j in range(3):
-                s += (a[j, i] if transpose_a else a[i, j]) * b[j, k]
-            out[i, k] = s
-    return out
-
-
-@njit(cache=True)
-def body_sample(q, qt, body_index, body_reference, body_mass, inertia, impulse, interval,
-                joint_parent, joint_child, to_parent, to_child, point_parent, point_child, joint_stiffness, active,
-                n_orbit, debris_mask, chaser, com, vel, rot, omega, force_lvlh, moment_lvlh, force_body, moment_body,
-                body_totals, joint_rotation, joint_rate, joint_energy, summary):
-    """Body and joint states of one sample, into the output arrays (all preallocated).
+def body_sample_buffers(n_bodies: int, n_joints: int) -> BodySample:
+    """Zeroed :class:`BodySample` arrays.
 
     Parameters
     ----------
-    q, qt : (N,) float        Exudyn's coordinates and velocities; body ``b`` starts at ``body_index[b]``
-                              (CoM displacement (m), rotation vector (rad); CoM velocity (m/s), omega (rad/s, body)).
-    body_reference : (nb, 3)  Reference CoM (m), LVLH.
-    inertia : (nb, 3, 3)      About the CoM, body frame (kg m^2).
-    impulse : (nb, 6)         Contact impulse and angular impulse about the CoM since the last sample (N s, N m s),
-                              LVLH; zeroed here.
-    interval : float          Time since the last sample (s); 0 gives zero contact force.
-    joint_* , to_*, point_*   Per joint: parent, child, joint frame in each body frame (3, 3), joint point in
-                              each body frame (m); ``joint_stiffness`` (nj, 6) penalty/torsion diagonals,
-                              ``active`` (nj,) 1.0 or 0.0 (released).
-    com, vel, omega : (nb, 3); rot : (nb, 3, 3)    Body states (omega in the body frame).
-    n_orbit : float           Mean motion (rad/s) of the Clohessy-Wiltshire potential; 0 without orbit.
-    debris_mask : (nb,) int   1 for debris bodies; ``chaser`` (int) the chaser's index or -1.
-    force_lvlh, moment_lvlh, force_body, moment_body : (nb, 3)   Mean contact force (N), moment about the CoM (N m).
-    body_totals : (nb, 9)     Per body: translational and rotational kinetic energy (J), CW potential (J),
-                              linear momentum (3, kg m/s), angular momentum about the LVLH origin (3, kg m^2/s).
-    joint_rotation, joint_rate : (nj, 3)   Relative rotation vector (rad) and rate (rad/s), joint frame.
-    joint_energy : (nj,)      Elastic energy of the penalty spring (J).
-    summary : (17,)           Debris CoM (3, m) and CoM velocity (3, m/s), LVLH; debris translational and
-                              rotational kinetic energy (J); CW potential of all bodies (J); the chaser's
-                              kinetic energy (J); linear (3) and angular (3) momentum of all bodies (as
-                              ``body_totals``); joint elastic energy (J).
+    n_bodies, n_joints : int
     """
+    nb, nj = n_bodies, n_joints
+    return BodySample(np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3, 3)), np.zeros((nb, 3)),
+                      np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 9)),
+                      np.zeros((nj, 3)), np.zeros((nj, 3)), np.zeros(nj), np.zeros(17))
+
+
+@njit(cache=True)
+def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
+    """Body and joint states of one sample, into ``out`` (preallocated).
+
+    Parameters
+    ----------
+    q, qt : (N,) float
+        Exudyn's coordinates and velocities; body ``b`` starts at ``bodies.index[b]`` (CoM displacement
+        (m), rotation vector (rad); CoM velocity (m/s), omega (rad/s, body frame)).
+    bodies : SampledBodies
+    joints : SampledJoints
+    active : (nj,) float
+        1.0 for a joint in place, 0.0 once released.
+    impulse : (nb, 6) float
+        Contact impulse and angular impulse about the CoM since the last sample (N s, N m s), LVLH;
+        zeroed here.
+    interval : float
+        Time since the last sample (s); 0 gives zero contact force.
+    n_orbit : float
+        Mean motion (rad/s) of the Clohessy-Wiltshire potential; 0 without orbit.
+    out : BodySample
+    """
+    body_reference, body_mass, inertia = bodies.reference_com_lvlh, bodies.mass, bodies.inertia_body
+    body_index, debris_mask, chaser = bodies.index, bodies.debris_mask, bodies.chaser
+    joint_parent, joint_child, to_parent, to_child = joints.parent, joints.child, joints.joint_to_parent, joints.joint_to_child
+    point_parent, point_child, joint_stiffness = joints.point_parent, joints.point_child, joints.stiffness
+    com, vel, rot, omega = out.com_lvlh, out.velocity_lvlh, out.body_to_lvlh, out.omega_body
+    force_lvlh, moment_lvlh, force_body, moment_body = out.force_lvlh, out.moment_lvlh, out.force_body, out.moment_body
+    body_totals, joint_rotation, joint_rate = out.body_totals, out.joint_rotation, out.joint_rate
+    joint_energy, summary = out.joint_energy, out.summary
     nb = body_mass.shape[0]
     for b in range(nb):
         i = body_index[b]
@@ -130,16 +147,16 @@ def body_sample(q, qt, body_index, body_reference, body_mass, inertia, impulse, 
         for d in range(3):
             force_lvlh[b, d] = impulse[b, d] / interval if interval > 0.0 else 0.0
             moment_lvlh[b, d] = impulse[b, 3 + d] / interval if interval > 0.0 else 0.0
-        _mat_t_vec(rot[b], force_lvlh[b], force_body[b])
-        _mat_t_vec(rot[b], moment_lvlh[b], moment_body[b])
+        force_body[b] = mattvec3(rot[b], force_lvlh[b])
+        moment_body[b] = mattvec3(rot[b], moment_lvlh[b])
         for d in range(6):
             impulse[b, d] = 0.0
         m = body_mass[b]
-        spin = _mat_vec(inertia[b], omega[b])  # body frame
+        spin = matvec3(inertia[b], omega[b])  # body frame
         body_totals[b, 0] = 0.5 * m * (vel[b, 0] ** 2 + vel[b, 1] ** 2 + vel[b, 2] ** 2)
         body_totals[b, 1] = 0.5 * (omega[b, 0] * spin[0] + omega[b, 1] * spin[1] + omega[b, 2] * spin[2])
         body_totals[b, 2] = m * 0.5 * n_orbit * n_orbit * (com[b, 2] ** 2 - 3.0 * com[b, 0] ** 2)
-        spin_lvlh = _mat_vec(rot[b], spin)
+        spin_lvlh = matvec3(rot[b], spin)
         for d in range(3):
             body_totals[b, 3 + d] = m * vel[b, d]
         body_totals[b, 6] = m * (com[b, 1] * vel[b, 2] - com[b, 2] * vel[b, 1]) + spin_lvlh[0]
@@ -147,14 +164,13 @@ def body_sample(q, qt, body_index, body_reference, body_mass, inertia, impulse, 
         body_totals[b, 8] = m * (com[b, 0] * vel[b, 1] - com[b, 1] * vel[b, 0]) + spin_lvlh[2]
     for j in range(joint_parent.shape[0]):
         p, c = joint_parent[j], joint_child[j]
-        frame = _mat_mat(rot[p], to_parent[j], False)  # joint frame (parent side) in LVLH
-        relative = _mat_mat(frame, _mat_mat(rot[c], to_child[j], False), True)
-        rotation_vector_from_matrix(relative, joint_rotation[j])
-        w = _mat_vec(rot[c], omega[c]) - _mat_vec(rot[p], omega[p])
-        _mat_t_vec(frame, w, joint_rate[j])
-        offset = _mat_vec(rot[c], point_child[j]) + com[c] - _mat_vec(rot[p], point_parent[j]) - com[p]
-        offset_joint = np.empty(3)
-        _mat_t_vec(frame, offset, offset_joint)
+        frame = matmat3(rot[p], to_parent[j])  # joint frame (parent side) in LVLH
+        relative = mattmat3(frame, matmat3(rot[c], to_child[j]))
+        rotation_vector_from_matrix_into(relative, joint_rotation[j])
+        w = matvec3(rot[c], omega[c]) - matvec3(rot[p], omega[p])
+        joint_rate[j] = mattvec3(frame, w)
+        offset = matvec3(rot[c], point_child[j]) + com[c] - matvec3(rot[p], point_parent[j]) - com[p]
+        offset_joint = mattvec3(frame, offset)
         energy = 0.0
         for d in range(3):
             energy += joint_stiffness[j, d] * offset_joint[d] ** 2 + joint_stiffness[j, 3 + d] * joint_rotation[j, d] ** 2

@@ -1,4 +1,5 @@
-"""Rotations shared by every package: scalar-first unit quaternions and rotation matrices.
+"""Rotations shared by every package: scalar-first unit quaternions, rotation matrices and rotation
+vectors (Exudyn's rotation-vector nodes; the log map of a rotation matrix).
 
 One implementation each, compiled (numba) so kernels and Python code call the same function.
 Convention: ``q = [q0, q1, q2, q3]`` with the scalar first and ``q0 >= 0``; the matrix of ``q``
@@ -36,7 +37,18 @@ def quaternion_from_matrix(body_to_inertial):
 
 @njit(cache=True, inline="always")
 def quaternion_from_matrix_tuple(a):
-    """:func:`quaternion_from_matrix` as a tuple (no allocation: the attitude controller runs every step)."""
+    """:func:`quaternion_from_matrix` as a tuple (no allocation: the attitude controller runs every step).
+
+    Parameters
+    ----------
+    a : (3, 3) float array
+        Rotation matrix body->inertial (or body->LVLH): columns are the body axes.
+
+    Returns
+    -------
+    tuple of 4 float
+        Unit quaternion (q0, q1, q2, q3), scalar first, q0 >= 0.
+    """
     trace = a[0, 0] + a[1, 1] + a[2, 2]
     if trace > max(a[0, 0], a[1, 1], a[2, 2]):
         s = 2.0 * math.sqrt(1.0 + trace)
@@ -77,3 +89,147 @@ def quaternion_to_matrix(q):
         [q1 * q1 + q2 * q2 - q3 * q3 - q4 * q4, 2.0 * (q2 * q3 - q1 * q4), 2.0 * (q2 * q4 + q1 * q3)],
         [2.0 * (q2 * q3 + q1 * q4), q1 * q1 - q2 * q2 + q3 * q3 - q4 * q4, 2.0 * (q4 * q3 - q1 * q2)],
         [2.0 * (q2 * q4 - q3 * q1), 2.0 * (q3 * q4 + q1 * q2), q1 * q1 - q2 * q2 - q3 * q3 + q4 * q4]])
+
+
+@njit(cache=True, inline="always")
+def quaternion_from_rotation_vector_tuple(rotation_vector):
+    """Scalar-first unit quaternion (tuple) of a rotation vector (rad): angle |r| about r / |r|.
+
+    Parameters
+    ----------
+    rotation_vector : (3,) float
+        Axis times angle (rad), of the rotation body->reference (in either frame's components: they
+        agree on the axis).
+
+    Returns
+    -------
+    tuple of 4 float
+        (q0, q1, q2, q3), scalar first.
+    """
+    x, y, z = rotation_vector[0], rotation_vector[1], rotation_vector[2]
+    angle = math.sqrt(x * x + y * y + z * z)
+    if angle < 1e-8:
+        return 1.0 - angle * angle / 8.0, 0.5 * x, 0.5 * y, 0.5 * z
+    s = math.sin(0.5 * angle) / angle
+    return math.cos(0.5 * angle), s * x, s * y, s * z
+
+
+@njit(cache=True)
+def rotation_matrix_from_rotation_vector(rotation_vector):
+    """Rotation matrix (3, 3) of a rotation vector (rad), e.g. body -> LVLH of an Exudyn rotation-vector
+    node; Rodrigues' formula :math:`I + \\frac{\\sin\\theta}{\\theta}K + \\frac{1-\\cos\\theta}{\\theta^2}K^2`,
+    written out in scalars (numba sends 3x3 products to BLAS, ~1 us a call).
+
+    Parameters
+    ----------
+    rotation_vector : (3,) float
+        Axis times angle (rad) of the rotation body->reference.
+
+    Returns
+    -------
+    (3, 3) float
+        body->reference matrix (columns: body axes in reference components, e.g. LVLH).
+    """
+    x, y, z = rotation_vector[0], rotation_vector[1], rotation_vector[2]
+    angle2 = x * x + y * y + z * z
+    if angle2 < 1e-16:
+        a, b = 1.0, 0.5
+    else:
+        angle = math.sqrt(angle2)
+        a, b = math.sin(angle) / angle, (1.0 - math.cos(angle)) / angle2
+    out = np.empty((3, 3))
+    # K^2 = r r^T - |r|^2 I
+    out[0, 0] = 1.0 + b * (x * x - angle2)
+    out[1, 1] = 1.0 + b * (y * y - angle2)
+    out[2, 2] = 1.0 + b * (z * z - angle2)
+    out[0, 1] = -a * z + b * x * y
+    out[1, 0] = a * z + b * x * y
+    out[0, 2] = a * y + b * x * z
+    out[2, 0] = -a * y + b * x * z
+    out[1, 2] = -a * x + b * y * z
+    out[2, 1] = a * x + b * y * z
+    return out
+
+
+@njit(cache=True, inline="always")
+def rotation_vector_from_quaternion_into(w, x, y, z, out):
+    """Rotation vector (rad, angle at most pi) of the unit quaternion (w, x, y, z) into ``out`` (3,).
+
+    Parameters
+    ----------
+    w, x, y, z : float
+        Unit quaternion, scalar first, of the rotation body->reference.
+    out : (3,) float
+        Output: axis times angle (rad).
+    """
+    if w < 0.0:
+        w, x, y, z = -w, -x, -y, -z
+    sine = math.sqrt(x * x + y * y + z * z)
+    if sine < 1e-12:  # angle below 2e-12 rad: 2 atan2(s, w) / s = 2 to round-off
+        out[0], out[1], out[2] = 2.0 * x, 2.0 * y, 2.0 * z
+        return
+    angle = 2.0 * math.atan2(sine, w)
+    out[0], out[1], out[2] = angle * x / sine, angle * y / sine, angle * z / sine
+
+
+@njit(cache=True)
+def rotation_vector_from_matrix_into(rotation, out):
+    """Rotation vector (rad) of a rotation matrix (the log map) into ``out`` (3,), through Shepperd's
+    quaternion (:func:`quaternion_from_matrix_tuple`): accurate at every angle up to pi.
+
+    Parameters
+    ----------
+    rotation : (3, 3) float
+        Rotation matrix body->reference (columns: body axes in reference components).
+    out : (3,) float
+        Output: axis times angle (rad).
+    """
+    w, x, y, z = quaternion_from_matrix_tuple(rotation)
+    rotation_vector_from_quaternion_into(w, x, y, z, out)
+
+
+@njit(cache=True)
+def rotation_vector_from_matrix(rotation):
+    """Rotation vector (3,) (rad) of a rotation matrix: :func:`rotation_vector_from_matrix_into`.
+
+    Parameters
+    ----------
+    rotation : (3, 3) float
+        Rotation matrix body->reference (columns: body axes in reference components).
+
+    Returns
+    -------
+    (3,) float
+        Axis times angle (rad), angle at most pi.
+    """
+    out = np.empty(3)
+    rotation_vector_from_matrix_into(rotation, out)
+    return out
+
+
+@njit(cache=True)
+def compose_rotation_vectors(rotation_vector, increment_body):
+    """Rotation vector (3,) of R(rotation_vector) R(increment_body): a rotation by ``increment_body``
+    (rad, body frame) after ``rotation_vector``; the Lie-group update Exudyn applies to rotation-vector
+    nodes. The result's angle is at most pi.
+
+    Parameters
+    ----------
+    rotation_vector : (3,) float
+        Current rotation body->reference (rad).
+    increment_body : (3,) float
+        Rotation increment (rad), body frame.
+
+    Returns
+    -------
+    (3,) float
+        The composed rotation body->reference (rad).
+    """
+    w0, x0, y0, z0 = quaternion_from_rotation_vector_tuple(rotation_vector)
+    w1, x1, y1, z1 = quaternion_from_rotation_vector_tuple(increment_body)
+    out = np.empty(3)
+    rotation_vector_from_quaternion_into(w0 * w1 - x0 * x1 - y0 * y1 - z0 * z1,
+                                         w0 * x1 + x0 * w1 + y0 * z1 - z0 * y1,
+                                         w0 * y1 - x0 * z1 + y0 * w1 + z0 * x1,
+                                         w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1, out)
+    return out

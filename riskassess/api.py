@@ -180,6 +180,15 @@ def open_run(path: str | Path) -> RunResult:
         The folder lacks its summary (not a finished impact run).
     ValueError
         Not a run folder of this tool (no readable manifest).
+
+    Parameters
+    ----------
+    path : str or Path
+        The run folder (holding ``manifest.json`` and ``summary.json``).
+
+    Returns
+    -------
+    RunResult
     """
     return RunResult(RunFolder(path))
 
@@ -277,7 +286,18 @@ class RunResult:
         return self._folder.structures_series if self._folder.has("structures.npz") else {}
 
     def body(self, name: str) -> int:
-        """Index of the body ``name`` along the body axis of :attr:`series`."""
+        """Index of the body ``name`` along the body axis of :attr:`series`.
+
+        Parameters
+        ----------
+        name : str
+            A body name of the case (``target.bodies[].name``); ``KeyError`` listing the names otherwise.
+
+        Returns
+        -------
+        int
+            Index along the body axis (axis 1 of the ``(n, bodies, 3)`` series).
+        """
         names = [str(n) for n in self.series["body_names"]]
         if name not in names:
             raise KeyError(f"no body '{name}' in {self.path} (bodies: {', '.join(names)})")

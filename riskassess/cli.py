@@ -67,6 +67,18 @@ def _announce_compilation(needed: bool) -> None:
 
 
 def impact_estimate_of(case: Case):
+    """The expected cost of the case's impact run (steps, wall time, recorded bytes).
+
+    Parameters
+    ----------
+    case : riskassess.cases.impact.Case
+        The validated impact case: simulated time and step (s), net nodes per side (the net has
+        that squared plus 4 bullets), target bodies (plus the chaser), output rates (Hz).
+
+    Returns
+    -------
+    riskassess.stages.estimate.Estimate
+    """
     from riskassess.stages.estimate import impact_estimate
 
     sim = case.simulation
@@ -259,6 +271,18 @@ def _cmd_tow(args) -> int:
 
 
 def tow_estimate_of(case):
+    """The expected cost of the case's tow (steps, wall time, recorded bytes).
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        The validated towing case: simulated time (s) and step (s); a full-net model adds the net's
+        step, nodes per side and sub-steps.
+
+    Returns
+    -------
+    riskassess.stages.estimate.Estimate
+    """
     from riskassess.stages.estimate import tow_estimate
 
     sim = case.simulation
@@ -299,6 +323,17 @@ def _cmd_identify(args) -> int:
 
 
 def print_perception(answer: dict, out: Path, console=None) -> None:
+    """The perception estimates as a table on the terminal, and where the results are.
+
+    Parameters
+    ----------
+    answer : dict
+        The perception answer (``perception.json``).
+    out : Path
+        The output folder, printed.
+    console : rich.console.Console, optional
+        Where to print; default the terminal.
+    """
     from riskassess.products.tables import perception_rows
 
     console = console or _console()
@@ -351,14 +386,22 @@ def _print_table(console, title: str, columns, rows, justify=None) -> None:
 
 def _console():
     """The terminal: markup only where the CLI writes it, every user string passed through
-    ``escape`` (issue 20: ``x[/red]`` in a name crashed, ``[link=...]`` was followed); no emoji codes."""
+    ``escape`` (``x[/red]`` in a name used to crash, ``[link=...]`` was followed); no emoji codes."""
     from rich.console import Console
 
     return Console(width=None if sys.stdout.isatty() else 150, emoji=False)
 
 
 def print_verdict(verdict: dict, console=None) -> None:
-    """The verdict table: location, criterion, peak demand, allowable, margin, fails?, released piece."""
+    """The verdict table: location, criterion, peak demand, allowable, margin, fails?, released piece.
+
+    Parameters
+    ----------
+    verdict : dict
+        The structural verdict (``structures.json``).
+    console : rich.console.Console, optional
+        Where to print; default the terminal.
+    """
     from riskassess.products.tables import STATE_TEXT, VERDICT_COLUMNS, debris_line, piece_fate, verdict_rows
 
     console = console or _console()
@@ -382,6 +425,17 @@ def print_verdict(verdict: dict, console=None) -> None:
 
 
 def print_summary(summary: dict, run_dir: Path, console=None) -> None:
+    """The run summary as a table (this run against the seed paper), and where the results are.
+
+    Parameters
+    ----------
+    summary : dict
+        The run summary (``summary.json``).
+    run_dir : Path
+        The run folder, printed.
+    console : rich.console.Console, optional
+        Where to print; default the terminal.
+    """
     from riskassess.products.tables import summary_rows
 
     console = console or _console()
@@ -701,6 +755,20 @@ def _simulation_command(sub, name, func, help_text, case_help, json_help):
 
 
 def main(argv=None) -> int:
+    """Run the ``riskassess`` command line.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after the program name; default ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        Exit code: 0 done, 2 bad input (invalid case, bad option, refused output folder, missing
+        data), :data:`EXIT_SIMULATION_FAILED` when the simulation failed its health checks, or the
+        command's own code (e.g. :data:`EXIT_INDETERMINATE`).
+    """
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)

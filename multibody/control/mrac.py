@@ -37,6 +37,7 @@ def mrac_params(kind, t_on, u_max, chaser_mass, k_mt, c_mt, z_d, k_p, k_d, **gai
 
     Parameters
     ----------
+    kind : {1, 2}       MRAC-1 or MRAC-2.
     t_on : float        Time the controller starts (s); thrust is 0 before.
     u_max : float       Thrust saturation (N).
     chaser_mass : float :math:`m_C` (kg), :math:`b = 1/m_C`.
@@ -59,14 +60,41 @@ def mrac_params(kind, t_on, u_max, chaser_mass, k_mt, c_mt, z_d, k_p, k_d, **gai
 def reference_steady_elongation(k_mt, k_p, z_d) -> float:
     """Elongation (m) the reference model of eq. (13) settles at while taut: its PD force balances the
     tether, :math:`k_{MT} z_m = K_P (z_d - z_m)`, so :math:`z_m = K_P z_d / (k_{MT} + K_P)` (not
-    :math:`z_d` itself: eq. 13 has no integral action)."""
+    :math:`z_d` itself: eq. 13 has no integral action).
+
+    Parameters
+    ----------
+    k_mt : float
+        Main-tether stiffness (N/m).
+    k_p : float
+        Reference-model proportional gain (N/m).
+    z_d : float
+        Desired elongation (m).
+    """
     return k_p * z_d / (k_mt + k_p)
 
 
 def mrac_initial_state(kind, params, z0, z_rate0) -> np.ndarray:
     """Reference model started on the measured state; adaptive parameters at their ideal values
     for the abstracted model (MRAC-1: :math:`\\hat h = m_C`, :math:`\\hat a = [k, c]`; MRAC-2:
-    :math:`\\hat K_z = [-K_P, -K_D]`, :math:`\\hat k_r = K_P`, :math:`\\hat\\Theta = [-k, -c]`)."""
+    :math:`\\hat K_z = [-K_P, -K_D]`, :math:`\\hat k_r = K_P`, :math:`\\hat\\Theta = [-k, -c]`).
+
+    Parameters
+    ----------
+    kind : {1, 2}
+        MRAC-1 or MRAC-2.
+    params : (k,) float
+        :func:`mrac_params` of that law.
+    z0 : float
+        Measured main-tether elongation at the start (m).
+    z_rate0 : float
+        Its rate (m/s).
+
+    Returns
+    -------
+    (N_STATE[kind],) float
+        [z_m, z_m rate, adaptive parameters...].
+    """
     if kind == 1:
         return np.array([z0, z_rate0, 1.0 / params[B], params[K_MT], params[C_MT]])
     return np.array([z0, z_rate0, -params[K_P], -params[K_D], params[K_P], -params[K_MT], -params[C_MT]])
@@ -74,7 +102,17 @@ def mrac_initial_state(kind, params, z0, z_rate0) -> np.ndarray:
 
 @njit(cache=True)
 def pulling(z, z_rate, k, c):
-    """:math:`g(z, \\dot z)`: 1 while a tension-only tether pulls, else 0."""
+    """:math:`g(z, \\dot z)`: 1 while a tension-only tether pulls, else 0.
+
+    Parameters
+    ----------
+    z : float
+        Elongation (m).
+    z_rate : float
+        Elongation rate (m/s).
+    k, c : float
+        Tether stiffness (N/m) and damping (N s/m).
+    """
     return 1.0 if z > 0.0 and k * z + c * z_rate > 0.0 else 0.0
 
 
@@ -95,7 +133,30 @@ def _advance_reference(params, state, zm_acc, step):
 
 @njit(cache=True)
 def mrac1_command(t, z, z_rate, params, state, step, advance):
-    """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16); ``state = [z_m, z_m rate, h, a1, a2]``."""
+    """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16); ``state = [z_m, z_m rate, h, a1, a2]``.
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    z : float
+        Main-tether elongation (m).
+    z_rate : float
+        Its rate (m/s).
+    params : (k,) float
+        :func:`mrac_params` of this law.
+    state : (n,) float
+        The law's state (:func:`mrac_initial_state`), advanced in place when ``advance``.
+    step : float
+        The controller's sampling step (s).
+    advance : bool
+        True once per new sampling time: integrate the adaptive and reference states.
+
+    Returns
+    -------
+    float
+        Commanded thrust (N), saturated at ``u_max``; 0 before ``t_on``.
+    """
     if t < params[T_ON]:
         return 0.0
     zm_acc = _reference_acceleration(params, state[ZM], state[ZM_RATE])
@@ -123,6 +184,28 @@ def mrac2_command(t, z, z_rate, params, state, step, advance):
     the e-modification vanish for :math:`u = \\dots - \\hat\\Theta^T\\phi` (Lavretsky & Wise 2013,
     Sec. 10.2): :math:`\\dot{\\hat\\Theta} = +\\Gamma_\\theta\\phi\\,e^TPB - \\dots`; the seed paper's
     eq. (20c) prints :math:`-\\Gamma_\\theta\\hat\\Theta^T e^TPB`, a typo (it does not type-check).
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    z : float
+        Main-tether elongation (m).
+    z_rate : float
+        Its rate (m/s).
+    params : (k,) float
+        :func:`mrac_params` of this law.
+    state : (n,) float
+        The law's state (:func:`mrac_initial_state`), advanced in place when ``advance``.
+    step : float
+        The controller's sampling step (s).
+    advance : bool
+        True once per new sampling time: integrate the adaptive and reference states.
+
+    Returns
+    -------
+    float
+        Commanded thrust (N), saturated at ``u_max``; 0 before ``t_on``.
     """
     if t < params[T_ON]:
         return 0.0

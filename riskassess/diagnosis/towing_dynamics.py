@@ -48,7 +48,18 @@ XE_MAXWELL, XE_ELONGATION, XE_DAMPER, EXTRA_STATES = 0, 1, 2, 5
 
 def initial_extra_states(omega_debris_body) -> np.ndarray:
     """``xe`` at t = 0: no Maxwell tension, elongation not yet seen (NaN), the damper turning with the
-    debris (rad/s, debris frame)."""
+    debris (rad/s, debris frame).
+
+    Parameters
+    ----------
+    omega_debris_body : (3,) float
+        Debris inertial angular velocity at t = 0, debris body frame (rad/s).
+
+    Returns
+    -------
+    xe : (EXTRA_STATES,) float
+        Layout ``XE_*``.
+    """
     xe = np.zeros(EXTRA_STATES)
     xe[XE_ELONGATION] = np.nan
     xe[XE_DAMPER:XE_DAMPER + 3] = omega_debris_body
@@ -57,27 +68,87 @@ def initial_extra_states(omega_debris_body) -> np.ndarray:
 
 @njit(TOWING_LAW_SIGNATURE, cache=True)
 def no_towing_load(t, q, v, p, work, xe, h, load):
-    """The nominal towing model: no effect."""
+    """The nominal towing model: no effect.
+
+    Parameters
+    ----------
+    t : float
+        Time (s), the towing case's clock.
+    q, v : (15,) float
+        Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
+        displacements from their reference positions (m, ECI; P's are stale, see
+        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
+        (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
+    p : (j,) float
+        Not used.
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+    xe : (EXTRA_STATES,) float
+        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); not used.
+    h : float
+        Step (s) over which ``xe`` is advanced; 0: do not advance.
+    load : (15,) float
+        Generalized forces, kernel layout, added to in place: nothing.
+    """
     return
 
 
 @njit(cache=True, inline="always")
 def point_position(work):
-    """P's position displacement (m) and velocity (m/s), inertial, at the last completed step."""
+    """P's position displacement (m) and velocity (m/s), inertial, at the last completed step.
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+
+    Returns
+    -------
+    x_point, v_point : (3,) float
+        P's displacement from its reference position (m, ECI) and its velocity (m/s, ECI); views
+        into ``work``.
+    """
     start = int(work[W_POINT])
     return work[start + X_N:start + X_N + 3], work[start + V_N:start + V_N + 3]
 
 
 @njit(cache=True, inline="always")
 def last_diagnostics(work):
-    """The last force evaluation's diagnostics (:data:`multibody.towing_kernel.MT_TENSION` ... layout)."""
+    """The last force evaluation's diagnostics (:data:`multibody.towing_kernel.MT_TENSION` ... layout).
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+
+    Returns
+    -------
+    diagnostics : (ST_TENSION,) float
+        Main-tether tension (N), elongation (m) and rate (m/s), thrust (N), control torque (N m,
+        chaser body frame), sliding variables; a view into ``work``.
+    """
     start = int(work[W_DIAG])
     return work[start:start + ST_TENSION]
 
 
 @njit(cache=True)
 def body_position(work, q, base):
-    """Absolute CoM position (m, Earth-centred inertial) of the body at ``base`` (CHASER or DEBRIS)."""
+    """Absolute CoM position (m, Earth-centred inertial) of the body at ``base`` (CHASER or DEBRIS).
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+    q : (15,) float
+        Positions, kernel layout (displacements from the reference positions, m, ECI).
+    base : int
+        ``CHASER`` or ``DEBRIS`` (index of the body's first coordinate).
+
+    Returns
+    -------
+    r_eci : (3,) float
+        CoM position from the Earth's centre, ECI (m).
+    """
     row = 1 if base == CHASER else 2
     reference = work[W_REFERENCE + 3 * row:W_REFERENCE + 3 * row + 3]
     return reference + q[base:base + 3]
@@ -86,7 +157,22 @@ def body_position(work, q, base):
 @njit(cache=True)
 def main_tether_direction(work, q):
     """Unit vector from the main tether's chaser end A to P (inertial) and the chaser rotation
-    (body -> inertial) at the state ``q``."""
+    (body -> inertial) at the state ``q``.
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+    q : (15,) float
+        Positions, kernel layout (m, ECI; rotation vectors, rad).
+
+    Returns
+    -------
+    direction_eci : (3,) float
+        Unit vector A -> P, ECI (-).
+    chaser_to_eci : (3, 3) float
+        Chaser body -> ECI rotation.
+    """
     rot_c = rotation_matrix_from_rotation_vector(q[CHASER + 3:CHASER + 6])
     attach = work[W_ATTACH_CHASER:W_TETHER]
     point, _ = point_position(work)
@@ -97,7 +183,30 @@ def main_tether_direction(work, q):
 @njit(types.void(_LAW, types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64, _VECTOR), cache=True)
 def apply_loads(law, t, q, v, p, work, xe, h, load):
     """Evaluate ``law`` at (``t``, ``q``, ``v``) into ``load`` and make it the packed model's further
-    forces for the coming force evaluation (advancing the effect states ``xe`` over ``h``)."""
+    forces for the coming force evaluation (advancing the effect states ``xe`` over ``h``).
+
+    Parameters
+    ----------
+    law : compiled function
+        Towing law (``TOWING_LAW_SIGNATURE``, see the module doc).
+    t : float
+        Time (s), the towing case's clock.
+    q, v : (15,) float
+        State, kernel layout (:mod:`multibody.towing_kernel`): displacements from the reference
+        positions (m, ECI) and rotation vectors body -> ECI (rad); velocities (m/s, ECI) and angular
+        velocities (rad/s, body frames).
+    p : (j,) float
+        The law's parameters.
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+        Its further-forces section is overwritten with ``load``.
+    xe : (EXTRA_STATES,) float
+        Effects' own states (``XE_*``), advanced in place by the law.
+    h : float
+        Step (s) over which ``xe`` is advanced; 0: do not advance.
+    load : (15,) float
+        Scratch, overwritten with the law's generalized forces (N, ECI; N m, body frames).
+    """
     load[:] = 0.0
     law(t, q, v, p, work, xe, h, load)
     extra = extra_forces(work)
@@ -109,7 +218,36 @@ def apply_loads(law, t, q, v, p, work, xe, h, load):
 def integrate(law, p, q, v, t0, n_steps, work, xe, record, out_q, out_v, out_diag, out_xe):
     """Integrate the packed towing model ``work`` from (``q``, ``v``) at ``t0`` (s) over ``n_steps``
     steps with the effect ``law``; records state, diagnostics and effect states after the steps
-    listed in ``record`` (increasing step indices, 0 = the initial state) into the ``out_*`` rows."""
+    listed in ``record`` (increasing step indices, 0 = the initial state) into the ``out_*`` rows.
+
+    Parameters
+    ----------
+    law : compiled function
+        Towing law (``TOWING_LAW_SIGNATURE``).
+    p : (j,) float
+        The law's parameters (at least one entry).
+    q, v : (15,) float
+        State, kernel layout (:mod:`multibody.towing_kernel`): displacements from the reference
+        positions (m, ECI) and rotation vectors body -> ECI (rad); velocities (m/s, ECI) and angular
+        velocities (rad/s, body frames).
+        Advanced in place.
+    t0 : float
+        Start time (s), the towing case's clock.
+    n_steps : int
+        Number of steps of ``work``'s step (s).
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+    xe : (EXTRA_STATES,) float
+        Effects' own states, advanced in place.
+    record : (r,) int64
+        Step indices to record, increasing.
+    out_q, out_v : (r, 15) float
+        Recorded states (kernel layout, units of ``q``, ``v``), written.
+    out_diag : (r, n_diag) float
+        Recorded diagnostics (:func:`diagnostics_size` columns; N, m, m/s, N m), written.
+    out_xe : (r, EXTRA_STATES) float
+        Recorded effect states, written.
+    """
     step = work[W_STEP]
     load = np.zeros(N_COORDINATES)
     apply_loads(law, t0, q, v, p, work, xe, 0.0, load)
@@ -132,7 +270,17 @@ def integrate(law, p, q, v, t0, n_steps, work, xe, record, out_q, out_v, out_dia
 
 
 def diagnostics_size(work) -> int:
-    """Columns of the diagnostics rows of a packed model (main tether, thrust, torque, sliding, STs)."""
+    """Columns of the diagnostics rows of a packed model (main tether, thrust, torque, sliding, STs).
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+
+    Returns
+    -------
+    n_diag : int
+    """
     return ST_TENSION + int(work[W_N_ATTACH])
 
 

@@ -11,7 +11,21 @@ from riskassess.products.plotting import legend, panels, plain, write_png
 
 
 def trajectory_figure(answer: dict, arrays: dict):
-    """MU paths (nodes and re-simulation), mouth segments every few nodes, the keep-out circle."""
+    """MU paths (nodes and re-simulation), mouth segments every few nodes, the keep-out circle.
+
+    Parameters
+    ----------
+    answer : dict
+        The approach answer (``case``, ``final_time`` (s), ``fuel_kg``).
+    arrays : dict of str to numpy.ndarray
+        The approach arrays (``approach.npz``): ``unit_paths`` (2, 2, n) and ``resim_unit_paths``
+        (2, 2, m) MU positions (MU, x/y, node or sample) (m, world frame), ``debris_center`` (2,) m
+        world, ``keep_out_radius`` (m); with a 3-D replay, ``replay_mouth_edge`` (k, p, 3) m.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig = Figure(figsize=(6.7, 4.2), layout="constrained")
     ax = fig.subplots()
     paths, fine = arrays["unit_paths"], arrays["resim_unit_paths"]
@@ -36,7 +50,21 @@ def trajectory_figure(answer: dict, arrays: dict):
 
 
 def controls_figure(answer: dict, arrays: dict):
-    """Thrust magnitudes, thrust angles, and masses or mouth width over time."""
+    """Thrust magnitudes, thrust angles, and masses or mouth width over time.
+
+    Parameters
+    ----------
+    answer : dict
+        The approach answer (``kind``: ``rigid_rod`` or another model).
+    arrays : dict of str to numpy.ndarray
+        The approach arrays (``approach.npz``): ``t`` (n,) s and ``resim_t`` (m,) s,
+        ``resim_controls`` (6, m) whose rows 0 and 1 are the thrust magnitudes (N),
+        ``thrust_angles`` (2, n) rad, ``masses`` (2, n) kg, ``thrust_bounds`` (2,) N.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, (ax_t, ax_a, ax_m) = panels(3, 1.6)
     t, rt = arrays["t"], arrays["resim_t"]
     for k, color in enumerate(("tab:blue", "tab:orange")):
@@ -56,7 +84,17 @@ def controls_figure(answer: dict, arrays: dict):
 
 
 def write_plots(out, answer: dict, arrays: dict) -> list[str]:
-    """approach_trajectory.png and approach_controls.png into ``out``; returns their names."""
+    """approach_trajectory.png and approach_controls.png into ``out``; returns their names.
+
+    Parameters
+    ----------
+    out : Path
+        The approach output folder (existing).
+    answer : dict
+        The approach answer.
+    arrays : dict of str to numpy.ndarray
+        The approach arrays (see :func:`trajectory_figure`, :func:`controls_figure`).
+    """
     names = []
     for name, make in (("approach_trajectory.png", trajectory_figure), ("approach_controls.png", controls_figure)):
         write_png(make(answer, arrays), out / name, dpi=120)

@@ -38,7 +38,22 @@ UNKNOWN = ("failed", "indeterminate", "pending")
 
 
 def no_debris_lower_bound(n: int, k: int, confidence: float) -> float:
-    """One-sided Clopper-Pearson lower bound of P(no debris) from n runs with k debris cases."""
+    """One-sided Clopper-Pearson lower bound of P(no debris) from n runs with k debris cases.
+
+    Parameters
+    ----------
+    n : int
+        Runs counted (n >= 0); 0 gives a bound of 0.
+    k : int
+        Of them, runs with debris (unknown runs included), 0 <= k <= n.
+    confidence : float
+        One-sided confidence c, in (0, 1).
+
+    Returns
+    -------
+    float
+        :math:`B^{-1}(1 - c;\\; n - k,\\; k + 1)` (module doc); 0 when every run has debris.
+    """
     if n == 0:
         return 0.0
     if k == n:
@@ -75,7 +90,21 @@ def debris_probability(rows: list[dict], confidence: float = 0.95) -> dict:
     say nothing (failed, indeterminate, pending: u of them) are never counted as safe: the
     interval is Clopper-Pearson's, its lower end with every unknown run taken as debris-free and its
     upper end with every unknown run taken as debris, so it holds whatever the unknown runs would
-    have shown. None where no run has a verdict."""
+    have shown. None where no run has a verdict.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Run rows of the sweep store (:meth:`riskassess.sweep.store.ResultStore.rows`).
+    confidence : float
+        Two-sided confidence of the interval, in (0, 1).
+
+    Returns
+    -------
+    dict
+        ``estimate`` (None without a verdict), ``interval`` [low, high] (None without runs),
+        ``confidence``, ``runs``, ``debris_runs``, ``no_debris_runs``, ``unknown_runs``.
+    """
     status = [run_status(r) for r in rows]
     k, m = status.count("debris"), status.count("no_debris")
     unknown = sum(status.count(s) for s in UNKNOWN)
@@ -93,7 +122,15 @@ def utilization_sensitivity(rows: list[dict]) -> dict:
     """Sensitivity of each weak location's utilization (peak over decisive allowable) to each
     varied or uncertain input: Spearman's rank correlation over the finished runs with a finite
     utilization (monotone effects count, whatever their shape; -1 to 1, None with fewer than 3
-    runs or a constant input). Returns {location: {input key: rho}}."""
+    runs or a constant input). Returns {location: {input key: rho}}.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Run rows of the sweep store (:meth:`riskassess.sweep.store.ResultStore.rows`); their
+        ``overrides`` (case key -> value, SI) are the inputs, ``result["locations"]`` the
+        utilizations (-).
+    """
     done = [r for r in rows if r["state"] == "done" and r["result"] and r["result"].get("locations")]
     keys = list(rows[0]["overrides"]) if rows else []
     locations = sorted({name for r in done for name in r["result"]["locations"]})
@@ -112,7 +149,15 @@ def utilization_sensitivity(rows: list[dict]) -> dict:
 
 
 def probability_statement(p: dict, inputs: list[str]) -> str:
-    """One sentence: P(secondary debris), its interval, over what."""
+    """One sentence: P(secondary debris), its interval, over what.
+
+    Parameters
+    ----------
+    p : dict
+        The result of :func:`debris_probability`.
+    inputs : list of str
+        The uncertain inputs as ``--uncertain`` gives them, e.g. ``"contact.mu_kinetic=uniform(0.1,0.2)"``.
+    """
     if p["estimate"] is None and p["interval"] is None:
         return "No Monte Carlo run has finished: no probability of secondary debris."
     low, high = p["interval"]
@@ -125,11 +170,36 @@ def probability_statement(p: dict, inputs: list[str]) -> str:
 
 
 def runs_needed(confidence: float, reliability: float) -> int:
-    """Debris-free runs per value needed to state P(no debris) >= reliability at that confidence."""
+    """Debris-free runs per value needed to state P(no debris) >= reliability at that confidence.
+
+    Parameters
+    ----------
+    confidence : float
+        Confidence c, in (0, 1).
+    reliability : float
+        Required P(no debris) R, in (0, 1).
+
+    Returns
+    -------
+    int
+        :math:`\\lceil \\ln(1 - c) / \\ln R \\rceil`.
+    """
     return math.ceil(math.log(1.0 - confidence) / math.log(reliability))
 
 
 def envelope_key(rows: list[dict]) -> str | None:
+    """The key the envelope is drawn against: ``launch.velocity`` when the sweep varies it, else its first key.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Run rows of the sweep store; the keys of the first row's ``overrides`` are the swept keys.
+
+    Returns
+    -------
+    str or None
+        A dotted case key; None without rows.
+    """
     varied = list(rows[0]["overrides"]) if rows else []
     return DEFAULT_KEY if DEFAULT_KEY in varied else (varied[0] if varied else None)
 
@@ -137,7 +207,13 @@ def envelope_key(rows: list[dict]) -> str | None:
 def run_status(row: dict) -> str:
     """``debris``, ``no_debris``, ``indeterminate``, ``failed``, ``pending``, or ``unassessed``
     (done, in a case without weak locations: no verdict to count). A "no debris" record whose
-    evidence is not finite is ``indeterminate`` (:func:`~riskassess.products.sweep_records.debris_state_of`)."""
+    evidence is not finite is ``indeterminate`` (:func:`~riskassess.products.sweep_records.debris_state_of`).
+
+    Parameters
+    ----------
+    row : dict
+        One run row of the sweep store (``state``, ``result``, ``debris_state``).
+    """
     if row["state"] != "done":
         return row["state"]
     record = dict(row["result"] or {})
@@ -147,7 +223,18 @@ def run_status(row: dict) -> str:
 
 
 def unknown_counts(rows: list[dict]) -> dict[str, int]:
-    """Runs the envelope cannot count as safe or unsafe: failed, indeterminate, pending."""
+    """Runs the envelope cannot count as safe or unsafe: failed, indeterminate, pending.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Run rows of the sweep store.
+
+    Returns
+    -------
+    dict of str to int
+        ``failed``, ``indeterminate``, ``pending`` -> number of runs.
+    """
     status = [run_status(r) for r in rows]
     return {what: status.count(what) for what in UNKNOWN}
 
@@ -181,6 +268,26 @@ def envelope(rows: list[dict], key: str | None = None, confidence: float = 0.95,
     Every value with a run is a point, including values whose runs all failed or are pending
     (they are never safe, so the limit cannot step over them). Runs of a case without weak
     locations (no verdict) are left out.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Run rows of the sweep store (:meth:`riskassess.sweep.store.ResultStore.rows`).
+    key : str, optional
+        The swept case key the envelope is drawn against (in its SI unit); default
+        :func:`envelope_key`.
+    confidence : float
+        One-sided confidence c of the bound, in (0, 1).
+    reliability : float
+        Required P(no debris) R, in (0, 1).
+
+    Returns
+    -------
+    dict
+        ``key``, ``confidence``, ``reliability``, ``points`` (one dict per value),
+        ``runs_needed_per_value``, ``safe_limit``, ``first_unsafe``, ``interpolated_limit`` (in the
+        unit of ``key``), the same with prefix ``deterministic_``, and the counts of unknown and
+        diverged runs.
     """
     key = key or envelope_key(rows)
     groups = defaultdict(list)
@@ -216,12 +323,24 @@ def _limits(points: list[dict], flag: str) -> dict:
 
 
 def is_probabilistic(env: dict) -> bool:
-    """Enough runs at every value for the confidence statement."""
+    """Enough runs at every value for the confidence statement.
+
+    Parameters
+    ----------
+    env : dict
+        The result of :func:`envelope`.
+    """
     return bool(env["points"]) and min(p["total_runs"] for p in env["points"]) >= env["runs_needed_per_value"]
 
 
 def envelope_statement(env: dict) -> str:
-    """One sentence for people: the safe limit and how sure it is."""
+    """One sentence for people: the safe limit and how sure it is.
+
+    Parameters
+    ----------
+    env : dict
+        The result of :func:`envelope`.
+    """
     key = env["key"]
     if not env["points"]:
         return "No finished run with a structural verdict yet: no envelope."

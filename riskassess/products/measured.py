@@ -9,7 +9,18 @@ from riskassess.products.results import atomic_write_bytes
 
 
 def write_measured(path, time, values: dict) -> None:
-    """Write a measured-data CSV (``time`` then the channels), atomically."""
+    """Write a measured-data CSV (``time`` then the channels), atomically.
+
+    Parameters
+    ----------
+    path : Path or str
+        Destination ``.csv`` file; its folder must exist.
+    time : (k,) float
+        Sample times (s), written with 6 decimals.
+    values : dict of str to (k,) float
+        Channel name -> samples, in the channel's SI unit (as the diagnosis case names it),
+        written with 9 significant digits.
+    """
     names = list(values)
     lines = [",".join(["time"] + names)]
     for k, t in enumerate(time):

@@ -44,22 +44,51 @@ class OutputRefused(ValueError):
 
 def safe_name(name: str) -> str:
     """A folder name from user text: runs of anything but ASCII letters, digits, ``_`` and ``-``
-    become one ``_`` (so no ``/``, ``..``, leading dot or absolute path survives); ``unnamed`` if empty."""
+    become one ``_`` (so no ``/``, ``..``, leading dot or absolute path survives); ``unnamed`` if empty.
+
+    Parameters
+    ----------
+    name : str
+        User text, typically a case name; cut to :data:`MAX_NAME` characters.
+    """
     safe = re.sub(r"[^A-Za-z0-9_-]+", "_", str(name)).strip("_-")[:MAX_NAME]
     return safe or "unnamed"
 
 
 def default_out(case_name: str, suffix: str = "", root: str | Path = "runs") -> Path:
-    """``root/<safe name><suffix>``: the default ``--out`` of a command, always inside ``root``."""
+    """``root/<safe name><suffix>``: the default ``--out`` of a command, always inside ``root``.
+
+    Parameters
+    ----------
+    case_name : str
+        The case's ``name``.
+    suffix : str
+        Appended to the name before cleaning (e.g. ``"_identify"``, ``"-diagnosis"``).
+    root : str or Path
+        Folder that holds the default output folders (``runs``).
+    """
     return Path(root) / safe_name(f"{case_name}{suffix}")
 
 
 def is_temporary(name: str) -> bool:
+    """Whether a file or folder name is one of the tool's temporary names (:data:`TEMPORARY`).
+
+    Parameters
+    ----------
+    name : str
+        A bare file or folder name (no path).
+    """
     return TEMPORARY.match(name) is not None
 
 
 def read_own_manifest(folder: Path) -> dict | None:
-    """The folder's manifest when it is one this tool wrote (any format ``riskassess-*``), else None."""
+    """The folder's manifest when it is one this tool wrote (any format ``riskassess-*``), else None.
+
+    Parameters
+    ----------
+    folder : Path
+        Folder that may hold a ``manifest.json`` (a symbolic link is never read).
+    """
     path = Path(folder) / MANIFEST
     try:
         manifest = json.loads(path.read_text()) if path.is_file() and not path.is_symlink() else None
@@ -71,7 +100,18 @@ def read_own_manifest(folder: Path) -> dict | None:
 
 
 def command_of(manifest: dict) -> str:
-    """The command family that wrote a manifest (older manifests carry no ``command``)."""
+    """The command family that wrote a manifest (older manifests carry no ``command``).
+
+    Parameters
+    ----------
+    manifest : dict
+        A manifest read by :func:`read_own_manifest`.
+
+    Returns
+    -------
+    str
+        ``run`` (``assess`` counts as ``run``), ``perceive``, ``identify``, or the stage name.
+    """
     command = manifest.get("command")
     if command is None:
         if manifest.get("format") == "riskassess-identify":
@@ -86,7 +126,20 @@ def command_of(manifest: dict) -> str:
 def owned_paths(folder: Path, manifest: dict) -> set[str]:
     """Relative paths (``/``-separated) of the files a manifest makes the tool's own: the manifest,
     its ``files`` and ``products``; a listed folder that holds its own manifest (a VTK export)
-    contributes that manifest's files."""
+    contributes that manifest's files.
+
+    Parameters
+    ----------
+    folder : Path
+        The output folder the manifest belongs to.
+    manifest : dict
+        Its manifest; entries outside the folder (absolute, ``..``) are ignored.
+
+    Returns
+    -------
+    set of str
+        Paths relative to ``folder``.
+    """
     owned = {MANIFEST}
     for name in [*manifest.get("files", []), *manifest.get("products", [])]:
         name = str(name).strip("/")
@@ -108,7 +161,20 @@ def _inside(folder: Path, name: str) -> bool:
 
 def foreign_entries(folder: Path, owned: set[str]) -> list[str]:
     """Everything in ``folder`` the tool did not make: neither owned, nor a temporary file, nor a
-    folder holding only those (symbolic links are never the tool's)."""
+    folder holding only those (symbolic links are never the tool's).
+
+    Parameters
+    ----------
+    folder : Path
+        The output folder to walk.
+    owned : set of str
+        Relative paths the tool owns, from :func:`owned_paths`.
+
+    Returns
+    -------
+    list of str
+        Sorted relative paths; folders end with ``/``.
+    """
     foreign = []
     parents = {str(Path(p).parent) for p in owned} | {str(q) for p in owned for q in Path(p).parents}
     for root, dirs, files in os.walk(folder):
@@ -135,7 +201,22 @@ def check(out: Path, identity: dict, overwrite: bool) -> dict | None:
     """Raise :class:`OutputRefused` unless ``out`` may receive this output (module rules); return
     the existing manifest to replace (with ``overwrite``), or None for a new or empty folder.
     ``identity``: ``format``, ``case``, ``command`` and any further keys that must match
-    (a VTK export's ``run``)."""
+    (a VTK export's ``run``).
+
+    Parameters
+    ----------
+    out : Path
+        The requested output folder (``--out``).
+    identity : dict
+        ``format``, ``case``, ``command`` (and e.g. ``run``) of the output about to be written.
+    overwrite : bool
+        The user passed ``--overwrite``.
+
+    Returns
+    -------
+    dict or None
+        The manifest of the output to replace, or None.
+    """
     out = Path(out)
     if out.is_symlink():
         raise OutputRefused(f"{out}: is a symbolic link; give the folder it points to ({out.resolve()}) as --out")
@@ -178,7 +259,17 @@ def _differing(theirs: dict, ours: dict) -> str:
 def remove_own(out: Path, manifest: dict, keep=lambda name: False) -> None:
     """Remove the files ``manifest`` lists (see :func:`owned_paths`) and the tool's temporary files,
     except those ``keep(relative path)`` holds on to; then the folders this emptied. Only after
-    :func:`check` found nothing else in ``out``."""
+    :func:`check` found nothing else in ``out``.
+
+    Parameters
+    ----------
+    out : Path
+        The output folder.
+    manifest : dict
+        Its existing manifest (the files to remove).
+    keep : callable
+        ``keep(relative_path) -> bool``: True keeps that file.
+    """
     owned = owned_paths(out, manifest)
     for rel in sorted(owned - {MANIFEST}, key=lambda p: -p.count("/")):
         if not keep(rel):
@@ -203,21 +294,45 @@ class OutputFolder:
         write_manifest(self.path, self.manifest)
 
     def add_files(self, *names: str) -> None:
-        """Record finished files of the stage (relative paths) in ``files``."""
+        """Record finished files of the stage (relative paths) in ``files``.
+
+        Parameters
+        ----------
+        *names : str
+            Paths relative to the output folder.
+        """
         files = self.manifest.setdefault("files", [])
         files += [n for n in names if n not in files]
         self.write()
 
     def finish(self, outcome: str = "complete", pending=(), **fields) -> None:
         """The stage's results are written with ``outcome`` (``complete``, ``not_observable``, ...);
-        the status says so at once, or stays ``running`` while ``pending`` products are to come."""
+        the status says so at once, or stays ``running`` while ``pending`` products are to come.
+
+        Parameters
+        ----------
+        outcome : str
+            The stage's outcome, stored under ``outcome`` (and ``status`` unless products are pending).
+        pending : sequence of str
+            Product steps still to come (``"report"``, ``"vtk"``); each ends with :func:`step_done`.
+        **fields
+            More manifest keys to store.
+        """
         self.manifest.update(fields, outcome=outcome, status="running" if pending else outcome)
         if pending:
             self.manifest["products_pending"] = list(pending)
         self.write()
 
     def fail(self, status: str, exc: BaseException) -> None:
-        """Record that the command stopped (``failed``, ``structures_failed``) and why."""
+        """Record that the command stopped (``failed``, ``structures_failed``) and why.
+
+        Parameters
+        ----------
+        status : str
+            The manifest status to record (``failed``, ``structures_failed``, ...).
+        exc : BaseException
+            The cause, recorded under ``error`` as ``"Type: message"``.
+        """
         self.manifest.update(status=status, error=f"{type(exc).__name__}: {exc}")
         self.write()
 
@@ -242,7 +357,30 @@ def claim(out: str | Path, case_name: str, command: str, overwrite: bool = False
           keep=None, **fields) -> OutputFolder:
     """Claim ``out`` for ``command`` on case ``case_name`` (module rules) and write its manifest
     with status ``running``. ``keep(relative path)``: old files to carry over on ``--overwrite``
-    (a cache still valid for the new run); ``fields``: more manifest keys (``software``)."""
+    (a cache still valid for the new run); ``fields``: more manifest keys (``software``).
+
+    Parameters
+    ----------
+    out : str or Path
+        The output folder (``--out``); created when missing.
+    case_name : str
+        The case's ``name``, recorded under ``case``.
+    command : str
+        The CLI command (``run``, ``assess``, ``tow``, ...).
+    overwrite : bool
+        The user passed ``--overwrite``.
+    stage : str, optional
+        Recorded under ``stage`` (``tow``, ``approach``, ``diagnose``; omitted for impact runs).
+    keep : callable, optional
+        ``keep(relative_path) -> bool`` for old files to carry over.
+    **fields
+        More manifest keys.
+
+    Returns
+    -------
+    OutputFolder
+        The claimed folder, its manifest written with status ``running``.
+    """
     out = Path(out)
     identity = {"format": FORMAT, "case": case_name, "command": command}
     existing = check(out, identity, overwrite)
@@ -263,7 +401,13 @@ def claim(out: str | Path, case_name: str, command: str, overwrite: bool = False
 
 
 def open_existing(run_dir: str | Path) -> OutputFolder:
-    """An output folder written earlier (by this tool), to record products made from it."""
+    """An output folder written earlier (by this tool), to record products made from it.
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        An output folder holding this tool's ``manifest.json``.
+    """
     manifest = read_own_manifest(Path(run_dir))
     if manifest is None:
         raise OutputRefused(f"{run_dir}: no riskassess manifest.json; not an output folder of this tool")
@@ -272,7 +416,17 @@ def open_existing(run_dir: str | Path) -> OutputFolder:
 
 def claim_product(run_dir: Path, manifest: dict, name: str) -> None:
     """Refuse to write product ``name`` (relative path) into ``run_dir`` over a file the tool did not
-    make (one its ``manifest`` does not list)."""
+    make (one its ``manifest`` does not list).
+
+    Parameters
+    ----------
+    run_dir : Path
+        The output folder the product goes into.
+    manifest : dict
+        Its manifest.
+    name : str
+        The product's path relative to ``run_dir`` (``report.html``, ``vtk``).
+    """
     target = Path(run_dir) / name
     if (target.exists() or target.is_symlink()) and name not in manifest.get("products", []) \
             and name not in manifest.get("files", []):
@@ -286,7 +440,17 @@ def step_done(run_dir: str | Path, step: str, error: BaseException | None = None
     becomes the stage's outcome, or ``products_failed`` when a step failed after complete results.
     Reads the manifest afresh: the step itself recorded its files under ``products``. A step the
     folder's command did not ask for (``riskassess report RUN`` on its own) changes nothing unless
-    it retries one that failed."""
+    it retries one that failed.
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        The output folder the product was made from.
+    step : str
+        The product step, ``"report"`` or ``"vtk"``.
+    error : BaseException, optional
+        Why the step failed; None when it succeeded.
+    """
     folder = open_existing(run_dir)
     m = folder.manifest
     errors = m.get("product_errors", {})

@@ -49,7 +49,16 @@ def _default_mode() -> int:
 
 
 def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file in the same folder."""
+    """Write ``data`` to ``path`` through a temporary file in the same folder.
+
+    Parameters
+    ----------
+    path : Path
+        Destination file; its folder must exist (the temporary file is made there so the
+        rename is atomic).
+    data : bytes
+        The whole content.
+    """
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -63,10 +72,28 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
 
 
 def atomic_write_json(path: Path, obj) -> None:
+    """Write ``obj`` as indented JSON to ``path``, atomically (numpy arrays and scalars as lists and numbers).
+
+    Parameters
+    ----------
+    path : Path
+        Destination ``.json`` file; its folder must exist.
+    obj : dict or list
+        JSON-serialisable content; ``numpy.ndarray`` and numpy scalars are converted.
+    """
     atomic_write_bytes(path, (json.dumps(obj, indent=2, default=_json_default) + "\n").encode())
 
 
 def atomic_write_npz(path: Path, arrays: dict) -> None:
+    """Write ``arrays`` to the compressed ``.npz`` file ``path``, atomically.
+
+    Parameters
+    ----------
+    path : Path
+        Destination ``.npz`` file; its folder must exist.
+    arrays : dict of str to numpy.ndarray
+        Array name -> array, stored under that name.
+    """
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".npz")
     os.close(fd)
@@ -80,7 +107,15 @@ def atomic_write_npz(path: Path, arrays: dict) -> None:
 
 
 def write_manifest(folder: Path, manifest: dict) -> None:
-    """The one writer of ``manifest.json`` (atomically); :mod:`riskassess.products.outfolder` keeps its content."""
+    """The one writer of ``manifest.json`` (atomically); :mod:`riskassess.products.outfolder` keeps its content.
+
+    Parameters
+    ----------
+    folder : Path
+        The output folder; ``manifest.json`` is (re)written in it.
+    manifest : dict
+        The manifest's whole content (format, version, case, status, files, ...).
+    """
     atomic_write_json(Path(folder) / "manifest.json", manifest)
 
 
@@ -97,6 +132,18 @@ def read_manifest(run_dir: Path, strict: bool = True) -> dict:
 
     ``strict=False`` accepts a folder whose listed files are not all there (readers that
     say per item what is missing, like the report).
+
+    Parameters
+    ----------
+    run_dir : Path
+        A run folder written by ``riskassess run`` (holding ``manifest.json``).
+    strict : bool
+        Raise when a file the manifest lists is missing (default); False accepts it.
+
+    Returns
+    -------
+    dict
+        The parsed ``manifest.json``.
     """
     path = Path(run_dir) / "manifest.json"
     if not path.is_file():
@@ -152,7 +199,13 @@ class RunFolder:
         return [f for f in CORE_FILES if not (self.path / f).is_file()]
 
     def has(self, name: str) -> bool:
-        """The run wrote ``name`` completely (listed in the manifest) and it is still there."""
+        """The run wrote ``name`` completely (listed in the manifest) and it is still there.
+
+        Parameters
+        ----------
+        name : str
+            File name relative to the run folder, e.g. ``"summary.json"``.
+        """
         return (self.path / name).is_file() and name in self.manifest.get("files", [])
 
     def _require(self, name: str) -> Path:
@@ -167,18 +220,47 @@ class RunFolder:
         return self.path / name
 
     def json(self, name: str) -> dict:
+        """A JSON file of the folder, parsed once and cached.
+
+        Parameters
+        ----------
+        name : str
+            File name relative to the run folder, e.g. ``"summary.json"``; :class:`MissingData`
+            when the run did not write it completely.
+        """
         if name not in self._cache:
             self._cache[name] = json.loads(self._require(name).read_text())
         return self._cache[name]
 
     def arrays(self, name: str) -> dict[str, np.ndarray]:
+        """The arrays of an ``.npz`` file of the folder, loaded once and cached.
+
+        Parameters
+        ----------
+        name : str
+            File name relative to the run folder, e.g. ``"timeseries.npz"``; :class:`MissingData`
+            when the run did not write it completely.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            Array name -> array, shapes and units as the module doc lists them.
+        """
         if name not in self._cache:
             with np.load(self._require(name)) as data:
                 self._cache[name] = {k: data[k] for k in data.files}
         return self._cache[name]
 
     def cached(self, name: str, build):
-        """``build(self)`` once per folder object (a derived product several readers share)."""
+        """``build(self)`` once per folder object (a derived product several readers share).
+
+        Parameters
+        ----------
+        name : str
+            Cache key (not a file name).
+        build : callable
+            ``build(run_folder) -> object``, called on the first request only.
+        """
         if name not in self._cache:
             self._cache[name] = build(self)
         return self._cache[name]
@@ -212,7 +294,15 @@ class RunFolder:
         return self.arrays("structures.npz")
 
     def key(self, data: dict, *path):
-        """``data[path[0]][path[1]]...``; :class:`MissingData` naming the key for older folders."""
+        """``data[path[0]][path[1]]...``; :class:`MissingData` naming the key for older folders.
+
+        Parameters
+        ----------
+        data : dict
+            Nested content, e.g. :attr:`summary`.
+        *path : str or int
+            The keys (or list indices) to follow, outermost first.
+        """
         value = data
         for k in path:
             try:
@@ -223,7 +313,13 @@ class RunFolder:
         return value
 
     def add_product(self, relative_path: str) -> None:
-        """Record a file made from this folder (report, export) in the manifest's ``products``."""
+        """Record a file made from this folder (report, export) in the manifest's ``products``.
+
+        Parameters
+        ----------
+        relative_path : str
+            The product's path relative to the run folder, e.g. ``"report.html"`` or ``"vtk"``.
+        """
         products = self.manifest.setdefault("products", [])
         if relative_path not in products:
             products.append(relative_path)
@@ -231,11 +327,37 @@ class RunFolder:
 
 
 def load_timeseries(run_dir: Path) -> dict[str, np.ndarray]:
+    """Every time series of a run (``timeseries.npz``) after checking the manifest (strict).
+
+    Parameters
+    ----------
+    run_dir : Path
+        A complete run folder of ``riskassess run``.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        The recorder's series: ``time`` (k,) s and the keys of :mod:`multibody.recorder`
+        (shapes, units and frames there), plus ``body_names``, ``joint_names``, ``joint_kinds``,
+        ``body_masses``.
+    """
     read_manifest(run_dir)
     with np.load(Path(run_dir) / "timeseries.npz") as data:
         return {k: data[k] for k in data.files}
 
 
 def load_summary(run_dir: Path) -> dict:
+    """The run summary (``summary.json``) after checking the manifest (strict).
+
+    Parameters
+    ----------
+    run_dir : Path
+        A complete run folder of ``riskassess run``.
+
+    Returns
+    -------
+    dict
+        As :func:`riskassess.products.summary.run_summary` wrote it.
+    """
     read_manifest(run_dir)
     return json.loads((Path(run_dir) / "summary.json").read_text())

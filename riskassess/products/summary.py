@@ -22,7 +22,21 @@ TRANSIENT_SKIP_S = 0.25
 
 
 def contact_totals_debris(series):
-    """Total contact force (N) and moment about the debris CoM (N m), LVLH, over time."""
+    """Total contact force (N) and moment about the debris CoM (N m), LVLH, over time.
+
+    Parameters
+    ----------
+    series : dict of str to numpy.ndarray
+        Recorder series (:mod:`multibody.recorder`): ``contact_force_lvlh``, ``contact_moment_lvlh``,
+        ``body_com_lvlh`` (k, nb, 3) and ``debris_com_lvlh`` (k, 3).
+
+    Returns
+    -------
+    force : (k, 3) float
+        Sum of the contact forces on all bodies (N), LVLH.
+    moment : (k, 3) float
+        Their moment about the debris CoM (N m), LVLH.
+    """
     force = series["contact_force_lvlh"].sum(axis=1)
     com = series["debris_com_lvlh"]
     arms = series["body_com_lvlh"] - com[:, None, :]
@@ -31,7 +45,19 @@ def contact_totals_debris(series):
 
 
 def momentum_exchange_velocity(assembly) -> np.ndarray:
-    """Debris velocity (m/s, LVLH) if net and debris ended with one common velocity."""
+    """Debris velocity (m/s, LVLH) if net and debris ended with one common velocity.
+
+    Parameters
+    ----------
+    assembly : multibody.assembly.ImpactAssembly
+        The assembly at its initial state: net node masses (kg) and velocities (m/s, LVLH), body
+        masses and CoM velocities (m/s, LVLH).
+
+    Returns
+    -------
+    (3,) float
+        Velocity of the common centre of mass (m/s), LVLH.
+    """
     net_momentum = (assembly.net.masses[:, None] * assembly.net_velocity).sum(axis=0)
     body_momentum = sum(b.mass * b.velocity_lvlh for b in assembly.bodies)
     total_mass = assembly.net.masses.sum() + sum(b.mass for b in assembly.bodies)
@@ -45,6 +71,26 @@ def _peak(t, values):
 
 
 def joint_extremes(series, joints, skip=TRANSIENT_SKIP_S):
+    """Per joint, the largest angle, rate, reaction moment and force of a run.
+
+    Parameters
+    ----------
+    series : dict of str to numpy.ndarray
+        Recorder series: ``time`` (k,) s and ``joint_rotation_joint``, ``joint_rate_joint``,
+        ``joint_force_joint``, ``joint_moment_joint`` (k, nj, 3), joint frame.
+    joints : sequence of multibody.assembly.JointSpec
+        The joints in the series' order (``name``, ``kind``).
+    skip : float
+        Time (s) before which moments count as transient (:data:`TRANSIENT_SKIP_S`).
+
+    Returns
+    -------
+    dict
+        Joint name -> ``kind``, ``max_abs_angle_rad`` (hinge angle, component 1, revolute only),
+        ``max_abs_rate_rad_s``, ``max_abs_moment_joint_Nm`` and ``max_abs_force_joint_N`` (3 per-axis
+        maxima, joint frame) and ``max_abs_moment_after_transient_Nm`` (None when the run is
+        shorter than ``skip``).
+    """
     t = series["time"]
     later = t >= skip
     out = {}
@@ -65,7 +111,22 @@ def joint_extremes(series, joints, skip=TRANSIENT_SKIP_S):
 
 
 def conservation_checks(series, mean_motion):
-    """Relative drift of energy balance and (without orbit) of momentum."""
+    """Relative drift of energy balance and (without orbit) of momentum.
+
+    Parameters
+    ----------
+    series : dict of str to numpy.ndarray
+        Recorder series: ``energy_total`` (k,) J, ``momentum_linear_lvlh`` (k, 3) kg m/s,
+        ``momentum_angular_lvlh`` (k, 3) kg m^2/s.
+    mean_motion : float
+        Orbital mean motion (rad/s); 0 without orbit, the only case where momentum is conserved.
+
+    Returns
+    -------
+    dict
+        ``energy_balance_relative_drift`` (-), and without orbit ``linear_momentum_relative_drift``
+        (-) and ``angular_momentum_drift_kg_m2_s``.
+    """
     e = series["energy_total"]
     checks = {"energy_balance_relative_drift": float(np.abs(e - e[0]).max() / max(abs(e[0]), 1e-300))}
     if mean_motion == 0.0:
@@ -84,6 +145,20 @@ def run_summary(recorder, assembly, case_name: str) -> dict:
     the last third of the run: once the net has wrapped, net and debris trade momentum back
     and forth (the net swings on the debris), and the mean is what the momentum-exchange
     estimate predicts.
+
+    Parameters
+    ----------
+    recorder : multibody.recorder.Recorder
+        The finished run's recorder (series, wall time, health).
+    assembly : multibody.assembly.ImpactAssembly
+        The run's assembly (initial state, bodies, joints, solver, mean motion).
+    case_name : str
+        The case's ``name``.
+
+    Returns
+    -------
+    dict
+        The content of ``summary.json`` (units in the key names, vectors in LVLH unless named).
     """
     s = recorder.series
     t = s["time"]
@@ -121,7 +196,28 @@ def sequential_summary(wall_recorder, wall_assembly, recorder, assembly, coupled
     (``coupled_assembly``: the driven run has no net) and the driven run's own energy balance (the
     recorded loads are external, so its momentum is not a check), plus the wall run's figures
     under ``wall_run``: the contact force and moment peaks on the fixed target (the paper's Figs. 6
-    and 7) and its conservation checks (net and wall form a closed system)."""
+    and 7) and its conservation checks (net and wall form a closed system).
+
+    Parameters
+    ----------
+    wall_recorder : multibody.recorder.Recorder
+        Recorder of the net on the fixed target.
+    wall_assembly : multibody.assembly.ImpactAssembly
+        Its assembly.
+    recorder : multibody.recorder.Recorder
+        Recorder of the free debris driven by the recorded loads.
+    assembly : multibody.assembly.ImpactAssembly
+        Its assembly (no net).
+    coupled_assembly : multibody.assembly.ImpactAssembly
+        The case's coupled assembly (real net), for the momentum-exchange estimate only.
+    case_name : str
+        The case's ``name``.
+
+    Returns
+    -------
+    dict
+        The content of ``summary.json``, with ``coupling`` and ``wall_run``.
+    """
     summary = run_summary(recorder, assembly, case_name)
     s = recorder.series
     estimate = momentum_exchange_velocity(coupled_assembly) - s["debris_velocity_lvlh"][0]

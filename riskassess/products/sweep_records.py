@@ -31,7 +31,14 @@ def _all_finite(value) -> bool:
 
 
 def evidence_is_finite(record: dict) -> bool:
-    """Every load, utilization and likelihood of the record is a finite number."""
+    """Every load, utilization and likelihood of the record is a finite number.
+
+    Parameters
+    ----------
+    record : dict
+        A run's record (:func:`riskassess.sweep.runner.run_record`): the fields of
+        :data:`EVIDENCE_KEYS` and per location those of :data:`LOCATION_EVIDENCE_KEYS`.
+    """
     locations = record.get("locations") or {}
     return (all(_all_finite(record.get(key)) for key in EVIDENCE_KEYS)
             and all(_all_finite(loc.get(key)) for loc in locations.values() for key in LOCATION_EVIDENCE_KEYS))
@@ -43,6 +50,11 @@ def debris_state_of(record: dict) -> str | None:
 
     The record's own ``debris_state`` wins when it has one; otherwise ``secondary_debris``
     (True / False / None) gives it. "No debris" on non-finite evidence is ``indeterminate``.
+
+    Parameters
+    ----------
+    record : dict
+        A done run's record (:func:`riskassess.sweep.runner.run_record`).
     """
     state = record.get("debris_state")
     if state not in DEBRIS_STATES:

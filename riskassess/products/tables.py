@@ -7,26 +7,65 @@ VERDICT_COLUMNS = ("location", "criterion", "max demand", "at", "allowable", "ma
 
 
 def format_value(value: float, unit: str) -> str:
-    """A value with its unit; stresses in MPa."""
+    """A value with its unit; stresses in MPa.
+
+    Parameters
+    ----------
+    value : float
+        The value in SI unit ``unit``.
+    unit : str
+        Its unit; ``"Pa"`` is shown in MPa.
+    """
     scale, shown = (1e-6, "MPa") if unit == "Pa" else (1.0, unit)
     return f"{value * scale:.4g} {shown}"
 
 
 def format_allowable(low: float, high: float, unit: str) -> str:
+    """An allowable (range) with its unit: one value when both ends agree, else 'low - high'.
+
+    Parameters
+    ----------
+    low, high : float
+        Ends of the allowable, in SI unit ``unit``.
+    unit : str
+        Their unit; ``"Pa"`` is shown in MPa.
+    """
     return format_value(low, unit) if low == high else f"{format_value(low, unit)} - {format_value(high, unit)}"
 
 
 def format_margin(margin: float) -> str:
-    """Margin of safety: two decimals near failure, three significant digits when it is large."""
+    """Margin of safety: two decimals near failure, three significant digits when it is large.
+
+    Parameters
+    ----------
+    margin : float
+        Margin of safety (-), allowable / demand - 1.
+    """
     return f"{margin:+.2f}" if abs(margin) < 100 else f"{margin:+.3g}"
 
 
 def format_vector(values, digits: int = 3) -> str:
+    """A vector as '[a, b, c]' with ``digits`` significant digits.
+
+    Parameters
+    ----------
+    values : sequence of float
+        The components (any unit; the caller names it).
+    digits : int
+        Significant digits per component.
+    """
     return "[" + ", ".join(f"{v:.{digits}g}" for v in values) + "]"
 
 
 def piece_text(piece: dict) -> str:
-    """'solar_array, 350 kg, 14.3 x 5 m, at 0.744 s'."""
+    """'solar_array, 350 kg, 14.3 x 5 m, at 0.744 s'.
+
+    Parameters
+    ----------
+    piece : dict
+        A released piece of the structural verdict: ``bodies``, ``mass_kg``, ``size_m`` (extents,
+        m), ``release_time_s``.
+    """
     size = " x ".join(f"{e:.3g}" for e in piece["size_m"][:2])
     return f"{'+'.join(piece['bodies'])}, {piece['mass_kg']:.4g} kg, {size} m, at {piece['release_time_s']:.3f} s"
 
@@ -39,7 +78,14 @@ DEBRIS_TEXT = {"debris": "YES", "no_debris": "none", "indeterminate": "INDETERMI
 
 def debris_line(verdict: dict) -> str:
     """'secondary debris: YES | none | INDETERMINATE (why)'; a verdict from before the three states
-    counts as its boolean."""
+    counts as its boolean.
+
+    Parameters
+    ----------
+    verdict : dict
+        The structural verdict (``structures.json``): ``debris_state`` or ``secondary_debris``,
+        and ``indeterminate_reasons``.
+    """
     state = verdict.get("debris_state") or ("debris" if verdict["secondary_debris"] else "no_debris")
     line = f"secondary debris: {DEBRIS_TEXT[state]}"
     if state == "indeterminate":
@@ -48,7 +94,13 @@ def debris_line(verdict: dict) -> str:
 
 
 def location_state(loc: dict) -> str:
-    """'fails' | 'holds' | 'indeterminate' of a verdict row (older folders: from ``fails``)."""
+    """'fails' | 'holds' | 'indeterminate' of a verdict row (older folders: from ``fails``).
+
+    Parameters
+    ----------
+    loc : dict
+        One entry of the verdict's ``locations``.
+    """
     return loc.get("state") or ("fails" if loc["fails"] else "holds")
 
 
@@ -71,6 +123,17 @@ def verdict_rows(verdict: dict) -> list[dict]:
 
     Likelihoods of released locations read '>= x': their loads after the release are not
     known, so the value is a lower bound.
+
+    Parameters
+    ----------
+    verdict : dict
+        The structural verdict (``structures.json``): ``locations`` with their ``criteria``
+        (``peak``, ``unit``, ``allowable``, ``margin_of_safety``, ...) and ``released_pieces``.
+
+    Returns
+    -------
+    list of dict
+        Rows keyed by :data:`VERDICT_COLUMNS` plus ``fails`` and ``state``.
     """
     pieces = {p["location"]: p for p in verdict["released_pieces"]}
     rows = []
@@ -94,14 +157,27 @@ def verdict_rows(verdict: dict) -> list[dict]:
 
 
 def piece_fate(piece: dict) -> str:
-    """Where a released piece is at the end of the run, relative to the chaser (LVLH)."""
+    """Where a released piece is at the end of the run, relative to the chaser (LVLH).
+
+    Parameters
+    ----------
+    piece : dict
+        A released piece: ``velocity_relative_to_chaser_lvlh_m_s`` (3,) m/s LVLH,
+        ``inside_net_at_end``, ``spin_rate_rad_s``.
+    """
     v = piece["velocity_relative_to_chaser_lvlh_m_s"]
     return (f"at end {'inside' if piece['inside_net_at_end'] else 'OUTSIDE'} the net, velocity rel. chaser "
             f"{format_vector(v)} m/s LVLH, spin {piece['spin_rate_rad_s']:.3f} rad/s")
 
 
 def summary_rows(summary: dict) -> list[tuple[str, str, str]]:
-    """(quantity, this run, paper reference) rows of a run summary."""
+    """(quantity, this run, paper reference) rows of a run summary.
+
+    Parameters
+    ----------
+    summary : dict
+        A run summary (``summary.json``, :func:`riskassess.products.summary.run_summary`).
+    """
     ref = summary["paper_reference"]
     f = summary["peak_contact_force_N"]
     m = summary["peak_contact_moment_about_debris_com_Nm"]
@@ -130,7 +206,15 @@ def summary_rows(summary: dict) -> list[tuple[str, str, str]]:
 
 def perception_rows(answer: dict) -> list[list[str]]:
     """Rows (quantity, estimate, 1 sigma, error vs truth) of a perception answer; a quantity the
-    data could not determine reads 'not observable'."""
+    data could not determine reads 'not observable'.
+
+    Parameters
+    ----------
+    answer : dict
+        The perception answer (``perception.json``): estimates, their 1-sigma and errors, keys
+        with their units (``mass_kg``, ``principal_moments_kg_m2``, ``center_of_mass_target_m``
+        in the target frame, ...); a missing or None estimate is not observable.
+    """
     def row(name, value, sigma, error, fmt="{:.5g}", error_fmt="{:+.3f} %"):
         if value is None:
             return [name, "not observable", "", ""]

@@ -41,7 +41,19 @@ from riskassess.products.vtk_frames import VtkExport, export_frames, nearest_sam
 
 def body_meshes(case) -> list[trimesh.Trimesh]:
     """Chaser cube (side L_C) and debris cylinder (d_D, L_D, axis z_body, centre at the
-    :func:`riskassess.stages.tow_fullnet.debris_geometry` offset) in their body frames (m)."""
+    :func:`riskassess.models.towing_fullnet.debris_geometry` offset) in their body frames (m).
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        The towing case (``chaser.side_length``, ``debris.diameter``, ``debris.length`` (m), the
+        sub-tether attachment points).
+
+    Returns
+    -------
+    list of trimesh.Trimesh
+        [chaser, debris], vertices (m) in the body frames.
+    """
     radius, half_length, z_centre = debris_geometry(case)
     cylinder = trimesh.creation.cylinder(radius=radius, height=2.0 * half_length, sections=48)
     cylinder.apply_translation([0.0, 0.0, z_centre])
@@ -105,6 +117,27 @@ class _TowFrames:
 def export_tow_vtk(run_dir: str | Path, out: str | Path | None = None, every: int | None = None, progress=None,
                    overwrite: bool = False, max_frames: int | None = None) -> VtkExport:
     """Write the VTK files of a full-net tow folder (module docstring); returns where and how many
-    (``every``, ``max_frames``: :func:`riskassess.products.vtk_frames.frame_stride`)."""
+    (``every``, ``max_frames``: :func:`riskassess.products.vtk_frames.frame_stride`).
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        A full-net ``riskassess tow`` output folder (``net.npz``, ``towing.npz``, ``case.toml``).
+    out : str or Path, optional
+        The export folder; default ``RUN_DIR/vtk``.
+    every : int, optional
+        Net snapshots to step, >= 1.
+    progress : callable, optional
+        ``progress(frames written, frames to write)``.
+    overwrite : bool
+        Replace an earlier export of the same run.
+    max_frames : int, optional
+        Most frames to write.
+
+    Returns
+    -------
+    VtkExport
+        Export folder, ``.pvd`` path, number of frames and their times (s).
+    """
     return export_frames(run_dir, out, every, progress, _TowFrames, ("net", "bodies", "tether"), "towing.pvd",
                          "positions in the debris' LVLH frame (m)", overwrite=overwrite, max_frames=max_frames)

@@ -29,7 +29,19 @@ def _tow_panels(axes, s, label, style="-"):
 def tow_figure(series: dict, title: str, others: dict | None = None):
     """Main-tether tension and thrust, chaser-debris distance, angular rates against time;
     ``others`` (label -> series) are drawn dashed on the same axes (e.g. thrust laws compared).
-    Call inside ``matplotlib.rc_context(STYLE)``; returns the matplotlib figure."""
+    Call inside ``matplotlib.rc_context(STYLE)``; returns the matplotlib figure.
+
+    Parameters
+    ----------
+    series : dict of str to numpy.ndarray
+        A tow's series: ``time`` (k,) s, ``main_tether_tension`` and ``thrust`` (k,) N,
+        ``debris_com_inertial`` and ``chaser_com_inertial`` (k, 3) m (inertial frame),
+        ``chaser_omega_body`` and ``debris_omega_body`` (k, 3) rad/s (body frames).
+    title : str
+        Figure title (a case name).
+    others : dict of str to dict, optional
+        Label -> series of the same form, drawn dashed.
+    """
     fig, axes = panels(3, 1.8)
     _tow_panels(axes, series, "")
     for label, other in (others or {}).items():
@@ -44,13 +56,36 @@ def tow_figure(series: dict, title: str, others: dict | None = None):
 
 
 def plot_tow(series: dict, path: Path, title: str, others: dict | None = None) -> None:
-    """:func:`tow_figure` written to ``path`` as PNG."""
+    """:func:`tow_figure` written to ``path`` as PNG.
+
+    Parameters
+    ----------
+    series : dict of str to numpy.ndarray
+        A tow's series (see :func:`tow_figure`).
+    path : Path
+        Destination ``.png`` file; its folder must exist.
+    title : str
+        Figure title (a case name).
+    others : dict of str to dict, optional
+        Label -> series of the same form, drawn dashed.
+    """
     with matplotlib.rc_context(STYLE):
         _save(tow_figure(series, title, others), path)
 
 
 def plot_convergence(histories: dict, path: Path, title: str) -> None:
-    """Best cost against evaluations for each optimizer run (label -> (evaluations, best cost))."""
+    """Best cost against evaluations for each optimizer run (label -> (evaluations, best cost)).
+
+    Parameters
+    ----------
+    histories : dict of str to (array, array)
+        Optimizer label -> (cost evaluations (n,) int, best cost so far (n,) float, > 0 for the log
+        axis; the cost is dimensionless).
+    path : Path
+        Destination ``.png`` file; its folder must exist.
+    title : str
+        Figure title.
+    """
     with matplotlib.rc_context(STYLE):
         fig, (ax,) = panels(1, 2.6, sharex=False)
         for label, (evaluations, best) in histories.items():
@@ -63,7 +98,19 @@ def plot_convergence(histories: dict, path: Path, title: str) -> None:
 
 
 def plot_fit(data: dict, fitted: dict, path: Path, title: str) -> None:
-    """One run's data (solid) against the identified model (dashed)."""
+    """One run's data (solid) against the identified model (dashed).
+
+    Parameters
+    ----------
+    data : dict of str to numpy.ndarray
+        The measured tow series (see :func:`tow_figure` for keys, shapes, units and frames).
+    fitted : dict of str to numpy.ndarray
+        The identified model's series, same form.
+    path : Path
+        Destination ``.png`` file; its folder must exist.
+    title : str
+        Figure title.
+    """
     with matplotlib.rc_context(STYLE):
         fig, axes = panels(3, 1.8)
         _tow_panels(axes, data, "data")

@@ -61,7 +61,20 @@ from riskassess.products.vtk_frames import VtkExport, export_frames, nearest_sam
 from riskassess.products.vtk_markers import joint_markers
 
 def release_times_by_body(run: RunFolder, body_names) -> np.ndarray:
-    """Per body the time (s) its piece is released; inf for bodies never released."""
+    """Per body the time (s) its piece is released; inf for bodies never released.
+
+    Parameters
+    ----------
+    run : RunFolder
+        The run folder (its ``structures.json``, when there, gives the released pieces).
+    body_names : sequence of str
+        Body names in the order of the series.
+
+    Returns
+    -------
+    (nb,) float
+        Release times (s).
+    """
     times = np.full(len(body_names), np.inf)
     if run.has("structures.json"):
         index = {name: k for k, name in enumerate(body_names)}
@@ -187,7 +200,28 @@ def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int | 
                overwrite: bool = False, max_frames: int | None = None) -> VtkExport:
     """Write the VTK files of a run folder (see the module docstring); returns where and how many.
     ``every``: export every N-th snapshot; ``max_frames``: at most that many, evenly strided; neither:
-    within :data:`~riskassess.products.vtk_frames.VTK_BUDGET_BYTES`."""
+    within :data:`~riskassess.products.vtk_frames.VTK_BUDGET_BYTES`.
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        The run folder of ``riskassess run`` / ``assess`` (or a full-net ``riskassess tow`` folder).
+    out : str or Path, optional
+        The export folder; default ``RUN_DIR/vtk``.
+    every : int, optional
+        Net snapshots to step, >= 1.
+    progress : callable, optional
+        ``progress(frames written, frames to write)``.
+    overwrite : bool
+        Replace an earlier export of the same run.
+    max_frames : int, optional
+        Most frames to write.
+
+    Returns
+    -------
+    VtkExport
+        Export folder, ``.pvd`` path, number of frames and their times (s).
+    """
     if RunFolder(run_dir).stage == "tow":  # a full-net tow folder: its own layout
         return export_tow_vtk(run_dir, out, every, progress, overwrite, max_frames)
     return export_frames(run_dir, out, every, progress, _Frames, ("net", "bodies", "bullets", "body_frames", "joints"),

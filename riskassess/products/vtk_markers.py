@@ -36,14 +36,43 @@ class JointMarkers:
     axis_parent: np.ndarray
 
     def at(self, body_to_lvlh, body_com_lvlh):
-        """Points (m) and axes (-) in LVLH for body poses (nb, 3, 3) and CoMs (nb, 3) of one sample."""
+        """Points (m) and axes (-) in LVLH for body poses (nb, 3, 3) and CoMs (nb, 3) of one sample.
+
+        Parameters
+        ----------
+        body_to_lvlh : (nb, 3, 3) float
+            Rotations body frame -> LVLH of every body at the sample.
+        body_com_lvlh : (nb, 3) float
+            Body CoMs (m), LVLH.
+
+        Returns
+        -------
+        points : (nj, 3) float
+            Joint points (m), LVLH.
+        axes : (nj, 3) float
+            Unit joint axes h2, LVLH.
+        """
         rot = np.asarray(body_to_lvlh)[self.parent]
         points = np.einsum("jab,jb->ja", rot, self.point_parent) + np.asarray(body_com_lvlh)[self.parent]
         return points, np.einsum("jab,jb->ja", rot, self.axis_parent)
 
 
 def joint_markers(case: dict, body_names, body_to_lvlh_0, body_com_lvlh_0) -> JointMarkers:
-    """The case's joints in their parent body frames, from the poses (nb, 3, 3), (nb, 3) of the first sample."""
+    """The case's joints in their parent body frames, from the poses (nb, 3, 3), (nb, 3) of the first sample.
+
+    Parameters
+    ----------
+    case : dict
+        The validated case (``case.json``): ``target.joints`` (``name``, ``parent``, ``position`` (m)
+        and ``axis`` in the target frame), ``target.position_lvlh`` (m) and
+        ``target.attitude_rotation_vector`` (rad, target frame -> LVLH at t = 0).
+    body_names : sequence of str
+        Body names in the order of the series; joints whose parent is not among them are left out.
+    body_to_lvlh_0 : (nb, 3, 3) float
+        Rotations body frame -> LVLH at the first sample.
+    body_com_lvlh_0 : (nb, 3) float
+        Body CoMs (m), LVLH, at the first sample.
+    """
     target = case["target"]
     target_to_lvlh = Rotation.from_rotvec(target["attitude_rotation_vector"]).as_matrix()
     origin = np.asarray(target["position_lvlh"], float)

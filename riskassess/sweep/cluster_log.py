@@ -34,6 +34,13 @@ class StderrToFile(WorkerPlugin):
         self.path = str(path)
 
     def setup(self, worker) -> None:
+        """Point the worker process's file descriptor 2 at the log file (called by Dask on each worker).
+
+        Parameters
+        ----------
+        worker : distributed.Worker
+            The worker the plugin is registered on (not used).
+        """
         fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
         os.dup2(fd, 2)
         os.close(fd)
@@ -43,7 +50,15 @@ class StderrToFile(WorkerPlugin):
 def distributed_logging_to(path: str | Path, terminal_level: int = logging.ERROR):
     """Within the block, the ``distributed`` loggers of this process write WARNING and above to
     ``path`` (appended; its folder created) and their terminal handlers only ``terminal_level``
-    and above; everything restored after."""
+    and above; everything restored after.
+
+    Parameters
+    ----------
+    path : str or Path
+        The log file, usually :data:`CLUSTER_LOG` in the sweep's products folder.
+    terminal_level : int
+        ``logging`` level below which the terminal handlers stay silent.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     logger = logging.getLogger("distributed")

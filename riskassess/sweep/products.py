@@ -38,7 +38,13 @@ class ProductConflict(StoreError):
 
 
 def products_dir(store_path: Path) -> Path:
-    """The folder of the products of the store at ``store_path`` (see the module notes)."""
+    """The folder of the products of the store at ``store_path`` (see the module notes).
+
+    Parameters
+    ----------
+    store_path : Path
+        The results store (``.sqlite`` file).
+    """
     store_path = Path(store_path)
     if store_path.name == DEFAULT_STORE_NAME:
         return store_path.parent
@@ -54,12 +60,40 @@ def _owned(store: ResultStore) -> dict[str, list[str]]:
 
 
 def check_products(store: ResultStore, names=PRODUCTS) -> Path:
-    """The products folder, after checking that no product path holds a file the store did not write."""
+    """The products folder, after checking that no product path holds a file the store did not write.
+
+    Parameters
+    ----------
+    store : riskassess.sweep.store.ResultStore
+        The open store; its ``products`` info holds the hashes of the products it wrote.
+    names : sequence of str
+        Product file names to check, of :data:`PRODUCTS`.
+
+    Returns
+    -------
+    Path
+        The products folder (:func:`products_dir`).
+    """
     return check_products_at(store.path, _owned(store), names)
 
 
 def check_products_at(store_path: Path, owned: dict[str, list[str]], names=PRODUCTS) -> Path:
-    """:func:`check_products` for a store that may not exist yet (``owned`` then empty)."""
+    """:func:`check_products` for a store that may not exist yet (``owned`` then empty).
+
+    Parameters
+    ----------
+    store_path : Path
+        The results store (``.sqlite`` file), existing or not.
+    owned : dict of str to list of str
+        Product name -> SHA-256 hex digests of the contents the store wrote.
+    names : sequence of str
+        Product file names to check, of :data:`PRODUCTS`.
+
+    Returns
+    -------
+    Path
+        The products folder (:func:`products_dir`).
+    """
     folder = products_dir(store_path)
     for name in names:
         path = folder / name
@@ -73,7 +107,22 @@ def check_products_at(store_path: Path, owned: dict[str, list[str]], names=PRODU
 
 
 def write_product(store: ResultStore, name: str, data: bytes) -> Path:
-    """Write one product atomically, recording its hash in the store first."""
+    """Write one product atomically, recording its hash in the store first.
+
+    Parameters
+    ----------
+    store : riskassess.sweep.store.ResultStore
+        The store open for writing.
+    name : str
+        Product file name, one of :data:`PRODUCTS`.
+    data : bytes
+        The whole content.
+
+    Returns
+    -------
+    Path
+        The written file.
+    """
     folder = check_products(store, (name,))
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / name
@@ -87,12 +136,29 @@ def write_product(store: ResultStore, name: str, data: bytes) -> Path:
 
 def write_sweep_products(store: ResultStore, confidence: float = 0.95, reliability: float = 0.9,
                          pdf: bool = True) -> dict:
-    """envelope.json and report.html (+ .pdf) in the store's products folder; returns the envelope."""
+    """envelope.json and report.html (+ .pdf) in the store's products folder; returns the envelope.
+
+    Parameters
+    ----------
+    store : riskassess.sweep.store.ResultStore
+        The store open for writing.
+    confidence : float
+        One-sided confidence of the envelope's bound, in (0, 1).
+    reliability : float
+        Required P(no debris), in (0, 1).
+    pdf : bool
+        Also write ``report.pdf``.
+
+    Returns
+    -------
+    dict
+        The envelope (:func:`riskassess.products.envelope.envelope`).
+    """
     folder = check_products(store, PRODUCTS if pdf else PRODUCTS[:2])
     rows = store.rows()
     info = store.info()
     env = envelope(rows, confidence=confidence, reliability=reliability)
-    # allow_nan=False: the envelope never holds a NaN (a "nan" limit was issue 20's false safe)
+    # allow_nan=False: the envelope never holds a NaN (a "nan" limit once read as a safe limit)
     write_product(store, "envelope.json", (json.dumps(env, indent=2, allow_nan=False) + "\n").encode())
     varied = [a.split(" ", 1)[1].split("=")[0] for a in info.get("arguments", []) if a.startswith("--vary ")]
     with matplotlib.rc_context(STYLE):

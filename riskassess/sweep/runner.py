@@ -88,6 +88,24 @@ def run_record(summary: dict, verdict: dict | None, overrides: dict) -> dict:
 
     ``debris_state`` is the verdict's (``debris`` / ``no_debris`` / ``indeterminate``; None for
     a case without weak locations) and ``secondary_debris`` the same as True / False / None.
+
+    Parameters
+    ----------
+    summary : dict
+        The run summary (:func:`riskassess.products.summary.run_summary`).
+    verdict : dict or None
+        The structural verdict (``structures.json``); None for a case without weak locations.
+    overrides : dict
+        Dotted case key -> value (SI) of this run.
+
+    Returns
+    -------
+    dict
+        ``inputs``, ``secondary_debris``, ``debris_state``, ``peak_contact_force_N``,
+        ``peak_contact_moment_Nm`` (about the debris CoM), ``joint_peak_moment_after_transient_Nm``,
+        ``energy_balance_relative_drift``, ``wall_time_s``, ``steps_per_second``, ``locations``
+        (per location ``utilization`` (-), ``likelihood``, ``peaks`` in their ``units``, ...),
+        ``released_pieces`` and ``breakup_likelihood``.
     """
     record = {
         "inputs": overrides,
@@ -128,6 +146,23 @@ def simulate_run(case_path: str, case_text: str, overrides: dict, keep_dir: str 
 
     A simulation stopped by the numerical health checks raises :class:`RunFailed` of kind
     ``diverged``, with the check's message.
+
+    Parameters
+    ----------
+    case_path : str
+        The case file (TOML); mesh paths in it are relative to its folder.
+    case_text : str
+        Its content, as the sweep read it.
+    overrides : dict
+        Dotted case key -> value (SI) of this run.
+    keep_dir : str, optional
+        Run folder to keep (``--keep-runs DIR/<run id>``); None runs in a temporary folder that is
+        removed afterwards.
+
+    Returns
+    -------
+    dict
+        The run's record (:func:`run_record`).
     """
     from riskassess.stages.run import run_case  # the pipeline imports Exudyn: only on the worker
 
@@ -149,7 +184,13 @@ def simulate_run(case_path: str, case_text: str, overrides: dict, keep_dir: str 
 
 
 def failure_kind(exc: BaseException) -> str:
-    """``diverged``, ``infrastructure`` (a resume retries it) or ``simulation`` (any other error of the run)."""
+    """``diverged``, ``infrastructure`` (a resume retries it) or ``simulation`` (any other error of the run).
+
+    Parameters
+    ----------
+    exc : BaseException
+        The exception a run's future raised on the client.
+    """
     if isinstance(exc, RunFailed):
         return exc.kind
     if isinstance(exc, SimulationFailed):
@@ -158,6 +199,13 @@ def failure_kind(exc: BaseException) -> str:
 
 
 def failure_message(exc: BaseException) -> str:
+    """The text stored under ``error`` for a failed run: the message of a :class:`RunFailed`, else 'Type: message'.
+
+    Parameters
+    ----------
+    exc : BaseException
+        The exception a run's future raised on the client.
+    """
     return str(exc) if isinstance(exc, RunFailed) else f"{type(exc).__name__}: {exc}"
 
 
@@ -169,6 +217,20 @@ def validation_sample(specs: list[RunSpec], limit: int = VALIDATE_ALL_UP_TO) -> 
     largest value), so every value of every key is checked at least once. A combination of
     values that only fails together is then found when its run starts, and recorded as a
     failed run (never as safe).
+
+    Parameters
+    ----------
+    specs : list of riskassess.sweep.spec.RunSpec
+        Every run of the sweep.
+    limit : int
+        Largest number of runs that are all validated.
+
+    Returns
+    -------
+    sample : list of riskassess.sweep.spec.RunSpec
+        The runs to validate.
+    what : str
+        The sentence saying which.
     """
     if len(specs) <= limit:
         return specs, f"all {len(specs)} runs validated"
@@ -191,7 +253,19 @@ def validation_sample(specs: list[RunSpec], limit: int = VALIDATE_ALL_UP_TO) -> 
 
 def validate_runs(case_path: str, case_text: str, specs: list[RunSpec], limit: int = VALIDATE_ALL_UP_TO) -> str:
     """The runs' cases must load before any run (:func:`validation_sample` says which are
-    checked): one message listing the bad ones. Returns the sentence of what was validated."""
+    checked): one message listing the bad ones. Returns the sentence of what was validated.
+
+    Parameters
+    ----------
+    case_path : str
+        The case file, named in the messages.
+    case_text : str
+        Its content (TOML).
+    specs : list of riskassess.sweep.spec.RunSpec
+        Every run of the sweep.
+    limit : int
+        Largest number of runs that are all validated.
+    """
     raw = tomllib.loads(case_text)
     sample, what = validation_sample(specs, limit)
     problems = []
@@ -233,6 +307,36 @@ def run_sweep(case_path: str | Path, specs: list[RunSpec], store: ResultStore, d
 
     ``validate=False`` when the caller already ran :func:`validate_runs`. ``log_path``: the Dask
     cluster's warnings go to this file instead of the terminal (:mod:`riskassess.sweep.cluster_log`).
+
+    Parameters
+    ----------
+    case_path : str or Path
+        The case file (TOML).
+    specs : list of riskassess.sweep.spec.RunSpec
+        Every run of the sweep (:func:`riskassess.sweep.spec.run_specs`).
+    store : ResultStore
+        The results store, open for writing.
+    definition : dict
+        Sweep definition recorded in the store (``arguments``, ``created``).
+    scheduler : str, optional
+        Address of a Dask scheduler; None starts a local cluster.
+    n_workers : int
+        Worker processes of the local cluster (one thread each), >= 1.
+    retry_failed : bool
+        Run again every failed run, not only those lost to the cluster.
+    keep_runs : str or Path, optional
+        Folder where each run keeps its run folder (``<keep_runs>/<run id>``).
+    progress : callable, optional
+        ``progress(done, failed, remaining)``, counts of runs.
+    validate : bool
+        Validate the runs' cases first (:func:`validate_runs`).
+    log_path : str or Path, optional
+        The cluster's log file (``dask.log``).
+
+    Returns
+    -------
+    SweepOutcome
+        Run counts and wall time (s).
     """
     if n_workers < 1:
         raise ValueError(f"n_workers must be >= 1. Got {n_workers} instead.")

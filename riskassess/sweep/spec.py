@@ -41,7 +41,20 @@ class RunSpec:
 
 
 def parse_vary(text: str) -> tuple[str, np.ndarray]:
-    """'KEY=START:STOP:N' -> (key, N evenly spaced values, ends included)."""
+    """'KEY=START:STOP:N' -> (key, N evenly spaced values, ends included).
+
+    Parameters
+    ----------
+    text : str
+        The ``--vary`` argument, e.g. ``"launch.velocity=10:30:5"`` (values in the key's SI unit).
+
+    Returns
+    -------
+    key : str
+        The dotted case key.
+    values : (N,) float
+        The values, ends included.
+    """
     key, _, spec = text.partition("=")
     parts = spec.split(":")
     try:
@@ -61,7 +74,17 @@ def parse_vary(text: str) -> tuple[str, np.ndarray]:
 
 
 def set_key(raw: dict, key: str, value) -> None:
-    """Set ``key`` in the parsed case file ``raw`` (in place); ``KeyError`` naming what is missing."""
+    """Set ``key`` in the parsed case file ``raw`` (in place); ``KeyError`` naming what is missing.
+
+    Parameters
+    ----------
+    raw : dict
+        The parsed case file (TOML), changed in place.
+    key : str
+        Dotted case key; list items by ``[name]`` or ``[index]``.
+    value : float or object
+        The new value (SI, as the case file takes it).
+    """
     node = raw
     parts = split_key(key)
     for depth, part in enumerate(parts):
@@ -99,13 +122,34 @@ def _select(items, selector: str, key: str):
 
 
 def run_id(overrides: dict) -> str:
-    """Stable id of a run from its overrides (values to 12 significant digits)."""
+    """Stable id of a run from its overrides (values to 12 significant digits).
+
+    Parameters
+    ----------
+    overrides : dict
+        Dotted case key -> value (SI).
+
+    Returns
+    -------
+    str
+        12 hex digits.
+    """
     canonical = json.dumps({k: float(f"{v:.12g}") for k, v in sorted(overrides.items())}, sort_keys=True)
     return hashlib.sha1(canonical.encode()).hexdigest()[:12]
 
 
 def check_options(workers: int, confidence: float, reliability: float) -> None:
-    """``workers`` >= 1; ``confidence`` and ``reliability`` strictly between 0 and 1."""
+    """``workers`` >= 1; ``confidence`` and ``reliability`` strictly between 0 and 1.
+
+    Parameters
+    ----------
+    workers : int
+        ``--workers``, worker processes.
+    confidence : float
+        ``--confidence``.
+    reliability : float
+        ``--reliability``, required P(no debris).
+    """
     if workers < 1:
         raise SweepSpecError(f"--workers must be >= 1. Got {workers} instead.")
     for name, value in (("confidence", confidence), ("reliability", reliability)):
@@ -120,6 +164,20 @@ def check_sweep(vary: list[tuple[str, np.ndarray]], uncertain: list[tuple[str, s
     Each key at most once; ``--monte-carlo`` >= 0, and >= 1 exactly when there are uncertain
     keys; something to vary; ``seed`` >= 0; at most :data:`MAX_RUNS` runs unless ``force``,
     and never more than :data:`HARD_MAX_RUNS`.
+
+    Parameters
+    ----------
+    vary : list of (str, (N,) float)
+        Varied keys and their values (:func:`parse_vary`).
+    uncertain : list of (str, str, tuple)
+        Uncertain keys, distribution names and parameters
+        (:func:`riskassess.cases.uncertain.parse_uncertain`).
+    monte_carlo : int
+        Samples per grid point (``--monte-carlo``).
+    seed : int
+        Seed of the random draw.
+    force : bool
+        Allow up to :data:`HARD_MAX_RUNS` runs.
     """
     keys = [key for key, _ in vary] + [key for key, _, _ in uncertain]
     repeated = sorted({k for k in keys if keys.count(k) > 1})
@@ -150,6 +208,23 @@ def run_specs(vary: list[tuple[str, np.ndarray]], uncertain: list[tuple[str, str
 
     The same samples are used at every grid point (common random numbers), so differences
     along the grid come from the varied keys, not from the draw.
+
+    Parameters
+    ----------
+    vary : list of (str, (N,) float)
+        Varied keys and their values (:func:`parse_vary`), values in the key's SI unit.
+    uncertain : list of (str, str, tuple)
+        Uncertain keys, distribution names and parameters
+        (:func:`riskassess.cases.uncertain.parse_uncertain`).
+    monte_carlo : int
+        Samples per grid point; >= 1 when ``uncertain`` is given.
+    seed : int
+        Seed of ``numpy.random.default_rng``.
+
+    Returns
+    -------
+    list of RunSpec
+        Grid point by grid point, the samples of each in order.
     """
     if uncertain and monte_carlo < 1:
         raise SweepSpecError("--uncertain needs --monte-carlo N (samples per grid point, N >= 1)")
@@ -169,7 +244,15 @@ def run_specs(vary: list[tuple[str, np.ndarray]], uncertain: list[tuple[str, str
 
 
 def case_with(raw: dict, overrides: dict) -> dict:
-    """A copy of the parsed case file with the overrides applied."""
+    """A copy of the parsed case file with the overrides applied.
+
+    Parameters
+    ----------
+    raw : dict
+        The parsed case file (TOML); not changed.
+    overrides : dict
+        Dotted case key -> value (SI).
+    """
     out = copy.deepcopy(raw)
     for key, value in overrides.items():
         set_key(out, key, value)

@@ -87,6 +87,13 @@ class StoreMismatch(StoreError):
 
 
 def case_fingerprint(case_text: str) -> str:
+    """The first 16 hex digits of the SHA-1 of a case file's content: which case a store belongs to.
+
+    Parameters
+    ----------
+    case_text : str
+        The case file's content.
+    """
     return hashlib.sha1(case_text.encode()).hexdigest()[:16]
 
 
@@ -113,7 +120,18 @@ def _connect_readonly(path: Path) -> sqlite3.Connection:
 
 
 def check_store_file(path: Path) -> int:
-    """The schema version of the store at ``path``, after checking it is ours and intact."""
+    """The schema version of the store at ``path``, after checking it is ours and intact.
+
+    Parameters
+    ----------
+    path : Path
+        An existing file given as a results store (``--store``).
+
+    Returns
+    -------
+    int
+        Schema version, 1 to :data:`SCHEMA_VERSION`.
+    """
     user_version, application_id = _header_fields(path)
     if application_id not in (APPLICATION_ID, 0):
         raise StoreError(f"{path}: an SQLite file of another application (application_id {application_id:#x}), "
@@ -232,7 +250,13 @@ class ResultStore:
 
     @classmethod
     def open_readonly(cls, path: str | Path) -> ResultStore:
-        """An existing store for reading only (SQLite ``mode=ro``; no lock, no change to the file)."""
+        """An existing store for reading only (SQLite ``mode=ro``; no lock, no change to the file).
+
+        Parameters
+        ----------
+        path : str or Path
+            The results store (``.sqlite`` file).
+        """
         if not Path(path).exists():
             raise StoreError(f"{path}: no such results store")
         return cls(path, readonly=True)
@@ -255,10 +279,31 @@ class ResultStore:
         return {k: json.loads(v) for k, v in self.db.execute("SELECT key, value FROM sweep")}
 
     def set_info(self, key: str, value) -> None:
+        """Store one entry of the sweep's definition (``sweep`` table), as JSON.
+
+        Parameters
+        ----------
+        key : str
+            Entry name (``arguments``, ``created``, ``products``, ...).
+        value : object
+            JSON-serialisable value.
+        """
         self.db.execute("INSERT OR REPLACE INTO sweep VALUES (?, ?)", (key, json.dumps(value)))
 
     def declare(self, case_path: str, case_text: str, definition: dict, specs) -> None:
-        """Record the sweep definition and its runs (``pending`` unless already there)."""
+        """Record the sweep definition and its runs (``pending`` unless already there).
+
+        Parameters
+        ----------
+        case_path : str
+            The case file.
+        case_text : str
+            Its content; the store refuses another content (:class:`StoreMismatch`).
+        definition : dict
+            More sweep entries (``arguments``, ``created``).
+        specs : list of riskassess.sweep.spec.RunSpec
+            Every run of the sweep.
+        """
         fingerprint = case_fingerprint(case_text)
         info = self.info()
         if info and info.get("case_fingerprint") != fingerprint:
@@ -277,7 +322,20 @@ class ResultStore:
         return dict(self.db.execute("SELECT run_id, state FROM runs"))
 
     def to_run(self, run_ids, retry_failed: bool = False) -> list[str]:
-        """Of ``run_ids``, those still to run: pending, infrastructure failures, and (if asked) all failures."""
+        """Of ``run_ids``, those still to run: pending, infrastructure failures, and (if asked) all failures.
+
+        Parameters
+        ----------
+        run_ids : iterable of str
+            Run ids of the sweep (:func:`riskassess.sweep.spec.run_id`).
+        retry_failed : bool
+            Include every failed run.
+
+        Returns
+        -------
+        list of str
+            The ids, in the order given, without repeats.
+        """
         rows = {rid: (state, kind) for rid, state, kind in self.db.execute("SELECT run_id, state, error_kind FROM runs")}
         keep = []
         for rid in dict.fromkeys(run_ids):
@@ -290,11 +348,31 @@ class ResultStore:
         return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
 
     def write_done(self, run_id: str, record: dict) -> None:
+        """Record a finished run (``done``) with its record and debris state, in one transaction.
+
+        Parameters
+        ----------
+        run_id : str
+            The run's id.
+        record : dict
+            Its record (:func:`riskassess.sweep.runner.run_record`).
+        """
         self.db.execute("UPDATE runs SET state='done', result=?, debris_state=?, error=NULL, error_kind=NULL, "
                         "wall_s=?, finished=?, attempts=attempts+1 WHERE run_id=?",
                         (json.dumps(record), debris_state_of(record), record.get("wall_time_s"), self._now(), run_id))
 
     def write_failed(self, run_id: str, error: str, kind: str) -> None:
+        """Record a failed run (``failed``) with its error, in one transaction.
+
+        Parameters
+        ----------
+        run_id : str
+            The run's id.
+        error : str
+            What went wrong.
+        kind : str
+            ``diverged``, ``simulation`` or ``infrastructure`` (:func:`riskassess.sweep.runner.failure_kind`).
+        """
         self.db.execute("UPDATE runs SET state='failed', result=NULL, debris_state=NULL, error=?, error_kind=?, "
                         "finished=?, attempts=attempts+1 WHERE run_id=?", (error, kind, self._now(), run_id))
 
@@ -314,6 +392,12 @@ class ResultStore:
 
 
 def default_store_path(case_name: str) -> Path:
-    """``sweeps/<case name>/results.sqlite``, the name reduced to one safe path component."""
+    """``sweeps/<case name>/results.sqlite``, the name reduced to one safe path component.
+
+    Parameters
+    ----------
+    case_name : str
+        The case's ``name``.
+    """
     safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in case_name).strip("._") or "sweep"
     return Path("sweeps") / safe / "results.sqlite"

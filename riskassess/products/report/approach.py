@@ -31,6 +31,18 @@ def _reference_rows(reference: dict) -> list[list[str]]:
 
 
 def approach_section(run: RunFolder) -> Section | None:
+    """The approach section: verdict on the constraints, solution and margins, paths and controls, the
+    paper's figures and the 3-D replay; None unless the folder holds ``approach.json``.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An output folder of ``riskassess approach`` (``approach.json``, ``approach.npz``).
+
+    Returns
+    -------
+    Section or None
+    """
     if not run.has("approach.json"):
         return None
     answer, arrays = run.json("approach.json"), run.arrays("approach.npz")

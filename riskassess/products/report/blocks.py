@@ -27,7 +27,17 @@ class Figure:
 
     @classmethod
     def from_matplotlib(cls, id: str, caption: str, fig) -> Figure:
-        """Render and close a matplotlib figure."""
+        """Render and close a matplotlib figure.
+
+        Parameters
+        ----------
+        id : str
+            Stable HTML id, e.g. ``"fig-contact"``.
+        caption : str
+            Caption under the figure.
+        fig : matplotlib.figure.Figure
+            The figure, rendered at :data:`FIGURE_DPI`.
+        """
         return cls(id, caption, base64.b64encode(png_bytes(fig, FIGURE_DPI)).decode("ascii"))
 
 

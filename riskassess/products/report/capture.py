@@ -19,6 +19,18 @@ MAX_LISTED_THREADS = 20
 
 
 def capture_section(run: RunFolder) -> Section:
+    """Snapshots of net and debris (LVLH, m) at first contact, peak load, each release and the end,
+    with the list of instants and a pointer to the animation and the viewer.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``net.npz``, ``timeseries.npz``, ``bodies.npz``).
+
+    Returns
+    -------
+    Section
+    """
     scene = scene_of(run)
     instants = scene.instants()
     png = snapshots_png(scene, instants, WIDTH_IN, FIGURE_DPI)
@@ -42,6 +54,18 @@ def _thread_name(scene, t: int) -> str:
 
 
 def net_integrity_section(run: RunFolder) -> Section:
+    """Highest and median thread tension (N) at the net snapshots against the thread's breaking load
+    (``net.thread.breaking_load``, N, when the case gives it), and the threads that reach it.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``net.npz``, ``case.json``).
+
+    Returns
+    -------
+    Section
+    """
     scene = scene_of(run)
     thread = run.key(run.case, "net", "thread")
     integrity = net_integrity(scene.tension, scene.time, thread.get("breaking_load"))

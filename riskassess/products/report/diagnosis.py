@@ -25,7 +25,21 @@ def _shown(answer: dict, arrays: dict) -> list[str]:
 
 
 def channels_figure(answer: dict, arrays: dict):
-    """Measured, nominal-fit and chosen-model channels, with the train / held-out split."""
+    """Measured, nominal-fit and chosen-model channels, with the train / held-out split.
+
+    Parameters
+    ----------
+    answer : dict
+        The diagnosis answer (``diagnosis.json``): ``residual_figures``, ``model``,
+        ``split_time_s`` (s).
+    arrays : dict of str to numpy.ndarray
+        The diagnosis arrays (``diagnosis.npz``): ``time`` (k,) s, ``channels``, and per channel c
+        ``measured/c``, ``nominal/c``, ``chosen/c`` (k,) in the channel's SI unit.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     shown = _shown(answer, arrays)
     fig, axes = panels(len(shown), 1.3)
     t = arrays["time"]
@@ -42,7 +56,20 @@ def channels_figure(answer: dict, arrays: dict):
 
 
 def residuals_figure(answer: dict, arrays: dict):
-    """Normalized residuals before (nominal) and after (chosen model), per shown channel."""
+    """Normalized residuals before (nominal) and after (chosen model), per shown channel.
+
+    Parameters
+    ----------
+    answer : dict
+        The diagnosis answer (``diagnosis.json``).
+    arrays : dict of str to numpy.ndarray
+        The diagnosis arrays: ``time`` (k,) s, ``channels``, and per channel c ``residual_before/c``
+        and ``residual_after/c`` (k,), residual over the channel's noise sigma (-).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     shown = _shown(answer, arrays)
     fig, axes = panels(len(shown), 1.2)
     t = arrays["time"]
@@ -59,7 +86,20 @@ def residuals_figure(answer: dict, arrays: dict):
 
 
 def spectrum_figure(answer: dict, arrays: dict):
-    """Welch PSD of the worst channel's normalized residual, before and after."""
+    """Welch PSD of the worst channel's normalized residual, before and after.
+
+    Parameters
+    ----------
+    answer : dict
+        The diagnosis answer (``diagnosis.json``).
+    arrays : dict of str to numpy.ndarray
+        The diagnosis arrays: ``time`` (k,) s (evenly sampled) and the normalized residuals
+        ``residual_before/c``, ``residual_after/c`` (k,) (-).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     worst = _shown(answer, arrays)[0]
     fig, (ax,) = panels(1, 2.2)
     t = arrays["time"]
@@ -77,7 +117,18 @@ def spectrum_figure(answer: dict, arrays: dict):
 
 
 def candidates_figure(answer: dict):
-    """BIC evidence of each candidate against the nominal model."""
+    """BIC evidence of each candidate against the nominal model.
+
+    Parameters
+    ----------
+    answer : dict
+        The diagnosis answer: ``candidates`` (``id``, ``delta_bic``), ``cause``,
+        ``decisive_delta_bic`` (-).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     rows = answer["candidates"]
     fig, (ax,) = panels(1, 0.25 * max(len(rows), 3) + 0.6, sharex=False)
     names = [r["id"] for r in rows][::-1]
@@ -108,7 +159,17 @@ def _figures(answer: dict, arrays: dict):
 
 
 def write_figures(out, answer: dict, arrays: dict) -> list[str]:
-    """Write the PNG figures into ``out`` atomically; returns their names."""
+    """Write the PNG figures into ``out`` atomically; returns their names.
+
+    Parameters
+    ----------
+    out : Path
+        The diagnosis output folder (existing).
+    answer : dict
+        The diagnosis answer.
+    arrays : dict of str to numpy.ndarray
+        The diagnosis arrays (see :func:`channels_figure`).
+    """
     names = []
     with matplotlib.rc_context(STYLE):
         for name, _, _, fig in _figures(answer, arrays):
@@ -123,6 +184,18 @@ def _fmt(value, std=None) -> str:
 
 
 def diagnosis_section(run) -> Section | None:
+    """The diagnosis section: named cause, held-out prediction gain per channel, fitted parameters
+    and the figures; None unless the folder holds ``diagnosis.json``.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An output folder of ``riskassess diagnose`` (``diagnosis.json``, ``diagnosis.npz``).
+
+    Returns
+    -------
+    Section or None
+    """
     if not run.has("diagnosis.json"):
         return None
     answer = run.json("diagnosis.json")

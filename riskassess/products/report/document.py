@@ -76,7 +76,19 @@ def tool_version() -> str:
 
 
 def build_sections(run: RunFolder, progress=None) -> list[Section]:
-    """Every applicable section; a section whose data is missing says what is missing."""
+    """Every applicable section; a section whose data is missing says what is missing.
+
+    Parameters
+    ----------
+    run : RunFolder
+        The output folder the report is made of.
+    progress : callable, optional
+        ``progress(sections done, sections, title of the next)``.
+
+    Returns
+    -------
+    list of Section
+    """
     sections = []
     for k, (section_id, title, build) in enumerate(SECTIONS):
         if progress:
@@ -95,6 +107,18 @@ def build_sections(run: RunFolder, progress=None) -> list[Section]:
 
 
 def folder_problems(run: RunFolder) -> list[str]:
+    """What the report's head warns about: a run that did not complete, missing core files.
+
+    Parameters
+    ----------
+    run : RunFolder
+        The output folder the report is made of.
+
+    Returns
+    -------
+    list of str
+        One sentence per problem.
+    """
     problems = []
     if not run.complete:
         problems.append(f"the run's status is '{run.manifest.get('status')}'"
@@ -107,6 +131,20 @@ def folder_problems(run: RunFolder) -> list[str]:
 
 
 def render_html(run: RunFolder, sections: list[Section]) -> str:
+    """The report of a run folder as one self-contained HTML document.
+
+    Parameters
+    ----------
+    run : RunFolder
+        The output folder the report is made of.
+    sections : list of Section
+        The sections, from :func:`build_sections`.
+
+    Returns
+    -------
+    str
+        The HTML text.
+    """
     case_name = run.manifest.get("case", run.path.name)
     try:
         description = run.case.get("description") or ""
@@ -118,7 +156,28 @@ def render_html(run: RunFolder, sections: list[Section]) -> str:
 
 def render_document(title: str, subtitle: str, folder: Path, created: str, problems: list[str],
                     sections: list[Section]) -> str:
-    """The report template filled with any list of sections (runs, sweeps, later stages)."""
+    """The report template filled with any list of sections (runs, sweeps, later stages).
+
+    Parameters
+    ----------
+    title : str
+        Document title.
+    subtitle : str
+        Line under the title (the case's description, the sweep's arguments).
+    folder : Path
+        The folder the report is written into, shown in the head.
+    created : str
+        When the results were made (ISO 8601 UTC).
+    problems : list of str
+        Warnings shown at the top.
+    sections : list of Section
+        The sections in reading order.
+
+    Returns
+    -------
+    str
+        The HTML text.
+    """
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True,
                              undefined=jinja2.StrictUndefined)
     env.tests.update(table=lambda b: isinstance(b, Table), figure=lambda b: isinstance(b, Figure),
@@ -131,7 +190,22 @@ def render_document(title: str, subtitle: str, folder: Path, created: str, probl
 
 
 def render_pdf(html: str, base_url: Path):
-    """WeasyPrint document of the HTML: (pdf bytes, page count, section id -> first page)."""
+    """WeasyPrint document of the HTML: (pdf bytes, page count, section id -> first page).
+
+    Parameters
+    ----------
+    html : str
+        The report HTML (:func:`render_document`).
+    base_url : Path
+        Folder that relative links of the HTML resolve against.
+
+    Returns
+    -------
+    pdf : bytes
+    pages : int
+    section_pages : dict of str to int
+        Anchor id -> 1-based page where it first appears.
+    """
     import weasyprint
 
     document = weasyprint.HTML(string=html, base_url=str(base_url)).render()
@@ -145,7 +219,24 @@ def render_pdf(html: str, base_url: Path):
 def write_report(run_dir: str | Path, pdf: bool = True, progress=None, views: bool = True) -> ReportOutput:
     """Write ``report.html`` (and ``report.pdf``) into the run folder, each atomically, and with
     ``views`` the animation and the viewer beside it (:func:`riskassess.products.view.products.write_views`);
-    refused (:class:`riskassess.products.outfolder.OutputRefused`) where a file of that name is not the run's own."""
+    refused (:class:`riskassess.products.outfolder.OutputRefused`) where a file of that name is not the run's own.
+
+    Parameters
+    ----------
+    run_dir : str or Path
+        An output folder of this tool (``run``, ``assess``, ``perceive``, ``tow``, ``approach``,
+        ``diagnose``).
+    pdf : bool
+        Also write ``report.pdf``.
+    progress : callable, optional
+        ``progress(sections done, sections, title of the next)``.
+    views : bool
+        Also write the animation and the interactive viewer when the folder has a capture to show.
+
+    Returns
+    -------
+    ReportOutput
+    """
     run = RunFolder(run_dir)
     for name in ("report.html", "report.pdf") if pdf else ("report.html",):
         claim_product(run.path, run.manifest, name)

@@ -18,6 +18,18 @@ def _release_times(run: RunFolder) -> dict[str, float]:
 
 
 def contact_section(run: RunFolder) -> Section:
+    """Net contact force on each debris body and the total contact moment about the debris CoM
+    (N, N m, LVLH), with their peaks and the seed paper's figures.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``timeseries.npz``, ``summary.json``).
+
+    Returns
+    -------
+    Section
+    """
     s = run.timeseries
     summary = run.summary
     t = s["time"]
@@ -52,6 +64,18 @@ def contact_section(run: RunFolder) -> Section:
 
 
 def debris_motion_section(run: RunFolder) -> Section:
+    """Debris CoM velocity change (m/s, LVLH) with the momentum-exchange estimate, and the main
+    body's angular velocity (rad/s, its body frame).
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``timeseries.npz``, ``summary.json``).
+
+    Returns
+    -------
+    Section
+    """
     s = run.timeseries
     summary = run.summary
     t = s["time"]
@@ -83,7 +107,17 @@ def debris_motion_section(run: RunFolder) -> Section:
 
 def hinge_section(run: RunFolder) -> Section:
     """Angle and rate of every revolute joint; after a release the curves continue in grey
-    (the relative rotation of two bodies no longer joined is not a hinge angle)."""
+    (the relative rotation of two bodies no longer joined is not a hinge angle).
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``timeseries.npz``; ``structures.json`` for the release times).
+
+    Returns
+    -------
+    Section
+    """
     s = run.timeseries
     t = s["time"]
     kinds = [str(k) for k in s["joint_kinds"]]
@@ -127,6 +161,18 @@ ENERGY_TERMS = (("energy_net_kinetic", "net kinetic"), ("energy_net_elastic", "n
 
 
 def energy_section(run: RunFolder) -> Section:
+    """Energy terms of net and debris (kJ in the figure) and the drift of their balance, with the
+    conservation checks.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``timeseries.npz``, ``summary.json``).
+
+    Returns
+    -------
+    Section
+    """
     s = run.timeseries
     t = s["time"]
     fig, (ax_e, ax_d) = panels(2, 2.2)

@@ -66,7 +66,17 @@ def _vector(values) -> str:
 
 
 def case_section(run: RunFolder) -> Section:
-    """At a glance, the scalar inputs with units, the bodies and the joints; every input is in the appendix."""
+    """At a glance, the scalar inputs with units, the bodies and the joints; every input is in the appendix.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``case.json``).
+
+    Returns
+    -------
+    Section
+    """
     case = run.case
     rows, warning = _validated_rows(case)
     scalar = [[key, value, unit] for key, value, unit, _ in rows
@@ -85,6 +95,17 @@ def case_section(run: RunFolder) -> Section:
 
 
 def appendix_inputs_section(run: RunFolder) -> Section:
+    """Every input of the validated case, grouped by table, with value, unit and meaning.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``case.json``).
+
+    Returns
+    -------
+    Section
+    """
     rows, warning = _validated_rows(run.case)
     blocks = [warning] if warning else []
     for group, items in groupby(rows, key=lambda r: r[0].rpartition(".")[0]):
@@ -113,6 +134,17 @@ def _flatten(data, prefix=""):
 
 
 def run_facts_section(run: RunFolder) -> Section:
+    """Integrator, step, wall time, output rates, folder format and software versions of the run.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``summary.json``, ``case.json``, ``timeseries.npz``, ``net.npz``).
+
+    Returns
+    -------
+    Section
+    """
     summary, manifest, case = run.summary, run.manifest, run.case
     sim = case["simulation"]
     steps_per_s = summary.get("steps_per_second")

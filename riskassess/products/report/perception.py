@@ -11,6 +11,18 @@ from riskassess.products.tables import perception_rows
 
 
 def perception_section(run: RunFolder) -> Section | None:
+    """The perception section: estimates with 1 sigma and errors, tracking per phase and its
+    figure; None unless the folder holds ``perception.json``.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An output folder of ``riskassess perceive`` (``perception.json``, ``perception.npz``).
+
+    Returns
+    -------
+    Section or None
+    """
     if not run.has("perception.json"):
         return None
     answer = run.json("perception.json")

@@ -19,6 +19,19 @@ def _not_assessed(run: RunFolder) -> bool:
 
 
 def verdict_section(run: RunFolder) -> Section:
+    """The verdict: secondary debris yes / no / indeterminate, the released pieces and one row per
+    weak location and criterion.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``structures.json``; ``case.json`` to tell a case without weak
+        locations).
+
+    Returns
+    -------
+    Section
+    """
     if _not_assessed(run):
         return Section("verdict", "Verdict: secondary debris", [Note(NOT_ASSESSED, "warning")])
     verdict = run.structures  # MissingData names the file when a case with weak locations lacks it
@@ -75,7 +88,22 @@ def _locations_with(verdict: dict, criteria: set) -> list[dict]:
 
 def while_joined(t, demand, loc: dict) -> np.ndarray:
     """The demand (any unit) with NaN after the location's release: a released load path carries
-    nothing, and a plotted 0 would read as a measured zero load."""
+    nothing, and a plotted 0 would read as a measured zero load.
+
+    Parameters
+    ----------
+    t : (k,) float
+        Sample times (s).
+    demand : (k,) float
+        The demand at those times.
+    loc : dict
+        The location's verdict entry (``released_at_s``, s or None).
+
+    Returns
+    -------
+    (k,) float
+        A copy of ``demand``, NaN after the release.
+    """
     demand = np.asarray(demand, float).copy()
     if loc["released_at_s"] is not None:
         demand[np.asarray(t) > loc["released_at_s"]] = np.nan   # the sample that broke it stays
@@ -90,7 +118,18 @@ def _decorate(ax, verdict: dict, loc: dict, time_end: float) -> None:
 
 
 def joint_loads_section(run: RunFolder) -> Section:
-    """Moment and force demands of every weak location that has a moment or force allowable."""
+    """Moment and force demands of every weak location that has a moment or force allowable.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``structures.json``, ``structures.npz``: ``time`` (k,) s and
+        ``<location>/moment`` (N m), ``<location>/force`` (N)).
+
+    Returns
+    -------
+    Section
+    """
     title = "Hinge and joint loads against allowables"
     if _not_assessed(run):
         return Section("joint-loads", title, [Note(NOT_ASSESSED, "warning")])
@@ -117,6 +156,19 @@ def joint_loads_section(run: RunFolder) -> Section:
 
 
 def stresses_section(run: RunFolder) -> Section:
+    """Peak normal and shear stress (MPa in the figure) at each section against the material's
+    strengths, and the peak stresses with their margins.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``structures.json``, ``structures.npz``: ``time`` (k,) s and
+        ``<location>/normal_stress``, ``<location>/shear_stress`` (Pa)).
+
+    Returns
+    -------
+    Section
+    """
     title = "Stresses against strengths"
     if _not_assessed(run):
         return Section("stresses", title, [Note(NOT_ASSESSED, "warning")])

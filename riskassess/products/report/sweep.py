@@ -37,6 +37,22 @@ def _band(ax, x, values_per_x, label, color=None, scale=1.0):
 
 
 def envelope_figure(rows: list[dict], env: dict, figure_id: str = "fig-envelope") -> Figure:
+    """Utilization, peak stresses and breakup likelihood of the runs against the envelope's key.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Run rows of the sweep store (:meth:`riskassess.sweep.store.ResultStore.rows`).
+    env : dict
+        The envelope (:func:`riskassess.products.envelope.envelope`); its ``key`` is the x axis,
+        in the key's SI unit.
+    figure_id : str
+        HTML id of the figure.
+
+    Returns
+    -------
+    Figure
+    """
     key = env["key"]
     groups = _by_value(rows, key)
     x = np.array(list(groups))
@@ -78,7 +94,21 @@ def envelope_figure(rows: list[dict], env: dict, figure_id: str = "fig-envelope"
 
 
 def envelope_section(rows: list[dict], env: dict, other_keys=()) -> Section:
-    """The envelope against ``env['key']``, plus one figure against each other varied key."""
+    """The envelope against ``env['key']``, plus one figure against each other varied key.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Run rows of the sweep store.
+    env : dict
+        The envelope (:func:`riskassess.products.envelope.envelope`).
+    other_keys : sequence of str
+        Further varied case keys, one figure each.
+
+    Returns
+    -------
+    Section
+    """
     blocks = [Note(envelope_statement(env), "info" if env["deterministic_safe_limit"] is not None else "alarm")]
     if any(p["runs"] for p in env["points"]):
         blocks.append(envelope_figure(rows, env))
@@ -107,7 +137,18 @@ def envelope_section(rows: list[dict], env: dict, other_keys=()) -> Section:
 
 def tornado_figure(sensitivity: dict) -> Figure:
     """One panel per weak location: the rank correlation of its utilization with each input, largest
-    magnitude on top (a tornado plot)."""
+    magnitude on top (a tornado plot).
+
+    Parameters
+    ----------
+    sensitivity : dict
+        Location -> {input key -> Spearman rho (-1 to 1) or None}
+        (:func:`riskassess.products.envelope.utilization_sensitivity`), at least one location.
+
+    Returns
+    -------
+    Figure
+    """
     names = list(sensitivity)
     keys = list(next(iter(sensitivity.values())))
     fig = MplFigure(figsize=(WIDTH_IN, 0.7 + len(names) * (0.35 + 0.28 * len(keys))), layout="constrained")
@@ -129,7 +170,17 @@ def tornado_figure(sensitivity: dict) -> Figure:
 
 
 def sensitivity_section(rows: list[dict]) -> Section | None:
-    """The tornado plot of :func:`tornado_figure`, for a sweep with at least 3 finished runs."""
+    """The tornado plot of :func:`tornado_figure`, for a sweep with at least 3 finished runs.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Run rows of the sweep store.
+
+    Returns
+    -------
+    Section or None
+    """
     sensitivity = utilization_sensitivity(rows)
     if not sensitivity or not any(v is not None for s in sensitivity.values() for v in s.values()):
         return None
@@ -141,6 +192,18 @@ def _number(value) -> str:
 
 
 def runs_section(rows: list[dict]) -> Section:
+    """The table of every run: id, overrides, state, secondary debris, peak contact force (N), wall
+    time (s) and error.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Run rows of the sweep store (:meth:`riskassess.sweep.store.ResultStore.rows`).
+
+    Returns
+    -------
+    Section
+    """
     keys = list(rows[0]["overrides"]) if rows else []
     table_rows = []
     for r in rows:

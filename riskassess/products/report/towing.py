@@ -55,7 +55,17 @@ def _scheme(summary: dict) -> str:
 
 
 def towing_section(run: RunFolder) -> Section | None:
-    """None unless the folder holds a tow run (``towing.json``)."""
+    """None unless the folder holds a tow run (``towing.json``).
+
+    Parameters
+    ----------
+    run : RunFolder
+        An output folder of ``riskassess tow`` (``towing.json``, ``towing.npz``).
+
+    Returns
+    -------
+    Section or None
+    """
     if not run.has("towing.json"):
         return None
     summary = run.json("towing.json")

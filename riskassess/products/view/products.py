@@ -28,7 +28,21 @@ class ViewFiles:
 def write_views(run: RunFolder, animation_frames: int = 30, viewer_frames: int = VIEWER_MAX_FRAMES) -> ViewFiles:
     """``capture.gif`` (at most ``animation_frames`` frames) and ``viewer.html`` (at most
     ``viewer_frames`` snapshots) in the run folder; :class:`~riskassess.products.results.MissingData` when the
-    folder lacks the net or the bodies."""
+    folder lacks the net or the bodies.
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``net.npz``, ``timeseries.npz``, ``bodies.npz``).
+    animation_frames : int
+        Most frames of the GIF, >= 2.
+    viewer_frames : int
+        Most snapshots of the viewer, >= 2.
+
+    Returns
+    -------
+    ViewFiles
+    """
     scene = scene_of(run)
     for name in (ANIMATION, VIEWER):
         claim_product(run.path, run.manifest, name)

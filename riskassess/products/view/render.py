@@ -32,7 +32,13 @@ VIEW_ELEV, VIEW_AZIM = 22.0, -58.0
 
 
 def tension_norm(scene: Scene) -> Normalize:
-    """Colour scale of the thread tension (N): 0 to :meth:`Scene.tension_scale` (higher: top colour)."""
+    """Colour scale of the thread tension (N): 0 to :meth:`Scene.tension_scale` (higher: top colour).
+
+    Parameters
+    ----------
+    scene : Scene
+        The run's scene.
+    """
     return Normalize(0.0, max(scene.tension_scale(), 1e-9), clip=True)
 
 
@@ -54,7 +60,19 @@ def _axes(ax, scene: Scene):
 
 def draw_frame(ax, scene: Scene, f: int, norm: Normalize) -> list:
     """Bodies (released ones cyan), threads coloured by tension and bullets of snapshot ``f``;
-    returns the artists drawn (an animation removes them before the next frame)."""
+    returns the artists drawn (an animation removes them before the next frame).
+
+    Parameters
+    ----------
+    ax : mpl_toolkits.mplot3d.axes3d.Axes3D
+        3-D axes in LVLH (m).
+    scene : Scene
+        The run's scene.
+    f : int
+        Net snapshot index.
+    norm : matplotlib.colors.Normalize
+        Tension colour scale (N), from :func:`tension_norm`.
+    """
     light = LightSource(azdeg=315, altdeg=45)
     released = scene.released(f)
     artists = []
@@ -85,7 +103,19 @@ def _title(scene: Scene, f: int, label: str) -> str:
 
 
 def snapshots_png(scene: Scene, instants: list[Instant], width_in: float, dpi: float) -> bytes:
-    """The given instants two per row, one tension colour scale; PNG bytes."""
+    """The given instants two per row, one tension colour scale; PNG bytes.
+
+    Parameters
+    ----------
+    scene : Scene
+        The run's scene.
+    instants : list of Instant
+        The snapshots to draw, one panel each.
+    width_in : float
+        Figure width (inch).
+    dpi : float
+        Resolution (dots per inch).
+    """
     norm = tension_norm(scene)
     cols = min(2, len(instants))
     rows = -(-len(instants) // cols)
@@ -105,7 +135,23 @@ def snapshots_png(scene: Scene, instants: list[Instant], width_in: float, dpi: f
 def write_animation(scene: Scene, path: Path, max_frames: int = 30, size_in: float = 3.6, dpi: float = 80,
                     fps: float = 8.0) -> int:
     """The capture as an animated GIF at ``path`` (at most ``max_frames`` evenly spread snapshots,
-    the first and last included); returns the number of frames written."""
+    the first and last included); returns the number of frames written.
+
+    Parameters
+    ----------
+    scene : Scene
+        The run's scene.
+    path : Path
+        Destination ``.gif`` file (written directly; callers go through a temporary folder).
+    max_frames : int
+        Most frames, >= 2.
+    size_in : float
+        Width of the animation (inch); the height is 0.5 inch more.
+    dpi : float
+        Resolution (dots per inch).
+    fps : float
+        Frames per second of the GIF.
+    """
     frames = decimation(scene.n_frames, max_frames)
     norm = tension_norm(scene)
     fig = Figure(figsize=(size_in, size_in + 0.5), layout="constrained")

@@ -72,20 +72,53 @@ class Scene:
         return len(self.time)
 
     def body_pose(self, f: int, k: int):
-        """(body_to_lvlh (3, 3), CoM (3,) m LVLH) of body ``k`` at snapshot ``f``."""
+        """(body_to_lvlh (3, 3), CoM (3,) m LVLH) of body ``k`` at snapshot ``f``.
+
+        Parameters
+        ----------
+        f : int
+            Net snapshot index.
+        k : int
+            Body index (order of ``body_names``).
+        """
         i = self.sample[f]
         return self.series["body_to_lvlh"][i, k], self.series["body_com_lvlh"][i, k]
 
     def body_vertices(self, f: int, k: int) -> np.ndarray:
-        """Surface vertices (m, LVLH) of body ``k`` at snapshot ``f``."""
+        """Surface vertices (m, LVLH) of body ``k`` at snapshot ``f``.
+
+        Parameters
+        ----------
+        f : int
+            Net snapshot index.
+        k : int
+            Body index (order of ``body_names``).
+
+        Returns
+        -------
+        (v, 3) float
+            The body's mesh vertices (m), LVLH.
+        """
         return surface_lvlh(self.meshes[k][0], *self.body_pose(f, k))
 
     def body_contact_force(self, f: int) -> np.ndarray:
-        """(nb, 3) net contact force on each body (N, LVLH) at the sample nearest snapshot ``f``."""
+        """(nb, 3) net contact force on each body (N, LVLH) at the sample nearest snapshot ``f``.
+
+        Parameters
+        ----------
+        f : int
+            Net snapshot index.
+        """
         return np.asarray(self.series["contact_force_lvlh"][self.sample[f]], float)
 
     def released(self, f: int) -> np.ndarray:
-        """(nb,) bool: the body belongs to a piece released at or before snapshot ``f``."""
+        """(nb,) bool: the body belongs to a piece released at or before snapshot ``f``.
+
+        Parameters
+        ----------
+        f : int
+            Net snapshot index.
+        """
         return self.time[f] >= self.released_from
 
     def instants(self) -> list[Instant]:
@@ -132,12 +165,31 @@ class Scene:
 
 
 def scene_of(run: RunFolder) -> Scene:
-    """The run's scene, built once per :class:`RunFolder` (the report, the animation and the viewer share it)."""
+    """The run's scene, built once per :class:`RunFolder` (the report, the animation and the viewer share it).
+
+    Parameters
+    ----------
+    run : RunFolder
+        An impact run folder (``net.npz``, ``timeseries.npz``, ``bodies.npz``).
+    """
     return run.cached("scene", Scene)
 
 
 def decimation(n_frames: int, max_frames: int) -> np.ndarray:
-    """Indices of at most ``max_frames`` evenly spread snapshots, the first and the last included."""
+    """Indices of at most ``max_frames`` evenly spread snapshots, the first and the last included.
+
+    Parameters
+    ----------
+    n_frames : int
+        Snapshots available.
+    max_frames : int
+        Most snapshots to keep, >= 2.
+
+    Returns
+    -------
+    (m,) int
+        Increasing snapshot indices, m <= ``max_frames``.
+    """
     if max_frames < 2:
         raise ValueError(f"max_frames must be >= 2; got {max_frames}")
     if n_frames <= max_frames:

@@ -33,7 +33,23 @@ def _significant(values, digits: int = 4):
 
 
 def scene_data(scene: Scene, max_frames: int = VIEWER_MAX_FRAMES) -> dict:
-    """The JSON the viewer draws: per kept snapshot the net, tensions, body poses and contact forces."""
+    """The JSON the viewer draws: per kept snapshot the net, tensions, body poses and contact forces.
+
+    Parameters
+    ----------
+    scene : Scene
+        The run's scene.
+    max_frames : int
+        Most snapshots to keep, >= 2.
+
+    Returns
+    -------
+    dict
+        JSON-ready: ``time`` (s), ``net`` node positions (m, LVLH, flattened), ``tension`` (N),
+        ``poses`` per body (body_to_lvlh row-major then CoM, m, LVLH), ``body_force`` and
+        ``node_force`` (N, LVLH), ``bodies`` (vertices in the body frame, m), ``bounds`` (m, LVLH),
+        ``instants``.
+    """
     frames = decimation(scene.n_frames, max_frames)
     low, high = scene.bounds()
     poses, body_force, node_force = [], [], []
@@ -72,7 +88,22 @@ def _script_json(data: dict) -> str:
 
 
 def viewer_html(scene: Scene, title: str, max_frames: int = VIEWER_MAX_FRAMES) -> str:
-    """The viewer page of ``scene``; ``title`` is user text (escaped)."""
+    """The viewer page of ``scene``; ``title`` is user text (escaped).
+
+    Parameters
+    ----------
+    scene : Scene
+        The run's scene.
+    title : str
+        Page title (user text, escaped).
+    max_frames : int
+        Most snapshots to keep, >= 2.
+
+    Returns
+    -------
+    str
+        The whole HTML page.
+    """
     data = scene_data(scene, max_frames)
     # JSON has no infinity: a body never released is null, which the script compares as "never"
     for body in data["bodies"]:
