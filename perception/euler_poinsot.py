@@ -252,7 +252,13 @@ class TorqueFreeFit:
         body_to_world : Rotation (k,)   Measured attitudes B->W.
         weights : (k, 3, 3) float       Square roots of the attitude information (1/rad), B frame.
         omega0_body : (3,) float        Starting rate at ``times[0]`` (rad/s), B frame.
-        moments0, principal_to_body0 :  Starting inertia (ignored when known).
+        moments0 : (3,) float           Starting [A/C, B/C, 1] (-); ignored when ``moments`` is known.
+        principal_to_body0 : (3, 3)     Starting rotation T->B; ignored when ``moments`` is known.
+
+        Returns
+        -------
+        TorqueFreeFit
+            ``self``, with the fitted attributes set.
         """
         times = np.asarray(times, float)
         if self.moments is None:

@@ -130,9 +130,10 @@ def mass_from_linear_momentum(velocity_change_world, others_momentum_change_worl
 
     Parameters
     ----------
-    velocity_change_world : (3,)      v1 - v0 of the debris CoM (m/s).
-    others_momentum_change_world : (3,)  Change of chaser + net linear momentum (N s).
-    cov_* : (3, 3)                    Their covariances (zero if omitted).
+    velocity_change_world : (3,)      v1 - v0 of the debris CoM (m/s, world frame).
+    others_momentum_change_world : (3,)  Change of chaser + net linear momentum (N s, world frame).
+    cov_velocity_change : (3, 3)      Covariance of ``velocity_change_world`` ((m/s)^2), zero if omitted.
+    cov_others_change : (3, 3)        Covariance of ``others_momentum_change_world`` ((N s)^2), zero if omitted.
     """
     zero = np.zeros((3, 3))
     mass, sigma, misfit = _scalar_least_squares(
@@ -175,11 +176,13 @@ def smallest_moment_from_angular_momentum(spin_change_per_c, orbital_change_per_
 
     Parameters
     ----------
-    spin_change_per_c : (3,)       h1 - h0 (rad/s), see :func:`spin_momentum_per_c`.
-    orbital_change_per_mass : (3,)  Delta (p x v) of the debris CoM about O (m^2/s).
+    spin_change_per_c : (3,)       h1 - h0 (rad/s, world frame), see :func:`spin_momentum_per_c`.
+    orbital_change_per_mass : (3,)  Delta (p x v) of the debris CoM about O (m^2/s, world frame).
     mass, mass_sigma : float       Debris mass and its 1 sigma (kg), from the linear balance.
-    others_angular_change : (3,)   Change of chaser + net angular momentum about O (N m s).
-    cov_* : (3, 3)                 Covariances (zero if omitted).
+    others_angular_change : (3,)   Change of chaser + net angular momentum about O (N m s, world frame).
+    cov_spin_change : (3, 3)       Covariance of ``spin_change_per_c`` ((rad/s)^2), zero if omitted.
+    cov_orbital_change_per_mass : (3, 3)  Covariance of ``orbital_change_per_mass`` ((m^2/s)^2), zero if omitted.
+    cov_others_change : (3, 3)     Covariance of ``others_angular_change`` ((N m s)^2), zero if omitted.
     """
     zero = np.zeros((3, 3))
     orbital = np.asarray(orbital_change_per_mass, float)
