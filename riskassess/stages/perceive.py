@@ -244,8 +244,9 @@ def observe_tumble_model_free(scene: Scene, frames: Frames, rng, progress=None):
             progress("observation", k + 1, count + 1)
     reg = p.registration
     track = track_scans(scans, reg.voxel, reg.max_correspondence)
-    tracker = DebrisTracker(reg.voxel, reg.max_correspondence, reg.model_frames, track.map_points, track.map_normals,
-                            seed=p.seed)
+    # No registered frame (e.g. empty scans): no map; the fits below answer "not observable".
+    tracker = DebrisTracker(reg.voxel, reg.max_correspondence, reg.model_frames,
+                            *((track.map_points, track.map_normals) if track.ok.any() else ()), seed=p.seed)
     tracker.alignments = map_alignments(track, frames.time)
     target_to_body = np.eye(4)
     if track.ok.any():

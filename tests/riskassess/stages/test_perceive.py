@@ -76,17 +76,20 @@ def test_case_takes_mass_properties_from_a_perception_result(perceived):
     assert body.inertia == answer["inertia_target_kg_m2"]
 
 
-def test_a_debris_that_does_not_turn_is_not_observable(tmp_path, capsys):
-    case = _shortened(tmp_path, 3.0, 1.0, angular_velocity="[0.0, 0.0, 0.0]")
+@pytest.mark.parametrize("model", ["known", "none"])
+def test_a_debris_that_does_not_turn_is_not_observable(tmp_path, capsys, model):
+    case = _shortened(tmp_path, 3.0, 1.0, angular_velocity="[0.0, 0.0, 0.0]", seed=f'0\nmodel = "{model}"')
     assert main(["perceive", str(case), "--out", str(tmp_path / "run"), "--json"]) == 3
     answer = json.loads(capsys.readouterr().out)
     assert "turn" in answer["not_observable"]
     assert "mass_estimate" not in answer
 
 
-def test_an_empty_scan_is_not_observable(tmp_path, capsys):
-    # the debris sits 10 m away; a 5 m range returns nothing: no pose, no estimate
-    case = _shortened(tmp_path, 2.0, 1.0, rate="10.0\nmax_range = 5.0")
+@pytest.mark.parametrize("model", ["known", "none"])
+def test_an_empty_scan_is_not_observable(tmp_path, capsys, model):
+    # the debris sits 10 m away; a 5 m range returns nothing: no pose, no estimate (with the mesh
+    # or without it: no map either)
+    case = _shortened(tmp_path, 2.0, 1.0, rate="10.0\nmax_range = 5.0", seed=f'0\nmodel = "{model}"')
     assert main(["perceive", str(case), "--out", str(tmp_path / "run"), "--json"]) == 3
     answer = json.loads(capsys.readouterr().out)
     assert "registered frames" in answer["not_observable"]
