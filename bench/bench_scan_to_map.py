@@ -12,6 +12,7 @@ and the figures printed per seed: registration time per frame, frames registered
 the world at t = 0, and the inertia-ratio errors of the torque-free fit.
 
     python bench/bench_scan_to_map.py [--seeds 0 1 2 3 4] [--duration 20] [--body featured|ellipsoid]
+                                      [--models none known]
 """
 from __future__ import annotations
 
@@ -73,6 +74,7 @@ def main():
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
     parser.add_argument("--duration", type=float, default=20.0, help="tumble tracked (s)")
     parser.add_argument("--body", choices=("featured", "ellipsoid"), default="featured")
+    parser.add_argument("--models", nargs="+", choices=("none", "known"), default=["none", "known"])
     args = parser.parse_args()
     times = np.arange(int(round(args.duration * LIDAR.rate)) + 1) / LIDAR.rate
     quaternions, _ = propagate_torque_free(np.array([1.0, 0, 0, 0]), OMEGA0, MOMENTS / MOMENTS[2], times, 0.005)
@@ -84,11 +86,14 @@ def main():
         rng = np.random.default_rng(seed)
         scans = [cast(LIDAR, [(mesh.vertices @ r.T + COM0 + VELOCITY * t, mesh.faces)], t, rng).points_sensor
                  for t, r in zip(times, body_to_world)]
-        free = track_scans(scans, VOXEL, CORRESPONDENCE)
-        records = alignments(free, times)
-        # B of the model-free track is the first scan's frame; the truth in it: R_k R_0^T (R_0 = I here)
-        print(f"seed {seed} none : " + _figures(times, body_to_world, free.world_to_body, free.ok,
-                                               np.array([a.information for a in records]), free.seconds))
+        if "none" in args.models:
+            free = track_scans(scans, VOXEL, CORRESPONDENCE)
+            records = alignments(free, times)
+            # B of the model-free track is the first scan's frame; the truth in it: R_k R_0^T (R_0 = I here)
+            print(f"seed {seed} none : " + _figures(times, body_to_world, free.world_to_body, free.ok,
+                                                   np.array([a.information for a in records]), free.seconds))
+        if "known" not in args.models:
+            continue
         known = DebrisTracker(VOXEL, CORRESPONDENCE, 30, *known_shape_model(mesh, VOXEL, seed), seed=seed)
         for t, points in zip(times, scans):
             known.update(t, points, np.zeros(3))
