@@ -27,7 +27,7 @@ from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING, ACC_CONTACT_F, ACC_CONTACTS,
                                          ACC_DEBRIS_F, ACC_DEBRIS_T, ACC_EXTERNAL, ACC_SIZE, ACC_TENSION, D_CLOSING,
                                          D_CONTACT_F, D_CONTACTS, D_ELONGATION, D_RATE, D_SIZE, D_TENSION, advance_net,
-                                         chaser_actuation, net_forces)
+                                         chaser_actuation, chaser_control, net_forces)
 from multibody.net_wrap import TowingNet
 from multibody.towing import HEALTH_EVERY_STEPS, TowedBodies, tow_failure_cause
 from multibody.net_towing_kernel import D_SLIDING, D_THRUST, D_TORQUE
@@ -92,13 +92,14 @@ def _bodies(q, v, reference_c, reference_d):
 
 @njit(cache=True)
 def step_forces(q, v, t, advance, x, xv, lag, clock, masses, radii, threads, rest, stiffness, damping, reference, mu, central,
-                main_tether, attach_c, body_masses, inertia, inverse_inertia_d, geometry, law, n_sub, step, attitude,
-                thrust_kind, along_z, thrust_params, thrust_state, body_reference, acc, diag, f, work):
+                main_tether, attach_c, body_masses, inertia, inverse_inertia_d, geometry, law, n_sub, step, control,
+                body_reference, acc, diag, f, work):
     """Generalized forces (12,) on chaser and debris at time ``t`` (s, absolute) for Exudyn's object.
     If ``advance``, the net (``x`` relative to ``reference``, ``xv``) is first sub-cycled from
     ``clock[CLOCK_TIME]`` to ``t`` (:func:`multibody.net_towing_kernel.advance_net`) and the bodies get
     the step's mean reactions; otherwise (the solver's initial evaluation, output samples) the
-    reactions at the current state. Thrust, attitude torque and gravity are evaluated at ``t``."""
+    reactions at the current state. Thrust and attitude torque (``control``, a
+    :class:`multibody.net_towing_kernel.ChaserControl`) and gravity are evaluated at ``t``."""
     bodies = _bodies(q, v, body_reference[0], body_reference[1])
     force = np.zeros(12)
     if advance:
@@ -139,8 +140,8 @@ def step_forces(q, v, t, advance, x, xv, lag, clock, masses, radii, threads, res
     u /= np.sqrt(u @ u)
     chaser = force[0:6]
     before = chaser[0:3].copy()
-    chaser_actuation(t, z, rate, u, rot_c, bodies[0, 0:3], bodies[0, 6:9], bodies[0, 9:12], inertia[0], attitude,
-                     thrust_kind, along_z, thrust_params, thrust_state, step, advance, chaser, diag)
+    chaser_actuation(t, z, rate, u, rot_c, bodies[0, 0:3], bodies[0, 6:9], bodies[0, 9:12], inertia[0], control, step,
+                     advance, chaser, diag)
     debris = force[6:12]
     add_body_gravity(chaser, 0, bodies[0, 0], bodies[0, 1], bodies[0, 2], body_masses[0], mu)
     add_body_gravity(debris, 0, bodies[1, 0], bodies[1, 1], bodies[1, 2], body_masses[1], mu)
@@ -164,6 +165,9 @@ class NetTowState:
         self.rest = top.rest_lengths.copy()
         self.stiffness = top.stiffness.copy()
         self.thrust_state = np.array(model.thrust_state, float)
+        self.control = chaser_control(np.ascontiguousarray(model.attitude, float), model.thrust_command,
+                                      bool(model.thrust_along_body_z), np.ascontiguousarray(model.thrust_params, float),
+                                      self.thrust_state)
         self.acc, self.diag = np.zeros(ACC_SIZE), np.zeros(D_SIZE)
         self.f, self.work, self.lag = np.zeros_like(self.x), np.zeros(21), np.zeros_like(self.x)
         self.tether_on = np.array(model.main_tether, float)
@@ -189,8 +193,8 @@ class NetTowState:
         return step_forces(q, v, t, advance, self.x, self.v, self.lag, self.clock, top.masses, top.radii, top.threads, self.rest,
                            self.stiffness, top.damping, self.reference, m.mu, m.net.central, tether,
                            m.attach_chaser_body, m.masses, m.inertia_body, m.inverse_inertia[1], m.geometry,
-                           m.contact_law, m.substeps, m.step, m.attitude, m.thrust_kind, m.thrust_along_body_z,
-                           m.thrust_params, self.thrust_state, m.positions, self.acc, self.diag, self.f, self.work)
+                           m.contact_law, m.substeps, m.step, self.control, m.positions, self.acc, self.diag, self.f,
+                           self.work)
 
     def momentum(self, v_bodies) -> np.ndarray:
         """Total linear momentum (N s, inertial) of chaser, debris and net."""

@@ -24,10 +24,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.experimental import structref
 
 from multibody.control.attitude import desired_attitude, sliding_mode_torque
-from multibody.control.thrust import thrust_command
+from multibody.control.thrust import THRUST_LAW
 from multibody.connection_point import implicit_point_step
 from multibody.contact import contact_over_step
 from multibody.contact_kernel import _effective_mass_along_normal, _substeps_to_resolve_contact
@@ -288,17 +289,61 @@ def _implicit_tether_step(x, v, f, mass, reference, central, main_tether, a_poin
     return _main_tether(x, v, reference, central, main_tether, a_point, a_velocity, com_c, h, f, acc)
 
 
+_VECTOR = types.float64[::1]
+
+
+@structref.register
+class ChaserControlType(types.StructRef):
+    """numba type of :class:`ChaserControl`."""
+
+
+class ChaserControl(structref.StructRefProxy):
+    """The chaser's controllers as the compiled full-net kernel takes them (make it with
+    :func:`chaser_control`).
+
+    Fields
+    ------
+    attitude : (8,) float       Sliding-mode attitude control: on (1/0), K (1/s), G (3,) (rad/s^2),
+                                boundary layer epsilon (3,) (rad/s) (eqs. 7-10).
+    thrust : first-class function   The thrust law's compiled ``command``
+                                (:data:`multibody.control.thrust.THRUST_LAW`).
+    along_body_z : bool         Thrust along the chaser's body z (True) or against its inertial velocity.
+    thrust_params : (k,) float  The law's constants; ``thrust_state`` (j,) float its states, advanced
+                                in place (shared with the array given, not copied).
+    """
+
+
+structref.define_proxy(ChaserControl, ChaserControlType, ["attitude", "thrust", "along_body_z", "thrust_params",
+                                                          "thrust_state"])
+#: numba type of the kernels' chaser-control argument.
+CHASER_CONTROL = ChaserControlType([("attitude", _VECTOR), ("thrust", THRUST_LAW), ("along_body_z", types.boolean),
+                                    ("thrust_params", _VECTOR), ("thrust_state", _VECTOR)])
+
+
+@njit(CHASER_CONTROL(_VECTOR, THRUST_LAW, types.boolean, _VECTOR, _VECTOR), cache=True)
+def chaser_control(attitude, thrust, along_body_z, thrust_params, thrust_state):
+    """The :class:`ChaserControl` of these fields (arrays shared, not copied)."""
+    control = structref.new(CHASER_CONTROL)
+    control.attitude = attitude
+    control.thrust = thrust
+    control.along_body_z = along_body_z
+    control.thrust_params = thrust_params
+    control.thrust_state = thrust_state
+    return control
+
+
 @njit(cache=True)
-def chaser_actuation(t, elongation, rate, u_inertial, rot_c, com_c, vel_c, omega_c, inertia_c, attitude, thrust_kind,
-                     along_body_z, thrust_params, thrust_state, step, advance, force, diag):
-    """Thrust (the case's law, :func:`multibody.control.thrust.thrust_command`, along the chaser's body z or
-    against its velocity as in the lower-order model) and the sliding-mode torque (eqs. 7-10,
-    :mod:`multibody.control.attitude`) from the main tether's elongation and direction ``u_inertial`` (A -> net
-    node). Adds them to ``force`` (6,: chaser force inertial, torque body) and fills ``diag``."""
-    magnitude = thrust_command(thrust_kind, t, elongation, rate, thrust_params, thrust_state, step, advance)
+def chaser_actuation(t, elongation, rate, u_inertial, rot_c, com_c, vel_c, omega_c, inertia_c, control, step, advance,
+                     force, diag):
+    """Thrust (the case's law ``control.thrust``, along the chaser's body z or against its velocity as in the
+    lower-order model) and the sliding-mode torque (eqs. 7-10, :mod:`multibody.control.attitude`) from the main
+    tether's elongation (m), its rate (m/s) and direction ``u_inertial`` (A -> net node); ``control`` a
+    :class:`ChaserControl`. Adds them to ``force`` (6,: chaser force inertial, torque body) and fills ``diag``."""
+    attitude = control.attitude
+    magnitude = control.thrust(t, elongation, rate, control.thrust_params, control.thrust_state, step, advance)
     diag[D_THRUST] = magnitude
     if magnitude != 0.0:
-        if along_body_z:
+        if control.along_body_z:
             direction = rot_c[:, 2].copy()
         else:
             direction = -vel_c / math.sqrt(vel_c[0] ** 2 + vel_c[1] ** 2 + vel_c[2] ** 2)

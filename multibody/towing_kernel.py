@@ -23,10 +23,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.experimental import structref
 
 from multibody.control.attitude import desired_attitude, sliding_mode_torque
-from multibody.control.thrust import thrust_command
+from multibody.control.thrust import THRUST_LAW
 from multibody.connection_point import STATE_SIZE, TIME, V_N, X_N, advance_point, initial_point_state
 from multibody.kernel import rotation_matrix_from_rotation_vector, verlet_evaluation_state
 from multibody.net import tension_only_kelvin_voigt
@@ -88,12 +89,13 @@ def _tether_to_body(x, v, rot, base, com, point_body, k, c, rest, out_force):
 
 @njit(cache=True)
 def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, attach_debris, tether, mu,
-                  attitude, thrust_kind, thrust_along_body_z, thrust_params, thrust_state, step, advance,
+                  attitude, thrust, thrust_along_body_z, thrust_params, thrust_state, step, advance,
                   out_force, out_diag):
     """Generalized forces (``out_force``, (15,)) of the lower-order model at time ``t`` (s).
 
     MT and ST tensions (eqs. 4, 5, 13, 14), two-body gravity on P, chaser and debris (eq. 1),
-    thrust (the ramp after eq. 2 or a :mod:`multibody.control.thrust` law), sliding-mode torque (eqs. 7-10).
+    thrust (``thrust``: the case's law, a compiled :mod:`multibody.control.thrust` command), sliding-mode
+    torque (eqs. 7-10).
     ``reference`` (3, 3) holds the reference positions of P, chaser and debris (m);
     ``masses`` = [m_P, m_C, m_D] (kg); ``tether`` = [k_MT, c_MT, l_MT0, k_ST, c_ST, l_ST0];
     ``attitude`` = [on, K, G (3), width (3)]. The thrust law's state advances by ``step`` when
@@ -120,7 +122,7 @@ def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, att
     add_body_gravity(out_force, CHASER, com_c[0], com_c[1], com_c[2], masses[1], mu)
     add_body_gravity(out_force, DEBRIS, com_d[0], com_d[1], com_d[2], masses[2], mu)
 
-    magnitude = thrust_command(thrust_kind, t, z, z_rate, thrust_params, thrust_state, step, advance)
+    magnitude = thrust(t, z, z_rate, thrust_params, thrust_state, step, advance)
     out_diag[THRUST] = magnitude
     if magnitude != 0.0:
         if thrust_along_body_z:
@@ -162,15 +164,16 @@ def accelerations(v, force, masses, inertia, inverse_inertia):
 
 # ---------------------------------------------------------------------------- packed model
 # One float array holds the whole model, the thrust law's state and the work buffers, so that a
-# step costs one call from Python (numba's dispatch costs ~0.2 us per argument).
-(W_N_ATTACH, W_KIND, W_ALONG_Z, W_STEP, W_MU, W_THRUST_PARAMS, W_N_THRUST_PARAMS, W_THRUST_STATE, W_N_THRUST_STATE,
- W_ATTACH, W_DIAG, W_FORCE, W_ACCEL, W_POINT, W_EXTRA) = range(15)
+# step costs one call from Python (numba's dispatch costs ~0.2 us per argument); the TowKernel
+# structref pairs it with the thrust law's compiled command.
+(W_N_ATTACH, W_ALONG_Z, W_STEP, W_MU, W_THRUST_PARAMS, W_N_THRUST_PARAMS, W_THRUST_STATE, W_N_THRUST_STATE,
+ W_ATTACH, W_DIAG, W_FORCE, W_ACCEL, W_POINT, W_EXTRA) = range(14)
 W_REFERENCE, W_MASSES, W_INERTIA, W_INVERSE, W_ATTACH_CHASER, W_TETHER, W_ATTITUDE, W_END = (
     16, 25, 28, 46, 64, 67, 73, 81)
 
 
-def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, attitude, thrust_kind,
-         thrust_along_body_z, thrust_params, thrust_state, step, point_velocity, start_time) -> np.ndarray:
+def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, attitude, thrust_along_body_z,
+         thrust_params, thrust_state, step, point_velocity, start_time) -> np.ndarray:
     """The packed model (see :func:`towing_forces` for the meaning of each part) with P's integrator
     state at ``start_time`` (s), P moving with ``point_velocity`` (m/s, inertial). The last section
     (:data:`W_EXTRA`, zero here) holds further generalized forces (15,) in the kernel layout that
@@ -181,7 +184,7 @@ def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, a
              N_COORDINATES]
     offsets = W_END + np.concatenate([[0], np.cumsum(sizes)])
     work = np.zeros(offsets[-1])
-    work[:15] = [n, thrust_kind, float(thrust_along_body_z), step, mu, offsets[1], len(thrust_params), offsets[2],
+    work[:14] = [n, float(thrust_along_body_z), step, mu, offsets[1], len(thrust_params), offsets[2],
                  len(thrust_state), offsets[0], offsets[3], offsets[4], offsets[5], offsets[6], offsets[7]]
     work[offsets[6]:offsets[7]] = initial_point_state(point_velocity, start_time)
     inertia = np.asarray(inertia, float)
@@ -190,6 +193,51 @@ def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, a
     for start, part in zip(offsets[:3], (np.ravel(attach_debris), thrust_params, thrust_state)):
         work[start:start + len(part)] = part
     return work
+
+
+_VECTOR = types.float64[::1]
+
+
+@structref.register
+class TowKernelType(types.StructRef):
+    """numba type of :class:`TowKernel`."""
+
+
+class TowKernel(structref.StructRefProxy):
+    """The lower-order model as the compiled kernels take it (make it with :func:`tow_kernel`).
+
+    Fields
+    ------
+    work : (m,) float    The packed model of :func:`pack` (geometry, masses, tethers, attitude control,
+                         the thrust law's params and state, P's state, work buffers; SI, inertial).
+    thrust : first-class function   The thrust law's compiled ``command``
+                         (:data:`multibody.control.thrust.THRUST_LAW`).
+    """
+
+    @property
+    def work(self) -> np.ndarray:
+        """The packed model (the kernel's own array, not a copy)."""
+        return _work_of(self)
+
+
+@njit(cache=True)
+def _work_of(tow):
+    return tow.work
+
+
+structref.define_proxy(TowKernel, TowKernelType, ["work", "thrust"])
+#: numba type of the kernels' model argument.
+TOW_KERNEL = TowKernelType([("work", _VECTOR), ("thrust", THRUST_LAW)])
+
+
+@njit(TOW_KERNEL(_VECTOR, THRUST_LAW), cache=True)
+def tow_kernel(work, thrust):
+    """The :class:`TowKernel` of the packed model ``work`` (:func:`pack`, shared, not copied) and the
+    thrust law ``thrust`` (a compiled ``command`` of :mod:`multibody.control.thrust_laws`)."""
+    tow = structref.new(TOW_KERNEL)
+    tow.work = work
+    tow.thrust = thrust
+    return tow
 
 
 @njit(cache=True, inline="always")
@@ -248,11 +296,12 @@ def _advance_connection_point(q, v, t, work, attach):
 
 
 @njit(cache=True)
-def packed_forces(q, v, t, work, advance):
-    """:func:`towing_forces` of the packed model; the force and diagnostics land in ``work``. P's
-    entries of ``q`` and ``v`` are overwritten with its implicit state at ``t`` (advanced first if
-    ``t`` is a new step time, the forces then taken at the bodies' predicted velocities at ``t``,
-    see :func:`_advance_connection_point`)."""
+def packed_forces(q, v, t, tow, advance):
+    """:func:`towing_forces` of the packed model ``tow`` (:class:`TowKernel`); the force and diagnostics
+    land in its ``work``. P's entries of ``q`` and ``v`` are overwritten with its implicit state at ``t``
+    (advanced first if ``t`` is a new step time, the forces then taken at the bodies' predicted
+    velocities at ``t``, see :func:`_advance_connection_point`)."""
+    work, thrust = tow.work, tow.thrust
     n = int(work[W_N_ATTACH])
     attach = work[int(work[W_ATTACH]):int(work[W_ATTACH]) + 3 * n].reshape((n, 3))
     v_eval = _advance_connection_point(q, v, t, work, attach)
@@ -260,7 +309,7 @@ def packed_forces(q, v, t, work, advance):
     force = work[int(work[W_FORCE]):int(work[W_FORCE]) + N_COORDINATES]
     towing_forces(q, v_eval, t, work[W_REFERENCE:W_MASSES].reshape((3, 3)), work[W_MASSES:W_INERTIA],
                   work[W_INERTIA:W_INERTIA + 9].reshape((3, 3)), work[W_ATTACH_CHASER:W_TETHER], attach,
-                  work[W_TETHER:W_ATTITUDE], work[W_MU], work[W_ATTITUDE:W_END], int(work[W_KIND]),
+                  work[W_TETHER:W_ATTITUDE], work[W_MU], work[W_ATTITUDE:W_END], thrust,
                   work[W_ALONG_Z] > 0.0, _section(work, W_THRUST_PARAMS, W_N_THRUST_PARAMS),
                   _section(work, W_THRUST_STATE, W_N_THRUST_STATE), work[W_STEP], advance, force, diag)
     extra = extra_forces(work)
@@ -277,23 +326,23 @@ def extra_forces(work):
 
 
 @njit(cache=True)
-def body_forces(q_bodies, v_bodies, t, work, advance):
+def body_forces(q_bodies, v_bodies, t, tow, advance):
     """The packed model's generalized forces on chaser and debris (12,) for Exudyn's object, which
-    holds only their coordinates (entries 3-14 of the kernel layout); P comes from ``work``; the
+    holds only their coordinates (entries 3-14 of the kernel layout); P comes from ``tow``; the
     thrust law's state advances when ``advance``."""
     q, v = np.zeros(N_COORDINATES), np.zeros(N_COORDINATES)
     q[3:], v[3:] = q_bodies, v_bodies
-    force, _ = packed_forces(q, v, t, work, advance)
-    _store_accelerations(v, force, work)  # as the twin does, for the next step's velocity prediction
+    force, _ = packed_forces(q, v, t, tow, advance)
+    _store_accelerations(v, force, tow.work)  # as the twin does, for the next step's velocity prediction
     return force[3:].copy()
 
 
 @njit(cache=True)
-def sampled_state(q_bodies, v_bodies, t, work):
+def sampled_state(q_bodies, v_bodies, t, tow):
     """Full state (15,) each and diagnostics at ``t`` from the bodies' state and P's stored state."""
     q, v = np.zeros(N_COORDINATES), np.zeros(N_COORDINATES)
     q[3:], v[3:] = q_bodies, v_bodies
-    diag = packed_forces(q, v, t, work, False)[1]
+    diag = packed_forces(q, v, t, tow, False)[1]
     return q, v, diag.copy()
 
 
@@ -306,50 +355,75 @@ def _store_accelerations(v, force, work):
 
 
 @njit(cache=True)
-def start_forces(q, v, t, work):
-    """Force at the initial state (thrust law advanced, as at every step); stores the initial
-    accelerations in ``work``; returns the force (15,)."""
-    force, _ = packed_forces(q, v, t, work, True)
-    _store_accelerations(v, force, work)
+def start_forces(q, v, t, tow):
+    """Force at the state (q, v) at time ``t`` (s), the thrust law advanced (as at every step); stores
+    the accelerations in ``tow.work`` for the next step; returns the force (15,)."""
+    force, _ = packed_forces(q, v, t, tow, True)
+    _store_accelerations(v, force, tow.work)
     return force
 
 
-@njit(cache=True)
-def step_forces(q, v, t, work):
-    """The force of the VelocityVerlet step that starts at (q, v) with the stored accelerations,
-    evaluated where Exudyn's VelocityVerlet evaluates it at time ``t`` (the step's end): half
-    kick, drift with the Lie-group update (:func:`multibody.kernel.verlet_evaluation_state`).
-    Stores the step's accelerations for the next call; returns the force (15,) and the
-    evaluation state (q, v)."""
-    start = int(work[W_ACCEL])
-    q_next, v_half = verlet_evaluation_state(q, v, work[start:start + N_COORDINATES], work[W_STEP], 3, 2)
-    force, _ = packed_forces(q_next, v_half, t, work, True)
-    _store_accelerations(v_half, force, work)
-    return force, q_next, v_half
+# ---------------------------------------------------------------------------- the Verlet loop
+#: numba signature of a load law ``law(t, q, v, p, work, xe, h, load)``: the further generalized
+#: forces a caller adds each step (:func:`verlet_run`; the diagnosis' effects): ``t`` (s), the
+#: evaluation state ``q``, ``v`` (15,) in the kernel layout (P's entries stale: read P from ``work``),
+#: the law's parameters ``p``, the packed model ``work``, the caller's own states ``xe`` advanced in
+#: place over ``h`` (s; 0: do not advance), ``load`` (15,) the loads it ADDS (forces N, inertial;
+#: torques N m, body frames). Laws are compiled eagerly with it (first-class functions).
+LOAD_LAW_SIGNATURE = types.void(types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64, _VECTOR)
+LOAD_LAW = types.FunctionType(LOAD_LAW_SIGNATURE)
 
 
-@njit(cache=True)
-def twin_run(q, v, t0, n_steps, every, work, out_q, out_v, out_diag):
-    """Integrate the lower-order model with exactly the scheme Exudyn's VelocityVerlet applies to the
-    coupled object: half kick, drift (Lie-group update of the rotation vectors), force at the new
-    state (:func:`step_forces`), half kick. Samples every ``every`` steps into ``out_q``/``out_v``
-    (k, 15) and ``out_diag`` (diagnostics at the sampled state, thrust law not advanced). ``q``,
-    ``v`` and ``work`` are updated in place; returns the final time (s)."""
+@njit(LOAD_LAW_SIGNATURE, cache=True)
+def no_load(t, q, v, p, work, xe, h, load):
+    """The nominal model: no further loads."""
+    return
+
+
+@njit(types.void(LOAD_LAW, types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64, _VECTOR),
+      cache=True)
+def apply_loads(law, t, q, v, p, work, xe, h, load):
+    """Evaluate ``law`` at (``t``, ``q``, ``v``) into ``load`` and make it the packed model's further
+    forces for the coming force evaluation (advancing the states ``xe`` over ``h``)."""
+    load[:] = 0.0
+    law(t, q, v, p, work, xe, h, load)
+    extra = extra_forces(work)
+    extra[:] = load
+
+
+_MATRIX = types.float64[:, ::1]
+
+
+@njit(types.void(TOW_KERNEL, LOAD_LAW, _VECTOR, _VECTOR, _VECTOR, types.float64, types.int64, _VECTOR,
+                  types.int64[::1], _MATRIX, _MATRIX, _MATRIX, _MATRIX), cache=True)
+def verlet_run(tow, law, p, q, v, t0, n_steps, xe, record, out_q, out_v, out_diag, out_xe):
+    """Integrate the lower-order model ``tow`` from (``q``, ``v``) (15,) each at ``t0`` (s) with exactly
+    the scheme Exudyn's VelocityVerlet applies to the coupled object: half kick, drift (Lie-group
+    update of the rotation vectors, :func:`multibody.kernel.verlet_evaluation_state`), the load law
+    ``law`` (:data:`LOAD_LAW_SIGNATURE`, parameters ``p``, states ``xe``; :func:`no_load` for the
+    nominal model) then the forces at the new state (P stepped implicitly), half kick. Records
+    state, diagnostics (at the recorded state, thrust law not advanced) and ``xe`` after the steps
+    listed in ``record`` (non-decreasing step indices, 0 = the initial state) into the ``out_*``
+    rows (record indices beyond ``n_steps`` are not reached). ``q``, ``v``, ``xe`` and ``tow.work``
+    are updated in place."""
+    work = tow.work
     step = work[W_STEP]
-    start_forces(q, v, t0, work)
-    acc = int(work[W_ACCEL])
-    sample = 0
+    load = np.zeros(N_COORDINATES)
+    apply_loads(law, t0, q, v, p, work, xe, 0.0, load)
+    start_forces(q, v, t0, tow)
+    acc = work[int(work[W_ACCEL]):int(work[W_ACCEL]) + N_COORDINATES]     # the stored accelerations (a view)
+    k = 0
     for n in range(n_steps + 1):
         t = t0 + n * step
-        if n % every == 0 and sample < out_q.shape[0]:
-            out_q[sample] = q
-            out_v[sample] = v
-            out_diag[sample] = packed_forces(q, v, t, work, False)[1]
-            sample += 1
+        while k < record.shape[0] and record[k] == n:
+            out_q[k], out_v[k], out_xe[k] = q, v, xe
+            out_diag[k] = packed_forces(q.copy(), v.copy(), t, tow, False)[1]
+            k += 1
         if n == n_steps:
             break
-        _, q_next, v_half = step_forces(q, v, t + step, work)
+        q_next, v_half = verlet_evaluation_state(q, v, acc, step, 3, 2)
+        apply_loads(law, t + step, q_next, v_half, p, work, xe, step, load)
+        start_forces(q_next, v_half, t + step, tow)
         q[:] = q_next
         for i in range(N_COORDINATES):
-            v[i] = v_half[i] + (0.5 * step) * work[acc + i]
-    return t0 + n_steps * step
+            v[i] = v_half[i] + (0.5 * step) * acc[i]
