@@ -27,7 +27,8 @@ from multibody.kernel import rotation_matrix_from_rotation_vector
 from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING, ACC_CONTACT_F, ACC_CONTACTS,
                                          ACC_DEBRIS_F, ACC_DEBRIS_T, ACC_EXTERNAL, ACC_SIZE, ACC_TENSION, D_CLOSING,
                                          D_CONTACT_F, D_CONTACTS, D_ELONGATION, D_RATE, D_SIZE, D_TENSION, advance_net,
-                                         chaser_actuation, chaser_control, net_forces)
+                                         DebrisBody, DebrisMotion, NetThreads, TetherEnd, chaser_actuation,
+                                         chaser_control, net_forces)
 from multibody.net_wrap import TowingNet
 from multibody.towing import HEALTH_EVERY_STEPS, TowedBodies, tow_failure_cause
 from multibody.net_towing_kernel import D_SLIDING, D_THRUST, D_TORQUE
@@ -91,22 +92,24 @@ def _bodies(q, v, reference_c, reference_d):
 
 
 @njit(cache=True)
-def step_forces(q, v, t, advance, x, xv, lag, clock, masses, radii, threads, rest, stiffness, damping, reference, mu, central,
-                main_tether, attach_c, body_masses, inertia, inverse_inertia_d, geometry, law, n_sub, step, control,
-                body_reference, acc, diag, f, work):
+def step_forces(q, v, t, advance, x, xv, lag, clock, net, reference, mu, central, main_tether, attach_c, body_masses,
+                inertia, debris, n_sub, step, control, body_reference, acc, diag, f, work):
     """Generalized forces (12,) on chaser and debris at time ``t`` (s, absolute) for Exudyn's object.
     If ``advance``, the net (``x`` relative to ``reference``, ``xv``) is first sub-cycled from
     ``clock[CLOCK_TIME]`` to ``t`` (:func:`multibody.net_towing_kernel.advance_net`) and the bodies get
     the step's mean reactions; otherwise (the solver's initial evaluation, output samples) the
     reactions at the current state. Thrust and attitude torque (``control``, a
-    :class:`multibody.net_towing_kernel.ChaserControl`) and gravity are evaluated at ``t``."""
+    :class:`multibody.net_towing_kernel.ChaserControl`) and gravity are evaluated at ``t``.
+    ``net`` (:class:`multibody.net_towing_kernel.NetThreads`) and ``debris``
+    (:class:`~multibody.net_towing_kernel.DebrisBody`) as the kernel takes them; ``body_masses`` (2,)
+    m_C, m_D (kg), ``inertia`` (2, 3, 3) their inertia (body frames, kg m^2), ``body_reference`` (2, 3)
+    their reference CoM positions (m, absolute); the other arguments as :meth:`NetTowState.forces` passes them."""
     bodies = _bodies(q, v, body_reference[0], body_reference[1])
     force = np.zeros(12)
     if advance:
         h_step = t - clock[CLOCK_TIME]
-        tension, z, rate = advance_net(x, xv, lag, clock[CLOCK_TIME], t, n_sub, masses, radii, threads, rest, stiffness,
-                                       damping, reference, mu, central, main_tether, attach_c, bodies, body_masses[1],
-                                       inverse_inertia_d, geometry, law, f, acc, work)
+        tension, z, rate = advance_net(x, xv, lag, clock[CLOCK_TIME], t, n_sub, net, reference, mu, central,
+                                       main_tether, attach_c, bodies, debris, f, acc, work)
         clock[CLOCK_TIME] = t
         clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3] += acc[ACC_EXTERNAL:ACC_EXTERNAL + 3]
         scale = 1.0 / h_step
@@ -120,10 +123,10 @@ def step_forces(q, v, t, advance, x, xv, lag, clock, masses, radii, threads, res
         a_point = bodies[0, 0:3] + arm
         a_velocity = bodies[0, 6:9] + rot_c @ np.cross(bodies[0, 9:12], attach_c)
         acc[:] = 0.0
-        tension, z, rate = net_forces(x, xv, lag.copy(), masses, radii, threads, rest, stiffness, damping, reference, mu, central,
-                                      main_tether, a_point, a_velocity, bodies[0, 0:3], bodies[1, 0:3] - reference,
-                                      rot_d, bodies[1, 6:9], rot_d @ bodies[1, 9:12], body_masses[1], inverse_inertia_d,
-                                      geometry, law, h, f, acc, work)
+        tension, z, rate = net_forces(x, xv, lag.copy(), net, reference, mu, central,
+                                      TetherEnd(main_tether, a_point, a_velocity, bodies[0, 0:3]),
+                                      DebrisMotion(bodies[1, 0:3] - reference, rot_d, bodies[1, 6:9], rot_d @ bodies[1, 9:12]),
+                                      debris, h, f, acc, work)
     rot_c = rotation_matrix_from_rotation_vector(bodies[0, 3:6])
     rot_d = rotation_matrix_from_rotation_vector(bodies[1, 3:6])
     force[0:3] = scale * acc[ACC_CHASER_F:ACC_CHASER_F + 3]
@@ -173,6 +176,8 @@ class NetTowState:
         self.tether_on = np.array(model.main_tether, float)
         self.tether_off = np.array([0.0, 0.0, model.main_tether[2]])
         self.reeling = model.closing_duration is not None
+        self.net = NetThreads(top.masses, top.radii, top.threads, self.rest, self.stiffness, top.damping)
+        self.debris = DebrisBody(float(model.masses[1]), model.inverse_inertia[1], model.geometry, model.contact_law)
         self.rest_open = top.rest_lengths[-len(model.net.closing_rest_closed):].copy()
 
     def reel(self, t):
@@ -186,15 +191,13 @@ class NetTowState:
         self.reeling = ramp < 1.0
 
     def forces(self, q, v, t, advance):
-        m, top = self.model, self.model.net.topology
+        m = self.model
         if self.reeling and t >= m.closing_time:
             self.reel(t)
         tether = self.tether_on if t >= m.closing_time else self.tether_off
-        return step_forces(q, v, t, advance, self.x, self.v, self.lag, self.clock, top.masses, top.radii, top.threads, self.rest,
-                           self.stiffness, top.damping, self.reference, m.mu, m.net.central, tether,
-                           m.attach_chaser_body, m.masses, m.inertia_body, m.inverse_inertia[1], m.geometry,
-                           m.contact_law, m.substeps, m.step, self.control, m.positions, self.acc, self.diag, self.f,
-                           self.work)
+        return step_forces(q, v, t, advance, self.x, self.v, self.lag, self.clock, self.net, self.reference, m.mu,
+                           m.net.central, tether, m.attach_chaser_body, m.masses, m.inertia_body, self.debris, m.substeps,
+                           m.step, self.control, m.positions, self.acc, self.diag, self.f, self.work)
 
     def momentum(self, v_bodies) -> np.ndarray:
         """Total linear momentum (N s, inertial) of chaser, debris and net."""

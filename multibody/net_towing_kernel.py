@@ -22,6 +22,7 @@ frame.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, types
@@ -48,6 +49,44 @@ D_TENSION, D_ELONGATION, D_RATE, D_THRUST, D_TORQUE, D_SLIDING, D_CONTACTS, D_CO
 CYL_RADIUS, CYL_HALF, CYL_Z = 0, 1, 2
 #: Contact law: k_n (N/m^n), n, d_n, mu_s, mu_k, V_t0 (see multibody.assembly.ContactLaw).
 C_K, C_EXP, C_D, C_MUS, C_MUK, C_VT = range(6)
+
+
+class NetThreads(NamedTuple):
+    """The net's nodes and threads as the towing kernels take them (n nodes, m threads; SI)."""
+
+    node_mass: np.ndarray     # (n,) node masses (kg)
+    node_radius: np.ndarray   # (n,) node contact radii (m)
+    threads: np.ndarray       # (m, 2) int64 node pairs; the closing loop is the last 12
+    rest: np.ndarray          # (m,) natural lengths (m); the closing loop's change in place while it is reeled in
+    stiffness: np.ndarray     # (m,) EA/l0 (N/m), likewise
+    damping: np.ndarray       # (m,) (N s/m)
+
+
+class DebrisBody(NamedTuple):
+    """The debris as the net's contact meets it: a rigid closed cylinder (SI)."""
+
+    mass: float                         # (kg)
+    inverse_inertia_body: np.ndarray    # (3, 3) inverse inertia about the CoM, debris frame (1/(kg m^2))
+    geometry: np.ndarray                # (3,) radius (m), half length (m), axial centre z_body (m): CYL_*
+    contact_law: np.ndarray             # (6,) k_n, n, d_n, mu_s, mu_k, V_t0: C_*
+
+
+class DebrisMotion(NamedTuple):
+    """The debris' motion at one net sub-step (inertial frame)."""
+
+    com: np.ndarray              # (3,) CoM relative to the nodes' reference point (m)
+    to_inertial: np.ndarray      # (3, 3) rotation debris frame -> inertial
+    velocity: np.ndarray         # (3,) CoM velocity (m/s)
+    omega_inertial: np.ndarray   # (3,) angular velocity, inertial components (rad/s)
+
+
+class TetherEnd(NamedTuple):
+    """The main tether (eq. 5a) and its end A on the chaser at one net sub-step (inertial frame)."""
+
+    params: np.ndarray        # (3,) k_MT (N/m), c_MT (N s/m), l_MT0 (m)
+    point: np.ndarray         # (3,) attachment point A, absolute (m)
+    velocity: np.ndarray      # (3,) A's velocity (m/s)
+    chaser_com: np.ndarray    # (3,) chaser CoM, absolute (m)
 
 
 @njit(cache=True, inline="always")
@@ -118,21 +157,23 @@ def _node_contact(i, x, v, lag, f, node_mass, penetration, nbx, nby, nbz, com, r
 
 
 @njit(cache=True)
-def net_forces(x, v, lag, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu, central,
-               main_tether, a_point, a_velocity, com_c, com_d, rot_d, vel_d, omega_d, mass_d, inverse_inertia_d, geometry,
-               law, h, f, acc, work, explicit_tether=True):
+def net_forces(x, v, lag, net, reference, mu, central, end, motion, debris, h, f, acc, work, explicit_tether=True):
     """Forces on every node (``f`` (n, 3), N) at positions ``x`` (displacements from ``reference``, m)
     and velocities ``v`` (m/s); the reactions on the bodies (force, torque about the CoM, inertial)
     are added to ``acc`` times ``h`` (impulses), with the main tether's tension, contact count, total
     contact force, largest closing-thread tension and the node gravity's impulse.
 
-    ``main_tether`` = [k_MT, c_MT, l_MT0] joins node ``central`` to the chaser's attachment
-    ``a_point`` (absolute, m) moving with ``a_velocity`` (m/s); chaser CoM ``com_c`` (absolute, m);
-    the debris (CoM ``com_d``, relative to ``reference`` like the nodes, attitude
-    ``rot_d``, velocity ``vel_d``, angular velocity ``omega_d`` inertial) is the cylinder ``geometry``.
+    ``net`` (:class:`NetThreads`) the nodes and threads; ``end`` (:class:`TetherEnd`) the main tether from
+    node ``central`` to the chaser's attachment; ``motion`` (:class:`DebrisMotion`, CoM relative to
+    ``reference`` like the nodes) and ``debris`` (:class:`DebrisBody`) the debris cylinder; ``mu``
+    (m^3/s^2), ``h`` the sub-step (s); ``f``, ``acc``, ``work`` buffers.
     Returns the main tether's (tension, elongation, elongation rate). With ``explicit_tether`` False
     the main tether is left out (the sub-cycle steps it implicitly, :func:`_implicit_tether_step`).
     """
+    node_mass, node_radius, threads, rest, stiffness, damping = net
+    main_tether, a_point, a_velocity, com_c = end
+    com_d, rot_d, vel_d, omega_d = motion
+    mass_d, inverse_inertia_d, geometry, law = debris
     f[:] = 0.0
     add_thread_forces(x, v, threads, rest, stiffness, damping, f)
     n = x.shape[0]
@@ -220,15 +261,17 @@ def _geodesic(rot_end, omega_body, back):
 
 
 @njit(cache=True)
-def advance_net(x, v, lag, t_start, t_end, n_sub, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu,
-                central, main_tether, attach_chaser_body, bodies, mass_d, inverse_inertia_d, geometry, law, f, acc,
-                work):
+def advance_net(x, v, lag, t_start, t_end, n_sub, net, reference, mu, central, main_tether, attach_chaser_body, bodies,
+                debris, f, acc, work):
     """Advance the net from ``t_start`` to ``t_end`` (s) by ``n_sub`` symplectic-Euler sub-steps while
     chaser and debris move as Verlet moves them over the step. ``bodies`` (2, 12): per body (chaser,
     debris) the CoM at ``t_end`` (absolute, m), rotation vector body->inertial at ``t_end`` (rad),
-    half-step CoM velocity (m/s) and angular velocity (rad/s, body frame). ``acc`` (ACC_SIZE) is
+    half-step CoM velocity (m/s) and angular velocity (rad/s, body frame). ``net``
+    (:class:`NetThreads`), ``debris`` (:class:`DebrisBody`), ``main_tether`` = [k_MT (N/m), c_MT (N s/m),
+    l_MT0 (m)], ``attach_chaser_body`` (3,) A in the chaser frame (m). ``acc`` (ACC_SIZE) is
     zeroed and receives the impulses over the step (:func:`net_forces`). Returns the main tether's
     (tension, elongation, rate) at the last sub-step."""
+    node_mass = net.node_mass
     acc[:] = 0.0
     h = (t_end - t_start) / n_sub
     rot_c_end = rotation_matrix_from_rotation_vector(bodies[0, 3:6])
@@ -242,9 +285,8 @@ def advance_net(x, v, lag, t_start, t_end, n_sub, node_mass, node_radius, thread
             com_d[a] = bodies[1, a] - back * bodies[1, 6 + a] - reference[a]
         _attachment(bodies[0], rot_c_end, attach_chaser_body, back, com_c, a_point, a_velocity)
         omega_d = rot_d @ bodies[1, 9:12]
-        net_forces(x, v, lag, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu, central,
-                   main_tether, a_point, a_velocity, com_c, com_d, rot_d, bodies[1, 6:9], omega_d,
-                   mass_d, inverse_inertia_d, geometry, law, h, f, acc, work, False)
+        net_forces(x, v, lag, net, reference, mu, central, TetherEnd(main_tether, a_point, a_velocity, com_c),
+                   DebrisMotion(com_d, rot_d, bodies[1, 6:9], omega_d), debris, h, f, acc, work, False)
         for i in range(x.shape[0]):
             if i == central:
                 continue
