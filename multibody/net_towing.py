@@ -18,7 +18,8 @@ from dataclasses import dataclass
 import exudyn as exu
 import numpy as np
 from exudyn.itemInterface import NodeRigidBodyRotVecLG, ObjectGenericODE2, ObjectRigidBody
-from numba import njit
+from numba import njit, types
+from numba.experimental import structref
 from scipy.spatial.transform import Rotation
 
 from multibody.health import HealthWatch
@@ -91,25 +92,70 @@ def _bodies(q, v, reference_c, reference_d):
     return out
 
 
+@structref.register
+class NetTowKernelType(types.StructRef):
+    """numba type of :class:`NetTowKernel`."""
+
+
+class NetTowKernel(structref.StructRefProxy):
+    """One full-net run as :func:`step_forces` takes it (made by :class:`NetTowState`; arrays shared with it).
+
+    Fields
+    ------
+    x, xv : (n, 3) float        Net nodes: positions relative to ``reference`` (m) and velocities (m/s), inertial.
+    lag : (n, 3) float          Contact velocity lags carried between sub-steps (m/s).
+    clock : (CLOCK_SIZE,) float Net time (s) and the external impulse since the start (3, N s, inertial).
+    net : NetThreads            Node masses and radii, threads (:class:`multibody.net_towing_kernel.NetThreads`).
+    reference : (3,) float      Origin of the node positions, absolute (m).
+    mu : float                  Gravitational parameter (m^3/s^2).
+    central : int               Node the main tether holds.
+    attach_c : (3,) float       Main-tether attachment A, chaser body frame (m).
+    body_masses : (2,) float    m_C, m_D (kg).
+    inertia : (2, 3, 3) float   Chaser and debris inertia about their CoMs, body frames (kg m^2).
+    debris : DebrisBody         The debris cylinder and contact law (:class:`multibody.net_towing_kernel.DebrisBody`).
+    n_sub : int                 Net sub-steps per body step.
+    step : float                Body step (s).
+    control : ChaserControl     Thrust law and attitude control (:class:`multibody.net_towing_kernel.ChaserControl`).
+    body_reference : (2, 3) float   Chaser and debris reference CoM positions, absolute (m).
+    acc, diag, f, work : float arrays   Per-step impulses (ACC_SIZE), diagnostics (D_SIZE), node forces (n, 3), scratch.
+    """
+
+
+_NET_TOW_FIELDS = ["x", "xv", "lag", "clock", "net", "reference", "mu", "central", "attach_c", "body_masses", "inertia",
+                   "debris", "n_sub", "step", "control", "body_reference", "acc", "diag", "f", "work"]
+structref.define_proxy(NetTowKernel, NetTowKernelType, _NET_TOW_FIELDS)
+
+
 @njit(cache=True)
-def step_forces(q, v, t, advance, x, xv, lag, clock, net, reference, mu, central, main_tether, attach_c, body_masses,
-                inertia, debris, n_sub, step, control, body_reference, acc, diag, f, work):
-    """Generalized forces (12,) on chaser and debris at time ``t`` (s, absolute) for Exudyn's object.
+def net_tow_kernel(x, xv, lag, clock, net, reference, mu, central, attach_c, body_masses, inertia, debris, n_sub, step,
+                   control, body_reference, acc, diag, f, work):
+    """The :class:`NetTowKernel` of these fields (compiled once and cached, unlike the proxy's own constructor)."""
+    return NetTowKernel(x, xv, lag, clock, net, reference, mu, central, attach_c, body_masses, inertia, debris, n_sub,
+                        step, control, body_reference, acc, diag, f, work)
+
+
+@njit(cache=True)
+def step_forces(q, v, t, advance, main_tether, tow):
+    """Generalized forces (12,) on chaser and debris at time ``t`` (s, absolute) for Exudyn's object,
+    from their coordinates ``q`` and velocities ``v`` (12,) (CoM displacement (m) and rotation vector,
+    CoM velocity (m/s, inertial) and angular velocity (rad/s, body), per body), the run ``tow``
+    (:class:`NetTowKernel`) and the main tether ``main_tether`` = [k_MT (N/m), c_MT (N s/m), l_MT0 (m)].
     If ``advance``, the net (``x`` relative to ``reference``, ``xv``) is first sub-cycled from
     ``clock[CLOCK_TIME]`` to ``t`` (:func:`multibody.net_towing_kernel.advance_net`) and the bodies get
     the step's mean reactions; otherwise (the solver's initial evaluation, output samples) the
     reactions at the current state. Thrust and attitude torque (``control``, a
-    :class:`multibody.net_towing_kernel.ChaserControl`) and gravity are evaluated at ``t``.
-    ``net`` (:class:`multibody.net_towing_kernel.NetThreads`) and ``debris``
-    (:class:`~multibody.net_towing_kernel.DebrisBody`) as the kernel takes them; ``body_masses`` (2,)
-    m_C, m_D (kg), ``inertia`` (2, 3, 3) their inertia (body frames, kg m^2), ``body_reference`` (2, 3)
-    their reference CoM positions (m, absolute); the other arguments as :meth:`NetTowState.forces` passes them."""
+    :class:`multibody.net_towing_kernel.ChaserControl`) and gravity are evaluated at ``t``."""
+    x, xv, lag, clock, net, reference = tow.x, tow.xv, tow.lag, tow.clock, tow.net, tow.reference
+    mu, central, attach_c, body_masses, inertia, debris_body = (tow.mu, tow.central, tow.attach_c, tow.body_masses,
+                                                                tow.inertia, tow.debris)
+    n_sub, step, control, body_reference = tow.n_sub, tow.step, tow.control, tow.body_reference
+    acc, diag, f, work = tow.acc, tow.diag, tow.f, tow.work
     bodies = _bodies(q, v, body_reference[0], body_reference[1])
     force = np.zeros(12)
     if advance:
         h_step = t - clock[CLOCK_TIME]
         tension, z, rate = advance_net(x, xv, lag, clock[CLOCK_TIME], t, n_sub, net, reference, mu, central,
-                                       main_tether, attach_c, bodies, debris, f, acc, work)
+                                       main_tether, attach_c, bodies, debris_body, f, acc, work)
         clock[CLOCK_TIME] = t
         clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3] += acc[ACC_EXTERNAL:ACC_EXTERNAL + 3]
         scale = 1.0 / h_step
@@ -126,7 +172,7 @@ def step_forces(q, v, t, advance, x, xv, lag, clock, net, reference, mu, central
         tension, z, rate = net_forces(x, xv, lag.copy(), net, reference, mu, central,
                                       TetherEnd(main_tether, a_point, a_velocity, bodies[0, 0:3]),
                                       DebrisMotion(bodies[1, 0:3] - reference, rot_d, bodies[1, 6:9], rot_d @ bodies[1, 9:12]),
-                                      debris, h, f, acc, work)
+                                      debris_body, h, f, acc, work)
     rot_c = rotation_matrix_from_rotation_vector(bodies[0, 3:6])
     rot_d = rotation_matrix_from_rotation_vector(bodies[1, 3:6])
     force[0:3] = scale * acc[ACC_CHASER_F:ACC_CHASER_F + 3]
@@ -178,6 +224,11 @@ class NetTowState:
         self.reeling = model.closing_duration is not None
         self.net = NetThreads(top.masses, top.radii, top.threads, self.rest, self.stiffness, top.damping)
         self.debris = DebrisBody(float(model.masses[1]), model.inverse_inertia[1], model.geometry, model.contact_law)
+        m = model
+        self.kernel = net_tow_kernel(self.x, self.v, self.lag, self.clock, self.net, self.reference, float(m.mu),
+                                     int(m.net.central), np.ascontiguousarray(m.attach_chaser_body, float), m.masses,
+                                     m.inertia_body, self.debris, int(m.substeps), float(m.step), self.control,
+                                     m.positions, self.acc, self.diag, self.f, self.work)
         self.rest_open = top.rest_lengths[-len(model.net.closing_rest_closed):].copy()
 
     def reel(self, t):
@@ -195,9 +246,7 @@ class NetTowState:
         if self.reeling and t >= m.closing_time:
             self.reel(t)
         tether = self.tether_on if t >= m.closing_time else self.tether_off
-        return step_forces(q, v, t, advance, self.x, self.v, self.lag, self.clock, self.net, self.reference, m.mu,
-                           m.net.central, tether, m.attach_chaser_body, m.masses, m.inertia_body, self.debris, m.substeps,
-                           m.step, self.control, m.positions, self.acc, self.diag, self.f, self.work)
+        return step_forces(q, v, t, advance, tether, self.kernel)
 
     def momentum(self, v_bodies) -> np.ndarray:
         """Total linear momentum (N s, inertial) of chaser, debris and net."""

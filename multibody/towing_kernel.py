@@ -21,6 +21,7 @@ gyroscopic terms are Exudyn's own (the twin adds them as Exudyn does).
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, types
@@ -87,21 +88,42 @@ def _tether_to_body(x, v, rot, base, com, point_body, k, c, rest, out_force):
     return tension, length - rest, rate, dx, dy, dz
 
 
+class TowingParts(NamedTuple):
+    """The lower-order model's constants as :func:`towing_forces` takes them (SI; inertial frame unless
+    ``_body``; n sub-tethers)."""
+
+    reference: np.ndarray        # (3, 3) reference positions of P, chaser CoM, debris CoM (m, absolute)
+    masses: np.ndarray           # (3,) m_P, m_C, m_D (kg)
+    inertia_chaser: np.ndarray   # (3, 3) J_C about the CoM, chaser body frame (kg m^2)
+    attach_chaser: np.ndarray    # (3,) MT attachment r_A/C, chaser body frame (m)
+    attach_debris: np.ndarray    # (n, 3) ST attachments r_i/D, debris body frame (m)
+    tether: np.ndarray           # (6,) k_MT (N/m), c_MT (N s/m), l_MT0 (m), k_ST, c_ST, l_ST0: K_MT ... L_ST
+    mu: float                    # gravitational parameter (m^3/s^2)
+    attitude: np.ndarray         # (8,) controller on (1/0), K (1/s), G (3,) (rad/s^2), width (3,) (rad/s): ATT_*
+
+
+class ThrustLaw(NamedTuple):
+    """The chaser's thrust law as :func:`towing_forces` takes it."""
+
+    command: object              # compiled command, :data:`multibody.control.thrust.THRUST_LAW` (first-class function)
+    along_body_z: bool           # along the chaser's body z (True) or against its inertial velocity
+    params: np.ndarray           # (k,) the law's constants
+    state: np.ndarray            # (j,) its states, advanced in place
+
+
 @njit(cache=True)
-def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, attach_debris, tether, mu,
-                  attitude, thrust, thrust_along_body_z, thrust_params, thrust_state, step, advance,
-                  out_force, out_diag):
+def towing_forces(q, v, t, parts, thrust, step, advance, out_force, out_diag):
     """Generalized forces (``out_force``, (15,)) of the lower-order model at time ``t`` (s).
 
     MT and ST tensions (eqs. 4, 5, 13, 14), two-body gravity on P, chaser and debris (eq. 1),
-    thrust (``thrust``: the case's law, a compiled :mod:`multibody.control.thrust` command), sliding-mode
-    torque (eqs. 7-10).
-    ``reference`` (3, 3) holds the reference positions of P, chaser and debris (m);
-    ``masses`` = [m_P, m_C, m_D] (kg); ``tether`` = [k_MT, c_MT, l_MT0, k_ST, c_ST, l_ST0];
-    ``attitude`` = [on, K, G (3), width (3)]. The thrust law's state advances by ``step`` when
-    ``advance``. ``out_diag`` receives MT tension, elongation and rate, thrust magnitude, control
-    torque (3, body), sliding variable (3) and the ST tensions.
+    thrust (``thrust``, a :class:`ThrustLaw`: the case's compiled :mod:`multibody.control.thrust` law),
+    sliding-mode torque (eqs. 7-10); the model's constants in ``parts`` (:class:`TowingParts`). The
+    thrust law's state advances by ``step`` (s) when ``advance``. ``out_diag`` receives MT tension,
+    elongation and rate, thrust magnitude, control torque (3, body), sliding variable (3) and the ST
+    tensions.
     """
+    reference, masses, inertia_chaser, attach_chaser, attach_debris, tether, mu, attitude = parts
+    command, thrust_along_body_z, thrust_params, thrust_state = thrust
     out_force[:] = 0.0
     x = np.empty(3)  # P, absolute (m)
     com_c = np.empty(3)
@@ -122,7 +144,7 @@ def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, att
     add_body_gravity(out_force, CHASER, com_c[0], com_c[1], com_c[2], masses[1], mu)
     add_body_gravity(out_force, DEBRIS, com_d[0], com_d[1], com_d[2], masses[2], mu)
 
-    magnitude = thrust(t, z, z_rate, thrust_params, thrust_state, step, advance)
+    magnitude = command(t, z, z_rate, thrust_params, thrust_state, step, advance)
     out_diag[THRUST] = magnitude
     if magnitude != 0.0:
         if thrust_along_body_z:
@@ -307,11 +329,12 @@ def packed_forces(q, v, t, tow, advance):
     v_eval = _advance_connection_point(q, v, t, work, attach)
     diag = work[int(work[W_DIAG]):int(work[W_DIAG]) + ST_TENSION + n]
     force = work[int(work[W_FORCE]):int(work[W_FORCE]) + N_COORDINATES]
-    towing_forces(q, v_eval, t, work[W_REFERENCE:W_MASSES].reshape((3, 3)), work[W_MASSES:W_INERTIA],
-                  work[W_INERTIA:W_INERTIA + 9].reshape((3, 3)), work[W_ATTACH_CHASER:W_TETHER], attach,
-                  work[W_TETHER:W_ATTITUDE], work[W_MU], work[W_ATTITUDE:W_END], thrust,
-                  work[W_ALONG_Z] > 0.0, _section(work, W_THRUST_PARAMS, W_N_THRUST_PARAMS),
-                  _section(work, W_THRUST_STATE, W_N_THRUST_STATE), work[W_STEP], advance, force, diag)
+    parts = TowingParts(work[W_REFERENCE:W_MASSES].reshape((3, 3)), work[W_MASSES:W_INERTIA],
+                        work[W_INERTIA:W_INERTIA + 9].reshape((3, 3)), work[W_ATTACH_CHASER:W_TETHER], attach,
+                        work[W_TETHER:W_ATTITUDE], work[W_MU], work[W_ATTITUDE:W_END])
+    law = ThrustLaw(thrust, work[W_ALONG_Z] > 0.0, _section(work, W_THRUST_PARAMS, W_N_THRUST_PARAMS),
+                    _section(work, W_THRUST_STATE, W_N_THRUST_STATE))
+    towing_forces(q, v_eval, t, parts, law, work[W_STEP], advance, force, diag)
     extra = extra_forces(work)
     for i in range(3, N_COORDINATES):
         force[i] += extra[i]
