@@ -1,4 +1,4 @@
-"""Full-net towing benchmark (issue 7 item 6: the 300 s full-net tow in under 10 min on 2 cores).
+"""Full-net towing benchmark (goal: the 300 s full-net tow in under 10 min on 2 cores).
 
     python bench/bench_fullnet_tow.py                      # the case's full run (25 -> 300 s)
     python bench/bench_fullnet_tow.py --study --end 60     # step study over 35 s of towing

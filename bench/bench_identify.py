@@ -10,7 +10,7 @@ processes.
 
 (defaults: the case's ``[identification.optimizers]``). Prints the CPU time of one evaluation (its
 10 runs, one after the other, in this process), then per optimizer: s, cost, largest relative error
-against s_true, evaluations, wall time, and the load average before and after. Goal (issue 7): every s
+against s_true, evaluations, wall time, and the load average before and after. Goal: every s
 within 1e-3 relative, < 10 min on 2 cores. Timings are upper bounds when other jobs share the machine
 (the load average says how much).
 """

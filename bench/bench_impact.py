@@ -48,7 +48,7 @@ def sized_inputs(case_path: Path, nodes_per_side: int, end_time: float, net_inte
     case = load_case(case_path)
     net = case.net.model_copy(update={"nodes_per_side": nodes_per_side})
     simulation = {"end_time": end_time}
-    if "net_integration" in type(case.simulation).model_fields:  # absent before issue 22 (for "before" figures)
+    if "net_integration" in type(case.simulation).model_fields:  # absent in older trees (for "before" figures)
         simulation["net_integration"] = net_integration
     case = case.model_copy(update={"net": net, "simulation": case.simulation.model_copy(update=simulation)})
     inputs = model_inputs(case, case_path.parent)

@@ -1,4 +1,4 @@
-"""Stick-slip check of the catalog's ``hinge_coulomb_friction`` (issue 24 item 4).
+"""Stick-slip check of the catalog's ``hinge_coulomb_friction`` (sticking hinges, docs/diagnosis.md).
 
     python bench/bench_stick_slip.py [--out DIR]
 

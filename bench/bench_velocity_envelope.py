@@ -4,7 +4,7 @@
 
 A joint released at its first exceedance carries nothing afterwards, so a sweep with release on
 records for it the demand at release, and its utilization hardly moves with the impact energy
-(issue 23: 1.11 / 1.16 / 1.15 at 5 / 12.5 / 20 m/s). With ``structures.release = "never"`` every
+(envisat_small's array hinge: 1.11 / 1.16 / 1.15 at 5 / 12.5 / 20 m/s). With ``structures.release = "never"`` every
 joint holds whatever it carries, so the recorded peak is the demand it would see if it held. This
 script runs the case (default ``cases/envisat_small.toml``) that way at each velocity on the sweep
 runner and prints, per velocity, every location's utilization (peak / decisive allowable), its

@@ -1,4 +1,4 @@
-"""Hostile-input probes of the whole CLI (issue 20): every command, fed what a careless or hostile
+"""Hostile-input probes of the whole CLI: every command, fed what a careless or hostile
 user would feed it, must answer with a clear error or a correct result, and never touch a file
 it did not create.
 

@@ -84,7 +84,22 @@ class JointSpec:
 
 
 def subtree_bodies(joints: list[JointSpec], root: int, cut_joints=()) -> list[int]:
-    """``root`` and every body attached below it through joints not in ``cut_joints`` (indices)."""
+    """``root`` and every body attached below it through joints not in ``cut_joints`` (indices).
+
+    Parameters
+    ----------
+    joints : list of JointSpec
+        The assembly's joints (parent -> child).
+    root : int
+        Index of the body the subtree starts from.
+    cut_joints : collection of int
+        Indices into ``joints`` of joints treated as broken.
+
+    Returns
+    -------
+    list of int
+        Body indices, ``root`` first, depth-first.
+    """
     out = [root]
     for k, joint in enumerate(joints):
         if joint.parent == root and k not in cut_joints:

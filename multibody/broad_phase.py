@@ -21,7 +21,17 @@ from numba import njit
 
 def box_shape_flags(triangles, triangle_range, box_min, box_max) -> np.ndarray:
     """(ns,) int64: 1 where a shape is the axis-aligned box of its body-frame bounds (12 triangles, every
-    corner at a bound), else 0 (the shape keeps the triangle search)."""
+    corner at a bound), else 0 (the shape keeps the triangle search).
+
+    Parameters
+    ----------
+    triangles : (T, 3, 3) float
+        Triangle corners of all shapes, each in its body's frame (m).
+    triangle_range : (ns, 2) int
+        First and past-the-last triangle of each shape.
+    box_min, box_max : (ns, 3) float
+        Bounds of each shape, body frame (m).
+    """
     flags = np.zeros(len(triangle_range), np.int64)
     for s, (first, last) in enumerate(triangle_range):
         if last - first != 12:
@@ -38,7 +48,20 @@ def box_shape_flags(triangles, triangle_range, box_min, box_max) -> np.ndarray:
 def box_signed_distance(px, py, pz, lo, hi):
     """Signed distance (m) of body-frame point p to the box [lo, hi] (negative inside), and the unit
     normal from the surface to the point (the face normal inside), body frame; as
-    :func:`multibody.contact.signed_distance_to_mesh` on the box's mesh."""
+    :func:`multibody.contact.signed_distance_to_mesh` on the box's mesh.
+
+    Parameters
+    ----------
+    px, py, pz : float
+        The point, body frame (origin at the body's CoM) (m).
+    lo, hi : (3,) float
+        The box's lower and upper corners, body frame (m).
+
+    Returns
+    -------
+    tuple of 4 float
+        Distance (m) and the unit normal's x, y, z components, body frame.
+    """
     cx, cy, cz = 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])
     dx, dy, dz = px - cx, py - cy, pz - cz
     qx, qy, qz = abs(dx) - 0.5 * (hi[0] - lo[0]), abs(dy) - 0.5 * (hi[1] - lo[1]), abs(dz) - 0.5 * (hi[2] - lo[2])
@@ -61,39 +84,59 @@ def box_signed_distance(px, py, pz, lo, hi):
 
 
 @njit(cache=True)
-def flag_candidates(x, reach, rots, coms, shape_body, box_min, box_max, shape_reach, flags):
-    """``flags[s, i]`` = 1 where node ``i`` (LVLH position ``x[i]`` (m)) is inside shape ``s``'s body-frame
+def flag_candidates(x_lvlh, reach, body_to_lvlh, com_lvlh, shape_body, box_min, box_max, shape_reach, flags):
+    """``flags[s, i]`` = 1 where node ``i`` (LVLH position ``x_lvlh[i]`` (m)) is inside shape ``s``'s body-frame
     bounding box grown by ``reach[i] + shape_reach[s]`` (m: what node and shape can close within the
     step), else 0; ``flags[ns, i]`` (the row after the ns shapes' rows) = 1 where any shape's flag is,
-    so the contact pass skips a far node with one read. ``rots``, ``coms``: body->LVLH attitudes and CoMs (m); bounds in the body frame.
-    Branch-free over the nodes, so the compiler vectorizes it: the positions are first copied
-    coordinate-major (3, n), since strided loads from (n, 3) kept the loop scalar (12 us against 3 us
-    a pass for the reference case's 1229 nodes and 5 shapes)."""
-    n = x.shape[0]
+    so the contact pass skips a far node with one read. Branch-free over the nodes, so the compiler
+    vectorizes it: the positions are first copied coordinate-major (3, n), since strided loads from
+    (n, 3) kept the loop scalar (12 us against 3 us a pass for the reference case's 1229 nodes and
+    5 shapes).
+
+    Parameters
+    ----------
+    x_lvlh : (n, 3) float
+        Net node positions, LVLH (m).
+    reach : (n,) float
+        Each node's contact radius plus the distance it can travel within the step (m).
+    body_to_lvlh : (nb, 3, 3) float
+        Body attitudes (columns: body axes in LVLH).
+    com_lvlh : (nb, 3) float
+        Body CoMs, LVLH (m).
+    shape_body : (ns,) int
+        Body carrying each shape.
+    box_min, box_max : (ns, 3) float
+        Bounds of each shape, body frame (m).
+    shape_reach : (ns,) float
+        Distance each shape's surface can travel within the step (m).
+    flags : (ns + 1, n) int
+        Output, overwritten: one row per shape, then the "near any shape" row.
+    """
+    n = x_lvlh.shape[0]
     xs = np.empty((3, n))
     for i in range(n):
-        xs[0, i] = x[i, 0]
-        xs[1, i] = x[i, 1]
-        xs[2, i] = x[i, 2]
+        xs[0, i] = x_lvlh[i, 0]
+        xs[1, i] = x_lvlh[i, 1]
+        xs[2, i] = x_lvlh[i, 2]
     x0, x1, x2 = xs[0], xs[1], xs[2]
     n_shapes = shape_body.shape[0]
     near_any = flags[n_shapes]
     near_any[:] = 0
     for s in range(n_shapes):
         b = shape_body[s]
-        r = rots[b]
+        body_to_lvlh_b = body_to_lvlh[b]
         # box centre in LVLH, half sizes in the body frame
         mx, my, mz = (0.5 * (box_min[s, 0] + box_max[s, 0]), 0.5 * (box_min[s, 1] + box_max[s, 1]),
                       0.5 * (box_min[s, 2] + box_max[s, 2]))
-        cx = coms[b, 0] + r[0, 0] * mx + r[0, 1] * my + r[0, 2] * mz
-        cy = coms[b, 1] + r[1, 0] * mx + r[1, 1] * my + r[1, 2] * mz
-        cz = coms[b, 2] + r[2, 0] * mx + r[2, 1] * my + r[2, 2] * mz
+        cx = com_lvlh[b, 0] + body_to_lvlh_b[0, 0] * mx + body_to_lvlh_b[0, 1] * my + body_to_lvlh_b[0, 2] * mz
+        cy = com_lvlh[b, 1] + body_to_lvlh_b[1, 0] * mx + body_to_lvlh_b[1, 1] * my + body_to_lvlh_b[1, 2] * mz
+        cz = com_lvlh[b, 2] + body_to_lvlh_b[2, 0] * mx + body_to_lvlh_b[2, 1] * my + body_to_lvlh_b[2, 2] * mz
         hx = 0.5 * (box_max[s, 0] - box_min[s, 0]) + shape_reach[s]
         hy = 0.5 * (box_max[s, 1] - box_min[s, 1]) + shape_reach[s]
         hz = 0.5 * (box_max[s, 2] - box_min[s, 2]) + shape_reach[s]
-        r00, r01, r02 = r[0, 0], r[0, 1], r[0, 2]
-        r10, r11, r12 = r[1, 0], r[1, 1], r[1, 2]
-        r20, r21, r22 = r[2, 0], r[2, 1], r[2, 2]
+        r00, r01, r02 = body_to_lvlh_b[0, 0], body_to_lvlh_b[0, 1], body_to_lvlh_b[0, 2]
+        r10, r11, r12 = body_to_lvlh_b[1, 0], body_to_lvlh_b[1, 1], body_to_lvlh_b[1, 2]
+        r20, r21, r22 = body_to_lvlh_b[2, 0], body_to_lvlh_b[2, 1], body_to_lvlh_b[2, 2]
         row = flags[s]
         for i in range(n):
             dx, dy, dz = x0[i] - cx, x1[i] - cy, x2[i] - cz

@@ -63,6 +63,15 @@ def hollar_friction_coefficient(slip_speed, mu_static, mu_kinetic, transition_sp
 
     Rises linearly from 0 to :math:`\\mu_s` below the transition speed :math:`V_{t,0}`
     (the regularization that replaces stiction) and decays to :math:`\\mu_k` above it.
+
+    Parameters
+    ----------
+    slip_speed : float
+        Tangential slip speed (m/s), >= 0.
+    mu_static, mu_kinetic : float
+        Static and kinetic coefficients (-).
+    transition_speed : float
+        :math:`V_{t,0}` (m/s), > 0.
     """
     ratio = slip_speed / transition_speed
     mu = mu_kinetic + 2.0 * (mu_static - mu_kinetic) / (1.0 + ratio * ratio)
@@ -74,7 +83,17 @@ def hollar_friction_coefficient(slip_speed, mu_static, mu_kinetic, transition_sp
 @njit(cache=True)
 def hollar_friction_coefficient_and_slope(slip_speed, mu_static, mu_kinetic, transition_speed):
     """:func:`hollar_friction_coefficient` (-) and its derivative with respect to the slip speed (s/m),
-    for Newton iterations on friction laws; the slope is one-sided (from above) at the transition."""
+    for Newton iterations on friction laws; the slope is one-sided (from above) at the transition.
+
+    Parameters
+    ----------
+    slip_speed : float
+        Tangential slip speed (m/s), >= 0.
+    mu_static, mu_kinetic : float
+        Static and kinetic coefficients (-).
+    transition_speed : float
+        Hollar's transition speed (m/s), > 0.
+    """
     ratio = slip_speed / transition_speed
     denominator = 1.0 + ratio * ratio
     mu = mu_kinetic + 2.0 * (mu_static - mu_kinetic) / denominator
@@ -95,6 +114,13 @@ def closest_point_on_triangle(px, py, pz, tri):
 
     Region tests of Ericson, *Real-Time Collision Detection* (2005), section 5.1.5, in scalar
     arithmetic (numba would send small-array products to BLAS).
+
+    Parameters
+    ----------
+    px, py, pz : float
+        The point (m), in the triangle's frame (a body frame in the kernel).
+    tri : (3, 3) float
+        The triangle's corners (m), one per row, same frame.
     """
     ax, ay, az = tri[0, 0], tri[0, 1], tri[0, 2]
     abx, aby, abz = tri[1, 0] - ax, tri[1, 1] - ay, tri[1, 2] - az
@@ -343,7 +369,17 @@ def contact_over_step(penetrations, relative_velocities, normals, external_force
 
 @njit(cache=True)
 def hertz_elastic_energy(penetration, stiffness, exponent):
-    """Elastic energy stored in a Hertz contact (J): :math:`k\\delta^{n+1}/(n+1)`, zero without contact."""
+    """Elastic energy stored in a Hertz contact (J): :math:`k\\delta^{n+1}/(n+1)`, zero without contact.
+
+    Parameters
+    ----------
+    penetration : float
+        :math:`\\delta` (m); <= 0 for a gap.
+    stiffness : float
+        :math:`k` (N/m^n).
+    exponent : float
+        :math:`n` (-), 1.5 for Hertz.
+    """
     if penetration <= 0.0:
         return 0.0
     return stiffness * _power(penetration, exponent) * penetration / (exponent + 1.0)

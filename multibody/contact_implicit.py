@@ -111,9 +111,23 @@ def _normal_residual(d1, d0, rate0, accel_n, step, reduced_mass, stiffness, expo
 def implicit_normal_step(d0, rate0, accel_n, step, reduced_mass, stiffness, exponent, damping):
     """End penetration (m), mean normal contact force over the step (N) and its non-elastic part (N).
 
-    ``d0`` penetration (m, negative for a gap) and ``rate0`` its rate (m/s, positive approaching) at
-    the start; ``accel_n`` the non-contact relative acceleration along the normal (m/s^2, positive
-    away from the body). Solves the module's equations for d1 by safeguarded Newton."""
+    Solves the module's equations for the end penetration by safeguarded Newton.
+
+    Parameters
+    ----------
+    d0 : float
+        Penetration at the start (m), negative for a gap.
+    rate0 : float
+        Its rate (m/s), positive approaching.
+    accel_n : float
+        Non-contact relative acceleration along the normal (m/s^2), positive away from the body.
+    step : float
+        (s).
+    reduced_mass : float
+        Node-body reduced mass along the normal (kg).
+    stiffness, exponent, damping : float
+        Hunt-Crossley :math:`k` (N/m^n), :math:`n` (-), :math:`d_n` (N s/m^(n+1)).
+    """
     free = d0 + step * rate0 - 0.5 * step * step * accel_n  # no contact force: the upper bracket
     if d0 <= 0.0 and free <= 0.0:
         return free, 0.0, 0.0  # a gap at both ends: free flight (the end penetration is at most ``free``)

@@ -14,11 +14,11 @@ from multibody.assembly import RigidBodySpec
 from multibody.hinge import add_penalty_joint
 from multibody.health import HealthWatch
 from multibody.impact import add_rigid_bodies, checked_post_step, explicit_settings, solve_checked
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.rotations import rotation_matrix_from_rotation_vector
 
 
 def free_motion(bodies: list[RigidBodySpec], joints, sample_times, step: float = 1e-3,
-                rest_attitudes=None, rest_coms=None):
+                rest_body_to_lvlh=None, rest_com_lvlh=None):
     """Integrate the bodies without external forces and sample their states.
 
     Parameters
@@ -26,6 +26,10 @@ def free_motion(bodies: list[RigidBodySpec], joints, sample_times, step: float =
     bodies, joints : the assembly's rigid bodies and joints at t = 0 (LVLH).
     sample_times : (k,) float   Increasing times (s), multiples of ``step``.
     step : float                RK44 step (s); 1e-3 s keeps a 2.3 rad/s tumble's energy within 1e-10.
+    rest_body_to_lvlh : list of (3, 3) float, optional
+        Per body, the attitude (body->LVLH) in which the joints are unloaded; default: the initial one.
+    rest_com_lvlh : list of (3,) float, optional
+        Per body, the CoM (m, LVLH) in which the joints are unloaded; default: the initial one.
 
     Returns
     -------
@@ -36,10 +40,10 @@ def free_motion(bodies: list[RigidBodySpec], joints, sample_times, step: float =
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     nodes, objects = add_rigid_bodies(mbs, bodies)
-    rest_attitudes = rest_attitudes or [b.body_to_lvlh for b in bodies]
-    rest_coms = rest_coms or [b.com_lvlh for b in bodies]
+    rest_body_to_lvlh = rest_body_to_lvlh or [b.body_to_lvlh for b in bodies]
+    rest_com_lvlh = rest_com_lvlh or [b.com_lvlh for b in bodies]
     for joint in joints:
-        add_penalty_joint(mbs, joint, bodies, objects, rest_attitudes[joint.child], rest_coms[joint.child], step)
+        add_penalty_joint(mbs, joint, bodies, objects, rest_body_to_lvlh[joint.child], rest_com_lvlh[joint.child], step)
     mbs.Assemble()
     index = [mbs.GetNodeODE2Index(nd) for nd in nodes]
     states = {key: [] for key in ("time", "body_com_lvlh", "body_velocity_lvlh", "body_to_lvlh", "body_omega_body")}

@@ -70,6 +70,13 @@ def stable_step_estimate(stiffness: float, mass: float) -> float:
 
     (central-difference stability, Bathe 2014, Sec. 9.2.1, with the margin of
     :data:`STABLE_STEP_FACTOR`). Returns ``inf`` for a zero stiffness.
+
+    Parameters
+    ----------
+    stiffness : float
+        Spring stiffness (N/m).
+    mass : float
+        Mass the spring acts on (kg).
     """
     if not (stiffness > 0 and mass > 0):
         return math.inf
@@ -77,7 +84,13 @@ def stable_step_estimate(stiffness: float, mass: float) -> float:
 
 
 def first_non_finite(values) -> int | None:
-    """Index of the first non-finite entry of ``values`` (any shape, flattened), or None."""
+    """Index of the first non-finite entry of ``values`` (any shape, flattened), or None.
+
+    Parameters
+    ----------
+    values : array_like of float
+        Any shape and unit (state coordinates, forces, ...).
+    """
     flat = np.asarray(values, float).ravel()
     finite = np.isfinite(flat)
     if finite.all():
@@ -86,15 +99,41 @@ def first_non_finite(values) -> int | None:
 
 
 def check_finite(time: float, values, quantity: str, cause: str) -> None:
-    """Raise :class:`SimulationFailed` when ``values`` holds a NaN or an infinity."""
+    """Raise :class:`SimulationFailed` when ``values`` holds a NaN or an infinity.
+
+    Parameters
+    ----------
+    time : float
+        Simulated time of the check (s).
+    values : array_like of float
+        Values to check, any shape and unit.
+    quantity : str
+        What ``values`` are, for the message ("state", ...).
+    cause : str
+        The likely cause in words, added to the failure message.
+    """
     k = first_non_finite(values)
     if k is not None:
         raise SimulationFailed(time, f"{quantity} is not finite (entry {k})", cause)
 
 
 def energy_drift(total_energy: float, initial_energy: float, reference_energy: float) -> float:
-    """Drift of the energy balance (J) relative to ``reference_energy`` (J); ``inf`` when the
-    total is not finite."""
+    """Drift of the energy balance relative to ``reference_energy``; ``inf`` when the total is not finite.
+
+    Parameters
+    ----------
+    total_energy : float
+        Mechanical + dissipated + released energy now (J).
+    initial_energy : float
+        The same balance at the start (J).
+    reference_energy : float
+        Energy the drift is measured against (J).
+
+    Returns
+    -------
+    float
+        ``|total - initial| / reference`` (-).
+    """
     if not math.isfinite(total_energy):
         return math.inf
     return abs(total_energy - initial_energy) / max(abs(reference_energy), 1e-300)
@@ -102,7 +141,19 @@ def energy_drift(total_energy: float, initial_energy: float, reference_energy: f
 
 def check_energy(time: float, total_energy: float, initial_energy: float, reference_energy: float,
                  cause: str, limit: float = ENERGY_DRIFT_LIMIT) -> float:
-    """The relative drift of :func:`energy_drift`; :class:`SimulationFailed` when it exceeds ``limit``."""
+    """The relative drift of :func:`energy_drift`; :class:`SimulationFailed` when it exceeds ``limit``.
+
+    Parameters
+    ----------
+    time : float
+        Simulated time of the check (s).
+    total_energy, initial_energy, reference_energy : float
+        As in :func:`energy_drift` (J).
+    cause : str
+        The likely cause in words, added to the failure message.
+    limit : float
+        Allowed drift, fraction of ``reference_energy`` (-).
+    """
     drift = energy_drift(total_energy, initial_energy, reference_energy)
     if drift > limit:
         raise SimulationFailed(time, f"energy balance drifted by {100 * drift:.3g} % of the reference energy "
@@ -111,7 +162,19 @@ def check_energy(time: float, total_energy: float, initial_energy: float, refere
 
 
 def check_solver_flag(success, end_time: float, reached_time: float, cause: str) -> None:
-    """Raise :class:`SimulationFailed` when the integrator reported failure (``success`` False)."""
+    """Raise :class:`SimulationFailed` when the integrator reported failure (``success`` False).
+
+    Parameters
+    ----------
+    success : bool
+        The integrator's flag.
+    end_time : float
+        Time the run was to reach (s).
+    reached_time : float
+        Time it reached (s).
+    cause : str
+        The likely cause in words, added to the failure message.
+    """
     if success is False:
         raise SimulationFailed(reached_time, f"the integrator stopped before the end time {end_time:g} s", cause)
 
@@ -156,7 +219,17 @@ class HealthWatch:
         return self.ok
 
     def state(self, time: float, *arrays, quantity: str = "state") -> bool:
-        """False (and :attr:`failure` set) when any of ``arrays`` holds a NaN or an infinity."""
+        """False (and :attr:`failure` set) when any of ``arrays`` holds a NaN or an infinity.
+
+        Parameters
+        ----------
+        time : float
+            Simulated time of the check (s).
+        *arrays : array_like of float
+            State arrays (coordinates, velocities), any shape and unit.
+        quantity : str
+            What the arrays are, for the message.
+        """
         # Fast path: a sum is finite only when every entry is (a NaN or an infinity propagates; a finite
         # sum that overflows only sends the array to the full check).
         if self.ok and all(math.isfinite(np.add.reduce(a, axis=None)) for a in arrays):
@@ -166,7 +239,15 @@ class HealthWatch:
     def energy(self, time: float, total_energy: float) -> bool:
         """False (and :attr:`failure` set) when the balance ``total_energy`` (J) has drifted past the
         limit for :data:`ENERGY_PERSISTENCE_S`, or past :data:`ENERGY_DRIFT_HARD_LIMIT` at once.
-        The first call sets the initial energy."""
+        The first call sets the initial energy.
+
+        Parameters
+        ----------
+        time : float
+            Simulated time of the check (s).
+        total_energy : float
+            Mechanical + dissipated + released energy now (J).
+        """
         if self.reference_energy is None or not self.ok:
             return self.ok
         if self.initial_energy is None:

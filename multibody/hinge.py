@@ -21,15 +21,29 @@ def hinge_frame_lvlh(axis_lvlh, point_lvlh, child_com_lvlh) -> np.ndarray:
 
     h2 is the hinge axis; h1 is anti-parallel to the child CoM offset from the hinge,
     projected normal to h2; h3 = h1 x h2.
+
+    Parameters
+    ----------
+    axis_lvlh : (3,) float
+        Hinge axis direction (any length), LVLH.
+    point_lvlh : (3,) float
+        Hinge point (m), LVLH.
+    child_com_lvlh : (3,) float
+        CoM of the child body (the appendage) (m), LVLH.
+
+    Returns
+    -------
+    (3, 3) float
+        hinge->LVLH rotation: columns h1, h2, h3 in LVLH components.
     """
-    h2 = np.asarray(axis_lvlh, float) / np.linalg.norm(axis_lvlh)
-    offset = np.asarray(child_com_lvlh, float) - np.asarray(point_lvlh, float)
-    h1 = -(offset - (offset @ h2) * h2)
-    if np.linalg.norm(h1) < 1e-9:
-        seed = np.array([1.0, 0.0, 0.0]) if abs(h2[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        h1 = seed - (seed @ h2) * h2
-    h1 /= np.linalg.norm(h1)
-    return np.column_stack([h1, h2, np.cross(h1, h2)])
+    h2_lvlh = np.asarray(axis_lvlh, float) / np.linalg.norm(axis_lvlh)
+    offset_lvlh = np.asarray(child_com_lvlh, float) - np.asarray(point_lvlh, float)
+    h1_lvlh = -(offset_lvlh - (offset_lvlh @ h2_lvlh) * h2_lvlh)
+    if np.linalg.norm(h1_lvlh) < 1e-9:
+        seed_lvlh = np.array([1.0, 0.0, 0.0]) if abs(h2_lvlh[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        h1_lvlh = seed_lvlh - (seed_lvlh @ h2_lvlh) * h2_lvlh
+    h1_lvlh /= np.linalg.norm(h1_lvlh)
+    return np.column_stack([h1_lvlh, h2_lvlh, np.cross(h1_lvlh, h2_lvlh)])
 
 
 #: Penalty joints are tuned to a frequency of PENALTY_STEP_FACTOR / step (rad/s): well under
@@ -49,10 +63,23 @@ def effective_mass_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: R
 
     Each body's inertia is taken about the joint point; the pair acts like two
     inertias on one spring, so the reduced value sets the penalty mode's frequency.
+
+    Parameters
+    ----------
+    joint : JointSpec
+        The joint (point and hinge frame in LVLH at t = 0).
+    parent, child : RigidBodySpec
+        The two bodies it connects (CoM, attitude and inertia at t = 0).
+
+    Returns
+    -------
+    (6,) float
+        [m, m, m, J_h1, J_h2, J_h3]: reduced mass (kg) three times, then reduced inertias (kg m^2)
+        about the hinge-frame axes.
     """
     reduced = [parent.mass * child.mass / (parent.mass + child.mass)] * 3
-    for axis in joint.hinge_to_lvlh.T:
-        j = [axis @ _inertia_about_point_lvlh(b, joint.point_lvlh) @ axis for b in (parent, child)]
+    for axis_lvlh in joint.hinge_to_lvlh.T:
+        j = [axis_lvlh @ _inertia_about_point_lvlh(b, joint.point_lvlh) @ axis_lvlh for b in (parent, child)]
         reduced.append(j[0] * j[1] / (j[0] + j[1]))
     return np.array(reduced)
 
@@ -66,6 +93,19 @@ def coupled_mode_inertia_joint_frame(joint: JointSpec, parent: RigidBodySpec, ch
     spring k on axis i rings at omega^2 = k c_i W c_i^T (c_i: the axis' relative-motion row).
     Unlike :func:`effective_mass_joint_frame` it counts the turn a translational spring gives
     each body about its CoM, and the translation a rotational one gives it.
+
+    Parameters
+    ----------
+    joint : JointSpec
+        The joint (point and hinge frame in LVLH at t = 0).
+    parent, child : RigidBodySpec
+        The two bodies it connects (CoM, attitude and inertia at t = 0).
+
+    Returns
+    -------
+    (6,) float
+        Modal mass (kg) on the three translations, then modal inertia (kg m^2) on the three
+        rotations, hinge-frame axes.
     """
     rows = _joint_motion_rows_lvlh(joint, parent, child)
     inverse_mass = np.zeros((12, 12))
@@ -86,20 +126,22 @@ def _joint_motion_rows_lvlh(joint: JointSpec, parent: RigidBodySpec, child: Rigi
     """(6, 12) rows giving the joint's relative motion (translation of the joint point, then
     rotation, along h1, h2, h3) from both bodies' (velocity, angular velocity) at their CoMs, LVLH."""
     def point_motion(body):          # velocity of the joint point = v + omega x r = v - r x omega
-        r = np.asarray(joint.point_lvlh) - body.com_lvlh
-        return np.hstack([np.eye(3), -np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])])
+        r_lvlh = np.asarray(joint.point_lvlh) - body.com_lvlh
+        skew_r_lvlh = np.array([[0, -r_lvlh[2], r_lvlh[1]], [r_lvlh[2], 0, -r_lvlh[0]], [-r_lvlh[1], r_lvlh[0], 0]])
+        return np.hstack([np.eye(3), -skew_r_lvlh])
     rotation = np.hstack([np.zeros((3, 3)), np.eye(3)])
     relative = np.vstack([np.hstack([-point_motion(parent), point_motion(child)]),
                           np.hstack([-rotation, rotation])])
-    axes = joint.hinge_to_lvlh
-    to_joint = np.block([[axes.T, np.zeros((3, 3))], [np.zeros((3, 3)), axes.T]])
+    hinge_to_lvlh = joint.hinge_to_lvlh
+    to_joint = np.block([[hinge_to_lvlh.T, np.zeros((3, 3))], [np.zeros((3, 3)), hinge_to_lvlh.T]])
     return to_joint @ relative
 
 
-def _inertia_about_point_lvlh(body: RigidBodySpec, point) -> np.ndarray:
-    r = body.com_lvlh - np.asarray(point)
-    j = body.body_to_lvlh @ body.inertia_body @ body.body_to_lvlh.T
-    return j + body.mass * ((r @ r) * np.eye(3) - np.outer(r, r))
+def _inertia_about_point_lvlh(body: RigidBodySpec, point_lvlh) -> np.ndarray:
+    offset_lvlh = body.com_lvlh - np.asarray(point_lvlh)
+    inertia_lvlh = body.body_to_lvlh @ body.inertia_body @ body.body_to_lvlh.T
+    return inertia_lvlh + body.mass * ((offset_lvlh @ offset_lvlh) * np.eye(3)
+                                       - np.outer(offset_lvlh, offset_lvlh))
 
 
 def joint_stiffness_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec,
@@ -115,6 +157,20 @@ def joint_stiffness_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: 
     which puts its modes up to ~2x faster than asked (a margin the 1 / step check leaves). Given
     values must stay below the explicit stability limit, and a structural mode must be resolved by at least
     ``STRUCTURAL_STEPS_PER_PERIOD`` steps; otherwise a ``ValueError`` names the joint.
+
+    Parameters
+    ----------
+    joint : JointSpec
+        The joint (point and hinge frame in LVLH at t = 0).
+    parent, child : RigidBodySpec
+        The two bodies it connects (CoM, attitude and inertia at t = 0).
+    step : float
+        Explicit integration step the automatic penalties are tuned to (s).
+
+    Returns
+    -------
+    (6,) float
+        Spring stiffness on [x, y, z] (N/m) and [rot h1, rot h2, rot h3] (N m/rad), hinge frame.
     """
     inertia = effective_mass_joint_frame(joint, parent, child)
     if joint.first_mode_hz is not None:
@@ -146,7 +202,23 @@ def joint_stiffness_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: 
 
 def joint_damping_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec,
                               stiffness: np.ndarray) -> np.ndarray:
-    """Diagonal damping: each penalty spring gets ``penalty_damping_ratio`` of critical damping."""
+    """Diagonal damping: each penalty spring gets ``penalty_damping_ratio`` of critical damping.
+
+    Parameters
+    ----------
+    joint : JointSpec
+        The joint (point and hinge frame in LVLH at t = 0).
+    parent, child : RigidBodySpec
+        The two bodies it connects (CoM, attitude and inertia at t = 0).
+    stiffness : (6,) float
+        The springs of :func:`joint_stiffness_joint_frame` (N/m, N m/rad), hinge frame.
+
+    Returns
+    -------
+    (6,) float
+        Damping on [x, y, z] (N s/m) and on the rotations (N m s/rad), hinge frame; the revolute
+        axis h2 gets the joint's torsional damping instead.
+    """
     inertia = effective_mass_joint_frame(joint, parent, child)
     c = 2.0 * joint.penalty_damping_ratio * np.sqrt(stiffness * inertia)
     if joint.kind == "revolute":
@@ -155,22 +227,44 @@ def joint_damping_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: Ri
 
 
 def add_penalty_joint(mbs, joint: JointSpec, bodies: list[RigidBodySpec], body_objects,
-                      child_body_to_lvlh_unrotated: np.ndarray, child_com_unrotated: np.ndarray, step: float):
+                      child_body_to_lvlh_unrotated: np.ndarray, child_com_lvlh_unrotated: np.ndarray, step: float):
     """Add the joint's connector to ``mbs``; return its object index.
 
     The joint frame is attached to the child as it was before any initial hinge angle, so
     the spring's rest state is the zero hinge angle.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        System to add the markers and the connector to.
+    joint : JointSpec
+        The joint (point and hinge frame in LVLH at t = 0).
+    bodies : list of RigidBodySpec
+        All bodies of the assembly; ``joint.parent`` and ``joint.child`` index into it.
+    body_objects : list of int
+        Exudyn object numbers of ``bodies``.
+    child_body_to_lvlh_unrotated : (3, 3) float
+        The child's attitude (body->LVLH) at zero hinge angle.
+    child_com_lvlh_unrotated : (3,) float
+        The child's CoM at zero hinge angle (m), LVLH.
+    step : float
+        Step the automatic penalty springs are tuned to (s).
+
+    Returns
+    -------
+    int
+        Exudyn object number of the connector.
     """
     parent, child = bodies[joint.parent], bodies[joint.child]
     joint_to_parent = parent.body_to_lvlh.T @ joint.hinge_to_lvlh
     joint_to_child = child_body_to_lvlh_unrotated.T @ joint.hinge_to_lvlh
-    point_parent = parent.body_to_lvlh.T @ (joint.point_lvlh - parent.com_lvlh)
-    point_child = child_body_to_lvlh_unrotated.T @ (joint.point_lvlh - child_com_unrotated)
+    point_parent_body = parent.body_to_lvlh.T @ (joint.point_lvlh - parent.com_lvlh)
+    point_child_body = child_body_to_lvlh_unrotated.T @ (joint.point_lvlh - child_com_lvlh_unrotated)
     stiffness = joint_stiffness_joint_frame(joint, parent, child, step)
     m0 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body_objects[joint.parent],
-                                       localHT=exu.HT(rotation=joint_to_parent, translation=point_parent)))
+                                       localHT=exu.HT(rotation=joint_to_parent, translation=point_parent_body)))
     m1 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body_objects[joint.child],
-                                       localHT=exu.HT(rotation=joint_to_child, translation=point_child)))
+                                       localHT=exu.HT(rotation=joint_to_child, translation=point_child_body)))
     return mbs.AddObject(ObjectConnectorRigidBodySpringDamper(
         name=joint.name, markerNumbers=[m0, m1],
         stiffness=np.diag(stiffness), damping=np.diag(joint_damping_joint_frame(joint, parent, child, stiffness)),
@@ -181,6 +275,18 @@ def relative_rotation_vector_joint_frame(parent_to_lvlh, child_to_lvlh, joint_to
     """Rotation vector (rad) of the child's joint frame relative to the parent's, joint frame.
 
     Component 1 is the hinge angle about h2 for a revolute joint.
+
+    Parameters
+    ----------
+    parent_to_lvlh, child_to_lvlh : (3, 3) float
+        Current attitudes (body->LVLH) of the parent and the child.
+    joint_to_parent, joint_to_child : (3, 3) float
+        Joint (hinge) frame in each body's frame (columns h1, h2, h3 in body components).
+
+    Returns
+    -------
+    (3,) float
+        Relative rotation vector (rad), joint frame (h1, h2, h3).
     """
-    relative = (parent_to_lvlh @ joint_to_parent).T @ (child_to_lvlh @ joint_to_child)
-    return rotation_vector_from_matrix(np.ascontiguousarray(relative, float))
+    child_joint_to_parent_joint = (parent_to_lvlh @ joint_to_parent).T @ (child_to_lvlh @ joint_to_child)
+    return rotation_vector_from_matrix(np.ascontiguousarray(child_joint_to_parent_joint, float))

@@ -58,13 +58,27 @@ class BuiltSystem:
     joint_objects: list
     joint_to_parent: list      # (3, 3) joint frame in parent body frame, per joint
     joint_to_child: list       # (3, 3) joint frame in child body frame (unrotated), per joint
-    joint_point_parent: list   # (3,) joint point, parent body frame (m)
-    joint_point_child: list    # (3,) joint point, child body frame (m)
+    joint_point_parent_body: list   # (3,) joint point, parent body frame (m)
+    joint_point_child_body: list    # (3,) joint point, child body frame (m)
     kernel_net: KernelNet | None = None  # the net's state when the kernel integrates it
 
     def net_state(self, q, qt):
         """(n, 3) node positions (m) and velocities (m/s), LVLH, at the end of the last step, from
-        the kernel (``kernel_net``) or from Exudyn's system vectors ``q``, ``qt`` (net node)."""
+        the kernel (``kernel_net``) or from Exudyn's system vectors ``q``, ``qt`` (net node).
+
+        Parameters
+        ----------
+        q : (N,) float
+            Exudyn's ODE2 coordinates: displacements from the reference configuration (m, LVLH;
+            rotation vectors (rad) for the bodies).
+        qt : (N,) float
+            Their time derivatives (m/s, LVLH; rad/s, body frame for the bodies).
+
+        Returns
+        -------
+        positions_lvlh, velocities_lvlh : (n, 3) float
+            Net node positions (m) and velocities (m/s), LVLH.
+        """
         if self.kernel_net is not None:
             return self.kernel_net.positions(), self.kernel_net.velocities()
         n = self.kernel.n_nodes
@@ -83,7 +97,19 @@ class BuiltSystem:
 
 
 def kernel_data(assembly: ImpactAssembly) -> KernelData:
-    """Arrays for the compiled force kernel."""
+    """Arrays for the compiled force kernel.
+
+    Parameters
+    ----------
+    assembly : ImpactAssembly
+        The simulation's description (SI, LVLH).
+
+    Returns
+    -------
+    KernelData
+        Net, bodies (reference CoMs in LVLH, inverse inertias in body frames), contact shapes
+        (body frames) and laws, as the kernel reads them.
+    """
     net, law = assembly.net, assembly.contact
     shapes = contact_shapes_body_frame([b.meshes_body for b in assembly.bodies],
                                        np.zeros((len(assembly.bodies), 3)))
@@ -97,9 +123,10 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
         mass=np.array([b.mass for b in assembly.bodies], float),
         inverse_inertia_body=np.array([np.linalg.inv(b.inertia_body) for b in assembly.bodies]).reshape(-1, 3, 3))
     shape_arrays = ShapeArrays(
-        triangles_body=shapes.triangles, normals_body=shapes.normals, body=shapes.shape_body,
-        triangle_range=shapes.triangle_range, box_min_body=shapes.box_min, box_max_body=shapes.box_max,
-        is_box=box_shape_flags(shapes.triangles, shapes.triangle_range, shapes.box_min, shapes.box_max))
+        triangles_body=shapes.triangles_body, normals_body=shapes.normals_body, body=shapes.shape_body,
+        triangle_range=shapes.triangle_range, box_min_body=shapes.box_min_body, box_max_body=shapes.box_max_body,
+        is_box=box_shape_flags(shapes.triangles_body, shapes.triangle_range, shapes.box_min_body,
+                               shapes.box_max_body))
     contact_law = ContactLaw(
         stiffness=float(law.stiffness), exponent=float(law.exponent), damping=float(law.damping),
         mu_static=float(law.mu_static), mu_kinetic=float(law.mu_kinetic), transition_speed=float(law.transition_speed),
@@ -131,7 +158,21 @@ def _inertia6(inertia):
 
 def add_rigid_bodies(mbs, bodies) -> tuple[list, list]:
     """Add each body as a rotation-vector node (Lie-group integration) and a rigid body;
-    returns the node and object numbers."""
+    returns the node and object numbers.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        System to add the bodies to.
+    bodies : list of RigidBodySpec
+        Mass, body-frame inertia, LVLH CoM, body->LVLH attitude, LVLH velocity and body-frame
+        angular velocity of each body at t = 0.
+
+    Returns
+    -------
+    nodes, objects : list of int
+        Exudyn node and object numbers, one per body.
+    """
     nodes, objects = [], []
     for body in bodies:
         node = mbs.AddNode(NodeRigidBodyRotVecLG(
@@ -144,19 +185,23 @@ def add_rigid_bodies(mbs, bodies) -> tuple[list, list]:
     return nodes, objects
 
 
-def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms=None) -> BuiltSystem:
+def build_impact_system(assembly: ImpactAssembly, rest_body_to_lvlh=None, rest_com_lvlh=None) -> BuiltSystem:
     """Assemble the coupled system in Exudyn.
 
     Parameters
     ----------
-    rest_attitudes, rest_coms : list, optional
-        Per body, attitude (body->LVLH) and CoM (m) in which the joints are unloaded;
-        default: the initial state. A case with an initial hinge angle passes the
-        unrotated child state here.
+    assembly : ImpactAssembly
+        The simulation's description (SI, LVLH).
+    rest_body_to_lvlh : list of (3, 3) float, optional
+        Per body, the attitude (body->LVLH) in which the joints are unloaded; default: the
+        initial state. A case with an initial hinge angle passes the unrotated child state here.
+    rest_com_lvlh : list of (3,) float, optional
+        Per body, the CoM (m, LVLH) in which the joints are unloaded (given with
+        ``rest_body_to_lvlh``).
     """
-    if rest_attitudes is None:
-        rest_attitudes = [b.body_to_lvlh for b in assembly.bodies]
-        rest_coms = [b.com_lvlh for b in assembly.bodies]
+    if rest_body_to_lvlh is None:
+        rest_body_to_lvlh = [b.body_to_lvlh for b in assembly.bodies]
+        rest_com_lvlh = [b.com_lvlh for b in assembly.bodies]
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     net = assembly.net
@@ -203,16 +248,16 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
         coupled = mbs.AddObject(ObjectGenericODE2(nodeNumbers=generic_nodes, massMatrix=mass,
                                                   forceUserFunction=coupled_forces))
 
-    joint_objects, to_parent, to_child, p_parent, p_child = [], [], [], [], []
+    joint_objects, joints_to_parent, joints_to_child, points_parent_body, points_child_body = [], [], [], [], []
     for joint in assembly.joints:
         joint_objects.append(add_penalty_joint(mbs, joint, assembly.bodies, body_objects,
-                                               rest_attitudes[joint.child], rest_coms[joint.child],
+                                               rest_body_to_lvlh[joint.child], rest_com_lvlh[joint.child],
                                                assembly.solver.joint_tuning_step or assembly.solver.step))
         parent = assembly.bodies[joint.parent]
-        to_parent.append(parent.body_to_lvlh.T @ joint.hinge_to_lvlh)
-        to_child.append(rest_attitudes[joint.child].T @ joint.hinge_to_lvlh)
-        p_parent.append(parent.body_to_lvlh.T @ (joint.point_lvlh - parent.com_lvlh))
-        p_child.append(rest_attitudes[joint.child].T @ (joint.point_lvlh - rest_coms[joint.child]))
+        joints_to_parent.append(parent.body_to_lvlh.T @ joint.hinge_to_lvlh)
+        joints_to_child.append(rest_body_to_lvlh[joint.child].T @ joint.hinge_to_lvlh)
+        points_parent_body.append(parent.body_to_lvlh.T @ (joint.point_lvlh - parent.com_lvlh))
+        points_child_body.append(rest_body_to_lvlh[joint.child].T @ (joint.point_lvlh - rest_com_lvlh[joint.child]))
     if assembly.body_loads is not None:
         add_recorded_loads(mbs, body_objects, assembly.body_loads, assembly.solver.step)
     mbs.Assemble()
@@ -227,12 +272,18 @@ def build_impact_system(assembly: ImpactAssembly, rest_attitudes=None, rest_coms
     else:
         layout["index"] = state_index
     return BuiltSystem(sc, mbs, kernel, net_node, body_nodes, body_objects, joint_objects,
-                       to_parent, to_child, p_parent, p_child, kernel_net)
+                       joints_to_parent, joints_to_child, points_parent_body, points_child_body, kernel_net)
 
 
 def uses_kernel_net(assembly: ImpactAssembly) -> bool:
     """True when the compiled kernel integrates the net (``solver.net_integration = "kernel"``,
-    VelocityVerlet only: Runge-Kutta stages need Exudyn to hold every coordinate)."""
+    VelocityVerlet only: Runge-Kutta stages need Exudyn to hold every coordinate).
+
+    Parameters
+    ----------
+    assembly : ImpactAssembly
+        The simulation's description (SI, LVLH).
+    """
     return (assembly.solver.net_integration == "kernel" and assembly.solver.integrator == "VelocityVerlet"
             and assembly.net.n_nodes > 0 and len(assembly.bodies) > 0)
 
@@ -294,7 +345,15 @@ class VerletForces:
 
 
 def explicit_settings(step: float, n_steps: int) -> exu.SimulationSettings:
-    """Explicit fixed-step settings with Lie-group rotation updates, no files written."""
+    """Explicit fixed-step settings with Lie-group rotation updates, no files written.
+
+    Parameters
+    ----------
+    step : float
+        Fixed time step (s).
+    n_steps : int
+        Number of steps; the end time is ``n_steps * step``.
+    """
     s = exu.SimulationSettings()
     s.timeIntegration.endTime = n_steps * step
     s.timeIntegration.numberOfSteps = n_steps
@@ -309,7 +368,13 @@ def explicit_settings(step: float, n_steps: int) -> exu.SimulationSettings:
 
 
 def simulation_settings(assembly: ImpactAssembly) -> exu.SimulationSettings:
-    """The impact's settings: explicit, sparse mass matrix factorized once."""
+    """The impact's settings: explicit, sparse mass matrix factorized once.
+
+    Parameters
+    ----------
+    assembly : ImpactAssembly
+        The simulation's description (SI, LVLH).
+    """
     s = explicit_settings(assembly.solver.step, assembly.solver.n_steps)
     s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     return s
@@ -332,6 +397,11 @@ def net_stable_step(net) -> float:
     zig-zag mode, docs/model.md "Step size"); Verlet is stable for :math:`h < 2/\\omega = \\sqrt{m/k}`,
     taken here with the stiffest thread on the lightest node. Contact and joints need smaller
     steps still: contact is sub-cycled and the joints are tuned to the step.
+
+    Parameters
+    ----------
+    net : NetTopology
+        The net (node masses (kg), thread stiffnesses (N/m)).
     """
     if not len(net.stiffness):
         return np.inf
@@ -339,7 +409,13 @@ def net_stable_step(net) -> float:
 
 
 def likely_failure_cause(assembly: ImpactAssembly) -> str:
-    """Words for a failed impact run: the step against the threads' stable step, or the inputs."""
+    """Words for a failed impact run: the step against the threads' stable step, or the inputs.
+
+    Parameters
+    ----------
+    assembly : ImpactAssembly
+        The simulation's description (SI, LVLH).
+    """
     step, limit = assembly.solver.step, net_stable_step(assembly.net)
     if step > 0.5 * limit:
         return (f"the step {step:g} s is too large for the net threads (explicit stability limit "
@@ -350,12 +426,19 @@ def likely_failure_cause(assembly: ImpactAssembly) -> str:
 
 
 def initial_kinetic_energy(assembly: ImpactAssembly) -> float:
-    """Kinetic energy (J) of net and bodies at t = 0: the reference of the energy-balance check."""
-    v = np.asarray(assembly.net_velocity, float).reshape(-1, 3)
-    energy = 0.5 * float(np.sum(assembly.net.masses * np.sum(v * v, axis=1))) if len(v) else 0.0
+    """Kinetic energy (J) of net and bodies at t = 0: the reference of the energy-balance check.
+
+    Parameters
+    ----------
+    assembly : ImpactAssembly
+        The simulation's description (SI, LVLH).
+    """
+    v_lvlh = np.asarray(assembly.net_velocity, float).reshape(-1, 3)
+    energy = 0.5 * float(np.sum(assembly.net.masses * np.sum(v_lvlh * v_lvlh, axis=1))) if len(v_lvlh) else 0.0
     for b in assembly.bodies:
-        omega = np.asarray(b.omega_body, float)
-        energy += 0.5 * b.mass * float(np.dot(b.velocity_lvlh, b.velocity_lvlh)) + 0.5 * omega @ b.inertia_body @ omega
+        omega_body = np.asarray(b.omega_body, float)
+        energy += (0.5 * b.mass * float(np.dot(b.velocity_lvlh, b.velocity_lvlh))
+                   + 0.5 * omega_body @ b.inertia_body @ omega_body)
     if assembly.body_loads is not None:     # driven by recorded loads: the recording run's reference
         energy = max(energy, assembly.body_loads.reference_energy)
     return energy
@@ -367,7 +450,22 @@ MIN_REFERENCE_ENERGY_J = 1.0
 
 def checked_post_step(watch: HealthWatch, post_step=None, every: int = 1):
     """A post-step function that calls ``post_step`` (if any) and checks the state is finite every
-    ``every`` steps; it stops the solver (returns False) at the first failure, kept in ``watch``."""
+    ``every`` steps; it stops the solver (returns False) at the first failure, kept in ``watch``.
+
+    Parameters
+    ----------
+    watch : HealthWatch
+        Keeps the first failure.
+    post_step : callable ``(mbs, t) -> bool``, optional
+        Exudyn post-step function to run first (t in s).
+    every : int
+        Check every ``every``-th step.
+
+    Returns
+    -------
+    callable ``(mbs, t) -> bool``
+        The post-step function for ``mbs.SetPostStepUserFunction``.
+    """
     count = [0]
 
     def hook(mbs, t):
@@ -383,7 +481,19 @@ def checked_post_step(watch: HealthWatch, post_step=None, every: int = 1):
 
 def solve_checked(mbs, settings, solver_type, watch: HealthWatch) -> None:
     """``exudyn.SolveDynamic`` with the health checks: raise :class:`SimulationFailed` when a hook
-    stopped the run (``watch.failure``), when the solver reports failure, or when it raised."""
+    stopped the run (``watch.failure``), when the solver reports failure, or when it raised.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        The assembled system.
+    settings : exudyn.SimulationSettings
+        Its settings (:func:`explicit_settings`).
+    solver_type : exudyn.DynamicSolverType
+        The explicit integrator.
+    watch : HealthWatch
+        The run's health record (the hooks' failures, the likely cause).
+    """
     end_time = settings.timeIntegration.endTime
     try:
         with solver_chatter_captured():
@@ -404,20 +514,31 @@ def solve_checked(mbs, settings, solver_type, watch: HealthWatch) -> None:
 class ImpactSimulation:
     """Build and run one coupled impact; ``run()`` returns the recorder with all time series."""
 
-    def __init__(self, assembly: ImpactAssembly, rest_attitudes=None, rest_coms=None):
+    def __init__(self, assembly: ImpactAssembly, rest_body_to_lvlh=None, rest_com_lvlh=None):
         self.assembly = assembly
-        self.system = build_impact_system(assembly, rest_attitudes, rest_coms)
+        self.system = build_impact_system(assembly, rest_body_to_lvlh, rest_com_lvlh)
         self.wall_time = None
         self.health = HealthWatch(likely_failure_cause(assembly),
                                   max(initial_kinetic_energy(assembly), MIN_REFERENCE_ENERGY_J))
 
     def run(self, progress=None, monitor=None) -> Recorder:
-        """Integrate to the end time; ``progress(t)`` is called at every output sample, and
-        ``monitor.check(...)`` after it (see :class:`~multibody.recorder.Recorder`).
+        """Integrate to the end time.
 
         Raises :class:`~multibody.health.SimulationFailed` at the first failed health check
         (non-finite state, energy balance drift, integrator failure); the recorder then holds
         the samples up to it (``self.recorder``).
+
+        Parameters
+        ----------
+        progress : callable ``(t) -> None``, optional
+            Called at every output sample with the time (s).
+        monitor : object with ``check(...)``, optional
+            Called after ``progress`` (see :class:`~multibody.recorder.Recorder`).
+
+        Returns
+        -------
+        Recorder
+            All time series of the run.
         """
         recorder = Recorder(self.assembly, self.system, progress=progress, monitor=monitor, health=self.health)
         self.recorder = recorder

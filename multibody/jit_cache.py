@@ -33,7 +33,13 @@ _cache_folder: Path | None = None
 
 
 def source_key(roots) -> str:
-    """Hex SHA-256 (first 16 digits) of the relative path and bytes of every ``.py`` file under ``roots``."""
+    """Hex SHA-256 (first 16 digits) of the relative path and bytes of every ``.py`` file under ``roots``.
+
+    Parameters
+    ----------
+    roots : iterable of path
+        Package folders; a missing one is skipped.
+    """
     digest = hashlib.sha256()
     for root in roots:
         root = Path(root)
@@ -100,6 +106,11 @@ def compiled_on_disk(dispatcher) -> bool:
     source on this CPU: the same index key numba looks up before compiling (signature, CPU name and
     features, hash of the bytecode and closure). False for a function without a disk cache.
 
+    Parameters
+    ----------
+    dispatcher : numba.core.registry.CPUDispatcher
+        A compiled function.
+
     Notes
     -----
     Reads numba's cache index only (``FunctionCache._cache_file._load_index``, numba 0.60 to 0.68);
@@ -119,5 +130,11 @@ def compiled_on_disk(dispatcher) -> bool:
 
 
 def all_compiled_on_disk(dispatchers) -> bool:
-    """Every one of ``dispatchers`` is :func:`compiled_on_disk`."""
+    """Every one of ``dispatchers`` is :func:`compiled_on_disk`.
+
+    Parameters
+    ----------
+    dispatchers : iterable of numba.core.registry.CPUDispatcher
+        Compiled functions.
+    """
     return all(compiled_on_disk(d) for d in dispatchers)

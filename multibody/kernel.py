@@ -45,7 +45,24 @@ def verlet_evaluation_state(q, qt, qtt, step, n_net_coordinates, n_bodies):
     """The state at which Exudyn's VelocityVerlet evaluates the forces of the step that starts
     at (q, qt, qtt): mid-step velocity qt + step/2 qtt and end position q + step * that;
     rigid-body rotation vectors are advanced by the Lie-group composition with the
-    mid-step angular velocity (body frame), as Exudyn does. Layout as in the module doc."""
+    mid-step angular velocity (body frame), as Exudyn does.
+
+    Parameters
+    ----------
+    q, qt, qtt : (N,) float
+        Coordinates, velocities and accelerations at the step's start, in the module doc's layout.
+    step : float
+        (s).
+    n_net_coordinates : int
+        Net coordinates ahead of the bodies' (3 n; 0 when the kernel holds the net).
+    n_bodies : int
+        Rigid bodies after them (6 coordinates each).
+
+    Returns
+    -------
+    q_next, v_half : (N,) float
+        The evaluation state: end positions (rotation vectors composed) and mid-step velocities.
+    """
     v_half = qt + (0.5 * step) * qtt
     q_next = q + step * v_half
     for b in range(n_bodies):
@@ -123,7 +140,7 @@ class KernelBuffers(NamedTuple):
     carries from step to step, and work space (so nothing is allocated per node)."""
 
     force: np.ndarray              # (3 n + 6 nb,) generalized forces (module doc)
-    body_impulse_lvlh: np.ndarray  # (nb, 6) accumulated contact impulse (N s) and angular impulse about the CoM (N m s), LVLH
+    body_impulse_lvlh: np.ndarray  # (nb, 6) accumulated contact impulse (N s), angular impulse about CoM (N m s), LVLH
     node_impulse_lvlh: np.ndarray  # (n, 3) accumulated contact impulse on each net node (N s), LVLH
     velocity_lag: np.ndarray       # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s), LVLH
     lag_body: np.ndarray           # (n,) int64 body of the node's last contact, -1 for none
@@ -134,7 +151,13 @@ class KernelBuffers(NamedTuple):
 
 
 def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffers:
-    """Zeroed :class:`KernelBuffers` for ``net`` and ``n_bodies`` bodies with ``n_shapes`` contact shapes."""
+    """Zeroed :class:`KernelBuffers` for ``net`` and ``n_bodies`` bodies with ``n_shapes`` contact shapes.
+
+    Parameters
+    ----------
+    net : NetArrays
+    n_bodies, n_shapes : int
+    """
     n = len(net.mass)
     work_node = np.zeros((4, n))
     work_node[3] = 1.0 / np.asarray(net.mass, float)  # constant: a product is cheaper than a division
@@ -195,10 +218,15 @@ class KernelData:
         return len(self.bodies.mass)
 
     def evaluate(self, q, qt, time=1.0):
-        """Generalized forces for coordinates ``q`` and velocities ``qt`` ((3n + 6nb,) each).
+        """Generalized forces (3 n + 6 nb,) at coordinates ``q`` and velocities ``qt`` (module doc).
 
-        At ``time`` 0 (the solver's initial-acceleration evaluation, which Verlet applies as
-        a half kick only) the contact is evaluated without sub-cycling.
+        Parameters
+        ----------
+        q, qt : (3 n + 6 nb,) float
+            Coordinates and velocities in the module doc's layout.
+        time : float
+            Time of the evaluation (s). At 0 (the solver's initial-acceleration evaluation, which
+            Verlet applies as a half kick only) the contact is evaluated without sub-cycling.
         """
         n_sub = max(1, int(math.ceil(self.step / self.contact_substep - 1e-9))) if time > 0.0 else 1
         return coupled_generalized_forces(q, qt, self.net, self.bodies, self.shapes, self.law, self.mounts,
@@ -233,76 +261,90 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
     net_reference, net_mass = net.reference_lvlh, net.mass
     n = net_mass.shape[0]
     nb = bodies.mass.shape[0]
-    x, f_net = work[0], work[1]
+    x, net_force_lvlh = work[0], work[1]
     for i in range(n):
         for d in range(3):
             x[i, d] = net_reference[i, d] + q[3 * i + d]
-            f_net[i, d] = 0.0
+            net_force_lvlh[i, d] = 0.0
     v = qt[: 3 * n].reshape(n, 3)
 
     elastic, power = add_thread_forces(x, v, net.threads, net.rest_lengths, net.thread_stiffness,
-                                       net.thread_damping, f_net)
+                                       net.thread_damping, net_force_lvlh)
     out_scalars[THREAD_ELASTIC] = elastic
-    out_scalars[BENDING_ELASTIC] = add_bending_forces(x, net.bending_triples, net.bending_stiffness, f_net)
+    out_scalars[BENDING_ELASTIC] = add_bending_forces(x, net.bending_triples, net.bending_stiffness, net_force_lvlh)
     out_scalars[THREAD_DISSIPATED] += power * step * stage_weight
 
     if n_orbit != 0.0:
         for i in range(n):
             ax, ay, az = clohessy_wiltshire_acceleration_xyz(x[i, 0], x[i, 2], v[i, 0], v[i, 1], n_orbit)
-            f_net[i, 0] += net_mass[i] * ax
-            f_net[i, 1] += net_mass[i] * ay
-            f_net[i, 2] += net_mass[i] * az
+            net_force_lvlh[i, 0] += net_mass[i] * ax
+            net_force_lvlh[i, 1] += net_mass[i] * ay
+            net_force_lvlh[i, 2] += net_mass[i] * az
 
     states = body_states(q, qt, n, bodies.reference_com_lvlh)
-    rots, coms, vels = states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh
-    f_body = np.zeros((nb, 3))
+    body_to_lvlh, com_lvlh, velocity_lvlh = states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh
+    body_force_lvlh = np.zeros((nb, 3))
     if n_orbit != 0.0:
         for b in range(nb):
-            f_body[b] += bodies.mass[b] * clohessy_wiltshire_acceleration(coms[b], vels[b], n_orbit)
+            body_force_lvlh[b] += bodies.mass[b] * clohessy_wiltshire_acceleration(com_lvlh[b], velocity_lvlh[b],
+                                                                                   n_orbit)
     torque_lvlh = np.zeros((nb, 3))
-    mount_elastic, mount_power = add_mount_forces(x, v, states, mounts, f_net, f_body, torque_lvlh)
+    mount_elastic, mount_power = add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torque_lvlh)
     # Mounts are the rods that hold the net's rim on the chaser: booked with the threads.
     out_scalars[THREAD_ELASTIC] += mount_elastic
     out_scalars[THREAD_DISSIPATED] += mount_power * step * stage_weight
     contact_energy, n_contacts, contact_dissipated = add_contact_forces(
-        x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, f_net, f_body, torque_lvlh)
+        x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, net_force_lvlh,
+        body_force_lvlh, torque_lvlh)
     for b in range(nb):
         base = 3 * n + 6 * b
-        out_force[base:base + 3] = f_body[b]
+        out_force[base:base + 3] = body_force_lvlh[b]
         for r in range(3):  # body-frame torque R^T t, in scalars (no BLAS call)
-            out_force[base + 3 + r] = (rots[b, 0, r] * torque_lvlh[b, 0] + rots[b, 1, r] * torque_lvlh[b, 1]
-                                       + rots[b, 2, r] * torque_lvlh[b, 2])
+            out_force[base + 3 + r] = (body_to_lvlh[b, 0, r] * torque_lvlh[b, 0]
+                                       + body_to_lvlh[b, 1, r] * torque_lvlh[b, 1]
+                                       + body_to_lvlh[b, 2, r] * torque_lvlh[b, 2])
     out_scalars[CONTACT_ELASTIC] = contact_energy
     out_scalars[N_CONTACTS] = n_contacts
     out_scalars[CONTACT_DISSIPATED] += contact_dissipated
     for i in range(n):
         for d in range(3):
-            out_force[3 * i + d] = f_net[i, d]
+            out_force[3 * i + d] = net_force_lvlh[i, d]
     return out_force
 
 
 @njit(cache=True)
-def add_mount_forces(x, v, states, mounts, f_net, f_body, torque_lvlh):
+def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torque_lvlh):
     """Spring-dampers from mounted net nodes to their points on a body, all LVLH.
 
-    ``x``, ``v`` (n, 3): node positions (m) and velocities (m/s); ``states``: :class:`BodyStates`;
-    ``mounts``: :class:`Mounts`. The node's force and the body's reaction act on the same line, through
-    the mount point, so linear and angular momentum are exchanged exactly. Returns the elastic energy
-    (J) and the dissipated power (W).
+    The node's force and the body's reaction act on the same line, through the mount point, so linear
+    and angular momentum are exchanged exactly. Returns the elastic energy (J) and the dissipated
+    power (W).
+
+    Parameters
+    ----------
+    x, v : (n, 3) float
+        Node positions (m) and velocities (m/s), LVLH.
+    states : BodyStates
+    mounts : Mounts
+    net_force_lvlh : (n, 3) float
+        Node force accumulator (N), LVLH.
+    body_force_lvlh, torque_lvlh : (nb, 3) float
+        Body force (N) and torque about the CoM (N m) accumulators, LVLH.
     """
     k, d = mounts.stiffness, mounts.damping
-    rots, coms, vels, omegas = states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh, states.omega_lvlh
+    body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
+    velocity_lvlh, omega_lvlh = states.velocity_lvlh, states.omega_lvlh
     elastic = 0.0
     power = 0.0
     for m in range(mounts.node.shape[0]):
         i = mounts.node[m]
         b = mounts.body[m]
-        arm = rots[b] @ mounts.point_body[m]
-        gap = x[i] - (coms[b] + arm)
-        rate = v[i] - (vels[b] + np.cross(omegas[b], arm))
+        arm = body_to_lvlh[b] @ mounts.point_body[m]
+        gap = x[i] - (com_lvlh[b] + arm)
+        rate = v[i] - (velocity_lvlh[b] + np.cross(omega_lvlh[b], arm))
         f = -k * gap - d * rate
-        f_net[i] += f
-        f_body[b] -= f
+        net_force_lvlh[i] += f
+        body_force_lvlh[b] -= f
         torque_lvlh[b] -= np.cross(arm, f)
         elastic += 0.5 * k * (gap @ gap)
         power += d * (rate @ rate)
@@ -312,18 +354,29 @@ def add_mount_forces(x, v, states, mounts, f_net, f_body, torque_lvlh):
 @njit(cache=True)
 def body_states(q, qt, n_nodes, reference_com_lvlh):
     """:class:`BodyStates` (attitude body->LVLH, CoM (m), CoM velocity (m/s), angular velocity (rad/s),
-    LVLH) from the coordinates ``q``, ``qt`` in the module doc's layout."""
+    LVLH) from the coordinates in the module doc's layout.
+
+    Parameters
+    ----------
+    q, qt : (3 n + 6 nb,) float
+        Coordinates and velocities (module doc).
+    n_nodes : int
+        Net nodes ahead of the bodies (0 when the kernel holds the net).
+    reference_com_lvlh : (nb, 3) float
+        Reference CoM positions (m), LVLH.
+    """
     nb = reference_com_lvlh.shape[0]
-    rots = np.empty((nb, 3, 3))
-    coms = np.empty((nb, 3))
-    vels = np.empty((nb, 3))
-    omegas = np.empty((nb, 3))
+    body_to_lvlh = np.empty((nb, 3, 3))
+    com_lvlh = np.empty((nb, 3))
+    velocity_lvlh = np.empty((nb, 3))
+    omega_lvlh = np.empty((nb, 3))
     for b in range(nb):
         base = 3 * n_nodes + 6 * b
-        coms[b] = reference_com_lvlh[b] + q[base:base + 3]
-        vels[b] = qt[base:base + 3]
-        rots[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
+        com_lvlh[b] = reference_com_lvlh[b] + q[base:base + 3]
+        velocity_lvlh[b] = qt[base:base + 3]
+        body_to_lvlh[b] = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
         # in scalars: numba sends small matrix products to BLAS, microseconds a call
         for r in range(3):
-            omegas[b, r] = rots[b, r, 0] * qt[base + 3] + rots[b, r, 1] * qt[base + 4] + rots[b, r, 2] * qt[base + 5]
-    return BodyStates(rots, coms, vels, omegas)
+            omega_lvlh[b, r] = (body_to_lvlh[b, r, 0] * qt[base + 3] + body_to_lvlh[b, r, 1] * qt[base + 4]
+                                + body_to_lvlh[b, r, 2] * qt[base + 5])
+    return BodyStates(body_to_lvlh, com_lvlh, velocity_lvlh, omega_lvlh)

@@ -45,6 +45,12 @@ class NetStepModelType(types.StructRef):
     """Numba type of :class:`NetStepModel`."""
 
     def preprocess_fields(self, fields):
+        """Field types without literal values (numba's structref hook), so one compilation serves every case.
+
+        Parameters
+        ----------
+        fields : tuple of (str, numba type)
+        """
         return tuple((name, types.unliteral(typ)) for name, typ in fields)
 
 
@@ -69,9 +75,15 @@ structref.define_proxy(NetStepModel, NetStepModelType, KERNEL_FIELDS + STATE_FIE
 
 
 def net_step_model(kernel: KernelData, net_velocity) -> tuple:
-    """The structref for ``kernel`` with the net in its reference position, moving at ``net_velocity``
-    ((n, 3) m/s, LVLH); returns it and its ``q``, ``qt`` arrays (a structref proxy has no Python
-    attributes: its fields are read in compiled code)."""
+    """The structref for ``kernel`` with the net in its reference position; returns it and its ``q``,
+    ``qt`` arrays (a structref proxy has no Python attributes: its fields are read in compiled code).
+
+    Parameters
+    ----------
+    kernel : KernelData
+    net_velocity : (n, 3) float
+        Initial node velocities (m/s), LVLH.
+    """
     n, nb = kernel.n_nodes, kernel.n_bodies
     n_substeps = max(1, int(np.ceil(kernel.step / kernel.contact_substep - 1e-9))) if np.isfinite(
         kernel.contact_substep) else 1
@@ -93,7 +105,14 @@ def _forces(m, time, n_substeps):
 def kernel_net_start(m, q_bodies, qt_bodies):
     """The forces at the initial state (the solver's initial acceleration; no sub-cycling, as
     :meth:`~multibody.kernel.KernelData.evaluate` at time 0): sets the net's acceleration and
-    returns the bodies' generalized forces (6 nb,)."""
+    returns the bodies' generalized forces (6 nb,).
+
+    Parameters
+    ----------
+    m : NetStepModel
+    q_bodies, qt_bodies : (6 nb,) float
+        The bodies' initial coordinates and velocities (Exudyn's layout, :mod:`multibody.kernel`).
+    """
     n3 = m.q.shape[0]
     m.q_eval[:n3] = m.q
     m.qt_eval[:n3] = m.qt
@@ -110,9 +129,15 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
     """One VelocityVerlet step of the net inside the bodies' step (module doc); returns the bodies'
     generalized forces (6 nb,) at the evaluation state, for Exudyn's coupled object.
 
-    ``q_bodies``, ``qt_bodies``, ``qtt_bodies`` (6 nb,): the bodies' coordinates, velocities and
-    accelerations at the start of the step (Exudyn's layout, multibody.kernel); ``time`` (s) the
-    time of the evaluation state (the step's end)."""
+    Parameters
+    ----------
+    m : NetStepModel
+    q_bodies, qt_bodies, qtt_bodies : (6 nb,) float
+        The bodies' coordinates, velocities and accelerations at the start of the step (Exudyn's
+        layout, :mod:`multibody.kernel`).
+    time : float
+        Time of the evaluation state, the step's end (s); 0 evaluates without sub-cycling.
+    """
     # the structref's arrays as locals: a field read inside a loop is not hoisted (stores through the
     # other arrays may alias it), which cost about 5 ns per coordinate, 18 us a step for the reference net
     q, qt, qtt, q_eval, qt_eval = m.q, m.qt, m.qtt, m.q_eval, m.qt_eval

@@ -55,29 +55,54 @@ def _reference(t, unit_paths):
 def replay_net(side_length, nodes_per_side, net_mass, axial_rigidity, damping, start_1, start_2, debris):
     """The square net laid flat in the world x-y plane: mouth edge from ``start_1`` to ``start_2``
     (its corners, compressed along the mouth when the MUs start closer than ``side_length``), the
-    rest trailing away from ``debris`` (all (2,) world, m). Returns the net and the mouth-edge nodes."""
+    rest trailing away from ``debris``.
+
+    Parameters
+    ----------
+    side_length : float
+        Side of the square net (m).
+    nodes_per_side : int
+        N of the N x N node grid.
+    net_mass : float
+        Whole net, the four corner bullets included (kg).
+    axial_rigidity : float
+        EA of a thread (N).
+    damping : float
+        Axial damping of every thread (N s/m).
+    start_1, start_2 : (2,) float
+        Initial MU positions, the mouth corners (m), world x-y.
+    debris : (2,) float
+        Debris centre (m), world x-y.
+
+    Returns
+    -------
+    net : NetTopology
+        Node positions (m) in the world frame (z = 0).
+    mouth_nodes : (N,) int
+        Nodes of the mouth edge, from ``start_1`` to ``start_2``.
+    """
     n = nodes_per_side
     node_mass = net_mass / (n * n + 4)
     net = flat_square_net(np.zeros(3), [0.0, 0.0, 1.0], side_length, n, node_mass, 0.005, axial_rigidity,
                           damping, node_mass, 0.005, side_length / (n - 1))
     start_1, start_2 = np.asarray(start_1, float), np.asarray(start_2, float)
-    mouth = start_2 - start_1
-    width = np.linalg.norm(mouth)
-    along = mouth / width
-    trailing = np.array([-along[1], along[0]])
-    middle = (start_1 + start_2) / 2.0
-    if trailing @ (middle - np.asarray(debris, float)) < 0:
-        trailing = -trailing
-    local = net.positions[:, :2] * [width / side_length, 1.0] + [0.0, side_length / 2.0]
-    world = middle + local[:, :1] * along + local[:, 1:2] * trailing
-    positions = np.c_[world, np.zeros(len(world))]
-    return replace(net, positions=positions), np.arange(n) * n
+    mouth_world = start_2 - start_1
+    width = np.linalg.norm(mouth_world)
+    along_world = mouth_world / width
+    trailing_world = np.array([-along_world[1], along_world[0]])
+    middle_world = (start_1 + start_2) / 2.0
+    if trailing_world @ (middle_world - np.asarray(debris, float)) < 0:
+        trailing_world = -trailing_world
+    positions_net = net.positions[:, :2] * [width / side_length, 1.0] + [0.0, side_length / 2.0]
+    positions_world_xy = middle_world + positions_net[:, :1] * along_world + positions_net[:, 1:2] * trailing_world
+    positions_world = np.c_[positions_world_xy, np.zeros(len(positions_world_xy))]
+    return replace(net, positions=positions_world), np.arange(n) * n
 
 
-def _unit_body(name, mass, position, velocity):
+def _unit_body(name, mass, position_world, velocity_world):
     inertia = 0.4 * mass * MU_RADIUS**2 * np.eye(3)
-    return RigidBodySpec(name=name, mass=mass, inertia_body=inertia, com_lvlh=np.r_[position, 0.0],
-                         velocity_lvlh=np.r_[velocity, 0.0])
+    return RigidBodySpec(name=name, mass=mass, inertia_body=inertia, com_lvlh=np.r_[position_world, 0.0],
+                         velocity_lvlh=np.r_[velocity_world, 0.0])
 
 
 class _TrackingLoad:
@@ -87,14 +112,14 @@ class _TrackingLoad:
         self.mbs, self.node, self.mass, self.spline, self.gains, self.log = mbs, node, mass, spline, gains, log
 
     def __call__(self, mbs, t, load):
-        r_ref = np.r_[self.spline(t), 0.0]
-        v_ref = np.r_[self.spline(t, 1), 0.0]
-        a_ref = np.r_[self.spline(t, 2), 0.0]
-        r = np.asarray(self.mbs.GetNodeOutput(self.node, exu.OutputVariableType.Position))
-        v = np.asarray(self.mbs.GetNodeOutput(self.node, exu.OutputVariableType.Velocity))
-        tracking = self.gains[0] * (r_ref - r) + self.gains[1] * (v_ref - v)
-        self.log[0] = float(np.linalg.norm(tracking))
-        return list(self.mass * a_ref + tracking)
+        r_ref_world = np.r_[self.spline(t), 0.0]
+        v_ref_world = np.r_[self.spline(t, 1), 0.0]
+        a_ref_world = np.r_[self.spline(t, 2), 0.0]
+        r_world = np.asarray(self.mbs.GetNodeOutput(self.node, exu.OutputVariableType.Position))
+        v_world = np.asarray(self.mbs.GetNodeOutput(self.node, exu.OutputVariableType.Velocity))
+        tracking_world = self.gains[0] * (r_ref_world - r_world) + self.gains[1] * (v_ref_world - v_world)
+        self.log[0] = float(np.linalg.norm(tracking_world))
+        return list(self.mass * a_ref_world + tracking_world)
 
 
 def replay(t_plan, unit_paths, unit_masses, net_spec: dict, debris, keep_out_radius, step, output_rate=50.0):
@@ -110,6 +135,7 @@ def replay(t_plan, unit_paths, unit_masses, net_spec: dict, debris, keep_out_rad
     debris : (2,) float              Debris centre (m), world.
     keep_out_radius : float          (m), for the report only.
     step : float                     Explicit step (s).
+    output_rate : float              Samples per second of the result (Hz).
     """
     splines = _reference(t_plan, unit_paths)
     net, mouth_nodes = replay_net(net_spec["side_length"], net_spec["nodes_per_side"], net_spec["net_mass"],
@@ -159,24 +185,25 @@ class _Sampler:
             return True
         q = np.asarray(self.built.mbs.GetNodeOutput(self.built.net_node, exu.OutputVariableType.Coordinates))
         reference = np.asarray(self.built.mbs.GetNodeParameter(self.built.net_node, "referenceCoordinates"))
-        nodes = (reference + q).reshape(-1, 3)
+        nodes_world = (reference + q).reshape(-1, 3)
         self.time.append(t)
-        self.edge.append(nodes[self.mouth_nodes])
+        self.edge.append(nodes_world[self.mouth_nodes])
         self.units.append([self.built.mbs.GetNodeOutput(n, exu.OutputVariableType.Position)
                            for n in self.built.body_nodes])
         self.force.append([log[0] for log in self.logs])
         return True
 
     def result(self, debris, keep_out_radius) -> ReplayResult:
-        units, edge = np.array(self.units), np.array(self.edge)
-        debris3 = np.r_[debris, 0.0]
-        chord_mid = units.mean(axis=1)
-        distance = np.linalg.norm(units - debris3, axis=2)
-        middle = edge[:, len(self.mouth_nodes) // 2]
-        summary = {"final_mouth_chord_center_distance_m": float(np.linalg.norm(chord_mid[-1] - debris3)),
-                   "final_mouth_edge_middle_node_distance_m": float(np.linalg.norm(middle[-1] - debris3)),
+        unit_positions_world, edge_world = np.array(self.units), np.array(self.edge)
+        debris_world = np.r_[debris, 0.0]
+        chord_mid_world = unit_positions_world.mean(axis=1)
+        distance = np.linalg.norm(unit_positions_world - debris_world, axis=2)
+        middle_world = edge_world[:, len(self.mouth_nodes) // 2]
+        summary = {"final_mouth_chord_center_distance_m":
+                   float(np.linalg.norm(chord_mid_world[-1] - debris_world)),
+                   "final_mouth_edge_middle_node_distance_m": float(np.linalg.norm(middle_world[-1] - debris_world)),
                    "min_unit_debris_distance_m": float(distance.min()),
                    "keep_out_respected": bool(distance.min() >= keep_out_radius),
                    "max_tracking_force_N": float(np.max(self.force)),
                    "final_time_s": float(self.time[-1])}
-        return ReplayResult(np.array(self.time), units, edge, np.array(self.force), summary)
+        return ReplayResult(np.array(self.time), unit_positions_world, edge_world, np.array(self.force), summary)

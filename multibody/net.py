@@ -51,8 +51,18 @@ class NetTopology:
 
 
 def single_node_net(position_lvlh, mass: float, radius: float) -> NetTopology:
-    """A "net" of one free node and no threads (m, kg, m): where a model needs a net and has none
-    (the sequential method's driven debris, analytic tests)."""
+    """A "net" of one free node and no threads: where a model needs a net and has none
+    (the sequential method's driven debris, analytic tests).
+
+    Parameters
+    ----------
+    position_lvlh : (3,) float
+        The node's position (m), LVLH.
+    mass : float
+        Its mass (kg).
+    radius : float
+        Its contact radius (m).
+    """
     return NetTopology(
         positions=np.atleast_2d(np.asarray(position_lvlh, float)), masses=np.array([float(mass)]),
         radii=np.array([float(radius)]), threads=np.zeros((0, 2), np.int64), rest_lengths=np.zeros(0),
@@ -61,7 +71,13 @@ def single_node_net(position_lvlh, mass: float, radius: float) -> NetTopology:
 
 
 def square_grid_threads(nodes_per_side: int) -> np.ndarray:
-    """Thread node pairs of a square mesh, row-major node numbering: (2 N (N-1), 2) int."""
+    """Thread node pairs of a square mesh, row-major node numbering: (2 N (N-1), 2) int.
+
+    Parameters
+    ----------
+    nodes_per_side : int
+        N of the N x N grid.
+    """
     idx = np.arange(nodes_per_side**2).reshape(nodes_per_side, nodes_per_side)
     along_first = np.c_[idx[:-1, :].ravel(), idx[1:, :].ravel()]
     along_second = np.c_[idx[:, :-1].ravel(), idx[:, 1:].ravel()]
@@ -69,7 +85,13 @@ def square_grid_threads(nodes_per_side: int) -> np.ndarray:
 
 
 def square_grid_bending_triples(nodes_per_side: int) -> np.ndarray:
-    """Triples of consecutive nodes along each thread line: (2 N (N-2), 3) int."""
+    """Triples of consecutive nodes along each thread line: (2 N (N-2), 3) int.
+
+    Parameters
+    ----------
+    nodes_per_side : int
+        N of the N x N grid.
+    """
     idx = np.arange(nodes_per_side**2).reshape(nodes_per_side, nodes_per_side)
     first = np.c_[idx[:-2, :].ravel(), idx[1:-1, :].ravel(), idx[2:, :].ravel()]
     second = np.c_[idx[:, :-2].ravel(), idx[:, 1:-1].ravel(), idx[:, 2:].ravel()]
@@ -77,7 +99,19 @@ def square_grid_bending_triples(nodes_per_side: int) -> np.ndarray:
 
 
 def thread_node_mass(side_length, nodes_per_side, diameter, density):
-    """Net node mass (kg): total thread mass spread evenly over the nodes (paper Sec. 2.2.2)."""
+    """Net node mass (kg): total thread mass spread evenly over the nodes (paper Sec. 2.2.2).
+
+    Parameters
+    ----------
+    side_length : float
+        Side of the square net (m).
+    nodes_per_side : int
+        N of the N x N grid.
+    diameter : float
+        Thread diameter (m).
+    density : float
+        Thread material density (kg/m^3).
+    """
     mesh = side_length / (nodes_per_side - 1)
     n_threads = 2 * nodes_per_side * (nodes_per_side - 1)
     area = np.pi * diameter**2 / 4.0
@@ -89,12 +123,23 @@ def in_plane_axes(direction):
 
     The first axis is LVLH x (radial) projected on the plane, or LVLH z when the
     launch is radial.
+
+    Parameters
+    ----------
+    direction : (3,) float
+        Launch direction (any length), LVLH (or any frame: the axes come in the same frame, the
+        first from its x axis).
+
+    Returns
+    -------
+    e1, e2 : (3,) float
+        Unit vectors, same frame; (e1, e2, direction) is right-handed.
     """
-    d = np.asarray(direction, float) / np.linalg.norm(direction)
-    seed = np.array([1.0, 0.0, 0.0]) if abs(d[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
-    e1 = seed - (seed @ d) * d
+    direction_unit = np.asarray(direction, float) / np.linalg.norm(direction)
+    seed_axis = np.array([1.0, 0.0, 0.0]) if abs(direction_unit[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
+    e1 = seed_axis - (seed_axis @ direction_unit) * direction_unit
     e1 /= np.linalg.norm(e1)
-    return e1, np.cross(d, e1)
+    return e1, np.cross(direction_unit, e1)
 
 
 def flat_square_net(center, direction, side_length, nodes_per_side, node_mass, node_radius,
@@ -105,7 +150,16 @@ def flat_square_net(center, direction, side_length, nodes_per_side, node_mass, n
     Parameters
     ----------
     center, direction : (3,) float
-        Net centre (m) and launch direction, LVLH.
+        Net centre (m) and launch direction, LVLH (the towing net passes the debris body frame:
+        positions come out in the frame given).
+    side_length : float
+        Side of the square of net nodes (m).
+    nodes_per_side : int
+        N of the N x N node grid.
+    node_mass, node_radius : float
+        Mass (kg) and contact radius (m) of each net node.
+    bullet_mass, bullet_radius : float
+        Mass (kg) and contact radius (m) of each corner bullet.
     thread_axial_rigidity : float
         EA of a thread (N); a thread of rest length l gets stiffness EA / l.
     thread_damping : float
@@ -180,9 +234,13 @@ def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
     Parameters
     ----------
     x, v : (n, 3) float
-        Node positions (m) and velocities (m/s), LVLH.
+        Node positions (m) and velocities (m/s), LVLH (inertial in the full-net tow: any one frame).
+    threads : (m, 2) int
+        Node pairs joined by a thread.
+    rest_lengths, stiffness, damping : (m,) float
+        Natural length (m), stiffness (N/m) and damping (N s/m) of each thread.
     force : (n, 3) float
-        Accumulator (N), LVLH.
+        Accumulator (N), frame of ``x``.
 
     Returns
     -------
@@ -233,7 +291,11 @@ def thread_tension_strain(x, v, threads, rest_lengths, stiffness, damping):
     Parameters
     ----------
     x, v : (..., n, 3) float
-        Node positions (m) and velocities (m/s), LVLH.
+        Node positions (m) and velocities (m/s), LVLH (any one frame).
+    threads : (m, 2) int
+        Node pairs joined by a thread.
+    rest_lengths, stiffness, damping : (m,) float
+        Natural length (m), stiffness (N/m) and damping (N s/m) of each thread.
 
     Returns
     -------
@@ -259,6 +321,17 @@ def add_bending_forces(x, triples, bending_stiffness, force):
     Energy :math:`E = k_b (1 - \\hat e_1\\cdot\\hat e_2)`, which is :math:`\\tfrac12 k_b\\theta^2`
     for small kink angles :math:`\\theta`; the forces are its exact negative gradient,
     so they conserve momentum and energy.
+
+    Parameters
+    ----------
+    x : (n, 3) float
+        Node positions (m), LVLH (any one frame).
+    triples : (b, 3) int
+        Node triples (a, b, c) along one thread line, b in the middle.
+    bending_stiffness : (b,) float
+        Rotational stiffness at b (N m/rad); 0 skips the triple.
+    force : (n, 3) float
+        Accumulator (N), frame of ``x``.
     """
     energy = 0.0
     for t in range(triples.shape[0]):

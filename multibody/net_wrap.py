@@ -48,13 +48,30 @@ class TowingNet:
     closing_axial_rigidity: float
 
     def closing_stiffness(self, rest):
-        """Stiffness EA/l0 (N/m) of each closing thread at natural lengths ``rest`` (m)."""
+        """Stiffness EA/l0 (N/m) of each closing thread at natural lengths ``rest``.
+
+        Parameters
+        ----------
+        rest : (12,) float
+            Natural lengths of the closing threads (m).
+        """
         return self.closing_axial_rigidity / np.asarray(rest)
 
 
 def closing_loop(nodes_per_side: int) -> np.ndarray:
     """The twelve lacing points in order around the perimeter (node indices; the corner masses are
-    :func:`~multibody.net.flat_square_net`'s bullets n^2 .. n^2+3 on grid corners 0, n-1, n(n-1), n^2-1)."""
+    :func:`~multibody.net.flat_square_net`'s bullets n^2 .. n^2+3 on grid corners 0, n-1, n(n-1), n^2-1).
+
+    Parameters
+    ----------
+    nodes_per_side : int
+        N of the N x N net.
+
+    Returns
+    -------
+    (12,) int
+        Node indices of the lacing points, in order around the perimeter.
+    """
     n = nodes_per_side
     j1 = int(round((n - 1) / 3))
     j2 = n - 1 - j1
@@ -65,9 +82,40 @@ def closing_loop(nodes_per_side: int) -> np.ndarray:
 
 def towing_net(side_length, nodes_per_side, net_mass, corner_mass, node_radius, corner_radius, thread_axial_rigidity,
                thread_damping, closing_axial_rigidity, closed_fraction, center_body, normal_body) -> TowingNet:
-    """A flat net of ``net_mass`` (kg, corner masses included) centred at ``center_body`` with its
-    normal ``normal_body`` (m, -), corner masses one mesh length out along the diagonals, closing loop
-    appended open (natural lengths = straight distances between lacing points)."""
+    """A flat net of ``net_mass`` centred at ``center_body`` with its normal ``normal_body``, corner
+    masses one mesh length out along the diagonals, closing loop appended open (natural lengths =
+    straight distances between lacing points).
+
+    Parameters
+    ----------
+    side_length : float
+        Side of the square net (m).
+    nodes_per_side : int
+        N of the N x N node grid.
+    net_mass : float
+        Whole net, corner masses included (kg).
+    corner_mass : float
+        Each of the four corner masses (kg).
+    node_radius, corner_radius : float
+        Contact radii of a net node and of a corner mass (m).
+    thread_axial_rigidity : float
+        EA of a net thread (N).
+    thread_damping : float
+        Axial damping of every thread (N s/m).
+    closing_axial_rigidity : float
+        EA of the closing thread (N).
+    closed_fraction : float
+        Closed loop length over its open length (-).
+    center_body : (3,) float
+        Net centre (m), debris body frame.
+    normal_body : (3,) float
+        Net normal (any length), debris body frame.
+
+    Returns
+    -------
+    TowingNet
+        Positions in the debris body frame (m).
+    """
     n = nodes_per_side
     node_mass = (net_mass - 4.0 * corner_mass) / (n * n)
     if node_mass <= 0.0:
@@ -102,16 +150,16 @@ class DrapeSchedule:
 
 
 @njit(cache=True)
-def _drape(x, v, masses, radii, threads, rest, stiffness, damping, central, rest_open, rest_closed, ea, geometry, law,
-           up, fall, reel, settle, gravity, drag, h):
+def _drape(x_body, v_body, masses, radii, threads, rest, stiffness, damping, central, rest_open, rest_closed, ea,
+           geometry, law, up_body, fall, reel, settle, gravity, drag, h):
     n_closing = rest_open.shape[0]
     first = threads.shape[0] - n_closing
-    f, lag = np.zeros_like(x), np.zeros_like(x)
+    f, lag = np.zeros_like(x_body), np.zeros_like(x_body)
     acc, work = np.zeros(ACC_SIZE), np.zeros(21)
     zeros3, big = np.zeros(3), 1e30
     rot, tether = np.eye(3), np.zeros(3)
     inverse = np.zeros((3, 3))
-    far = 1e9 * up  # the (force-free) main tether's other end
+    far_body = 1e9 * up_body  # the (force-free) main tether's other end
     n_steps = int((fall + reel + settle) / h)
     for k in range(n_steps):
         t = k * h
@@ -119,39 +167,73 @@ def _drape(x, v, masses, radii, threads, rest, stiffness, damping, central, rest
         for c in range(n_closing):
             rest[first + c] = rest_open[c] + ramp * (rest_closed[c] - rest_open[c])
             stiffness[first + c] = ea / rest[first + c]
-        net_forces(x, v, lag, NetThreads(masses, radii, threads, rest, stiffness, damping), zeros3, 0.0, central,
-                   TetherEnd(tether, far, zeros3, zeros3), DebrisMotion(zeros3, rot, zeros3, zeros3),
+        net_forces(x_body, v_body, lag, NetThreads(masses, radii, threads, rest, stiffness, damping), zeros3, 0.0,
+                   central, TetherEnd(tether, far_body, zeros3, zeros3), DebrisMotion(zeros3, rot, zeros3, zeros3),
                    DebrisBody(big, inverse, geometry, law), h, f, acc, work)
         g = gravity if t < fall + reel else 0.0
-        for i in range(x.shape[0]):
+        for i in range(x_body.shape[0]):
             for a in range(3):
-                f[i, a] -= masses[i] * g * up[a]
-                v[i, a] += h * (f[i, a] / masses[i] - drag * v[i, a])
-                x[i, a] += h * v[i, a]
-    v[:] = 0.0
+                f[i, a] -= masses[i] * g * up_body[a]
+                v_body[i, a] += h * (f[i, a] / masses[i] - drag * v_body[i, a])
+                x_body[i, a] += h * v_body[i, a]
+    v_body[:] = 0.0
 
 
 def drape_and_close(net: TowingNet, geometry, contact_law, up_body, schedule: DrapeSchedule = DrapeSchedule()) -> np.ndarray:
-    """The wrapped node positions (n, 3) (m, debris frame) after draping ``net`` (built flat on the
-    ``up_body`` side of the cylinder ``geometry`` = [radius, half length, axial centre z] (m), the
-    pseudo-gravity along -``up_body``) and closing it (module doc); ``contact_law`` is the kernel's
-    contact array. The net's threads end at the closed natural lengths."""
+    """The wrapped node positions after draping ``net`` and closing it (module doc). The net's
+    threads end at the closed natural lengths.
+
+    Parameters
+    ----------
+    net : TowingNet
+        Built flat on the ``up_body`` side of the cylinder, debris body frame.
+    geometry : (3,) float
+        The cylinder: [radius, half length, axial centre z] (m), debris body frame.
+    contact_law : (k,) float
+        The kernel's contact array (:mod:`multibody.net_towing_kernel`).
+    up_body : (3,) float
+        Unit vector from the cylinder towards the flat net, debris body frame; the pseudo-gravity
+        acts along ``-up_body``.
+    schedule : DrapeSchedule
+        Pseudo-time schedule (s, m/s^2, 1/s).
+
+    Returns
+    -------
+    (n, 3) float
+        Node positions (m), debris body frame.
+    """
     top = net.topology
-    x = np.array(top.positions, float)
-    v = np.zeros_like(x)
+    x_body = np.array(top.positions, float)
+    v_body = np.zeros_like(x_body)
     rest, stiffness = top.rest_lengths.copy(), top.stiffness.copy()
-    _drape(x, v, top.masses, top.radii, top.threads, rest, stiffness, top.damping, net.central, net.closing_rest_open,
-           net.closing_rest_closed, net.closing_axial_rigidity, np.asarray(geometry, float),
+    _drape(x_body, v_body, top.masses, top.radii, top.threads, rest, stiffness, top.damping, net.central,
+           net.closing_rest_open, net.closing_rest_closed, net.closing_axial_rigidity, np.asarray(geometry, float),
            np.asarray(contact_law, float), np.asarray(up_body, float), schedule.fall, schedule.reel, schedule.settle, schedule.pseudo_gravity,
            schedule.drag, schedule.step)
-    return x
+    return x_body
 
 
 def wrap_summary(x_body, net: TowingNet, geometry) -> dict:
     """Shape figures of a wrapped net (debris frame): smallest node clearance to the cylinder (m),
-    largest thread strain (-), how far the central node sits from the cylinder axis (m)."""
+    largest thread strain (-), how far the central node sits from the cylinder axis (m).
+
+    Parameters
+    ----------
+    x_body : (n, 3) float
+        Node positions (m), debris body frame.
+    net : TowingNet
+        The net (radii, threads, closed natural lengths).
+    geometry : (3,) float
+        The cylinder: [radius, half length, axial centre z] (m), debris body frame.
+
+    Returns
+    -------
+    dict
+        JSON-ready figures (keys end in their unit; ``central_node_body`` in m, debris body frame).
+    """
     top = net.topology
-    clear = [cylinder_distance(p[0], p[1], p[2], np.asarray(geometry, float))[0] - r for p, r in zip(x_body, top.radii)]
+    clear = [cylinder_distance(p_body[0], p_body[1], p_body[2], np.asarray(geometry, float))[0] - r
+             for p_body, r in zip(x_body, top.radii)]
     length = np.linalg.norm(x_body[top.threads[:, 1]] - x_body[top.threads[:, 0]], axis=1)
     rest = np.r_[top.rest_lengths[:-N_CLOSING], net.closing_rest_closed]
     strain = length / rest - 1.0

@@ -34,20 +34,54 @@ class RecordedBodyLoads:
     reference_energy: float
 
     def interval(self, t: float) -> int:
-        """Index of the interval holding ``t`` (s); the last one past the end (then the load is 0)."""
+        """Index of the interval holding ``t``; the last one past the end (then the load is 0).
+
+        Parameters
+        ----------
+        t : float
+            Time (s).
+        """
         return int(np.searchsorted(self.time, t - 1e-9 * (self.time[1] - self.time[0] if len(self.time) > 1 else 1.0)))
 
     def held(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """((nb, 3) forces LVLH (N), (nb, 3) moments body frame (N m)) held at ``t``; zero outside the record."""
+        """Loads held at ``t`` on every body; zero outside the record.
+
+        Parameters
+        ----------
+        t : float
+            Time (s).
+
+        Returns
+        -------
+        force_lvlh : (nb, 3) float
+            Forces at the CoMs (N), LVLH.
+        moment_body : (nb, 3) float
+            Moments about the CoMs (N m), each body's frame.
+        """
         k = self.interval(t)
         if t <= 0.0 or k >= len(self.time):
             return np.zeros_like(self.force_lvlh[0]), np.zeros_like(self.moment_body[0])
         return self.force_lvlh[k], self.moment_body[k]
 
     def at(self, t: float, body: int) -> tuple[np.ndarray, np.ndarray]:
-        """(force LVLH (N), moment body frame (N m)) on ``body`` at ``t``; zero outside the record."""
-        force, moment = self.held(t)
-        return force[body], moment[body]
+        """Loads on one body at ``t``; zero outside the record.
+
+        Parameters
+        ----------
+        t : float
+            Time (s).
+        body : int
+            Body index.
+
+        Returns
+        -------
+        force_lvlh : (3,) float
+            Force at the CoM (N), LVLH.
+        moment_body : (3,) float
+            Moment about the CoM (N m), body frame.
+        """
+        force_lvlh, moment_body = self.held(t)
+        return force_lvlh[body], moment_body[body]
 
 
 def applied_work(loads: RecordedBodyLoads, step: float, t0: float, t1: float, com_start_lvlh, com_end_lvlh,
@@ -60,18 +94,20 @@ def applied_work(loads: RecordedBodyLoads, step: float, t0: float, t1: float, co
 
     Parameters
     ----------
+    loads : RecordedBodyLoads                         The record (forces LVLH, moments body frames).
     step : float                                      The solver's step h (s).
+    t0, t1 : float                                    Start and end of the interval (s).
     com_start_lvlh, com_end_lvlh : (nb, 3) float      Body CoMs at t0 and t1 (m), LVLH.
     velocity_start_lvlh : (nb, 3) float               Body CoM velocities at t0 (m/s), LVLH.
     omega_start_body, omega_end_body : (nb, 3) float  Body rates at t0 and t1 (rad/s), body frames.
     """
-    (force, moment), (force_before, moment_before) = loads.held(t1), loads.held(t0)
-    displacement = np.asarray(com_end_lvlh) - np.asarray(com_start_lvlh)
-    omega0 = np.asarray(omega_start_body)
-    mean_rate = 0.5 * (omega0 + np.asarray(omega_end_body))
-    work = np.sum(force * displacement) + (t1 - t0) * np.sum(moment * mean_rate)
-    handover = 0.5 * step * (np.sum((force_before - force) * np.asarray(velocity_start_lvlh))
-                             + np.sum((moment_before - moment) * omega0))
+    (force_lvlh, moment_body), (force_before_lvlh, moment_before_body) = loads.held(t1), loads.held(t0)
+    displacement_lvlh = np.asarray(com_end_lvlh) - np.asarray(com_start_lvlh)
+    omega0_body = np.asarray(omega_start_body)
+    mean_omega_body = 0.5 * (omega0_body + np.asarray(omega_end_body))
+    work = np.sum(force_lvlh * displacement_lvlh) + (t1 - t0) * np.sum(moment_body * mean_omega_body)
+    handover = 0.5 * step * (np.sum((force_before_lvlh - force_lvlh) * np.asarray(velocity_start_lvlh))
+                             + np.sum((moment_before_body - moment_body) * omega0_body))
     return float(work + handover)
 
 
@@ -93,7 +129,19 @@ class _HeldLoad:
 
 def add_recorded_loads(mbs, body_objects, loads: RecordedBodyLoads, step: float) -> None:
     """Add, for every body, the recorded force (LVLH) and moment (body frame) at its CoM, read for
-    a VelocityVerlet step of ``step`` (s)."""
+    a VelocityVerlet step of ``step``.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+        System to add the loads to.
+    body_objects : list of int
+        Exudyn object numbers of the bodies, in the record's body order.
+    loads : RecordedBodyLoads
+        The record (forces LVLH, moments body frame).
+    step : float
+        The solver's (VelocityVerlet) step (s).
+    """
     for k, body in enumerate(body_objects):
         marker = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body, localPosition=[0.0, 0.0, 0.0]))
         mbs.AddLoad(LoadForceVector(markerNumber=marker, loadVector=[0.0] * 3, bodyFixed=False,

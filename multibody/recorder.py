@@ -125,14 +125,28 @@ class Recorder:
             parent=np.array([j.parent for j in joints], np.int64), child=np.array([j.child for j in joints], np.int64),
             joint_to_parent=np.array(system.joint_to_parent, float).reshape(nj, 3, 3),
             joint_to_child=np.array(system.joint_to_child, float).reshape(nj, 3, 3),
-            point_parent=np.array(system.joint_point_parent, float).reshape(nj, 3),
-            point_child=np.array(system.joint_point_child, float).reshape(nj, 3),
+            point_parent=np.array(system.joint_point_parent_body, float).reshape(nj, 3),
+            point_child=np.array(system.joint_point_child_body, float).reshape(nj, 3),
             stiffness=np.array(self._joint_stiffness, float).reshape(nj, 6))
         self._body_out = body_sample_buffers(nb, nj)
         self._net_totals = np.zeros(8)
 
     # -- Exudyn hook -----------------------------------------------------------------
     def post_step(self, mbs, t):
+        """Exudyn post-step function: sample at the output times, check the state in between.
+
+        Parameters
+        ----------
+        mbs : exudyn.MainSystem
+            The running system.
+        t : float
+            Time at the end of the step (s).
+
+        Returns
+        -------
+        bool
+            False stops the solver (a failed health check).
+        """
         half = 0.5 * self.step
         self._steps += 1
         if t >= self._next_output - half or t >= self._end_time - half:
@@ -146,12 +160,21 @@ class Recorder:
 
     # -- sampling --------------------------------------------------------------------
     def sample(self, t):
+        """Record one row of the time series at ``t`` (and a net snapshot when one is due).
+
+        Nothing is recorded from a non-finite state or past a failed energy check (the run stops).
+
+        Parameters
+        ----------
+        t : float
+            Current simulated time (s).
+        """
         arrays = self.system.state_arrays()
         q, qt = arrays[:2]
         if not self.health.state(t, *arrays):
             return  # nothing recorded from a lost state; the run stops at this step
-        x, v = self.system.net_state(q, qt)
-        row = self._compute_row(t, q, qt, x, v)
+        x_lvlh, v_lvlh = self.system.net_state(q, qt)
+        row = self._compute_row(t, q, qt, x_lvlh, v_lvlh)
         if not self.health.energy(t, row["energy_total"]):
             return
         self._store(row)
@@ -160,8 +183,8 @@ class Recorder:
         if t == 0.0 or t >= self._next_net - 0.5 * self.step:
             k = self._n_net
             self._net_time[k] = t
-            self._net_positions[k] = x
-            self._net_velocities[k] = v
+            self._net_positions[k] = x_lvlh
+            self._net_velocities[k] = v_lvlh
             self._net_contact_force[k] = self._node_contact_force(t)
             self._n_net += 1
             if t > 0.0:
@@ -171,12 +194,12 @@ class Recorder:
 
     def _node_contact_force(self, t):
         """Contact force on each net node (N, LVLH), averaged since the previous net snapshot."""
-        impulse = self.system.kernel.buffers.node_impulse_lvlh
+        impulse_lvlh = self.system.kernel.buffers.node_impulse_lvlh
         interval = t - self._last_net_time
-        force = impulse / interval if interval > 0.0 else np.zeros_like(impulse)
-        impulse[:] = 0.0
+        force_lvlh = impulse_lvlh / interval if interval > 0.0 else np.zeros_like(impulse_lvlh)
+        impulse_lvlh[:] = 0.0
         self._last_net_time = t
-        return force
+        return force_lvlh
 
     def _check_monitor(self, t, row):
         before = len(self.monitor.events)
@@ -187,7 +210,7 @@ class Recorder:
             self.joint_active[event.joint] = False
             self._released_energy += event.stored_energy
 
-    def _compute_row(self, t, q, qt, x, v) -> dict:
+    def _compute_row(self, t, q, qt, x_lvlh, v_lvlh) -> dict:
         """One sample's values (see the module doc), from the compiled sums of multibody.recorder_kernel."""
         w = self._body_out
         interval = t - self._last_output_time
@@ -195,16 +218,16 @@ class Recorder:
         body_sample(q, qt, self._bodies, self._joints, self.joint_active.astype(float),
                     self.system.kernel.buffers.body_impulse_lvlh, interval, self.assembly.mean_motion, w)
         net = self._net_totals
-        net_sums(x, v, self._net_masses, self.assembly.mean_motion, net)
+        net_sums(x_lvlh, v_lvlh, self._net_masses, self.assembly.mean_motion, net)
         mbs = self.system.mbs
         nj = len(self.system.joint_objects)
-        forces, moments = np.zeros((nj, 3)), np.zeros((nj, 3))
+        forces_joint, moments_joint = np.zeros((nj, 3)), np.zeros((nj, 3))
         for j, obj in enumerate(self.system.joint_objects):
             if self.joint_active[j]:
                 # Exudyn's connector force is the spring force acting on marker 1 (child) with
                 # reversed sign; the parent's load on the child is its negative.
-                forces[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)
-                moments[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)
+                forces_joint[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)
+                moments_joint[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)
         self._joint_energies = w.joint_energy
         summary = w.summary.tolist()
         scalars = self.system.kernel.buffers.scalars.tolist()
@@ -214,7 +237,7 @@ class Recorder:
                "body_com_lvlh": w.com_lvlh, "body_velocity_lvlh": w.velocity_lvlh, "body_omega_body": w.omega_body,
                "body_to_lvlh": w.body_to_lvlh, "debris_com_lvlh": summary[0:3], "debris_velocity_lvlh": summary[3:6],
                "joint_rotation_joint": w.joint_rotation, "joint_rate_joint": w.joint_rate,
-               "joint_force_joint": -forces, "joint_moment_joint": -moments}
+               "joint_force_joint": -forces_joint, "joint_moment_joint": -moments_joint}
         e = {
             "net_kinetic": net[0],
             "net_elastic": scalars[THREAD_ELASTIC],
@@ -243,9 +266,9 @@ class Recorder:
         """Work (J) done by the recorded loads since t = 0: the energy they bring in, which the
         balance subtracts so that it stays closed."""
         if self._previous_body_state is not None:
-            t0, com0, velocity0, omega0 = self._previous_body_state
-            self._applied_work += applied_work(self.assembly.body_loads, self.step, t0, t, com0, com_lvlh, velocity0,
-                                               omega0, omega_body)
+            t0, com0_lvlh, velocity0_lvlh, omega0_body = self._previous_body_state
+            self._applied_work += applied_work(self.assembly.body_loads, self.step, t0, t, com0_lvlh, com_lvlh,
+                                               velocity0_lvlh, omega0_body, omega_body)
         self._previous_body_state = (t, com_lvlh.copy(), velocity_lvlh.copy(), omega_body.copy())
         return self._applied_work
 
@@ -259,6 +282,13 @@ class Recorder:
         self._n_rows += 1
 
     def finish(self, wall_time):
+        """Trim the preallocated arrays to the samples taken into :attr:`series` and :attr:`net`.
+
+        Parameters
+        ----------
+        wall_time : float
+            Wall-clock duration of the run (s).
+        """
         self.wall_time = wall_time
         self.series = {key: value[:self._n_rows].copy() for key, value in self._series.items()}
         self.net = {"time": self._net_time[:self._n_net].copy(), "positions_lvlh": self._net_positions[:self._n_net].copy(),

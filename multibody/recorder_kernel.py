@@ -20,7 +20,19 @@ from multibody.rotations import rotation_matrix_from_rotation_vector, rotation_v
 def net_sums(x, v, masses, n_orbit, out):
     """Net totals into ``out`` (8,): kinetic energy (J), Clohessy-Wiltshire potential
     :math:`\\sum m\\,\\tfrac12 n^2 (z^2 - 3x^2)` (J), linear momentum (3, kg m/s) and angular momentum
-    about the LVLH origin (3, kg m^2/s). ``x``, ``v`` (n, 3) positions (m) and velocities (m/s), LVLH."""
+    about the LVLH origin (3, kg m^2/s).
+
+    Parameters
+    ----------
+    x, v : (n, 3) float
+        Node positions (m) and velocities (m/s), LVLH.
+    masses : (n,) float
+        Node masses (kg).
+    n_orbit : float
+        Mean motion (rad/s); 0 without orbit.
+    out : (8,) float
+        Output.
+    """
     for k in range(8):
         out[k] = 0.0
     for i in range(masses.shape[0]):
@@ -82,7 +94,12 @@ class BodySample(NamedTuple):
 
 
 def body_sample_buffers(n_bodies: int, n_joints: int) -> BodySample:
-    """Zeroed :class:`BodySample` arrays."""
+    """Zeroed :class:`BodySample` arrays.
+
+    Parameters
+    ----------
+    n_bodies, n_joints : int
+    """
     nb, nj = n_bodies, n_joints
     return BodySample(np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3, 3)), np.zeros((nb, 3)),
                       np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 9)),

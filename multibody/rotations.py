@@ -37,7 +37,18 @@ def quaternion_from_matrix(body_to_inertial):
 
 @njit(cache=True, inline="always")
 def quaternion_from_matrix_tuple(a):
-    """:func:`quaternion_from_matrix` as a tuple (no allocation: the attitude controller runs every step)."""
+    """:func:`quaternion_from_matrix` as a tuple (no allocation: the attitude controller runs every step).
+
+    Parameters
+    ----------
+    a : (3, 3) float array
+        Rotation matrix body->inertial (or body->LVLH): columns are the body axes.
+
+    Returns
+    -------
+    tuple of 4 float
+        Unit quaternion (q0, q1, q2, q3), scalar first, q0 >= 0.
+    """
     trace = a[0, 0] + a[1, 1] + a[2, 2]
     if trace > max(a[0, 0], a[1, 1], a[2, 2]):
         s = 2.0 * math.sqrt(1.0 + trace)
@@ -82,7 +93,19 @@ def quaternion_to_matrix(q):
 
 @njit(cache=True, inline="always")
 def quaternion_from_rotation_vector_tuple(rotation_vector):
-    """Scalar-first unit quaternion (tuple) of a rotation vector (rad): angle |r| about r / |r|."""
+    """Scalar-first unit quaternion (tuple) of a rotation vector (rad): angle |r| about r / |r|.
+
+    Parameters
+    ----------
+    rotation_vector : (3,) float
+        Axis times angle (rad), of the rotation body->reference (in either frame's components: they
+        agree on the axis).
+
+    Returns
+    -------
+    tuple of 4 float
+        (q0, q1, q2, q3), scalar first.
+    """
     x, y, z = rotation_vector[0], rotation_vector[1], rotation_vector[2]
     angle = math.sqrt(x * x + y * y + z * z)
     if angle < 1e-8:
@@ -95,7 +118,18 @@ def quaternion_from_rotation_vector_tuple(rotation_vector):
 def rotation_matrix_from_rotation_vector(rotation_vector):
     """Rotation matrix (3, 3) of a rotation vector (rad), e.g. body -> LVLH of an Exudyn rotation-vector
     node; Rodrigues' formula :math:`I + \\frac{\\sin\\theta}{\\theta}K + \\frac{1-\\cos\\theta}{\\theta^2}K^2`,
-    written out in scalars (numba sends 3x3 products to BLAS, ~1 us a call)."""
+    written out in scalars (numba sends 3x3 products to BLAS, ~1 us a call).
+
+    Parameters
+    ----------
+    rotation_vector : (3,) float
+        Axis times angle (rad) of the rotation body->reference.
+
+    Returns
+    -------
+    (3, 3) float
+        body->reference matrix (columns: body axes in reference components, e.g. LVLH).
+    """
     x, y, z = rotation_vector[0], rotation_vector[1], rotation_vector[2]
     angle2 = x * x + y * y + z * z
     if angle2 < 1e-16:
@@ -119,7 +153,15 @@ def rotation_matrix_from_rotation_vector(rotation_vector):
 
 @njit(cache=True, inline="always")
 def rotation_vector_from_quaternion_into(w, x, y, z, out):
-    """Rotation vector (rad, angle at most pi) of the unit quaternion (w, x, y, z) into ``out`` (3,)."""
+    """Rotation vector (rad, angle at most pi) of the unit quaternion (w, x, y, z) into ``out`` (3,).
+
+    Parameters
+    ----------
+    w, x, y, z : float
+        Unit quaternion, scalar first, of the rotation body->reference.
+    out : (3,) float
+        Output: axis times angle (rad).
+    """
     if w < 0.0:
         w, x, y, z = -w, -x, -y, -z
     sine = math.sqrt(x * x + y * y + z * z)
@@ -133,14 +175,33 @@ def rotation_vector_from_quaternion_into(w, x, y, z, out):
 @njit(cache=True)
 def rotation_vector_from_matrix_into(rotation, out):
     """Rotation vector (rad) of a rotation matrix (the log map) into ``out`` (3,), through Shepperd's
-    quaternion (:func:`quaternion_from_matrix_tuple`): accurate at every angle up to pi."""
+    quaternion (:func:`quaternion_from_matrix_tuple`): accurate at every angle up to pi.
+
+    Parameters
+    ----------
+    rotation : (3, 3) float
+        Rotation matrix body->reference (columns: body axes in reference components).
+    out : (3,) float
+        Output: axis times angle (rad).
+    """
     w, x, y, z = quaternion_from_matrix_tuple(rotation)
     rotation_vector_from_quaternion_into(w, x, y, z, out)
 
 
 @njit(cache=True)
 def rotation_vector_from_matrix(rotation):
-    """Rotation vector (3,) (rad) of a rotation matrix: :func:`rotation_vector_from_matrix_into`."""
+    """Rotation vector (3,) (rad) of a rotation matrix: :func:`rotation_vector_from_matrix_into`.
+
+    Parameters
+    ----------
+    rotation : (3, 3) float
+        Rotation matrix body->reference (columns: body axes in reference components).
+
+    Returns
+    -------
+    (3,) float
+        Axis times angle (rad), angle at most pi.
+    """
     out = np.empty(3)
     rotation_vector_from_matrix_into(rotation, out)
     return out
@@ -150,7 +211,20 @@ def rotation_vector_from_matrix(rotation):
 def compose_rotation_vectors(rotation_vector, increment_body):
     """Rotation vector (3,) of R(rotation_vector) R(increment_body): a rotation by ``increment_body``
     (rad, body frame) after ``rotation_vector``; the Lie-group update Exudyn applies to rotation-vector
-    nodes. The result's angle is at most pi."""
+    nodes. The result's angle is at most pi.
+
+    Parameters
+    ----------
+    rotation_vector : (3,) float
+        Current rotation body->reference (rad).
+    increment_body : (3,) float
+        Rotation increment (rad), body frame.
+
+    Returns
+    -------
+    (3,) float
+        The composed rotation body->reference (rad).
+    """
     w0, x0, y0, z0 = quaternion_from_rotation_vector_tuple(rotation_vector)
     w1, x1, y1, z1 = quaternion_from_rotation_vector_tuple(increment_body)
     out = np.empty(3)

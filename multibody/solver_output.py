@@ -35,13 +35,25 @@ _DESTINATION: contextvars.ContextVar[Path | None] = contextvars.ContextVar("solv
 
 
 def is_routine(line: str) -> bool:
-    """The solver's ``line`` is one of :data:`ROUTINE_NOTICES` (kept in the log only)."""
+    """The solver's ``line`` is one of :data:`ROUTINE_NOTICES` (kept in the log only).
+
+    Parameters
+    ----------
+    line : str
+        One line the solver printed.
+    """
     return any(p.search(line) for p in ROUTINE_NOTICES)
 
 
 @contextlib.contextmanager
 def solver_log(path: str | Path):
-    """Within the block, what the solver prints is appended to ``path`` (created if needed)."""
+    """Within the block, what the solver prints is appended to ``path`` (created if needed).
+
+    Parameters
+    ----------
+    path : str or Path
+        The log file.
+    """
     token = _DESTINATION.set(Path(path))
     try:
         yield Path(path)

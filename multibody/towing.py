@@ -121,7 +121,13 @@ class TowingModel(TowedBodies):
 def packed(model: TowingModel) -> TowKernel:
     """The model for the compiled kernels: one float array (:func:`multibody.towing_kernel.pack`,
     ``.work``) and the thrust law's compiled command (``.thrust``); the array also carries the
-    thrust law's state, so each run needs its own."""
+    thrust law's state, so each run needs its own.
+
+    Parameters
+    ----------
+    model : TowingModel
+        The run (SI; positions and velocities inertial, rates and inertias in the body frames).
+    """
     work = pack(model.positions, model.masses, model.inertia_body, model.attach_chaser_body,
                 model.attach_debris_body, model.tether, model.mu, model.attitude, model.thrust_along_body_z,
                 model.thrust_params, model.thrust_state, model.step, model.velocities[0], model.start_time)
@@ -143,7 +149,7 @@ class TowResult:
     def series(self) -> dict:
         """Named time series (SI; frames in the names), see docs/towing.md."""
         m = self.model
-        rot = np.array([[rotation_matrix_from_rotation_vector(self.q[k, b + 3:b + 6]) for b in (3, 9)]
+        body_to_inertial = np.array([[rotation_matrix_from_rotation_vector(self.q[k, b + 3:b + 6]) for b in (3, 9)]
                         for k in range(len(self.time))]).reshape(-1, 2, 3, 3)
         return {
             "time": self.time,
@@ -152,7 +158,7 @@ class TowResult:
             "debris_com_inertial": m.positions[2] + self.q[:, 9:12],
             "connection_point_velocity_inertial": self.v[:, 0:3],
             "chaser_velocity_inertial": self.v[:, 3:6], "debris_velocity_inertial": self.v[:, 9:12],
-            "chaser_to_inertial": rot[:, 0], "debris_to_inertial": rot[:, 1],
+            "chaser_to_inertial": body_to_inertial[:, 0], "debris_to_inertial": body_to_inertial[:, 1],
             "chaser_omega_body": self.v[:, 6:9], "debris_omega_body": self.v[:, 12:15],
             "main_tether_tension": self.diag[:, MT_TENSION],
             "main_tether_elongation": self.diag[:, MT_ELONGATION],
@@ -170,7 +176,18 @@ def _sample_buffers(model: TowingModel):
 
 def run_twin(model: TowingModel) -> TowResult:
     """Integrate ``model`` with the compiled twin of Exudyn's scheme (:func:`~multibody.towing_kernel.verlet_run`
-    with no further loads), sampled every ``model.every`` steps."""
+    with no further loads).
+
+    Parameters
+    ----------
+    model : TowingModel
+        The run (SI; positions and velocities inertial, rates and inertias in the body frames).
+
+    Returns
+    -------
+    TowResult
+        Samples every ``model.every`` steps from ``start_time``.
+    """
     q, v = model.initial_state()
     out_q, out_v, out_diag = _sample_buffers(model)
     record = model.every * np.arange(len(out_q), dtype=np.int64)
@@ -232,8 +249,20 @@ class _Sampler:
 
 def build_towing_system(model: TowingModel, forces: _TowForces):
     """The Exudyn system: chaser and debris rigid bodies and one coupled generic object whose force
-    is ``forces`` (the connection point P is advanced inside it, implicitly). Returns (system
-    container, main system, node list)."""
+    is ``forces`` (the connection point P is advanced inside it, implicitly).
+
+    Parameters
+    ----------
+    model : TowingModel
+        The run (SI; positions and velocities inertial, rates and inertias in the body frames).
+    forces : _TowForces
+        Force user function of the coupled object.
+
+    Returns
+    -------
+    tuple
+        (system container, main system, node list [chaser, debris]).
+    """
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     q0, v0 = model.initial_state()
@@ -242,9 +271,9 @@ def build_towing_system(model: TowingModel, forces: _TowForces):
         node = mbs.AddNode(NodeRigidBodyRotVecLG(referenceCoordinates=list(model.positions[b + 1]) + [0.0] * 3,
                                                  initialCoordinates=list(q0[base:base + 6]),
                                                  initialVelocities=list(v0[base:base + 6])))
-        j = model.inertia_body[b]
+        inertia_body = model.inertia_body[b]
         mbs.AddObject(ObjectRigidBody(nodeNumber=node, mass=float(model.masses[b + 1]),
-                                      inertia=[j[0, 0], j[1, 1], j[2, 2], j[1, 2], j[0, 2], j[0, 1]]))
+                                      inertia=[inertia_body[0, 0], inertia_body[1, 1], inertia_body[2, 2], inertia_body[1, 2], inertia_body[0, 2], inertia_body[0, 1]]))
         nodes.append(node)
     mbs.AddObject(ObjectGenericODE2(nodeNumbers=nodes, forceUserFunction=forces))
     mbs.Assemble()
@@ -252,7 +281,18 @@ def build_towing_system(model: TowingModel, forces: _TowForces):
 
 
 def run_exudyn(model: TowingModel) -> TowResult:
-    """Build and integrate ``model`` in Exudyn (VelocityVerlet, fixed step, Lie-group rotations)."""
+    """Build and integrate ``model`` in Exudyn (VelocityVerlet, fixed step, Lie-group rotations).
+
+    Parameters
+    ----------
+    model : TowingModel
+        The run (SI; positions and velocities inertial, rates and inertias in the body frames).
+
+    Returns
+    -------
+    TowResult
+        Samples every ``model.every`` steps from ``start_time``.
+    """
     forces = _TowForces(model)
     sc, mbs, nodes = build_towing_system(model, forces)
     sampler = _Sampler(forces, _object_state_index(mbs, nodes, [6, 6]), _sample_buffers(model))
@@ -272,7 +312,13 @@ HEALTH_EVERY_STEPS = 10
 
 
 def tow_failure_cause(step: float) -> str:
-    """Words for a failed tow (the connection point is implicit, so no single explicit limit applies)."""
+    """Words for a failed tow (the connection point is implicit, so no single explicit limit applies).
+
+    Parameters
+    ----------
+    step : float
+        The run's step (s).
+    """
     return (f"at the step {step:g} s the bodies' rotation or the tethers lost stability: reduce simulation.step "
             f"and check the tether stiffness and damping, the thrust and the initial rates for extreme values")
 
@@ -288,6 +334,13 @@ def stable_step(model: TowingModel, safety: float = 0.5) -> float:
     stability for :math:`h^2\\omega^2 + 2h\\gamma < 4`, i.e.
     :math:`h < (\\sqrt{\\gamma^2 + 4\\omega^2} - \\gamma)/\\omega^2`. With ``safety`` 0.5,
     :math:`h\\gamma < 1`: the damped mode does not oscillate from step to step.
+
+    Parameters
+    ----------
+    model : TowingModel
+        The run (SI; positions and velocities inertial, rates and inertias in the body frames).
+    safety : float
+        Fraction of the stability limit (-).
     """
     n = len(model.attach_debris_body)
     omega2 = (model.tether[0] + n * model.tether[3]) / model.masses[0]

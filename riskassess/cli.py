@@ -386,7 +386,7 @@ def _print_table(console, title: str, columns, rows, justify=None) -> None:
 
 def _console():
     """The terminal: markup only where the CLI writes it, every user string passed through
-    ``escape`` (issue 20: ``x[/red]`` in a name crashed, ``[link=...]`` was followed); no emoji codes."""
+    ``escape`` (``x[/red]`` in a name used to crash, ``[link=...]`` was followed); no emoji codes."""
     from rich.console import Console
 
     return Console(width=None if sys.stdout.isatty() else 150, emoji=False)

@@ -46,7 +46,23 @@ class ReleaseMonitor:
         return {e.joint for e in self.events}
 
     def check(self, t, force_joint, moment_joint, joint_energies):
-        """One output sample: (nj, 3) joint loads (joint frame) and (nj,) joint elastic energies (J)."""
+        """One output sample: (nj, 3) joint loads (joint frame) and (nj,) joint elastic energies (J).
+
+        Releases (:meth:`release`) every location not yet released whose demand reaches its decisive
+        allowable; does nothing before ``skip_until``.
+
+        Parameters
+        ----------
+        t : float
+            Simulation time of the sample (s).
+        force_joint : (nj, 3) float
+            Reaction force of each joint, the load the parent exerts on the child (N), joint frame
+            (h1, h2, h3).
+        moment_joint : (nj, 3) float
+            Reaction moment of each joint at the joint point (N m), joint frame.
+        joint_energies : (nj,) float
+            Elastic energy stored in each penalty joint at the sample (J).
+        """
         if t < self.skip_until:
             return
         released = self.released_joints()
@@ -59,13 +75,47 @@ class ReleaseMonitor:
                 released.add(loc.joint)
 
     def release(self, location: WeakLocation, t, criterion, demand, stored_energy=0.0):
+        """Switch the joint of ``location`` off in the Exudyn system and record the event.
+
+        Parameters
+        ----------
+        location : WeakLocation
+            The failed location; its joint's connector is deactivated.
+        t : float
+            Release time (s).
+        criterion : str
+            Name of the criterion that failed (``"normal_stress"``, ``"shear_stress"``, ``"moment"``,
+            ``"force"``).
+        demand : float
+            Demand at release, in the criterion's SI unit (Pa, N m or N).
+        stored_energy : float
+            Elastic energy of the penalty joint let go at release (J).
+        """
         mbs = self.system.mbs
         mbs.SetObjectParameter(self.system.joint_objects[location.joint], "activeConnector", False)
         self.events.append(ReleaseEvent(location.name, location.joint, float(t), criterion, demand, stored_energy))
 
 
 def piece_size(bodies, members, attitudes, coms) -> list[float]:
-    """Oriented bounding-box extents (m) of the piece's shapes, sorted large to small."""
+    """Oriented bounding-box extents (m) of the piece's shapes, sorted large to small.
+
+    Parameters
+    ----------
+    bodies : list of RigidBodySpec
+        All bodies of the assembly (their ``meshes_body``: contact shapes, body frame, origin at
+        the CoM, m).
+    members : list of int
+        Indices of the bodies in the piece.
+    attitudes : list of (3, 3) float
+        Rotation body -> LVLH of every body (indexed like ``bodies``).
+    coms : list of (3,) float
+        CoM position of every body, LVLH (m).
+
+    Returns
+    -------
+    list of 3 float
+        Box extents (m), largest first.
+    """
     meshes = []
     for k in members:
         for mesh in bodies[k].meshes_body:
@@ -79,7 +129,20 @@ def piece_size(bodies, members, attitudes, coms) -> list[float]:
 
 
 def inside_net(point_lvlh, net_positions_lvlh) -> bool:
-    """True if the point lies inside the convex hull of the net nodes (the net wraps it)."""
+    """True if the point lies inside the convex hull of the net nodes (the net wraps it).
+
+    Parameters
+    ----------
+    point_lvlh : (3,) float
+        Point to test, LVLH (m).
+    net_positions_lvlh : (n, 3) float
+        Net node positions, LVLH (m).
+
+    Returns
+    -------
+    bool
+        False also for a flat or degenerate node cloud (nothing is enclosed).
+    """
     try:
         hull = trimesh.convex.convex_hull(np.asarray(net_positions_lvlh, float))
     except Exception:  # flat or degenerate node cloud: nothing is enclosed
@@ -88,7 +151,29 @@ def inside_net(point_lvlh, net_positions_lvlh) -> bool:
 
 
 def released_pieces(events: list[ReleaseEvent], assembly, series, net_positions_final) -> list[dict]:
-    """Report per release event (see module doc); states are the last recorded sample."""
+    """Report per release event (see module doc); states are the last recorded sample.
+
+    Parameters
+    ----------
+    events : list of ReleaseEvent
+        The releases of the run (:attr:`ReleaseMonitor.events`).
+    assembly : multibody.assembly.ImpactAssembly
+        The simulated assembly (bodies, joints; initial poses give the piece's shape).
+    series : dict
+        Recorded series (:mod:`multibody.recorder`): ``body_com_lvlh`` (k, nb, 3) m,
+        ``body_velocity_lvlh`` (k, nb, 3) m/s, ``body_omega_body`` (k, nb, 3) rad/s body frame,
+        ``body_to_lvlh`` (k, nb, 3, 3).
+    net_positions_final : (n, 3) float
+        Net node positions at the end of the run, LVLH (m).
+
+    Returns
+    -------
+    list of dict
+        One JSON-ready dict per event, in release order: location, joint, release time (s),
+        criterion and demand, bodies, mass (kg), size (m), and at the end of the run the piece's
+        CoM position (m) and velocity (m/s) relative to the chaser, LVLH, spin (rad/s, LVLH),
+        and whether it is inside the net.
+    """
     bodies, joints = assembly.bodies, assembly.joints
     masses = np.array([b.mass for b in bodies])
     attitudes0 = [b.body_to_lvlh for b in bodies]

@@ -25,7 +25,28 @@ class SectionProperties:
 def bending_properties(area, i2, i3, c2, c3, torsion, shear2, shear3, round_=False) -> SectionProperties:
     """Section properties from the area (m^2), second moments I2, I3 (m^4), extreme-fibre distances
     c2, c3 (m), and the peak shear stresses per unit torque (1/m^3) and per unit shear force along
-    axes 2 and 3 (1/m^2); ``round_``: bending peaks combine as a resultant."""
+    axes 2 and 3 (1/m^2); ``round_``: bending peaks combine as a resultant.
+
+    Parameters
+    ----------
+    area : float
+        Cross-section area (m^2).
+    i2, i3 : float
+        Second moments of area about section axes 2 and 3 (m^4).
+    c2, c3 : float
+        Distance of the extreme fibre from the neutral axis along section axes 2 and 3 (m).
+    torsion : float
+        Peak shear stress per unit torque (Pa per N m = 1/m^3).
+    shear2, shear3 : float
+        Peak transverse shear stress per unit shear force along axes 2 and 3 (Pa per N = 1/m^2).
+    round_ : bool
+        True for a circular section: the bending peaks combine as a resultant.
+
+    Returns
+    -------
+    SectionProperties
+        Normal stress per unit moment is c3 / I2 about axis 2 and c2 / I3 about axis 3 (1/m^3).
+    """
     return SectionProperties(area=area, second_moment_2=i2, second_moment_3=i3,
                              normal_per_axial=1.0 / area, normal_per_moment2=c3 / i2, normal_per_moment3=c2 / i3,
                              shear_per_torque=torsion, shear_per_force2=shear2, shear_per_force3=shear3,

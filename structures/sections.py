@@ -34,6 +34,8 @@ def section_stresses(section: SectionProperties, force_section, moment_section) 
 
     Parameters
     ----------
+    section : SectionProperties
+        Per-unit-load peak stresses of the cross-section (:mod:`structures.section_shapes`).
     force_section, moment_section : (k, 3) array
         Internal force (N, V2, V3) (N) and moment (T, M2, M3) (N m) per sample.
 

@@ -15,7 +15,7 @@ DEBRIS_STATES = (DEBRIS, NO_DEBRIS, INDETERMINATE)
 
 
 #: A verdict needs at least this many judged samples (after ``skip_initial``): a peak read from
-#: fewer is not a load history (the reproducer of issue 20: end_time below skip_initial, or an
+#: fewer is not a load history (a run whose end_time was below skip_initial, or an
 #: output rate of 1e-300 Hz, judged nothing and said "pass").
 MIN_JUDGED_SAMPLES = 10
 #: Longest sample interval a verdict accepts (s). Joint loads are sampled, not averaged, so a
@@ -55,7 +55,23 @@ def evidence_gaps(time, contact_force_debris_lvlh, skip_until: float) -> list[st
 
 def location_state(result: dict, gaps: list[str]) -> tuple[str, str | None]:
     """('fails' | 'holds' | 'indeterminate', reason) of one judged location. An exceedance seen
-    is a failure whatever else is missing; a pass needs judged, finite loads and no evidence gap."""
+    is a failure whatever else is missing; a pass needs judged, finite loads and no evidence gap.
+
+    Parameters
+    ----------
+    result : dict
+        The location's verdict (:func:`structures.weak_location.assess`) with ``released_at_s``
+        (s, or None) added.
+    gaps : list of str
+        Evidence gaps of the run (:func:`evidence_gaps`); empty when the samples can support a
+        verdict.
+
+    Returns
+    -------
+    state : {"fails", "holds", "indeterminate"}
+    reason : str or None
+        Why the state is indeterminate; None otherwise.
+    """
     if result["fails"] or result["released_at_s"] is not None:
         return "fails", None
     if not result["judged"]:
@@ -68,7 +84,33 @@ def location_state(result: dict, gaps: list[str]) -> tuple[str, str | None]:
 def structures_verdict(locations: list[WeakLocation], series: dict, assembly, events: list[ReleaseEvent],
                        net_positions_final, skip_until: float, policy: str) -> dict:
     """JSON-ready verdict: per location the criteria, margins, likelihood and any release, and the
-    answer ``debris_state`` (:data:`DEBRIS_STATES`) with the reasons when it is indeterminate."""
+    answer ``debris_state`` (:data:`DEBRIS_STATES`) with the reasons when it is indeterminate.
+
+    Parameters
+    ----------
+    locations : list of WeakLocation
+        The weak locations to judge.
+    series : dict
+        Recorded series (:mod:`multibody.recorder`): ``time`` (k,) s, ``contact_force_lvlh``
+        (k, nb, 3) N LVLH, ``joint_force_joint`` (k, nj, 3) N and ``joint_moment_joint``
+        (k, nj, 3) N m in each joint frame, and the body states :func:`released_pieces` reads.
+    assembly : multibody.assembly.ImpactAssembly
+        The simulated assembly (joint names, debris bodies).
+    events : list of ReleaseEvent
+        The run's releases (empty without release).
+    net_positions_final : (n, 3) float
+        Net node positions at the end of the run, LVLH (m).
+    skip_until : float
+        Loads before this time are not judged (s).
+    policy : {"low", "nominal", "high", "never"}
+        The case's release policy; "never" judges range allowables at their low end.
+
+    Returns
+    -------
+    dict
+        ``skip_initial_s``, ``release_policy``, ``locations`` (one verdict each), ``released_pieces``,
+        ``debris_state``, ``secondary_debris`` (True / False / None) and ``indeterminate_reasons``.
+    """
     time = series["time"]
     released_at = {e.location: e for e in events}
     gaps = evidence_gaps(time, series["contact_force_lvlh"][:, list(assembly.debris_indices)], skip_until)
@@ -170,7 +212,21 @@ def condition_sentence(result: dict, policy: str) -> str:
 
 
 def demand_series(locations: list[WeakLocation], series: dict) -> dict:
-    """Per location and demand, the time series (SI), keyed ``<location>/<demand>``, for the run folder."""
+    """Per location and demand, the time series (SI), keyed ``<location>/<demand>``, for the run folder.
+
+    Parameters
+    ----------
+    locations : list of WeakLocation
+        The weak locations.
+    series : dict
+        Recorded series: ``time`` (k,) s, ``joint_force_joint`` (k, nj, 3) N and
+        ``joint_moment_joint`` (k, nj, 3) N m, joint frame.
+
+    Returns
+    -------
+    dict of (k,) float
+        ``time`` (s) and every demand of every location (Pa, N m or N).
+    """
     out = {"time": series["time"]}
     for loc in locations:
         for name, values in demands(loc, series["joint_force_joint"][:, loc.joint],

@@ -54,7 +54,24 @@ class WeakLocation:
 
 
 def internal_loads_section_frame(location: WeakLocation, force_joint, moment_joint):
-    """Internal force (N, V2, V3) and moment (T, M2, M3) at the cut, section frame; (k, 3) each."""
+    """Internal force (N, V2, V3) and moment (T, M2, M3) at the cut, section frame; (k, 3) each.
+
+    Parameters
+    ----------
+    location : WeakLocation
+        Gives the cut offset (m, joint frame) and the section axes in the joint frame.
+    force_joint : (k, 3) or (3,) float
+        Joint reaction force (N), joint frame.
+    moment_joint : (k, 3) or (3,) float
+        Joint reaction moment at the joint point (N m), joint frame.
+
+    Returns
+    -------
+    force_section : (k, 3) float
+        (N, V2, V3) (N), section frame.
+    moment_section : (k, 3) float
+        (T, M2, M3) at the cut, M_cut = M_joint - r x F (N m), section frame.
+    """
     f = np.atleast_2d(np.asarray(force_joint, float))
     m = np.atleast_2d(np.asarray(moment_joint, float)) - np.cross(location.offset_joint, f)
     rot = location.section_to_joint
@@ -62,7 +79,24 @@ def internal_loads_section_frame(location: WeakLocation, force_joint, moment_joi
 
 
 def demands(location: WeakLocation, force_joint, moment_joint) -> dict:
-    """Demand time series per criterion ((k,) arrays, SI), plus the section's stress breakdown."""
+    """Demand time series per criterion ((k,) arrays, SI), plus the section's stress breakdown.
+
+    Parameters
+    ----------
+    location : WeakLocation
+        The location (section, moment axes).
+    force_joint : (k, 3) float
+        Joint reaction force (N), joint frame.
+    moment_joint : (k, 3) float
+        Joint reaction moment (N m), joint frame.
+
+    Returns
+    -------
+    dict of (k,) float
+        ``moment`` (N m) and ``force`` (N); with a section also ``normal_stress``,
+        ``shear_stress``, ``von_mises_stress``, ``bending_stress``, ``axial_stress``,
+        ``torsion_stress`` and ``transverse_shear_stress`` (Pa).
+    """
     out = {}
     f = np.atleast_2d(np.asarray(force_joint, float))
     m = np.atleast_2d(np.asarray(moment_joint, float))
@@ -85,6 +119,29 @@ def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0
     initial impact loads that have no time to propagate). ``policy`` picks the value of a
     range allowable that decides pass/fail and the margin ("low", "nominal", "high");
     the likelihood always uses the whole range.
+
+    Parameters
+    ----------
+    location : WeakLocation
+        The location to judge.
+    time : (k,) float
+        Sample times (s).
+    force_joint : (k, 3) float
+        Joint reaction force (N), joint frame.
+    moment_joint : (k, 3) float
+        Joint reaction moment (N m), joint frame.
+    skip_until : float
+        Start of the judged window (s).
+    policy : {"low", "nominal", "high"}
+        Value of a range allowable that decides.
+
+    Returns
+    -------
+    dict
+        ``name``, ``criteria`` (per criterion: peak, its time (s), allowable, margin, likelihood,
+        first exceedance (s), ...), ``fails``, ``fails_normal``, ``fails_shear``, ``judged``,
+        ``likelihood`` (None when not judged), ``first_exceedance_s`` and, with a section,
+        ``peak_von_mises_stress_Pa``.
     """
     time = np.asarray(time, float)
     series = demands(location, force_joint, moment_joint)
@@ -136,7 +193,22 @@ PEAK_HISTORY_SAMPLES = 101
 def history_around_peak(time, demand, k: int) -> dict:
     """The demand around its peak sample ``k``: ``peak_history`` {"time_s", "demand"} over
     +-:data:`PEAK_HISTORY_HALF_WIDTH_S`, and ``peak_width_s``, how long the demand stays at or above
-    half the peak around it (a spike of one sample gives one sample interval)."""
+    half the peak around it (a spike of one sample gives one sample interval).
+
+    Parameters
+    ----------
+    time : (k,) float
+        Sample times (s).
+    demand : (k,) float
+        Demand series, in the criterion's SI unit (Pa, N m or N).
+    k : int
+        Index of the peak sample.
+
+    Returns
+    -------
+    dict
+        ``peak_width_s`` (s) and ``peak_history`` with ``time_s`` (s) and ``demand`` (SI) lists.
+    """
     window = np.flatnonzero(np.abs(time - time[k]) <= PEAK_HISTORY_HALF_WIDTH_S)
     thin = max(1, -(-window.size // PEAK_HISTORY_SAMPLES))
     kept = np.union1d(window[(window - k) % thin == 0], [k])
@@ -150,7 +222,24 @@ def history_around_peak(time, demand, k: int) -> dict:
 
 def exceeds_now(location: WeakLocation, force_joint, moment_joint, policy="low"):
     """The first criterion (name, demand) whose demand reaches its decisive allowable for one
-    sample of joint loads ((3,) each), or None: what a run checks to release a joint."""
+    sample of joint loads ((3,) each), or None: what a run checks to release a joint.
+
+    Parameters
+    ----------
+    location : WeakLocation
+        The location to check.
+    force_joint : (3,) float
+        Joint reaction force at this sample (N), joint frame.
+    moment_joint : (3,) float
+        Joint reaction moment at this sample (N m), joint frame.
+    policy : {"low", "nominal", "high"}
+        Value of a range allowable that decides.
+
+    Returns
+    -------
+    tuple of (str, float) or None
+        Criterion name and its demand (Pa, N m or N).
+    """
     series = demands(location, np.reshape(force_joint, (1, 3)), np.reshape(moment_joint, (1, 3)))
     for name, allowable in location.criteria().items():
         if series[name][0] >= allowable.threshold(policy):

@@ -40,7 +40,14 @@ OWN_SEED = {"towing_viscoelastic.csv": np.random.default_rng(2025)}
 
 
 def main(only=None) -> None:
-    """Write every sample, or those whose file name is in ``only``."""
+    """Write every sample, or those whose file name is in ``only``.
+
+    Parameters
+    ----------
+    only : sequence of str or None
+        CSV file names of :data:`SAMPLES` to remake (e.g. ``["towing_viscoelastic.csv"]``); all when
+        empty or None. Each file holds 300 s at 10 Hz (time in s, channels in SI) under ``cases/data``.
+    """
     rng = np.random.default_rng(2024)
     times = sample_times(300.0, 10.0)
     for case_name, data_name, effect, values in SAMPLES:

@@ -19,7 +19,18 @@ from multibody.rotations import quaternion_from_matrix_tuple
 @njit(cache=True)
 def kinematics_matrix(q):
     """Quaternion kinematics matrix :math:`Q(q)` (4, 3), paper eq. (8) (Schaub & Junkins' B):
-    :math:`\\dot q = \\tfrac12 Q(q)\\,\\omega_{body}`."""
+    :math:`\\dot q = \\tfrac12 Q(q)\\,\\omega_{body}`.
+
+    Parameters
+    ----------
+    q : (4,) float
+        Scalar-first unit quaternion of the body->inertial rotation.
+
+    Returns
+    -------
+    (4, 3) float
+        Q(q); half of it times the body-frame angular velocity (rad/s) is the quaternion rate (1/s).
+    """
     return np.array([[-q[1], -q[2], -q[3]],
                      [q[0], -q[3], q[2]],
                      [q[3], q[0], -q[1]],
@@ -54,17 +65,18 @@ def desired_attitude(u_main_tether_inertial, r_chaser_inertial):
     r_chaser_inertial : (3,) float
         Chaser CoM from the Earth's centre (m), inertial.
     """
-    u, r = u_main_tether_inertial, r_chaser_inertial
-    u_norm, r_norm = math.sqrt(dot3(u, u)), math.sqrt(dot3(r, r))
-    ez = -u[0] / u_norm, -u[1] / u_norm, -u[2] / u_norm  # tuples: this runs every step of a tow
-    radial = r[0] / r_norm, r[1] / r_norm, r[2] / r_norm
-    ex = _cross(ez, radial)
-    ex_norm = math.sqrt(dot3(ex, ex))
-    ex = ex[0] / ex_norm, ex[1] / ex_norm, ex[2] / ex_norm
-    ey = _cross(ez, ex)
+    u_inertial, r_inertial = u_main_tether_inertial, r_chaser_inertial
+    u_norm, r_norm = math.sqrt(dot3(u_inertial, u_inertial)), math.sqrt(dot3(r_inertial, r_inertial))
+    # tuples: this runs every step of a tow
+    ez_inertial = -u_inertial[0] / u_norm, -u_inertial[1] / u_norm, -u_inertial[2] / u_norm
+    radial_inertial = r_inertial[0] / r_norm, r_inertial[1] / r_norm, r_inertial[2] / r_norm
+    ex_inertial = _cross(ez_inertial, radial_inertial)
+    ex_norm = math.sqrt(dot3(ex_inertial, ex_inertial))
+    ex_inertial = ex_inertial[0] / ex_norm, ex_inertial[1] / ex_norm, ex_inertial[2] / ex_norm
+    ey_inertial = _cross(ez_inertial, ex_inertial)
     out = np.empty((3, 3))
     for i in range(3):
-        out[i, 0], out[i, 1], out[i, 2] = ex[i], ey[i], ez[i]
+        out[i, 0], out[i, 1], out[i, 2] = ex_inertial[i], ey_inertial[i], ez_inertial[i]
     return out
 
 
@@ -133,11 +145,10 @@ def sliding_mode_torque(body_to_inertial, omega_body, desired_to_inertial, inert
     sign = 1.0 if qd[0] * q[0] + qd[1] * q[1] + qd[2] * q[2] + qd[3] * q[3] >= 0.0 else -1.0
     error = _kinematics_transpose_times(qd, q)
     feedforward = _kinematics_transpose_times(qd, _kinematics_times(q, omega_body))
-    w = omega_body
-    jw = matvec3(inertia_body, w)
+    j_omega_body = matvec3(inertia_body, omega_body)
     s, demand = np.empty(3), np.empty(3)
     for i in range(3):
-        s[i] = w[i] + k_gain * sign * error[i]
+        s[i] = omega_body[i] + k_gain * sign * error[i]
         demand[i] = -0.5 * k_gain * sign * feedforward[i] - gain[i] * min(1.0, max(-1.0, s[i] / width[i]))
-    torque = cross3(w, jw) + matvec3(inertia_body, demand)
-    return torque, s
+    torque_body = cross3(omega_body, j_omega_body) + matvec3(inertia_body, demand)
+    return torque_body, s

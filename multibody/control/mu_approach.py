@@ -193,25 +193,40 @@ def straight_line_guess(problem: ApproachProblem):
     mouth turns across the approach direction, both along :func:`_progress`; the controls are
     the thrusts this motion needs (clipped to the bounds), so the guess nearly satisfies the
     dynamics. (A guess with constant velocities from the rest start left IPOPT hundreds of
-    iterations from the answer.) Returns states (nx, 2N+1) and controls (4, 2N+1) on the nodes
-    and midpoints interleaved, and t_f (s)."""
+    iterations from the answer.)
+
+    Parameters
+    ----------
+    problem : ApproachProblem
+        The optimal-control problem (SI, world frame).
+
+    Returns
+    -------
+    states : (nx, 2N+1) float
+        States on the nodes and midpoints interleaved, world frame (``model.state_names``).
+    controls : (6, 2N+1) float
+        :data:`~multibody.control.mu_dynamics.CONTROLS` at the same points.
+    tf : float
+        Final time of the guess (s).
+    """
     tf = problem.final_time or problem.final_time_guess
     t = tf * point_fractions(problem)
     model, x0 = problem.model, np.asarray(problem.initial_state, float)
     x1, y1, x2, y2 = model.unit_positions(x0)
-    center0 = np.array([x1 + x2, y1 + y2]) / 2.0
-    approach = np.asarray(problem.debris_center, float) - center0
+    center0_world = np.array([x1 + x2, y1 + y2]) / 2.0
+    approach_world = np.asarray(problem.debris_center, float) - center0_world
     angle0 = np.arctan2(y2 - y1, x2 - x1)
     s = _progress(t / tf, problem.final_at_rest)
-    angle = angle0 + s * (_facing_angle(approach, angle0) - angle0)
-    center = center0[:, None] + s * approach[:, None]
+    angle = angle0 + s * (_facing_angle(approach_world, angle0) - angle0)
+    center_world = center0_world[:, None] + s * approach_world[:, None]
     half = np.hypot(x2 - x1, y2 - y1) / 2.0
     if problem.width_bounds is not None:
         half = np.clip(half, *np.asarray(problem.width_bounds) / 2.0)
     if model.kind == "rigid_rod":
-        return _rod_guess(problem, t, center, angle) + (tf,)
-    offset = half * np.array([np.cos(angle), np.sin(angle)])
-    return _units_guess(problem, t, center - offset, center + offset, x0[[4, 9]]) + (tf,)
+        return _rod_guess(problem, t, center_world, angle) + (tf,)
+    offset_world = half * np.array([np.cos(angle), np.sin(angle)])
+    return _units_guess(problem, t, center_world - offset_world, center_world + offset_world,
+                        x0[[4, 9]]) + (tf,)
 
 
 def _derivative(values, t):
@@ -223,28 +238,29 @@ def _thrust_for(force_world, bounds):
     return np.clip(np.hypot(*force_world), *bounds), np.unwrap(np.arctan2(force_world[1], force_world[0]))
 
 
-def _rod_guess(problem, t, center, angle):
+def _rod_guess(problem, t, center_world, angle):
     model = problem.model
-    velocity, rate = _derivative(center, t), _derivative(angle, t)
-    acceleration, angular_acceleration = _derivative(velocity, t), _derivative(rate, t)
-    normal = np.array([-np.sin(angle), np.cos(angle)])
+    velocity_world, rate = _derivative(center_world, t), _derivative(angle, t)
+    acceleration_world, angular_acceleration = _derivative(velocity_world, t), _derivative(rate, t)
+    normal_world = np.array([-np.sin(angle), np.cos(angle)])
     # F1 + F2 = 2 m a (eqs. 1-2); (F2 - F1) . n = 2 I phi'' / L (eq. 3), F2 - F1 along n
-    couple = rod_moment_of_inertia(model.mass, model.length) * angular_acceleration / model.length * normal
-    thrust_1, world_1 = _thrust_for(model.mass * acceleration - couple, problem.thrust_bounds)
-    thrust_2, world_2 = _thrust_for(model.mass * acceleration + couple, problem.thrust_bounds)
-    states = np.array([center[0], velocity[0], center[1], velocity[1], angle, rate])
-    return states, controls_from_angles(thrust_1, thrust_2, angle - world_1, angle - world_2)
+    couple_world = (rod_moment_of_inertia(model.mass, model.length) * angular_acceleration / model.length
+                    * normal_world)
+    thrust_1, angle_1_world = _thrust_for(model.mass * acceleration_world - couple_world, problem.thrust_bounds)
+    thrust_2, angle_2_world = _thrust_for(model.mass * acceleration_world + couple_world, problem.thrust_bounds)
+    states = np.array([center_world[0], velocity_world[0], center_world[1], velocity_world[1], angle, rate])
+    return states, controls_from_angles(thrust_1, thrust_2, angle - angle_1_world, angle - angle_2_world)
 
 
-def _units_guess(problem, t, path_1, path_2, initial_masses):
+def _units_guess(problem, t, path_1_world, path_2_world, initial_masses):
     k = problem.model.fuel_rate
     states, controls = [], [[], [], [], []]
-    for i, (path, mass0) in enumerate(zip((path_1, path_2), initial_masses)):
-        velocity = _derivative(path, t)
-        thrust, world = _thrust_for(mass0 * _derivative(velocity, t), problem.thrust_bounds)
+    for i, (path_world, mass0) in enumerate(zip((path_1_world, path_2_world), initial_masses)):
+        velocity_world = _derivative(path_world, t)
+        thrust, angle_world = _thrust_for(mass0 * _derivative(velocity_world, t), problem.thrust_bounds)
         spent = np.r_[0.0, np.cumsum((thrust[1:] + thrust[:-1]) / 2.0 * np.diff(t))]
-        states += [path[0], path[1], velocity[0], velocity[1], mass0 - k * spent]
-        controls[i], controls[2 + i] = thrust, world
+        states += [path_world[0], path_world[1], velocity_world[0], velocity_world[1], mass0 - k * spent]
+        controls[i], controls[2 + i] = thrust, angle_world
     return np.array(states), controls_from_angles(*controls)
 
 
@@ -318,6 +334,16 @@ def solve(problem: ApproachProblem) -> ApproachSolution:
     so these constraints are weakly active near the start (zero multipliers on the bound), which
     cost IPOPT 2-4 times the wall time (measured on case study 2: minimum time 0.75 s against
     3.6 s, combined 1.5 s against 3.9 s). Not for min_fuel (see below).
+
+    Parameters
+    ----------
+    problem : ApproachProblem
+        The optimal-control problem (SI, world frame).
+
+    Returns
+    -------
+    ApproachSolution
+        The last mesh's solution; ``success`` says whether IPOPT converged.
     """
     # min_fuel: every direction profile at the lowest thrust is optimal, so the answer without the
     # width constraints is an arbitrary point of that set and a poor start (measured 435 against
@@ -339,8 +365,22 @@ def solve(problem: ApproachProblem) -> ApproachSolution:
 
 
 def constraint_report(problem: ApproachProblem, states, controls) -> dict:
-    """Smallest margins of every constraint along a trajectory (states (nx, M), controls (6, M));
-    a negative margin is a violation (m, N or kg)."""
+    """Smallest margins of every constraint along a trajectory; a negative margin is a violation.
+
+    Parameters
+    ----------
+    problem : ApproachProblem
+        The optimal-control problem (SI, world frame).
+    states : (nx, M) float
+        States along the trajectory, world frame (``model.state_names``).
+    controls : (6, M) float
+        :data:`~multibody.control.mu_dynamics.CONTROLS` at the same times.
+
+    Returns
+    -------
+    dict
+        JSON-ready margins, keys ending in their unit (m, N, kg).
+    """
     x1, y1, x2, y2 = problem.model.unit_positions(states)
     xo, yo = problem.debris_center
     clearance = np.minimum(np.hypot(x1 - xo, y1 - yo), np.hypot(x2 - xo, y2 - yo))

@@ -46,13 +46,28 @@ def _stack(components):
 
 
 def controls_from_angles(thrust_1, thrust_2, theta_1, theta_2):
-    """:data:`CONTROLS` from thrust magnitudes (N) and angles (rad), stacked (6, ...)."""
+    """:data:`CONTROLS` from thrust magnitudes (N) and angles (rad), stacked (6, ...).
+
+    Parameters
+    ----------
+    thrust_1, thrust_2 : float or array
+        Thrust magnitudes of MU1 and MU2 (N).
+    theta_1, theta_2 : float or array
+        Their thrust angles (rad), as the model defines them (from the rod, clockwise, for the
+        rigid rod; from the world x axis, counter-clockwise, for independent units).
+    """
     lib = _lib(theta_1, theta_2)
     return _stack([thrust_1, thrust_2, lib.cos(theta_1), lib.sin(theta_1), lib.cos(theta_2), lib.sin(theta_2)])
 
 
 def thrust_angles(controls):
-    """Thrust angles (rad) of MU1 and MU2 in [0, 2 pi) from :data:`CONTROLS` (NumPy)."""
+    """Thrust angles (rad) of MU1 and MU2 in [0, 2 pi) from :data:`CONTROLS` (NumPy).
+
+    Parameters
+    ----------
+    controls : (6,) or (6, n) float
+        :data:`CONTROLS` (N, N, -, -, -, -).
+    """
     return (np.mod(np.arctan2(controls[3], controls[2]), 2 * np.pi),
             np.mod(np.arctan2(controls[5], controls[4]), 2 * np.pi))
 
@@ -83,7 +98,15 @@ def rod_thrust_world(thrust, cos_theta, sin_theta, phi):
 
 def rod_moment_of_inertia(mass, length):
     """Moment of inertia of two point masses ``mass`` (kg) at the ends of a massless rod of
-    ``length`` (m) about their CoM (kg m^2): :math:`I = 2 m (L/2)^2 = m L^2 / 2` (paper Sec. 2.1)."""
+    ``length`` (m) about their CoM (kg m^2): :math:`I = 2 m (L/2)^2 = m L^2 / 2` (paper Sec. 2.1).
+
+    Parameters
+    ----------
+    mass : float or symbol
+        Mass of one MU (kg).
+    length : float or symbol
+        Rod length (m).
+    """
     return mass * length**2 / 2.0
 
 
@@ -121,11 +144,19 @@ def rigid_rod_rhs(state, controls, mass, length):
 
 def rod_unit_positions(state, length):
     """World positions (m) of MU1 and MU2 from the rigid-rod state (paper Sec. 2.1):
-    :math:`X_{1,2} = X_{com} \\mp \\tfrac L2(\\cos\\phi, \\sin\\phi)`. Returns (x1, y1, x2, y2)."""
+    :math:`X_{1,2} = X_{com} \\mp \\tfrac L2(\\cos\\phi, \\sin\\phi)`. Returns (x1, y1, x2, y2).
+
+    Parameters
+    ----------
+    state : (6,) or (6, n)
+        :data:`ROD_STATE`, world frame (m, m/s, rad, rad/s).
+    length : float
+        Rod length (m).
+    """
     lib = _lib(state)
-    x, y, phi = state[0], state[2], state[4]
-    dx, dy = length / 2.0 * lib.cos(phi), length / 2.0 * lib.sin(phi)
-    return x - dx, y - dy, x + dx, y + dy
+    x_world, y_world, phi = state[0], state[2], state[4]
+    dx_world, dy_world = length / 2.0 * lib.cos(phi), length / 2.0 * lib.sin(phi)
+    return x_world - dx_world, y_world - dy_world, x_world + dx_world, y_world + dy_world
 
 
 def unit_rhs(state, thrust, cos_theta, sin_theta, fuel_rate):
@@ -148,8 +179,17 @@ def unit_rhs(state, thrust, cos_theta, sin_theta, fuel_rate):
 
 
 def independent_units_rhs(state, controls, fuel_rate):
-    """Time derivative of two independent MUs (paper case study 2): ``state`` is MU1's
-    :data:`UNIT_STATE` followed by MU2's, (10,) or (10, n); ``controls`` :data:`CONTROLS`."""
+    """Time derivative of two independent MUs (paper case study 2).
+
+    Parameters
+    ----------
+    state : (10,) or (10, n)
+        MU1's :data:`UNIT_STATE` followed by MU2's, world frame (m, m/s, kg).
+    controls : (6,) or (6, n)
+        :data:`CONTROLS` (N, N, -, -, -, -); angles from the world x axis, counter-clockwise.
+    fuel_rate : float
+        k, fuel mass per thrust impulse (kg/(N s)).
+    """
     f1, f2, c1, s1, c2, s2 = (controls[i] for i in range(6))
     first = unit_rhs(state[0:5], f1, c1, s1, fuel_rate)
     second = unit_rhs(state[5:10], f2, c2, s2, fuel_rate)
@@ -159,7 +199,13 @@ def independent_units_rhs(state, controls, fuel_rate):
 
 
 def independent_unit_positions(state):
-    """World positions (m) of MU1 and MU2 from the two-unit state: (x1, y1, x2, y2)."""
+    """World positions (m) of MU1 and MU2 from the two-unit state: (x1, y1, x2, y2).
+
+    Parameters
+    ----------
+    state : (10,) or (10, n)
+        MU1's :data:`UNIT_STATE` followed by MU2's, world frame (m, m/s, kg).
+    """
     return state[0], state[1], state[5], state[6]
 
 
@@ -185,16 +231,45 @@ class RigidRodMUs:
         self.mass, self.length, self.fuel_rate = mass, length, fuel_rate
 
     def rhs(self, state, controls):
+        """:func:`rigid_rod_rhs` of this model.
+
+        Parameters
+        ----------
+        state : (6,) or (6, n)
+            :data:`ROD_STATE`, world frame (m, m/s, rad, rad/s).
+        controls : (6,) or (6, n)
+            :data:`CONTROLS` (N, N, -, -, -, -).
+        """
         return rigid_rod_rhs(state, controls, self.mass, self.length)
 
     def unit_positions(self, state):
+        """World positions (m) of MU1 and MU2: (x1, y1, x2, y2) (:func:`rod_unit_positions`).
+
+        Parameters
+        ----------
+        state : (6,) or (6, n)
+            :data:`ROD_STATE`, world frame (m, m/s, rad, rad/s).
+        """
         return rod_unit_positions(state, self.length)
 
     def mouth_center(self, state):
-        """Mouth centre (m, world): the CoM, the middle of the rod."""
+        """Mouth centre (m, world): the CoM, the middle of the rod.
+
+        Parameters
+        ----------
+        state : (6,) or (6, n)
+            :data:`ROD_STATE`, world frame (m, m/s, rad, rad/s).
+        """
         return state[0], state[2]
 
     def unit_masses(self, state):
+        """Masses of MU1 and MU2 (kg): constant, broadcast to the state's shape.
+
+        Parameters
+        ----------
+        state : (6,) or (6, n)
+            :data:`ROD_STATE`, world frame (m, m/s, rad, rad/s).
+        """
         return self.mass + 0.0 * state[0], self.mass + 0.0 * state[0]
 
 
@@ -217,15 +292,44 @@ class IndependentMUs:
         self.fuel_rate = fuel_rate
 
     def rhs(self, state, controls):
+        """:func:`independent_units_rhs` of this model.
+
+        Parameters
+        ----------
+        state : (10,) or (10, n)
+            MU1's then MU2's :data:`UNIT_STATE`, world frame (m, m/s, kg).
+        controls : (6,) or (6, n)
+            :data:`CONTROLS` (N, N, -, -, -, -).
+        """
         return independent_units_rhs(state, controls, self.fuel_rate)
 
     def unit_positions(self, state):
+        """World positions (m) of MU1 and MU2: (x1, y1, x2, y2).
+
+        Parameters
+        ----------
+        state : (10,) or (10, n)
+            MU1's then MU2's :data:`UNIT_STATE`, world frame (m, m/s, kg).
+        """
         return independent_unit_positions(state)
 
     def mouth_center(self, state):
-        """Mouth centre (m, world): the midpoint of the two MUs (paper eq. 14)."""
-        x1, y1, x2, y2 = independent_unit_positions(state)
-        return (x1 + x2) / 2.0, (y1 + y2) / 2.0
+        """Mouth centre (m, world): the midpoint of the two MUs (paper eq. 14).
+
+        Parameters
+        ----------
+        state : (10,) or (10, n)
+            MU1's then MU2's :data:`UNIT_STATE`, world frame (m, m/s, kg).
+        """
+        x1_world, y1_world, x2_world, y2_world = independent_unit_positions(state)
+        return (x1_world + x2_world) / 2.0, (y1_world + y2_world) / 2.0
 
     def unit_masses(self, state):
+        """Current masses of MU1 and MU2 (kg), from the state.
+
+        Parameters
+        ----------
+        state : (10,) or (10, n)
+            MU1's then MU2's :data:`UNIT_STATE`, world frame (m, m/s, kg).
+        """
         return state[4], state[9]

@@ -24,14 +24,26 @@ from multibody.control.mu_problem import ApproachProblem, ApproachSolution
 NU = len(CONTROLS)
 
 def interval_widths(problem: ApproachProblem) -> np.ndarray:
-    """Interval widths (N,) in normalized time zeta = t / t_f (-)."""
+    """Interval widths (N,) in normalized time zeta = t / t_f (-).
+
+    Parameters
+    ----------
+    problem : ApproachProblem
+        The optimal-control problem (SI, world frame).
+    """
     if problem.mesh is None:
         return np.full(problem.intervals, 1.0 / problem.intervals)
     return np.asarray(problem.mesh, float)
 
 
 def node_fractions(problem: ApproachProblem) -> np.ndarray:
-    """Normalized node times (N+1,) (-), 0 to 1."""
+    """Normalized node times (N+1,) (-), 0 to 1.
+
+    Parameters
+    ----------
+    problem : ApproachProblem
+        The optimal-control problem (SI, world frame).
+    """
     if problem.mesh is None:
         return np.linspace(0.0, 1.0, problem.intervals + 1)
     return np.r_[0.0, np.cumsum(interval_widths(problem))]
@@ -40,7 +52,13 @@ def node_fractions(problem: ApproachProblem) -> np.ndarray:
 def point_fractions(problem: ApproachProblem) -> np.ndarray:
     """Normalized times (2N+1,) (-) of the nodes and midpoints interleaved. (On the uniform mesh
     exactly ``linspace``: the initial guess's thrust angles where the guessed force vanishes are
-    arctan2 of rounding noise, and their change by other roundings cost 93 -> 212 iterations.)"""
+    arctan2 of rounding noise, and their change by other roundings cost 93 -> 212 iterations.)
+
+    Parameters
+    ----------
+    problem : ApproachProblem
+        The optimal-control problem (SI, world frame).
+    """
     if problem.mesh is None:
         return np.linspace(0.0, 1.0, 2 * problem.intervals + 1)
     nodes = node_fractions(problem)
@@ -55,7 +73,15 @@ def local_errors(solution: ApproachSolution, rtol: float = 1e-9) -> np.ndarray:
     end node, :math:`\\max_i |\\Delta x_i| / (1 + \\max_t |x_i|)` (the relative error of Betts
     2010, Sec. 4.7.1, with a DOP853 solution in place of his quadrature). All intervals are
     integrated at once in their local time tau in [0, 1]. A thrust switch inside an interval,
-    which the quadratic control cannot follow, shows up here."""
+    which the quadratic control cannot follow, shows up here.
+
+    Parameters
+    ----------
+    solution : ApproachSolution
+        A collocation solution (SI, world frame).
+    rtol : float
+        DOP853's relative (and absolute) tolerance (-).
+    """
     nx, n = solution.states.shape[0], solution.problem.intervals
     u0, um, u1 = solution.controls[:, :-1], solution.mid_controls, solution.controls[:, 1:]
     h, model, bounds = np.diff(solution.t), solution.problem.model, solution.problem.thrust_bounds
@@ -74,7 +100,13 @@ SPLIT = 8
 
 def refine_mesh(solution: ApproachSolution) -> ApproachProblem | None:
     """The problem on a mesh whose intervals with a local error (:func:`local_errors`) over
-    ``mesh_tolerance`` are split into :data:`SPLIT` equal ones; None when no interval is over it."""
+    ``mesh_tolerance`` are split into :data:`SPLIT` equal ones; None when no interval is over it.
+
+    Parameters
+    ----------
+    solution : ApproachSolution
+        A collocation solution (SI, world frame).
+    """
     problem = solution.problem
     errors = local_errors(solution)
     if errors.max() <= problem.mesh_tolerance:
@@ -87,7 +119,20 @@ def refine_mesh(solution: ApproachSolution) -> ApproachProblem | None:
 
 def interpolated_start(solution: ApproachSolution, refined: ApproachProblem):
     """Decision vector on ``refined``'s mesh, linear in time between the solution's nodes and
-    midpoints, direction cosines renormalized."""
+    midpoints, direction cosines renormalized.
+
+    Parameters
+    ----------
+    solution : ApproachSolution
+        A collocation solution (SI, world frame).
+    refined : ApproachProblem
+        The same problem on the refined mesh (:func:`refine_mesh`).
+
+    Returns
+    -------
+    (n_w,) float
+        States, midpoint states, controls, midpoint controls (column-major), then t_f (s) when free.
+    """
     t, states, controls = collocation_points(solution)
     zeta = point_fractions(refined)
     states = np.array([np.interp(zeta, t / solution.final_time, row) for row in states])
@@ -103,7 +148,18 @@ def quadratic_controls(u_start, u_mid, u_end, tau, thrust_bounds):
     """Controls on one interval at local times ``tau`` in [0, 1]: the quadratic through the node,
     midpoint and node values (the Hermite-Simpson control), thrust clipped to its bounds (the
     quadratic overshoots at a thrust switch), directions renormalized to unit vectors.
-    Values (6,) and ``tau`` (M,), or values (6, M) of M intervals and one ``tau``: returns (6, M)."""
+    Values (6,) and ``tau`` (M,), or values (6, M) of M intervals and one ``tau``: returns (6, M).
+
+    Parameters
+    ----------
+    u_start, u_mid, u_end : (6,) or (6, M) float
+        :data:`~multibody.control.mu_dynamics.CONTROLS` at the interval's start node, midpoint and
+        end node (N, N, -, -, -, -).
+    tau : float or (M,) float
+        Local time in the interval, 0 to 1 (-).
+    thrust_bounds : (2,) float
+        Thrust magnitude bounds (N).
+    """
     tau = np.atleast_1d(tau)
     basis = (2 * (tau - 0.5) * (tau - 1.0), -4 * tau * (tau - 1.0), 2 * tau * (tau - 0.5))
     u = sum(np.reshape(v, (NU, -1)) * b for v, b in zip((u_start, u_mid, u_end), basis))
@@ -134,7 +190,17 @@ def _interval_rhs(solution: ApproachSolution, k: int):
 def resimulate(solution: ApproachSolution, points_per_interval: int = 20, rtol: float = 1e-10) -> Resimulation:
     """Integrate the NumPy dynamics from the initial state with the interpolated controls
     (:func:`quadratic_controls`), interval by interval (DOP853), sampled ``points_per_interval``
-    times per interval: the fine check of the constraints between the collocation points."""
+    times per interval: the fine check of the constraints between the collocation points.
+
+    Parameters
+    ----------
+    solution : ApproachSolution
+        A collocation solution (SI, world frame).
+    points_per_interval : int
+        Samples per interval (-).
+    rtol : float
+        DOP853's relative (and absolute) tolerance (-).
+    """
     n, bounds = solution.problem.intervals, solution.problem.thrust_bounds
     x = np.asarray(solution.problem.initial_state, float)
     ts, xs, us = [], [], []
@@ -152,7 +218,22 @@ def resimulate(solution: ApproachSolution, points_per_interval: int = 20, rtol: 
 
 
 def collocation_points(solution: ApproachSolution):
-    """Times (2N+1,) (s), states and controls at the nodes and midpoints in time order."""
+    """Times (2N+1,) (s), states and controls at the nodes and midpoints in time order.
+
+    Parameters
+    ----------
+    solution : ApproachSolution
+        A collocation solution (SI, world frame).
+
+    Returns
+    -------
+    t : (2N+1,) float
+        Times (s).
+    states : (nx, 2N+1) float
+        States, world frame.
+    controls : (6, 2N+1) float
+        :data:`~multibody.control.mu_dynamics.CONTROLS`.
+    """
     n = solution.problem.intervals
     t = solution.final_time * point_fractions(solution.problem)
     states = np.empty((solution.states.shape[0], 2 * n + 1))

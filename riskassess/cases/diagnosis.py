@@ -271,7 +271,19 @@ class DiagnosisCaseFile(RootModel):
 def scenario_form(raw: dict) -> dict:
     """The file's content with its scenario as the ``kind`` the scenario models discriminate on: a
     file says ``kind = "diagnosis"`` and ``scenario = "towing"``; files written before case kinds
-    were explicit say ``kind = "towing"`` (the scenario) and are read as they are."""
+    were explicit say ``kind = "towing"`` (the scenario) and are read as they are.
+
+    Parameters
+    ----------
+    raw : dict
+        Parsed TOML of a diagnosis case file (not modified).
+
+    Returns
+    -------
+    dict
+        A copy with ``kind`` = the scenario and no ``scenario`` key; ``raw`` itself when it has no
+        ``kind = "diagnosis"``.
+    """
     if raw.get("kind") != "diagnosis":
         return raw
     raw = dict(raw)
@@ -283,14 +295,46 @@ def scenario_form(raw: dict) -> dict:
 
 def diagnosis_case_from_dict(raw: dict, case_dir=".", effect_catalog=None) -> DiagnosisCase:
     """Validate parsed case content; file references (``towing``) are relative to ``case_dir``;
-    ``[[effects]]`` are checked against ``effect_catalog`` (id -> effect; required when there are any)."""
+    ``[[effects]]`` are checked against ``effect_catalog`` (id -> effect; required when there are any).
+
+    Parameters
+    ----------
+    raw : dict
+        Parsed TOML of a diagnosis case file.
+    case_dir : str or Path
+        Folder of the case file; referenced files are resolved against it.
+    effect_catalog : dict or None
+        Effect id -> effect (:mod:`riskassess.diagnosis`), for ``[[effects]]``.
+
+    Returns
+    -------
+    DiagnosisCase
+        The scenario model (tumbling_rigid, hinged_appendage or towing).
+
+    Raises
+    ------
+    pydantic.ValidationError
+        For content that does not fit the schema.
+    """
     context = {"case_dir": str(case_dir), "effect_catalog": effect_catalog}
     return DiagnosisCaseFile.model_validate(scenario_form(raw), context=context).root
 
 
 def load_diagnosis_case(path, effect_catalog=None) -> DiagnosisCase:
     """Read and validate a diagnosis case; :class:`~riskassess.cases.impact.CaseError` names file and key.
-    ``effect_catalog``: as in :func:`diagnosis_case_from_dict`."""
+    ``effect_catalog``: as in :func:`diagnosis_case_from_dict`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The case file (TOML).
+    effect_catalog : dict or None
+        Effect id -> effect, for the case's ``[[effects]]``.
+
+    Returns
+    -------
+    DiagnosisCase
+    """
     path = Path(path)
     try:
         return diagnosis_case_from_dict(read_toml(path), path.parent, effect_catalog)
@@ -315,7 +359,20 @@ def _toml_value(value) -> str:
 
 def toml_text(data: dict, prefix: str = "") -> str:
     """TOML text of a case dictionary (scalars and lists, tables, arrays of tables); enough for the
-    case files, which hold nothing else."""
+    case files, which hold nothing else.
+
+    Parameters
+    ----------
+    data : dict
+        The case content: scalars, lists of scalars, tables (dict) and arrays of tables (list of dict).
+    prefix : str
+        Dotted key path of ``data`` inside the file (``""`` at the top level), for table headers.
+
+    Returns
+    -------
+    str
+        TOML text, without a trailing newline.
+    """
     lines = [f"{k} = {_toml_value(v)}" for k, v in data.items()
              if not isinstance(v, dict) and not (isinstance(v, list) and v and isinstance(v[0], dict))]
     for key, value in data.items():

@@ -71,8 +71,7 @@ SECTIONS = [
     ("[simulation]", c.Simulation), ('[orbit] kind = "circular"', c.CircularOrbit), ('[orbit] kind = "none"', c.NoOrbit),
     ("[net]", c.Net), ("[net.thread]", c.Thread), ("[bullets]", c.Bullets), ("[launch]", c.Launch),
     ("[contact]", c.Contact), ("[target]", c.Target), ("[[target.bodies]]", c.Body),
-    ('shapes: kind = "box"', c.Box), ('shapes: kind = "cylinder"', c.Cylinder), ('shapes: kind = "sphere"', c.Sphere),
-    ('shapes: kind = "ellipsoid"', c.Ellipsoid), ('shapes: kind = "mesh"', c.MeshFile),
+    *((f'shapes: kind = "{name}"', model) for name, model in c.SHAPE_MODELS.items()),
     ("[[target.joints]]", c.Joint), ("[chaser] (optional)", c.Chaser),
     ("[perception] (optional; for riskassess perceive)", c.Perception), ("[perception.lidar]", c.Lidar),
     ("[perception.registration]", c.Registration), ("[structures] (optional)", c.Structures),
@@ -92,7 +91,18 @@ def _is_unit(text: str) -> bool:
 
 
 def field_unit(field) -> str:
-    """The SI unit a field's description states in parentheses, e.g. 'N m/rad'; '' if none."""
+    """The SI unit a field's description states in parentheses, e.g. 'N m/rad'; '' if none.
+
+    Parameters
+    ----------
+    field : pydantic.fields.FieldInfo
+        A case-model field; its ``description`` is searched.
+
+    Returns
+    -------
+    str
+        The first parenthesised group built only of :data:`UNIT_SYMBOLS`, or ''.
+    """
     for group in re.findall(r"\(([^()]*)\)", field.description or ""):
         if _is_unit(group):
             return group
@@ -107,7 +117,19 @@ def _models_in(annotation) -> list[type[BaseModel]]:
 
 
 def key_unit(key: str) -> str:
-    """The unit of a case key such as 'launch.velocity' or 'target.joints[hinge].torsional_damping'."""
+    """The unit of a case key such as 'launch.velocity' or 'target.joints[hinge].torsional_damping'.
+
+    Parameters
+    ----------
+    key : str
+        Dotted path into an impact case (:class:`~riskassess.cases.impact.Case`); list selectors
+        ``[...]`` are ignored.
+
+    Returns
+    -------
+    str
+        The SI unit of the field (:func:`field_unit`); '' for an unknown key or a field without unit.
+    """
     models, field = [c.Case], None
     for part in re.sub(r"\[[^\]]*\]", "", key).split("."):
         field = next((m.model_fields[part] for m in models if part in m.model_fields), None)
@@ -141,7 +163,7 @@ def _compact_model(model: BaseModel) -> str:
 
 
 #: Nested models shown as one line each in input tables (they are details of their parent).
-COMPACT = (c.Box, c.Cylinder, c.Sphere, c.MeshFile, *c.SECTION_MODELS.values(), c.Material)
+COMPACT = (*c.SHAPE_MODELS.values(), *c.SECTION_MODELS.values(), c.Material)
 
 
 def input_rows(model: BaseModel, prefix: str = "") -> list[tuple[str, str, str, str]]:
@@ -149,6 +171,18 @@ def input_rows(model: BaseModel, prefix: str = "") -> list[tuple[str, str, str, 
 
     List items are keyed by their ``name`` where they have one (``target.bodies[solar_array]``);
     shapes, sections and materials are one row each.
+
+    Parameters
+    ----------
+    model : pydantic.BaseModel
+        A validated case or one of its tables.
+    prefix : str
+        Key path of ``model`` in the case, ending in '.' (``""`` for the case itself).
+
+    Returns
+    -------
+    list of (str, str, str, str)
+        Key path, formatted value, SI unit ('' if none) and the field's description.
     """
     rows = []
     for name, field in type(model).model_fields.items():
@@ -171,6 +205,18 @@ def input_rows(model: BaseModel, prefix: str = "") -> list[tuple[str, str, str, 
 
 
 def model_table(model: type[BaseModel]) -> str:
+    """The keys of one case model as a Markdown table (key, required, default, meaning with limits).
+
+    Parameters
+    ----------
+    model : type of pydantic.BaseModel
+        A case-model class; its ``kind`` field is left out.
+
+    Returns
+    -------
+    str
+        Markdown table, one row per field.
+    """
     rows = ["| key | required | default | meaning |", "|---|---|---|---|"]
     for name, field in model.model_fields.items():
         if name == "kind":

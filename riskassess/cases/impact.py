@@ -22,6 +22,7 @@ from typing import Annotated, Literal, Union, get_args
 import numpy as np
 from pydantic import BaseModel, Field, ValidationError, create_model, field_validator, model_validator
 
+from multibody.shapes import SHAPES as CONTACT_SHAPES
 from riskassess.cases.inputs import (JSON_FILE_LIMIT, KIND_NOTE, MESH_FILE_LIMIT, CaseError, CaseName, ItemName,
                                     RelativeFile, Strict, Text, decode_utf8, read_limited, read_toml, resolve_reference,
                                     unique_names)
@@ -37,7 +38,18 @@ NonNegative = Annotated[float, Field(ge=0)]
 
 def check_physical_inertia(j):
     """The inertia tensor ``j`` (3, 3) (kg m^2) of a rigid body, or ValueError: it must be
-    symmetric, positive definite and obey the triangle inequality of principal moments."""
+    symmetric, positive definite and obey the triangle inequality of principal moments.
+
+    Parameters
+    ----------
+    j : (3, 3) float or nested list
+        Inertia about the CoM (kg m^2), in whatever frame the case gives it.
+
+    Returns
+    -------
+    (3, 3) float or nested list
+        ``j`` unchanged (usable as a validator).
+    """
     m = np.asarray(j, float)
     if not np.allclose(m, m.T, rtol=1e-9, atol=1e-9 * np.abs(m).max()):
         raise ValueError("inertia must be symmetric")
@@ -179,45 +191,32 @@ class Contact(Strict):
 
 
 # ---------------------------------------------------------------------------- target
-class Box(Strict):
-    kind: Literal["box"]
-    size: Annotated[list[Positive], Field(min_length=3, max_length=3)] = Field(description="Edge lengths (m).")
-    center: Vector3 = Field(description="Centre, target frame (m).")
-    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Box->target rotation (rad).")
+#: Kind of value of a contact shape's key (:data:`multibody.shape_base.VALUES`) -> its checked type.
+SHAPE_VALUE_TYPES = {
+    "positive": Positive,
+    "positive_vector3": Annotated[list[Positive], Field(min_length=3, max_length=3)],
+    "vector3": Vector3,
+    "file": RelativeFile,
+}
 
 
-class Cylinder(Strict):
-    kind: Literal["cylinder"]
-    radius: Positive = Field(description="(m)")
-    length: Positive = Field(description="(m)")
-    axis: Vector3 = Field(description="Axis direction, target frame (-).")
-    center: Vector3 = Field(description="Centre, target frame (m).")
+def _model_class_name(kind: str) -> str:
+    return "".join(part.capitalize() for part in kind.split("_"))
 
 
-class Sphere(Strict):
-    kind: Literal["sphere"]
-    radius: Positive = Field(description="(m)")
-    center: Vector3 = Field(description="Centre, target frame (m).")
+def _shape_model(shape) -> type[Strict]:
+    """The case schema of one contact shape (:mod:`multibody.shapes`): its ``kind`` and its keys,
+    each checked as its kind of value and described as the shape describes it."""
+    fields = {"kind": (Literal[shape.NAME], ...)}
+    for key in shape.KEYS:
+        default = ... if key.default is None else (list(key.default) if isinstance(key.default, tuple) else key.default)
+        fields[key.name] = (SHAPE_VALUE_TYPES[key.value], Field(default, description=key.description))
+    return create_model(_model_class_name(shape.NAME), __base__=Strict, __module__=__name__, **fields)
 
 
-class Ellipsoid(Strict):
-    kind: Literal["ellipsoid"]
-    semi_axes: Annotated[list[Positive], Field(min_length=3, max_length=3)] = Field(
-        description="Semi-axes along the ellipsoid's own x, y, z (m).")
-    center: Vector3 = Field(description="Centre, target frame (m).")
-    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Ellipsoid->target rotation (rad).")
-
-
-class MeshFile(Strict):
-    kind: Literal["mesh"]
-    file: RelativeFile = Field(description="Closed triangle mesh (STL, OBJ, PLY...), path relative to the case file, "
-                                           "in its folder or below.")
-    scale: Positive = Field(1.0, description="Factor taking file units to metres (-).")
-    center: Vector3 = Field([0.0, 0.0, 0.0], description="Translation of the mesh, target frame (m).")
-    rotation_vector: Vector3 = Field([0.0, 0.0, 0.0], description="Mesh->target rotation (rad).")
-
-
-Shape = Annotated[Union[Box, Cylinder, Sphere, Ellipsoid, MeshFile], Field(discriminator="kind")]
+#: Shape kind -> its schema, one per shape file of multibody/shapes.
+SHAPE_MODELS = {name: _shape_model(shape) for name, shape in CONTACT_SHAPES.items()}
+Shape = Annotated[Union[tuple(SHAPE_MODELS.values())], Field(discriminator="kind")]
 
 
 class Body(Strict):
@@ -369,8 +368,7 @@ def _section_model(shape) -> type[Strict]:
     its dimensions, each a :data:`SectionLength` described as the shape describes it."""
     fields = {"kind": (Literal[shape.NAME], ...)}
     fields.update({name: (SectionLength, Field(description=text)) for name, text in shape.DIMENSIONS.items()})
-    class_name = "".join(part.capitalize() for part in shape.NAME.split("_"))
-    return create_model(class_name, __base__=Strict, __module__=__name__, **fields)
+    return create_model(_model_class_name(shape.NAME), __base__=Strict, __module__=__name__, **fields)
 
 
 #: Section kind -> its schema, one per shape file of structures/section_shapes.
@@ -380,7 +378,17 @@ Section = Annotated[Union[tuple(SECTION_MODELS.values())], Field(discriminator="
 
 def section_properties(spec):
     """Section properties (:mod:`structures.sections`) from a case section table (raises ValueError
-    for impossible dimensions)."""
+    for impossible dimensions).
+
+    Parameters
+    ----------
+    spec : Section
+        A validated ``section`` table: ``kind`` and the shape's dimensions (m).
+
+    Returns
+    -------
+    structures.section_base.SectionProperties
+    """
     params = spec.model_dump()
     return SECTIONS[params.pop("kind")](**params)
 
@@ -528,7 +536,20 @@ def _format_location(loc) -> str:
 
 
 def format_validation_error(path: Path, error: ValidationError) -> str:
-    """scikit-learn-style messages, one per problem: ``file: key.path: message. Got X instead.``"""
+    """scikit-learn-style messages, one per problem: ``file: key.path: message. Got X instead.``
+
+    Parameters
+    ----------
+    path : Path
+        The case file, named in every line.
+    error : pydantic.ValidationError
+        The validation error of that file's content.
+
+    Returns
+    -------
+    str
+        One line per problem.
+    """
     lines = []
     for e in error.errors():
         where = _format_location(e["loc"])
@@ -553,7 +574,20 @@ def _is_table(value) -> bool:
 
 def load_model(path: str | Path, model: type[BaseModel]):
     """Read the TOML file ``path`` into the pydantic ``model`` (a stage's own case schema, e.g.
-    towing or approach); raise :class:`CaseError` naming the file, every bad key and what is allowed."""
+    towing or approach); raise :class:`CaseError` naming the file, every bad key and what is allowed.
+
+    Parameters
+    ----------
+    path : str or Path
+        The case file (TOML).
+    model : type of pydantic.BaseModel
+        The schema to validate against.
+
+    Returns
+    -------
+    pydantic.BaseModel
+        An instance of ``model``.
+    """
     path = Path(path)
     try:
         return model.model_validate(read_toml(path))
@@ -562,13 +596,36 @@ def load_model(path: str | Path, model: type[BaseModel]):
 
 
 def load_case(path: str | Path) -> Case:
-    """Read and validate a net-impact case file; raise :class:`CaseError` naming every problem."""
+    """Read and validate a net-impact case file; raise :class:`CaseError` naming every problem.
+
+    Parameters
+    ----------
+    path : str or Path
+        The case file (TOML); mesh and perception files it names are relative to its folder.
+
+    Returns
+    -------
+    Case
+    """
     return validate_case(read_toml(path), path)
 
 
 def validate_case(raw: dict, path: str | Path) -> Case:
     """Validate the parsed content of the case file ``path`` (mesh paths are relative to it);
-    raise :class:`CaseError` naming every problem. Sweeps call it for every varied case."""
+    raise :class:`CaseError` naming every problem. Sweeps call it for every varied case.
+
+    Parameters
+    ----------
+    raw : dict
+        Parsed TOML content (not modified).
+    path : str or Path
+        The file the content belongs to: named in errors, its folder resolves referenced files.
+
+    Returns
+    -------
+    Case
+        The validated case (files, sections and the net's reach checked).
+    """
     path = Path(path)
     raw, problems = _with_perceived_mass_properties(raw, path.parent)
     if problems:
@@ -637,15 +694,16 @@ def _fill_perceived(body: dict, source: str, base: Path) -> str | None:
 
 
 def _check_files(case: Case, base: Path) -> list[str]:
-    """Every mesh file is a regular file below the case's folder, at most MESH_FILE_LIMIT bytes."""
+    """Every mesh file a shape names (its keys of kind "file") is a regular file below the case's
+    folder, at most MESH_FILE_LIMIT bytes."""
     problems = []
     for i, body in enumerate(case.target.bodies):
         for k, shape in enumerate(body.shapes):
-            if isinstance(shape, MeshFile):
+            for key in (key.name for key in CONTACT_SHAPES[shape.kind].KEYS if key.value == "file"):
                 try:
-                    resolve_reference(base, shape.file, MESH_FILE_LIMIT)
+                    resolve_reference(base, getattr(shape, key), MESH_FILE_LIMIT)
                 except ValueError as exc:
-                    problems.append(f"target.bodies[{i}].shapes[{k}].file: mesh file {exc}")
+                    problems.append(f"target.bodies[{i}].shapes[{k}].{key}: mesh file {exc}")
     return problems
 
 

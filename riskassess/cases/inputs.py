@@ -66,7 +66,20 @@ def _size_text(n: int) -> str:
 
 def check_regular_file(path: Path, limit: int) -> int:
     """The size (bytes) of ``path``, or ValueError (message without the path) when it is missing,
-    not a regular file (a directory, a device such as /dev/zero, a pipe) or larger than ``limit``."""
+    not a regular file (a directory, a device such as /dev/zero, a pipe) or larger than ``limit``.
+
+    Parameters
+    ----------
+    path : Path
+        The file to check (a symbolic link is followed).
+    limit : int
+        Largest accepted size (bytes).
+
+    Returns
+    -------
+    int
+        The file's size (bytes).
+    """
     try:
         info = os.stat(path)
     except FileNotFoundError:
@@ -84,7 +97,19 @@ def check_regular_file(path: Path, limit: int) -> int:
 
 def read_limited(path: Path, limit: int) -> bytes:
     """The bytes of the regular file ``path``, at most ``limit`` of them; ValueError otherwise (a file
-    that grows while read, or a /proc file of size 0 that is not, is cut at the limit and refused)."""
+    that grows while read, or a /proc file of size 0 that is not, is cut at the limit and refused).
+
+    Parameters
+    ----------
+    path : Path
+        The file to read.
+    limit : int
+        Largest accepted size (bytes).
+
+    Returns
+    -------
+    bytes
+    """
     check_regular_file(path, limit)
     try:
         with open(path, "rb") as f:
@@ -97,7 +122,23 @@ def read_limited(path: Path, limit: int) -> bytes:
 
 
 def decode_utf8(data: bytes, path: Path, what: str, bom: bool = False) -> str:
-    """``data`` as text; ValueError naming ``path`` and the first bad byte when it is not UTF-8."""
+    """``data`` as text; ValueError naming ``path`` and the first bad byte when it is not UTF-8.
+
+    Parameters
+    ----------
+    data : bytes
+        The file's content.
+    path : Path
+        The file, named in the error.
+    what : str
+        What the file is ("case file", "measured-data file"), named in the error.
+    bom : bool
+        True to drop a leading byte-order mark.
+
+    Returns
+    -------
+    str
+    """
     try:
         return data.decode("utf-8-sig" if bom else "utf-8")
     except UnicodeDecodeError as exc:
@@ -107,7 +148,23 @@ def decode_utf8(data: bytes, path: Path, what: str, bom: bool = False) -> str:
 
 def read_text(path: Path, limit: int, what: str, bom: bool = False) -> str:
     """The text of the regular UTF-8 file ``path`` (a ``what`` such as "case file") of at most
-    ``limit`` bytes, a byte-order mark dropped if ``bom``; ValueError starting with the path otherwise."""
+    ``limit`` bytes, a byte-order mark dropped if ``bom``; ValueError starting with the path otherwise.
+
+    Parameters
+    ----------
+    path : Path
+        The file to read.
+    limit : int
+        Largest accepted size (bytes).
+    what : str
+        What the file is, named in errors.
+    bom : bool
+        True to drop a leading byte-order mark.
+
+    Returns
+    -------
+    str
+    """
     try:
         data = read_limited(path, limit)
     except ValueError as exc:
@@ -118,7 +175,18 @@ def read_text(path: Path, limit: int, what: str, bom: bool = False) -> str:
 
 def reference_problem(name: str) -> str | None:
     """Why the file name ``name`` written in a case is refused, or None: it must be a relative path
-    below the case file's folder (no absolute path, drive or '..' component)."""
+    below the case file's folder (no absolute path, drive or '..' component).
+
+    Parameters
+    ----------
+    name : str
+        A file name as written in a case file.
+
+    Returns
+    -------
+    str or None
+        The reason, phrased to follow the key ("must be relative to the case file; ...").
+    """
     if not name or not name.strip():
         return "must name a file; it is empty"
     if "\x00" in name:
@@ -140,7 +208,22 @@ def _relative_file(name: str) -> str:
 
 def resolve_reference(base: Path, name: str, limit: int) -> Path:
     """The file ``name`` named by a case in folder ``base``: a regular file of at most ``limit`` bytes
-    below ``base``; ValueError (message without the key) otherwise."""
+    below ``base``; ValueError (message without the key) otherwise.
+
+    Parameters
+    ----------
+    base : Path
+        Folder of the case file.
+    name : str
+        The file name written in the case (relative to ``base``).
+    limit : int
+        Largest accepted size (bytes).
+
+    Returns
+    -------
+    Path
+        ``base / name``.
+    """
     problem = reference_problem(name)
     if problem:
         raise ValueError(f"'{name}' {problem}")
@@ -155,7 +238,17 @@ def resolve_reference(base: Path, name: str, limit: int) -> Path:
 
 # ---------------------------------------------------------------------------- TOML
 def nesting_depth(value) -> int:
-    """How deep tables and arrays nest in parsed TOML (a scalar is 0, ``{"a": [1]}`` is 2)."""
+    """How deep tables and arrays nest in parsed TOML (a scalar is 0, ``{"a": [1]}`` is 2).
+
+    Parameters
+    ----------
+    value : dict, list or scalar
+        Parsed TOML content.
+
+    Returns
+    -------
+    int
+    """
     deepest, stack = 0, [(value, 0)]
     while stack:
         item, depth = stack.pop()
@@ -172,7 +265,17 @@ def nesting_depth(value) -> int:
 def read_toml(path: str | Path) -> dict:
     """The parsed TOML of a case file; :class:`CaseError` naming the file when it is missing, not a
     regular file, larger than :data:`CASE_FILE_LIMIT`, not UTF-8, not TOML or nested deeper than
-    :data:`MAX_NESTING`."""
+    :data:`MAX_NESTING`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The case file.
+
+    Returns
+    -------
+    dict
+    """
     path = Path(path)
     try:
         text = read_text(path, CASE_FILE_LIMIT, "case file")
@@ -246,7 +349,22 @@ RelativeFile = Annotated[str, AfterValidator(_relative_file)]
 
 
 def unique_names(items: list, what: str, attribute: str = "name") -> list:
-    """``items`` if no two share ``attribute``; ValueError listing the repeated names and where."""
+    """``items`` if no two share ``attribute``; ValueError listing the repeated names and where.
+
+    Parameters
+    ----------
+    items : list
+        Validated items (bodies, joints, weak locations, effects).
+    what : str
+        What an item is ("body", "joint"), named in the error.
+    attribute : str
+        The attribute that must be unique.
+
+    Returns
+    -------
+    list
+        ``items`` unchanged (usable as a validator).
+    """
     names = [getattr(item, attribute) for item in items]
     repeated = {n: [k for k, m in enumerate(names) if m == n] for n in names if names.count(n) > 1}
     if repeated:

@@ -12,10 +12,24 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from multibody.geometry import shape_mesh
+from multibody.shapes import SHAPES
 
 
 def body_meshes_target_frame(case, base: Path):
-    """Per body, its shapes as trimesh meshes in the target frame (m)."""
+    """Per body, its shapes as trimesh meshes in the target frame (m).
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case (its ``target.bodies``).
+    base : Path
+        Folder of the case file; mesh files are relative to it.
+
+    Returns
+    -------
+    list of list of trimesh.Trimesh
+        One list per body, one mesh per shape, vertices in the target frame (m).
+    """
     meshes = []
     for body in case.target.bodies:
         meshes.append([shape_mesh(**_shape_kwargs(s, base)) for s in body.shapes])
@@ -23,25 +37,66 @@ def body_meshes_target_frame(case, base: Path):
 
 
 def _shape_kwargs(shape, base: Path) -> dict:
+    """The keys of a case shape for :func:`multibody.geometry.shape_mesh`; files relative to ``base``."""
     kwargs = shape.model_dump()
-    if shape.kind == "mesh":
-        kwargs["file"] = base / shape.file
+    for key in SHAPES[shape.kind].KEYS:
+        if key.value == "file":
+            kwargs[key.name] = base / kwargs[key.name]
     return kwargs
 
 
 def target_pose_lvlh(case):
-    """Target-frame origin (m) and target->LVLH rotation matrix at t = 0."""
+    """Target-frame origin (m) and target->LVLH rotation matrix at t = 0.
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case (``target.position_lvlh`` in m, ``target.attitude_rotation_vector`` in rad).
+
+    Returns
+    -------
+    origin_lvlh : (3,) float
+        Target-frame origin, LVLH (m).
+    target_to_lvlh : (3, 3) float
+        Rotation matrix; its columns are the target axes in LVLH.
+    """
     rot = Rotation.from_rotvec(case.target.attitude_rotation_vector).as_matrix()
     return np.asarray(case.target.position_lvlh, float), rot
 
 
 def target_points_lvlh(case, points_target) -> np.ndarray:
-    """Points given in the target frame ((3,) or (k, 3), m) at t = 0, in LVLH (m)."""
+    """Points given in the target frame ((3,) or (k, 3), m) at t = 0, in LVLH (m).
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case (the target's pose).
+    points_target : (3,) or (k, 3) float
+        Points, target frame (m).
+
+    Returns
+    -------
+    (3,) or (k, 3) float
+        The same points, LVLH (m).
+    """
     origin, rot = target_pose_lvlh(case)
     return origin + np.asarray(points_target, float) @ rot.T
 
 
 def target_vertices_lvlh(case, base: Path = Path(".")) -> np.ndarray:
-    """Vertices of every target shape at t = 0, LVLH (m)."""
+    """Vertices of every target shape at t = 0, LVLH (m).
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case.
+    base : Path
+        Folder of the case file; mesh files are relative to it.
+
+    Returns
+    -------
+    (k, 3) float
+        All vertices of all shapes of all bodies, LVLH (m).
+    """
     return target_points_lvlh(case, np.vstack([m.vertices for body in body_meshes_target_frame(case, base)
                                                 for m in body]))

@@ -34,7 +34,28 @@ class SweepSpecError(ValueError):
 
 
 def parse_uncertain(text: str) -> tuple[str, str, tuple]:
-    """'KEY=DIST(a,b)' -> (key, distribution name, parameters)."""
+    """'KEY=DIST(a,b)' -> (key, distribution name, parameters).
+
+    Parameters
+    ----------
+    text : str
+        One uncertain input, ``KEY=DIST(p1, p2, ...)`` with DIST in :data:`DISTRIBUTIONS`.
+
+    Returns
+    -------
+    key : str
+        Dotted case key.
+    name : str
+        Distribution name.
+    params : tuple of float
+        Its parameters, in the key's SI unit (``sigma_log`` is dimensionless).
+
+    Raises
+    ------
+    SweepSpecError
+        For bad syntax, an unknown distribution, a wrong number of parameters or parameters out
+        of range.
+    """
     key, _, spec = text.partition("=")
     match = re.fullmatch(r"\s*([a-z]+)\s*\(([^)]*)\)\s*", spec)
     allowed = ", ".join(f"{name}({', '.join(p)})" for name, (p, _) in DISTRIBUTIONS.items())
@@ -58,12 +79,35 @@ def parse_uncertain(text: str) -> tuple[str, str, tuple]:
 
 
 def check_key(key: str, option: str, text: str) -> None:
+    """SweepSpecError when ``key`` is not shaped like a case key (dotted names, optional ``[item]``).
+
+    Parameters
+    ----------
+    key : str
+        The key, such as ``target.joints[solar_array_hinge].torsional_damping``.
+    option : str
+        The command-line option it came from, named in the error.
+    text : str
+        The whole argument, quoted in the error.
+    """
     if not key or not all(KEY_TOKEN.fullmatch(part) for part in split_key(key)):
         raise SweepSpecError(f"{option} {text!r}: '{key}' is not a case key like launch.velocity or "
                              f"target.joints[solar_array_hinge].torsional_damping")
 
 
 def split_key(key: str) -> list[str]:
+    """The dotted parts of a case key, each with its ``[item]`` selectors.
+
+    Parameters
+    ----------
+    key : str
+        A case key, e.g. ``target.joints[hinge].torsional_damping``.
+
+    Returns
+    -------
+    list of str
+        E.g. ``["target", "joints[hinge]", "torsional_damping"]``.
+    """
     return re.findall(r"[^.\[]+(?:\[[^\]]+\])*", key)
 
 

@@ -9,10 +9,32 @@ from riskassess.diagnosis.effects import CATALOG
 
 def load_diagnosis_case(path) -> schema.DiagnosisCase:
     """Read and validate a diagnosis case file, its ``[[effects]]`` against the catalog;
-    :class:`~riskassess.cases.impact.CaseError` names the file and the key."""
+    :class:`~riskassess.cases.impact.CaseError` names the file and the key.
+
+    Parameters
+    ----------
+    path : str or Path
+        The case file (TOML).
+
+    Returns
+    -------
+    case : DiagnosisCase
+    """
     return schema.load_diagnosis_case(path, CATALOG)
 
 
 def diagnosis_case_from_dict(raw: dict, case_dir=".") -> schema.DiagnosisCase:
-    """:func:`riskassess.cases.diagnosis.diagnosis_case_from_dict` with the effect catalog."""
+    """:func:`riskassess.cases.diagnosis.diagnosis_case_from_dict` with the effect catalog.
+
+    Parameters
+    ----------
+    raw : dict
+        Parsed case content.
+    case_dir : str or Path, optional
+        Folder the case's file references (``towing``) are relative to.
+
+    Returns
+    -------
+    case : DiagnosisCase
+    """
     return schema.diagnosis_case_from_dict(raw, case_dir, CATALOG)

@@ -20,13 +20,38 @@ _COMPILED: dict = {}     # (law, law, split) -> compiled pair law: each pair com
 
 
 def can_pair(first: Effect, second: Effect) -> bool:
-    """Whether the two effects can be fitted together (different effects, not both with extra states)."""
+    """Whether the two effects can be fitted together (different effects, not both with extra states).
+
+    Parameters
+    ----------
+    first, second : Effect
+        Catalog effects.
+
+    Returns
+    -------
+    ok : bool
+    """
     return first.id != second.id and not (first.extra_state and second.extra_state)
 
 
 def paired_law(law_a, law_b, split: int, towing: bool = False):
     """One compiled load law that calls ``law_a`` with ``p[:split]`` and ``law_b`` with ``p[split:]``
-    (the fast model's signature, or the towing model's with ``towing``)."""
+    (the fast model's signature, or the towing model's with ``towing``).
+
+    Parameters
+    ----------
+    law_a, law_b : compiled function
+        The two effects' laws (``LAW_SIGNATURE`` or ``TOWING_LAW_SIGNATURE``).
+    split : int
+        Length of ``law_a``'s parameter array.
+    towing : bool
+        Whether the laws are towing laws.
+
+    Returns
+    -------
+    law : compiled function
+        Same signature; cached per (laws, split, towing).
+    """
     key = (law_a, law_b, split, towing)
     if key not in _COMPILED:
         if towing:
@@ -76,7 +101,15 @@ class EffectPair(Effect):
         return values[:self.n_first], values[self.n_first:]
 
     def parameter_specs(self, case, channels=None) -> list[Parameter]:
-        """Both effects' parameters; a name the two share is prefixed with its effect's id."""
+        """Both effects' parameters; a name the two share is prefixed with its effect's id.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Not read (the specs were made for the pair's case).
+        channels : sequence of str, optional
+            Not read.
+        """
         a, b = self._specs
         shared = {p.name for p in a} & {p.name for p in b}
         rename = [lambda p, e=e: p if p.name not in shared else Parameter(f"{e.id}.{p.name}", p.unit, p.description,
@@ -85,45 +118,149 @@ class EffectPair(Effect):
         return [rename[0](p) for p in a] + [rename[1](p) for p in b]
 
     def not_applicable(self, case, channels):
+        """The first reason either effect gives, or None.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case.
+        channels : sequence of str
+            Measured channel names.
+        """
         return self.first.not_applicable(case, channels) or self.second.not_applicable(case, channels)
 
     def law_parameters(self, plant, values):
+        """Both laws' parameters, concatenated.
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant the law runs on.
+        values : (m_first + m_second,) float
+            Both effects' physical values (SI), the first's then the second's.
+        """
         a, b = self._split(values)
         return np.r_[self.first.law_parameters(plant, a), self.second.law_parameters(plant, b)]
 
     def towing_law_parameters(self, plant, values):
+        """Both towing laws' parameters, concatenated.
+
+        Parameters
+        ----------
+        plant : TowingPlant
+            The towing plant the law runs on.
+        values : (m_first + m_second,) float
+            Both effects' physical values (SI), the first's then the second's.
+        """
         a, b = self._split(values)
         return np.r_[self.first.towing_law_parameters(plant, a), self.second.towing_law_parameters(plant, b)]
 
     def modify_plant(self, plant, values):
+        """The plant changed by the first effect, then by the second.
+
+        Parameters
+        ----------
+        plant : Plant or TowingPlant
+            The nominal plant.
+        values : (m_first + m_second,) float
+            Both effects' physical values (SI), the first's then the second's.
+        """
         a, b = self._split(values)
         return self.second.modify_plant(self.first.modify_plant(plant, a), b)
 
     def sample_times(self, times, values):
+        """The sample times shifted by the first effect, then by the second.
+
+        Parameters
+        ----------
+        times : (k,) float
+            Sample time tags (s).
+        values : (m_first + m_second,) float
+            Both effects' physical values (SI), the first's then the second's.
+        """
         a, b = self._split(values)
         return self.second.sample_times(self.first.sample_times(times, a), b)
 
     def measure(self, outputs, values, names):
+        """The channels measured through the first effect's sensor model, then the second's.
+
+        Parameters
+        ----------
+        outputs : dict of str to (k,) float
+            Simulated channels (channel units).
+        values : (m_first + m_second,) float
+            Both effects' physical values (SI), the first's then the second's.
+        names : sequence of str
+            Both effects' parameter names, in the same order.
+        """
         a, b = self._split(values)
         names = list(names)
         return self.second.measure(self.first.measure(outputs, a, names[:self.n_first]), b, names[self.n_first:])
 
     def starts(self, specs):
         """Each effect's own starts, and its fitted values from its single fit when known (forward
-        selection's step 1): the pair starts where each effect alone ended."""
+        selection's step 1): the pair starts where each effect alone ended.
+
+        Parameters
+        ----------
+        specs : list of Parameter
+            Both effects' parameters (:meth:`parameter_specs`).
+
+        Returns
+        -------
+        starts : list of (m_first + m_second,) float
+            At most four combinations (SI).
+        """
         a_specs, b_specs = specs[:self.n_first], specs[self.n_first:]
         firsts = [v for v in (self._start_values[0],) if v is not None] + self.first.starts(a_specs)
         seconds = [v for v in (self._start_values[1],) if v is not None] + self.second.starts(b_specs)
         return [np.r_[a, b] for a in firsts[:2] for b in seconds[:2]]
 
     def stiffness_rate(self, plant, specs):
+        """The larger of the two effects' rates (1/s).
+
+        Parameters
+        ----------
+        plant : Plant
+            The nominal plant.
+        specs : list of Parameter
+            Both effects' parameters.
+
+        Returns
+        -------
+        rate : float
+            (1/s).
+        """
         return max(self.first.stiffness_rate(plant, specs[:self.n_first]),
                    self.second.stiffness_rate(plant, specs[self.n_first:]))
 
     def parameter_free_stiffness_rate(self, plant):
+        """The larger of the two effects' parameter-free rates (1/s).
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant.
+
+        Returns
+        -------
+        rate : float
+            (1/s).
+        """
         return max(self.first.parameter_free_stiffness_rate(plant), self.second.parameter_free_stiffness_rate(plant))
 
     def add_to_exudyn(self, builder, values, names):
+        """Both effects on the Exudyn builder.
+
+        Parameters
+        ----------
+        builder : ExudynScenario
+            The scenario builder.
+        values : (m_first + m_second,) float
+            Both effects' physical values (SI), the first's then the second's.
+        names : sequence of str
+            Both effects' parameter names.
+        """
         a, b = self._split(values)
         names = list(names)
         self.first.add_to_exudyn(builder, a, names[:self.n_first])

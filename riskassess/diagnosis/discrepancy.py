@@ -43,7 +43,25 @@ def _legendre(t, t0, t1):
 
 @njit(LAW_SIGNATURE, cache=True)
 def law(t, x, p, env, load):
-    """``p`` = [t0, t1, hinged (0/1), body torque coefficients (3 axes x 3, B), hinge torque (3)]."""
+    """``p`` = [t0, t1, hinged (0/1), body torque coefficients (3 axes x 3, B), hinge torque (3)].
+
+    Parameters
+    ----------
+    t : float
+        Time (s) from the record's t = 0.
+    x : (STATE_SIZE,) float
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
+    p : (3 + 3 TERMS [+ TERMS],) float
+        t0, t1 (s), hinged flag, Legendre coefficients of the body torque (N m, B) and of the hinge
+        torque (N m).
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+    load : (LOAD_SIZE,) float
+        Loads, layout ``L_*``, added to in place: the torque on the main body (``L_TM``, B, N m) and the
+        hinge torque (``L_TH``, N m).
+    """
     b0, b1, b2 = _legendre(t, p[0], p[1])
     for axis in range(3):
         k = 3 + TERMS * axis
@@ -54,7 +72,18 @@ def law(t, x, p, env, load):
 
 
 def body_torque_scale(plant: Plant) -> float:
-    """Size of a body torque that matters (N m): one that changes the tumble's rate by 1 % per radian."""
+    """Size of a body torque that matters (N m): one that changes the tumble's rate by 1 % per radian.
+
+    Parameters
+    ----------
+    plant : Plant
+        Its largest principal inertia (kg m^2) and fastest rate (rad/s).
+
+    Returns
+    -------
+    scale : float
+        0.01 J_max omega^2 (N m), at least 1e-9.
+    """
     inertia = float(np.max(np.linalg.eigvalsh(np.asarray(plant.inertia_main, float))))
     return max(0.01 * inertia * plant.rate_scale() ** 2, 1e-9)
 
@@ -71,6 +100,15 @@ class Discrepancy(Effect):
         self.t0, self.t1 = float(t0), float(t1)
 
     def parameter_specs(self, case, channels=None) -> list[Parameter]:
+        """Three Legendre coefficients (N m) per body axis (B) and, hinged, for the hinge torque.
+
+        Parameters
+        ----------
+        case : TumblingRigidCase or HingedAppendageCase
+            Validated diagnosis case; its plant sizes the torques.
+        channels : sequence of str, optional
+            Not used.
+        """
         plant = Plant.from_case(case)
         specs = []
         for axis in "xyz":
@@ -84,12 +122,49 @@ class Discrepancy(Effect):
         return specs
 
     def law_parameters(self, plant: Plant, values: np.ndarray) -> np.ndarray:
+        """[t0, t1, hinged] followed by the coefficients.
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant (hinged or not).
+        values : (9,) or (12,) float
+            Legendre coefficients (N m): body torque about B x, y, z, then the hinge torque.
+
+        Returns
+        -------
+        p : (12,) or (15,) float
+            The law's parameters.
+        """
         return np.r_[self.t0, self.t1, float(plant.hinged), np.asarray(values, float)]
 
     def starts(self, specs):
+        """One start: no torque.
+
+        Parameters
+        ----------
+        specs : list of Parameter
+            The coefficients.
+
+        Returns
+        -------
+        starts : list of (m,) float
+            Zeros (N m).
+        """
         return [np.zeros(len(specs))]
 
     def add_to_exudyn(self, builder, values, names):
+        """The series torques on the main body (B) and the hinge.
+
+        Parameters
+        ----------
+        builder : ExudynScenario
+            The scenario builder; a body torque (N m, body frame) and a hinge torque (N m).
+        values : (9,) or (12,) float
+            Legendre coefficients (N m).
+        names : sequence of str
+            Not used.
+        """
         values = np.asarray(values, float)
         t0, t1 = self.t0, self.t1
 
@@ -106,7 +181,22 @@ class Discrepancy(Effect):
 def none_of_these(decision: dict, fits: dict, weights: dict) -> dict:
     """The decision with the "none of these" alternative: a named cause whose BIC is not lower than
     the discrepancy model's becomes "unexplained"; the confidence is the cause's posterior weight
-    among every model including the discrepancy (``weights``)."""
+    among every model including the discrepancy (``weights``).
+
+    Parameters
+    ----------
+    decision : dict
+        :func:`riskassess.diagnosis.selection.decide`'s answer over the catalog models.
+    fits : dict of str to FitResult
+        Fitted models by id, the discrepancy's among them.
+    weights : dict of str to float
+        Posterior weights over every model including the discrepancy (-).
+
+    Returns
+    -------
+    decision : dict
+        The answer, its cause, confidence (-) and reason revised.
+    """
     if DISCREPANCY_ID not in fits:
         return decision
     cause = decision["cause"]

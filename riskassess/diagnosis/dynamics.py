@@ -59,7 +59,20 @@ ENV_SIZE = 36
 
 
 def environment(plant: Plant) -> np.ndarray:
-    """The ``env`` array of a plant (layout ``E_*``)."""
+    """The ``env`` array of a plant (layout ``E_*``).
+
+    Parameters
+    ----------
+    plant : Plant
+        The scenario's plant (SI).
+
+    Returns
+    -------
+    env : (ENV_SIZE,) float
+        Mean motion (rad/s), inclination and argument of latitude at t = 0 (rad), orbit radius (m),
+        masses (kg), inertias (kg m^2, row-major, B axes), hinge axis (-), hinge point and appendage
+        CoM offsets (m, B), spring (N m/rad), damper (N m s/rad), hinged flag (0/1).
+    """
     env = np.zeros(ENV_SIZE)
     env[[E_N, E_INC, E_U0, E_RADIUS, E_MM, E_MA, E_K, E_C, E_HINGED]] = (
         plant.mean_motion, plant.inclination, plant.latitude0, plant.orbit_radius, plant.mass_main,
@@ -73,7 +86,20 @@ def environment(plant: Plant) -> np.ndarray:
 
 
 def initial_state(plant: Plant) -> np.ndarray:
-    """State at t = 0: the tracked point and the CoM velocity in LVLH give the system CoM in I."""
+    """State at t = 0: the tracked point and the CoM velocity in LVLH give the system CoM in I.
+
+    Parameters
+    ----------
+    plant : Plant
+        The scenario's plant (initial attitude B -> I, omega_B, hinge angle and rate, tracked point
+        and CoM velocity in LVLH at t = 0).
+
+    Returns
+    -------
+    x0 : (STATE_SIZE,) float
+        Layout ``X_*``; the CoM velocity is the inertial one, v_LVLH + n z x rho (m/s, I); the
+        damper turns with the body and the stick anchor is at the initial hinge angle.
+    """
     x = np.zeros(STATE_SIZE)
     x[X_Q:X_Q + 4] = quaternion_from_matrix(np.ascontiguousarray(plant.attitude0))
     x[X_W:X_W + 3] = plant.omega0
@@ -93,7 +119,25 @@ def initial_state(plant: Plant) -> np.ndarray:
 @njit(cache=True)
 def observe(states, times, env, origin_main):
     """Channels (k, 12) from states: omega_B (3), quaternion B->LVLH(t) (4), tracked point in LVLH
-    (3), hinge angle and rate; see :mod:`riskassess.diagnosis.observation`."""
+    (3), hinge angle and rate; see :mod:`riskassess.diagnosis.observation`.
+
+    Parameters
+    ----------
+    states : (k, STATE_SIZE) float
+        Fast-model states, layout ``X_*``.
+    times : (k,) float
+        Their times (s) from t = 0.
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+    origin_main : (3,) float
+        Tracked point (target-frame origin) minus main CoM, B (m).
+
+    Returns
+    -------
+    channels : (k, 12) float
+        omega_B (rad/s), quaternion B -> LVLH(t) (scalar first, -), tracked point, LVLH(t) (m),
+        hinge angle (rad) and rate (rad/s).
+    """
     n = env[E_N]
     share = env[E_MA] / (env[E_MM] + env[E_MA])
     out = np.empty((states.shape[0], 12))
@@ -115,7 +159,20 @@ def observe(states, times, env, origin_main):
 
 @njit(cache=True)
 def axis_rotation(axis, angle):
-    """Rodrigues: rotation by ``angle`` (rad) about the unit ``axis``."""
+    """Rodrigues: rotation by ``angle`` (rad) about the unit ``axis``.
+
+    Parameters
+    ----------
+    axis : (3,) float
+        Unit rotation axis (-), in the frame the matrix acts in.
+    angle : float
+        Rotation angle (rad), right-handed.
+
+    Returns
+    -------
+    rotation : (3, 3) float
+        Rotated frame -> reference frame (e.g. appendage at ``angle`` -> B for the hinge axis).
+    """
     c, s = np.cos(angle), np.sin(angle)
     out = np.empty((3, 3))
     for i in range(3):
@@ -132,7 +189,24 @@ def axis_rotation(axis, angle):
 
 @njit(cache=True)
 def appendage_state(env, angle):
-    """Appendage CoM from the hinge s (m), from the main CoM d (m), and its inertia (kg m^2), all B."""
+    """Appendage CoM from the hinge s (m), from the main CoM d (m), and its inertia (kg m^2), all B.
+
+    Parameters
+    ----------
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+    angle : float
+        Hinge angle (rad).
+
+    Returns
+    -------
+    s : (3,) float
+        Appendage CoM minus hinge point, B (m).
+    d : (3,) float
+        Appendage CoM minus main CoM, B (m).
+    inertia : (3, 3) float
+        Appendage inertia about its CoM, B axes (kg m^2).
+    """
     rot = axis_rotation(env[E_AXIS:E_AXIS + 3], angle)
     s = rot @ env[E_S0:E_S0 + 3]
     inertia = rot @ env[E_JA:E_JA + 9].reshape(3, 3) @ rot.T
@@ -141,14 +215,40 @@ def appendage_state(env, angle):
 
 @njit(cache=True)
 def radial_inertial(n, t):
-    """Chaser radial unit vector (LVLH x) at time t, expressed in I (-)."""
+    """Chaser radial unit vector (LVLH x) at time t, expressed in I (-).
+
+    Parameters
+    ----------
+    n : float
+        Mean motion (rad/s).
+    t : float
+        Time (s) from t = 0.
+
+    Returns
+    -------
+    r_hat_inertial : (3,) float
+        (cos nt, sin nt, 0), I (-).
+    """
     return np.array([np.cos(n * t), np.sin(n * t), 0.0])
 
 
 # ------------------------------------------------------------------------------ equations
 @njit(cache=True)
 def solve_spd(m, f):
-    """Solution of m u = f for a small symmetric positive definite m (Cholesky, in place on copies)."""
+    """Solution of m u = f for a small symmetric positive definite m (Cholesky, in place on copies).
+
+    Parameters
+    ----------
+    m : (n, n) float
+        Symmetric positive definite matrix (here the Kane mass matrix, kg m^2).
+    f : (n,) float
+        Right-hand side (here generalized forces, N m).
+
+    Returns
+    -------
+    u : (n,) float
+        m^-1 f (here generalized accelerations, rad/s^2).
+    """
     n = f.shape[0]
     low = np.zeros((n, n))
     for i in range(n):
@@ -176,34 +276,110 @@ def solve_spd(m, f):
 # allocating version cost 7x more per evaluation with the hinge).
 @njit(cache=True, inline="always")
 def tcross(a, b):
+    """Cross product a x b of two 3-vectors in the same frame, as a tuple.
+
+    Parameters
+    ----------
+    a, b : (3,) float or 3-tuple
+        Vectors, one frame.
+
+    Returns
+    -------
+    c : tuple of 3 float
+        a x b, same frame.
+    """
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 @njit(cache=True, inline="always")
 def tdot(a, b):
+    """Dot product a . b of two 3-vectors in the same frame.
+
+    Parameters
+    ----------
+    a, b : (3,) float or 3-tuple
+        Vectors, one frame.
+
+    Returns
+    -------
+    dot : float
+    """
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 @njit(cache=True, inline="always")
 def tlin(ca, a, cb, b):
-    """ca a + cb b."""
+    """ca a + cb b.
+
+    Parameters
+    ----------
+    ca, cb : float
+        Coefficients.
+    a, b : (3,) float or 3-tuple
+        Vectors, one frame.
+
+    Returns
+    -------
+    c : tuple of 3 float
+        Same frame.
+    """
     return (ca * a[0] + cb * b[0], ca * a[1] + cb * b[1], ca * a[2] + cb * b[2])
 
 
 @njit(cache=True, inline="always")
 def tmv(m, v):
+    """Matrix times vector, m v, with m a row-major 9-sequence.
+
+    Parameters
+    ----------
+    m : (9,) float or 9-tuple
+        3 x 3 matrix, row-major (a rotation a -> b, or an inertia).
+    v : (3,) float or 3-tuple
+        Vector (frame a).
+
+    Returns
+    -------
+    w : tuple of 3 float
+        m v (frame b).
+    """
     return (m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
             m[6] * v[0] + m[7] * v[1] + m[8] * v[2])
 
 
 @njit(cache=True, inline="always")
 def tmtv(m, v):
+    """Transposed matrix times vector, m^T v, with m a row-major 9-sequence.
+
+    Parameters
+    ----------
+    m : (9,) float or 9-tuple
+        3 x 3 matrix, row-major (a rotation a -> b).
+    v : (3,) float or 3-tuple
+        Vector (frame b).
+
+    Returns
+    -------
+    w : tuple of 3 float
+        m^T v (frame a).
+    """
     return (m[0] * v[0] + m[3] * v[1] + m[6] * v[2], m[1] * v[0] + m[4] * v[1] + m[7] * v[2],
             m[2] * v[0] + m[5] * v[1] + m[8] * v[2])
 
 
 @njit(cache=True, inline="always")
 def quaternion_rows(q):
+    """Rotation matrix of a unit quaternion, row-major 9-tuple.
+
+    Parameters
+    ----------
+    q : (4,) float
+        Unit quaternion [w, x, y, z], scalar first (here B -> I).
+
+    Returns
+    -------
+    rows : tuple of 9 float
+        The matrix (B -> I: maps B components to I components), row-major.
+    """
     w, x, y, z = q[0], q[1], q[2], q[3]
     return (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
             2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
@@ -212,6 +388,20 @@ def quaternion_rows(q):
 
 @njit(cache=True, inline="always")
 def axis_rows(a, angle):
+    """Rodrigues rotation about a unit axis, row-major 9-tuple (:func:`axis_rotation` without allocating).
+
+    Parameters
+    ----------
+    a : (3,) float or 3-tuple
+        Unit axis (-), here the hinge axis in B.
+    angle : float
+        Rotation angle (rad), here the hinge angle.
+
+    Returns
+    -------
+    rows : tuple of 9 float
+        Appendage -> B at that hinge angle, row-major.
+    """
     c, s = np.cos(angle), np.sin(angle)
     k = 1.0 - c
     return (k * a[0] * a[0] + c, k * a[0] * a[1] - s * a[2], k * a[0] * a[2] + s * a[1],
@@ -221,7 +411,22 @@ def axis_rows(a, angle):
 
 @njit(cache=True, inline="always")
 def sandwich(rot, inertia, v):
-    """rot inertia rot^T v: the appendage's inertia (given at zero angle) applied in B."""
+    """rot inertia rot^T v: the appendage's inertia (given at zero angle) applied in B.
+
+    Parameters
+    ----------
+    rot : 9-tuple
+        Appendage -> B rotation, row-major (:func:`axis_rows`).
+    inertia : (9,) float
+        Appendage inertia about its CoM at zero angle, B axes, row-major (kg m^2).
+    v : (3,) float or 3-tuple
+        Angular velocity or direction, B (rad/s or -).
+
+    Returns
+    -------
+    w : tuple of 3 float
+        J_a(theta) v, B (kg m^2 times the unit of ``v``).
+    """
     return tmv(rot, tmv(inertia, tmtv(rot, v)))
 
 
@@ -280,7 +485,26 @@ def _rotation_rates(t, x, env, load, rot):
 
 @njit(_VECTOR(types.float64, _VECTOR, _LAW, _VECTOR, _VECTOR), cache=True)
 def derivative(t, x, law, p, env):
-    """dx/dt of the state (layout ``X_*``) with the effect ``law`` and its parameters ``p``."""
+    """dx/dt of the state (layout ``X_*``) with the effect ``law`` and its parameters ``p``.
+
+    Parameters
+    ----------
+    t : float
+        Time (s) from t = 0.
+    x : (STATE_SIZE,) float
+        State, layout ``X_*`` (see the module doc).
+    law : compiled function
+        Effect load law ``law(t, x, p, env, load)`` (``LAW_SIGNATURE``).
+    p : (j,) float
+        The law's parameters.
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+
+    Returns
+    -------
+    dx : (STATE_SIZE,) float
+        Time derivative of every state, in its unit per second.
+    """
     load = np.zeros(LOAD_SIZE)
     law(t, x, p, env, load)
     q = x[X_Q:X_Q + 4]
@@ -310,7 +534,28 @@ def derivative(t, x, law, p, env):
 @njit(types.float64[:, ::1](_LAW, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64), cache=True)
 def integrate(law, p, env, x0, times, max_step):
     """States (k, STATE_SIZE) at ``times`` (s, non-decreasing, >= 0) from ``x0`` at t = 0, by
-    RK4 with steps no longer than ``max_step`` (s); the quaternion is renormalised every step."""
+    RK4 with steps no longer than ``max_step`` (s); the quaternion is renormalised every step.
+
+    Parameters
+    ----------
+    law : compiled function
+        Effect load law (``LAW_SIGNATURE``); :func:`no_load` for the nominal model.
+    p : (j,) float
+        The law's parameters (at least one entry).
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+    x0 : (STATE_SIZE,) float
+        State at t = 0 (:func:`initial_state`).
+    times : (k,) float
+        Output times (s).
+    max_step : float
+        Longest RK4 step (s).
+
+    Returns
+    -------
+    states : (k, STATE_SIZE) float
+        Layout ``X_*``.
+    """
     out = np.empty((times.shape[0], STATE_SIZE))
     x = x0.copy()
     t = 0.0
@@ -333,13 +578,42 @@ def integrate(law, p, env, x0, times, max_step):
 
 @njit(LAW_SIGNATURE, cache=True)
 def no_load(t, x, p, env, load):
-    """The nominal model: no effect."""
+    """The nominal model: no effect.
+
+    Parameters
+    ----------
+    t : float
+        Time (s) from the record's t = 0.
+    x : (STATE_SIZE,) float
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
+    p : (j,) float
+        Not used.
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+    load : (LOAD_SIZE,) float
+        Loads, layout ``L_*``, added to in place: nothing.
+    """
     return
 
 
 def angular_momentum_inertial(plant: Plant, states) -> np.ndarray:
     """Angular momentum of the bodies about the system CoM, I (kg m^2/s), (k, 3); without the
-    extra states (a damper's momentum is added by its effect's tests)."""
+    extra states (a damper's momentum is added by its effect's tests).
+
+    Parameters
+    ----------
+    plant : Plant
+        The scenario's plant.
+    states : (k, STATE_SIZE) or (STATE_SIZE,) float
+        States, layout ``X_*``.
+
+    Returns
+    -------
+    h_inertial : (k, 3) float
+        Main body and appendage angular momentum about the system CoM, I (kg m^2/s).
+    """
     env = environment(plant)
     out = []
     for x in np.atleast_2d(states):

@@ -53,18 +53,63 @@ class ExudynScenario:
 
     # -- effect hooks ------------------------------------------------------------------
     def add_body_torque(self, fn):
+        """Register a torque on the bodies.
+
+        Parameters
+        ----------
+        fn : callable
+            ``fn(t, body, body_to_inertial, omega_body) -> torque_body``: time (s), body index (0 main,
+            1 appendage), (3, 3) rotation body -> I, (3,) inertial angular velocity in the body frame
+            (rad/s); returns the (3,) torque on that body, body frame (N m).
+        """
         self.body_torques.append(fn)
 
     def add_hinge_torque(self, fn):
+        """Register a torque on the appendage about the hinge axis.
+
+        Parameters
+        ----------
+        fn : callable
+            ``fn(t, angle, rate) -> torque``: time (s), hinge angle (rad), hinge rate (rad/s); returns
+            the torque on the appendage about the axis (N m).
+        """
         self.hinge_torques.append(fn)
 
     def add_com_acceleration(self, fn):
+        """Register an acceleration of every body's CoM.
+
+        Parameters
+        ----------
+        fn : callable
+            ``fn(t, r_inertial) -> a_inertial``: time (s), the body's CoM position (m, I); returns its
+            (3,) acceleration (m/s^2, I).
+        """
         self.com_accelerations.append(fn)
 
     def add_damper(self, inertia, damping):
+        """Add a nutation damper: a rotor at the main CoM coupled by a rotational damper.
+
+        Parameters
+        ----------
+        inertia : float
+            Rotor inertia J_d, isotropic (kg m^2).
+        damping : float
+            Rotational damping c (N m s).
+        """
         self.damper = (float(inertia), float(damping))
 
     def inertia_body(self, body: int) -> np.ndarray:
+        """A body's inertia about its CoM, its own axes (kg m^2).
+
+        Parameters
+        ----------
+        body : int
+            0 main body, 1 appendage.
+
+        Returns
+        -------
+        inertia_body : (3, 3) float
+        """
         return self.bodies[body].inertia_body
 
     # -- bodies at t = 0 -----------------------------------------------------------------
@@ -163,7 +208,18 @@ class ExudynScenario:
         return nodes[0]
 
     def simulate(self, times) -> dict[str, np.ndarray]:
-        """Channels at ``times`` (s, increasing, >= 0), linearly interpolated between steps."""
+        """Channels at ``times`` (s, increasing, >= 0), linearly interpolated between steps.
+
+        Parameters
+        ----------
+        times : (k,) float
+            Sample times (s) from t = 0.
+
+        Returns
+        -------
+        channels : dict of str to (k,) float
+            Units and frames of :mod:`riskassess.diagnosis.channels`.
+        """
         times = np.asarray(times, float)
         sc, mbs, nodes = self._build()
         recorder = _Recorder(mbs, nodes[:len(self.bodies)], times, self.step)
@@ -240,7 +296,28 @@ class _Recorder:
 
 
 def simulate_exudyn(plant: Plant, times, effect=None, values=(), names=(), step: float | None = None) -> dict:
-    """Channels at ``times`` (s) of ``plant`` with ``effect`` at ``values`` (physical, SI), by Exudyn."""
+    """Channels at ``times`` (s) of ``plant`` with ``effect`` at ``values`` (physical, SI), by Exudyn.
+
+    Parameters
+    ----------
+    plant : Plant
+        A rigid or hinged plant.
+    times : (k,) float
+        Sample times (s) from t = 0, increasing.
+    effect : Effect, optional
+        The effect; None: the nominal model.
+    values : (m,) float
+        Its physical parameter values (SI, order of its ``parameter_specs``).
+    names : sequence of str
+        Their names.
+    step : float, optional
+        Exudyn RK44 step (s); default ``HINGED_STEP`` or ``RIGID_STEP``.
+
+    Returns
+    -------
+    channels : dict of str to (k,) float
+        Units and frames of :mod:`riskassess.diagnosis.channels`.
+    """
     values = np.asarray(values, float)
     sample_times = np.asarray(times, float)
     if effect is not None:
@@ -256,7 +333,22 @@ def simulate_exudyn(plant: Plant, times, effect=None, values=(), names=(), step:
 def simulate_case(case, times, step: float | None = None) -> dict:
     """Channels at ``times`` (s) of a case with every effect its ``[[effects]]`` lists (an extended
     case written by `riskassess diagnose`), by Exudyn: plant changes, loads and sensor effects in
-    the order given."""
+    the order given.
+
+    Parameters
+    ----------
+    case : DiagnosisCase
+        Validated diagnosis case (a towing case: at most one effect).
+    times : (k,) float
+        Sample times (s) from the record's t = 0, increasing.
+    step : float, optional
+        Exudyn step (s); default the scenario's.
+
+    Returns
+    -------
+    channels : dict of str to (k,) float
+        Units and frames of :mod:`riskassess.diagnosis.channels`.
+    """
     if case.kind == "towing":
         return _simulate_towing_case(case, times, CATALOG)
     plant = Plant.from_case(case)

@@ -89,6 +89,24 @@ class Problem:
 
     @classmethod
     def build(cls, case, measured, holdout_fraction: float) -> "Problem":
+        """The problem of a case and its measured record: the channels the scenario predicts, their noise,
+        the training samples (all but the last ``holdout_fraction`` of the record) and the uncertain
+        nominal parameters (towing: the fit step resolved against the noise, :func:`resolved_step`).
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case.
+        measured : MeasuredData
+            The record (:func:`riskassess.diagnosis.measured.read_measured`): times (s), channels (SI),
+            noise 1-sigma (channel units).
+        holdout_fraction : float
+            Share of the record's duration held out of the fit (-), in (0, 1).
+
+        Returns
+        -------
+        problem : Problem
+        """
         plant = plant_of(case)
         used = [c for c in measured.values if c in scenario_channels(plant)]
         time = measured.time
@@ -145,7 +163,22 @@ DIVERGED_RESIDUAL_SIGMA = 1e6
 
 def sample_residuals(model, measured, sigma) -> np.ndarray:
     """(model - measured) / sigma per sample: 0 where the measurement is missing (NaN), and
-    :data:`DIVERGED_RESIDUAL_SIGMA` where it exists but the model's value is not finite."""
+    :data:`DIVERGED_RESIDUAL_SIGMA` where it exists but the model's value is not finite.
+
+    Parameters
+    ----------
+    model : (k,) float
+        Predicted channel (channel unit).
+    measured : (k,) float
+        Measured channel (channel unit), NaN where missing.
+    sigma : float
+        The channel's 1-sigma noise (channel unit).
+
+    Returns
+    -------
+    r : (k,) float
+        Normalized residuals (-).
+    """
     model, measured = np.asarray(model, float), np.asarray(measured, float)
     present = np.isfinite(measured)
     r = np.where(np.isfinite(model), (model - np.where(present, measured, 0.0)) / sigma, DIVERGED_RESIDUAL_SIGMA)
@@ -153,7 +186,22 @@ def sample_residuals(model, measured, sigma) -> np.ndarray:
 
 
 def first_unpredicted_time(times, model: dict, measured: dict) -> float | None:
-    """Time (s) of the first measured sample a model prediction leaves non-finite, or None."""
+    """Time (s) of the first measured sample a model prediction leaves non-finite, or None.
+
+    Parameters
+    ----------
+    times : (k,) float
+        Sample times (s).
+    model : dict of str to (k,) float
+        Predicted channels.
+    measured : dict of str to (k,) float
+        Measured channels, NaN where missing.
+
+    Returns
+    -------
+    time : float or None
+        (s).
+    """
     bad = np.zeros(len(times), bool)
     for c, values in measured.items():
         if c in model:
@@ -186,17 +234,54 @@ class CandidateFit:
 
     # -- parameter vector ------------------------------------------------------------------
     def unpack(self, z):
+        """The nominal parameters and the effect's parameters (SI) of the fit variables ``z``.
+
+        Parameters
+        ----------
+        z : (n_nominal + m,) float
+            Fit variables: the nominal parameters as (value - case value) / prior sigma (-), then the
+            effect's scaled parameters (:meth:`scaled`, -).
+
+        Returns
+        -------
+        nominal : (n_nominal,) float
+            Nominal parameter values (units and frames of :func:`riskassess.diagnosis.plant.nominal_vector`).
+        values : (m,) float
+            The effect's physical parameters (SI).
+        """
         n = len(self.problem.nominal_center)
         nominal = self.problem.nominal_center + self.problem.nominal_sigma * z[:n]
         return nominal, self.physical(z[n:])
 
     def physical(self, z_effect) -> np.ndarray:
         """The effect's parameters (SI) from their fit variables: value / scale, or ln(value / typical)
-        for a ``log`` parameter."""
+        for a ``log`` parameter.
+
+        Parameters
+        ----------
+        z_effect : (m,) float
+            The effect's fit variables (-).
+
+        Returns
+        -------
+        values : (m,) float
+            Physical values, each in its parameter's unit.
+        """
         return self.scale * np.where(self.log, np.exp(np.where(self.log, z_effect, 0.0)), z_effect)
 
     def scaled(self, values) -> np.ndarray:
-        """The fit variables of the effect's parameters ``values`` (SI): the inverse of :meth:`physical`."""
+        """The fit variables of the effect's parameters ``values`` (SI): the inverse of :meth:`physical`.
+
+        Parameters
+        ----------
+        values : (m,) float
+            Physical values, each in its parameter's unit.
+
+        Returns
+        -------
+        z_effect : (m,) float
+            Fit variables (-).
+        """
         values = np.asarray(values, float)
         ratio = values / self.scale
         return np.where(self.log, np.log(np.where(self.log, np.maximum(ratio, 1e-300), 1.0)), ratio)
@@ -217,11 +302,42 @@ class CandidateFit:
 
     # -- model ---------------------------------------------------------------------------
     def predict(self, z, times) -> dict:
+        """Channels of the model at the fit variables ``z``.
+
+        Parameters
+        ----------
+        z : (n_nominal + m,) float
+            Fit variables: the nominal parameters as (value - case value) / prior sigma (-), then the
+            effect's scaled parameters (:meth:`scaled`, -).
+        times : (k,) float
+            Sample times (s).
+
+        Returns
+        -------
+        channels : dict of str to (k,) float
+            Units and frames of :mod:`riskassess.diagnosis.channels`.
+        """
         nominal, values = self.unpack(z)
         plant = with_nominal(self.problem.plant, self.problem.nominal_names, nominal)
         return predict(plant, times, self.effect, values, [s.name for s in self.specs], self.step)
 
     def residuals(self, z, use) -> np.ndarray:
+        """The least-squares residual vector: normalized data residuals of the ``use`` samples, channel
+        after channel, then the nominal parameters' prior residuals.
+
+        Parameters
+        ----------
+        z : (n_nominal + m,) float
+            Fit variables: the nominal parameters as (value - case value) / prior sigma (-), then the
+            effect's scaled parameters (:meth:`scaled`, -).
+        use : (k,) bool
+            Mask of the problem's samples to use.
+
+        Returns
+        -------
+        f : (n_channels * k_use + n_nominal,) float
+            (model - measured) / sigma, then (value - case value) / prior sigma (-).
+        """
         p = self.problem
         model = aligned_quaternion(self.predict(z, p.time[use]), {c: v[use] for c, v in p.values.items()})
         r = np.concatenate([sample_residuals(model[c], v[use], p.noise[c]) for c, v in p.values.items()])
@@ -235,7 +351,21 @@ class CandidateFit:
     def jacobian(self, z, use):
         """Forward differences (:meth:`difference_jacobian`); for the towing model, whose runs cost
         ~0.1 s, only every ``BROYDEN_REFRESH + 1``-th call, Broyden's rank-one update of the last one
-        in between (Broyden 1965; the linear parameters' columns stay exact)."""
+        in between (Broyden 1965; the linear parameters' columns stay exact).
+
+        Parameters
+        ----------
+        z : (n_nominal + m,) float
+            Fit variables: the nominal parameters as (value - case value) / prior sigma (-), then the
+            effect's scaled parameters (:meth:`scaled`, -).
+        use : (k,) bool
+            Mask of the problem's samples to use.
+
+        Returns
+        -------
+        jac : (len(f), len(z)) float
+            d residuals / d z (-).
+        """
         if not self.broyden:
             return self.difference_jacobian(z, use)
         z_last, f0 = self._cache.get("last", (None, None))
@@ -258,7 +388,21 @@ class CandidateFit:
 
     def difference_jacobian(self, z, use):
         """Forward differences, one column per parameter (together through ``columns`` when given);
-        the columns of linear parameters are computed once per sample set and reused."""
+        the columns of linear parameters are computed once per sample set and reused.
+
+        Parameters
+        ----------
+        z : (n_nominal + m,) float
+            Fit variables: the nominal parameters as (value - case value) / prior sigma (-), then the
+            effect's scaled parameters (:meth:`scaled`, -).
+        use : (k,) bool
+            Mask of the problem's samples to use.
+
+        Returns
+        -------
+        jac : (len(f), len(z)) float
+            d residuals / d z (-).
+        """
         z_last, f0 = self._cache.get("last", (None, None))
         if z_last is None or not np.array_equal(z_last, z):
             f0 = self.residuals(z, use)
@@ -292,7 +436,18 @@ class CandidateFit:
 
     def fit(self, nominal_start: FitResult | None = None) -> FitResult:
         """Fit from the case values, or from the nominal parameters of ``nominal_start`` (the nominal
-        model's fit: a candidate then starts where the nominal model ended)."""
+        model's fit: a candidate then starts where the nominal model ended).
+
+        Parameters
+        ----------
+        nominal_start : FitResult, optional
+            The nominal model's fit of the same problem.
+
+        Returns
+        -------
+        result : FitResult
+            Values (SI, nominal then effect), their standard deviations, chi^2 and BIC.
+        """
         start = clock.perf_counter()
         p = self.problem
         t_train = p.time[p.train]
@@ -382,7 +537,20 @@ def early_starts(starts, residuals) -> list:
     case's state predicts the early span ten times better (slow towing seed 1: 5e7 against 9e8). Among
     starts that differ only where the early span sees little (two field directions both normal to the
     spin: 4.914e7 and 4.915e7) one run cannot tell which leads to the truth (the first ended at chi^2
-    2.6e7 on the training span, the second at 1.2e5, the truth has 2.3e4), so the near-ties are all fitted."""
+    2.6e7 on the training span, the second at 1.2e5, the truth has 2.3e4), so the near-ties are all fitted.
+
+    Parameters
+    ----------
+    starts : list of (n,) float
+        Starting fit variables z (-).
+    residuals : callable
+        z -> normalized residual vector on the early span (-).
+
+    Returns
+    -------
+    chosen : list of (n,) float
+        The starts to fit, best first.
+    """
     early = sorted((float(np.sum(residuals(z) ** 2)), k) for k, z in enumerate(starts))
     return [starts[k] for chi2, k in early[:EARLY_FITS] if chi2 <= EARLY_TIE * early[0][0]]
 
@@ -391,7 +559,24 @@ def predicted_decrease(jac, f, z, low, high) -> float:
     """Decrease of chi^2 = |f|^2 that a Gauss-Newton step from ``z`` (residuals ``f``, Jacobian ``jac``)
     predicts, |J d|^2 with d the least-squares solution of J d = -f; a variable at a bound that the
     gradient pushes outwards is held. Near a minimum the parameters are then about sqrt(decrease)
-    standard deviations from it (the quadratic model)."""
+    standard deviations from it (the quadratic model).
+
+    Parameters
+    ----------
+    jac : (r, n) float
+        d f / d z (-).
+    f : (r,) float
+        Normalized residuals (-).
+    z : (n,) float
+        Fit variables (-).
+    low, high : (n,) float
+        Their bounds (-).
+
+    Returns
+    -------
+    decrease : float
+        Predicted chi^2 decrease (-).
+    """
     g = jac.T @ f
     held = ((z <= low + 1e-10) & (g > 0)) | ((z >= high - 1e-10) & (g < 0))
     free = jac[:, ~held]
@@ -403,7 +588,24 @@ def resolved_step(plant, times, noise: dict, halvings: int = 3) -> float:
     """The towing model's step (s): the case's ``fit_step``, halved until the nominal model's
     discretization error, estimated by the step-doubling difference |y(h) - y(h/2)| (RMS per
     channel), is below ``STEP_ERROR_SIGMA`` of each channel's noise (at most ``halvings`` times): quiet
-    sensors must not see the fit model's step as a discrepancy."""
+    sensors must not see the fit model's step as a discrepancy.
+
+    Parameters
+    ----------
+    plant : TowingPlant
+        The towing plant (its ``fit_step``, s).
+    times : (k,) float
+        Sample times (s).
+    noise : dict of str to float
+        1-sigma noise per channel (channel units).
+    halvings : int
+        Most halvings.
+
+    Returns
+    -------
+    step : float
+        (s).
+    """
     step = plant.fit_step
     coarse = predict(plant, times, step=step)
     for _ in range(halvings):
@@ -436,7 +638,24 @@ def _fitted(problem: Problem, effect: Effect | None, fit: FitResult):
 
 
 def prediction(problem: Problem, effect: Effect | None, fit: FitResult, times) -> dict:
-    """Channels of a fitted model at ``times`` (s)."""
+    """Channels of a fitted model at ``times`` (s).
+
+    Parameters
+    ----------
+    problem : Problem
+        The problem the model was fitted to.
+    effect : Effect or None
+        The candidate's effect; None: the nominal model.
+    fit : FitResult
+        Its fit.
+    times : (k,) float
+        Sample times (s).
+
+    Returns
+    -------
+    channels : dict of str to (k,) float
+        Units and frames of :mod:`riskassess.diagnosis.channels`.
+    """
     candidate, z = _fitted(problem, effect, fit)
     return candidate.predict(z, times)
 
@@ -445,7 +664,24 @@ def step_error_sigma(problem: Problem, effect: Effect | None, fit: FitResult, pr
     """Per channel: the fitted model's own discretization error on the training part (RMS, noise sigmas),
     estimated as 2 |y(h) - y(h/2)| (the error of y(h) for a first-order scheme: the tension-only tethers'
     kinks make the towing scheme's convergence no better than first order); ``predicted``: y(h) over the
-    whole record (:func:`prediction`), so that only y(h/2) is run here."""
+    whole record (:func:`prediction`), so that only y(h/2) is run here.
+
+    Parameters
+    ----------
+    problem : Problem
+        The problem the model was fitted to.
+    effect : Effect or None
+        The candidate's effect; None: the nominal model.
+    fit : FitResult
+        Its fit.
+    predicted : dict of str to (k,) float
+        The fitted model's channels at every sample of the record.
+
+    Returns
+    -------
+    errors : dict of str to float
+        Per channel, in noise sigmas (-).
+    """
     candidate, z = _fitted(problem, effect, fit)
     candidate.step /= 2.0
     fine = candidate.predict(z, problem.time[problem.train])

@@ -18,7 +18,22 @@ ITERATIONS = 10
 def library(time, frequency_hz: float, model: dict) -> dict[str, np.ndarray]:
     """Candidate terms at ``time`` (s), each scaled to unit RMS: constant, drift, quadratic drift,
     oscillation at the residual's dominant frequency (plain and growing), and the nominal model's
-    channels (centred)."""
+    channels (centred).
+
+    Parameters
+    ----------
+    time : (k,) float
+        Sample times (s).
+    frequency_hz : float
+        The residual's dominant frequency (Hz); 0: no oscillation terms.
+    model : dict of str to (k,) float
+        The nominal model's channels (channel units).
+
+    Returns
+    -------
+    terms : dict of str to (k,) float
+        Term name -> values scaled to unit RMS (-); constant terms other than "1" dropped.
+    """
     t = (time - time[0]) / max(time[-1] - time[0], 1e-12)
     phase = 2.0 * np.pi * frequency_hz * (time - time[0])
     terms = {"1": np.ones_like(t), "t": t, "t^2": t * t}
@@ -32,7 +47,20 @@ def library(time, frequency_hz: float, model: dict) -> dict[str, np.ndarray]:
 
 def sparse_terms(residual, terms: dict) -> list[dict]:
     """STLSQ fit ``residual ~ sum c_k term_k``; returns the kept terms with their coefficient
-    (normalized units) and the share of the residual's variance they explain together."""
+    (normalized units) and the share of the residual's variance they explain together.
+
+    Parameters
+    ----------
+    residual : (k,) float
+        Normalized residual (-), NaN where missing.
+    terms : dict of str to (k,) float
+        The library (:func:`library`), unit RMS (-).
+
+    Returns
+    -------
+    kept : list of dict
+        ``term``, ``coefficient`` (sigma) and ``explained_share`` (-), largest coefficient first.
+    """
     ok = np.isfinite(residual)
     names = list(terms)
     theta = np.column_stack([terms[n][ok] for n in names])
@@ -53,6 +81,19 @@ def sparse_terms(residual, terms: dict) -> list[dict]:
 
 
 def describe_terms(channel: str, kept: list[dict]) -> str:
+    """One sentence naming the largest kept terms of a channel's residual.
+
+    Parameters
+    ----------
+    channel : str
+        Channel name.
+    kept : list of dict
+        :func:`sparse_terms`.
+
+    Returns
+    -------
+    sentence : str
+    """
     if not kept:
         return f"{channel}: no library term carries the residual"
     terms = " + ".join(f"{k['coefficient']:+.2g} {k['term']}" for k in kept[:4])

@@ -59,7 +59,20 @@ class MeasuredData:
 
 def read_measured(path, noise: dict | None = None) -> MeasuredData:
     """Read and check ``path``; ``noise`` gives 1-sigma values (channel -> sigma) that override the
-    estimate. Raises :class:`MeasuredDataError` naming the file and what is wrong."""
+    estimate. Raises :class:`MeasuredDataError` naming the file and what is wrong.
+
+    Parameters
+    ----------
+    path : str or Path
+        Measured-data CSV file (format in the module doc).
+    noise : dict of str to float, optional
+        1-sigma noise per channel (channel units, :data:`riskassess.diagnosis.channels.UNITS`).
+
+    Returns
+    -------
+    measured : MeasuredData
+        Times (s), known channels (SI; quaternion signs made continuous) and their noise.
+    """
     path = Path(path)
     header, rows = _read_rows(path)
     data = _numeric(path, header, rows)
@@ -164,6 +177,16 @@ def difference_noise(column) -> float:
     stops falling with the order (the signal is gone): the first m with sigma_m <= 1.05
     sigma_(m+1), averaged with sigma_(m+1); differences beyond 6 robust sigmas (outliers) are
     dropped. Missing samples are skipped.
+
+    Parameters
+    ----------
+    column : (k,) float
+        Uniformly sampled channel (its unit), NaN where missing.
+
+    Returns
+    -------
+    sigma : float
+        1-sigma noise (the channel's unit).
     """
     y = np.asarray(column, float)
     y = y[np.isfinite(y)]

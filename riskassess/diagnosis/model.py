@@ -19,13 +19,47 @@ MAX_STEP = 0.25
 
 def max_step(plant: Plant, stiffness_rate: float = 0.0) -> float:
     """The RK4 step (s) for a plant and an effect's fastest decay rate (1/s); the towing model's
-    Verlet step is the case's ``fit_step``."""
+    Verlet step is the case's ``fit_step``.
+
+    Parameters
+    ----------
+    plant : Plant or TowingPlant
+        The plant (its fastest motion rate, rad/s, or its ``fit_step``, s).
+    stiffness_rate : float
+        The effect's fastest decay rate (1/s); 0: none.
+
+    Returns
+    -------
+    step : float
+        (s).
+    """
     step = plant.fit_step if is_towing(plant) else min(MAX_STEP, ANGLE_PER_STEP / plant.rate_scale())
     return min(step, 1.5 / stiffness_rate) if stiffness_rate > 0 else step
 
 
 def predict(plant: Plant, times, effect: Effect | None = None, values=(), names=(), step: float | None = None) -> dict:
-    """Channels (dict of (k,) arrays) at ``times`` (s) of ``plant`` with ``effect`` at ``values``."""
+    """Channels (dict of (k,) arrays) at ``times`` (s) of ``plant`` with ``effect`` at ``values``.
+
+    Parameters
+    ----------
+    plant : Plant or TowingPlant
+        The plant (nominal parameters already set).
+    times : (k,) float
+        Sample times (s) from the record's t = 0, non-decreasing.
+    effect : Effect, optional
+        The effect; None: the nominal model.
+    values : (m,) float
+        Its physical parameter values (SI, order of its ``parameter_specs``).
+    names : sequence of str
+        Their names.
+    step : float, optional
+        Integration step (s); default :func:`max_step`.
+
+    Returns
+    -------
+    channels : dict of str to (k,) float
+        Units and frames of :mod:`riskassess.diagnosis.channels`.
+    """
     times = np.asarray(times, float)
     values = np.asarray(values, float)
     if is_towing(plant):

@@ -17,19 +17,58 @@ from riskassess.diagnosis.plant import Plant
 
 
 def scenario_channels(plant: Plant) -> tuple[str, ...]:
-    """Channels a scenario's model predicts."""
+    """Channels a scenario's model predicts.
+
+    Parameters
+    ----------
+    plant : Plant or TowingPlant
+        The scenario's plant.
+
+    Returns
+    -------
+    channels : tuple of str
+        Names from :mod:`riskassess.diagnosis.channels`.
+    """
     if getattr(plant, "kind", None) == "towing":
         return OMEGA + QUATERNION + REL + TENSION
     return OMEGA + QUATERNION + (HINGE if plant.hinged else ()) + REL
 
 
 def lvlh_from_inertial(n: float, times) -> Rotation:
-    """I -> LVLH(t): LVLH turns at ``n`` (rad/s) about its z axis (the orbit normal)."""
+    """I -> LVLH(t): LVLH turns at ``n`` (rad/s) about its z axis (the orbit normal).
+
+    Parameters
+    ----------
+    n : float
+        Mean motion (rad/s).
+    times : (k,) float
+        Times (s) from t = 0.
+
+    Returns
+    -------
+    inertial_to_lvlh : Rotation
+        k rotations mapping I components to LVLH(t) components.
+    """
     return Rotation.from_rotvec(np.outer(-n * np.asarray(times, float), [0.0, 0.0, 1.0]))
 
 
 def outputs(plant: Plant, times, states) -> dict[str, np.ndarray]:
-    """Every channel of ``scenario_channels(plant)`` at ``times`` (s) from states (k, STATE_SIZE)."""
+    """Every channel of ``scenario_channels(plant)`` at ``times`` (s) from states (k, STATE_SIZE).
+
+    Parameters
+    ----------
+    plant : Plant
+        The scenario's plant.
+    times : (k,) float
+        Times (s) from t = 0.
+    states : (k, STATE_SIZE) float
+        Fast-model states (layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics`).
+
+    Returns
+    -------
+    channels : dict of str to (k,) float
+        Units and frames of :mod:`riskassess.diagnosis.channels`.
+    """
     values = observe(np.ascontiguousarray(states), np.ascontiguousarray(times, float), environment(plant),
                      np.ascontiguousarray(plant.origin_main, float))
     names = OMEGA + QUATERNION + REL + (HINGE if plant.hinged else ())

@@ -75,6 +75,20 @@ class Plant:
 
     @classmethod
     def from_case(cls, case) -> "Plant":
+        """The plant of a rigid or hinged diagnosis case, in SI.
+
+        Parameters
+        ----------
+        case : TumblingRigidCase or HingedAppendageCase
+            Validated diagnosis case (:mod:`riskassess.cases.diagnosis`): main body (kg, kg m^2, CoM in
+            the target frame, m), appendage and hinge (target frame), circular orbit or none, initial
+            state (attitude target -> LVLH as a rotation vector (rad), omega (rad/s, target frame),
+            position and velocity in LVLH (m, m/s)).
+
+        Returns
+        -------
+        plant : Plant
+        """
         main = case.main_body
         com = np.asarray(main.center_of_mass, float)
         hinged = case.kind == "hinged_appendage"
@@ -106,7 +120,18 @@ class Plant:
         return self.mass_main + self.mass_appendage
 
     def appendage_offset(self, angle) -> np.ndarray:
-        """Appendage CoM minus main CoM (m), B, at hinge angle(s) ``angle`` (rad): (3,) or (k, 3)."""
+        """Appendage CoM minus main CoM (m), B, at hinge angle(s) ``angle`` (rad): (3,) or (k, 3).
+
+        Parameters
+        ----------
+        angle : float or (k,) float
+            Hinge angle(s) (rad).
+
+        Returns
+        -------
+        offset : (3,) or (k, 3) float
+            Appendage CoM minus main CoM, B (m).
+        """
         angle = np.asarray(angle, float)
         s = Rotation.from_rotvec(np.multiply.outer(angle, self.axis)).apply(self.appendage_from_hinge)
         return self.hinge_main + s
@@ -139,12 +164,35 @@ class Plant:
 
 
 def is_towing(plant) -> bool:
+    """Whether ``plant`` is the towing scenario's (:class:`riskassess.diagnosis.towing_plant.TowingPlant`).
+
+    Parameters
+    ----------
+    plant : Plant or TowingPlant
+
+    Returns
+    -------
+    towing : bool
+    """
     return getattr(plant, "kind", None) == "towing"
 
 
 def nominal_parameter_names(case, channels) -> list[str]:
     """Nominal parameters the fit estimates: those with a prior 1-sigma > 0 that the scenario has and
-    the channels can see (position and velocity only with rel_x..z)."""
+    the channels can see (position and velocity only with rel_x..z).
+
+    Parameters
+    ----------
+    case : DiagnosisCase
+        Validated diagnosis case (its ``uncertain`` priors and ``kind``).
+    channels : sequence of str
+        Measured channel names.
+
+    Returns
+    -------
+    names : list of str
+        Keys of ``NOMINAL_PARAMETERS``, in its order.
+    """
     names = []
     for name in NOMINAL_PARAMETERS:
         if getattr(case.uncertain, name, 0.0) <= 0:
@@ -162,7 +210,22 @@ def nominal_parameter_names(case, channels) -> list[str]:
 
 def nominal_vector(plant: Plant, names) -> np.ndarray:
     """The case values of the nominal parameters ``names``, flattened (the attitude as a zero
-    perturbation, rad)."""
+    perturbation, rad).
+
+    Parameters
+    ----------
+    plant : Plant or TowingPlant
+        The scenario's plant.
+    names : sequence of str
+        Nominal parameter names (``NOMINAL_PARAMETERS`` keys).
+
+    Returns
+    -------
+    vector : (m,) float
+        Concatenated values in each name's unit (``NOMINAL_PARAMETERS``): attitude perturbation
+        (rad, B), angular velocity (rad/s, B), position (m, LVLH), velocity (m/s, LVLH), hinge angle
+        (rad), rate (rad/s), stiffness (N m/rad), damping (N m s/rad).
+    """
     if is_towing(plant):
         return plant.nominal_vector(names)
     values = {"attitude": np.zeros(3), "angular_velocity": plant.omega0, "position": plant.position0,
@@ -173,7 +236,22 @@ def nominal_vector(plant: Plant, names) -> np.ndarray:
 
 def with_nominal(plant: Plant, names, vector) -> Plant:
     """``plant`` with the nominal parameters ``names`` set from ``vector`` (attitude: a rotation
-    vector (rad), B frame, composed after the case attitude)."""
+    vector (rad), B frame, composed after the case attitude).
+
+    Parameters
+    ----------
+    plant : Plant or TowingPlant
+        The scenario's plant.
+    names : sequence of str
+        Nominal parameter names (``NOMINAL_PARAMETERS`` keys).
+    vector : (m,) float
+        Their values, laid out as :func:`nominal_vector` returns them (units and frames there).
+
+    Returns
+    -------
+    plant : Plant or TowingPlant
+        A changed copy.
+    """
     if is_towing(plant):
         return plant.with_nominal(names, vector)
     changes, k = {}, 0
@@ -192,5 +270,19 @@ def with_nominal(plant: Plant, names, vector) -> Plant:
 
 
 def prior_sigmas(case, names) -> np.ndarray:
+    """The prior 1-sigma of every entry of the nominal vector of ``names``.
+
+    Parameters
+    ----------
+    case : DiagnosisCase
+        Validated diagnosis case (its ``uncertain`` table).
+    names : sequence of str
+        Nominal parameter names.
+
+    Returns
+    -------
+    sigmas : (m,) float
+        Per entry, in the entry's unit (rad, rad/s, m, m/s, N m/rad, N m s/rad).
+    """
     return np.concatenate([np.full(NOMINAL_PARAMETERS[n][0], getattr(case.uncertain, n)) for n in names]) \
         if names else np.zeros(0)

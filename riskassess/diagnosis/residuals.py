@@ -20,7 +20,21 @@ SIGNIFICANCE = 1e-3
 
 
 def aligned_quaternion(model: dict, measured: dict) -> dict:
-    """``model`` with its quaternion signs turned to the measured ones sample by sample."""
+    """``model`` with its quaternion signs turned to the measured ones sample by sample.
+
+    Parameters
+    ----------
+    model : dict of str to (k,) float
+        Predicted channels.
+    measured : dict of str to (k,) float
+        Measured channels.
+
+    Returns
+    -------
+    model : dict of str to (k,) float
+        A copy with q_w..q_z negated where they point against the measured quaternion (unchanged
+        without all four in both).
+    """
     if not all(c in measured and c in model for c in QUATERNION):
         return model
     dot = sum(np.nan_to_num(model[c] * measured[c]) for c in QUATERNION)
@@ -29,13 +43,40 @@ def aligned_quaternion(model: dict, measured: dict) -> dict:
 
 
 def normalized_residuals(model: dict, measured: dict, noise: dict) -> dict:
-    """(measured - model) / sigma per measured channel (NaN where a sample is missing)."""
+    """(measured - model) / sigma per measured channel (NaN where a sample is missing).
+
+    Parameters
+    ----------
+    model : dict of str to (k,) float
+        Predicted channels (channel units).
+    measured : dict of str to (k,) float
+        Measured channels (channel units).
+    noise : dict of str to float
+        1-sigma noise per channel (channel units).
+
+    Returns
+    -------
+    residuals : dict of str to (k,) float
+        Per channel both have (-).
+    """
     model = aligned_quaternion(model, measured)
     return {c: (measured[c] - model[c]) / noise[c] for c in measured if c in model}
 
 
 def ljung_box(r, lags: int = LJUNG_BOX_LAGS) -> tuple[float, float]:
-    """Ljung-Box statistic Q and its p-value (chi^2 with ``lags`` dof) of a series (NaNs dropped)."""
+    """Ljung-Box statistic Q and its p-value (chi^2 with ``lags`` dof) of a series (NaNs dropped).
+
+    Parameters
+    ----------
+    r : (k,) float
+        Normalized residual (-), NaN where a sample is missing.
+    lags : int
+        Number of autocorrelation lags (at most a quarter of the samples).
+
+    Returns
+    -------
+    q, p_value : float
+    """
     r = np.asarray(r, float)
     r = r[np.isfinite(r)] - np.nanmean(r)
     n = len(r)
@@ -50,7 +91,21 @@ def ljung_box(r, lags: int = LJUNG_BOX_LAGS) -> tuple[float, float]:
 
 def trend(time, r) -> tuple[float, float]:
     """Slope of a straight line through the residual (1/s, normalized units) and its p-value
-    (Spearman rank correlation with time: no assumption on the residual's distribution)."""
+    (Spearman rank correlation with time: no assumption on the residual's distribution).
+
+    Parameters
+    ----------
+    time : (k,) float
+        Sample times (s).
+    r : (k,) float
+        Normalized residual (-), NaN where a sample is missing.
+
+    Returns
+    -------
+    slope : float
+        (sigma/s).
+    p_value : float
+    """
     ok = np.isfinite(r)
     slope = float(np.polyfit(time[ok], r[ok], 1)[0])
     return slope, float(stats.spearmanr(time[ok], r[ok]).pvalue)
@@ -58,7 +113,20 @@ def trend(time, r) -> tuple[float, float]:
 
 def spectrum(time, r) -> dict:
     """Welch PSD of the residual (uniform sampling assumed at the median step): frequencies (Hz),
-    PSD, the dominant frequency and the share of the power within +-1 bin of it."""
+    PSD, the dominant frequency and the share of the power within +-1 bin of it.
+
+    Parameters
+    ----------
+    time : (k,) float
+        Sample times (s).
+    r : (k,) float
+        Normalized residual (-), NaN where a sample is missing.
+
+    Returns
+    -------
+    spectrum : dict
+        ``frequency_hz`` (Hz), ``psd`` (sigma^2/Hz), ``dominant_hz`` (Hz), ``dominant_share`` (-).
+    """
     ok = np.isfinite(r)
     dt = float(np.median(np.diff(time)))
     segment = min(int(ok.sum()), 256)
@@ -69,7 +137,22 @@ def spectrum(time, r) -> dict:
 
 
 def channel_report(time, r) -> dict:
-    """Every figure of one channel's normalized residual ``r`` at ``time`` (s)."""
+    """Every figure of one channel's normalized residual ``r`` at ``time`` (s).
+
+    Parameters
+    ----------
+    time : (k,) float
+        Sample times (s).
+    r : (k,) float
+        Normalized residual (-), NaN where a sample is missing.
+
+    Returns
+    -------
+    report : dict
+        ``rms``, ``mean`` (sigma), Ljung-Box ``ljung_box_q`` and ``white_p``, ``trend_per_s``
+        (sigma/s) and ``trend_p``, ``window_rms`` (sigma) and ``window_start_s`` (s),
+        ``dominant_hz`` (Hz), ``dominant_share`` (-).
+    """
     ok = np.isfinite(r)
     q, p_white = ljung_box(r)
     slope, p_trend = trend(time, r)
@@ -83,7 +166,19 @@ def channel_report(time, r) -> dict:
 
 
 def describe(name: str, report: dict) -> str:
-    """One sentence on where and how a channel's residual departs from noise."""
+    """One sentence on where and how a channel's residual departs from noise.
+
+    Parameters
+    ----------
+    name : str
+        Channel name.
+    report : dict
+        Its :func:`channel_report`.
+
+    Returns
+    -------
+    sentence : str
+    """
     parts = [f"{name}: RMS {report['rms']:.2f} sigma, mean {report['mean']:+.2f} sigma"]
     parts.append("white" if report["white_p"] >= SIGNIFICANCE else f"not white (Ljung-Box p = {report['white_p']:.1e})")
     if report["trend_p"] < SIGNIFICANCE:
@@ -98,6 +193,23 @@ def describe(name: str, report: dict) -> str:
 
 
 def analyse(time, model: dict, measured: dict, noise: dict) -> dict:
-    """Per channel: the normalized residual series and its report (see :func:`channel_report`)."""
+    """Per channel: the normalized residual series and its report (see :func:`channel_report`).
+
+    Parameters
+    ----------
+    time : (k,) float
+        Sample times (s).
+    model : dict of str to (k,) float
+        Predicted channels (channel units).
+    measured : dict of str to (k,) float
+        Measured channels (channel units).
+    noise : dict of str to float
+        1-sigma noise per channel (channel units).
+
+    Returns
+    -------
+    analysis : dict of str to dict
+        Per channel: ``residual`` (k,) (-) and the report's figures.
+    """
     residuals = normalized_residuals(model, measured, noise)
     return {c: {"residual": r, **channel_report(time, r)} for c, r in residuals.items()}

@@ -10,7 +10,17 @@ from riskassess.diagnosis.towing_plant import TowingPlant
 
 def plant_of(case):
     """The plant of a diagnosis case: :class:`~riskassess.diagnosis.plant.Plant`, or
-    :class:`~riskassess.diagnosis.towing_plant.TowingPlant` for the towing scenario."""
+    :class:`~riskassess.diagnosis.towing_plant.TowingPlant` for the towing scenario.
+
+    Parameters
+    ----------
+    case : DiagnosisCase
+        Validated diagnosis case.
+
+    Returns
+    -------
+    plant : Plant or TowingPlant
+    """
     if case.kind == "towing":
         return TowingPlant.from_case(case)
     return Plant.from_case(case)

@@ -66,6 +66,18 @@ PRIOR_PULL_LIMIT = 3.5
 
 
 def posterior_weights(fits: dict[str, FitResult]) -> dict[str, float]:
+    """BIC posterior weight of every model, equal prior odds: exp(-BIC/2) normalized.
+
+    Parameters
+    ----------
+    fits : dict of str to FitResult
+        Fitted models by id ("nominal", effect ids, pairs "a+b").
+
+    Returns
+    -------
+    weights : dict of str to float
+        Per model id, summing to 1 (-).
+    """
     bic = {k: f.bic for k, f in fits.items()}
     low = min(bic.values())
     w = {k: np.exp(-0.5 * (b - low)) for k, b in bic.items()}
@@ -75,7 +87,22 @@ def posterior_weights(fits: dict[str, FitResult]) -> dict[str, float]:
 
 def channel_rms(problem: Problem, model: dict, part: np.ndarray) -> dict:
     """Per channel: normalized RMS residual and RMSE (channel units) over the samples ``part``, and
-    the residual's structure (:func:`structure`)."""
+    the residual's structure (:func:`structure`).
+
+    Parameters
+    ----------
+    problem : Problem
+        The measured channels, their noise (channel units) and times (s).
+    model : dict of str to (k,) float
+        Predicted channels at every sample of the record.
+    part : (k,) bool
+        Mask of the samples to score.
+
+    Returns
+    -------
+    figures : dict of str to dict
+        Per channel: ``rms_sigma`` (-), ``rmse`` (channel unit) and :func:`structure`'s figures.
+    """
     measured = {c: v[part] for c, v in problem.values.items()}
     r = normalized_residuals({c: v[part] for c, v in model.items()}, measured, problem.noise)
     out = {}
@@ -89,7 +116,20 @@ def channel_rms(problem: Problem, model: dict, part: np.ndarray) -> dict:
 def structure(time, r) -> dict:
     """What is left in a normalized residual ``r`` beyond white noise: Ljung-Box p-value and the RMS
     of the autocorrelation over its lags, the trend's p-value and its rise over the part (sigmas);
-    ``structured`` when either is significant (p < :data:`STRUCTURE_P`) and material."""
+    ``structured`` when either is significant (p < :data:`STRUCTURE_P`) and material.
+
+    Parameters
+    ----------
+    time : (k,) float
+        Sample times (s).
+    r : (k,) float
+        Normalized residual (-), NaN where missing.
+
+    Returns
+    -------
+    figures : dict
+        ``white_p``, ``acf_rms`` (-), ``trend_p``, ``trend_rise_sigma`` (sigma), ``structured`` (bool).
+    """
     ok = np.isfinite(r)
     if ok.sum() < 16:
         return {"white_p": 1.0, "acf_rms": 0.0, "trend_p": 1.0, "trend_rise_sigma": 0.0, "structured": False}
@@ -108,7 +148,18 @@ def structure(time, r) -> dict:
 
 def structured_channels(model_scores: dict) -> list[str]:
     """'channel (part)' of every channel whose residual keeps structure, training or held-out, leaving
-    out channels dominated by the model's own step error (:data:`STRUCTURE_STEP_ERROR`)."""
+    out channels dominated by the model's own step error (:data:`STRUCTURE_STEP_ERROR`).
+
+    Parameters
+    ----------
+    model_scores : dict
+        One model's :func:`score` figures (``train`` and ``holdout`` per channel).
+
+    Returns
+    -------
+    channels : list of str
+        Descriptions for the report.
+    """
     out = []
     for part in ("train", "holdout"):
         for c, v in model_scores[part].items():
@@ -129,20 +180,60 @@ def _structure_text(v: dict) -> str:
 
 def prior_pulls(fit: FitResult, problem: Problem) -> dict[str, float]:
     """Fitted nominal parameters more than :data:`PRIOR_PULL_LIMIT` prior sigmas from their centre:
-    name -> pull (sigmas, signed)."""
+    name -> pull (sigmas, signed).
+
+    Parameters
+    ----------
+    fit : FitResult
+        A fitted model (its nominal values first, in their units).
+    problem : Problem
+        The priors: centres (parameter units) and 1-sigma.
+
+    Returns
+    -------
+    pulls : dict of str to float
+        (value - centre) / sigma (-), only beyond the limit.
+    """
     n = fit.nominal_count
     z = (np.asarray(fit.values[:n], float) - problem.nominal_center) / problem.nominal_sigma
     return {name: float(v) for name, v in zip(fit.names[:n], z) if abs(v) > PRIOR_PULL_LIMIT}
 
 
 def aggregate_rms(per_channel: dict) -> float:
-    """RMS over channels of their normalized RMS (sigma units)."""
+    """RMS over channels of their normalized RMS (sigma units).
+
+    Parameters
+    ----------
+    per_channel : dict of str to dict
+        :func:`channel_rms` figures (their ``rms_sigma``).
+
+    Returns
+    -------
+    rms : float
+        (-).
+    """
     return float(np.sqrt(np.mean([v["rms_sigma"] ** 2 for v in per_channel.values()])))
 
 
 def score(problem: Problem, predictions: dict[str, dict], step_errors: dict | None = None) -> dict[str, dict]:
     """Training and held-out figures of every model's prediction over the whole record; ``step_errors``:
-    model -> channel -> its discretization error on the training part (sigmas, fit.step_error_sigma)."""
+    model -> channel -> its discretization error on the training part (sigmas, fit.step_error_sigma).
+
+    Parameters
+    ----------
+    problem : Problem
+        The measured record and its training mask.
+    predictions : dict of str to dict
+        Per model id, its channels at every sample (channel units).
+    step_errors : dict of str to dict of str to float, optional
+        Per model id and channel, the discretization error (-).
+
+    Returns
+    -------
+    scores : dict of str to dict
+        Per model id: ``train`` and ``holdout`` per-channel figures (:func:`channel_rms`) and their
+        aggregates ``train_rms_sigma``, ``holdout_rms_sigma`` (-).
+    """
     test = ~problem.train
     out = {}
     for key, model in predictions.items():
@@ -155,12 +246,37 @@ def score(problem: Problem, predictions: dict[str, dict], step_errors: dict | No
 
 
 def gain_percent(before: float, after: float) -> float:
+    """Relative improvement from ``before`` to ``after`` (%); 0 when ``before`` is 0.
+
+    Parameters
+    ----------
+    before, after : float
+        RMS values (same unit, here sigma).
+
+    Returns
+    -------
+    gain : float
+        (%).
+    """
     return float(100.0 * (before - after) / before) if before > 0 else 0.0
 
 
 def material_gain(scores: dict[str, dict], key: str) -> float:
     """Largest gain (%) of model ``key`` over the nominal model: overall or in the channel the nominal
-    model fits worst, on the training or the held-out part."""
+    model fits worst, on the training or the held-out part.
+
+    Parameters
+    ----------
+    scores : dict of str to dict
+        Per model id, :func:`score`'s figures.
+    key : str
+        The model's id.
+
+    Returns
+    -------
+    gain : float
+        (%).
+    """
     gains = []
     for part in ("train", "holdout"):
         nominal, model = scores["nominal"][part], scores[key][part]
@@ -184,7 +300,27 @@ def _rms_adequate(model_scores: dict, adequate_rms: float) -> bool:
 def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float, adequate_rms: float,
            problem: Problem | None = None) -> dict:
     """The answer: cause (an effect id, "none" or "unexplained"), confidence, and why (module
-    docstring). ``problem`` gives the priors for the pull check (3b); without it the check is off."""
+    docstring). ``problem`` gives the priors for the pull check (3b); without it the check is off.
+
+    Parameters
+    ----------
+    fits : dict of str to FitResult
+        Fitted models by id ("nominal", effect ids, pairs "a+b").
+    scores : dict of str to dict
+        Per model id, :func:`score`'s figures.
+    decisive : float
+        BIC difference counted as decisive (-).
+    adequate_rms : float
+        Largest training residual RMS of an adequate model (noise sigmas, -).
+    problem : Problem, optional
+        The priors of the nominal parameters.
+
+    Returns
+    -------
+    answer : dict
+        ``cause``, ``model``, ``confidence`` (-, or None), ``reason`` and the figures behind them
+        (``weights``, ``ranked``, ``adequate``, ``structure``, ``prior_pulls``).
+    """
     weights = posterior_weights(fits)
     nominal = fits["nominal"]
     ranked = sorted((k for k in fits if k != "nominal"), key=lambda k: fits[k].bic)

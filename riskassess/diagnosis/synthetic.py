@@ -18,23 +18,85 @@ NOISE = {"omega": 2e-4, "q": 1e-3, "hinge_angle": 1e-3, "hinge_rate": 1e-3, "rel
 
 
 def channel_noise(channel: str, scale: float = 1.0) -> float:
+    """Default 1-sigma noise of a channel (channel units), times ``scale``.
+
+    Parameters
+    ----------
+    channel : str
+        Channel name (:mod:`riskassess.diagnosis.channels`).
+    scale : float
+        Factor on the defaults of ``NOISE`` (-).
+
+    Returns
+    -------
+    sigma : float
+        (rad/s, -, rad, m or N: the channel's unit).
+    """
     key = channel if channel in NOISE else channel.split("_")[0]
     return scale * NOISE[key]
 
 
 def sample_times(duration: float, rate: float) -> np.ndarray:
+    """Uniform sample times from 0 to ``duration``.
+
+    Parameters
+    ----------
+    duration : float
+        Record length (s).
+    rate : float
+        Sampling rate (Hz).
+
+    Returns
+    -------
+    times : (round(duration rate) + 1,) float
+        (s).
+    """
     return np.arange(int(round(duration * rate)) + 1) / rate
 
 
 def noisy(clean: dict, rng, noise_scale: float = 1.0) -> tuple[dict, dict]:
-    """``clean`` channels plus white Gaussian noise; returns (noisy channels, sigma per channel)."""
+    """``clean`` channels plus white Gaussian noise; returns (noisy channels, sigma per channel).
+
+    Parameters
+    ----------
+    clean : dict of str to (k,) float
+        Simulated channels (channel units).
+    rng : numpy.random.Generator
+        Random generator.
+    noise_scale : float
+        Factor on the default noise (-).
+
+    Returns
+    -------
+    noisy : dict of str to (k,) float
+        Channels with noise (channel units).
+    sigma : dict of str to float
+        1-sigma noise per channel (channel units).
+    """
     sigma = {c: channel_noise(c, noise_scale) for c in clean}
     return {c: v + rng.normal(0.0, sigma[c], v.shape) for c, v in clean.items()}, sigma
 
 
 def simulate_effect(case, times, effect_id: str | None = None, values=None) -> dict:
     """Clean channels of the case's Exudyn model with ``effect_id`` at ``values`` (dict name -> SI); the
-    towing scenario's is :func:`riskassess.diagnosis.towing_exudyn.simulate_towing_exudyn`."""
+    towing scenario's is :func:`riskassess.diagnosis.towing_exudyn.simulate_towing_exudyn`.
+
+    Parameters
+    ----------
+    case : DiagnosisCase
+        Validated diagnosis case.
+    times : (k,) float
+        Sample times (s) from the record's t = 0.
+    effect_id : str, optional
+        Catalog effect id; None: the nominal model.
+    values : dict of str to float, optional
+        The effect's parameters by name (SI).
+
+    Returns
+    -------
+    channels : dict of str to (k,) float
+        Units and frames of :mod:`riskassess.diagnosis.channels`.
+    """
     plant = plant_of(case)
     simulate = simulate_exudyn
     if is_towing(plant):
@@ -48,7 +110,22 @@ def simulate_effect(case, times, effect_id: str | None = None, values=None) -> d
 
 def simulate_constant_body_torque(case, times, torque_body) -> dict:
     """Clean channels with a constant torque (N m) fixed in the main body's frame (an outgassing jet,
-    not in the catalog): the out-of-catalog check of the tests."""
+    not in the catalog): the out-of-catalog check of the tests.
+
+    Parameters
+    ----------
+    case : TumblingRigidCase or HingedAppendageCase
+        Validated diagnosis case.
+    times : (k,) float
+        Sample times (s) from t = 0.
+    torque_body : (3,) float
+        Torque on the main body, B (N m).
+
+    Returns
+    -------
+    channels : dict of str to (k,) float
+        Units and frames of :mod:`riskassess.diagnosis.channels`.
+    """
     scenario = ExudynScenario(Plant.from_case(case))
     torque = np.asarray(torque_body, float)
     scenario.add_body_torque(lambda t, body, rot, omega: torque if body == 0 else np.zeros(3))

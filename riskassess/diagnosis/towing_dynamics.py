@@ -48,7 +48,18 @@ XE_MAXWELL, XE_ELONGATION, XE_DAMPER, EXTRA_STATES = 0, 1, 2, 5
 
 def initial_extra_states(omega_debris_body) -> np.ndarray:
     """``xe`` at t = 0: no Maxwell tension, elongation not yet seen (NaN), the damper turning with the
-    debris (rad/s, debris frame)."""
+    debris (rad/s, debris frame).
+
+    Parameters
+    ----------
+    omega_debris_body : (3,) float
+        Debris inertial angular velocity at t = 0, debris body frame (rad/s).
+
+    Returns
+    -------
+    xe : (EXTRA_STATES,) float
+        Layout ``XE_*``.
+    """
     xe = np.zeros(EXTRA_STATES)
     xe[XE_ELONGATION] = np.nan
     xe[XE_DAMPER:XE_DAMPER + 3] = omega_debris_body
@@ -57,21 +68,60 @@ def initial_extra_states(omega_debris_body) -> np.ndarray:
 
 @njit(cache=True, inline="always")
 def point_position(work):
-    """P's position displacement (m) and velocity (m/s), inertial, at the last completed step."""
+    """P's position displacement (m) and velocity (m/s), inertial, at the last completed step.
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+
+    Returns
+    -------
+    x_point, v_point : (3,) float
+        P's displacement from its reference position (m, ECI) and its velocity (m/s, ECI); views
+        into ``work``.
+    """
     start = int(work[W_POINT])
     return work[start + X_N:start + X_N + 3], work[start + V_N:start + V_N + 3]
 
 
 @njit(cache=True, inline="always")
 def last_diagnostics(work):
-    """The last force evaluation's diagnostics (:data:`multibody.towing_kernel.MT_TENSION` ... layout)."""
+    """The last force evaluation's diagnostics (:data:`multibody.towing_kernel.MT_TENSION` ... layout).
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+
+    Returns
+    -------
+    diagnostics : (ST_TENSION,) float
+        Main-tether tension (N), elongation (m) and rate (m/s), thrust (N), control torque (N m,
+        chaser body frame), sliding variables; a view into ``work``.
+    """
     start = int(work[W_DIAG])
     return work[start:start + ST_TENSION]
 
 
 @njit(cache=True)
 def body_position(work, q, base):
-    """Absolute CoM position (m, Earth-centred inertial) of the body at ``base`` (CHASER or DEBRIS)."""
+    """Absolute CoM position (m, Earth-centred inertial) of the body at ``base`` (CHASER or DEBRIS).
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+    q : (15,) float
+        Positions, kernel layout (displacements from the reference positions, m, ECI).
+    base : int
+        ``CHASER`` or ``DEBRIS`` (index of the body's first coordinate).
+
+    Returns
+    -------
+    r_eci : (3,) float
+        CoM position from the Earth's centre, ECI (m).
+    """
     row = 1 if base == CHASER else 2
     reference = work[W_REFERENCE + 3 * row:W_REFERENCE + 3 * row + 3]
     return reference + q[base:base + 3]
@@ -80,7 +130,22 @@ def body_position(work, q, base):
 @njit(cache=True)
 def main_tether_direction(work, q):
     """Unit vector from the main tether's chaser end A to P (inertial) and the chaser rotation
-    (body -> inertial) at the state ``q``."""
+    (body -> inertial) at the state ``q``.
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+    q : (15,) float
+        Positions, kernel layout (m, ECI; rotation vectors, rad).
+
+    Returns
+    -------
+    direction_eci : (3,) float
+        Unit vector A -> P, ECI (-).
+    chaser_to_eci : (3, 3) float
+        Chaser body -> ECI rotation.
+    """
     rot_c = rotation_matrix_from_rotation_vector(q[CHASER + 3:CHASER + 6])
     attach = work[W_ATTACH_CHASER:W_TETHER]
     point, _ = point_position(work)
@@ -89,7 +154,17 @@ def main_tether_direction(work, q):
 
 
 def diagnostics_size(work) -> int:
-    """Columns of the diagnostics rows of a packed model (main tether, thrust, torque, sliding, STs)."""
+    """Columns of the diagnostics rows of a packed model (main tether, thrust, torque, sliding, STs).
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+
+    Returns
+    -------
+    n_diag : int
+    """
     return ST_TENSION + int(work[W_N_ATTACH])
 
 

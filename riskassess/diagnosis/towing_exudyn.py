@@ -50,7 +50,28 @@ class _EffectForces:
 
 
 def simulate_towing_exudyn(plant: TowingPlant, times, effect=None, values=(), names=(), step: float = EXUDYN_STEP) -> dict:
-    """Channels at ``times`` (s from the record's t = 0) of ``plant`` with ``effect`` at ``values``, by Exudyn."""
+    """Channels at ``times`` (s from the record's t = 0) of ``plant`` with ``effect`` at ``values``, by Exudyn.
+
+    Parameters
+    ----------
+    plant : TowingPlant
+        The towing plant.
+    times : (k,) float
+        Sample times (s from the record's t = 0).
+    effect : Effect, optional
+        The effect (its towing law); None: the nominal model.
+    values : (m,) float
+        Its physical parameter values (SI).
+    names : sequence of str
+        Their names.
+    step : float, optional
+        Exudyn Verlet step (s), a divisor of ``RECORD_INTERVAL``.
+
+    Returns
+    -------
+    channels : dict of str to (k,) float
+        See :mod:`riskassess.diagnosis.towing_plant` (rad/s, D; D -> LVLH; m, LVLH; N).
+    """
     values = np.asarray(values, float)
     sample_times = np.asarray(times, float)
     law, p = no_towing_load, np.zeros(1)

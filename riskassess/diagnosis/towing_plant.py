@@ -67,6 +67,19 @@ class TowingPlant:
 
     @classmethod
     def from_case(cls, diagnosis_case) -> "TowingPlant":
+        """The towing plant of a towing diagnosis case: the towing case's debris state, replaced by the
+        diagnosis case's ``[initial]`` values where given.
+
+        Parameters
+        ----------
+        diagnosis_case : TowingDiagnosisCase
+            Validated case (:mod:`riskassess.cases.diagnosis`) with its towing case loaded; ``initial``:
+            attitude change (rad, D), angular velocity (rad/s, D), position and velocity (m, m/s, L0).
+
+        Returns
+        -------
+        plant : TowingPlant
+        """
         c = diagnosis_case.towing_case
         init = diagnosis_case.initial
         de, ch = c.debris, c.chaser
@@ -112,11 +125,39 @@ class TowingPlant:
         return float(max(np.linalg.norm(self.omega0), 0.01))
 
     def nominal_vector(self, names) -> np.ndarray:
+        """The plant's values of the nominal parameters ``names``, flattened (attitude as a zero perturbation).
+
+        Parameters
+        ----------
+        names : sequence of str
+            Keys of ``TOWING_PARAMETERS``.
+
+        Returns
+        -------
+        vector : (3 m,) float
+            Attitude perturbation (rad, D), angular velocity (rad/s, D), position (m, L0), velocity
+            (m/s, L0), in the order of ``names``.
+        """
         values = {"attitude": np.zeros(3), "angular_velocity": self.omega0, "position": self.position0,
                   "velocity": self.velocity0}
         return np.concatenate([values[n] for n in names]) if names else np.zeros(0)
 
     def with_nominal(self, names, vector) -> "TowingPlant":
+        """The plant with the nominal parameters ``names`` set from ``vector`` (attitude: a rotation vector
+        composed after the plant's attitude, D).
+
+        Parameters
+        ----------
+        names : sequence of str
+            Keys of ``TOWING_PARAMETERS``.
+        vector : (3 m,) float
+            Their values, laid out as :meth:`nominal_vector` returns them.
+
+        Returns
+        -------
+        plant : TowingPlant
+            A changed copy.
+        """
         changes = {}
         for k, name in enumerate(names):
             value = np.asarray(vector[3 * k:3 * k + 3], float)
@@ -128,7 +169,19 @@ class TowingPlant:
 
     # -- the lower-order model -------------------------------------------------------------
     def towing_case(self, step: float):
-        """The towing case with this plant's debris state and CoM, sampled at ``step`` (s)."""
+        """The towing case with this plant's debris state and CoM, sampled at ``step`` (s).
+
+        Parameters
+        ----------
+        step : float
+            Output interval (s) of the returned case.
+
+        Returns
+        -------
+        case : TowingCase
+            Debris CoM position and velocity (m, m/s, ECI), attitude quaternion and spin from the
+            plant; sub-tether attachments moved by the CoM offset (m, D).
+        """
         c = self.case
         ch = c.chaser
         l0 = self.lvlh0
@@ -145,14 +198,41 @@ class TowingPlant:
             "simulation": c.simulation.model_copy(update={"output_interval": step})})
 
     def model(self, duration: float, step: float):
-        """The :class:`multibody.towing.TowingModel` over ``duration`` (s) from the record's t = 0."""
+        """The :class:`multibody.towing.TowingModel` over ``duration`` (s) from the record's t = 0.
+
+        Parameters
+        ----------
+        duration : float
+            Simulated span (s) from the record's t = 0.
+        step : float
+            Integration step (s).
+
+        Returns
+        -------
+        model : TowingModel
+        """
         case = self.towing_case(step)
         return towing_model(case, step=step, end_time=case.simulation.start_time + duration)
 
 
 def model_step(plant: TowingPlant, times, step: float | None = None) -> float:
     """Step (s) no longer than ``step`` (default: the plant's) that divides the median sample spacing,
-    so that uniformly sampled records fall on steps."""
+    so that uniformly sampled records fall on steps.
+
+    Parameters
+    ----------
+    plant : TowingPlant
+        Its ``fit_step`` (s) is the default.
+    times : (k,) float
+        Sample times (s).
+    step : float, optional
+        Longest step (s).
+
+    Returns
+    -------
+    step : float
+        (s).
+    """
     h = step or plant.fit_step
     dt = float(np.median(np.diff(times))) if len(times) > 1 else h
     return dt / np.ceil(dt / h - 1e-9)
@@ -160,7 +240,27 @@ def model_step(plant: TowingPlant, times, step: float | None = None) -> float:
 
 def simulate(plant: TowingPlant, times, law=no_towing_load, p=None, step: float | None = None) -> dict:
     """Channels (dict of (k,) arrays) at ``times`` (s from the record's t = 0, non-decreasing) of the
-    fast model with the towing ``law`` at parameters ``p``; linear between the steps around a time."""
+    fast model with the towing ``law`` at parameters ``p``; linear between the steps around a time.
+
+    Parameters
+    ----------
+    plant : TowingPlant
+        The towing plant.
+    times : (k,) float
+        Sample times (s from the record's t = 0).
+    law : compiled function, optional
+        Towing law (``TOWING_LAW_SIGNATURE``); default: none.
+    p : (j,) float, optional
+        The law's parameters.
+    step : float, optional
+        Longest step (s); default the plant's ``fit_step``.
+
+    Returns
+    -------
+    channels : dict of str to (k,) float
+        See the module doc (rad/s, D; quaternion D -> LVLH; m, LVLH; N); every entry ``FAILED``
+        when the run diverges.
+    """
     times = np.asarray(times, float)
     h = model_step(plant, times, step)
     model = plant.model(float(times[-1]) + 2 * h, h)
@@ -188,7 +288,26 @@ def debris_in_lvlh(lvlh_to_eci_rows, rotation_vectors, debris_minus_chaser, com_
     """Attitude D -> LVLH(t) (k, 4) (unit quaternions, scalar first, w >= 0) and target origin minus
     chaser CoM, LVLH(t) components (k, 3) (m), from the rows' LVLH -> ECI rotations (k, 3, 3), the
     debris' rotation vectors D -> ECI (k, 3) (rad), its CoM minus the chaser's, ECI (k, 3) (m) and its
-    CoM minus target origin, D (3,) (m). Compiled: scipy's rotations of these rows took 7 % of a fit."""
+    CoM minus target origin, D (3,) (m). Compiled: scipy's rotations of these rows took 7 % of a fit.
+
+    Parameters
+    ----------
+    lvlh_to_eci_rows : (k, 3, 3) float
+        LVLH(t) -> ECI rotations.
+    rotation_vectors : (k, 3) float
+        Debris rotation vectors D -> ECI (rad).
+    debris_minus_chaser : (k, 3) float
+        Debris CoM minus chaser CoM, ECI (m).
+    com_offset : (3,) float
+        Debris CoM minus target origin, D (m).
+
+    Returns
+    -------
+    quat : (k, 4) float
+        D -> LVLH(t), scalar first (-).
+    rel : (k, 3) float
+        Target origin minus chaser CoM, LVLH(t) (m).
+    """
     k = rotation_vectors.shape[0]
     quat, rel = np.empty((k, 4)), np.empty((k, 3))
     m = np.empty((3, 3))
@@ -206,7 +325,26 @@ def debris_in_lvlh(lvlh_to_eci_rows, rotation_vectors, debris_minus_chaser, com_
 
 def channels(plant: TowingPlant, model, q, v, diag, xe) -> dict:
     """The measured channels (see the module doc) from kernel-layout states (k, 15), diagnostics and
-    effect states."""
+    effect states.
+
+    Parameters
+    ----------
+    plant : TowingPlant
+        The plant (its CoM offset, m, D).
+    model : TowingModel
+        The model that ran (its reference positions, m, ECI).
+    q, v : (k, 15) float
+        States, kernel layout (:mod:`multibody.towing_kernel`).
+    diag : (k, n_diag) float
+        Diagnostics rows (main-tether tension in column ``MT_TENSION``, N).
+    xe : (k, EXTRA_STATES) float
+        Effect states (not used: a branch's tension is in the kernel's).
+
+    Returns
+    -------
+    channels : dict of str to (k,) float
+        omega_x..z (rad/s, D), q_w..q_z (D -> LVLH(t)), rel_x..z (m, LVLH(t)), tether_tension (N).
+    """
     r_c, v_c = model.positions[1] + q[:, 3:6], v[:, 3:6]
     r_d = model.positions[2] + q[:, 9:12]
     quat, rel = debris_in_lvlh(lvlh_to_eci(r_c, v_c), np.ascontiguousarray(q[:, 12:15]), r_d - r_c,

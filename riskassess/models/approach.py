@@ -12,7 +12,27 @@ from riskassess.cases.impact import CaseError
 
 
 def build_problem(case: ApproachCase, source: str = "case") -> ApproachProblem:
-    """The optimal-control problem of a validated case; CaseError for an impossible start."""
+    """The optimal-control problem of a validated case; CaseError for an impossible start.
+
+    Parameters
+    ----------
+    case : ApproachCase
+        The validated approach case (positions in m and velocities in m/s in the 2-D world frame,
+        masses in kg, thrust bounds in N).
+    source : str
+        What the case came from (its file name), named in errors.
+
+    Returns
+    -------
+    multibody.control.mu_problem.ApproachProblem
+        Initial state x0: rigid rod [x_com, vx_com, y_com, vy_com, phi, phi_dot] (m, m/s, rad,
+        rad/s); independent units [r1 (2,), v1 (2,), m1, r2, v2, m2] (m, m/s, kg), world frame.
+
+    Raises
+    ------
+    CaseError
+        When an MU starts inside the keep-out circle plus margin or outside the width bounds.
+    """
     m, obj = case.model, case.objective
     if m.kind == "rigid_rod":
         model = RigidRodMUs(m.mass, m.length, m.fuel_rate)

@@ -34,7 +34,21 @@ class ModelInputs:
 
 
 def mass_properties_target_frame(case: Case, meshes):
-    """Per body: (CoM (m), inertia about CoM (kg m^2)), target frame; defaults from geometry."""
+    """Per body: (CoM (m), inertia about CoM (kg m^2)), target frame; defaults from geometry.
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case; a body without ``center_of_mass`` or ``inertia`` gets the uniform-density
+        value of its shapes.
+    meshes : list of list of trimesh.Trimesh
+        Per body, its shapes in the target frame (m) (:func:`body_meshes_target_frame`).
+
+    Returns
+    -------
+    list of ((3,) float, (3, 3) float)
+        Per body, its CoM (m) and inertia about the CoM (kg m^2), target frame.
+    """
     props = []
     for body, body_meshes in zip(case.target.bodies, meshes):
         com = (np.asarray(body.center_of_mass, float) if body.center_of_mass is not None
@@ -46,7 +60,21 @@ def mass_properties_target_frame(case: Case, meshes):
 
 
 def build_net(case: Case):
-    """Net topology (LVLH) and initial node velocities for the case's launch."""
+    """Net topology (LVLH) and initial node velocities for the case's launch.
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case (net, thread, bullets, launch, target pose).
+
+    Returns
+    -------
+    topology : multibody.net.NetTopology
+        Flat square net centred ``launch.distance`` before the aim point, normal to the launch
+        direction, node positions in LVLH (m).
+    velocity : (n, 3) float
+        Initial node velocities, all ``launch.velocity`` along the launch direction (m/s, LVLH).
+    """
     net, launch, bullets = case.net, case.launch, case.bullets
     thread = net.thread
     mesh = net.mesh_size
@@ -72,7 +100,27 @@ def build_net(case: Case):
 
 
 def build_bodies_and_joints(case: Case, base: Path):
-    """Rigid-body and joint specs in LVLH at t = 0, and the joints' rest states."""
+    """Rigid-body and joint specs in LVLH at t = 0, and the joints' rest states.
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case (target bodies, joints, pose and rates).
+    base : Path
+        Folder of the case file; mesh files are relative to it.
+
+    Returns
+    -------
+    bodies : list of RigidBodySpec
+        CoM (m), velocity (m/s) and attitude in LVLH, angular velocity (rad/s) and inertia
+        (kg m^2) in the body frame, shapes in the body frame (m); initial hinge angles and rates applied.
+    joints : list of JointSpec
+        Joint points (m) and hinge frames in LVLH.
+    rest_attitudes : list of (3, 3) float
+        Body -> LVLH rotation of each body before the initial hinge angles.
+    rest_coms : list of (3,) float
+        CoM of each body before the initial hinge angles, LVLH (m).
+    """
     target = case.target
     meshes = body_meshes_target_frame(case, base)
     props = mass_properties_target_frame(case, meshes)
@@ -122,14 +170,43 @@ def _apply_initial_hinge_state(bodies, joints, index, angle, rate):
 
 
 def rim_nodes(nodes_per_side: int) -> np.ndarray:
-    """Indices of the square grid's perimeter nodes (row-major grid, see multibody.net)."""
+    """Indices of the square grid's perimeter nodes (row-major grid, see multibody.net).
+
+    Parameters
+    ----------
+    nodes_per_side : int
+        Nodes along one side of the square net.
+
+    Returns
+    -------
+    (4 nodes_per_side - 4,) int
+        Node indices, ascending.
+    """
     i, j = np.divmod(np.arange(nodes_per_side**2), nodes_per_side)
     return np.flatnonzero((i == 0) | (j == 0) | (i == nodes_per_side - 1) | (j == nodes_per_side - 1))
 
 
 def build_chaser(case: Case, net, index: int) -> tuple[RigidBodySpec, NetMount]:
     """The chaser body behind the net plane, moving with the net, and the rods holding the rim
-    on it; ``index`` is the chaser's place in the assembly's body list."""
+    on it; ``index`` is the chaser's place in the assembly's body list.
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case with a ``[chaser]`` table.
+    net : multibody.net.NetTopology
+        The launched net (:func:`build_net`), node positions in LVLH (m).
+    index : int
+        The chaser's index in the assembly's body list.
+
+    Returns
+    -------
+    body : RigidBodySpec
+        The chaser, ``chaser.standoff`` (m) behind the net centre, moving at the launch velocity
+        (m/s, LVLH), body axes parallel to LVLH.
+    mount : NetMount
+        Rim nodes held by spring-dampers at their initial offsets from the chaser CoM (m, body frame).
+    """
     chaser, launch = case.chaser, case.launch
     direction = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)
     n = case.net.nodes_per_side
@@ -144,7 +221,21 @@ def build_chaser(case: Case, net, index: int) -> tuple[RigidBodySpec, NetMount]:
 
 
 def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
-    """Everything :class:`multibody.impact.ImpactSimulation` needs for this case."""
+    """Everything :class:`multibody.impact.ImpactSimulation` needs for this case.
+
+    Parameters
+    ----------
+    case : Case
+        A validated net-impact case.
+    base : Path
+        Folder of the case file; mesh files are relative to it.
+
+    Returns
+    -------
+    ModelInputs
+        The assembly (net, bodies, joints, contact, solver, orbit mean motion (rad/s), chaser) and
+        the joints' rest states.
+    """
     net, velocity = build_net(case)
     bodies, joints, rest_att, rest_com = build_bodies_and_joints(case, base)
     mount = chaser_index = None
@@ -171,7 +262,22 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
 
 
 def weak_locations(case: Case, assembly) -> list:
-    """The case's weak locations with axes and offsets in their joint frames (t = 0)."""
+    """The case's weak locations with axes and offsets in their joint frames (t = 0).
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case (``structures.weak_locations``: offset (m) and section axes in the
+        target frame).
+    assembly : multibody.assembly.ImpactAssembly
+        The built assembly (joint frames in LVLH at t = 0).
+
+    Returns
+    -------
+    list of structures.weak_location.WeakLocation
+        Empty without a ``[structures]`` table. Revolute joints are judged by default on the
+        moment about h1 and h3 (not the hinge axis h2).
+    """
     if case.structures is None:
         return []
     _, target_to_lvlh = target_pose_lvlh(case)

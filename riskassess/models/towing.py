@@ -19,7 +19,19 @@ from multibody.towing import TowingModel
 from riskassess.cases.towing import TowingCase
 
 def case_decision_vector(case: TowingCase) -> np.ndarray:
-    """The case's own sub-tether parameters as s (eq. 22)."""
+    """The case's own sub-tether parameters as s (eq. 22).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A validated towing case.
+
+    Returns
+    -------
+    (4,) float
+        [log10 k_ST (k_ST in N/m), l_ST0 (m), log10 c_ST (c_ST in N s/m; 1e-300 stands in for 0),
+        m_P/m_net (-)].
+    """
     st = case.sub_tethers
     return np.array([np.log10(st.stiffness), st.natural_length, np.log10(max(st.damping, 1e-300)),
                      st.connection_mass_fraction])
@@ -29,7 +41,26 @@ def connection_point_start(debris_com, debris_to_inertial, attach_body, toward, 
     """Initial connection point (m, inertial): on the line from the debris CoM towards ``toward``
     (the main tether's chaser end), where the farthest sub-tether attachment is exactly
     ``rest_length`` away (all sub-tethers just slack or taut); the point nearest to all
-    attachments when ``rest_length`` cannot reach them."""
+    attachments when ``rest_length`` cannot reach them.
+
+    Parameters
+    ----------
+    debris_com : (3,) float
+        Debris CoM, inertial (m).
+    debris_to_inertial : (3, 3) float
+        Debris attitude, rotation debris body -> inertial.
+    attach_body : (n, 3) float
+        Sub-tether attachment points relative to the debris CoM, debris body frame (m).
+    toward : (3,) float
+        Main-tether attachment on the chaser, inertial (m).
+    rest_length : float
+        Sub-tether natural length l_ST0 (m).
+
+    Returns
+    -------
+    (3,) float
+        Connection point P, inertial (m).
+    """
     axis = (toward - debris_com) / np.linalg.norm(toward - debris_com)
     points = debris_com + attach_body @ debris_to_inertial.T
 
@@ -44,9 +75,29 @@ def connection_point_start(debris_com, debris_to_inertial, attach_body, toward, 
 
 
 def case_thrust_law(case: TowingCase, tether, z0, z_rate0):
-    """The case's thrust law (a plug-in of :mod:`multibody.control.thrust_laws`): (law module, parameters,
-    initial state) for the main tether ``tether`` = [k_MT (N/m), c_MT (N s/m), ...], elongation z0 (m)
-    and rate z_rate0 (m/s)."""
+    """The case's thrust law (a plug-in of :mod:`multibody.control.thrust_laws`), its parameters and
+    initial state.
+
+    Parameters
+    ----------
+    case : TowingCase
+        A validated towing case (``[thrust]``, the law's ``CASE_SECTIONS``, chaser mass).
+    tether : (3,) or (6,) float
+        Main tether first: k_MT (N/m), c_MT (N s/m), ...; only the first two are read.
+    z0 : float
+        Initial main-tether elongation (m).
+    z_rate0 : float
+        Initial elongation rate (m/s).
+
+    Returns
+    -------
+    law : module
+        The law's plug-in module (``NAME``, ``ALONG_BODY_Z``, compiled ``command``).
+    params : (p,) float
+        The law's constants (its module doc).
+    state : (q,) float
+        Its initial state.
+    """
     law = thrust_law(case.thrust.kind)
     params, state = law.arrays(case, tether, z0, z_rate0)
     return law, params, state
@@ -55,7 +106,18 @@ def case_thrust_law(case: TowingCase, tether, z0, z_rate0):
 def reference_command(case: TowingCase) -> float:
     """The elongation command z_d of the MRAC reference model (eq. 13) (m): ``mrac.desired_elongation``
     itself, or, with ``mrac.settle_at_desired``, z_d (k_MT + K_P) / K_P, the command whose static
-    balance :math:`k_{MT} z_m = K_P (z_d - z_m)` puts the reference at the desired elongation."""
+    balance :math:`k_{MT} z_m = K_P (z_d - z_m)` puts the reference at the desired elongation.
+
+    Parameters
+    ----------
+    case : TowingCase
+        A validated towing case (``[mrac]``, main-tether stiffness k_MT in N/m).
+
+    Returns
+    -------
+    float
+        z_d (m).
+    """
     m = case.mrac
     return command_elongation(m.desired_elongation, case.main_tether.stiffness, m.k_p, m.settle_at_desired)
 
@@ -65,7 +127,25 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
     """The lower-order model of ``case`` with the debris spinning at ``spin_rate_deg_s`` (default: the
     case's) and sub-tethers ``s`` (default: the case's). The step is the case's (or ``step``),
     reduced to a divisor of the output interval. The connection point is implicit
-    (:mod:`multibody.connection_point`), so the step does not depend on ``s``."""
+    (:mod:`multibody.connection_point`), so the step does not depend on ``s``.
+
+    Parameters
+    ----------
+    case : TowingCase
+        A validated towing case (states in the inertial frame, Earth-centred).
+    spin_rate_deg_s : float or None
+        Debris spin rate about ``debris.spin_axis_body`` (deg/s, the case's unit; converted to rad/s).
+    s : (4,) float or None
+        Sub-tether decision vector [log10 k_ST, l_ST0 (m), log10 c_ST, m_P/m_net] (eq. 22).
+    step : float or None
+        Integration step (s).
+    end_time : float or None
+        End of the run (s).
+
+    Returns
+    -------
+    multibody.towing.TowingModel
+    """
     s = case_decision_vector(case) if s is None else np.asarray(s, float)
     sim, ch, de = case.simulation, case.chaser, case.debris
     mt = case.main_tether

@@ -29,12 +29,36 @@ DROP_HEIGHT = 0.3
 def debris_geometry(case: TowingCase) -> np.ndarray:
     """Cylinder [radius, half length, axial centre z_body] (m): d_D and L_D of Table 1; the geometric
     centre sits where the sub-tether attachments' axial asymmetry puts it (Table 1: z = -5.717 and
-    5.283 for L_D = 11 m give -0.217 m: the CoM is 0.217 m towards +z_body, Sec. 4.1)."""
+    5.283 for L_D = 11 m give -0.217 m: the CoM is 0.217 m towards +z_body, Sec. 4.1).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case (debris diameter and length, sub-tether attachments in the debris body frame).
+
+    Returns
+    -------
+    (3,) float
+        Radius (m), half length (m), axial centre along z, debris body frame (m).
+    """
     z = np.asarray(case.sub_tethers.attachment_points_body, float)[:, 2]
     return np.array([case.debris.diameter / 2.0, case.debris.length / 2.0, 0.5 * (z.min() + z.max())])
 
 
 def contact_law(case: TowingCase) -> np.ndarray:
+    """The kernel's contact array of the node-debris contact (:mod:`multibody.net_towing_kernel`).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with a ``[full_net.contact]`` table.
+
+    Returns
+    -------
+    (6,) float
+        k_n (N/m^n), n (-), d_n = 1.5 alpha k_n (Hunt-Crossley, alpha in s/m), mu_s (-), mu_k (-),
+        V_t0 (m/s).
+    """
     c = case.full_net.contact
     return np.array([c.stiffness, c.exponent, 1.5 * c.hunt_crossley_alpha * c.stiffness, c.mu_static, c.mu_kinetic,
                      c.transition_speed])
@@ -49,7 +73,20 @@ def _bodies(case: TowingCase):
 
 def wrapped_net(case: TowingCase):
     """The net and its wrapped node positions (n, 3) (m, debris frame): built flat on the cylinder's
-    side that faces the chaser's attachment point, draped and closed. Returns (TowingNet, x_body)."""
+    side that faces the chaser's attachment point, draped and closed. Returns (TowingNet, x_body).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with a ``[full_net]`` table.
+
+    Returns
+    -------
+    net : multibody.net_wrap.TowingNet
+        The net, closing loop at its closed lengths.
+    x_body : (n, 3) float
+        Wrapped node positions relative to the debris CoM, debris body frame (m).
+    """
     fn = case.full_net
     geometry = debris_geometry(case)
     rot, com = _bodies(case)
@@ -70,7 +107,30 @@ def wrapped_net(case: TowingCase):
 
 def wrapped_start(case: TowingCase, net, x_body, spin_rate_deg_s: float):
     """Initial state of the wrapped start (module doc): node positions and velocities (n, 3)
-    (m, m/s, inertial), chaser CoM (m, inertial), debris angular velocity (rad/s, body)."""
+    (m, m/s, inertial), chaser CoM (m, inertial), debris angular velocity (rad/s, body).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case (chaser and debris states, inertial frame).
+    net : multibody.net_wrap.TowingNet
+        The wrapped net (:func:`wrapped_net`).
+    x_body : (n, 3) float
+        Wrapped node positions relative to the debris CoM, debris body frame (m).
+    spin_rate_deg_s : float
+        Debris spin rate about ``debris.spin_axis_body`` (deg/s).
+
+    Returns
+    -------
+    nodes : (n, 3) float
+        Node positions, inertial (m).
+    velocities : (n, 3) float
+        Node velocities, inertial (m/s), turning with the debris.
+    chaser : (3,) float
+        Chaser CoM, inertial (m).
+    omega : (3,) float
+        Debris angular velocity, debris body frame (rad/s).
+    """
     rot, com = _bodies(case)
     de = case.debris
     omega = np.deg2rad(spin_rate_deg_s) * np.asarray(de.spin_axis_body, float) / np.linalg.norm(de.spin_axis_body)
@@ -90,7 +150,15 @@ def capture_start(case: TowingCase, spin_rate_deg_s: float):
     centred ``full_net.launch_offset`` ahead of the attachment, every node moving at the chaser's
     velocity plus ``full_net.launch_speed`` along r_D/C. Returns (TowingNet, node positions (n, 3)
     (m, inertial), node velocities (n, 3) (m/s, inertial), chaser CoM (m, inertial), debris angular
-    velocity (rad/s, body))."""
+    velocity (rad/s, body)).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with ``full_net.start = "capture"`` (launch offset in m, launch speed in m/s).
+    spin_rate_deg_s : float
+        Debris spin rate about ``debris.spin_axis_body`` (deg/s).
+    """
     fn, de = case.full_net, case.debris
     rot, com = _bodies(case)
     a_point = com[0] + rot[0] @ np.asarray(case.chaser.tether_attachment_body, float)
@@ -109,7 +177,27 @@ def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapp
     """The full-net model of ``case`` at ``spin_rate_deg_s`` (default: the case's): from the wrapped
     state at ``simulation.start_time`` (``wrapped`` = (net, x_body) of :func:`wrapped_net`, computed
     if not given) or, with ``full_net.start = "capture"``, from the net's ejection at t = 0
-    (:func:`capture_start`; ``wrapped`` is not used)."""
+    (:func:`capture_start`; ``wrapped`` is not used).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with a ``[full_net]`` table.
+    spin_rate_deg_s : float or None
+        Debris spin rate about ``debris.spin_axis_body`` (deg/s).
+    wrapped : tuple (TowingNet, (n, 3) float) or None
+        A wrapped net and its node positions (m, debris body frame), to reuse across runs.
+    end_time : float or None
+        End of the run (s); default the case's.
+    step : float or None
+        Integration step (s); default ``full_net.step``; reduced to a divisor of the output interval.
+    substeps : int or None
+        Net substeps per step; default ``full_net.substeps``.
+
+    Returns
+    -------
+    multibody.net_towing.FullNetModel
+    """
     fn, sim, ch, de = case.full_net, case.simulation, case.chaser, case.debris
     rate = de.spin_rate_deg_s if spin_rate_deg_s is None else spin_rate_deg_s
     if fn.start == "capture":

@@ -65,7 +65,24 @@ def _reference_comparison(case: ApproachCase, answer: dict) -> dict | None:
 
 
 def solve_case(case: ApproachCase, source: str = "case"):
-    """Solve and check a case; returns (answer dict, solution, re-simulation)."""
+    """Solve and check a case; returns (answer dict, solution, re-simulation).
+
+    Parameters
+    ----------
+    case : ApproachCase
+        A validated approach case.
+    source : str
+        What the case came from (its file name), named in errors.
+
+    Returns
+    -------
+    answer : dict
+        JSON-ready: solver status, final time (s), fuel (kg), impulse (N s), constraint reports at the
+        collocation points and re-simulated (m), whether they hold, comparison with the case's reference.
+    solution : multibody.control.mu_problem.ApproachSolution
+    resim : multibody.control.mu_mesh.Resimulation
+        The controls replayed open loop through the dynamics (DOP853).
+    """
     problem = build_problem(case, source)
     solution = solve(problem)
     resim = resimulate(solution)
@@ -111,7 +128,26 @@ def _replay(case: ApproachCase, solution, resim) -> tuple[dict, dict]:
 def approach_case(case_path, out_dir, replay: bool = False, case: ApproachCase | None = None,
                   overwrite: bool = False) -> dict:
     """Load (unless given), claim the output folder (:func:`riskassess.products.outfolder.claim`), solve, check,
-    optionally replay, and write the output folder."""
+    optionally replay, and write the output folder.
+
+    Parameters
+    ----------
+    case_path : str or Path
+        The approach case file (copied into the folder as ``case.toml``).
+    out_dir : str or Path
+        The output folder.
+    replay : bool
+        Also replay the solved unit paths with a net between the units (``[replay]`` table).
+    case : ApproachCase or None
+        The already validated case; read from ``case_path`` when None.
+    overwrite : bool
+        Replace an earlier approach output in ``out_dir``.
+
+    Returns
+    -------
+    dict
+        The answer (:func:`solve_case`, plus ``replay``), also written to ``approach.json``.
+    """
     case_path = Path(case_path)
     case = case or load_model(case_path, ApproachCase)
     folder = claim(out_dir, case.name, "approach", overwrite, stage="approach")

@@ -70,7 +70,24 @@ def _cost_order(problem: Problem, effect_ids: list[str]) -> list[str]:
 def fit_candidates(problem: Problem, effect_ids: list[str], workers: int = WORKERS, progress=None) -> dict:
     """The nominal model (its finite-difference Jacobian columns in the worker processes), then every
     effect from the nominal fit, one per worker process (forked when ``workers`` > 1); returns
-    id -> :class:`FitResult`."""
+    id -> :class:`FitResult`.
+
+    Parameters
+    ----------
+    problem : riskassess.diagnosis.fit.Problem
+        The case, measured channels and the train / hold-out split.
+    effect_ids : list of str
+        Catalog ids of the effects to fit beside the nominal model.
+    workers : int
+        Worker processes (1: everything in this process).
+    progress : callable or None
+        ``progress("fitting", done, total)`` after each fitted model.
+
+    Returns
+    -------
+    dict
+        ``"nominal"`` and each effect id -> :class:`~riskassess.diagnosis.fit.FitResult`.
+    """
     global _PROBLEM
     single_threaded_blas()
     _PROBLEM = problem
@@ -130,7 +147,20 @@ def _hint(problem: Problem, analysis: dict, nominal_prediction: dict) -> dict:
 
 def effect_entries(fit: FitResult, effect) -> list[dict]:
     """The ``[[effects]]`` entries of a fitted model: one for a single effect, one per effect for a
-    pair (:class:`~riskassess.diagnosis.composite.EffectPair`; a name the two shared loses its prefix)."""
+    pair (:class:`~riskassess.diagnosis.composite.EffectPair`; a name the two shared loses its prefix).
+
+    Parameters
+    ----------
+    fit : FitResult
+        The fitted model (its effect parameters follow the nominal ones).
+    effect : Effect or EffectPair
+        The catalog effect (or pair) that was fitted.
+
+    Returns
+    -------
+    list of dict
+        ``{"id": ..., "parameters": {name: value (the parameter's SI unit)}}`` per effect.
+    """
     values = {n: p["value"] for n, p in _parameters(fit, nominal=False).items()}
     if not isinstance(effect, EffectPair):
         return [{"id": fit.id, "parameters": values}]
@@ -140,7 +170,25 @@ def effect_entries(fit: FitResult, effect) -> list[dict]:
 
 
 def extended_case(case_path: Path, problem: Problem, fit: FitResult, effect=None) -> str:
-    """The input case with the named effect(s) and fitted parameters (and the fitted nominal values)."""
+    """The input case with the named effect(s) and fitted parameters (and the fitted nominal values).
+
+    Parameters
+    ----------
+    case_path : Path
+        The diagnosis case file.
+    problem : riskassess.diagnosis.fit.Problem
+        The diagnosis problem (its plant's initial attitude, main body -> inertial, composes a fitted
+        attitude change).
+    fit : FitResult
+        The chosen model's fit: initial state (rad, rad/s, m, m/s), hinge values and effect parameters, SI.
+    effect : Effect or EffectPair or None
+        The chosen catalog effect(s).
+
+    Returns
+    -------
+    str
+        TOML text of the extended case, with a comment header.
+    """
     from scipy.spatial.transform import Rotation
 
     raw = read_toml(case_path)
@@ -205,7 +253,35 @@ def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = N
     """Run the diagnosis; returns the answer (also written to ``diagnosis.json``). ``candidates``: the
     effect ids to fit (default: the whole catalog; the applicable ones among them are fitted);
     ``figures``: write the PNG plots (the report needs them; tests about the answer leave them out);
-    ``out_dir`` default ``runs/<safe case name>-diagnosis``."""
+    ``out_dir`` default ``runs/<safe case name>-diagnosis``.
+
+    Parameters
+    ----------
+    case_path : str or Path
+        The diagnosis case file.
+    measured_path : str or Path
+        The measured-data CSV (``time`` in s, then channels in SI).
+    out_dir : str or Path or None
+        The output folder.
+    noise : dict or None
+        Channel -> 1-sigma measurement noise (the channel's SI unit), overriding the estimate.
+    workers : int
+        Worker processes for the fits.
+    progress : callable or None
+        ``progress(stage, done, total)``.
+    candidates : list of str or None
+        Effect ids to fit.
+    figures : bool
+        Write the PNG plots.
+    overwrite : bool
+        Replace an earlier diagnosis in the output folder.
+
+    Returns
+    -------
+    dict
+        The answer: cause, confidence, fitted parameters (SI, with units), RMSE before and after per
+        channel, candidates, residual analyses, hint.
+    """
     case_path = Path(case_path)
     case = load_diagnosis_case(case_path)
     measured = read_measured(measured_path, noise)

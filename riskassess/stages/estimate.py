@@ -60,7 +60,28 @@ def _duration(seconds: float) -> str:
 
 def impact_estimate(end_time: float, step: float, n_nodes: int, n_bodies: int, output_rate: float,
                     net_output_rate: float) -> Estimate:
-    """Cost of an impact run of ``end_time`` (s) at ``step`` (s) with ``n_nodes`` net nodes."""
+    """Cost of an impact run of ``end_time`` (s) at ``step`` (s) with ``n_nodes`` net nodes.
+
+    Parameters
+    ----------
+    end_time : float
+        Simulated time (s).
+    step : float
+        Integrator step (s).
+    n_nodes : int
+        Net nodes (bullets included).
+    n_bodies : int
+        Rigid bodies.
+    output_rate : float
+        Time-series samples per second (Hz).
+    net_output_rate : float
+        Net snapshots per second (Hz).
+
+    Returns
+    -------
+    Estimate
+        Steps, wall time (s) and recorded data (bytes).
+    """
     steps = end_time / step
     wall = steps * (IMPACT_US_PER_STEP + IMPACT_US_PER_NODE_STEP * n_nodes) * 1e-6
     samples = min(end_time * output_rate, steps) + 2
@@ -70,7 +91,24 @@ def impact_estimate(end_time: float, step: float, n_nodes: int, n_bodies: int, o
 
 
 def tow_estimate(duration: float, step: float, net_nodes: int = 0, substeps: int = 1) -> Estimate:
-    """Cost of a tow of ``duration`` (s): lower-order (``net_nodes`` 0) or full-net."""
+    """Cost of a tow of ``duration`` (s): lower-order (``net_nodes`` 0) or full-net.
+
+    Parameters
+    ----------
+    duration : float
+        Simulated time (s).
+    step : float
+        Integrator step (s).
+    net_nodes : int
+        Net nodes of a full-net tow; 0 for the lower-order model.
+    substeps : int
+        Net sub-steps per step (full-net).
+
+    Returns
+    -------
+    Estimate
+        Steps, wall time (s) and recorded data (bytes, 200 per step).
+    """
     steps = duration / step
     if net_nodes:
         wall = steps * substeps * net_nodes * FULL_NET_US_PER_NODE_SUBSTEP * 1e-6
@@ -82,7 +120,16 @@ def tow_estimate(duration: float, step: float, net_nodes: int = 0, substeps: int
 
 
 def check_budget(estimate: Estimate, force: bool) -> None:
-    """Raise :class:`TooMuchWork` when ``estimate`` is above the limits (the soft ones unless ``force``)."""
+    """Raise :class:`TooMuchWork` when ``estimate`` is above the limits (the soft ones unless ``force``).
+
+    Parameters
+    ----------
+    estimate : Estimate
+        The estimated work.
+    force : bool
+        Skip the soft limits (:data:`LIMIT_WALL_S`, :data:`LIMIT_MEMORY_BYTES`); the hard one,
+        :data:`HARD_LIMIT_STEPS`, always applies.
+    """
     if estimate.steps > HARD_LIMIT_STEPS:
         raise TooMuchWork(f"{estimate.text()}; more than {HARD_LIMIT_STEPS:.0e} steps is refused even with --force "
                           f"(check simulation.end_time and simulation.step)")

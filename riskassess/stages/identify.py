@@ -44,7 +44,19 @@ COMPARED = ("relative_position", "chaser_omega_body", "debris_omega_body", "main
 def compared_series(result) -> dict:
     """r_D/C (m, inertial), both angular velocities (rad/s, body frames) and the MT tension (N) of a run:
     the entries of :meth:`multibody.towing.TowResult.series`, bit for bit, taken straight from the samples
-    (``series`` also forms two rotation matrices per sample, a fifth of an identification run's time)."""
+    (``series`` also forms two rotation matrices per sample, a fifth of an identification run's time).
+
+    Parameters
+    ----------
+    result : multibody.towing.TowResult
+        A lower-order run (its generalized coordinates ``q``, velocities ``v`` and diagnostics).
+
+    Returns
+    -------
+    dict
+        ``relative_position`` (k, 3) m, inertial; ``chaser_omega_body`` and ``debris_omega_body``
+        (k, 3) rad/s, each body's frame; ``main_tether_tension`` (k,) N.
+    """
     m, q, v = result.model, result.q, result.v
     return {"relative_position": (m.positions[2] + q[:, 9:12]) - (m.positions[1] + q[:, 3:6]),
             "chaser_omega_body": v[:, 6:9], "debris_omega_body": v[:, 12:15],
@@ -52,20 +64,58 @@ def compared_series(result) -> dict:
 
 
 def rmse(model, data) -> float:
-    """:math:`\\sqrt{\\sum_g \\|x^L_g - x^H_g\\|^2 / N_t}` over the samples, eqs. (19), (21)."""
+    r""":math:`\sqrt{\sum_g \|x^L_g - x^H_g\|^2 / N_t}` over the samples, eqs. (19), (21).
+
+    Parameters
+    ----------
+    model : (k,) or (k, d) float
+        The lower-order model's series (any unit).
+    data : (k,) or (k, d) float
+        The data series, same unit and frame.
+
+    Returns
+    -------
+    float
+        RMSE of the vector norm, in the series' unit.
+    """
     diff = (np.asarray(model) - np.asarray(data)).reshape(len(data), -1)
     return float(np.sqrt(np.mean(np.sum(diff**2, axis=1))))
 
 
 def cost_f1(model: dict, data: dict, weights) -> float:
-    """One run's term of eq. (18): :math:`w_1 RMSE_r + w_2 (RMSE_{\\omega_D} + RMSE_{\\omega_C})`."""
+    r"""One run's term of eq. (18): :math:`w_1 RMSE_r + w_2 (RMSE_{\omega_D} + RMSE_{\omega_C})`.
+
+    Parameters
+    ----------
+    model, data : dict
+        Compared series (:func:`compared_series`): r_D/C (m, inertial), angular velocities (rad/s, body).
+    weights : (2,) float
+        w_1 (1/m) and w_2 (s/rad), ``identification.weights``; the cost is dimensionless.
+
+    Returns
+    -------
+    float
+    """
     return weights[0] * rmse(model["relative_position"], data["relative_position"]) + weights[1] * (
         rmse(model["debris_omega_body"], data["debris_omega_body"])
         + rmse(model["chaser_omega_body"], data["chaser_omega_body"]))
 
 
 def cost_f2(model: dict, data: dict, weights=None) -> float:
-    """One run's term of eq. (20): the RMSE of the main-tether tension."""
+    """One run's term of eq. (20): the RMSE of the main-tether tension.
+
+    Parameters
+    ----------
+    model, data : dict
+        Compared series (:func:`compared_series`); ``main_tether_tension`` (k,) N.
+    weights : None
+        Not used (same signature as :func:`cost_f1`).
+
+    Returns
+    -------
+    float
+        RMSE of the tension (N).
+    """
     return rmse(model["main_tether_tension"], data["main_tether_tension"])
 
 
@@ -74,7 +124,24 @@ COSTS = {"f1": cost_f1, "f2": cost_f2}
 
 def simulate(case: TowingCase, rate_deg_s: float, s, end_time=None) -> dict:
     """The compared series of one lower-order run (twin, step ``identification.step``) at spin rate
-    ``rate_deg_s`` with sub-tethers ``s``."""
+    ``rate_deg_s`` with sub-tethers ``s``.
+
+    Parameters
+    ----------
+    case : TowingCase
+        A validated towing case.
+    rate_deg_s : float
+        Debris spin rate (deg/s).
+    s : (4,) float
+        Sub-tether decision vector [log10 k_ST, l_ST0 (m), log10 c_ST, m_P/m_net] (eq. 22).
+    end_time : float or None
+        End of the run (s); default the case's.
+
+    Returns
+    -------
+    dict
+        :func:`compared_series` of the run.
+    """
     return compared_series(run_twin(towing_model(case, rate_deg_s, s, step=case.identification.step,
                                                   end_time=end_time)))
 
@@ -137,7 +204,27 @@ def identify(case: TowingCase, data: list[dict], optimizer: str, end_time=None, 
     """Minimize the case's cost (``identification.cost``) against ``data`` (one dict per run: the
     compared series and ``rate_deg_s``) with ``optimizer``, a name of
     :data:`riskassess.stages.optimizers.OPTIMIZERS` ('pso', 'pattern', 'polish'; one file each), from
-    ``initial_guess`` (default the case's s0). ``ValueError`` listing the known names for another."""
+    ``initial_guess`` (default the case's s0). ``ValueError`` listing the known names for another.
+
+    Parameters
+    ----------
+    case : TowingCase
+        A validated towing case (bounds, cost, weights, optimizer settings).
+    data : list of dict
+        Per run: :func:`compared_series` entries and ``rate_deg_s`` (deg/s).
+    optimizer : str
+        Optimizer name.
+    end_time : float or None
+        End of each run (s); default the case's.
+    workers : int or None
+        Worker processes; default ``identification.workers``.
+    initial_guess : (4,) float or None
+        Start s_0.
+
+    Returns
+    -------
+    Identified
+    """
     search = optimizer_search(optimizer)        # an unknown name fails here, before any run
     ident = case.identification
     settings = ident.optimizers
@@ -151,7 +238,24 @@ def identify(case: TowingCase, data: list[dict], optimizer: str, end_time=None, 
 
 
 def training_data(case: TowingCase, s, rates, end_time=None) -> list[dict]:
-    """Lower-order runs with sub-tethers ``s`` at ``rates`` (deg/s): the benchmark's data (Sec. 4.3)."""
+    """Lower-order runs with sub-tethers ``s`` at ``rates`` (deg/s): the benchmark's data (Sec. 4.3).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A validated towing case.
+    s : (4,) float
+        Sub-tether decision vector (eq. 22).
+    rates : sequence of float
+        Debris spin rates (deg/s).
+    end_time : float or None
+        End of each run (s).
+
+    Returns
+    -------
+    list of dict
+        Per rate, :func:`compared_series` and ``rate_deg_s``.
+    """
     return [{**simulate(case, rate, s, end_time), "rate_deg_s": rate} for rate in rates]
 
 
@@ -165,7 +269,21 @@ def run_optimizers(case: TowingCase, data: list[dict], optimizers=None, end_time
     """Each of ``optimizers`` (default ``identification.searches``: 'pso' and/or 'pattern') on ``data``
     with :func:`identify`; with ``optimizers.polish_evaluations`` > 0 the PSO's best is polished by a
     pattern search, reported as 'pso+pattern' (evaluations and wall time include the PSO's).
-    Returns {name: :class:`Identified`} in the order run."""
+    Returns {name: :class:`Identified`} in the order run.
+
+    Parameters
+    ----------
+    case : TowingCase
+        A validated towing case.
+    data : list of dict
+        Per run: compared series and ``rate_deg_s`` (deg/s).
+    optimizers : list of str or None
+        Optimizer names.
+    end_time : float or None
+        End of each run (s).
+    workers : int or None
+        Worker processes.
+    """
     found = {}
     for name in case.identification.searches if optimizers is None else optimizers:
         found[name] = identify(case, data, name, end_time, workers)
@@ -181,7 +299,26 @@ def run_optimizers(case: TowingCase, data: list[dict], optimizers=None, end_time
 def benchmark(case: TowingCase, optimizers=None, rates=None, end_time=None, workers=None) -> dict:
     """Sec. 4.3: data from ``benchmark_truth`` at the training rates (same model and step as the
     fit), identified by each optimizer (:func:`run_optimizers`). Returns per optimizer s, cost,
-    relative error against the truth, evaluations and wall time."""
+    relative error against the truth, evaluations and wall time.
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with ``identification.benchmark_truth``.
+    optimizers : list of str or None
+        Optimizer names; default ``identification.searches``.
+    rates : sequence of float or None
+        Spin rates of the data (deg/s); default ``rates.training_deg_s``.
+    end_time : float or None
+        End of each run (s).
+    workers : int or None
+        Worker processes.
+
+    Returns
+    -------
+    dict
+        ``truth``, ``cost_function``, ``rates_deg_s``, ``data_wall_s`` (s) and ``runs`` per optimizer.
+    """
     truth = np.asarray(case.identification.benchmark_truth, float)
     rates = case.rates.training_deg_s if rates is None else rates
     start = time.perf_counter()
@@ -198,7 +335,25 @@ def benchmark_case(case_path, out_dir, case: TowingCase | None = None, end_time=
     """`riskassess identify CASE --benchmark`: run :func:`benchmark` and write ``identification.json``
     (every run, history included), ``convergence.png`` and a manifest to ``out_dir`` (claimed by
     :func:`riskassess.products.outfolder.claim`); returns the answer with the best run's ``s``, ``cost``,
-    ``optimizer`` and ``wall_s`` on top."""
+    ``optimizer`` and ``wall_s`` on top.
+
+    Parameters
+    ----------
+    case_path : str or Path
+        The towing case file (copied into the folder as ``case.toml``).
+    out_dir : str or Path
+        The output folder.
+    case : TowingCase or None
+        The already validated case; read from ``case_path`` when None.
+    end_time : float or None
+        End of each run (s).
+    overwrite : bool
+        Replace an earlier identification in ``out_dir``.
+
+    Returns
+    -------
+    dict
+    """
     case = case or load_model(case_path, TowingCase)
     folder = claim_identify_folder(out_dir, case_path, case.name, overwrite)
     with folder.recording():
@@ -209,7 +364,24 @@ def benchmark_case(case_path, out_dir, case: TowingCase | None = None, end_time=
 
 def claim_identify_folder(out_dir, case_path, case_name: str, overwrite: bool) -> OutputFolder:
     """Claim the folder of `riskassess identify` and copy the case into it; on ``overwrite`` the cached
-    full-net runs (``fullnet/``) stay when the folder's ``case.toml`` is byte-identical to the case file."""
+    full-net runs (``fullnet/``) stay when the folder's ``case.toml`` is byte-identical to the case file.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        The output folder.
+    case_path : str or Path
+        The towing case file.
+    case_name : str
+        The case's ``name`` (recorded in the manifest).
+    overwrite : bool
+        Replace an earlier identification in ``out_dir``.
+
+    Returns
+    -------
+    OutputFolder
+        The claimed folder, status ``running``.
+    """
     out, case_path = Path(out_dir), Path(case_path)
     same_case = (out / "case.toml").is_file() and (out / "case.toml").read_bytes() == case_path.read_bytes()
     folder = claim(out, case_name, "identify", overwrite, stage="identify",

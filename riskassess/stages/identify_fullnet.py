@@ -52,7 +52,30 @@ def _run_full_net(task):
 
 def full_net_runs(case: TowingCase, rates, out: Path, end, workers, record=None) -> list[dict]:
     """Full-net runs at ``rates`` (deg/s), read from ``out``'s cache where present (same end time);
-    ``record(relative path)`` is told of each new cache file (the output folder lists it)."""
+    ``record(relative path)`` is told of each new cache file (the output folder lists it).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with a ``[full_net]`` table (wrapped start).
+    rates : sequence of float
+        Debris spin rates (deg/s).
+    out : Path
+        The output folder; runs are cached in ``out/fullnet``.
+    end : float
+        End of each run (s).
+    workers : int
+        Most worker processes.
+    record : callable or None
+        ``record(relative path)`` for each new cache file.
+
+    Returns
+    -------
+    list of dict
+        Per rate: compared series (r_D/C (k, 3) m inertial, angular velocities (k, 3) rad/s body
+        frames, main-tether tension (k,) N), ``rate_deg_s``, ``chaser_start_inertial`` and
+        ``node_start_inertial`` (3,) m, ``wall_s`` (s).
+    """
     cache = out / "fullnet"
     cache.mkdir(parents=True, exist_ok=True)
     path = {rate: cache / f"rate_{rate:.2f}_end_{end:g}.npz" for rate in rates}
@@ -69,7 +92,21 @@ def full_net_runs(case: TowingCase, rates, out: Path, end, workers, record=None)
 
 
 def lower_order_case(case: TowingCase, run: dict) -> TowingCase:
-    """The case whose lower-order runs start from the full-net start state (module doc, item 2)."""
+    """The case whose lower-order runs start from the full-net start state (module doc, item 2).
+
+    Parameters
+    ----------
+    case : TowingCase
+        The towing case.
+    run : dict
+        A full-net run (:func:`full_net_runs`): ``chaser_start_inertial`` and ``node_start_inertial``
+        (3,) m, inertial.
+
+    Returns
+    -------
+    TowingCase
+        A copy with the chaser position and ``sub_tethers.connection_point_start_inertial`` replaced.
+    """
     chaser = case.chaser.model_copy(update={"position_inertial": list(map(float, run["chaser_start_inertial"]))})
     tethers = case.sub_tethers.model_copy(
         update={"connection_point_start_inertial": list(map(float, run["node_start_inertial"]))})
@@ -77,7 +114,24 @@ def lower_order_case(case: TowingCase, run: dict) -> TowingCase:
 
 
 def comparison_rows(case: TowingCase, s, data: list[dict], end) -> list[dict]:
-    """Per run of ``data``: RMSE of each channel and both costs (eqs. 18-21) of the lower-order model with ``s``."""
+    """Per run of ``data``: RMSE of each channel and both costs (eqs. 18-21) of the lower-order model with ``s``.
+
+    Parameters
+    ----------
+    case : TowingCase
+        The lower-order case (:func:`lower_order_case`).
+    s : (4,) float
+        Sub-tether decision vector (eq. 22).
+    data : list of dict
+        Full-net runs (:func:`full_net_runs`).
+    end : float
+        End of each run (s).
+
+    Returns
+    -------
+    list of dict
+        Per run: ``rate_deg_s``, ``rmse_<channel>`` (m, rad/s or N) and the costs ``f1``, ``f2``.
+    """
     rows = []
     for run in data:
         model = simulate(case, run["rate_deg_s"], s, end)
@@ -106,7 +160,25 @@ def identify_full_net(case_path, out_dir, case: TowingCase, optimizers=None, ove
     cost; writes ``identification.json`` (every optimizer's run), ``convergence.png`` and a manifest to
     ``out_dir`` (claimed by :func:`riskassess.products.outfolder.claim`; with ``overwrite`` the cached full-net runs
     are kept when the folder's ``case.toml`` is the same file, byte for byte). Returns the answer with the
-    best run's ``s``, ``cost`` and ``optimizer`` on top."""
+    best run's ``s``, ``cost`` and ``optimizer`` on top.
+
+    Parameters
+    ----------
+    case_path : str or Path
+        The towing case file.
+    out_dir : str or Path
+        The output folder.
+    case : TowingCase
+        The validated case; it needs a ``[full_net]`` table with the wrapped start.
+    optimizers : list of str or None
+        Optimizer names.
+    overwrite : bool
+        Replace an earlier identification in ``out_dir``.
+
+    Returns
+    -------
+    dict
+    """
     fn = case.full_net
     if fn is None:
         raise CaseError(f"{case_path}: identification against full-net runs needs a [full_net] section")

@@ -27,7 +27,22 @@ KINDS = {
 def case_kind(raw: dict) -> str:
     """'impact', 'approach', 'towing' or 'diagnosis' for the parsed TOML of a case file: its
     top-level ``kind``. Files written before the kind was explicit are told by their tables
-    (a diagnosis file then names its scenario in ``kind``)."""
+    (a diagnosis file then names its scenario in ``kind``).
+
+    Parameters
+    ----------
+    raw : dict
+        Parsed TOML of a case file.
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    ValueError
+        For a ``kind`` that is not a text or not a known kind (the message lists the kinds).
+    """
     kind = raw.get("kind")
     if kind is not None and not isinstance(kind, str):
         raise ValueError(f"kind: a text is expected (one of {', '.join(KINDS)}); got {type(kind).__name__}")
@@ -62,7 +77,19 @@ def _known(kind: str) -> None:
 
 def load_any_case(path: str | Path) -> tuple[str, object]:
     """(kind, validated case) of any case file; :class:`~riskassess.cases.impact.CaseError` naming the
-    file and the keys when it is not valid for its kind."""
+    file and the keys when it is not valid for its kind.
+
+    Parameters
+    ----------
+    path : str or Path
+        A case file of any kind.
+
+    Returns
+    -------
+    kind : str
+    case : pydantic.BaseModel
+        The validated case of that kind.
+    """
     try:
         kind = case_kind(read_toml(path))
     except CaseError:
@@ -75,7 +102,17 @@ def load_any_case(path: str | Path) -> tuple[str, object]:
 def case_schema(kind: str = "impact") -> dict:
     """The JSON schema (draft 2020-12, pydantic's) of a case file of ``kind``: keys, units in the
     descriptions, ranges, required keys; a diagnosis file is one of its scenario kinds (``kind``
-    discriminator). ``ValueError`` listing the kinds for an unknown one."""
+    discriminator). ``ValueError`` listing the kinds for an unknown one.
+
+    Parameters
+    ----------
+    kind : str
+        One of :data:`KINDS`.
+
+    Returns
+    -------
+    dict
+    """
     _known(kind)
     model, _, commands = KINDS[kind]
     schema = model.model_json_schema()

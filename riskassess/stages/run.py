@@ -50,7 +50,31 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
     (:func:`riskassess.products.outfolder.claim`), simulate and write the run folder. ``pending``: product
     steps (``report``, ``vtk``) the caller makes next; the status stays ``running`` until they end.
     A sequential case (``simulation.coupling``) runs the net against the fixed target first and
-    judges the free debris under the recorded loads (:mod:`riskassess.models.impact_sequential`)."""
+    judges the free debris under the recorded loads (:mod:`riskassess.models.impact_sequential`).
+
+    Parameters
+    ----------
+    case_path : str or Path
+        The impact case file (mesh files relative to it).
+    out_dir : str or Path
+        The run folder.
+    progress : callable or None
+        ``progress(t)`` with the simulated time t (s) at every output sample (a sequential run's two
+        steps each cover half of 0..end_time).
+    case : Case or None
+        The already validated case; read from ``case_path`` when None.
+    overwrite : bool
+        Replace an earlier run in ``out_dir``.
+    pending : sequence of str
+        Product steps still to come.
+    command : str
+        The command recorded in the manifest (``run``, ``assess``, ...).
+
+    Returns
+    -------
+    RunOutput
+        The run folder, the summary and the structures verdict (None without weak locations).
+    """
     case_path = Path(case_path)
     case = case or load_case(case_path)
     sequential = case.simulation.coupling == "sequential"
@@ -103,7 +127,21 @@ def _scaled(progress, offset: float):
 def run_recorded(simulation: ImpactSimulation, folder: OutputFolder, **run_options):
     """``simulation.run(**run_options)``; when it stops (a failed health check, :mod:`multibody.health`,
     or any error) the manifest also gets the verdict 'indeterminate' and the health record, and the
-    folder's recording marks it 'failed'."""
+    folder's recording marks it 'failed'.
+
+    Parameters
+    ----------
+    simulation : ImpactSimulation
+        The Exudyn model.
+    folder : OutputFolder
+        The claimed run folder.
+    **run_options
+        ``progress`` and ``monitor`` of :meth:`multibody.impact.ImpactSimulation.run`.
+
+    Returns
+    -------
+    multibody.recorder.Recorder
+    """
     try:
         return simulation.run(**run_options)
     except BaseException:
@@ -114,7 +152,25 @@ def run_recorded(simulation: ImpactSimulation, folder: OutputFolder, **run_optio
 def begin_run_folder(out: Path, case_path: Path, case: Case, overwrite: bool = False,
                      command: str = "run") -> OutputFolder:
     """Claim the run folder and write the case into it; the manifest says 'running', so an
-    interrupted run is recognisable by later stages."""
+    interrupted run is recognisable by later stages.
+
+    Parameters
+    ----------
+    out : Path
+        The run folder.
+    case_path : Path
+        The case file (copied as ``case.toml``; the validated case goes to ``case.json``).
+    case : Case
+        The validated case.
+    overwrite : bool
+        Replace an earlier run in ``out``.
+    command : str
+        The command recorded in the manifest.
+
+    Returns
+    -------
+    OutputFolder
+    """
     folder = claim(out, case.name, command, overwrite, stage="impact", software=software_versions())
     with folder.recording():
         results.atomic_write_bytes(folder.path / "case.toml", case_path.read_bytes())
@@ -125,7 +181,24 @@ def begin_run_folder(out: Path, case_path: Path, case: Case, overwrite: bool = F
 
 def write_simulation(folder: OutputFolder, recorder, simulation: ImpactSimulation, case: Case) -> dict:
     """Write the simulation's results and summary and list them in the manifest (the status stays
-    'running': the caller finishes the folder)."""
+    'running': the caller finishes the folder).
+
+    Parameters
+    ----------
+    folder : OutputFolder
+        The claimed run folder.
+    recorder : multibody.recorder.Recorder
+        The finished run's series and net snapshots.
+    simulation : ImpactSimulation
+        The simulated model.
+    case : Case
+        The case (its name goes into the summary).
+
+    Returns
+    -------
+    dict
+        The summary, as in ``summary.json``.
+    """
     summary = run_summary(recorder, simulation.assembly, case.name)
     write_simulation_results(folder.path, recorder, simulation)
     results.atomic_write_json(folder.path / "summary.json", summary)
@@ -138,7 +211,30 @@ def write_sequential(folder: OutputFolder, wall_recorder, wall: ImpactSimulation
     """Write a sequential run: the driven debris' series (``timeseries.npz``), the net of the wall
     run (``net.npz``) and the wall run's own series (``wall_timeseries.npz``: the loads recorded on
     the fixed target, the net's energies), and the summary of both; ``coupled``: the case's own
-    assembly (its net gives the momentum-exchange estimate)."""
+    assembly (its net gives the momentum-exchange estimate).
+
+    Parameters
+    ----------
+    folder : OutputFolder
+        The claimed run folder.
+    wall_recorder : multibody.recorder.Recorder
+        Step 1, the net against the fixed target.
+    wall : ImpactSimulation
+        Step 1's model.
+    recorder : multibody.recorder.Recorder
+        Step 2, the driven debris (series with the applied contact loads).
+    simulation : ImpactSimulation
+        Step 2's model.
+    coupled : multibody.assembly.ImpactAssembly
+        The case's own (coupled) assembly.
+    case : Case
+        The case.
+
+    Returns
+    -------
+    dict
+        The summary, as in ``summary.json``.
+    """
     summary = sequential_summary(wall_recorder, wall.assembly, recorder, simulation.assembly, coupled, case.name)
     write_net_and_bodies(folder.path, wall_recorder, wall)
     results.atomic_write_npz(folder.path / "wall_timeseries.npz", dict(wall_recorder.series))
@@ -149,7 +245,17 @@ def write_sequential(folder: OutputFolder, wall_recorder, wall: ImpactSimulation
 
 
 def write_series(out: Path, recorder, simulation: ImpactSimulation) -> None:
-    """``timeseries.npz``: the recorder's series with the body and joint names."""
+    """``timeseries.npz``: the recorder's series with the body and joint names.
+
+    Parameters
+    ----------
+    out : Path
+        The run folder.
+    recorder : multibody.recorder.Recorder
+        The run's recorder (series in SI, frames in the key names).
+    simulation : ImpactSimulation
+        The simulated model (body names, masses (kg), joint names and kinds).
+    """
     assembly = simulation.assembly
     series = dict(recorder.series)
     series["body_names"] = np.array([b.name for b in assembly.bodies])
@@ -160,12 +266,35 @@ def write_series(out: Path, recorder, simulation: ImpactSimulation) -> None:
 
 
 def write_simulation_results(out: Path, recorder, simulation: ImpactSimulation) -> None:
+    """``timeseries.npz``, ``net.npz`` and ``bodies.npz`` of a coupled run (:func:`write_series`,
+    :func:`write_net_and_bodies`).
+
+    Parameters
+    ----------
+    out : Path
+        The run folder.
+    recorder : multibody.recorder.Recorder
+        The run's recorder.
+    simulation : ImpactSimulation
+        The simulated model.
+    """
     write_series(out, recorder, simulation)
     write_net_and_bodies(out, recorder, simulation)
 
 
 def write_net_and_bodies(out: Path, recorder, simulation: ImpactSimulation) -> None:
-    """``net.npz`` (the recorder's net snapshots and the net's arrays) and ``bodies.npz`` (meshes)."""
+    """``net.npz`` (the recorder's net snapshots and the net's arrays) and ``bodies.npz`` (meshes).
+
+    Parameters
+    ----------
+    out : Path
+        The run folder.
+    recorder : multibody.recorder.Recorder
+        The run's recorder (net snapshots, LVLH).
+    simulation : ImpactSimulation
+        The simulated model: net threads, rest lengths (m), stiffness, damping, masses (kg), radii (m);
+        body meshes (m, body frame).
+    """
     assembly = simulation.assembly
     net = assembly.net
     results.atomic_write_npz(out / "net.npz", dict(

@@ -33,7 +33,21 @@ from riskassess.products.towing_plots import plot_tow
 def summarize(case: TowingCase, result, s) -> dict:
     """The numbers ``riskassess tow`` prints and writes to towing.json (SI):
     :func:`~riskassess.products.towing_figures.run_figures`, the decision vector s and the sub-tethers' peak tension,
-    wall time."""
+    wall time.
+
+    Parameters
+    ----------
+    case : TowingCase
+        The towing case.
+    result : multibody.towing.TowResult
+        The finished lower-order run.
+    s : (4,) float
+        Its sub-tether decision vector (eq. 22).
+
+    Returns
+    -------
+    dict
+    """
     series = result.series()
     return {**run_figures(case, series, result.model), "decision_vector_s": [float(x) for x in s],
             "sub_tether_peak_tension_N": float(series["sub_tether_tension"].max()),
@@ -44,7 +58,24 @@ def tow_case(case_path: str | Path, out_dir: str | Path, case: TowingCase | None
              overwrite: bool = False) -> dict:
     """Load the case (unless given), claim the output folder (:func:`riskassess.products.outfolder.claim`),
     run the lower-order tow in Exudyn (or the full-net tow when ``simulation.model = "full-net"``,
-    :mod:`riskassess.stages.tow_fullnet`), write the run folder; return the summary."""
+    :mod:`riskassess.stages.tow_fullnet`), write the run folder; return the summary.
+
+    Parameters
+    ----------
+    case_path : str or Path
+        The towing case file (copied as ``case.toml``).
+    out_dir : str or Path
+        The run folder.
+    case : TowingCase or None
+        The already validated case; read from ``case_path`` when None.
+    overwrite : bool
+        Replace an earlier tow in ``out_dir``.
+
+    Returns
+    -------
+    dict
+        The summary, as in ``towing.json``.
+    """
     case_path = Path(case_path)
     case = case or load_model(case_path, TowingCase)
     model = towing_model(case)

@@ -17,14 +17,40 @@ from riskassess.cases.towing import TowingCase
 
 def momentum_residual(series: dict) -> float:
     """Largest |P(t) - P(t0) - external impulse| over the run (N s): chaser, debris and net together
-    exchange momentum only through internal forces (threads, contact, main tether)."""
+    exchange momentum only through internal forces (threads, contact, main tether).
+
+    Parameters
+    ----------
+    series : dict
+        Full-net series: ``total_momentum_inertial`` and ``external_impulse_inertial``, (k, 3) N s, inertial.
+
+    Returns
+    -------
+    float
+        (N s).
+    """
     p, j = series["total_momentum_inertial"], series["external_impulse_inertial"]
     return float(np.linalg.norm(p - p[0] - (j - j[0]), axis=1).max())
 
 
 def summarize_full_net(case: TowingCase, result, wrap: dict) -> dict:
     """The figures of every towing run (:func:`riskassess.products.towing_figures.run_figures`) for a full-net run, plus
-    the net's: wrapped-state shape, contact, closing-loop tension, momentum balance."""
+    the net's: wrapped-state shape, contact, closing-loop tension, momentum balance.
+
+    Parameters
+    ----------
+    case : TowingCase
+        The towing case.
+    result : multibody.net_towing.NetTowResult
+        The finished full-net run.
+    wrap : dict or None
+        :func:`multibody.net_wrap.wrap_summary` of the wrapped start (None for the capture start).
+
+    Returns
+    -------
+    dict
+        JSON-ready, SI (tensions in N, momentum residual in N s, times in s).
+    """
     series = result.series()
     model = result.model
     return {
@@ -40,7 +66,15 @@ def summarize_full_net(case: TowingCase, result, wrap: dict) -> dict:
 
 def run_full_net(case: TowingCase, out: Path) -> tuple[dict, dict]:
     """Run the case's full-net tow; write towing.npz, net.npz, towing.json to ``out``. Returns
-    (summary, series)."""
+    (summary, series).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with a ``[full_net]`` table.
+    out : Path
+        The claimed run folder.
+    """
     if case.full_net.start == "capture":
         model = full_net_model(case)
         net, wrap = model.net, None

@@ -158,7 +158,7 @@ def write_sweep_products(store: ResultStore, confidence: float = 0.95, reliabili
     rows = store.rows()
     info = store.info()
     env = envelope(rows, confidence=confidence, reliability=reliability)
-    # allow_nan=False: the envelope never holds a NaN (a "nan" limit was issue 20's false safe)
+    # allow_nan=False: the envelope never holds a NaN (a "nan" limit once read as a safe limit)
     write_product(store, "envelope.json", (json.dumps(env, indent=2, allow_nan=False) + "\n").encode())
     varied = [a.split(" ", 1)[1].split("=")[0] for a in info.get("arguments", []) if a.startswith("--vary ")]
     with matplotlib.rc_context(STYLE):

@@ -17,7 +17,25 @@ DIMENSIONS = {
 def circular_tube(outer_diameter: float, wall: float) -> SectionProperties:
     """Circular tube (a solid shaft when wall = outer_diameter / 2): exact A, I and polar
     J = 2 I; torsion T r / J; transverse shear V Q / (I (D - d)) with Q = (D^3 - d^3) / 12,
-    which gives 2 V / A for thin tubes and 4 V / (3 A) for solid shafts."""
+    which gives 2 V / A for thin tubes and 4 V / (3 A) for solid shafts.
+
+    Parameters
+    ----------
+    outer_diameter : float
+        Outer diameter D (m).
+    wall : float
+        Wall thickness (m), in (0, D / 2].
+
+    Returns
+    -------
+    SectionProperties
+        Per-unit-load peak stresses, section frame (bending combined as a resultant).
+
+    Raises
+    ------
+    ValueError
+        For a wall outside (0, D / 2].
+    """
     d_out, t = outer_diameter, wall
     if not 0.0 < t <= d_out / 2.0:
         raise ValueError(f"circular_tube: wall must be in (0, outer_diameter/2 = {d_out / 2:g} m]. Got {t:g} instead")

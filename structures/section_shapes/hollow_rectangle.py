@@ -16,7 +16,27 @@ DIMENSIONS = {
 def hollow_rectangle(width: float, height: float, wall: float) -> SectionProperties:
     """Rectangular tube of uniform wall thickness: exact area and second moments (outer minus
     inner rectangle); torsion by Bredt, tau = T / (2 A_m t), A_m enclosed by the wall's
-    midline; transverse shear V Q / (I 2t) at the neutral axis."""
+    midline; transverse shear V Q / (I 2t) at the neutral axis.
+
+    Parameters
+    ----------
+    width : float
+        Outer extent along section axis 2 (m).
+    height : float
+        Outer extent along section axis 3 (m).
+    wall : float
+        Uniform wall thickness (m), below half the smaller side.
+
+    Returns
+    -------
+    SectionProperties
+        Per-unit-load peak stresses, section frame.
+
+    Raises
+    ------
+    ValueError
+        For a wall that is not > 0 and < half the smaller side.
+    """
     b, h, t = width, height, wall
     if not 0.0 < 2.0 * t < min(b, h):
         raise ValueError(f"hollow_rectangle: wall must be > 0 and < half the smaller side ({min(b, h) / 2:g} m). "

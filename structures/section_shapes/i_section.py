@@ -17,7 +17,29 @@ DIMENSIONS = {
 def i_section(height: float, flange_width: float, flange_thickness: float, web_thickness: float) -> SectionProperties:
     """I-section, web along axis 3 (strong bending about axis 2). Exact A and I; torsion of
     an open section, tau = T t_max / J with J = sum b t^3 / 3; transverse shear along the
-    web V Q / (I t_w) at the neutral axis, across the flanges V Q / (I 2 t_f)."""
+    web V Q / (I t_w) at the neutral axis, across the flanges V Q / (I 2 t_f).
+
+    Parameters
+    ----------
+    height : float
+        Overall depth along section axis 3, the web direction (m).
+    flange_width : float
+        Flange extent along section axis 2 (m).
+    flange_thickness : float
+        Thickness of each flange (m); 2 flange_thickness < height.
+    web_thickness : float
+        Thickness of the web (m); at most flange_width.
+
+    Returns
+    -------
+    SectionProperties
+        Per-unit-load peak stresses, section frame.
+
+    Raises
+    ------
+    ValueError
+        For flanges or a web that do not fit.
+    """
     h, b, tf, tw = height, flange_width, flange_thickness, web_thickness
     if not (0.0 < 2.0 * tf < h and 0.0 < tw <= b):
         raise ValueError("i_section: need 0 < 2 flange_thickness < height and 0 < web_thickness <= flange_width. "

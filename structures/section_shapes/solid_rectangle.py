@@ -14,7 +14,20 @@ DIMENSIONS = {
 
 def solid_rectangle(width: float, height: float) -> SectionProperties:
     """Solid b x h rectangle. Torsion: tau_max = T (3a + 1.8b) / (a^2 b^2) with a >= b
-    (Roark Table 10.1 case 4, within 4 % of the exact series); transverse shear 1.5 V / A."""
+    (Roark Table 10.1 case 4, within 4 % of the exact series); transverse shear 1.5 V / A.
+
+    Parameters
+    ----------
+    width : float
+        Extent along section axis 2 (m).
+    height : float
+        Extent along section axis 3 (m).
+
+    Returns
+    -------
+    SectionProperties
+        Per-unit-load peak stresses, section frame.
+    """
     b, h = width, height
     a, c = max(b, h), min(b, h)
     area = b * h

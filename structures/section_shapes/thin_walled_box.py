@@ -17,7 +17,29 @@ DIMENSIONS = {
 def thin_walled_box(width: float, height: float, flange_thickness: float, web_thickness: float) -> SectionProperties:
     """Thin-walled box: flanges (the walls along axis 2, thickness t_f) and webs (along
     axis 3, t_w), dimensions to the wall midlines, thin-wall approximations (Roark Table 10.1
-    case 16 for torsion: tau = T / (2 A_m t) at the thinner wall)."""
+    case 16 for torsion: tau = T / (2 A_m t) at the thinner wall).
+
+    Parameters
+    ----------
+    width : float
+        Midline extent along section axis 2 (m).
+    height : float
+        Midline extent along section axis 3 (m).
+    flange_thickness : float
+        Thickness t_f of the two walls along axis 2 (m), in (0, height / 2).
+    web_thickness : float
+        Thickness t_w of the two walls along axis 3 (m), in (0, width / 2).
+
+    Returns
+    -------
+    SectionProperties
+        Per-unit-load peak stresses, section frame.
+
+    Raises
+    ------
+    ValueError
+        For wall thicknesses outside those ranges.
+    """
     b, h, tf, tw = width, height, flange_thickness, web_thickness
     if not (0.0 < tf < h / 2.0 and 0.0 < tw < b / 2.0):
         raise ValueError("thin_walled_box: flange_thickness must be in (0, height/2) and web_thickness in "

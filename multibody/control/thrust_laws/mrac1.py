@@ -23,7 +23,30 @@ LAMBDA0, K_S, GAMMA, XI_H, XI_A1, XI_A2 = range(8, 14)
 
 @njit(THRUST_SIGNATURE, cache=True)
 def command(t, z, z_rate, params, state, step, advance):
-    """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16)."""
+    """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16).
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    z : float
+        Main-tether elongation (m).
+    z_rate : float
+        Its rate (m/s).
+    params : (k,) float
+        The law's constants (module doc).
+    state : (j,) float
+        The law's state (module doc), advanced in place when ``advance``.
+    step : float
+        The controller's sampling step (s).
+    advance : bool
+        True once per new sampling time: integrate the adaptive and reference states.
+
+    Returns
+    -------
+    float
+        Commanded thrust (N), saturated at ``u_max``; 0 before ``t_on``.
+    """
     if t < params[T_ON]:
         return 0.0
     zm_acc = reference_acceleration(params, state[ZM], state[ZM_RATE])
@@ -46,7 +69,19 @@ def command(t, z, z_rate, params, state, step, advance):
 def arrays(case, tether, z0, z_rate0) -> tuple[np.ndarray, np.ndarray]:
     """``params`` from the case's ``[thrust]`` and ``[mrac]``; the reference model starts on the
     measured state and the adaptive parameters at their ideal values for the abstracted model
-    (:math:`\\hat h = m_C`, :math:`\\hat a = [k, c]`)."""
+    (:math:`\\hat h = m_C`, :math:`\\hat a = [k, c]`).
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        The towing case (read: ``thrust``, ``mrac``, ``chaser.mass``, ``main_tether.stiffness``).
+    tether : (>= 2,) float
+        k_MT (N/m), c_MT (N s/m), ... of the model's main tether.
+    z0 : float
+        Main-tether elongation at the start (m).
+    z_rate0 : float
+        Its rate (m/s).
+    """
     m = case.mrac
     params = np.array(common_params(case, tether) + [m.lambda0, m.k_s, m.gamma, m.xi_h, *m.xi_a], float)
     return params, np.array([z0, z_rate0, 1.0 / params[B], params[K_MT], params[C_MT]])

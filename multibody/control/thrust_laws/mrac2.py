@@ -30,6 +30,28 @@ def command(t, z, z_rate, params, state, step, advance):
     the e-modification vanish for :math:`u = \\dots - \\hat\\Theta^T\\phi` (Lavretsky & Wise 2013,
     Sec. 10.2): :math:`\\dot{\\hat\\Theta} = +\\Gamma_\\theta\\phi\\,e^TPB - \\dots`; the seed paper's
     eq. (20c) prints :math:`-\\Gamma_\\theta\\hat\\Theta^T e^TPB`, a typo (it does not type-check).
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    z : float
+        Main-tether elongation (m).
+    z_rate : float
+        Its rate (m/s).
+    params : (k,) float
+        The law's constants (module doc).
+    state : (j,) float
+        The law's state (module doc), advanced in place when ``advance``.
+    step : float
+        The controller's sampling step (s).
+    advance : bool
+        True once per new sampling time: integrate the adaptive and reference states.
+
+    Returns
+    -------
+    float
+        Commanded thrust (N), saturated at ``u_max``; 0 before ``t_on``.
     """
     if t < params[T_ON]:
         return 0.0
@@ -58,7 +80,19 @@ def arrays(case, tether, z0, z_rate0) -> tuple[np.ndarray, np.ndarray]:
     """``params`` from the case's ``[thrust]`` and ``[mrac]`` with P solving eq. (21a) for
     Q = diag(``mrac.q``); the reference model starts on the measured state and the adaptive
     parameters at their ideal values for the abstracted model (:math:`\\hat K_z = [-K_P, -K_D]`,
-    :math:`\\hat k_r = K_P`, :math:`\\hat\\Theta = [-k, -c]`)."""
+    :math:`\\hat k_r = K_P`, :math:`\\hat\\Theta = [-k, -c]`).
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        The towing case (read: ``thrust``, ``mrac``, ``chaser.mass``, ``main_tether.stiffness``).
+    tether : (>= 2,) float
+        k_MT (N/m), c_MT (N s/m), ... of the model's main tether.
+    z0 : float
+        Main-tether elongation at the start (m).
+    z_rate0 : float
+        Its rate (m/s).
+    """
     m = case.mrac
     head = common_params(case, tether)
     b, k_mt, c_mt, k_p, k_d = head[B], head[K_MT], head[C_MT], head[K_P], head[K_D]

@@ -40,7 +40,18 @@ class Parameter:
 
 
 def switched_off(specs: list[Parameter]) -> np.ndarray:
-    """The parameters at zero, clipped into their bounds (SI): the effect switched off."""
+    """The parameters at zero, clipped into their bounds (SI): the effect switched off.
+
+    Parameters
+    ----------
+    specs : list of Parameter, length m
+        The effect's parameters (:meth:`Effect.parameter_specs`).
+
+    Returns
+    -------
+    values : (m,) float
+        max(lower, min(0, upper)) per parameter, in each parameter's unit.
+    """
     return np.clip(np.zeros(len(specs)), [p.lower for p in specs], [p.upper for p in specs])
 
 
@@ -64,10 +75,39 @@ class Effect:
     towing_law = staticmethod(no_towing_load)
 
     def parameter_specs(self, case, channels=None) -> list[Parameter]:
+        """The effect's physical parameters for this case: names, SI units, typical sizes and bounds.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case (:mod:`riskassess.cases.diagnosis`); its plant sizes the typical
+            values and bounds (inertia, hinge spring, orbit).
+        channels : sequence of str, optional
+            Measured channel names (:mod:`riskassess.diagnosis.channels`); None: every channel. Only an
+            effect whose parameters follow the channels (``sensor_bias``) reads it.
+
+        Returns
+        -------
+        specs : list of Parameter, length m
+            In the order of the effect's value vector ``values`` used by every other method.
+        """
         raise NotImplementedError
 
     def not_applicable(self, case, channels) -> str | None:
-        """Why the effect cannot be diagnosed for this case and these channels, or None."""
+        """Why the effect cannot be diagnosed for this case and these channels, or None.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case; its ``kind`` must be one of :attr:`scenarios`.
+        channels : sequence of str
+            Measured channel names; at least one of :attr:`channels` must be among them.
+
+        Returns
+        -------
+        reason : str or None
+            A sentence for the report, or None when the effect applies.
+        """
         if case.kind not in self.scenarios:
             return f"applies to the {' / '.join(self.scenarios)} scenario(s), not to '{case.kind}'"
         if self.channels and not set(self.channels) & set(channels):
@@ -75,49 +115,188 @@ class Effect:
         return None
 
     def law_parameters(self, plant: Plant, values: np.ndarray) -> np.ndarray:
-        """Parameters ``p`` of the numba law from the physical values (same order by default)."""
+        """Parameters ``p`` of the numba law from the physical values (same order by default).
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant the law runs on (after :meth:`modify_plant`).
+        values : (m,) float
+            Physical parameter values, SI, in the order of :meth:`parameter_specs`.
+
+        Returns
+        -------
+        p : (j,) float
+            The array handed to :attr:`law` as ``p`` (layout chosen by the effect).
+        """
         return np.asarray(values, float)
 
     def towing_law_parameters(self, plant, values: np.ndarray) -> np.ndarray:
-        """Parameters ``p`` of the towing law from the physical values (same order by default)."""
+        """Parameters ``p`` of the towing law from the physical values (same order by default).
+
+        Parameters
+        ----------
+        plant : TowingPlant
+            The towing plant the law runs on (after :meth:`modify_plant`).
+        values : (m,) float
+            Physical parameter values, SI, in the order of :meth:`parameter_specs`.
+
+        Returns
+        -------
+        p : (j,) float
+            The array handed to :attr:`towing_law` as ``p`` (layout chosen by the effect).
+        """
         return np.asarray(values, float)
 
     def modify_plant(self, plant: Plant, values: np.ndarray) -> Plant:
+        """The plant with the effect's changes of mass properties or geometry (none by default).
+
+        Parameters
+        ----------
+        plant : Plant or TowingPlant
+            The nominal plant (SI; frames in :mod:`riskassess.diagnosis.plant`,
+            :mod:`riskassess.diagnosis.towing_plant`).
+        values : (m,) float
+            Physical parameter values, SI, in the order of :meth:`parameter_specs`.
+
+        Returns
+        -------
+        plant : Plant or TowingPlant
+            A changed copy, or ``plant`` itself.
+        """
         return plant
 
     def sample_times(self, times: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """Times at which the model's state is read for samples tagged ``times`` (unchanged by default).
+
+        Parameters
+        ----------
+        times : (k,) float
+            Sample time tags (s, from the record's t = 0, non-decreasing).
+        values : (m,) float
+            Physical parameter values, SI, in the order of :meth:`parameter_specs`.
+
+        Returns
+        -------
+        times : (k,) float
+            Times (s) at which the simulated state is sampled.
+        """
         return times
 
     def measure(self, outputs: dict, values: np.ndarray, names) -> dict:
-        """The measured channels from the simulated ones (``names``: the parameter names)."""
+        """The measured channels from the simulated ones (``names``: the parameter names).
+
+        Parameters
+        ----------
+        outputs : dict of str to (k,) float
+            Simulated channels by name, units and frames of :mod:`riskassess.diagnosis.channels`.
+        values : (m,) float
+            Physical parameter values, SI, in the order of :meth:`parameter_specs`.
+        names : sequence of str, length m
+            The parameter names of ``values`` (a sensor effect finds its channel by name).
+
+        Returns
+        -------
+        outputs : dict of str to (k,) float
+            The channels as the sensors report them (unchanged by default).
+        """
         return outputs
 
     def starts(self, specs: list[Parameter]) -> list[np.ndarray]:
-        """Starting points of the fit (physical values): by default one, at a third of typical."""
+        """Starting points of the fit (physical values): by default one, at a third of typical.
+
+        Parameters
+        ----------
+        specs : list of Parameter, length m
+            The effect's parameters (:meth:`parameter_specs`).
+
+        Returns
+        -------
+        starts : list of (m,) float
+            Starting values, each in the parameters' SI units.
+        """
         return [np.array([p.typical / 3.0 if p.lower <= p.typical / 3.0 <= p.upper else 0.0 for p in specs])]
 
     def stiffness_rate(self, plant: Plant, specs: list[Parameter]) -> float:
         """Fastest decay rate (1/s) the law can add within its bounds; the fit's RK4 step stays below
-        1.5 / rate (RK4 is stable up to 2.78 / rate)."""
+        1.5 / rate (RK4 is stable up to 2.78 / rate).
+
+        Parameters
+        ----------
+        plant : Plant
+            The nominal plant.
+        specs : list of Parameter
+            The effect's parameters, whose bounds limit the rate.
+
+        Returns
+        -------
+        rate : float
+            (1/s); 0 when the law adds no stiff term.
+        """
         return 0.0
 
     def parameter_free_stiffness_rate(self, plant: Plant) -> float:
         """Decay rate (1/s) the law adds whatever its parameters (a stick law's hold, for example);
-        :func:`riskassess.diagnosis.model.predict` keeps its default RK4 step below 1.5 / rate."""
+        :func:`riskassess.diagnosis.model.predict` keeps its default RK4 step below 1.5 / rate.
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant the law runs on.
+
+        Returns
+        -------
+        rate : float
+            (1/s); 0 when the law adds no stiff term.
+        """
         return 0.0
 
     def add_to_exudyn(self, builder, values: np.ndarray, names) -> None:
-        """Apply the effect to an Exudyn scenario builder before it is assembled."""
+        """Apply the effect to an Exudyn scenario builder before it is assembled.
+
+        Parameters
+        ----------
+        builder : ExudynScenario
+            The builder (:class:`riskassess.diagnosis.exudyn_model.ExudynScenario`); the effect registers
+            body torques (N m, body frame), hinge torques (N m, about the hinge axis), CoM accelerations
+            (m/s^2, I) or a damper through its ``add_*`` hooks.
+        values : (m,) float
+            Physical parameter values, SI, in the order of :meth:`parameter_specs`.
+        names : sequence of str, length m
+            The parameter names of ``values``.
+        """
 
 
 def torque_scale(plant: Plant) -> float:
     """Size of the hinge's torques (N m): the spring at the initial (or a 0.05 rad) angle, or the
-    appendage's inertia times the square of the motion's fastest rate."""
+    appendage's inertia times the square of the motion's fastest rate.
+
+    Parameters
+    ----------
+    plant : Plant
+        A hinged plant (stiffness N m/rad, hinge inertia kg m^2, rates rad/s).
+
+    Returns
+    -------
+    scale : float
+        (N m), at least 1e-6.
+    """
     angle = max(abs(plant.hinge_angle0), 0.05)
     return max(plant.stiffness * angle, plant.hinge_inertia() * plant.rate_scale() ** 2 * angle, 1e-6)
 
 
 def reference_angle(plant: Plant) -> float:
-    """Hinge angle amplitude of the nominal motion (rad), at least 0.05 rad."""
+    """Hinge angle amplitude of the nominal motion (rad), at least 0.05 rad.
+
+    Parameters
+    ----------
+    plant : Plant
+        A hinged plant: initial hinge angle (rad) and rate (rad/s), spring (N m/rad).
+
+    Returns
+    -------
+    angle : float
+        max(|theta0|, |theta0'| / omega_hinge, 0.05) (rad).
+    """
     omega = np.sqrt(plant.stiffness / plant.hinge_inertia()) if plant.stiffness > 0 else 0.0
     return max(abs(plant.hinge_angle0), abs(plant.hinge_rate0) / omega if omega else 0.0, 0.05)

@@ -18,7 +18,7 @@ from riskassess.diagnosis.dynamics import (LAW_SIGNATURE, E_AXIS, E_HINGED, E_JA
                                 quaternion_rows, radial_inertial, sandwich, tcross, tmtv, tmv)
 from riskassess.diagnosis.effects.base import Effect, Parameter
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, W_INERTIA, body_position
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import CHASER, DEBRIS
 from riskassess.diagnosis.scenario import plant_of
 
@@ -26,7 +26,22 @@ from riskassess.diagnosis.scenario import plant_of
 @njit(cache=True)
 def gravity_gradient(radial_body, inertia_times_radial, mean_motion):
     """Gravity-gradient torque (N m, 3-tuple) in the frame of ``radial_body`` (unit, -), given the
-    inertia times it, J r (kg m^2)."""
+    inertia times it, J r (kg m^2).
+
+    Parameters
+    ----------
+    radial_body : (3,) float
+        Unit radial direction (away from the Earth's centre), body frame (-).
+    inertia_times_radial : (3,) float
+        J r, the body's inertia about its CoM times ``radial_body``, body frame (kg m^2).
+    mean_motion : float
+        n (rad/s).
+
+    Returns
+    -------
+    torque_body : tuple of 3 float
+        3 n^2 r x (J r), body frame (N m).
+    """
     c = tcross(radial_body, inertia_times_radial)
     k = 3.0 * mean_motion ** 2
     return (k * c[0], k * c[1], k * c[2])
@@ -34,6 +49,24 @@ def gravity_gradient(radial_body, inertia_times_radial, mean_motion):
 
 @njit(LAW_SIGNATURE, cache=True)
 def law(t, x, p, env, load):
+    """Gravity-gradient torque on the main body and, hinged, on the appendage.
+
+    Parameters
+    ----------
+    t : float
+        Time (s) from the record's t = 0.
+    x : (STATE_SIZE,) float
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
+    p : (1,) float
+        [n (rad/s)], the mean motion the torque sees.
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+    load : (LOAD_SIZE,) float
+        Loads, layout ``L_*``, added to in place: torques on the main body (``L_TM``) and the appendage
+        (``L_TA``), B (N m).
+    """
     n = env[E_N]
     r_b = tmtv(quaternion_rows(x[X_Q:X_Q + 4]), (np.cos(n * t), np.sin(n * t), 0.0))
     main = gravity_gradient(r_b, tmv(env[E_JM:E_JM + 9], r_b), p[0])
@@ -48,7 +81,29 @@ def law(t, x, p, env, load):
 
 @njit(TOWING_LAW_SIGNATURE, cache=True)
 def towing_law(t, q, v, p, work, xe, h, load):
-    """On chaser and debris of the towing model: r from the Earth's centre to each CoM (ECI)."""
+    """On chaser and debris of the towing model: r from the Earth's centre to each CoM (ECI).
+
+    Parameters
+    ----------
+    t : float
+        Time (s), the towing case's clock.
+    q, v : (15,) float
+        Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
+        displacements from their reference positions (m, ECI; P's are stale, see
+        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
+        (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
+    p : (1,) float
+        [n (rad/s)].
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+    xe : (EXTRA_STATES,) float
+        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); not used.
+    h : float
+        Step (s) over which ``xe`` is advanced; 0: do not advance.
+    load : (15,) float
+        Generalized forces, kernel layout, added to in place: torques on chaser and debris (N m, their
+        body frames).
+    """
     for b, base in enumerate((CHASER, DEBRIS)):
         r = body_position(work, q, base)
         rot = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
@@ -68,19 +123,60 @@ class GravityGradientTorque(Effect):
     towing_law = staticmethod(towing_law)
 
     def not_applicable(self, case, channels):
+        """Needs an orbit outside the towing scenario; otherwise as the base class.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case.
+        channels : sequence of str
+            Measured channel names.
+        """
         if case.kind != "towing" and case.orbit.kind != "circular":
             return "the case has no orbit ([orbit] kind = 'circular' with its altitude)"
         return super().not_applicable(case, channels)
 
     def parameter_specs(self, case, channels=None):
+        """The mean motion n (rad/s), expected at the case orbit's, bounded by 10 n.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case; its orbit (or the towing chaser's radius) gives n.
+        channels : sequence of str, optional
+            Measured channel names (not used).
+        """
         n = plant_of(case).mean_motion
         return [Parameter("mean_motion", "rad/s", "orbit mean motion seen by the torque (the case orbit's: "
                           f"{n:.4g})", n, 0.0, 10.0 * n)]
 
     def starts(self, specs):
+        """One start: the case orbit's n.
+
+        Parameters
+        ----------
+        specs : list of Parameter
+            [mean_motion].
+
+        Returns
+        -------
+        starts : list of (m,) float
+            [n] (rad/s).
+        """
         return [np.array([specs[0].typical])]
 
     def add_to_exudyn(self, builder, values, names):
+        """The torque on every body (main and appendage), r the radial direction at the plant's n.
+
+        Parameters
+        ----------
+        builder : ExudynScenario
+            The scenario builder; a body torque (N m, body frame) per body.
+        values : (m,) float
+            [n (rad/s)].
+        names : sequence of str
+            Parameter names (not used).
+        """
         n_orbit = builder.plant.mean_motion
         def torque(t, body, rot, omega):
             r_b = rot.T @ radial_inertial(n_orbit, t)

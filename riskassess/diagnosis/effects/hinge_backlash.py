@@ -17,12 +17,44 @@ from riskassess.diagnosis.plant import Plant
 
 @njit(cache=True)
 def backlash_torque(angle, stiffness, half_gap):
-    """Torque (N m) that cancels the spring ``stiffness`` (N m/rad) inside the gap +-``half_gap`` (rad)."""
+    """Torque (N m) that cancels the spring ``stiffness`` (N m/rad) inside the gap +-``half_gap`` (rad).
+
+    Parameters
+    ----------
+    angle : float
+        Hinge angle (rad).
+    stiffness : float
+        The case's torsional spring k (N m/rad).
+    half_gap : float
+        Half width b of the free-play band (rad).
+
+    Returns
+    -------
+    torque : float
+        k clip(angle, -b, b), on the appendage about the hinge axis (N m).
+    """
     return stiffness * min(max(angle, -half_gap), half_gap)
 
 
 @njit(LAW_SIGNATURE, cache=True)
 def law(t, x, p, env, load):
+    """Backlash: cancels the hinge spring inside the gap.
+
+    Parameters
+    ----------
+    t : float
+        Time (s) from the record's t = 0.
+    x : (STATE_SIZE,) float
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
+    p : (1,) float
+        [half gap b (rad)].
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+    load : (LOAD_SIZE,) float
+        Loads, layout ``L_*``, added to in place: the hinge torque (``L_TH``, N m, about the axis).
+    """
     load[L_TH] += backlash_torque(x[X_TH], env[E_K], p[0])
 
 
@@ -34,15 +66,44 @@ class HingeBacklash(Effect):
     law = staticmethod(law)
 
     def not_applicable(self, case, channels):
+        """A hinge without a spring has no free play to see; otherwise as the base class.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case.
+        channels : sequence of str
+            Measured channel names.
+        """
         if case.kind == "hinged_appendage" and case.hinge.torsional_stiffness == 0:
             return "the hinge has no torsional spring: free play changes nothing"
         return super().not_applicable(case, channels)
 
     def parameter_specs(self, case, channels=None):
+        """The half gap (rad), up to 1.5 times the nominal hinge amplitude.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case; a hinged appendage; its hinge amplitude sizes the gap.
+        channels : sequence of str, optional
+            Measured channel names (not used).
+        """
         angle = reference_angle(Plant.from_case(case))
         return [Parameter("half_gap", "rad", "half width of the free-play band", 0.2 * angle, 0.0, 1.5 * angle)]
 
     def add_to_exudyn(self, builder, values, names):
+        """The backlash torque on the hinge.
+
+        Parameters
+        ----------
+        builder : ExudynScenario
+            The scenario builder; a hinge torque (N m, about the axis).
+        values : (m,) float
+            [half gap b (rad)].
+        names : sequence of str
+            Parameter names (not used).
+        """
         k = builder.plant.stiffness
         builder.add_hinge_torque(lambda t, angle, rate: backlash_torque(angle, k, values[0]))
 

@@ -48,38 +48,132 @@ def holding_torque(angle, rate, anchor, stiffness, stick_damping, stick_stiffnes
     """Torque (N m) that would hold the hinge at its stick ``anchor`` (rad): it cancels the hinge
     spring ``stiffness`` (N m/rad) at ``angle`` (rad) and adds a critically damped hold, the
     ``stick_damping`` (N m s/rad) on the ``rate`` (rad/s) and the ``stick_stiffness`` (N m/rad)
-    towards the anchor."""
+    towards the anchor.
+
+    Parameters
+    ----------
+    angle : float
+        Hinge angle theta (rad).
+    rate : float
+        Hinge rate theta' (rad/s).
+    anchor : float
+        Stick anchor theta_a (rad).
+    stiffness : float
+        The case's torsional spring k (N m/rad).
+    stick_damping : float
+        c_s (N m s/rad).
+    stick_stiffness : float
+        k_s (N m/rad).
+
+    Returns
+    -------
+    hold : float
+        k theta - c_s theta' - k_s (theta - theta_a), about the hinge axis (N m).
+    """
     return stiffness * angle - stick_damping * rate - stick_stiffness * (angle - anchor)
 
 
 @njit(cache=True)
 def friction_torque(hold, friction):
     """Friction torque (N m): the holding torque ``hold`` (N m) within the Coulomb limit ``friction``
-    (N m); at the limit the hinge slides with -+T_c."""
+    (N m); at the limit the hinge slides with -+T_c.
+
+    Parameters
+    ----------
+    hold : float
+        Holding torque (N m), :func:`holding_torque`.
+    friction : float
+        Coulomb limit T_c (N m), >= 0.
+
+    Returns
+    -------
+    torque : float
+        clip(hold, -T_c, T_c), on the appendage about the hinge axis (N m).
+    """
     return min(max(hold, -friction), friction)
 
 
 @njit(cache=True)
 def anchor_rate(angle, anchor, hold, friction, follow_rate):
     """d anchor / dt (rad/s): fixed while the hinge sticks (|hold| < T_c), following the sliding hinge
-    at ``follow_rate`` (1/s) so that it is at the angle where the hinge stops."""
+    at ``follow_rate`` (1/s) so that it is at the angle where the hinge stops.
+
+    Parameters
+    ----------
+    angle : float
+        Hinge angle (rad).
+    anchor : float
+        Stick anchor (rad).
+    hold : float
+        Holding torque (N m), :func:`holding_torque`.
+    friction : float
+        Coulomb limit T_c (N m).
+    follow_rate : float
+        Rate at which the anchor follows a sliding hinge (1/s).
+
+    Returns
+    -------
+    rate : float
+        (rad/s).
+    """
     return 0.0 if abs(hold) < friction else follow_rate * (angle - anchor)
 
 
 def stick_rate(plant: Plant) -> float:
-    """lambda_s (1/s): the stuck hinge's double decay rate x 2 and the anchor's follow rate."""
+    """lambda_s (1/s): the stuck hinge's double decay rate x 2 and the anchor's follow rate.
+
+    Parameters
+    ----------
+    plant : Plant
+        A hinged plant; its fastest motion rate (rad/s) sets lambda_s.
+
+    Returns
+    -------
+    rate : float
+        ``STICK_RATE_PER_MOTION_RATE`` times the plant's rate scale (1/s).
+    """
     return STICK_RATE_PER_MOTION_RATE * plant.rate_scale()
 
 
 def stick_gains(plant: Plant) -> tuple[float, float]:
     """(c_s (N m s/rad), k_s (N m/rad)): the stuck hinge J theta'' = -c_s theta' - k_s (theta - anchor)
-    is critically damped with its double root at -lambda_s / 2 (J: hinge mode with the body free)."""
+    is critically damped with its double root at -lambda_s / 2 (J: hinge mode with the body free).
+
+    Parameters
+    ----------
+    plant : Plant
+        A hinged plant (effective hinge inertia J, kg m^2).
+
+    Returns
+    -------
+    stick_damping, stick_stiffness : float
+        c_s = lambda_s J (N m s/rad), k_s = lambda_s^2 J / 4 (N m/rad).
+    """
     rate, inertia = stick_rate(plant), plant.effective_hinge_inertia()
     return rate * inertia, 0.25 * rate ** 2 * inertia
 
 
 @njit(LAW_SIGNATURE, cache=True)
 def law(t, x, p, env, load):
+    """Coulomb friction with stiction on the hinge, and the stick anchor's rate.
+
+    Parameters
+    ----------
+    t : float
+        Time (s) from the record's t = 0.
+    x : (STATE_SIZE,) float
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
+    p : (4,) float
+        [T_c (N m), c_s (N m s/rad), k_s (N m/rad), anchor follow rate (1/s)]
+        (:meth:`HingeCoulombFriction.law_parameters`).
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+    load : (LOAD_SIZE,) float
+        Loads, layout ``L_*``, added to in place: the hinge torque (``L_TH``, N m, about the axis) and
+        the anchor's rate (``L_ANCHOR``, rad/s).
+    """
     hold = holding_torque(x[X_TH], x[X_THD], x[X_ANCHOR], env[E_K], p[1], p[2])
     load[L_TH] += friction_torque(hold, p[0])
     load[L_ANCHOR] += anchor_rate(x[X_TH], x[X_ANCHOR], hold, p[0], p[3])
@@ -112,20 +206,80 @@ class HingeCoulombFriction(Effect):
     law = staticmethod(law)
 
     def parameter_specs(self, case, channels=None):
+        """The Coulomb torque T_c (N m), up to twice the hinge's torque scale.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case; a hinged appendage; its hinge torque scale sizes T_c.
+        channels : sequence of str, optional
+            Measured channel names (not used).
+        """
         scale = torque_scale(Plant.from_case(case))
         return [Parameter("friction_torque", "N m", "Coulomb friction torque magnitude (sliding and break-away)",
                           0.1 * scale, 0.0, 2.0 * scale)]
 
     def law_parameters(self, plant, values):
+        """[T_c, c_s, k_s, lambda_s]: the friction limit and the plant's stick gains.
+
+        Parameters
+        ----------
+        plant : Plant
+            A hinged plant (sets the stick gains).
+        values : (m,) float
+            [T_c (N m)].
+
+        Returns
+        -------
+        p : (4,) float
+            [T_c (N m), c_s (N m s/rad), k_s (N m/rad), lambda_s (1/s)].
+        """
         return np.array([float(values[0]), *stick_gains(plant), stick_rate(plant)])
 
     def parameter_free_stiffness_rate(self, plant):
+        """lambda_s plus the hinge damper's rate c / J (1/s): the stuck hinge's hold, whatever T_c.
+
+        Parameters
+        ----------
+        plant : Plant
+            A hinged plant.
+
+        Returns
+        -------
+        rate : float
+            (1/s).
+        """
         return stick_rate(plant) + plant.damping / plant.effective_hinge_inertia()
 
     def stiffness_rate(self, plant, specs):
+        """The parameter-free rate (the hold does not depend on T_c).
+
+        Parameters
+        ----------
+        plant : Plant
+            A hinged plant.
+        specs : list of Parameter
+            Not used.
+
+        Returns
+        -------
+        rate : float
+            (1/s).
+        """
         return self.parameter_free_stiffness_rate(plant)
 
     def add_to_exudyn(self, builder, values, names):
+        """The stick-slip friction on the hinge, with its anchor as a stateful user function.
+
+        Parameters
+        ----------
+        builder : ExudynScenario
+            The scenario builder; a hinge torque (N m, about the axis).
+        values : (m,) float
+            [T_c (N m)].
+        names : sequence of str
+            Parameter names (not used).
+        """
         builder.add_hinge_torque(_StickAnchor(float(values[0]), builder.plant))
 
 
@@ -164,7 +318,20 @@ def analytic_turning_points(theta0, stiffness, inertia, torque):
 
 def turning_points(times, angle):
     """Sampled turning points of a swing: local maxima of |angle| (``times`` (s) and ``angle`` (rad),
-    shape (k,)); returns their times (s) and angles (rad)."""
+    shape (k,)); returns their times (s) and angles (rad).
+
+    Parameters
+    ----------
+    times : (k,) float
+        Sample times (s).
+    angle : (k,) float
+        Hinge angle (rad).
+
+    Returns
+    -------
+    times, angles : (n,) float
+        Times (s) and hinge angles (rad) at the interior local maxima of |angle|.
+    """
     a = np.abs(angle)
     k = np.nonzero((a[1:-1] >= a[:-2]) & (a[1:-1] > a[2:]))[0] + 1
     return times[k], angle[k]

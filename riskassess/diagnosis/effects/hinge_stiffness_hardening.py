@@ -15,12 +15,42 @@ from riskassess.diagnosis.plant import Plant
 
 @njit(cache=True)
 def hardening_torque(angle, cubic_stiffness):
-    """Cubic spring torque (N m) at hinge ``angle`` (rad), ``cubic_stiffness`` (N m/rad^3)."""
+    """Cubic spring torque (N m) at hinge ``angle`` (rad), ``cubic_stiffness`` (N m/rad^3).
+
+    Parameters
+    ----------
+    angle : float
+        Hinge angle theta (rad).
+    cubic_stiffness : float
+        k_3 (N m/rad^3).
+
+    Returns
+    -------
+    torque : float
+        -k_3 theta^3, on the appendage about the hinge axis (N m).
+    """
     return -cubic_stiffness * angle ** 3
 
 
 @njit(LAW_SIGNATURE, cache=True)
 def law(t, x, p, env, load):
+    """The cubic hardening torque on the hinge.
+
+    Parameters
+    ----------
+    t : float
+        Time (s) from the record's t = 0.
+    x : (STATE_SIZE,) float
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
+    p : (1,) float
+        [k_3 (N m/rad^3)].
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+    load : (LOAD_SIZE,) float
+        Loads, layout ``L_*``, added to in place: the hinge torque (``L_TH``, N m, about the axis).
+    """
     load[L_TH] += hardening_torque(x[X_TH], p[0])
 
 
@@ -32,12 +62,32 @@ class HingeStiffnessHardening(Effect):
     law = staticmethod(law)
 
     def parameter_specs(self, case, channels=None):
+        """k_3 (N m/rad^3), typical: the hinge torque scale at the nominal amplitude cubed.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case; a hinged appendage; its hinge torque scale and amplitude size k_3.
+        channels : sequence of str, optional
+            Measured channel names (not used).
+        """
         plant = Plant.from_case(case)
         typical = torque_scale(plant) / reference_angle(plant) ** 3
         return [Parameter("cubic_stiffness", "N m/rad^3", "cubic hardening coefficient k3", typical, 0.0,
                           50.0 * typical)]
 
     def add_to_exudyn(self, builder, values, names):
+        """The cubic torque on the hinge.
+
+        Parameters
+        ----------
+        builder : ExudynScenario
+            The scenario builder; a hinge torque (N m, about the axis).
+        values : (m,) float
+            [k_3 (N m/rad^3)].
+        names : sequence of str
+            Parameter names (not used).
+        """
         builder.add_hinge_torque(lambda t, angle, rate: hardening_torque(angle, values[0]))
 
 

@@ -25,12 +25,47 @@ from multibody.towing_kernel import DEBRIS
 
 @njit(cache=True)
 def damper_torque(omega_body, omega_damper, inertia, time_constant):
-    """Torque on the body (N m, B) from the damper rotating at ``omega_damper`` (rad/s, B)."""
+    """Torque on the body (N m, B) from the damper rotating at ``omega_damper`` (rad/s, B).
+
+    Parameters
+    ----------
+    omega_body : (3,) float
+        Inertial angular velocity of the body, body frame (rad/s).
+    omega_damper : (3,) float
+        Inertial angular velocity of the damper rotor, body frame (rad/s).
+    inertia : float
+        Rotor inertia J_d (kg m^2).
+    time_constant : float
+        T_d = J_d / c (s), > 0.
+
+    Returns
+    -------
+    torque_body : (3,) float
+        c (omega_d - omega), body frame (N m).
+    """
     return inertia / time_constant * (omega_damper - omega_body)
 
 
 @njit(LAW_SIGNATURE, cache=True)
 def law(t, x, p, env, load):
+    """The damper's torque on the main body and the damper's angular acceleration.
+
+    Parameters
+    ----------
+    t : float
+        Time (s) from the record's t = 0.
+    x : (STATE_SIZE,) float
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
+        states).
+    p : (2,) float
+        [J_d (kg m^2), T_d (s)].
+    env : (ENV_SIZE,) float
+        Plant constants, layout ``E_*``.
+    load : (LOAD_SIZE,) float
+        Loads, layout ``L_*``, added to in place: the torque on the main body (``L_TM``, B, N m) and the
+        rate of the damper's angular velocity (``L_E``, B, rad/s^2).
+    """
     w = x[X_W:X_W + 3]
     wd = x[X_E:X_E + 3]
     torque = damper_torque(w, wd, p[0], p[1])
@@ -41,7 +76,30 @@ def law(t, x, p, env, load):
 @njit(TOWING_LAW_SIGNATURE, cache=True)
 def towing_law(t, q, v, p, work, xe, h, load):
     """The damper in the towed debris; its rate (``XE_DAMPER``, debris frame) advanced by explicit
-    Euler over the step (h / T_d <= 0.05 at the fit's 50 ms limit and T_d >= 1 s)."""
+    Euler over the step (h / T_d <= 0.05 at the fit's 50 ms limit and T_d >= 1 s).
+
+    Parameters
+    ----------
+    t : float
+        Time (s), the towing case's clock.
+    q, v : (15,) float
+        Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
+        displacements from their reference positions (m, ECI; P's are stale, see
+        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
+        (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
+    p : (2,) float
+        [J_d (kg m^2), T_d (s)].
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+    xe : (EXTRA_STATES,) float
+        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); ``XE_DAMPER``,
+        the rotor's angular velocity (rad/s, debris frame), advanced in place.
+    h : float
+        Step (s) over which ``xe`` is advanced; 0: do not advance.
+    load : (15,) float
+        Generalized forces, kernel layout, added to in place: the torque on the debris (N m, debris body
+        frame).
+    """
     w = v[DEBRIS + 3:DEBRIS + 6]
     wd = xe[XE_DAMPER:XE_DAMPER + 3]
     torque = damper_torque(w, wd, p[0], p[1])
@@ -60,17 +118,63 @@ class InternalEnergyDissipation(Effect):
     towing_law = staticmethod(towing_law)
 
     def parameter_specs(self, case, channels=None):
+        """J_d (kg m^2, up to 0.2 J_min) and T_d (s, 1 to 3000).
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case; the smallest principal inertia of its main body (kg m^2) sizes J_d.
+        channels : sequence of str, optional
+            Measured channel names (not used).
+        """
         j_min = float(np.linalg.eigvalsh(plant_of(case).inertia_main)[0])
         return [Parameter("damper_inertia", "kg m^2", "inertia of the damper rotor", 0.01 * j_min, 0.0, 0.2 * j_min),
                 Parameter("time_constant", "s", "damper time constant J_d / c", 30.0, 1.0, 3000.0)]
 
     def starts(self, specs):
+        """Two starts at the typical J_d: T_d = 10 s and 100 s.
+
+        Parameters
+        ----------
+        specs : list of Parameter
+            [damper_inertia, time_constant].
+
+        Returns
+        -------
+        starts : list of (m,) float
+            [J_d (kg m^2), T_d (s)].
+        """
         return [np.array([specs[0].typical, 10.0]), np.array([specs[0].typical, 100.0])]
 
     def stiffness_rate(self, plant, specs):
+        """1 / T_d at its lower bound (1/s): the damper's fastest relaxation.
+
+        Parameters
+        ----------
+        plant : Plant
+            Not used.
+        specs : list of Parameter
+            [damper_inertia, time_constant]; the lower bound of T_d (s) sets the rate.
+
+        Returns
+        -------
+        rate : float
+            (1/s).
+        """
         return 1.0 / specs[1].lower
 
     def add_to_exudyn(self, builder, values, names):
+        """A rotor body of inertia J_d coupled to the main body by a rotational damper c = J_d / T_d.
+
+        Parameters
+        ----------
+        builder : ExudynScenario
+            The scenario builder (its damper hook: J_d (kg m^2), c (N m s)).
+        values : (m,) float
+            [J_d (kg m^2), T_d (s)]; J_d = 0 adds nothing.
+        names : sequence of str
+            Parameter names (not used).
+        """
         if values[0] > 0:
             builder.add_damper(values[0], values[0] / values[1])
 

@@ -29,6 +29,15 @@ class SensorBias(Effect):
     linear = True
 
     def parameter_specs(self, case, channels=None):
+        """One bias ``bias_<channel>`` per measured channel that may carry one, in that channel's unit.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case; hinge channels only for a hinged appendage, tension only for towing.
+        channels : sequence of str, optional
+            Measured channel names; None: every channel of ``BIASED``.
+        """
         present = [c for c in BIASED if channels is None or c in channels]
         if case.kind != "hinged_appendage":
             present = [c for c in present if not c.startswith("hinge")]
@@ -36,9 +45,37 @@ class SensorBias(Effect):
                 for c in present if c != "tether_tension" or case.kind == "towing"]
 
     def starts(self, specs):
+        """One start: no bias.
+
+        Parameters
+        ----------
+        specs : list of Parameter
+            The biases.
+
+        Returns
+        -------
+        starts : list of (m,) float
+            Zeros (channel units).
+        """
         return [np.zeros(len(specs))]
 
     def measure(self, outputs, values, names):
+        """Each channel plus its bias.
+
+        Parameters
+        ----------
+        outputs : dict of str to (k,) float
+            Simulated channels (units of :mod:`riskassess.diagnosis.channels`).
+        values : (m,) float
+            The biases (channel units: rad/s, rad, m, N).
+        names : sequence of str, length m
+            ``bias_<channel>``: which channel each bias is added to.
+
+        Returns
+        -------
+        outputs : dict of str to (k,) float
+            A copy with the biases added.
+        """
         out = dict(outputs)
         for name, value in zip(names, values):
             channel = name.removeprefix("bias_")

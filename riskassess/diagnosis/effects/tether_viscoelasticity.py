@@ -38,7 +38,20 @@ from multibody.towing_kernel import K_MT, L_MT, MT_ELONGATION
 
 @njit(cache=True)
 def step_gain(relaxation_time, h):
-    """b / k_m: the branch's stiffness over a step of ``h`` (s) per unit k_m (-); 1 for h << tau_m."""
+    """b / k_m: the branch's stiffness over a step of ``h`` (s) per unit k_m (-); 1 for h << tau_m.
+
+    Parameters
+    ----------
+    relaxation_time : float
+        tau_m (s), > 0.
+    h : float
+        Step (s).
+
+    Returns
+    -------
+    gain : float
+        (1 - exp(-h/tau_m)) / (h/tau_m) (-).
+    """
     ratio = h / relaxation_time
     return (1.0 - math.exp(-ratio)) / ratio if ratio > 1e-8 else 1.0 - 0.5 * ratio
 
@@ -47,7 +60,26 @@ def step_gain(relaxation_time, h):
 def branch_after(maxwell_tension, elongation_before, elongation_after, maxwell_stiffness, relaxation_time, h):
     """T_m (N) after a step of ``h`` (s) in which the elongation went from ``elongation_before`` to
     ``elongation_after`` (m) at a constant rate (the exact solution), loaded over the stretched part
-    only and kept >= 0."""
+    only and kept >= 0.
+
+    Parameters
+    ----------
+    maxwell_tension : float
+        T_m at the step's start (N).
+    elongation_before, elongation_after : float
+        Main-tether elongation e = l - l0 at the step's start and end (m).
+    maxwell_stiffness : float
+        k_m (N/m).
+    relaxation_time : float
+        tau_m (s).
+    h : float
+        Step (s).
+
+    Returns
+    -------
+    maxwell_tension : float
+        T_m at the step's end (N), >= 0.
+    """
     decay = math.exp(-h / relaxation_time)
     change = max(elongation_after, 0.0) - max(elongation_before, 0.0)
     return max(0.0, maxwell_tension * decay + maxwell_stiffness * step_gain(relaxation_time, h) * change)
@@ -56,7 +88,30 @@ def branch_after(maxwell_tension, elongation_before, elongation_after, maxwell_s
 @njit(TOWING_LAW_SIGNATURE, cache=True)
 def towing_law(t, q, v, p, work, xe, h, load):
     """``p`` = [k_m, tau_m, k (N/m), l0 (m) of the case's main tether]. Sets the kernel's main-tether
-    stiffness and rest length for the coming step (no load)."""
+    stiffness and rest length for the coming step (no load).
+
+    Parameters
+    ----------
+    t : float
+        Time (s), the towing case's clock.
+    q, v : (15,) float
+        Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
+        displacements from their reference positions (m, ECI; P's are stale, see
+        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
+        (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
+    p : (4,) float
+        [k_m (N/m), tau_m (s), the case's main-tether stiffness k (N/m) and rest length l0 (m)].
+    work : (w,) float
+        Packed towing model (:func:`multibody.towing.packed`).
+    xe : (EXTRA_STATES,) float
+        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); ``XE_MAXWELL``
+        (N) and ``XE_ELONGATION`` (m), advanced in place.
+    h : float
+        Step (s) over which ``xe`` is advanced; 0: do not advance.
+    load : (15,) float
+        Generalized forces, kernel layout, added to in place: none (the branch acts through the main
+        tether's stiffness and rest length in ``work``).
+    """
     if h <= 0.0:
         return
     k_m, tau, k, rest = p[0], p[1], p[2], p[3]
@@ -80,11 +135,34 @@ class TetherViscoelasticity(Effect):
     towing_law = staticmethod(towing_law)
 
     def towing_law_parameters(self, plant, values):
+        """[k_m, tau_m] followed by the case's main-tether stiffness and rest length.
+
+        Parameters
+        ----------
+        plant : TowingPlant
+            The towing plant (its case's main tether).
+        values : (m,) float
+            [k_m (N/m), tau_m (s)].
+
+        Returns
+        -------
+        p : (4,) float
+            [k_m (N/m), tau_m (s), k (N/m), l0 (m)].
+        """
         tether = plant.case.main_tether
         return np.r_[np.asarray(values, float), tether.stiffness, tether.natural_length]
 
     def parameter_specs(self, case, channels=None):
         # (outside towing the effect is not applicable; 1 kN/m only sizes the listed parameters)
+        """k_m (N/m) and tau_m (s), both fitted on a log scale.
+
+        Parameters
+        ----------
+        case : DiagnosisCase
+            Validated diagnosis case; the towing case's main-tether stiffness (N/m) sizes k_m.
+        channels : sequence of str, optional
+            Measured channel names (not used).
+        """
         k = case.towing_case.main_tether.stiffness if case.kind == "towing" else 1000.0
         # typical: a branch as stiff as the tether relaxing over tens of seconds (creep of a polymer braid);
         # weaker or faster branches hide in the damped tether (c = 300 N s/m in the Zenit-2 case)
@@ -100,7 +178,18 @@ class TetherViscoelasticity(Effect):
         """A grid over both parameters' decades (k_m: k / 3 .. 3 k; tau_m: 3 .. 300 s): a towing candidate's
         fit starts from the best of them on the training span (one run each, riskassess.diagnosis.fit), as the
         fit from one start stopped in another basin (k_m 8384 N/m and tau_m 151 s, chi^2 1060 above
-        the truth's, for a 12000 N/m, 80 s tether; docs/diagnosis.md)."""
+        the truth's, for a 12000 N/m, 80 s tether; docs/diagnosis.md).
+
+        Parameters
+        ----------
+        specs : list of Parameter
+            [maxwell_stiffness, relaxation_time].
+
+        Returns
+        -------
+        starts : list of (m,) float
+            Nine [k_m (N/m), tau_m (s)].
+        """
         return [np.array([k_m, tau]) for k_m in specs[0].typical * np.array([1 / 3, 1.0, 3.0])
                 for tau in (3.0, 30.0, 300.0)]
 

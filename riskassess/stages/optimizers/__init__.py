@@ -22,7 +22,18 @@ for _info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
 
 
 def optimizer_search(name: str):
-    """The ``search`` function of optimizer ``name``; ``ValueError`` listing the known names."""
+    """The ``search`` function of optimizer ``name``; ``ValueError`` listing the known names.
+
+    Parameters
+    ----------
+    name : str
+        An optimizer name (:data:`OPTIMIZERS`).
+
+    Returns
+    -------
+    callable
+        ``search(problem, x0, settings) -> (s, cost)``.
+    """
     if name not in OPTIMIZERS:
         raise ValueError(f"unknown optimizer '{name}'; the optimizers are: {', '.join(sorted(OPTIMIZERS))}")
     return OPTIMIZERS[name].search

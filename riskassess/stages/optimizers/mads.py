@@ -31,7 +31,22 @@ def _evaluate_block(problem, block) -> list[bool]:
 
 def search(problem, x0, settings):
     """MADS from ``x0`` within the problem's bounds; returns (best s, best cost). An error inside an
-    evaluation stops the search and is raised here (NOMAD's C++ side cannot carry it)."""
+    evaluation stops the search and is raised here (NOMAD's C++ side cannot carry it).
+
+    Parameters
+    ----------
+    problem : riskassess.stages.identify.TowingFit
+        The bounded pymoo problem (4 variables).
+    x0 : (4,) float
+        Start point s_0, inside the bounds.
+    settings : identification.optimizers table
+        ``mads_evaluations``, ``mads_iterations``, ``mads_mesh_tolerance``, ``seed``.
+
+    Returns
+    -------
+    s : (4,) float
+    cost : float
+    """
     params = ["BB_OUTPUT_TYPE OBJ", f"MAX_BB_EVAL {settings.mads_evaluations}",
               f"MAX_ITERATIONS {settings.mads_iterations}", f"MIN_MESH_SIZE * {settings.mads_mesh_tolerance:g}",
               f"BB_MAX_BLOCK_SIZE {2 * problem.n_var}", f"SEED {settings.seed}", "DISPLAY_DEGREE 0"]

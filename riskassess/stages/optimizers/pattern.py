@@ -18,7 +18,22 @@ FIRST_DELTA = 0.25
 
 def search(problem, x0, settings):
     """:func:`restarted_pattern_search` from ``x0`` with first step :data:`FIRST_DELTA` and
-    ``settings.pattern_evaluations`` evaluations."""
+    ``settings.pattern_evaluations`` evaluations.
+
+    Parameters
+    ----------
+    problem : riskassess.stages.identify.TowingFit
+        The bounded pymoo problem (4 variables).
+    x0 : (4,) float
+        Start point s_0.
+    settings : identification.optimizers table
+        The case's optimizer settings.
+
+    Returns
+    -------
+    s : (4,) float
+    cost : float
+    """
     return restarted_pattern_search(problem, x0, settings, FIRST_DELTA, settings.pattern_evaluations)
 
 
@@ -72,7 +87,21 @@ def restarted_pattern_search(problem, x0, settings, first_delta, budget):
     A leg without improvement shrinks all steps tenfold. A leg ends when its step is below
     ``settings.pattern_tolerance`` of every bound range (:class:`StepTolerance`) or after
     ``settings.restart_evaluations``; the search stops after ``budget`` evaluations or when every first step
-    is below the tolerance. Returns (best s, best cost)."""
+    is below the tolerance. Returns (best s, best cost).
+
+    Parameters
+    ----------
+    problem : riskassess.stages.identify.TowingFit
+        The bounded pymoo problem (4 variables); its ``evaluations`` count the budget.
+    x0 : (4,) float
+        Start point.
+    settings : identification.optimizers table
+        ``restart_evaluations``, ``pattern_tolerance``, ``seed``.
+    first_delta : float
+        First exploration step, as a fraction of each bound range (-).
+    budget : int
+        Total evaluations of the problem after which no leg starts.
+    """
     span = problem.xu - problem.xl
     x, f, delta = np.asarray(x0, float), np.inf, np.full(problem.n_var, float(first_delta))
     leg = 0
