@@ -129,7 +129,8 @@ structref.define_proxy(NetTowKernel, NetTowKernelType, _NET_TOW_FIELDS)
 @njit(cache=True)
 def net_tow_kernel(x, xv, lag, clock, net, reference, mu, central, attach_c, body_masses, inertia, debris, n_sub, step,
                    control, body_reference, acc, diag, f, work):
-    """The :class:`NetTowKernel` of these fields (compiled once and cached, unlike the proxy's own constructor)."""
+    """The :class:`NetTowKernel` of these fields (compiled once and cached, unlike the proxy's own
+    constructor); the parameters are its fields (shapes, units and frames in :class:`NetTowKernel`)."""
     return NetTowKernel(x, xv, lag, clock, net, reference, mu, central, attach_c, body_masses, inertia, debris, n_sub,
                         step, control, body_reference, acc, diag, f, work)
 

@@ -364,7 +364,19 @@ CHASER_CONTROL = ChaserControlType([("attitude", _VECTOR), ("thrust", THRUST_LAW
 
 @njit(CHASER_CONTROL(_VECTOR, THRUST_LAW, types.boolean, _VECTOR, _VECTOR), cache=True)
 def chaser_control(attitude, thrust, along_body_z, thrust_params, thrust_state):
-    """The :class:`ChaserControl` of these fields (arrays shared, not copied)."""
+    """The :class:`ChaserControl` of these fields (arrays shared, not copied).
+
+    Parameters
+    ----------
+    attitude : (8,) float
+        On (1/0), K (1/s), G (3,) (rad/s^2), epsilon (3,) (rad/s).
+    thrust : first-class function
+        The thrust law's compiled command (:data:`multibody.control.thrust.THRUST_LAW`).
+    along_body_z : bool
+        Thrust along the chaser's body z (True) or against its inertial velocity.
+    thrust_params, thrust_state : (k,), (j,) float
+        The law's constants and states (states advanced in place).
+    """
     control = structref.new(CHASER_CONTROL)
     control.attitude = attitude
     control.thrust = thrust

@@ -121,6 +121,27 @@ def towing_forces(q, v, t, parts, thrust, step, advance, out_force, out_diag):
     thrust law's state advances by ``step`` (s) when ``advance``. ``out_diag`` receives MT tension,
     elongation and rate, thrust magnitude, control torque (3, body), sliding variable (3) and the ST
     tensions.
+
+    Parameters
+    ----------
+    q, v : (15,) float
+        State at ``t``, kernel layout (module doc): P, chaser and debris displacements from the
+        reference positions (m, inertial) and rotation vectors body -> inertial (rad); velocities
+        (m/s, inertial) and angular velocities (rad/s, body frames).
+    t : float
+        Time (s).
+    parts : TowingParts
+        The model's constants.
+    thrust : ThrustLaw
+        The thrust law, its parameters and state.
+    step : float
+        The controller's sampling step (s).
+    advance : bool
+        Advance the thrust law's state.
+    out_force : (15,) float
+        Generalized forces, kernel layout (N, inertial; N m, body frames), overwritten.
+    out_diag : (ST_TENSION + n,) float
+        Diagnostics (N, m, m/s, N, N m body, rad/s, N), written.
     """
     reference, masses, inertia_chaser, attach_chaser, attach_debris, tether, mu, attitude = parts
     command, thrust_along_body_z, thrust_params, thrust_state = thrust
@@ -255,7 +276,15 @@ TOW_KERNEL = TowKernelType([("work", _VECTOR), ("thrust", THRUST_LAW)])
 @njit(TOW_KERNEL(_VECTOR, THRUST_LAW), cache=True)
 def tow_kernel(work, thrust):
     """The :class:`TowKernel` of the packed model ``work`` (:func:`pack`, shared, not copied) and the
-    thrust law ``thrust`` (a compiled ``command`` of :mod:`multibody.control.thrust_laws`)."""
+    thrust law ``thrust`` (a compiled ``command`` of :mod:`multibody.control.thrust_laws`).
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed model (:func:`pack`).
+    thrust : first-class function
+        The thrust law's compiled command (:data:`multibody.control.thrust.THRUST_LAW`).
+    """
     tow = structref.new(TOW_KERNEL)
     tow.work = work
     tow.thrust = thrust
@@ -399,7 +428,27 @@ LOAD_LAW = types.FunctionType(LOAD_LAW_SIGNATURE)
 
 @njit(LOAD_LAW_SIGNATURE, cache=True)
 def no_load(t, q, v, p, work, xe, h, load):
-    """The nominal model: no further loads."""
+    """The nominal model: no further loads (:data:`LOAD_LAW_SIGNATURE`; every argument unused).
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    q, v : (15,) float
+        State, kernel layout (module doc): displacements from the reference positions (m, inertial)
+        and rotation vectors body -> inertial (rad); velocities (m/s, inertial) and angular
+        velocities (rad/s, body frames).
+    p : (j,) float
+        The law's parameters.
+    work : (w,) float
+        Packed model (:func:`pack`).
+    xe : (e,) float
+        The caller's own states.
+    h : float
+        Step (s) over which ``xe`` is advanced; 0: do not advance.
+    load : (15,) float
+        Generalized forces, kernel layout, added to in place: nothing.
+    """
     return
 
 
@@ -407,7 +456,29 @@ def no_load(t, q, v, p, work, xe, h, load):
       cache=True)
 def apply_loads(law, t, q, v, p, work, xe, h, load):
     """Evaluate ``law`` at (``t``, ``q``, ``v``) into ``load`` and make it the packed model's further
-    forces for the coming force evaluation (advancing the states ``xe`` over ``h``)."""
+    forces for the coming force evaluation (advancing the states ``xe`` over ``h``).
+
+    Parameters
+    ----------
+    law : first-class function
+        Load law (:data:`LOAD_LAW_SIGNATURE`).
+    t : float
+        Time (s).
+    q, v : (15,) float
+        State, kernel layout (module doc): displacements from the reference positions (m, inertial)
+        and rotation vectors body -> inertial (rad); velocities (m/s, inertial) and angular
+        velocities (rad/s, body frames).
+    p : (j,) float
+        The law's parameters.
+    work : (w,) float
+        Packed model (:func:`pack`); its further-forces section is overwritten with ``load``.
+    xe : (e,) float
+        The caller's own states, advanced in place by the law.
+    h : float
+        Step (s) over which ``xe`` is advanced; 0: do not advance.
+    load : (15,) float
+        Scratch, overwritten with the law's generalized forces (N, inertial; N m, body frames).
+    """
     load[:] = 0.0
     law(t, q, v, p, work, xe, h, load)
     extra = extra_forces(work)
@@ -428,7 +499,36 @@ def verlet_run(tow, law, p, q, v, t0, n_steps, xe, record, out_q, out_v, out_dia
     state, diagnostics (at the recorded state, thrust law not advanced) and ``xe`` after the steps
     listed in ``record`` (non-decreasing step indices, 0 = the initial state) into the ``out_*``
     rows (record indices beyond ``n_steps`` are not reached). ``q``, ``v``, ``xe`` and ``tow.work``
-    are updated in place."""
+    are updated in place.
+
+    Parameters
+    ----------
+    tow : TowKernel
+        The packed model and its thrust law (:func:`tow_kernel`).
+    law : first-class function
+        Load law (:data:`LOAD_LAW_SIGNATURE`), :func:`no_load` for none.
+    p : (j,) float
+        The law's parameters (at least one entry).
+    q, v : (15,) float
+        State, kernel layout (module doc): displacements from the reference positions (m, inertial)
+        and rotation vectors body -> inertial (rad); velocities (m/s, inertial) and angular
+        velocities (rad/s, body frames).
+        Advanced in place.
+    t0 : float
+        Start time (s).
+    n_steps : int
+        Number of steps of the model's step ``work[W_STEP]`` (s).
+    xe : (e,) float
+        The law's own states (at least one entry), advanced in place.
+    record : (r,) int64
+        Step indices to record, non-decreasing.
+    out_q, out_v : (r, 15) float
+        Recorded states (kernel layout, units of ``q``, ``v``), written.
+    out_diag : (r, ST_TENSION + n) float
+        Recorded diagnostics (:func:`towing_forces`: N, m, m/s, N, N m, rad/s, N), written.
+    out_xe : (r, e) float
+        Recorded ``xe``, written.
+    """
     work = tow.work
     step = work[W_STEP]
     load = np.zeros(N_COORDINATES)

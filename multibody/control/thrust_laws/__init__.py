@@ -28,7 +28,13 @@ for _info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
 
 
 def thrust_law(name: str) -> ModuleType:
-    """The law module called ``name``; a ValueError listing the known laws otherwise."""
+    """The law module called ``name``; a ValueError listing the known laws otherwise.
+
+    Parameters
+    ----------
+    name : str
+        A case's ``thrust.kind``.
+    """
     if name not in LAWS:
         raise ValueError(f"thrust.kind: unknown thrust law '{name}'; the known laws are: {', '.join(LAWS)}")
     return LAWS[name]

@@ -15,7 +15,17 @@ CASE_SECTIONS = ()
 @njit(cache=True)
 def ramp_thrust(t, t_on, t_slope, f_max):
     """Open-loop thrust magnitude (N): zero until ``t_on``, linear to ``f_max`` over ``t_slope``,
-    then constant (s, s, N)."""
+    then constant.
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    t_on, t_slope : float
+        Thrust-on time and ramp duration (s).
+    f_max : float
+        Final thrust (N).
+    """
     if t <= t_on:
         return 0.0
     if t < t_on + t_slope:
@@ -25,11 +35,37 @@ def ramp_thrust(t, t_on, t_slope, f_max):
 
 @njit(THRUST_SIGNATURE, cache=True)
 def command(t, z, z_rate, params, state, step, advance):
-    """:func:`ramp_thrust` behind the common interface (:mod:`multibody.control.thrust`)."""
+    """:func:`ramp_thrust` behind the common interface (:mod:`multibody.control.thrust`).
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    z, z_rate : float
+        Main-tether elongation (m) and rate (m/s); not used (open loop).
+    params : (3,) float
+        t_on (s), t_slope (s), f_max (N).
+    state : (1,) float
+        Not used.
+    step : float
+        Sampling step (s); not used.
+    advance : bool
+        Not used.
+    """
     return ramp_thrust(t, params[0], params[1], params[2])
 
 
 def arrays(case, tether, z0, z_rate0) -> tuple[np.ndarray, np.ndarray]:
-    """``params`` from the case's ``[thrust]`` table; the state is one unused slot."""
+    """``params`` from the case's ``[thrust]`` table; the state is one unused slot.
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        The towing case (read: ``thrust``).
+    tether : (>= 2,) float
+        Main tether k_MT (N/m), c_MT (N s/m), ...; not used.
+    z0, z_rate0 : float
+        Initial elongation (m) and rate (m/s); not used.
+    """
     th = case.thrust
     return np.array([th.t_on, th.t_slope, th.max_force]), np.zeros(1)
