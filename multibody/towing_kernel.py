@@ -462,20 +462,10 @@ def apply_loads(law, t, q, v, p, work, xe, h, load):
     ----------
     law : first-class function
         Load law (:data:`LOAD_LAW_SIGNATURE`).
-    t : float
-        Time (s).
-    q, v : (15,) float
-        State, kernel layout (module doc): displacements from the reference positions (m, inertial)
-        and rotation vectors body -> inertial (rad); velocities (m/s, inertial) and angular
-        velocities (rad/s, body frames).
-    p : (j,) float
-        The law's parameters.
+    t, q, v, p, xe, h
+        As the law takes them (:func:`no_load`); ``xe`` advanced in place by the law.
     work : (w,) float
         Packed model (:func:`pack`); its further-forces section is overwritten with ``load``.
-    xe : (e,) float
-        The caller's own states, advanced in place by the law.
-    h : float
-        Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float
         Scratch, overwritten with the law's generalized forces (N, inertial; N m, body frames).
     """

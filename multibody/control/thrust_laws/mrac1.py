@@ -23,29 +23,17 @@ LAMBDA0, K_S, GAMMA, XI_H, XI_A1, XI_A2 = range(8, 14)
 
 @njit(THRUST_SIGNATURE, cache=True)
 def command(t, z, z_rate, params, state, step, advance):
-    """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16).
+    """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16), saturated at u_max; 0 before t_on.
 
     Parameters
     ----------
-    t : float
-        Time (s).
-    z : float
-        Main-tether elongation (m).
-    z_rate : float
-        Its rate (m/s).
-    params : (k,) float
-        The law's constants (module doc).
-    state : (j,) float
-        The law's state (module doc), advanced in place when ``advance``.
-    step : float
-        The controller's sampling step (s).
-    advance : bool
-        True once per new sampling time: integrate the adaptive and reference states.
-
-    Returns
-    -------
-    float
-        Commanded thrust (N), saturated at ``u_max``; 0 before ``t_on``.
+    t, z, z_rate, step, advance
+        As in the thrust-law interface (:mod:`multibody.control.thrust`): time (s), main-tether
+        elongation (m) and rate (m/s), sampling step (s), whether to advance the states.
+    params : (14,) float
+        The common head (:mod:`multibody.control.mrac`), then lambda_0 (1/s), k_s (N s/m), gamma, xi_h, xi_a (2) (-).
+    state : (5,) float
+        z_m (m), z_m rate (m/s), h (kg), a1 (N/m), a2 (N s/m); advanced in place when ``advance``.
     """
     if t < params[T_ON]:
         return 0.0
@@ -73,14 +61,9 @@ def arrays(case, tether, z0, z_rate0) -> tuple[np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    case : riskassess.cases.towing.TowingCase
-        The towing case (read: ``thrust``, ``mrac``, ``chaser.mass``, ``main_tether.stiffness``).
-    tether : (>= 2,) float
-        k_MT (N/m), c_MT (N s/m), ... of the model's main tether.
-    z0 : float
-        Main-tether elongation at the start (m).
-    z_rate0 : float
-        Its rate (m/s).
+    case, tether, z0, z_rate0
+        See :mod:`multibody.control.thrust_laws`; reads ``[thrust]``, ``[mrac]`` (MRAC-1 gains), the
+        chaser mass and k_MT, c_MT.
     """
     m = case.mrac
     params = np.array(common_params(case, tether) + [m.lambda0, m.k_s, m.gamma, m.xi_h, *m.xi_a], float)

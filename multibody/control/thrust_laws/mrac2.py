@@ -24,7 +24,7 @@ GZ1, GZ2, GAMMA_R, GT1, GT2, XI_2, P11, P12, P21, P22 = range(8, 18)
 
 @njit(THRUST_SIGNATURE, cache=True)
 def command(t, z, z_rate, params, state, step, advance):
-    """MRAC-2 thrust (N), eqs. (19)-(21).
+    """MRAC-2 thrust (N), eqs. (19)-(21), saturated at u_max; 0 before t_on.
 
     The :math:`\\hat\\Theta` law is taken with the sign that makes the Lyapunov derivative of
     the e-modification vanish for :math:`u = \\dots - \\hat\\Theta^T\\phi` (Lavretsky & Wise 2013,
@@ -33,25 +33,12 @@ def command(t, z, z_rate, params, state, step, advance):
 
     Parameters
     ----------
-    t : float
-        Time (s).
-    z : float
-        Main-tether elongation (m).
-    z_rate : float
-        Its rate (m/s).
-    params : (k,) float
-        The law's constants (module doc).
-    state : (j,) float
-        The law's state (module doc), advanced in place when ``advance``.
-    step : float
-        The controller's sampling step (s).
-    advance : bool
-        True once per new sampling time: integrate the adaptive and reference states.
-
-    Returns
-    -------
-    float
-        Commanded thrust (N), saturated at ``u_max``; 0 before ``t_on``.
+    t, z, z_rate, step, advance
+        As :func:`multibody.control.thrust_laws.mrac1.command` takes them (s, m, m/s, s, bool).
+    params : (18,) float
+        The common head (:mod:`multibody.control.mrac`), then Gamma_z (2), gamma_r, Gamma_theta (2), xi_2, P (2x2).
+    state : (7,) float
+        z_m (m), z_m rate (m/s), Kz (2), kr, Theta (2); advanced in place when ``advance``.
     """
     if t < params[T_ON]:
         return 0.0
@@ -84,14 +71,9 @@ def arrays(case, tether, z0, z_rate0) -> tuple[np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    case : riskassess.cases.towing.TowingCase
-        The towing case (read: ``thrust``, ``mrac``, ``chaser.mass``, ``main_tether.stiffness``).
-    tether : (>= 2,) float
-        k_MT (N/m), c_MT (N s/m), ... of the model's main tether.
-    z0 : float
-        Main-tether elongation at the start (m).
-    z_rate0 : float
-        Its rate (m/s).
+    case, tether, z0, z_rate0
+        See :mod:`multibody.control.thrust_laws`; reads ``[thrust]``, ``[mrac]`` (MRAC-2 gains and Q),
+        the chaser mass and k_MT, c_MT.
     """
     m = case.mrac
     head = common_params(case, tether)

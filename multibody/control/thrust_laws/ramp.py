@@ -41,16 +41,10 @@ def command(t, z, z_rate, params, state, step, advance):
     ----------
     t : float
         Time (s).
-    z, z_rate : float
-        Main-tether elongation (m) and rate (m/s); not used (open loop).
     params : (3,) float
         t_on (s), t_slope (s), f_max (N).
-    state : (1,) float
-        Not used.
-    step : float
-        Sampling step (s); not used.
-    advance : bool
-        Not used.
+    z, z_rate, state, step, advance
+        Not used (open loop, no state).
     """
     return ramp_thrust(t, params[0], params[1], params[2])
 
@@ -60,12 +54,10 @@ def arrays(case, tether, z0, z_rate0) -> tuple[np.ndarray, np.ndarray]:
 
     Parameters
     ----------
-    case : riskassess.cases.towing.TowingCase
-        The towing case (read: ``thrust``).
-    tether : (>= 2,) float
-        Main tether k_MT (N/m), c_MT (N s/m), ...; not used.
-    z0, z_rate0 : float
-        Initial elongation (m) and rate (m/s); not used.
+    case
+        The towing case (:mod:`multibody.control.thrust_laws`); read: ``thrust``.
+    tether, z0, z_rate0
+        Not used.
     """
     th = case.thrust
     return np.array([th.t_on, th.t_slope, th.max_force]), np.zeros(1)
