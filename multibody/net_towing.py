@@ -130,7 +130,13 @@ structref.define_proxy(NetTowKernel, NetTowKernelType, _NET_TOW_FIELDS)
 def net_tow_kernel(x, xv, lag, clock, net, reference, mu, central, attach_c, body_masses, inertia, debris, n_sub, step,
                    control, body_reference, acc, diag, f, work):
     """The :class:`NetTowKernel` of these fields (compiled once and cached, unlike the proxy's own
-    constructor); the parameters are its fields (shapes, units and frames in :class:`NetTowKernel`)."""
+    constructor).
+
+    Parameters
+    ----------
+    x, xv, lag, clock, net, reference, mu, central, attach_c, body_masses, inertia, debris, n_sub, step, control, body_reference, acc, diag, f, work
+        The fields of :class:`NetTowKernel` (shapes, units and frames there).
+    """
     return NetTowKernel(x, xv, lag, clock, net, reference, mu, central, attach_c, body_masses, inertia, debris, n_sub,
                         step, control, body_reference, acc, diag, f, work)
 
@@ -145,7 +151,21 @@ def step_forces(q, v, t, advance, main_tether, tow):
     ``clock[CLOCK_TIME]`` to ``t`` (:func:`multibody.net_towing_kernel.advance_net`) and the bodies get
     the step's mean reactions; otherwise (the solver's initial evaluation, output samples) the
     reactions at the current state. Thrust and attitude torque (``control``, a
-    :class:`multibody.net_towing_kernel.ChaserControl`) and gravity are evaluated at ``t``."""
+    :class:`multibody.net_towing_kernel.ChaserControl`) and gravity are evaluated at ``t``.
+
+    Parameters
+    ----------
+    q, v : (12,) float
+        Chaser and debris coordinates and velocities (see above).
+    t : float
+        Time (s, absolute).
+    advance : bool
+        Sub-cycle the net to ``t`` and advance the thrust law.
+    main_tether : (3,) float
+        k_MT (N/m), c_MT (N s/m), l_MT0 (m).
+    tow : NetTowKernel
+        The run.
+    """
     x, xv, lag, clock, net, reference = tow.x, tow.xv, tow.lag, tow.clock, tow.net, tow.reference
     mu, central, attach_c, body_masses, inertia, debris_body = (tow.mu, tow.central, tow.attach_c, tow.body_masses,
                                                                 tow.inertia, tow.debris)

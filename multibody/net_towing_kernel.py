@@ -169,6 +169,37 @@ def net_forces(x, v, lag, net, reference, mu, central, end, motion, debris, h, f
     (m^3/s^2), ``h`` the sub-step (s); ``f``, ``acc``, ``work`` buffers.
     Returns the main tether's (tension, elongation, elongation rate). With ``explicit_tether`` False
     the main tether is left out (the sub-cycle steps it implicitly, :func:`_implicit_tether_step`).
+
+    Parameters
+    ----------
+    x, v : (n, 3) float
+        Node positions relative to ``reference`` (m) and velocities (m/s), inertial.
+    lag : (n, 3) float
+        Contact velocity lags (m/s), released and set in place.
+    net : NetThreads
+        Nodes and threads.
+    reference : (3,) float
+        Origin of the node positions, absolute (m).
+    mu : float
+        Gravitational parameter (m^3/s^2); 0: no gravity.
+    central : int
+        Node the main tether holds.
+    end : TetherEnd
+        Main tether and its chaser end A.
+    motion : DebrisMotion
+        The debris' motion at this sub-step.
+    debris : DebrisBody
+        The debris cylinder, its mass properties and the contact law.
+    h : float
+        Sub-step (s).
+    f : (n, 3) float
+        Node forces (N, inertial), overwritten.
+    acc : (ACC_SIZE,) float
+        Impulses and scalars (``ACC_*``), added to.
+    work : (21,) float
+        Scratch of the contact solver.
+    explicit_tether : bool
+        Include the main tether's force.
     """
     node_mass, node_radius, threads, rest, stiffness, damping = net
     main_tether, a_point, a_velocity, com_c = end
@@ -270,7 +301,29 @@ def advance_net(x, v, lag, t_start, t_end, n_sub, net, reference, mu, central, m
     (:class:`NetThreads`), ``debris`` (:class:`DebrisBody`), ``main_tether`` = [k_MT (N/m), c_MT (N s/m),
     l_MT0 (m)], ``attach_chaser_body`` (3,) A in the chaser frame (m). ``acc`` (ACC_SIZE) is
     zeroed and receives the impulses over the step (:func:`net_forces`). Returns the main tether's
-    (tension, elongation, rate) at the last sub-step."""
+    (tension, elongation, rate) at the last sub-step.
+
+    Parameters
+    ----------
+    x, v, lag : (n, 3) float
+        Net state (:func:`net_forces`), advanced in place.
+    t_start, t_end : float
+        The step's interval (s).
+    n_sub : int
+        Sub-steps.
+    net, reference, mu, central
+        As :func:`net_forces` takes them.
+    main_tether : (3,) float
+        k_MT (N/m), c_MT (N s/m), l_MT0 (m).
+    attach_chaser_body : (3,) float
+        A in the chaser frame (m).
+    bodies : (2, 12) float
+        See above.
+    debris : DebrisBody
+        The debris cylinder, its mass properties and the contact law.
+    f, acc, work
+        Buffers (:func:`net_forces`); ``acc`` zeroed first.
+    """
     node_mass = net.node_mass
     acc[:] = 0.0
     h = (t_end - t_start) / n_sub
@@ -392,7 +445,35 @@ def chaser_actuation(t, elongation, rate, u_inertial, rot_c, com_c, vel_c, omega
     """Thrust (the case's law ``control.thrust``, along the chaser's body z or against its velocity as in the
     lower-order model) and the sliding-mode torque (eqs. 7-10, :mod:`multibody.control.attitude`) from the main
     tether's elongation (m), its rate (m/s) and direction ``u_inertial`` (A -> net node); ``control`` a
-    :class:`ChaserControl`. Adds them to ``force`` (6,: chaser force inertial, torque body) and fills ``diag``."""
+    :class:`ChaserControl`. Adds them to ``force`` (6,: chaser force inertial, torque body) and fills ``diag``.
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    elongation, rate : float
+        Main-tether elongation (m) and rate (m/s).
+    u_inertial : (3,) float
+        Unit vector A -> net node (inertial).
+    rot_c : (3, 3) float
+        Chaser body -> inertial.
+    com_c, vel_c : (3,) float
+        Chaser CoM (m, absolute) and velocity (m/s), inertial.
+    omega_c : (3,) float
+        Chaser angular velocity, body frame (rad/s).
+    inertia_c : (3, 3) float
+        Chaser inertia, body frame (kg m^2).
+    control : ChaserControl
+        Thrust law and attitude controller.
+    step : float
+        Sampling step (s).
+    advance : bool
+        Advance the thrust law's state.
+    force : (6,) float
+        Added to: chaser force (N, inertial), torque (N m, body).
+    diag : (D_SIZE,) float
+        ``D_THRUST``, ``D_TORQUE``, ``D_SLIDING`` written.
+    """
     attitude = control.attitude
     magnitude = control.thrust(t, elongation, rate, control.thrust_params, control.thrust_state, step, advance)
     diag[D_THRUST] = magnitude

@@ -351,7 +351,26 @@ def packed_forces(q, v, t, tow, advance):
     """:func:`towing_forces` of the packed model ``tow`` (:class:`TowKernel`); the force and diagnostics
     land in its ``work``. P's entries of ``q`` and ``v`` are overwritten with its implicit state at ``t``
     (advanced first if ``t`` is a new step time, the forces then taken at the bodies' predicted
-    velocities at ``t``, see :func:`_advance_connection_point`)."""
+    velocities at ``t``, see :func:`_advance_connection_point`).
+
+    Parameters
+    ----------
+    q, v : (15,) float
+        State, kernel layout (module doc); P's entries are overwritten with its implicit state at ``t``.
+    t : float
+        Time (s).
+    tow : TowKernel
+        The packed model and its thrust law (:func:`tow_kernel`).
+    advance : bool
+        Advance the thrust law's state (once per new step time).
+
+    Returns
+    -------
+    force : (15,) float
+        Generalized forces, kernel layout (N, inertial; N m, body frames); a view into ``tow.work``.
+    diag : (ST_TENSION + n,) float
+        Diagnostics (:func:`towing_forces`); a view into ``tow.work``.
+    """
     work, thrust = tow.work, tow.thrust
     n = int(work[W_N_ATTACH])
     attach = work[int(work[W_ATTACH]):int(work[W_ATTACH]) + 3 * n].reshape((n, 3))
@@ -381,7 +400,19 @@ def extra_forces(work):
 def body_forces(q_bodies, v_bodies, t, tow, advance):
     """The packed model's generalized forces on chaser and debris (12,) for Exudyn's object, which
     holds only their coordinates (entries 3-14 of the kernel layout); P comes from ``tow``; the
-    thrust law's state advances when ``advance``."""
+    thrust law's state advances when ``advance``.
+
+    Parameters
+    ----------
+    q_bodies, v_bodies : (12,) float
+        Chaser and debris entries (3-14) of the kernel layout's ``q`` and ``v`` (module doc).
+    t : float
+        Time (s).
+    tow : TowKernel
+        The packed model and its thrust law.
+    advance : bool
+        Advance the thrust law (and P, if ``t`` is a new step time).
+    """
     q, v = np.zeros(N_COORDINATES), np.zeros(N_COORDINATES)
     q[3:], v[3:] = q_bodies, v_bodies
     force, _ = packed_forces(q, v, t, tow, advance)
@@ -391,7 +422,18 @@ def body_forces(q_bodies, v_bodies, t, tow, advance):
 
 @njit(cache=True)
 def sampled_state(q_bodies, v_bodies, t, tow):
-    """Full state (15,) each and diagnostics at ``t`` from the bodies' state and P's stored state."""
+    """Full state (15,) each and diagnostics at ``t`` from the bodies' state and P's stored state
+    (thrust law not advanced).
+
+    Parameters
+    ----------
+    q_bodies, v_bodies : (12,) float
+        Chaser and debris entries (3-14) of the kernel layout's ``q`` and ``v`` (module doc).
+    t : float
+        Time (s).
+    tow : TowKernel
+        The packed model and its thrust law.
+    """
     q, v = np.zeros(N_COORDINATES), np.zeros(N_COORDINATES)
     q[3:], v[3:] = q_bodies, v_bodies
     diag = packed_forces(q, v, t, tow, False)[1]
@@ -409,7 +451,17 @@ def _store_accelerations(v, force, work):
 @njit(cache=True)
 def start_forces(q, v, t, tow):
     """Force at the state (q, v) at time ``t`` (s), the thrust law advanced (as at every step); stores
-    the accelerations in ``tow.work`` for the next step; returns the force (15,)."""
+    the accelerations in ``tow.work`` for the next step; returns the force (15,).
+
+    Parameters
+    ----------
+    q, v : (15,) float
+        State, kernel layout (module doc); P's entries are overwritten with its implicit state at ``t``.
+    t : float
+        Time (s).
+    tow : TowKernel
+        The packed model and its thrust law.
+    """
     force, _ = packed_forces(q, v, t, tow, True)
     _store_accelerations(v, force, tow.work)
     return force
