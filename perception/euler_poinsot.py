@@ -40,7 +40,28 @@ def _quaternion_rate(q, omega):
 def propagate_torque_free(q0, omega0, principal_moments, times, max_step):
     """Attitude quaternions (k, 4) [w, x, y, z] principal->world and rates (k, 3) (rad/s,
     principal frame) at ``times`` (s, increasing, ``times[0]`` the initial time), by RK4
-    with steps no longer than ``max_step`` (s)."""
+    with steps no longer than ``max_step`` (s).
+
+    Parameters
+    ----------
+    q0 : (4,) float
+        Initial attitude quaternion [w, x, y, z], principal->world, unit norm.
+    omega0 : (3,) float
+        Initial angular rate (rad/s, principal frame).
+    principal_moments : (3,) float
+        Principal moments; only their ratios matter (normalized [J1, J2, 1] here, or kg m^2).
+    times : (k,) float
+        Output times (s), increasing; ``times[0]`` is the time of ``q0`` and ``omega0``.
+    max_step : float
+        Largest RK4 step (s).
+
+    Returns
+    -------
+    qs : (k, 4) float
+        Quaternions [w, x, y, z] principal->world at ``times``.
+    omegas : (k, 3) float
+        Angular rates (rad/s, principal frame) at ``times``.
+    """
     k = times.shape[0]
     qs = np.empty((k, 4))
     ws = np.empty((k, 3))
@@ -70,6 +91,18 @@ def propagate_torque_free(q0, omega0, principal_moments, times, max_step):
 
 
 def rotations_from_wxyz(q) -> Rotation:
+    """Rotations from scalar-first quaternions (SciPy's are scalar-last).
+
+    Parameters
+    ----------
+    q : (k, 4) float
+        Unit quaternions [w, x, y, z]; the frames they map between are kept as they are.
+
+    Returns
+    -------
+    Rotation
+        The k rotations.
+    """
     return Rotation.from_quat(np.asarray(q)[:, [1, 2, 3, 0]])
 
 
@@ -77,7 +110,20 @@ def normalized_inertia_linear(omega_body, omega_dot_body) -> np.ndarray:
     """Normalized inertia (3, 3), scaled to trace 3, body frame, from
     rates (k, 3) and accelerations (k, 3) through the torque-free Euler equation
     J ω' + ω x J ω = 0, linear and homogeneous in the six entries of J (Tang et al. 2023,
-    eq. 18): the right singular vector of the smallest singular value."""
+    eq. 18): the right singular vector of the smallest singular value.
+
+    Parameters
+    ----------
+    omega_body : (k, 3) float
+        Angular rates (rad/s, body frame B).
+    omega_dot_body : (k, 3) float
+        Angular accelerations at the same instants (rad/s^2, body frame B).
+
+    Returns
+    -------
+    (3, 3) float
+        Symmetric normalized inertia (-, trace 3, body frame B).
+    """
     w = np.asarray(omega_body, float)
     a = np.asarray(omega_dot_body, float)
     # J = [[j0, j3, j4], [j3, j1, j5], [j4, j5, j2]]
@@ -97,7 +143,20 @@ def normalized_inertia_linear(omega_body, omega_dot_body) -> np.ndarray:
 
 def principal_frame(normalized_inertia) -> tuple[np.ndarray, np.ndarray]:
     """Principal moments (3,) divided by the smallest, sorted so the last is 1 (the paper's
-    C axis is the minimum), and the rotation T->B (3, 3) whose columns are the principal axes."""
+    C axis is the minimum), and the rotation T->B (3, 3) whose columns are the principal axes.
+
+    Parameters
+    ----------
+    normalized_inertia : (3, 3) float
+        Symmetric inertia in frame B, in any scale (e.g. from :func:`normalized_inertia_linear`).
+
+    Returns
+    -------
+    moments : (3,) float
+        [A/C, B/C, 1] (-), largest first.
+    principal_to_body : (3, 3) float
+        Rotation T->B (a proper rotation, det +1).
+    """
     values, vectors = np.linalg.eigh(normalized_inertia)
     order = np.argsort(values)[::-1]
     values, vectors = values[order], vectors[:, order]
@@ -147,7 +206,19 @@ class TorqueFreeFit:
         return t2w, omega, moments, t2b
 
     def predict_body_to_world(self, times) -> Rotation:
-        """Attitudes B->W at ``times`` (s) of the fitted motion."""
+        """Attitudes B->W at ``times`` (s) of the fitted motion.
+
+        Parameters
+        ----------
+        times : (k,) float
+            Times (s) on the clock of the ``times`` given to :meth:`fit`, increasing, the first
+            being the fit's ``times[0]`` (the propagation starts there).
+
+        Returns
+        -------
+        Rotation
+            The k attitudes body B -> world W.
+        """
         t2w, omega, moments, t2b = self._unpack(self._p)
         return self._body_to_world(t2w, omega, moments, t2b, np.asarray(times, float))
 
@@ -181,7 +252,13 @@ class TorqueFreeFit:
         body_to_world : Rotation (k,)   Measured attitudes B->W.
         weights : (k, 3, 3) float       Square roots of the attitude information (1/rad), B frame.
         omega0_body : (3,) float        Starting rate at ``times[0]`` (rad/s), B frame.
-        moments0, principal_to_body0 :  Starting inertia (ignored when known).
+        moments0 : (3,) float           Starting [A/C, B/C, 1] (-); ignored when ``moments`` is known.
+        principal_to_body0 : (3, 3)     Starting rotation T->B; ignored when ``moments`` is known.
+
+        Returns
+        -------
+        TorqueFreeFit
+            ``self``, with the fitted attributes set.
         """
         times = np.asarray(times, float)
         if self.moments is None:

@@ -52,7 +52,20 @@ class LidarSpec:
 
 def sensor_to_platform(boresight, up) -> np.ndarray:
     """Rotation sensor -> platform frame (3, 3) of a sensor whose boresight (+x) and up (+z,
-    made orthogonal to the boresight) are given in the platform frame."""
+    made orthogonal to the boresight) are given in the platform frame.
+
+    Parameters
+    ----------
+    boresight : (3,) float
+        Boresight direction (any length, platform frame: LVLH or world in the pipeline).
+    up : (3,) float
+        Direction of the sensor's +z (platform frame), not parallel to ``boresight``.
+
+    Returns
+    -------
+    (3, 3) float
+        Rotation sensor -> platform; its columns are the sensor axes in the platform frame.
+    """
     x = np.asarray(boresight, float) / np.linalg.norm(boresight)
     z = np.asarray(up, float) - (np.asarray(up, float) @ x) * x
     z /= np.linalg.norm(z)
@@ -60,13 +73,32 @@ def sensor_to_platform(boresight, up) -> np.ndarray:
 
 
 def direction_sensor(elevation, azimuth) -> np.ndarray:
-    """Unit ray directions (..., 3), sensor frame, for broadcastable angle arrays (rad)."""
+    """Unit ray directions (..., 3), sensor frame, for broadcastable angle arrays (rad).
+
+    Parameters
+    ----------
+    elevation : float or array
+        Elevation towards +z (rad, sensor frame).
+    azimuth : float or array
+        Azimuth about +z from +x towards +y (rad), broadcastable with ``elevation``.
+    """
     el, az = np.broadcast_arrays(elevation, azimuth)
     return np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=-1)
 
 
 def angles_of(points_sensor) -> tuple[np.ndarray, np.ndarray]:
-    """Elevation and azimuth (rad) of points (n, 3), sensor frame."""
+    """Elevation and azimuth (rad) of points (n, 3), sensor frame.
+
+    Parameters
+    ----------
+    points_sensor : (n, 3) float
+        Points (m, sensor frame).
+
+    Returns
+    -------
+    elevation, azimuth : (n,) float
+        Angles (rad) as in :func:`direction_sensor`.
+    """
     p = np.asarray(points_sensor, float)
     return np.arctan2(p[:, 2], np.hypot(p[:, 0], p[:, 1])), np.arctan2(p[:, 1], p[:, 0])
 
@@ -79,6 +111,7 @@ def rays_towards(spec: LidarSpec, centers_sensor, radii) -> np.ndarray:
 
     Parameters
     ----------
+    spec : LidarSpec                The sensor (field of view, resolution).
     centers_sensor : (k, 3) float   Bounding-sphere centres (m), sensor frame.
     radii : (k,) float              Their radii (m).
     """
@@ -132,7 +165,9 @@ def cast(spec: LidarSpec, meshes_sensor, time: float, rng: np.random.Generator) 
 
     Parameters
     ----------
+    spec : LidarSpec             The sensor.
     meshes_sensor : list of (vertices (v, 3) float, faces (f, 3) int)   In metres, sensor frame.
+    time : float                 Time stamp of the frame (s), stored in the :class:`Scan`.
     rng : numpy Generator        Range noise.
     """
     scene = o3d.t.geometry.RaycastingScene()

@@ -31,7 +31,26 @@ MIN_SIGNIFICANCE = 5.0
 
 def point_masses_momentum(masses, positions_world, velocities_world, origin_world=(0.0, 0.0, 0.0)):
     """Linear (3,) (N s) and angular (3,) (N m s, about ``origin_world``) momentum of point masses
-    (n,) (kg) at positions (n, 3) (m) moving at velocities (n, 3) (m/s), world frame."""
+    (n,) (kg) at positions (n, 3) (m) moving at velocities (n, 3) (m/s), world frame.
+
+    Parameters
+    ----------
+    masses : (n,) float
+        Point masses (kg).
+    positions_world : (n, 3) float
+        Their positions (m, world frame).
+    velocities_world : (n, 3) float
+        Their velocities (m/s, world frame).
+    origin_world : (3,) float
+        Point the angular momentum is taken about (m, world frame).
+
+    Returns
+    -------
+    linear : (3,) float
+        Linear momentum (N s, world frame).
+    angular : (3,) float
+        Angular momentum about ``origin_world`` (N m s, world frame).
+    """
     masses = np.asarray(masses, float)
     p = masses[:, None] * np.asarray(velocities_world, float)
     arms = np.asarray(positions_world, float) - np.asarray(origin_world, float)
@@ -42,7 +61,29 @@ def rigid_body_momentum(mass, inertia_body, com_world, velocity_world, body_to_w
                         origin_world=(0.0, 0.0, 0.0)):
     """Linear (3,) and angular (3,) momentum (about ``origin_world``) of a rigid body, world frame.
 
-    inertia_body : (3, 3) about the CoM, body frame (kg m^2); omega_body : (3,) (rad/s), body frame.
+    Parameters
+    ----------
+    mass : float
+        Body mass (kg).
+    inertia_body : (3, 3) float
+        Inertia about the CoM (kg m^2, body frame).
+    com_world : (3,) float
+        CoM position (m, world frame).
+    velocity_world : (3,) float
+        CoM velocity (m/s, world frame).
+    body_to_world : (3, 3) float
+        Attitude, rotation body -> world.
+    omega_body : (3,) float
+        Angular velocity (rad/s, body frame).
+    origin_world : (3,) float
+        Point the angular momentum is taken about (m, world frame).
+
+    Returns
+    -------
+    linear : (3,) float
+        Linear momentum (N s, world frame).
+    angular : (3,) float
+        Angular momentum about ``origin_world`` (N m s, world frame): orbital plus spin.
     """
     linear = mass * np.asarray(velocity_world, float)
     spin = np.asarray(body_to_world, float) @ (np.asarray(inertia_body, float) @ np.asarray(omega_body, float))
@@ -89,9 +130,10 @@ def mass_from_linear_momentum(velocity_change_world, others_momentum_change_worl
 
     Parameters
     ----------
-    velocity_change_world : (3,)      v1 - v0 of the debris CoM (m/s).
-    others_momentum_change_world : (3,)  Change of chaser + net linear momentum (N s).
-    cov_* : (3, 3)                    Their covariances (zero if omitted).
+    velocity_change_world : (3,)      v1 - v0 of the debris CoM (m/s, world frame).
+    others_momentum_change_world : (3,)  Change of chaser + net linear momentum (N s, world frame).
+    cov_velocity_change : (3, 3)      Covariance of ``velocity_change_world`` ((m/s)^2), zero if omitted.
+    cov_others_change : (3, 3)        Covariance of ``others_momentum_change_world`` ((N s)^2), zero if omitted.
     """
     zero = np.zeros((3, 3))
     mass, sigma, misfit = _scalar_least_squares(
@@ -106,7 +148,22 @@ def mass_from_linear_momentum(velocity_change_world, others_momentum_change_worl
 
 def spin_momentum_per_c(normalized_moments, principal_to_world, omega_principal) -> np.ndarray:
     """h = R_T->W diag(A/C, B/C, 1) omega_T (rad/s), world frame: the debris spin angular
-    momentum divided by its smallest principal moment C."""
+    momentum divided by its smallest principal moment C.
+
+    Parameters
+    ----------
+    normalized_moments : (3,) float
+        [A/C, B/C, 1] (-).
+    principal_to_world : (3, 3) float
+        Rotation principal frame T -> world W.
+    omega_principal : (3,) float
+        Angular velocity (rad/s, principal frame T).
+
+    Returns
+    -------
+    (3,) float
+        h (rad/s, world frame).
+    """
     return np.asarray(principal_to_world, float) @ (np.asarray(normalized_moments, float)
                                                      * np.asarray(omega_principal, float))
 
@@ -119,11 +176,13 @@ def smallest_moment_from_angular_momentum(spin_change_per_c, orbital_change_per_
 
     Parameters
     ----------
-    spin_change_per_c : (3,)       h1 - h0 (rad/s), see :func:`spin_momentum_per_c`.
-    orbital_change_per_mass : (3,)  Delta (p x v) of the debris CoM about O (m^2/s).
+    spin_change_per_c : (3,)       h1 - h0 (rad/s, world frame), see :func:`spin_momentum_per_c`.
+    orbital_change_per_mass : (3,)  Delta (p x v) of the debris CoM about O (m^2/s, world frame).
     mass, mass_sigma : float       Debris mass and its 1 sigma (kg), from the linear balance.
-    others_angular_change : (3,)   Change of chaser + net angular momentum about O (N m s).
-    cov_* : (3, 3)                 Covariances (zero if omitted).
+    others_angular_change : (3,)   Change of chaser + net angular momentum about O (N m s, world frame).
+    cov_spin_change : (3, 3)       Covariance of ``spin_change_per_c`` ((rad/s)^2), zero if omitted.
+    cov_orbital_change_per_mass : (3, 3)  Covariance of ``orbital_change_per_mass`` ((m^2/s)^2), zero if omitted.
+    cov_others_change : (3, 3)     Covariance of ``others_angular_change`` ((N m s)^2), zero if omitted.
     """
     zero = np.zeros((3, 3))
     orbital = np.asarray(orbital_change_per_mass, float)

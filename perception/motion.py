@@ -25,7 +25,24 @@ class NotObservable(ValueError):
 def rates_from_attitudes(times, body_to_world: Rotation, half_window: int = 5):
     """Angular velocity (k, 3) (rad/s) and acceleration (k, 3) (rad/s^2), body frame, from a
     quadratic fit of log(R_k^-1 R_j) against (t_j - t_k) over the 2 half_window + 1 frames
-    around each frame (fewer at the ends)."""
+    around each frame (fewer at the ends).
+
+    Parameters
+    ----------
+    times : (k,) float
+        Frame times (s), increasing.
+    body_to_world : Rotation (k,)
+        Attitudes B->world at ``times``.
+    half_window : int
+        Frames on each side of a frame in its local fit.
+
+    Returns
+    -------
+    omega_body : (k, 3) float
+        Angular velocity (rad/s, body frame B).
+    omega_dot_body : (k, 3) float
+        Angular acceleration (rad/s^2, body frame B).
+    """
     times = np.asarray(times, float)
     k = len(times)
     omega = np.zeros((k, 3))
@@ -57,6 +74,13 @@ class CenterOfMassLine:
     covariance: np.ndarray
 
     def position_world(self, times) -> np.ndarray:
+        """CoM positions (k, 3) (m, world frame) on the fitted line.
+
+        Parameters
+        ----------
+        times : (k,) float
+            Times (s), on the clock of ``time0``.
+        """
         return self.position0_world + np.outer(np.asarray(times) - self.time0, self.velocity_world)
 
 
@@ -68,6 +92,13 @@ def center_of_mass_line(times, body_to_world, origin_world, com_body=None) -> Ce
     times : (k,) float             (s)
     body_to_world : (k, 3, 3)      Attitudes B->world.
     origin_world : (k, 3) float    Position of B's origin, world frame (m).
+    com_body : (3,) float, optional  Known CoM (m, frame B); None: estimated (the body must turn).
+
+    Returns
+    -------
+    CenterOfMassLine
+        ``time0`` = ``times[0]``; ``covariance`` (9, 9) over (c_B, p_0, v), or (6, 6) over
+        (p_0, v) with ``com_body`` given.
     """
     times = np.asarray(times, float)
     rot = np.asarray(body_to_world, float)
@@ -106,7 +137,18 @@ def integrated_autocorrelation_time(residuals) -> float:
     Registration errors of successive scans are correlated (the same view gives the same bias
     for a while); a least-squares covariance that assumes white errors is then too small by
     about tau, the number of frames that carry one independent error (variance of a mean of k
-    correlated samples = sigma^2 tau / k)."""
+    correlated samples = sigma^2 tau / k).
+
+    Parameters
+    ----------
+    residuals : (k, d) float
+        Residuals in frame order, any unit (d components, pooled; one row per frame).
+
+    Returns
+    -------
+    float
+        tau (frames, >= 1).
+    """
     r = np.asarray(residuals, float)
     r = (r - r.mean(axis=0)).reshape(len(r), -1)
     variance = np.sum(r * r)
@@ -125,7 +167,19 @@ def attitude_sqrt_information(informations) -> np.ndarray:
     """Square roots W (k, 3, 3) (1/rad) of the attitude information of k registrations, from their
     (6, 6) pose information (rotation first): the rotation block of the covariance, the
     translation marginalized out, so that |W e|^2 is the attitude error's chi^2. A frame whose
-    information is singular (too few or degenerate points) gets the mean of the others."""
+    information is singular (too few or degenerate points) gets the mean of the others.
+
+    Parameters
+    ----------
+    informations : sequence of k (6, 6) float
+        Pose information of each registration over (rotation vector, translation), left
+        perturbation, body frame B (1/rad^2, 1/(rad m), 1/m^2), e.g. ``Alignment.information``.
+
+    Returns
+    -------
+    (k, 3, 3) float
+        Upper-triangular W with W^T W the attitude information (1/rad, body frame B).
+    """
     weights = np.full((len(informations), 3, 3), np.nan)
     for k, information in enumerate(informations):
         if np.linalg.matrix_rank(information) == 6:
@@ -148,7 +202,19 @@ def isotropic_attitude_weights(sqrt_information) -> np.ndarray:
     axes. Weighting by the anisotropic information then lets those errors bias the fitted motion:
     on Tang et al.'s ellipsoid the angular momentum direction came out 0.27 deg off, against
     0.03-0.1 deg with isotropic weights (60 s of 10 Hz scans, seeds 0 and 1). A frame's overall
-    quality (how many points, how much of the surface) is kept."""
+    quality (how many points, how much of the surface) is kept.
+
+    Parameters
+    ----------
+    sqrt_information : (k, 3, 3) float
+        Attitude information square roots (1/rad, body frame B), from
+        :func:`attitude_sqrt_information`.
+
+    Returns
+    -------
+    (k, 3, 3) float
+        s_k I (1/rad); isotropic, so the same in any frame.
+    """
     w = np.asarray(sqrt_information, float)
     scale = np.abs(np.linalg.det(w)) ** (1.0 / 3.0)
     return scale[:, None, None] * np.eye(3)

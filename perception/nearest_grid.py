@@ -74,7 +74,23 @@ class NearestPointGrid:
 
     def query(self, points, distance_upper_bound=np.inf) -> tuple[np.ndarray, np.ndarray]:
         """Distance (m) to and index of the nearest model point for points (k, 3) (m), like
-        ``scipy.spatial.cKDTree.query``: no match gives distance inf and index n."""
+        ``scipy.spatial.cKDTree.query``: no match gives distance inf and index n.
+
+        Parameters
+        ----------
+        points : (k, 3) float
+            Query points (m), in the frame of the model points.
+        distance_upper_bound : float
+            Matches farther than this (m) are dropped; points in grid cells farther than about
+            ``reach`` from every model point find nothing whatever the bound.
+
+        Returns
+        -------
+        distance : (k,) float
+            Distance to the found model point (m); inf without a match.
+        index : (k,) int
+            Row of the found model point; n (the number of model points) without a match.
+        """
         points = np.ascontiguousarray(points, dtype=float)
         return _nearest(points, self.low, self.cell, np.array(self.shape, np.int64), self.table, self.points,
                         self.neighbours, float(distance_upper_bound), DESCENT_STEPS)

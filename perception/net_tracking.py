@@ -27,8 +27,23 @@ from scipy.sparse.linalg import spsolve
 def thread_mesh(positions, threads, radius, sides=6) -> tuple[np.ndarray, np.ndarray]:
     """Threads as open prisms of ``sides`` faces around each segment, for ray casting.
 
-    positions : (n, 3) node positions (m); threads : (m, 2) node pairs; radius : float (m).
-    Returns vertices (2 sides m, 3) and triangle faces (2 sides m, 3).
+    Parameters
+    ----------
+    positions : (n, 3) float
+        Node positions (m), in the frame the mesh is wanted in (world, or sensor for a cast).
+    threads : (m, 2) int
+        Node pairs joined by a thread.
+    radius : float
+        Prism circumradius (m), the thread's radius.
+    sides : int
+        Faces around each thread.
+
+    Returns
+    -------
+    vertices : (2 sides m, 3) float
+        Prism vertices (m, the frame of ``positions``).
+    faces : (2 sides m, 3) int
+        Triangles as vertex indices.
     """
     a = np.asarray(positions, float)[threads[:, 0]]
     b = np.asarray(positions, float)[threads[:, 1]]
@@ -50,7 +65,28 @@ def thread_mesh(positions, threads, radius, sides=6) -> tuple[np.ndarray, np.nda
 
 def nearest_segments(points, positions, threads, chunk=4096):
     """For each point (p, 3): index of its nearest thread, the parameter s in [0, 1] of the
-    nearest point on it (from the thread's first node) and the distance (m)."""
+    nearest point on it (from the thread's first node) and the distance (m).
+
+    Parameters
+    ----------
+    points : (p, 3) float
+        Query points (m), in the frame of ``positions`` (world in the pipeline).
+    positions : (n, 3) float
+        Node positions (m).
+    threads : (m, 2) int
+        Node pairs joined by a thread.
+    chunk : int
+        Points handled at once (memory: chunk x m x 3 floats).
+
+    Returns
+    -------
+    index : (p,) int
+        Row of ``threads`` of the nearest thread.
+    param : (p,) float
+        Position s (-) of the nearest point along it, 0 at ``threads[index, 0]``.
+    distance : (p,) float
+        Distance to it (m).
+    """
     a = positions[threads[:, 0]]
     ab = positions[threads[:, 1]] - a
     length2 = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-12)
@@ -108,7 +144,10 @@ def fit_net_nodes(points_world, predicted_world, threads, prior: NetPrior = NetP
     points_world : (p, 3)       Candidate returns (m), world frame.
     predicted_world : (n, 3)    Predicted node positions (m), world frame.
     threads : (m, 2) int        Node pairs joined by a thread.
-    anchors : (node indices (a,), positions (a, 3)) or None: nodes held near known points.
+    prior : NetPrior            Weights of the terms as standard deviations (m).
+    anchors : (node indices (a,), positions (a, 3)) or None: nodes held near known points
+                                (m, world frame; the chaser's rod tips).
+    iterations : int            Re-associations of the returns to the threads.
     """
     predicted = np.asarray(predicted_world, float)
     points = np.asarray(points_world, float).reshape(-1, 3)
@@ -174,14 +213,42 @@ def fit_net_nodes(points_world, predicted_world, threads, prior: NetPrior = NetP
 
 def carried_by_chaser(positions_world, chaser_from, chaser_to) -> np.ndarray:
     """Node positions moved rigidly with the chaser from pose ``chaser_from`` to ``chaser_to``
-    (each a (4, 4) chaser-body -> world transform): the net's prediction between frames."""
+    (each a (4, 4) chaser-body -> world transform): the net's prediction between frames.
+
+    Parameters
+    ----------
+    positions_world : (n, 3) float
+        Node positions at ``chaser_from`` (m, world frame).
+    chaser_from, chaser_to : (4, 4) float
+        Chaser body -> world transforms (m) at the earlier and the later frame.
+
+    Returns
+    -------
+    (n, 3) float
+        Node positions at ``chaser_to`` (m, world frame).
+    """
     relative = np.asarray(chaser_to) @ np.linalg.inv(chaser_from)
     return np.asarray(positions_world) @ relative[:3, :3].T + relative[:3, 3]
 
 
 def node_velocities(times, positions_world, window=7) -> np.ndarray:
     """Node velocities (k, n, 3) (m/s) from positions (k, n, 3) at equally spaced ``times``
-    (k,) (s): local quadratic fits over ``window`` frames (Savitzky-Golay), not raw differences."""
+    (k,) (s): local quadratic fits over ``window`` frames (Savitzky-Golay), not raw differences.
+
+    Parameters
+    ----------
+    times : (k,) float
+        Frame times (s), equally spaced, k >= 3.
+    positions_world : (k, n, 3) float
+        Node positions per frame (m, world frame).
+    window : int
+        Frames per local fit; shortened to the largest odd number <= k.
+
+    Returns
+    -------
+    (k, n, 3) float
+        Node velocities (m/s, world frame).
+    """
     positions = np.asarray(positions_world, float)
     window = min(window, len(times) - (1 - len(times) % 2))
     if window < 3:

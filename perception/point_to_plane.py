@@ -14,13 +14,43 @@ from numba import njit
 
 def point_to_plane_information(points_body, normals, sigma) -> np.ndarray:
     """Information (6, 6) of a point-to-plane alignment of scan points (n, 3) (B frame) on model
-    planes with normals (n, 3), residual scatter ``sigma`` (m): J^T J / sigma^2."""
+    planes with normals (n, 3), residual scatter ``sigma`` (m): J^T J / sigma^2.
+
+    Parameters
+    ----------
+    points_body : (n, 3) float
+        Posed scan points (m, frame B).
+    normals : (n, 3) float
+        Unit normals of their matched model points (frame B).
+    sigma : float
+        Point-to-plane residual scatter, 1 sigma (m).
+
+    Returns
+    -------
+    (6, 6) float
+        Information of (rotation vector, translation), left perturbation, frame B
+        (1/rad^2, 1/(rad m), 1/m^2 blocks).
+    """
     jac = plane_jacobian(points_body, normals)
     return jac.T @ jac / sigma**2
 
 
 def plane_jacobian(points_body, normals) -> np.ndarray:
-    """Rows [(q x n), n] (n, 6); the cross product written out (np.cross costs more than the product on small arrays)."""
+    """Rows [(q x n), n] (n, 6); the cross product written out (np.cross costs more than the product on small arrays).
+
+    Parameters
+    ----------
+    points_body : (n, 3) float
+        Posed scan points q (m, frame B).
+    normals : (n, 3) float
+        Unit normals n of their matched model points (frame B).
+
+    Returns
+    -------
+    (n, 6) float
+        d r / d (rotation vector (rad), translation (m)): m/rad for the first three columns,
+        - for the last three.
+    """
     q, n = points_body, normals
     return np.column_stack([q[:, 1] * n[:, 2] - q[:, 2] * n[:, 1], q[:, 2] * n[:, 0] - q[:, 0] * n[:, 2],
                             q[:, 0] * n[:, 1] - q[:, 1] * n[:, 0], n])
@@ -31,7 +61,32 @@ def tukey_normal_equations(points_body, nearest, model_points, model_normals, tu
     """Hessian (6, 6), gradient (6,) = sum w J^T r, the weight sum and the number of weighted
     residuals, of the Tukey-weighted
     point-to-plane residuals of scan points (n, 3) matched to model points ``nearest`` (n,)
-    (index len(model_points): unmatched, skipped); ``tukey_k`` (m) the weight's cut-off."""
+    (index len(model_points): unmatched, skipped); ``tukey_k`` (m) the weight's cut-off.
+
+    Parameters
+    ----------
+    points_body : (n, 3) float
+        Posed scan points (m, frame B).
+    nearest : (n,) int
+        Row of each point's matched model point; len(model_points) when unmatched.
+    model_points : (k, 3) float
+        Model points (m, frame B).
+    model_normals : (k, 3) float
+        Their unit normals (frame B).
+    tukey_k : float
+        Residual (m) beyond which a point gets weight 0.
+
+    Returns
+    -------
+    hessian : (6, 6) float
+        sum w J^T J over (rotation vector, translation), frame B.
+    gradient : (6,) float
+        sum w J^T r.
+    weight_sum : float
+        sum w (-).
+    count : int
+        Residuals with nonzero weight.
+    """
     hessian = np.zeros((6, 6))
     gradient = np.zeros(6)
     weight_sum = 0.0

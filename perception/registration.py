@@ -179,7 +179,31 @@ def free_space_violation(points_world, model_world, sensor_world, bin_angle, mar
     along a surface that runs almost along the rays (the limb), tens of cm deeper at 20-30 m;
     without this, correct poses failed on limb bins beyond ~20 m (violation 0.09 at 20 m, 0.22 at
     30 m; 0.003 and 0.02 with it). The model's own incidence is used, so a wrong pose that puts the
-    model's face where the scan's limb is still violates."""
+    model's face where the scan's limb is still violates.
+
+    Parameters
+    ----------
+    points_world : (n, 3) float
+        Scan returns (m, world frame).
+    model_world : (k, 3) float
+        Model points at the pose under test (m, world frame).
+    sensor_world : (3,) float
+        Sensor position (m, world frame); the bins are elevation/azimuth about the world axes
+        as seen from it.
+    bin_angle : float
+        Angular size of a viewing-direction bin (rad).
+    margin : float
+        Depth (m) by which a model point must lie in front of the nearest return to count.
+    model_normals_world : (k, 3) float, optional
+        Unit outward normals of the model points (world frame).
+    sample_spacing : float
+        The scan's point spacing (m); used only with ``model_normals_world``.
+
+    Returns
+    -------
+    float
+        Share (0 to 1) of the bins holding returns in which the model blocks a return.
+    """
     def bins(points):
         d = points - sensor_world
         r = np.sqrt(np.einsum("ij,ij->i", d, d))
@@ -235,7 +259,24 @@ def _twist(step) -> np.ndarray:
 
 def known_shape_model(mesh, voxel, seed) -> tuple[np.ndarray, np.ndarray]:
     """Registration model of a known debris mesh (frame B = target frame): surface samples (n, 3)
-    (m) about 0.4 voxel apart (denser than the thinned scan), with their faces' exact outward normals (n, 3)."""
+    (m) about 0.4 voxel apart (denser than the thinned scan), with their faces' exact outward normals (n, 3).
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        The debris surface (m, target frame, which becomes frame B).
+    voxel : float
+        The tracker's scan thinning (m); sets the sample spacing.
+    seed : int
+        Seed of the surface sampling (reproducible samples).
+
+    Returns
+    -------
+    points_body : (n, 3) float
+        Surface samples (m, frame B).
+    normals_body : (n, 3) float
+        Outward unit normals of the faces they lie on (frame B).
+    """
     count = int(np.ceil(mesh.area / (0.4 * voxel) ** 2))
     points, faces = trimesh.sample.sample_surface(mesh, count, seed=seed)
     return points, mesh.face_normals[faces]
@@ -243,7 +284,20 @@ def known_shape_model(mesh, voxel, seed) -> tuple[np.ndarray, np.ndarray]:
 
 def predict_pose(previous, before) -> np.ndarray:
     """world_to_body at the next frame from the last two, at constant rotation and translation
-    rates (equal frame spacing): T_next = (T_prev T_before^-1) T_prev."""
+    rates (equal frame spacing): T_next = (T_prev T_before^-1) T_prev.
+
+    Parameters
+    ----------
+    previous : (4, 4) float
+        world_to_body at the last frame (homogeneous transform, m).
+    before : (4, 4) float
+        world_to_body at the frame before it.
+
+    Returns
+    -------
+    (4, 4) float
+        Predicted world_to_body at the next frame.
+    """
     return previous @ np.linalg.inv(before) @ previous
 
 
@@ -317,7 +371,15 @@ class DebrisTracker:
         return self._model_points
 
     def distance_to_model(self, points_body, upper) -> np.ndarray:
-        """Distance (n,) (m) of points (n, 3) (m, frame B) to the nearest model point; inf beyond ``upper`` (m)."""
+        """Distance (n,) (m) of points (n, 3) (m, frame B) to the nearest model point; inf beyond ``upper`` (m).
+
+        Parameters
+        ----------
+        points_body : (n, 3) float
+            Query points (m, frame B).
+        upper : float
+            Largest distance looked for (m).
+        """
         return self._tree.query(points_body, distance_upper_bound=upper)[0]
 
     def _model_features(self):
@@ -351,9 +413,24 @@ class DebrisTracker:
     def update(self, time_s, points_world, sensor_world, gate=None) -> Alignment:
         """Register one scan (n, 3) (m, world frame) taken from ``sensor_world`` (3,) (m).
 
-        gate : float, optional (m)  With a motion prediction, register only the scan points within
-            ``gate`` of the model at the predicted pose (to the nearest model point, ``voxel``
-            apart): returns of other objects, e.g. net threads in front of the debris, are dropped.
+        Parameters
+        ----------
+        time_s : float
+            Time of the scan (s); recorded in the :class:`Alignment`.
+        points_world : (n, 3) float
+            Scan returns (m, world frame).
+        sensor_world : (3,) float
+            Sensor position at the scan (m, world frame), for the free-space check.
+        gate : float, optional
+            With a motion prediction, register only the scan points within ``gate`` (m) of the
+            model at the predicted pose (to the nearest model point, ``voxel`` apart): returns of
+            other objects, e.g. net threads in front of the debris, are dropped.
+
+        Returns
+        -------
+        Alignment
+            The frame's pose (world -> B), information and check figures; also appended to
+            ``alignments``.
         """
         start = time.perf_counter()
         scan = _cloud(points_world).voxel_down_sample(self.voxel)

@@ -13,13 +13,40 @@ def half_turn_symmetries(mesh: trimesh.Trimesh, tolerance: float, samples: int =
     """Rotations S (3, 3), mesh frame, that map the surface onto itself: the identity and those
     half turns about the principal axes (through the centroid) after which every sampled surface
     point lies within ``tolerance`` (m) of the surface. A uniform ellipsoid has all three; a
-    generic body only the identity."""
+    generic body only the identity.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        The surface (m, mesh frame).
+    tolerance : float
+        Largest distance (m) of a turned sample from the surface for a symmetry.
+    samples : int
+        Surface points tested (fixed seed).
+
+    Returns
+    -------
+    list of (3, 3) float
+        Rotations of the mesh frame, the identity first.
+    """
     return [transform[:3, :3] for transform in half_turn_symmetry_transforms(mesh, tolerance, samples)]
 
 
 def half_turn_symmetry_transforms(mesh: trimesh.Trimesh, tolerance: float, samples: int = 4000) -> list[np.ndarray]:
     """The same symmetries as homogeneous transforms (4, 4) of the mesh frame, turning about the
-    centroid: x -> S (x - c) + c."""
+    centroid: x -> S (x - c) + c.
+
+    Parameters
+    ----------
+    mesh, tolerance, samples :
+        As in :func:`half_turn_symmetries`.
+
+    Returns
+    -------
+    list of (4, 4) float
+        Homogeneous transforms of the mesh frame (m), the identity first; c is the centre of
+        mass of a watertight mesh, else the surface centroid.
+    """
     points = trimesh.sample.sample_surface(mesh, samples, seed=1)[0]
     scene = o3d.t.geometry.RaycastingScene()
     scene.add_triangles(o3d.core.Tensor(np.asarray(mesh.vertices, np.float32)),
@@ -44,7 +71,22 @@ def half_turn_symmetry_transforms(mesh: trimesh.Trimesh, tolerance: float, sampl
 
 def rotation_error(estimated_body_to_world, true_body_to_world, symmetries) -> float:
     """Smallest rotation angle (rad) between an estimated attitude and the true one or any of its
-    indistinguishable variants ``R_true S``."""
+    indistinguishable variants ``R_true S``.
+
+    Parameters
+    ----------
+    estimated_body_to_world : (3, 3) float
+        Estimated attitude, model frame B -> world (B the mesh frame of a known shape).
+    true_body_to_world : (3, 3) float
+        True attitude, mesh frame -> world.
+    symmetries : list of (3, 3) float
+        Rotations S of the mesh frame (:func:`half_turn_symmetries`), the identity included.
+
+    Returns
+    -------
+    float
+        Angle (rad), in [0, pi].
+    """
     angles = []
     for s in symmetries:
         relative = np.asarray(estimated_body_to_world) @ (np.asarray(true_body_to_world) @ s).T
