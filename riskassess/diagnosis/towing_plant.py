@@ -24,7 +24,7 @@ from scipy.spatial.transform import Rotation
 
 from riskassess.diagnosis.channels import OMEGA, QUATERNION, REL, TENSION
 from riskassess.diagnosis.towing_dynamics import EXTRA_STATES, diagnostics_size, initial_extra_states, no_towing_load
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing import packed
 from multibody.towing_kernel import MT_TENSION, verlet_run
 from multibody.orbit import lvlh_to_eci
