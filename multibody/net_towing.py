@@ -18,16 +18,18 @@ from dataclasses import dataclass
 import exudyn as exu
 import numpy as np
 from exudyn.itemInterface import NodeRigidBodyRotVecLG, ObjectGenericODE2, ObjectRigidBody
-from numba import njit
+from numba import njit, types
+from numba.experimental import structref
 from scipy.spatial.transform import Rotation
 
 from multibody.health import HealthWatch
 from multibody.impact import checked_post_step, explicit_settings, solve_checked
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.rotations import rotation_matrix_from_rotation_vector
 from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING, ACC_CONTACT_F, ACC_CONTACTS,
                                          ACC_DEBRIS_F, ACC_DEBRIS_T, ACC_EXTERNAL, ACC_SIZE, ACC_TENSION, D_CLOSING,
                                          D_CONTACT_F, D_CONTACTS, D_ELONGATION, D_RATE, D_SIZE, D_TENSION, advance_net,
-                                         chaser_actuation, net_forces)
+                                         DebrisBody, DebrisMotion, NetThreads, TetherEnd, chaser_actuation,
+                                         chaser_control, net_forces)
 from multibody.net_wrap import TowingNet
 from multibody.towing import HEALTH_EVERY_STEPS, TowedBodies, tow_failure_cause
 from multibody.net_towing_kernel import D_SLIDING, D_THRUST, D_TORQUE
@@ -90,22 +92,91 @@ def _bodies(q, v, reference_c, reference_d):
     return out
 
 
+@structref.register
+class NetTowKernelType(types.StructRef):
+    """numba type of :class:`NetTowKernel`."""
+
+
+class NetTowKernel(structref.StructRefProxy):
+    """One full-net run as :func:`step_forces` takes it (made by :class:`NetTowState`; arrays shared with it).
+
+    Fields
+    ------
+    x, xv : (n, 3) float        Net nodes: positions relative to ``reference`` (m) and velocities (m/s), inertial.
+    lag : (n, 3) float          Contact velocity lags carried between sub-steps (m/s).
+    clock : (CLOCK_SIZE,) float Net time (s) and the external impulse since the start (3, N s, inertial).
+    net : NetThreads            Node masses and radii, threads (:class:`multibody.net_towing_kernel.NetThreads`).
+    reference : (3,) float      Origin of the node positions, absolute (m).
+    mu : float                  Gravitational parameter (m^3/s^2).
+    central : int               Node the main tether holds.
+    attach_c : (3,) float       Main-tether attachment A, chaser body frame (m).
+    body_masses : (2,) float    m_C, m_D (kg).
+    inertia : (2, 3, 3) float   Chaser and debris inertia about their CoMs, body frames (kg m^2).
+    debris : DebrisBody         The debris cylinder and contact law (:class:`multibody.net_towing_kernel.DebrisBody`).
+    n_sub : int                 Net sub-steps per body step.
+    step : float                Body step (s).
+    control : ChaserControl     Thrust law and attitude control (:class:`multibody.net_towing_kernel.ChaserControl`).
+    body_reference : (2, 3) float   Chaser and debris reference CoM positions, absolute (m).
+    acc, diag, f, work : float arrays   Per-step impulses (ACC_SIZE), diagnostics (D_SIZE), node forces (n, 3), scratch.
+    """
+
+
+_NET_TOW_FIELDS = ["x", "xv", "lag", "clock", "net", "reference", "mu", "central", "attach_c", "body_masses", "inertia",
+                   "debris", "n_sub", "step", "control", "body_reference", "acc", "diag", "f", "work"]
+structref.define_proxy(NetTowKernel, NetTowKernelType, _NET_TOW_FIELDS)
+
+
 @njit(cache=True)
-def step_forces(q, v, t, advance, x, xv, lag, clock, masses, radii, threads, rest, stiffness, damping, reference, mu, central,
-                main_tether, attach_c, body_masses, inertia, inverse_inertia_d, geometry, law, n_sub, step, attitude,
-                thrust_kind, along_z, thrust_params, thrust_state, body_reference, acc, diag, f, work):
-    """Generalized forces (12,) on chaser and debris at time ``t`` (s, absolute) for Exudyn's object.
+def net_tow_kernel(x, xv, lag, clock, net, reference, mu, central, attach_c, body_masses, inertia, debris, n_sub, step,
+                   control, body_reference, acc, diag, f, work):
+    """The :class:`NetTowKernel` of these fields (compiled once and cached, unlike the proxy's own
+    constructor).
+
+    Parameters
+    ----------
+    x, xv, lag, clock, net, reference, mu, central, attach_c, body_masses, inertia, debris, n_sub, step, control, body_reference, acc, diag, f, work
+        The fields of :class:`NetTowKernel` (shapes, units and frames there).
+    """
+    return NetTowKernel(x, xv, lag, clock, net, reference, mu, central, attach_c, body_masses, inertia, debris, n_sub,
+                        step, control, body_reference, acc, diag, f, work)
+
+
+@njit(cache=True)
+def step_forces(q, v, t, advance, main_tether, tow):
+    """Generalized forces (12,) on chaser and debris at time ``t`` (s, absolute) for Exudyn's object,
+    from their coordinates ``q`` and velocities ``v`` (12,) (CoM displacement (m) and rotation vector,
+    CoM velocity (m/s, inertial) and angular velocity (rad/s, body), per body), the run ``tow``
+    (:class:`NetTowKernel`) and the main tether ``main_tether`` = [k_MT (N/m), c_MT (N s/m), l_MT0 (m)].
     If ``advance``, the net (``x`` relative to ``reference``, ``xv``) is first sub-cycled from
     ``clock[CLOCK_TIME]`` to ``t`` (:func:`multibody.net_towing_kernel.advance_net`) and the bodies get
     the step's mean reactions; otherwise (the solver's initial evaluation, output samples) the
-    reactions at the current state. Thrust, attitude torque and gravity are evaluated at ``t``."""
+    reactions at the current state. Thrust and attitude torque (``control``, a
+    :class:`multibody.net_towing_kernel.ChaserControl`) and gravity are evaluated at ``t``.
+
+    Parameters
+    ----------
+    q, v : (12,) float
+        Chaser and debris coordinates and velocities (see above).
+    t : float
+        Time (s, absolute).
+    advance : bool
+        Sub-cycle the net to ``t`` and advance the thrust law.
+    main_tether : (3,) float
+        k_MT (N/m), c_MT (N s/m), l_MT0 (m).
+    tow : NetTowKernel
+        The run.
+    """
+    x, xv, lag, clock, net, reference = tow.x, tow.xv, tow.lag, tow.clock, tow.net, tow.reference
+    mu, central, attach_c, body_masses, inertia, debris_body = (tow.mu, tow.central, tow.attach_c, tow.body_masses,
+                                                                tow.inertia, tow.debris)
+    n_sub, step, control, body_reference = tow.n_sub, tow.step, tow.control, tow.body_reference
+    acc, diag, f, work = tow.acc, tow.diag, tow.f, tow.work
     bodies = _bodies(q, v, body_reference[0], body_reference[1])
     force = np.zeros(12)
     if advance:
         h_step = t - clock[CLOCK_TIME]
-        tension, z, rate = advance_net(x, xv, lag, clock[CLOCK_TIME], t, n_sub, masses, radii, threads, rest, stiffness,
-                                       damping, reference, mu, central, main_tether, attach_c, bodies, body_masses[1],
-                                       inverse_inertia_d, geometry, law, f, acc, work)
+        tension, z, rate = advance_net(x, xv, lag, clock[CLOCK_TIME], t, n_sub, net, reference, mu, central,
+                                       main_tether, attach_c, bodies, debris_body, f, acc, work)
         clock[CLOCK_TIME] = t
         clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3] += acc[ACC_EXTERNAL:ACC_EXTERNAL + 3]
         scale = 1.0 / h_step
@@ -119,10 +190,10 @@ def step_forces(q, v, t, advance, x, xv, lag, clock, masses, radii, threads, res
         a_point = bodies[0, 0:3] + arm
         a_velocity = bodies[0, 6:9] + rot_c @ np.cross(bodies[0, 9:12], attach_c)
         acc[:] = 0.0
-        tension, z, rate = net_forces(x, xv, lag.copy(), masses, radii, threads, rest, stiffness, damping, reference, mu, central,
-                                      main_tether, a_point, a_velocity, bodies[0, 0:3], bodies[1, 0:3] - reference,
-                                      rot_d, bodies[1, 6:9], rot_d @ bodies[1, 9:12], body_masses[1], inverse_inertia_d,
-                                      geometry, law, h, f, acc, work)
+        tension, z, rate = net_forces(x, xv, lag.copy(), net, reference, mu, central,
+                                      TetherEnd(main_tether, a_point, a_velocity, bodies[0, 0:3]),
+                                      DebrisMotion(bodies[1, 0:3] - reference, rot_d, bodies[1, 6:9], rot_d @ bodies[1, 9:12]),
+                                      debris_body, h, f, acc, work)
     rot_c = rotation_matrix_from_rotation_vector(bodies[0, 3:6])
     rot_d = rotation_matrix_from_rotation_vector(bodies[1, 3:6])
     force[0:3] = scale * acc[ACC_CHASER_F:ACC_CHASER_F + 3]
@@ -139,8 +210,8 @@ def step_forces(q, v, t, advance, x, xv, lag, clock, masses, radii, threads, res
     u /= np.sqrt(u @ u)
     chaser = force[0:6]
     before = chaser[0:3].copy()
-    chaser_actuation(t, z, rate, u, rot_c, bodies[0, 0:3], bodies[0, 6:9], bodies[0, 9:12], inertia[0], attitude,
-                     thrust_kind, along_z, thrust_params, thrust_state, step, advance, chaser, diag)
+    chaser_actuation(t, z, rate, u, rot_c, bodies[0, 0:3], bodies[0, 6:9], bodies[0, 9:12], inertia[0], control, step,
+                     advance, chaser, diag)
     debris = force[6:12]
     add_body_gravity(chaser, 0, bodies[0, 0], bodies[0, 1], bodies[0, 2], body_masses[0], mu)
     add_body_gravity(debris, 0, bodies[1, 0], bodies[1, 1], bodies[1, 2], body_masses[1], mu)
@@ -164,11 +235,21 @@ class NetTowState:
         self.rest = top.rest_lengths.copy()
         self.stiffness = top.stiffness.copy()
         self.thrust_state = np.array(model.thrust_state, float)
+        self.control = chaser_control(np.ascontiguousarray(model.attitude, float), model.thrust_command,
+                                      bool(model.thrust_along_body_z), np.ascontiguousarray(model.thrust_params, float),
+                                      self.thrust_state)
         self.acc, self.diag = np.zeros(ACC_SIZE), np.zeros(D_SIZE)
         self.f, self.work, self.lag = np.zeros_like(self.x), np.zeros(21), np.zeros_like(self.x)
         self.tether_on = np.array(model.main_tether, float)
         self.tether_off = np.array([0.0, 0.0, model.main_tether[2]])
         self.reeling = model.closing_duration is not None
+        self.net = NetThreads(top.masses, top.radii, top.threads, self.rest, self.stiffness, top.damping)
+        self.debris = DebrisBody(float(model.masses[1]), model.inverse_inertia[1], model.geometry, model.contact_law)
+        m = model
+        self.kernel = net_tow_kernel(self.x, self.v, self.lag, self.clock, self.net, self.reference, float(m.mu),
+                                     int(m.net.central), np.ascontiguousarray(m.attach_chaser_body, float), m.masses,
+                                     m.inertia_body, self.debris, int(m.substeps), float(m.step), self.control,
+                                     m.positions, self.acc, self.diag, self.f, self.work)
         self.rest_open = top.rest_lengths[-len(model.net.closing_rest_closed):].copy()
 
     def reel(self, t):
@@ -182,15 +263,11 @@ class NetTowState:
         self.reeling = ramp < 1.0
 
     def forces(self, q, v, t, advance):
-        m, top = self.model, self.model.net.topology
+        m = self.model
         if self.reeling and t >= m.closing_time:
             self.reel(t)
         tether = self.tether_on if t >= m.closing_time else self.tether_off
-        return step_forces(q, v, t, advance, self.x, self.v, self.lag, self.clock, top.masses, top.radii, top.threads, self.rest,
-                           self.stiffness, top.damping, self.reference, m.mu, m.net.central, tether,
-                           m.attach_chaser_body, m.masses, m.inertia_body, m.inverse_inertia[1], m.geometry,
-                           m.contact_law, m.substeps, m.step, m.attitude, m.thrust_kind, m.thrust_along_body_z,
-                           m.thrust_params, self.thrust_state, m.positions, self.acc, self.diag, self.f, self.work)
+        return step_forces(q, v, t, advance, tether, self.kernel)
 
     def momentum(self, v_bodies) -> np.ndarray:
         """Total linear momentum (N s, inertial) of chaser, debris and net."""

@@ -22,16 +22,18 @@ frame.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.experimental import structref
 
 from multibody.control.attitude import desired_attitude, sliding_mode_torque
-from multibody.control.thrust import thrust_command
+from multibody.control.thrust import THRUST_LAW
 from multibody.connection_point import implicit_point_step
 from multibody.contact import contact_over_step
 from multibody.contact_kernel import _effective_mass_along_normal, _substeps_to_resolve_contact
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from multibody.rotations import rotation_matrix_from_rotation_vector
 from multibody.net import add_thread_forces, tension_only_kelvin_voigt
 from multibody.orbit import two_body_acceleration_xyz
 
@@ -47,6 +49,44 @@ D_TENSION, D_ELONGATION, D_RATE, D_THRUST, D_TORQUE, D_SLIDING, D_CONTACTS, D_CO
 CYL_RADIUS, CYL_HALF, CYL_Z = 0, 1, 2
 #: Contact law: k_n (N/m^n), n, d_n, mu_s, mu_k, V_t0 (see multibody.assembly.ContactLaw).
 C_K, C_EXP, C_D, C_MUS, C_MUK, C_VT = range(6)
+
+
+class NetThreads(NamedTuple):
+    """The net's nodes and threads as the towing kernels take them (n nodes, m threads; SI)."""
+
+    node_mass: np.ndarray     # (n,) node masses (kg)
+    node_radius: np.ndarray   # (n,) node contact radii (m)
+    threads: np.ndarray       # (m, 2) int64 node pairs; the closing loop is the last 12
+    rest: np.ndarray          # (m,) natural lengths (m); the closing loop's change in place while it is reeled in
+    stiffness: np.ndarray     # (m,) EA/l0 (N/m), likewise
+    damping: np.ndarray       # (m,) (N s/m)
+
+
+class DebrisBody(NamedTuple):
+    """The debris as the net's contact meets it: a rigid closed cylinder (SI)."""
+
+    mass: float                         # (kg)
+    inverse_inertia_body: np.ndarray    # (3, 3) inverse inertia about the CoM, debris frame (1/(kg m^2))
+    geometry: np.ndarray                # (3,) radius (m), half length (m), axial centre z_body (m): CYL_*
+    contact_law: np.ndarray             # (6,) k_n, n, d_n, mu_s, mu_k, V_t0: C_*
+
+
+class DebrisMotion(NamedTuple):
+    """The debris' motion at one net sub-step (inertial frame)."""
+
+    com: np.ndarray              # (3,) CoM relative to the nodes' reference point (m)
+    to_inertial: np.ndarray      # (3, 3) rotation debris frame -> inertial
+    velocity: np.ndarray         # (3,) CoM velocity (m/s)
+    omega_inertial: np.ndarray   # (3,) angular velocity, inertial components (rad/s)
+
+
+class TetherEnd(NamedTuple):
+    """The main tether (eq. 5a) and its end A on the chaser at one net sub-step (inertial frame)."""
+
+    params: np.ndarray        # (3,) k_MT (N/m), c_MT (N s/m), l_MT0 (m)
+    point: np.ndarray         # (3,) attachment point A, absolute (m)
+    velocity: np.ndarray      # (3,) A's velocity (m/s)
+    chaser_com: np.ndarray    # (3,) chaser CoM, absolute (m)
 
 
 @njit(cache=True, inline="always")
@@ -117,21 +157,54 @@ def _node_contact(i, x, v, lag, f, node_mass, penetration, nbx, nby, nbz, com, r
 
 
 @njit(cache=True)
-def net_forces(x, v, lag, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu, central,
-               main_tether, a_point, a_velocity, com_c, com_d, rot_d, vel_d, omega_d, mass_d, inverse_inertia_d, geometry,
-               law, h, f, acc, work, explicit_tether=True):
+def net_forces(x, v, lag, net, reference, mu, central, end, motion, debris, h, f, acc, work, explicit_tether=True):
     """Forces on every node (``f`` (n, 3), N) at positions ``x`` (displacements from ``reference``, m)
     and velocities ``v`` (m/s); the reactions on the bodies (force, torque about the CoM, inertial)
     are added to ``acc`` times ``h`` (impulses), with the main tether's tension, contact count, total
     contact force, largest closing-thread tension and the node gravity's impulse.
 
-    ``main_tether`` = [k_MT, c_MT, l_MT0] joins node ``central`` to the chaser's attachment
-    ``a_point`` (absolute, m) moving with ``a_velocity`` (m/s); chaser CoM ``com_c`` (absolute, m);
-    the debris (CoM ``com_d``, relative to ``reference`` like the nodes, attitude
-    ``rot_d``, velocity ``vel_d``, angular velocity ``omega_d`` inertial) is the cylinder ``geometry``.
+    ``net`` (:class:`NetThreads`) the nodes and threads; ``end`` (:class:`TetherEnd`) the main tether from
+    node ``central`` to the chaser's attachment; ``motion`` (:class:`DebrisMotion`, CoM relative to
+    ``reference`` like the nodes) and ``debris`` (:class:`DebrisBody`) the debris cylinder; ``mu``
+    (m^3/s^2), ``h`` the sub-step (s); ``f``, ``acc``, ``work`` buffers.
     Returns the main tether's (tension, elongation, elongation rate). With ``explicit_tether`` False
     the main tether is left out (the sub-cycle steps it implicitly, :func:`_implicit_tether_step`).
+
+    Parameters
+    ----------
+    x, v : (n, 3) float
+        Node positions relative to ``reference`` (m) and velocities (m/s), inertial.
+    lag : (n, 3) float
+        Contact velocity lags (m/s), released and set in place.
+    net : NetThreads
+        Nodes and threads.
+    reference : (3,) float
+        Origin of the node positions, absolute (m).
+    mu : float
+        Gravitational parameter (m^3/s^2); 0: no gravity.
+    central : int
+        Node the main tether holds.
+    end : TetherEnd
+        Main tether and its chaser end A.
+    motion : DebrisMotion
+        The debris' motion at this sub-step.
+    debris : DebrisBody
+        The debris cylinder, its mass properties and the contact law.
+    h : float
+        Sub-step (s).
+    f : (n, 3) float
+        Node forces (N, inertial), overwritten.
+    acc : (ACC_SIZE,) float
+        Impulses and scalars (``ACC_*``), added to.
+    work : (21,) float
+        Scratch of the contact solver.
+    explicit_tether : bool
+        Include the main tether's force.
     """
+    node_mass, node_radius, threads, rest, stiffness, damping = net
+    main_tether, a_point, a_velocity, com_c = end
+    com_d, rot_d, vel_d, omega_d = motion
+    mass_d, inverse_inertia_d, geometry, law = debris
     f[:] = 0.0
     add_thread_forces(x, v, threads, rest, stiffness, damping, f)
     n = x.shape[0]
@@ -219,15 +292,39 @@ def _geodesic(rot_end, omega_body, back):
 
 
 @njit(cache=True)
-def advance_net(x, v, lag, t_start, t_end, n_sub, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu,
-                central, main_tether, attach_chaser_body, bodies, mass_d, inverse_inertia_d, geometry, law, f, acc,
-                work):
+def advance_net(x, v, lag, t_start, t_end, n_sub, net, reference, mu, central, main_tether, attach_chaser_body, bodies,
+                debris, f, acc, work):
     """Advance the net from ``t_start`` to ``t_end`` (s) by ``n_sub`` symplectic-Euler sub-steps while
     chaser and debris move as Verlet moves them over the step. ``bodies`` (2, 12): per body (chaser,
     debris) the CoM at ``t_end`` (absolute, m), rotation vector body->inertial at ``t_end`` (rad),
-    half-step CoM velocity (m/s) and angular velocity (rad/s, body frame). ``acc`` (ACC_SIZE) is
+    half-step CoM velocity (m/s) and angular velocity (rad/s, body frame). ``net``
+    (:class:`NetThreads`), ``debris`` (:class:`DebrisBody`), ``main_tether`` = [k_MT (N/m), c_MT (N s/m),
+    l_MT0 (m)], ``attach_chaser_body`` (3,) A in the chaser frame (m). ``acc`` (ACC_SIZE) is
     zeroed and receives the impulses over the step (:func:`net_forces`). Returns the main tether's
-    (tension, elongation, rate) at the last sub-step."""
+    (tension, elongation, rate) at the last sub-step.
+
+    Parameters
+    ----------
+    x, v, lag : (n, 3) float
+        Net state (:func:`net_forces`), advanced in place.
+    t_start, t_end : float
+        The step's interval (s).
+    n_sub : int
+        Sub-steps.
+    net, reference, mu, central
+        As :func:`net_forces` takes them.
+    main_tether : (3,) float
+        k_MT (N/m), c_MT (N s/m), l_MT0 (m).
+    attach_chaser_body : (3,) float
+        A in the chaser frame (m).
+    bodies : (2, 12) float
+        See above.
+    debris : DebrisBody
+        The debris cylinder, its mass properties and the contact law.
+    f, acc, work
+        Buffers (:func:`net_forces`); ``acc`` zeroed first.
+    """
+    node_mass = net.node_mass
     acc[:] = 0.0
     h = (t_end - t_start) / n_sub
     rot_c_end = rotation_matrix_from_rotation_vector(bodies[0, 3:6])
@@ -241,9 +338,8 @@ def advance_net(x, v, lag, t_start, t_end, n_sub, node_mass, node_radius, thread
             com_d[a] = bodies[1, a] - back * bodies[1, 6 + a] - reference[a]
         _attachment(bodies[0], rot_c_end, attach_chaser_body, back, com_c, a_point, a_velocity)
         omega_d = rot_d @ bodies[1, 9:12]
-        net_forces(x, v, lag, node_mass, node_radius, threads, rest, stiffness, damping, reference, mu, central,
-                   main_tether, a_point, a_velocity, com_c, com_d, rot_d, bodies[1, 6:9], omega_d,
-                   mass_d, inverse_inertia_d, geometry, law, h, f, acc, work, False)
+        net_forces(x, v, lag, net, reference, mu, central, TetherEnd(main_tether, a_point, a_velocity, com_c),
+                   DebrisMotion(com_d, rot_d, bodies[1, 6:9], omega_d), debris, h, f, acc, work, False)
         for i in range(x.shape[0]):
             if i == central:
                 continue
@@ -288,17 +384,101 @@ def _implicit_tether_step(x, v, f, mass, reference, central, main_tether, a_poin
     return _main_tether(x, v, reference, central, main_tether, a_point, a_velocity, com_c, h, f, acc)
 
 
+_VECTOR = types.float64[::1]
+
+
+@structref.register
+class ChaserControlType(types.StructRef):
+    """numba type of :class:`ChaserControl`."""
+
+
+class ChaserControl(structref.StructRefProxy):
+    """The chaser's controllers as the compiled full-net kernel takes them (make it with
+    :func:`chaser_control`).
+
+    Fields
+    ------
+    attitude : (8,) float       Sliding-mode attitude control: on (1/0), K (1/s), G (3,) (rad/s^2),
+                                boundary layer epsilon (3,) (rad/s) (eqs. 7-10).
+    thrust : first-class function   The thrust law's compiled ``command``
+                                (:data:`multibody.control.thrust.THRUST_LAW`).
+    along_body_z : bool         Thrust along the chaser's body z (True) or against its inertial velocity.
+    thrust_params : (k,) float  The law's constants; ``thrust_state`` (j,) float its states, advanced
+                                in place (shared with the array given, not copied).
+    """
+
+
+structref.define_proxy(ChaserControl, ChaserControlType, ["attitude", "thrust", "along_body_z", "thrust_params",
+                                                          "thrust_state"])
+#: numba type of the kernels' chaser-control argument.
+CHASER_CONTROL = ChaserControlType([("attitude", _VECTOR), ("thrust", THRUST_LAW), ("along_body_z", types.boolean),
+                                    ("thrust_params", _VECTOR), ("thrust_state", _VECTOR)])
+
+
+@njit(CHASER_CONTROL(_VECTOR, THRUST_LAW, types.boolean, _VECTOR, _VECTOR), cache=True)
+def chaser_control(attitude, thrust, along_body_z, thrust_params, thrust_state):
+    """The :class:`ChaserControl` of these fields (arrays shared, not copied).
+
+    Parameters
+    ----------
+    attitude : (8,) float
+        On (1/0), K (1/s), G (3,) (rad/s^2), epsilon (3,) (rad/s).
+    thrust : first-class function
+        The thrust law's compiled command (:data:`multibody.control.thrust.THRUST_LAW`).
+    along_body_z : bool
+        Thrust along the chaser's body z (True) or against its inertial velocity.
+    thrust_params, thrust_state : (k,), (j,) float
+        The law's constants and states (states advanced in place).
+    """
+    control = structref.new(CHASER_CONTROL)
+    control.attitude = attitude
+    control.thrust = thrust
+    control.along_body_z = along_body_z
+    control.thrust_params = thrust_params
+    control.thrust_state = thrust_state
+    return control
+
+
 @njit(cache=True)
-def chaser_actuation(t, elongation, rate, u_inertial, rot_c, com_c, vel_c, omega_c, inertia_c, attitude, thrust_kind,
-                     along_body_z, thrust_params, thrust_state, step, advance, force, diag):
-    """Thrust (the case's law, :func:`multibody.control.thrust.thrust_command`, along the chaser's body z or
-    against its velocity as in the lower-order model) and the sliding-mode torque (eqs. 7-10,
-    :mod:`multibody.control.attitude`) from the main tether's elongation and direction ``u_inertial`` (A -> net
-    node). Adds them to ``force`` (6,: chaser force inertial, torque body) and fills ``diag``."""
-    magnitude = thrust_command(thrust_kind, t, elongation, rate, thrust_params, thrust_state, step, advance)
+def chaser_actuation(t, elongation, rate, u_inertial, rot_c, com_c, vel_c, omega_c, inertia_c, control, step, advance,
+                     force, diag):
+    """Thrust (the case's law ``control.thrust``, along the chaser's body z or against its velocity as in the
+    lower-order model) and the sliding-mode torque (eqs. 7-10, :mod:`multibody.control.attitude`) from the main
+    tether's elongation (m), its rate (m/s) and direction ``u_inertial`` (A -> net node); ``control`` a
+    :class:`ChaserControl`. Adds them to ``force`` (6,: chaser force inertial, torque body) and fills ``diag``.
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    elongation, rate : float
+        Main-tether elongation (m) and rate (m/s).
+    u_inertial : (3,) float
+        Unit vector A -> net node (inertial).
+    rot_c : (3, 3) float
+        Chaser body -> inertial.
+    com_c, vel_c : (3,) float
+        Chaser CoM (m, absolute) and velocity (m/s), inertial.
+    omega_c : (3,) float
+        Chaser angular velocity, body frame (rad/s).
+    inertia_c : (3, 3) float
+        Chaser inertia, body frame (kg m^2).
+    control : ChaserControl
+        Thrust law and attitude controller.
+    step : float
+        Sampling step (s).
+    advance : bool
+        Advance the thrust law's state.
+    force : (6,) float
+        Added to: chaser force (N, inertial), torque (N m, body).
+    diag : (D_SIZE,) float
+        ``D_THRUST``, ``D_TORQUE``, ``D_SLIDING`` written.
+    """
+    attitude = control.attitude
+    magnitude = control.thrust(t, elongation, rate, control.thrust_params, control.thrust_state, step, advance)
     diag[D_THRUST] = magnitude
     if magnitude != 0.0:
-        if along_body_z:
+        if control.along_body_z:
             direction = rot_c[:, 2].copy()
         else:
             direction = -vel_c / math.sqrt(vel_c[0] ** 2 + vel_c[1] ** 2 + vel_c[2] ** 2)

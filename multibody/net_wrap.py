@@ -21,7 +21,8 @@ import numpy as np
 from numba import njit
 
 from multibody.net import NetTopology, flat_square_net
-from multibody.net_towing_kernel import ACC_SIZE, CYL_HALF, CYL_RADIUS, CYL_Z, cylinder_distance, net_forces
+from multibody.net_towing_kernel import (ACC_SIZE, CYL_HALF, CYL_RADIUS, CYL_Z, DebrisBody, DebrisMotion, NetThreads,
+                                         TetherEnd, cylinder_distance, net_forces)
 
 #: Threads of the closing loop (four corner masses and eight perimeter nodes, Sec. 2.1).
 N_CLOSING = 12
@@ -166,8 +167,9 @@ def _drape(x_body, v_body, masses, radii, threads, rest, stiffness, damping, cen
         for c in range(n_closing):
             rest[first + c] = rest_open[c] + ramp * (rest_closed[c] - rest_open[c])
             stiffness[first + c] = ea / rest[first + c]
-        net_forces(x_body, v_body, lag, masses, radii, threads, rest, stiffness, damping, zeros3, 0.0, central, tether,
-                   far_body, zeros3, zeros3, zeros3, rot, zeros3, zeros3, big, inverse, geometry, law, h, f, acc, work)
+        net_forces(x_body, v_body, lag, NetThreads(masses, radii, threads, rest, stiffness, damping), zeros3, 0.0,
+                   central, TetherEnd(tether, far_body, zeros3, zeros3), DebrisMotion(zeros3, rot, zeros3, zeros3),
+                   DebrisBody(big, inverse, geometry, law), h, f, acc, work)
         g = gravity if t < fall + reel else 0.0
         for i in range(x_body.shape[0]):
             for a in range(3):

@@ -25,8 +25,10 @@ from scipy.spatial.transform import Rotation
 
 from multibody.health import HealthWatch
 from multibody.impact import _object_state_index, checked_post_step, explicit_settings, solve_checked
-from multibody.kernel import rotation_matrix_from_rotation_vector
-from multibody.towing_kernel import N_COORDINATES, ST_TENSION, body_forces, pack, sampled_state, twin_run
+from multibody.rotations import rotation_matrix_from_rotation_vector
+from multibody.control.thrust_laws import thrust_law
+from multibody.towing_kernel import (N_COORDINATES, ST_TENSION, TowKernel, body_forces, no_load, pack, sampled_state,
+                                     tow_kernel, verlet_run)
 from multibody.towing_kernel import MT_ELONGATION, MT_ELONGATION_RATE, MT_TENSION, SLIDING, THRUST, TORQUE
 
 
@@ -42,7 +44,7 @@ class TowedBodies:
     attach_chaser_body : (3,) float MT attachment r_A/C, chaser frame (m).
     mu : float                      Gravitational parameter (m^3/s^2).
     attitude : (8,) float           Controller on (1/0), K (1/s), G (3,) (rad/s^2), epsilon (3,) (rad/s).
-    thrust_kind : int               :data:`multibody.control.thrust.KINDS` code.
+    thrust_law : str                The thrust law's name (a module of :mod:`multibody.control.thrust_laws`).
     thrust_along_body_z : bool      Thrust along the chaser's body z (MRAC) or against its velocity (ramp).
     thrust_params, thrust_state : (k,) float   The thrust law's constants and initial states.
     positions, velocities : (b, 3) float       Point masses' and CoMs' positions (m, absolute) and velocities
@@ -56,7 +58,7 @@ class TowedBodies:
     attach_chaser_body: np.ndarray
     mu: float
     attitude: np.ndarray
-    thrust_kind: int
+    thrust_law: str
     thrust_along_body_z: bool
     thrust_params: np.ndarray
     thrust_state: np.ndarray
@@ -72,6 +74,12 @@ class TowedBodies:
 
     def __post_init__(self):
         self.inverse_inertia = np.linalg.inv(self.inertia_body)
+        thrust_law(self.thrust_law)     # an unknown law is refused here, listing the known ones
+
+    @property
+    def thrust_command(self):
+        """The thrust law's compiled ``command`` (:data:`multibody.control.thrust.THRUST_SIGNATURE`)."""
+        return thrust_law(self.thrust_law).command
 
     @property
     def n_steps(self) -> int:
@@ -110,19 +118,20 @@ class TowingModel(TowedBodies):
         return q, v
 
 
-def packed(model: TowingModel) -> np.ndarray:
-    """The model as one float array for the compiled kernel (:func:`multibody.towing_kernel.pack`);
-    it also carries the thrust law's state, so each run needs its own.
+def packed(model: TowingModel) -> TowKernel:
+    """The model for the compiled kernels: one float array (:func:`multibody.towing_kernel.pack`,
+    ``.work``) and the thrust law's compiled command (``.thrust``); the array also carries the
+    thrust law's state, so each run needs its own.
 
     Parameters
     ----------
     model : TowingModel
         The run (SI; positions and velocities inertial, rates and inertias in the body frames).
     """
-    return pack(model.positions, model.masses, model.inertia_body, model.attach_chaser_body,
-                model.attach_debris_body, model.tether, model.mu, model.attitude, model.thrust_kind,
-                model.thrust_along_body_z, model.thrust_params, model.thrust_state, model.step, model.velocities[0],
-                model.start_time)
+    work = pack(model.positions, model.masses, model.inertia_body, model.attach_chaser_body,
+                model.attach_debris_body, model.tether, model.mu, model.attitude, model.thrust_along_body_z,
+                model.thrust_params, model.thrust_state, model.step, model.velocities[0], model.start_time)
+    return tow_kernel(work, model.thrust_command)
 
 
 @dataclass
@@ -166,7 +175,8 @@ def _sample_buffers(model: TowingModel):
 
 
 def run_twin(model: TowingModel) -> TowResult:
-    """Integrate ``model`` with the compiled twin of Exudyn's scheme (:func:`~multibody.towing_kernel.twin_run`).
+    """Integrate ``model`` with the compiled twin of Exudyn's scheme (:func:`~multibody.towing_kernel.verlet_run`
+    with no further loads).
 
     Parameters
     ----------
@@ -180,8 +190,11 @@ def run_twin(model: TowingModel) -> TowResult:
     """
     q, v = model.initial_state()
     out_q, out_v, out_diag = _sample_buffers(model)
+    record = model.every * np.arange(len(out_q), dtype=np.int64)
+    tow = packed(model)
     start = time.perf_counter()
-    twin_run(q, v, model.start_time, model.n_steps, model.every, packed(model), out_q, out_v, out_diag)
+    verlet_run(tow, no_load, np.zeros(1), q, v, model.start_time, model.n_steps, np.zeros(1), record, out_q, out_v,
+               out_diag, np.zeros((len(out_q), 1)))
     wall = time.perf_counter() - start
     times = model.start_time + model.step * model.every * np.arange(len(out_q))
     return TowResult(model, times, out_q, out_v, out_diag, wall)
@@ -200,13 +213,13 @@ class _TowForces:
 
     def __init__(self, model: TowingModel):
         self.model = model
-        self.work = packed(model)
+        self.tow = packed(model)
         self.last_time = -np.inf
 
     def __call__(self, mbs, t, item, q, q_t):
         advance = t > self.last_time
         self.last_time = max(t, self.last_time)
-        return body_forces(np.asarray(q), np.asarray(q_t), self.model.start_time + t, self.work, advance)
+        return body_forces(np.asarray(q), np.asarray(q_t), self.model.start_time + t, self.tow, advance)
 
 
 class _Sampler:
@@ -224,7 +237,7 @@ class _Sampler:
         if self.index is not None:
             q, v = q[self.index], v[self.index]
         self.out_q[sample], self.out_v[sample], self.out_diag[sample] = sampled_state(
-            np.asarray(q), np.asarray(v), self.forces.model.start_time + t, self.forces.work)
+            np.asarray(q), np.asarray(v), self.forces.model.start_time + t, self.forces.tow)
 
     def __call__(self, mbs, t):
         if self.count % self.every == 0 and self.sample < len(self.out_q):

@@ -21,14 +21,17 @@ gyroscopic terms are Exudyn's own (the twin adds them as Exudyn does).
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.experimental import structref
 
 from multibody.control.attitude import desired_attitude, sliding_mode_torque
-from multibody.control.thrust import thrust_command
+from multibody.control.thrust import THRUST_LAW
 from multibody.connection_point import STATE_SIZE, TIME, V_N, X_N, advance_point, initial_point_state
-from multibody.kernel import rotation_matrix_from_rotation_vector, verlet_evaluation_state
+from multibody.kernel import verlet_evaluation_state
+from multibody.rotations import rotation_matrix_from_rotation_vector
 from multibody.net import tension_only_kelvin_voigt
 from multibody.orbit import add_body_gravity
 
@@ -86,20 +89,63 @@ def _tether_to_body(x, v, rot, base, com, point_body, k, c, rest, out_force):
     return tension, length - rest, rate, dx, dy, dz
 
 
+class TowingParts(NamedTuple):
+    """The lower-order model's constants as :func:`towing_forces` takes them (SI; inertial frame unless
+    ``_body``; n sub-tethers)."""
+
+    reference: np.ndarray        # (3, 3) reference positions of P, chaser CoM, debris CoM (m, absolute)
+    masses: np.ndarray           # (3,) m_P, m_C, m_D (kg)
+    inertia_chaser: np.ndarray   # (3, 3) J_C about the CoM, chaser body frame (kg m^2)
+    attach_chaser: np.ndarray    # (3,) MT attachment r_A/C, chaser body frame (m)
+    attach_debris: np.ndarray    # (n, 3) ST attachments r_i/D, debris body frame (m)
+    tether: np.ndarray           # (6,) k_MT (N/m), c_MT (N s/m), l_MT0 (m), k_ST, c_ST, l_ST0: K_MT ... L_ST
+    mu: float                    # gravitational parameter (m^3/s^2)
+    attitude: np.ndarray         # (8,) controller on (1/0), K (1/s), G (3,) (rad/s^2), width (3,) (rad/s): ATT_*
+
+
+class ThrustLaw(NamedTuple):
+    """The chaser's thrust law as :func:`towing_forces` takes it."""
+
+    command: object              # compiled command, :data:`multibody.control.thrust.THRUST_LAW` (first-class function)
+    along_body_z: bool           # along the chaser's body z (True) or against its inertial velocity
+    params: np.ndarray           # (k,) the law's constants
+    state: np.ndarray            # (j,) its states, advanced in place
+
+
 @njit(cache=True)
-def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, attach_debris, tether, mu,
-                  attitude, thrust_kind, thrust_along_body_z, thrust_params, thrust_state, step, advance,
-                  out_force, out_diag):
+def towing_forces(q, v, t, parts, thrust, step, advance, out_force, out_diag):
     """Generalized forces (``out_force``, (15,)) of the lower-order model at time ``t`` (s).
 
     MT and ST tensions (eqs. 4, 5, 13, 14), two-body gravity on P, chaser and debris (eq. 1),
-    thrust (the ramp after eq. 2 or a :mod:`multibody.control.thrust` law), sliding-mode torque (eqs. 7-10).
-    ``reference`` (3, 3) holds the reference positions of P, chaser and debris (m);
-    ``masses`` = [m_P, m_C, m_D] (kg); ``tether`` = [k_MT, c_MT, l_MT0, k_ST, c_ST, l_ST0];
-    ``attitude`` = [on, K, G (3), width (3)]. The thrust law's state advances by ``step`` when
-    ``advance``. ``out_diag`` receives MT tension, elongation and rate, thrust magnitude, control
-    torque (3, body), sliding variable (3) and the ST tensions.
+    thrust (``thrust``, a :class:`ThrustLaw`: the case's compiled :mod:`multibody.control.thrust` law),
+    sliding-mode torque (eqs. 7-10); the model's constants in ``parts`` (:class:`TowingParts`). The
+    thrust law's state advances by ``step`` (s) when ``advance``. ``out_diag`` receives MT tension,
+    elongation and rate, thrust magnitude, control torque (3, body), sliding variable (3) and the ST
+    tensions.
+
+    Parameters
+    ----------
+    q, v : (15,) float
+        State at ``t``, kernel layout (module doc): P, chaser and debris displacements from the
+        reference positions (m, inertial) and rotation vectors body -> inertial (rad); velocities
+        (m/s, inertial) and angular velocities (rad/s, body frames).
+    t : float
+        Time (s).
+    parts : TowingParts
+        The model's constants.
+    thrust : ThrustLaw
+        The thrust law, its parameters and state.
+    step : float
+        The controller's sampling step (s).
+    advance : bool
+        Advance the thrust law's state.
+    out_force : (15,) float
+        Generalized forces, kernel layout (N, inertial; N m, body frames), overwritten.
+    out_diag : (ST_TENSION + n,) float
+        Diagnostics (N, m, m/s, N, N m body, rad/s, N), written.
     """
+    reference, masses, inertia_chaser, attach_chaser, attach_debris, tether, mu, attitude = parts
+    command, thrust_along_body_z, thrust_params, thrust_state = thrust
     out_force[:] = 0.0
     x = np.empty(3)  # P, absolute (m)
     com_c = np.empty(3)
@@ -120,7 +166,7 @@ def towing_forces(q, v, t, reference, masses, inertia_chaser, attach_chaser, att
     add_body_gravity(out_force, CHASER, com_c[0], com_c[1], com_c[2], masses[1], mu)
     add_body_gravity(out_force, DEBRIS, com_d[0], com_d[1], com_d[2], masses[2], mu)
 
-    magnitude = thrust_command(thrust_kind, t, z, z_rate, thrust_params, thrust_state, step, advance)
+    magnitude = command(t, z, z_rate, thrust_params, thrust_state, step, advance)
     out_diag[THRUST] = magnitude
     if magnitude != 0.0:
         if thrust_along_body_z:
@@ -162,15 +208,16 @@ def accelerations(v, force, masses, inertia, inverse_inertia):
 
 # ---------------------------------------------------------------------------- packed model
 # One float array holds the whole model, the thrust law's state and the work buffers, so that a
-# step costs one call from Python (numba's dispatch costs ~0.2 us per argument).
-(W_N_ATTACH, W_KIND, W_ALONG_Z, W_STEP, W_MU, W_THRUST_PARAMS, W_N_THRUST_PARAMS, W_THRUST_STATE, W_N_THRUST_STATE,
- W_ATTACH, W_DIAG, W_FORCE, W_ACCEL, W_POINT, W_EXTRA) = range(15)
+# step costs one call from Python (numba's dispatch costs ~0.2 us per argument); the TowKernel
+# structref pairs it with the thrust law's compiled command.
+(W_N_ATTACH, W_ALONG_Z, W_STEP, W_MU, W_THRUST_PARAMS, W_N_THRUST_PARAMS, W_THRUST_STATE, W_N_THRUST_STATE,
+ W_ATTACH, W_DIAG, W_FORCE, W_ACCEL, W_POINT, W_EXTRA) = range(14)
 W_REFERENCE, W_MASSES, W_INERTIA, W_INVERSE, W_ATTACH_CHASER, W_TETHER, W_ATTITUDE, W_END = (
     16, 25, 28, 46, 64, 67, 73, 81)
 
 
-def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, attitude, thrust_kind,
-         thrust_along_body_z, thrust_params, thrust_state, step, point_velocity, start_time) -> np.ndarray:
+def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, attitude, thrust_along_body_z,
+         thrust_params, thrust_state, step, point_velocity, start_time) -> np.ndarray:
     """The packed model (see :func:`towing_forces` for the meaning of each part) with P's integrator
     state at ``start_time`` (s), P moving with ``point_velocity`` (m/s, inertial). The last section
     (:data:`W_EXTRA`, zero here) holds further generalized forces (15,) in the kernel layout that
@@ -181,7 +228,7 @@ def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, a
              N_COORDINATES]
     offsets = W_END + np.concatenate([[0], np.cumsum(sizes)])
     work = np.zeros(offsets[-1])
-    work[:15] = [n, thrust_kind, float(thrust_along_body_z), step, mu, offsets[1], len(thrust_params), offsets[2],
+    work[:14] = [n, float(thrust_along_body_z), step, mu, offsets[1], len(thrust_params), offsets[2],
                  len(thrust_state), offsets[0], offsets[3], offsets[4], offsets[5], offsets[6], offsets[7]]
     work[offsets[6]:offsets[7]] = initial_point_state(point_velocity, start_time)
     inertia = np.asarray(inertia, float)
@@ -190,6 +237,59 @@ def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, a
     for start, part in zip(offsets[:3], (np.ravel(attach_debris), thrust_params, thrust_state)):
         work[start:start + len(part)] = part
     return work
+
+
+_VECTOR = types.float64[::1]
+
+
+@structref.register
+class TowKernelType(types.StructRef):
+    """numba type of :class:`TowKernel`."""
+
+
+class TowKernel(structref.StructRefProxy):
+    """The lower-order model as the compiled kernels take it (make it with :func:`tow_kernel`).
+
+    Fields
+    ------
+    work : (m,) float    The packed model of :func:`pack` (geometry, masses, tethers, attitude control,
+                         the thrust law's params and state, P's state, work buffers; SI, inertial).
+    thrust : first-class function   The thrust law's compiled ``command``
+                         (:data:`multibody.control.thrust.THRUST_LAW`).
+    """
+
+    @property
+    def work(self) -> np.ndarray:
+        """The packed model (the kernel's own array, not a copy)."""
+        return _work_of(self)
+
+
+@njit(cache=True)
+def _work_of(tow):
+    return tow.work
+
+
+structref.define_proxy(TowKernel, TowKernelType, ["work", "thrust"])
+#: numba type of the kernels' model argument.
+TOW_KERNEL = TowKernelType([("work", _VECTOR), ("thrust", THRUST_LAW)])
+
+
+@njit(TOW_KERNEL(_VECTOR, THRUST_LAW), cache=True)
+def tow_kernel(work, thrust):
+    """The :class:`TowKernel` of the packed model ``work`` (:func:`pack`, shared, not copied) and the
+    thrust law ``thrust`` (a compiled ``command`` of :mod:`multibody.control.thrust_laws`).
+
+    Parameters
+    ----------
+    work : (w,) float
+        Packed model (:func:`pack`).
+    thrust : first-class function
+        The thrust law's compiled command (:data:`multibody.control.thrust.THRUST_LAW`).
+    """
+    tow = structref.new(TOW_KERNEL)
+    tow.work = work
+    tow.thrust = thrust
+    return tow
 
 
 @njit(cache=True, inline="always")
@@ -248,21 +348,42 @@ def _advance_connection_point(q, v, t, work, attach):
 
 
 @njit(cache=True)
-def packed_forces(q, v, t, work, advance):
-    """:func:`towing_forces` of the packed model; the force and diagnostics land in ``work``. P's
-    entries of ``q`` and ``v`` are overwritten with its implicit state at ``t`` (advanced first if
-    ``t`` is a new step time, the forces then taken at the bodies' predicted velocities at ``t``,
-    see :func:`_advance_connection_point`)."""
+def packed_forces(q, v, t, tow, advance):
+    """:func:`towing_forces` of the packed model ``tow`` (:class:`TowKernel`); the force and diagnostics
+    land in its ``work``. P's entries of ``q`` and ``v`` are overwritten with its implicit state at ``t``
+    (advanced first if ``t`` is a new step time, the forces then taken at the bodies' predicted
+    velocities at ``t``, see :func:`_advance_connection_point`).
+
+    Parameters
+    ----------
+    q, v : (15,) float
+        State, kernel layout (module doc); P's entries are overwritten with its implicit state at ``t``.
+    t : float
+        Time (s).
+    tow : TowKernel
+        The packed model and its thrust law (:func:`tow_kernel`).
+    advance : bool
+        Advance the thrust law's state (once per new step time).
+
+    Returns
+    -------
+    force : (15,) float
+        Generalized forces, kernel layout (N, inertial; N m, body frames); a view into ``tow.work``.
+    diag : (ST_TENSION + n,) float
+        Diagnostics (:func:`towing_forces`); a view into ``tow.work``.
+    """
+    work, thrust = tow.work, tow.thrust
     n = int(work[W_N_ATTACH])
     attach = work[int(work[W_ATTACH]):int(work[W_ATTACH]) + 3 * n].reshape((n, 3))
     v_eval = _advance_connection_point(q, v, t, work, attach)
     diag = work[int(work[W_DIAG]):int(work[W_DIAG]) + ST_TENSION + n]
     force = work[int(work[W_FORCE]):int(work[W_FORCE]) + N_COORDINATES]
-    towing_forces(q, v_eval, t, work[W_REFERENCE:W_MASSES].reshape((3, 3)), work[W_MASSES:W_INERTIA],
-                  work[W_INERTIA:W_INERTIA + 9].reshape((3, 3)), work[W_ATTACH_CHASER:W_TETHER], attach,
-                  work[W_TETHER:W_ATTITUDE], work[W_MU], work[W_ATTITUDE:W_END], int(work[W_KIND]),
-                  work[W_ALONG_Z] > 0.0, _section(work, W_THRUST_PARAMS, W_N_THRUST_PARAMS),
-                  _section(work, W_THRUST_STATE, W_N_THRUST_STATE), work[W_STEP], advance, force, diag)
+    parts = TowingParts(work[W_REFERENCE:W_MASSES].reshape((3, 3)), work[W_MASSES:W_INERTIA],
+                        work[W_INERTIA:W_INERTIA + 9].reshape((3, 3)), work[W_ATTACH_CHASER:W_TETHER], attach,
+                        work[W_TETHER:W_ATTITUDE], work[W_MU], work[W_ATTITUDE:W_END])
+    law = ThrustLaw(thrust, work[W_ALONG_Z] > 0.0, _section(work, W_THRUST_PARAMS, W_N_THRUST_PARAMS),
+                    _section(work, W_THRUST_STATE, W_N_THRUST_STATE))
+    towing_forces(q, v_eval, t, parts, law, work[W_STEP], advance, force, diag)
     extra = extra_forces(work)
     for i in range(3, N_COORDINATES):
         force[i] += extra[i]
@@ -277,23 +398,46 @@ def extra_forces(work):
 
 
 @njit(cache=True)
-def body_forces(q_bodies, v_bodies, t, work, advance):
+def body_forces(q_bodies, v_bodies, t, tow, advance):
     """The packed model's generalized forces on chaser and debris (12,) for Exudyn's object, which
-    holds only their coordinates (entries 3-14 of the kernel layout); P comes from ``work``; the
-    thrust law's state advances when ``advance``."""
+    holds only their coordinates (entries 3-14 of the kernel layout); P comes from ``tow``; the
+    thrust law's state advances when ``advance``.
+
+    Parameters
+    ----------
+    q_bodies, v_bodies : (12,) float
+        Chaser and debris entries (3-14) of the kernel layout's ``q`` and ``v`` (module doc).
+    t : float
+        Time (s).
+    tow : TowKernel
+        The packed model and its thrust law.
+    advance : bool
+        Advance the thrust law (and P, if ``t`` is a new step time).
+    """
     q, v = np.zeros(N_COORDINATES), np.zeros(N_COORDINATES)
     q[3:], v[3:] = q_bodies, v_bodies
-    force, _ = packed_forces(q, v, t, work, advance)
-    _store_accelerations(v, force, work)  # as the twin does, for the next step's velocity prediction
+    force, _ = packed_forces(q, v, t, tow, advance)
+    _store_accelerations(v, force, tow.work)  # as the twin does, for the next step's velocity prediction
     return force[3:].copy()
 
 
 @njit(cache=True)
-def sampled_state(q_bodies, v_bodies, t, work):
-    """Full state (15,) each and diagnostics at ``t`` from the bodies' state and P's stored state."""
+def sampled_state(q_bodies, v_bodies, t, tow):
+    """Full state (15,) each and diagnostics at ``t`` from the bodies' state and P's stored state
+    (thrust law not advanced).
+
+    Parameters
+    ----------
+    q_bodies, v_bodies : (12,) float
+        Chaser and debris entries (3-14) of the kernel layout's ``q`` and ``v`` (module doc).
+    t : float
+        Time (s).
+    tow : TowKernel
+        The packed model and its thrust law.
+    """
     q, v = np.zeros(N_COORDINATES), np.zeros(N_COORDINATES)
     q[3:], v[3:] = q_bodies, v_bodies
-    diag = packed_forces(q, v, t, work, False)[1]
+    diag = packed_forces(q, v, t, tow, False)[1]
     return q, v, diag.copy()
 
 
@@ -306,50 +450,146 @@ def _store_accelerations(v, force, work):
 
 
 @njit(cache=True)
-def start_forces(q, v, t, work):
-    """Force at the initial state (thrust law advanced, as at every step); stores the initial
-    accelerations in ``work``; returns the force (15,)."""
-    force, _ = packed_forces(q, v, t, work, True)
-    _store_accelerations(v, force, work)
+def start_forces(q, v, t, tow):
+    """Force at the state (q, v) at time ``t`` (s), the thrust law advanced (as at every step); stores
+    the accelerations in ``tow.work`` for the next step; returns the force (15,).
+
+    Parameters
+    ----------
+    q, v : (15,) float
+        State, kernel layout (module doc); P's entries are overwritten with its implicit state at ``t``.
+    t : float
+        Time (s).
+    tow : TowKernel
+        The packed model and its thrust law.
+    """
+    force, _ = packed_forces(q, v, t, tow, True)
+    _store_accelerations(v, force, tow.work)
     return force
 
 
-@njit(cache=True)
-def step_forces(q, v, t, work):
-    """The force of the VelocityVerlet step that starts at (q, v) with the stored accelerations,
-    evaluated where Exudyn's VelocityVerlet evaluates it at time ``t`` (the step's end): half
-    kick, drift with the Lie-group update (:func:`multibody.kernel.verlet_evaluation_state`).
-    Stores the step's accelerations for the next call; returns the force (15,) and the
-    evaluation state (q, v)."""
-    start = int(work[W_ACCEL])
-    q_next, v_half = verlet_evaluation_state(q, v, work[start:start + N_COORDINATES], work[W_STEP], 3, 2)
-    force, _ = packed_forces(q_next, v_half, t, work, True)
-    _store_accelerations(v_half, force, work)
-    return force, q_next, v_half
+# ---------------------------------------------------------------------------- the Verlet loop
+#: numba signature of a load law ``law(t, q, v, p, work, xe, h, load)``: the further generalized
+#: forces a caller adds each step (:func:`verlet_run`; the diagnosis' effects): ``t`` (s), the
+#: evaluation state ``q``, ``v`` (15,) in the kernel layout (P's entries stale: read P from ``work``),
+#: the law's parameters ``p``, the packed model ``work``, the caller's own states ``xe`` advanced in
+#: place over ``h`` (s; 0: do not advance), ``load`` (15,) the loads it ADDS (forces N, inertial;
+#: torques N m, body frames). Laws are compiled eagerly with it (first-class functions).
+LOAD_LAW_SIGNATURE = types.void(types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64, _VECTOR)
+LOAD_LAW = types.FunctionType(LOAD_LAW_SIGNATURE)
 
 
-@njit(cache=True)
-def twin_run(q, v, t0, n_steps, every, work, out_q, out_v, out_diag):
-    """Integrate the lower-order model with exactly the scheme Exudyn's VelocityVerlet applies to the
-    coupled object: half kick, drift (Lie-group update of the rotation vectors), force at the new
-    state (:func:`step_forces`), half kick. Samples every ``every`` steps into ``out_q``/``out_v``
-    (k, 15) and ``out_diag`` (diagnostics at the sampled state, thrust law not advanced). ``q``,
-    ``v`` and ``work`` are updated in place; returns the final time (s)."""
+@njit(LOAD_LAW_SIGNATURE, cache=True)
+def no_load(t, q, v, p, work, xe, h, load):
+    """The nominal model: no further loads (:data:`LOAD_LAW_SIGNATURE`; every argument unused).
+
+    Parameters
+    ----------
+    t : float
+        Time (s).
+    q, v : (15,) float
+        State, kernel layout (module doc): displacements from the reference positions (m, inertial)
+        and rotation vectors body -> inertial (rad); velocities (m/s, inertial) and angular
+        velocities (rad/s, body frames).
+    p : (j,) float
+        The law's parameters.
+    work : (w,) float
+        Packed model (:func:`pack`).
+    xe : (e,) float
+        The caller's own states.
+    h : float
+        Step (s) over which ``xe`` is advanced; 0: do not advance.
+    load : (15,) float
+        Generalized forces, kernel layout, added to in place: nothing.
+    """
+    return
+
+
+@njit(types.void(LOAD_LAW, types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64, _VECTOR),
+      cache=True)
+def apply_loads(law, t, q, v, p, work, xe, h, load):
+    """Evaluate ``law`` at (``t``, ``q``, ``v``) into ``load`` and make it the packed model's further
+    forces for the coming force evaluation (advancing the states ``xe`` over ``h``).
+
+    Parameters
+    ----------
+    law : first-class function
+        Load law (:data:`LOAD_LAW_SIGNATURE`).
+    t, q, v, p, xe, h
+        As the law takes them (:func:`no_load`); ``xe`` advanced in place by the law.
+    work : (w,) float
+        Packed model (:func:`pack`); its further-forces section is overwritten with ``load``.
+    load : (15,) float
+        Scratch, overwritten with the law's generalized forces (N, inertial; N m, body frames).
+    """
+    load[:] = 0.0
+    law(t, q, v, p, work, xe, h, load)
+    extra = extra_forces(work)
+    extra[:] = load
+
+
+_MATRIX = types.float64[:, ::1]
+
+
+@njit(types.void(TOW_KERNEL, LOAD_LAW, _VECTOR, _VECTOR, _VECTOR, types.float64, types.int64, _VECTOR,
+                  types.int64[::1], _MATRIX, _MATRIX, _MATRIX, _MATRIX), cache=True)
+def verlet_run(tow, law, p, q, v, t0, n_steps, xe, record, out_q, out_v, out_diag, out_xe):
+    """Integrate the lower-order model ``tow`` from (``q``, ``v``) (15,) each at ``t0`` (s) with exactly
+    the scheme Exudyn's VelocityVerlet applies to the coupled object: half kick, drift (Lie-group
+    update of the rotation vectors, :func:`multibody.kernel.verlet_evaluation_state`), the load law
+    ``law`` (:data:`LOAD_LAW_SIGNATURE`, parameters ``p``, states ``xe``; :func:`no_load` for the
+    nominal model) then the forces at the new state (P stepped implicitly), half kick. Records
+    state, diagnostics (at the recorded state, thrust law not advanced) and ``xe`` after the steps
+    listed in ``record`` (non-decreasing step indices, 0 = the initial state) into the ``out_*``
+    rows (record indices beyond ``n_steps`` are not reached). ``q``, ``v``, ``xe`` and ``tow.work``
+    are updated in place.
+
+    Parameters
+    ----------
+    tow : TowKernel
+        The packed model and its thrust law (:func:`tow_kernel`).
+    law : first-class function
+        Load law (:data:`LOAD_LAW_SIGNATURE`), :func:`no_load` for none.
+    p : (j,) float
+        The law's parameters (at least one entry).
+    q, v : (15,) float
+        State, kernel layout (module doc): displacements from the reference positions (m, inertial)
+        and rotation vectors body -> inertial (rad); velocities (m/s, inertial) and angular
+        velocities (rad/s, body frames).
+        Advanced in place.
+    t0 : float
+        Start time (s).
+    n_steps : int
+        Number of steps of the model's step ``work[W_STEP]`` (s).
+    xe : (e,) float
+        The law's own states (at least one entry), advanced in place.
+    record : (r,) int64
+        Step indices to record, non-decreasing.
+    out_q, out_v : (r, 15) float
+        Recorded states (kernel layout, units of ``q``, ``v``), written.
+    out_diag : (r, ST_TENSION + n) float
+        Recorded diagnostics (:func:`towing_forces`: N, m, m/s, N, N m, rad/s, N), written.
+    out_xe : (r, e) float
+        Recorded ``xe``, written.
+    """
+    work = tow.work
     step = work[W_STEP]
-    start_forces(q, v, t0, work)
-    acc = int(work[W_ACCEL])
-    sample = 0
+    load = np.zeros(N_COORDINATES)
+    apply_loads(law, t0, q, v, p, work, xe, 0.0, load)
+    start_forces(q, v, t0, tow)
+    acc = work[int(work[W_ACCEL]):int(work[W_ACCEL]) + N_COORDINATES]     # the stored accelerations (a view)
+    k = 0
     for n in range(n_steps + 1):
         t = t0 + n * step
-        if n % every == 0 and sample < out_q.shape[0]:
-            out_q[sample] = q
-            out_v[sample] = v
-            out_diag[sample] = packed_forces(q, v, t, work, False)[1]
-            sample += 1
+        while k < record.shape[0] and record[k] == n:
+            out_q[k], out_v[k], out_xe[k] = q, v, xe
+            out_diag[k] = packed_forces(q.copy(), v.copy(), t, tow, False)[1]
+            k += 1
         if n == n_steps:
             break
-        _, q_next, v_half = step_forces(q, v, t + step, work)
+        q_next, v_half = verlet_evaluation_state(q, v, acc, step, 3, 2)
+        apply_loads(law, t + step, q_next, v_half, p, work, xe, step, load)
+        start_forces(q_next, v_half, t + step, tow)
         q[:] = q_next
         for i in range(N_COORDINATES):
-            v[i] = v_half[i] + (0.5 * step) * work[acc + i]
-    return t0 + n_steps * step
+            v[i] = v_half[i] + (0.5 * step) * acc[i]

@@ -11,50 +11,57 @@ mass with saturated force. The adaptive states are integrated with the controlle
 step (forward Euler, the controller is digital with zero-order hold) and frozen while the
 command saturates (the :math:`H(u_{max}-|u|)` factor of eqs. 15 and 20).
 
-``params`` layouts (see :func:`mrac_params`) and ``state`` layouts (:func:`mrac_initial_state`)
-are flat float arrays for the compiled towing kernel; the common interface is described in
-:mod:`multibody.control.thrust`.
+This module holds what both laws share (parameter head, reference model); each law is a plug-in of
+:mod:`multibody.control.thrust_laws` (``mrac1.py``, ``mrac2.py``: its gains, ``command``, initial
+state); ``params`` and ``state`` are flat float arrays for the compiled towing kernels, the common
+interface is described in :mod:`multibody.control.thrust`.
 """
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
-from scipy.linalg import solve_continuous_lyapunov
 
-# params indices common to both laws
+# params indices common to both laws; each law appends its gains (thrust_laws/mrac1.py, mrac2.py)
 T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D = range(8)
-# MRAC-1 constants
-LAMBDA0, K_S, GAMMA, XI_H, XI_A1, XI_A2 = range(8, 14)
-# MRAC-2 constants: Gamma_z (2), gamma_r, Gamma_theta (2), xi_2, P (2x2 row-major)
-GZ1, GZ2, GAMMA_R, GT1, GT2, XI_2, P11, P12, P21, P22 = range(8, 18)
+N_COMMON = 8
 # state: reference model z_m, z_m rate, then adaptive parameters
 ZM, ZM_RATE, A0 = 0, 1, 2
-N_STATE = {1: 5, 2: 7}
 
 
-def mrac_params(kind, t_on, u_max, chaser_mass, k_mt, c_mt, z_d, k_p, k_d, **gains) -> np.ndarray:
-    """Flat parameter array of MRAC-``kind`` (1 or 2).
+def command_elongation(desired, k_mt, k_p, settle_at_desired) -> float:
+    """The elongation command z_d of the reference model (eq. 13) (m): ``desired`` itself, or, with
+    ``settle_at_desired``, ``desired`` (k_MT + K_P) / K_P, the command whose static balance
+    :math:`k_{MT} z_m = K_P (z_d - z_m)` puts the reference at ``desired``.
 
     Parameters
     ----------
-    kind : {1, 2}       MRAC-1 or MRAC-2.
-    t_on : float        Time the controller starts (s); thrust is 0 before.
-    u_max : float       Thrust saturation (N).
-    chaser_mass : float :math:`m_C` (kg), :math:`b = 1/m_C`.
-    k_mt, c_mt : float  Main-tether stiffness (N/m) and damping (N s/m) of the abstracted model.
-    z_d : float         Desired elongation (m).
-    k_p, k_d : float    Reference-model PD gains (N/m, N s/m).
-    gains : MRAC-1: ``lambda0`` (1/s), ``k_s`` (N s/m), ``gamma`` (-), ``xi_h``, ``xi_a`` (2,);
-            MRAC-2: ``gamma_z`` (2,), ``gamma_r``, ``gamma_theta`` (2,), ``xi_2``, ``q`` (2, 2).
+    desired : float
+        Desired elongation (m).
+    k_mt : float
+        Main-tether stiffness (N/m).
+    k_p : float
+        Reference-model proportional gain (N/m).
+    settle_at_desired : bool
+        Command the reference model so that it settles at ``desired``.
     """
-    b = 1.0 / chaser_mass
-    head = [t_on, u_max, b, k_mt, c_mt, z_d, k_p, k_d]
-    if kind == 1:
-        return np.array(head + [gains["lambda0"], gains["k_s"], gains["gamma"], gains["xi_h"], *gains["xi_a"]], float)
-    a_m = np.array([[0.0, 1.0], [-b * (k_mt + k_p), -b * (c_mt + k_d)]])
-    p = solve_continuous_lyapunov(a_m.T, -np.asarray(gains["q"], float))  # eq. (21a): P A + A^T P = -Q
-    return np.array(head + [*gains["gamma_z"], gains["gamma_r"], *gains["gamma_theta"], gains["xi_2"],
-                            *p.ravel()], float)
+    return desired * (k_mt + k_p) / k_p if settle_at_desired else desired
+
+
+def common_params(case, tether) -> list:
+    """The parameters both laws share (indices ``T_ON`` ... ``K_D``) from a towing case (``thrust``,
+    ``mrac``, ``chaser.mass``, ``main_tether.stiffness``) and its main tether ``tether`` = [k_MT (N/m),
+    c_MT (N s/m), ...]: thrust-on time (s), saturation u_max (N), b = 1/m_C (1/kg), k_MT, c_MT,
+    z_d (m), K_P (N/m), K_D (N s/m).
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        The towing case (read: ``thrust``, ``mrac``, ``chaser.mass``, ``main_tether.stiffness``).
+    tether : (>= 2,) float
+        k_MT (N/m), c_MT (N s/m), ... of the model's main tether.
+    """
+    th, m = case.thrust, case.mrac
+    z_d = command_elongation(m.desired_elongation, case.main_tether.stiffness, m.k_p, m.settle_at_desired)
+    return [th.t_on, th.max_force, 1.0 / case.chaser.mass, tether[0], tether[1], z_d, m.k_p, m.k_d]
 
 
 def reference_steady_elongation(k_mt, k_p, z_d) -> float:
@@ -74,32 +81,6 @@ def reference_steady_elongation(k_mt, k_p, z_d) -> float:
     return k_p * z_d / (k_mt + k_p)
 
 
-def mrac_initial_state(kind, params, z0, z_rate0) -> np.ndarray:
-    """Reference model started on the measured state; adaptive parameters at their ideal values
-    for the abstracted model (MRAC-1: :math:`\\hat h = m_C`, :math:`\\hat a = [k, c]`; MRAC-2:
-    :math:`\\hat K_z = [-K_P, -K_D]`, :math:`\\hat k_r = K_P`, :math:`\\hat\\Theta = [-k, -c]`).
-
-    Parameters
-    ----------
-    kind : {1, 2}
-        MRAC-1 or MRAC-2.
-    params : (k,) float
-        :func:`mrac_params` of that law.
-    z0 : float
-        Measured main-tether elongation at the start (m).
-    z_rate0 : float
-        Its rate (m/s).
-
-    Returns
-    -------
-    (N_STATE[kind],) float
-        [z_m, z_m rate, adaptive parameters...].
-    """
-    if kind == 1:
-        return np.array([z0, z_rate0, 1.0 / params[B], params[K_MT], params[C_MT]])
-    return np.array([z0, z_rate0, -params[K_P], -params[K_D], params[K_P], -params[K_MT], -params[C_MT]])
-
-
 @njit(cache=True)
 def pulling(z, z_rate, k, c):
     """:math:`g(z, \\dot z)`: 1 while a tension-only tether pulls, else 0.
@@ -117,8 +98,16 @@ def pulling(z, z_rate, k, c):
 
 
 @njit(cache=True)
-def _reference_acceleration(params, zm, zm_rate):
-    """Reference model, eq. (13): the abstracted mass under a saturated PD force (m/s^2)."""
+def reference_acceleration(params, zm, zm_rate):
+    """Reference model, eq. (13): the abstracted mass under a saturated PD force (m/s^2).
+
+    Parameters
+    ----------
+    params : (k,) float
+        The law's parameters (common head ``T_ON`` ... ``K_D`` used).
+    zm, zm_rate : float
+        Reference elongation (m) and its rate (m/s).
+    """
     b, k, c = params[B], params[K_MT], params[C_MT]
     pd = params[K_P] * (params[Z_D] - zm) - params[K_D] * zm_rate
     pd = min(max(pd, -params[U_MAX]), params[U_MAX])
@@ -126,105 +115,20 @@ def _reference_acceleration(params, zm, zm_rate):
 
 
 @njit(cache=True)
-def _advance_reference(params, state, zm_acc, step):
+def advance_reference(params, state, zm_acc, step):
+    """Reference model's state (z_m (m), its rate (m/s)) advanced over ``step`` (s) by forward Euler
+    (digital controller) with the acceleration ``zm_acc`` (m/s^2).
+
+    Parameters
+    ----------
+    params : (k,) float
+        The law's parameters (unused here; kept for the laws' call shape).
+    state : (j,) float
+        The law's state, ``ZM`` and ``ZM_RATE`` advanced in place.
+    zm_acc : float
+        Reference acceleration (m/s^2).
+    step : float
+        The controller's sampling step (s).
+    """
     state[ZM] += step * state[ZM_RATE]
     state[ZM_RATE] += step * zm_acc
-
-
-@njit(cache=True)
-def mrac1_command(t, z, z_rate, params, state, step, advance):
-    """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16); ``state = [z_m, z_m rate, h, a1, a2]``.
-
-    Parameters
-    ----------
-    t : float
-        Time (s).
-    z : float
-        Main-tether elongation (m).
-    z_rate : float
-        Its rate (m/s).
-    params : (k,) float
-        :func:`mrac_params` of this law.
-    state : (n,) float
-        The law's state (:func:`mrac_initial_state`), advanced in place when ``advance``.
-    step : float
-        The controller's sampling step (s).
-    advance : bool
-        True once per new sampling time: integrate the adaptive and reference states.
-
-    Returns
-    -------
-    float
-        Commanded thrust (N), saturated at ``u_max``; 0 before ``t_on``.
-    """
-    if t < params[T_ON]:
-        return 0.0
-    zm_acc = _reference_acceleration(params, state[ZM], state[ZM_RATE])
-    lam = params[LAMBDA0]
-    eta = zm_acc - lam * (z_rate - state[ZM_RATE])                          # eq. (12)
-    s = (z_rate - state[ZM_RATE]) + lam * (z - state[ZM])                   # eq. (14)
-    g = pulling(z, z_rate, params[K_MT], params[C_MT])
-    u = state[A0] * eta + g * (state[A0 + 1] * z + state[A0 + 2] * z_rate) - params[K_S] * s   # eq. (11)
-    force = min(max(u, -params[U_MAX]), params[U_MAX])                      # eq. (16)
-    if advance:
-        if abs(u) < params[U_MAX]:                                          # H(u_max - |u|)
-            gamma = params[GAMMA]
-            state[A0] += step * (-s * gamma * eta - s * s * params[XI_H] * state[A0])            # eq. (15a)
-            state[A0 + 1] += step * (-s * gamma * z - s * s * params[XI_A1] * state[A0 + 1])     # eq. (15b)
-            state[A0 + 2] += step * (-s * gamma * z_rate - s * s * params[XI_A2] * state[A0 + 2])
-        _advance_reference(params, state, zm_acc, step)
-    return force
-
-
-@njit(cache=True)
-def mrac2_command(t, z, z_rate, params, state, step, advance):
-    """MRAC-2 thrust (N), eqs. (19)-(21); ``state = [z_m, z_m rate, Kz1, Kz2, kr, theta1, theta2]``.
-
-    The :math:`\\hat\\Theta` law is taken with the sign that makes the Lyapunov derivative of
-    the e-modification vanish for :math:`u = \\dots - \\hat\\Theta^T\\phi` (Lavretsky & Wise 2013,
-    Sec. 10.2): :math:`\\dot{\\hat\\Theta} = +\\Gamma_\\theta\\phi\\,e^TPB - \\dots`; the seed paper's
-    eq. (20c) prints :math:`-\\Gamma_\\theta\\hat\\Theta^T e^TPB`, a typo (it does not type-check).
-
-    Parameters
-    ----------
-    t : float
-        Time (s).
-    z : float
-        Main-tether elongation (m).
-    z_rate : float
-        Its rate (m/s).
-    params : (k,) float
-        :func:`mrac_params` of this law.
-    state : (n,) float
-        The law's state (:func:`mrac_initial_state`), advanced in place when ``advance``.
-    step : float
-        The controller's sampling step (s).
-    advance : bool
-        True once per new sampling time: integrate the adaptive and reference states.
-
-    Returns
-    -------
-    float
-        Commanded thrust (N), saturated at ``u_max``; 0 before ``t_on``.
-    """
-    if t < params[T_ON]:
-        return 0.0
-    zm_acc = _reference_acceleration(params, state[ZM], state[ZM_RATE])
-    g = pulling(z, z_rate, params[K_MT], params[C_MT])
-    phi1, phi2 = (g - 1.0) * z, (g - 1.0) * z_rate                           # eq. (18c)
-    z_d = params[Z_D]
-    u = (state[2] * z + state[3] * z_rate + state[4] * z_d
-         - (state[5] * phi1 + state[6] * phi2))                             # eq. (19)
-    force = min(max(u, -params[U_MAX]), params[U_MAX])
-    if advance:
-        if abs(u) < params[U_MAX]:
-            e1, e2 = z - state[ZM], z_rate - state[ZM_RATE]
-            epb = (e1 * params[P12] + e2 * params[P22]) * params[B]        # e^T P B, B = [0, b]
-            damp = params[XI_2] * abs(epb)
-            state[2] += step * params[GZ1] * (-z * epb - damp * state[2])   # eq. (20a)
-            state[3] += step * params[GZ2] * (-z_rate * epb - damp * state[3])
-            state[4] += step * params[GAMMA_R] * (-z_d * epb - damp * z_d * state[4])   # eq. (20b)
-            state[5] += step * params[GT1] * (phi1 * epb - damp * state[5])  # eq. (20c), sign: see above
-            state[6] += step * params[GT2] * (phi2 * epb - damp * state[6])
-        _advance_reference(params, state, zm_acc, step)
-    return force

@@ -1,52 +1,28 @@
-"""Thrust laws of the towing chaser: one small interface for the open-loop ramp and the
-main-tether elongation controllers.
+"""Thrust laws of the towing chaser: the plug-in interface shared by the open-loop ramp and the
+main-tether elongation controllers (one module each in :mod:`multibody.control.thrust_laws`).
 
-Every law is a compiled function of the same signature, called once per integration step
-(a digital controller with zero-order hold over the step):
+Every law is a compiled function of the same signature (:data:`THRUST_SIGNATURE`), called once per
+integration step (a digital controller with zero-order hold over the step):
 
 ``command(t, z, z_rate, params, state, step, advance) -> F_t``
 
 * ``t`` time (s); ``z`` main-tether elongation :math:`l_{MT} - l_{MT,0}` (m) and ``z_rate`` its
   rate (m/s), measured at the chaser;
-* ``params`` (float array) the law's constants, ``state`` (float array) its internal states
-  (reference model, adaptive parameters), updated in place over ``step`` (s) when ``advance``;
+* ``params`` (k,) float the law's constants, ``state`` (j,) float its internal states (reference
+  model, adaptive parameters), updated in place over ``step`` (s) when ``advance``;
 * returns the thrust magnitude (N) along the chaser's thrust direction.
 
-:data:`KINDS` maps a case's ``thrust.kind`` to the integer the compiled towing kernel
-dispatches on (:func:`thrust_command`).
+The towing kernels take the law as a numba first-class function (:data:`THRUST_LAW`), so adding a
+law is adding one module to :mod:`multibody.control.thrust_laws` (its contents are listed there).
 """
 from __future__ import annotations
 
-from numba import njit
+from numba import types
 
-from multibody.control.mrac import mrac1_command, mrac2_command
-
-#: Thrust law of a case -> integer code of the compiled dispatch.
-KINDS = {"ramp": 0, "mrac1": 1, "mrac2": 2}
-
-
-@njit(cache=True)
-def ramp_thrust(t, t_on, t_slope, f_max):
-    """Open-loop thrust magnitude (N), Boonrath, Singh & Botta 2024, equation after eq. (2):
-    zero until ``t_on``, linear to ``f_max`` over ``t_slope``, then constant (s, s, N)."""
-    if t <= t_on:
-        return 0.0
-    if t < t_on + t_slope:
-        return f_max * (t - t_on) / t_slope
-    return f_max
-
-
-@njit(cache=True)
-def ramp_command(t, z, z_rate, params, state, step, advance):
-    """:func:`ramp_thrust` behind the common interface; ``params = [t_on, t_slope, f_max]``."""
-    return ramp_thrust(t, params[0], params[1], params[2])
-
-
-@njit(cache=True)
-def thrust_command(kind, t, z, z_rate, params, state, step, advance):
-    """Dispatch on ``kind`` (:data:`KINDS`) to the thrust law's ``command``."""
-    if kind == 1:
-        return mrac1_command(t, z, z_rate, params, state, step, advance)
-    if kind == 2:
-        return mrac2_command(t, z, z_rate, params, state, step, advance)
-    return ramp_command(t, z, z_rate, params, state, step, advance)
+_VECTOR = types.float64[::1]
+#: numba signature of a thrust law's ``command`` (see the module doc); every law is compiled eagerly
+#: with it so that one compiled towing kernel takes any of them.
+THRUST_SIGNATURE = types.float64(types.float64, types.float64, types.float64, _VECTOR, _VECTOR, types.float64,
+                                 types.boolean)
+#: numba type of a thrust law passed to a compiled kernel (first-class function).
+THRUST_LAW = types.FunctionType(THRUST_SIGNATURE)

@@ -13,6 +13,7 @@ from typing import Annotated, Literal, get_args
 import numpy as np
 from pydantic import Field, model_validator
 
+from multibody.control.thrust_laws import LAWS as THRUST_LAWS
 from riskassess.cases.impact import NonNegative, Positive, Strict, Vector3
 from riskassess.cases.inputs import KIND_NOTE, CaseName, Text
 
@@ -73,7 +74,7 @@ class SubTethers(Strict):
 
 
 class Thrust(Strict):
-    kind: Literal["ramp", "mrac1", "mrac2"] = Field(
+    kind: Literal[tuple(THRUST_LAWS)] = Field(   # one plug-in module each, multibody/control/thrust_laws
         "ramp", description="'ramp': open loop against the orbital velocity (paper after eq. 2); 'mrac1'/'mrac2': "
                             "main-tether elongation control along the chaser's body z (MRAC paper eqs. 9-21).")
     t_on: NonNegative = Field(description="Thruster on (s), Sec. 4.1.")
@@ -272,8 +273,9 @@ class TowingCase(Strict):
 
     @model_validator(mode="after")
     def _mrac_given(self):
-        if self.thrust.kind != "ramp" and self.mrac is None:
-            raise ValueError(f"thrust.kind = '{self.thrust.kind}' needs an [mrac] section")
+        for section in THRUST_LAWS[self.thrust.kind].CASE_SECTIONS:
+            if getattr(self, section) is None:
+                raise ValueError(f"thrust.kind = '{self.thrust.kind}' needs an [{section}] section")
         if self.simulation.model == "full-net" and self.full_net is None:
             raise ValueError("simulation.model = 'full-net' needs a [full_net] section")
         if self.full_net is not None and 4 * self.full_net.corner_mass >= self.net_mass:

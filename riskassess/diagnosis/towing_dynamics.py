@@ -2,10 +2,10 @@
 
 The nominal model is :mod:`multibody.towing` (chaser, connection point P, main tether and
 sub-tethers, two-body gravity, thrust law, sliding-mode attitude control; Boonrath, Singh & Botta
-2024, Sec. 2.2). :func:`integrate` runs exactly the twin's scheme
-(:func:`multibody.towing_kernel.twin_run`: Verlet half kick, Lie-group drift, forces at the
-evaluation state with P stepped implicitly, half kick) and, before each force evaluation, calls an
-effect's *towing law*; the law's loads go into the packed model's further-forces section
+2024, Sec. 2.2). It is integrated by the twin's own loop
+(:func:`multibody.towing_kernel.verlet_run`: Verlet half kick, Lie-group drift, forces at the
+evaluation state with P stepped implicitly, half kick), which before each force evaluation calls an
+effect's *towing law* (its load hook); the law's loads go into the packed model's further-forces section
 (:func:`multibody.towing_kernel.extra_forces`) and so act in that step, P's share inside its
 implicit step. ``tests/diagnosis/test_towing.py`` checks that with no effect it reproduces
 :func:`multibody.towing.run_twin` to round-off.
@@ -28,19 +28,19 @@ Loads are evaluated once per step and held over it (as the thrust law and P's up
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, types
+from numba import njit
 
 from multibody.connection_point import V_N, X_N
-from multibody.kernel import rotation_matrix_from_rotation_vector, verlet_evaluation_state
-from multibody.towing_kernel import (CHASER, DEBRIS, N_COORDINATES, ST_TENSION, W_ACCEL, W_ATTACH_CHASER, W_INERTIA,
-                                     W_DIAG, W_MASSES, W_POINT, W_REFERENCE, W_STEP, W_TETHER, extra_forces, packed_forces, start_forces)
-from multibody.towing_kernel import W_N_ATTACH
+from multibody.rotations import rotation_matrix_from_rotation_vector
+from multibody.towing_kernel import (CHASER, DEBRIS, LOAD_LAW_SIGNATURE, ST_TENSION, W_ATTACH_CHASER, W_DIAG,
+                                     W_INERTIA, W_MASSES, W_N_ATTACH, W_POINT, W_REFERENCE, W_TETHER, no_load)
 
-_VECTOR = types.float64[::1]
-#: numba signature of a towing law (see the module doc); laws are compiled eagerly with it so that one
+#: numba signature of a towing law (see the module doc): the towing kernel's load hook
+#: (:data:`multibody.towing_kernel.LOAD_LAW_SIGNATURE`); laws are compiled eagerly with it so that one
 #: compiled integrator takes any of them as a first-class function.
-TOWING_LAW_SIGNATURE = types.void(types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64, _VECTOR)
-_LAW = types.FunctionType(TOWING_LAW_SIGNATURE)
+TOWING_LAW_SIGNATURE = LOAD_LAW_SIGNATURE
+#: The nominal towing model: no effect.
+no_towing_load = no_load
 #: Effects' own states: Maxwell-branch tension (N), the main tether's elongation when it was last
 #: advanced (m), damper angular velocity (3, debris frame, rad/s).
 XE_MAXWELL, XE_ELONGATION, XE_DAMPER, EXTRA_STATES = 0, 1, 2, 5
@@ -64,33 +64,6 @@ def initial_extra_states(omega_debris_body) -> np.ndarray:
     xe[XE_ELONGATION] = np.nan
     xe[XE_DAMPER:XE_DAMPER + 3] = omega_debris_body
     return xe
-
-
-@njit(TOWING_LAW_SIGNATURE, cache=True)
-def no_towing_load(t, q, v, p, work, xe, h, load):
-    """The nominal towing model: no effect.
-
-    Parameters
-    ----------
-    t : float
-        Time (s), the towing case's clock.
-    q, v : (15,) float
-        Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
-        displacements from their reference positions (m, ECI; P's are stale, see
-        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
-        (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
-    p : (j,) float
-        Not used.
-    work : (w,) float
-        Packed towing model (:func:`multibody.towing.packed`).
-    xe : (EXTRA_STATES,) float
-        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); not used.
-    h : float
-        Step (s) over which ``xe`` is advanced; 0: do not advance.
-    load : (15,) float
-        Generalized forces, kernel layout, added to in place: nothing.
-    """
-    return
 
 
 @njit(cache=True, inline="always")
@@ -180,95 +153,6 @@ def main_tether_direction(work, q):
     return d / np.sqrt(d @ d), rot_c
 
 
-@njit(types.void(_LAW, types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64, _VECTOR), cache=True)
-def apply_loads(law, t, q, v, p, work, xe, h, load):
-    """Evaluate ``law`` at (``t``, ``q``, ``v``) into ``load`` and make it the packed model's further
-    forces for the coming force evaluation (advancing the effect states ``xe`` over ``h``).
-
-    Parameters
-    ----------
-    law : compiled function
-        Towing law (``TOWING_LAW_SIGNATURE``, see the module doc).
-    t : float
-        Time (s), the towing case's clock.
-    q, v : (15,) float
-        State, kernel layout (:mod:`multibody.towing_kernel`): displacements from the reference
-        positions (m, ECI) and rotation vectors body -> ECI (rad); velocities (m/s, ECI) and angular
-        velocities (rad/s, body frames).
-    p : (j,) float
-        The law's parameters.
-    work : (w,) float
-        Packed towing model (:func:`multibody.towing.packed`).
-        Its further-forces section is overwritten with ``load``.
-    xe : (EXTRA_STATES,) float
-        Effects' own states (``XE_*``), advanced in place by the law.
-    h : float
-        Step (s) over which ``xe`` is advanced; 0: do not advance.
-    load : (15,) float
-        Scratch, overwritten with the law's generalized forces (N, ECI; N m, body frames).
-    """
-    load[:] = 0.0
-    law(t, q, v, p, work, xe, h, load)
-    extra = extra_forces(work)
-    extra[:] = load
-
-
-@njit(types.void(_LAW, _VECTOR, _VECTOR, _VECTOR, types.float64, types.int64, _VECTOR, _VECTOR, types.int64[::1],
-                 types.float64[:, ::1], types.float64[:, ::1], types.float64[:, ::1], types.float64[:, ::1]), cache=True)
-def integrate(law, p, q, v, t0, n_steps, work, xe, record, out_q, out_v, out_diag, out_xe):
-    """Integrate the packed towing model ``work`` from (``q``, ``v``) at ``t0`` (s) over ``n_steps``
-    steps with the effect ``law``; records state, diagnostics and effect states after the steps
-    listed in ``record`` (increasing step indices, 0 = the initial state) into the ``out_*`` rows.
-
-    Parameters
-    ----------
-    law : compiled function
-        Towing law (``TOWING_LAW_SIGNATURE``).
-    p : (j,) float
-        The law's parameters (at least one entry).
-    q, v : (15,) float
-        State, kernel layout (:mod:`multibody.towing_kernel`): displacements from the reference
-        positions (m, ECI) and rotation vectors body -> ECI (rad); velocities (m/s, ECI) and angular
-        velocities (rad/s, body frames).
-        Advanced in place.
-    t0 : float
-        Start time (s), the towing case's clock.
-    n_steps : int
-        Number of steps of ``work``'s step (s).
-    work : (w,) float
-        Packed towing model (:func:`multibody.towing.packed`).
-    xe : (EXTRA_STATES,) float
-        Effects' own states, advanced in place.
-    record : (r,) int64
-        Step indices to record, increasing.
-    out_q, out_v : (r, 15) float
-        Recorded states (kernel layout, units of ``q``, ``v``), written.
-    out_diag : (r, n_diag) float
-        Recorded diagnostics (:func:`diagnostics_size` columns; N, m, m/s, N m), written.
-    out_xe : (r, EXTRA_STATES) float
-        Recorded effect states, written.
-    """
-    step = work[W_STEP]
-    load = np.zeros(N_COORDINATES)
-    apply_loads(law, t0, q, v, p, work, xe, 0.0, load)
-    start_forces(q, v, t0, work)
-    acc = work[int(work[W_ACCEL]):int(work[W_ACCEL]) + N_COORDINATES]     # the stored accelerations (a view)
-    k = 0
-    for n in range(n_steps + 1):
-        t = t0 + n * step
-        while k < record.shape[0] and record[k] == n:
-            out_q[k], out_v[k], out_xe[k] = q, v, xe
-            out_diag[k] = packed_forces(q.copy(), v.copy(), t, work, False)[1]
-            k += 1
-        if n == n_steps or k == record.shape[0]:
-            break
-        q_next, v_half = verlet_evaluation_state(q, v, acc, step, 3, 2)
-        apply_loads(law, t + step, q_next, v_half, p, work, xe, step, load)
-        start_forces(q_next, v_half, t + step, work)
-        q[:] = q_next
-        v[:] = v_half + (0.5 * step) * acc
-
-
 def diagnostics_size(work) -> int:
     """Columns of the diagnostics rows of a packed model (main tether, thrust, torque, sliding, STs).
 
@@ -285,4 +169,4 @@ def diagnostics_size(work) -> int:
 
 
 __all__ = ["DEBRIS", "EXTRA_STATES", "TOWING_LAW_SIGNATURE", "W_INERTIA", "W_MASSES", "W_TETHER", "XE_DAMPER",
-           "XE_MAXWELL", "integrate", "main_tether_direction", "no_towing_load", "point_position"]
+           "XE_MAXWELL", "main_tether_direction", "no_towing_load", "point_position"]

@@ -4,7 +4,7 @@ of the tests' and samples' measured data.
 :func:`multibody.towing.build_towing_system` (chaser and debris Exudyn rigid bodies, one generic
 object whose force user function evaluates the compiled towing forces with P stepped implicitly);
 its force user function here first evaluates the effect's towing law at the state Exudyn passes
-(:func:`riskassess.diagnosis.towing_dynamics.apply_loads`), as the fast model does. Sampled on a fine grid and
+(:func:`multibody.towing_kernel.apply_loads`), as the fast model does. Sampled on a fine grid and
 interpolated linearly to the requested times (sensor delays shift them off the grid).
 """
 from __future__ import annotations
@@ -12,11 +12,11 @@ from __future__ import annotations
 import exudyn as exu
 import numpy as np
 
-from riskassess.diagnosis.towing_dynamics import apply_loads, initial_extra_states, no_towing_load
+from riskassess.diagnosis.towing_dynamics import initial_extra_states, no_towing_load
 from riskassess.diagnosis.towing_plant import TowingPlant, channels
 from multibody.impact import _object_state_index, explicit_settings
 from multibody.towing import build_towing_system, packed
-from multibody.towing_kernel import N_COORDINATES, body_forces, sampled_state
+from multibody.towing_kernel import N_COORDINATES, apply_loads, body_forces, sampled_state
 from multibody.solver_output import solver_chatter_captured
 
 #: Exudyn step (s): the towing case's default (docs/towing.md: step study, 1.3e-4 m and 3.5e-5 rad/s
@@ -33,7 +33,8 @@ class _EffectForces:
     def __init__(self, model, law, p):
         self.model, self.law = model, law
         self.p = np.zeros(1) if len(p) == 0 else np.ascontiguousarray(p, float)
-        self.work = packed(model)
+        self.tow = packed(model)
+        self.work = self.tow.work      # the same array (the effect laws read it)
         self.xe = initial_extra_states(model.omega_body[1])
         self.load = np.zeros(N_COORDINATES)
         self.last_time = None
@@ -45,7 +46,7 @@ class _EffectForces:
         full_q, full_v = np.zeros(N_COORDINATES), np.zeros(N_COORDINATES)
         full_q[3:], full_v[3:] = q, q_t
         apply_loads(self.law, self.model.start_time + t, full_q, full_v, self.p, self.work, self.xe, h, self.load)
-        return body_forces(np.asarray(q), np.asarray(q_t), self.model.start_time + t, self.work, advance)
+        return body_forces(np.asarray(q), np.asarray(q_t), self.model.start_time + t, self.tow, advance)
 
 
 def simulate_towing_exudyn(plant: TowingPlant, times, effect=None, values=(), names=(), step: float = EXUDYN_STEP) -> dict:
@@ -89,7 +90,7 @@ def simulate_towing_exudyn(plant: TowingPlant, times, effect=None, values=(), na
         if len(rows) < model.n_steps // every + 1 and round(t / step) % every == 0:
             data = mbs_.systemData
             q, v = np.asarray(data.GetODE2Coordinates())[index], np.asarray(data.GetODE2Coordinates_t())[index]
-            rows.append((*sampled_state(q, v, model.start_time + t, forces.work), forces.xe.copy()))
+            rows.append((*sampled_state(q, v, model.start_time + t, forces.tow), forces.xe.copy()))
         return True
 
     mbs.SetPostStepUserFunction(record)      # Exudyn also calls it at the initial time

@@ -23,11 +23,10 @@ from numba import njit
 from scipy.spatial.transform import Rotation
 
 from riskassess.diagnosis.channels import OMEGA, QUATERNION, REL, TENSION
-from riskassess.diagnosis.towing_dynamics import (EXTRA_STATES, diagnostics_size, initial_extra_states, integrate,
-                                      no_towing_load)
-from multibody.kernel import rotation_matrix_from_rotation_vector
+from riskassess.diagnosis.towing_dynamics import EXTRA_STATES, diagnostics_size, initial_extra_states, no_towing_load
+from multibody.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing import packed
-from multibody.towing_kernel import MT_TENSION
+from multibody.towing_kernel import MT_TENSION, verlet_run
 from multibody.orbit import lvlh_to_eci
 from multibody.rotations import quaternion_from_matrix
 from riskassess.models.towing import towing_model
@@ -271,11 +270,11 @@ def simulate(plant: TowingPlant, times, law=no_towing_load, p=None, step: float 
     weight[weight < 1e-9] = 0.0
     record = np.unique(np.r_[lower, lower[weight > 0] + 1]).astype(np.int64)
     q, v = model.initial_state()
-    work = packed(model)
+    tow = packed(model)
     xe = initial_extra_states(model.omega_body[1])
-    out = [np.zeros((len(record), n)) for n in (15, 15, diagnostics_size(work), EXTRA_STATES)]
+    out = [np.zeros((len(record), n)) for n in (15, 15, diagnostics_size(tow.work), EXTRA_STATES)]
     p = np.zeros(1) if p is None or len(p) == 0 else np.ascontiguousarray(p, float)
-    integrate(law, p, q, v, model.start_time, int(record[-1]), work, xe, record, *out)
+    verlet_run(tow, law, p, q, v, model.start_time, int(record[-1]), xe, record, *out)
     if not all(np.isfinite(a).all() for a in out[:3]):      # a run that blew up (a parameter far off)
         return {c: np.full(len(times), FAILED) for c in OMEGA + QUATERNION + REL + TENSION}
     rows = channels(plant, model, *out)

@@ -2,7 +2,7 @@
 
 :func:`towing_model` turns the validated case (:mod:`riskassess.cases.towing`) into a
 :class:`multibody.towing.TowingModel` for a given debris spin rate and sub-tether decision vector
-``s = [log10 k_ST, l_ST0, log10 c_ST, m_P/m_net]`` (eq. 22); :func:`thrust_law` is the case's thrust
+``s = [log10 k_ST, l_ST0, log10 c_ST, m_P/m_net]`` (eq. 22); :func:`case_thrust_law` is the case's thrust
 law, shared with the full-net model (:mod:`riskassess.models.towing_fullnet`). The stage
 ``riskassess tow`` that runs them and writes the run folder is :mod:`riskassess.stages.tow`.
 """
@@ -13,8 +13,8 @@ from scipy.optimize import brentq, minimize_scalar
 
 from multibody.control.attitude import sampled_boundary_layer
 from multibody.rotations import quaternion_to_matrix
-from multibody.control.mrac import mrac_initial_state, mrac_params
-from multibody.control.thrust import KINDS
+from multibody.control.mrac import command_elongation
+from multibody.control.thrust_laws import thrust_law
 from multibody.towing import TowingModel
 from riskassess.cases.towing import TowingCase
 
@@ -74,13 +74,14 @@ def connection_point_start(debris_com, debris_to_inertial, attach_body, toward, 
     return debris_com + brentq(reach, nearest, span, xtol=1e-12) * axis
 
 
-def thrust_law(case: TowingCase, tether, z0, z_rate0):
-    """The case's thrust law: (kind code, parameters, initial state) for elongation z0 (m), rate z_rate0 (m/s).
+def case_thrust_law(case: TowingCase, tether, z0, z_rate0):
+    """The case's thrust law (a plug-in of :mod:`multibody.control.thrust_laws`), its parameters and
+    initial state.
 
     Parameters
     ----------
     case : TowingCase
-        A validated towing case (``[thrust]``, ``[mrac]``, chaser mass).
+        A validated towing case (``[thrust]``, the law's ``CASE_SECTIONS``, chaser mass).
     tether : (3,) or (6,) float
         Main tether first: k_MT (N/m), c_MT (N s/m), ...; only the first two are read.
     z0 : float
@@ -90,22 +91,16 @@ def thrust_law(case: TowingCase, tether, z0, z_rate0):
 
     Returns
     -------
-    kind : int
-        :data:`multibody.control.thrust.KINDS` code (0 ramp, 1 MRAC-1, 2 MRAC-2).
+    law : module
+        The law's plug-in module (``NAME``, ``ALONG_BODY_Z``, compiled ``command``).
     params : (p,) float
-        Ramp: [t_on (s), t_slope (s), max_force (N)]; MRAC: :func:`multibody.control.mrac.mrac_params`.
+        The law's constants (its module doc).
     state : (q,) float
-        Initial controller state (zero for the ramp; :func:`multibody.control.mrac.mrac_initial_state`).
+        Its initial state.
     """
-    kind = KINDS[case.thrust.kind]
-    th = case.thrust
-    if kind == 0:
-        return kind, np.array([th.t_on, th.t_slope, th.max_force]), np.zeros(1)
-    m = case.mrac
-    params = mrac_params(kind, th.t_on, th.max_force, case.chaser.mass, tether[0], tether[1], reference_command(case),
-                         m.k_p, m.k_d, lambda0=m.lambda0, k_s=m.k_s, gamma=m.gamma, xi_h=m.xi_h, xi_a=m.xi_a,
-                         gamma_z=m.gamma_z, gamma_r=m.gamma_r, gamma_theta=m.gamma_theta, xi_2=m.xi_2, q=np.diag(m.q))
-    return kind, params, mrac_initial_state(kind, params, z0, z_rate0)
+    law = thrust_law(case.thrust.kind)
+    params, state = law.arrays(case, tether, z0, z_rate0)
+    return law, params, state
 
 
 def reference_command(case: TowingCase) -> float:
@@ -123,8 +118,8 @@ def reference_command(case: TowingCase) -> float:
     float
         z_d (m).
     """
-    m, k_mt = case.mrac, case.main_tether.stiffness
-    return m.desired_elongation * (k_mt + m.k_p) / m.k_p if m.settle_at_desired else m.desired_elongation
+    m = case.mrac
+    return command_elongation(m.desired_elongation, case.main_tether.stiffness, m.k_p, m.settle_at_desired)
 
 
 def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None, step: float | None = None,
@@ -167,11 +162,11 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
         p0 = np.asarray(case.sub_tethers.connection_point_start_inertial, float)
     v_p0 = np.asarray(de.velocity_inertial) + rot[1] @ np.cross(omega[1], rot[1].T @ (p0 - com[1]))
     z0 = np.linalg.norm(p0 - a_point) - mt.natural_length
-    kind, params, state = thrust_law(case, tether, z0, 0.0)
+    law, params, state = case_thrust_law(case, tether, z0, 0.0)
     model = TowingModel(
         masses=masses, inertia_body=np.array([np.diag(ch.principal_inertia), np.diag(de.principal_inertia)], float),
         attach_chaser_body=np.asarray(ch.tether_attachment_body, float), attach_debris_body=attach_debris,
-        tether=tether, mu=sim.mu, attitude=np.zeros(8), thrust_kind=kind, thrust_along_body_z=kind != 0,
+        tether=tether, mu=sim.mu, attitude=np.zeros(8), thrust_law=law.NAME, thrust_along_body_z=law.ALONG_BODY_Z,
         thrust_params=params, thrust_state=state,
         positions=np.array([p0, com[0], com[1]]), velocities=np.array([v_p0, ch.velocity_inertial, de.velocity_inertial], float),
         body_to_inertial=rot, omega_body=omega, start_time=sim.start_time,

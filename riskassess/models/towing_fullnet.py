@@ -19,7 +19,7 @@ from multibody.control.attitude import sampled_boundary_layer
 from multibody.rotations import quaternion_to_matrix
 from multibody.net_towing import FullNetModel
 from multibody.net_wrap import drape_and_close, towing_net
-from riskassess.models.towing import thrust_law
+from riskassess.models.towing import case_thrust_law
 from riskassess.cases.towing import TowingCase
 
 #: Height of the flat net above the cylinder before draping (m).
@@ -211,7 +211,7 @@ def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapp
     mt = case.main_tether
     tether = np.array([mt.stiffness, mt.damping, mt.natural_length])
     a_point = chaser + rot[0] @ np.asarray(ch.tether_attachment_body, float)
-    kind, params, state = thrust_law(case, tether, np.linalg.norm(nodes[net.central] - a_point) - mt.natural_length, 0.0)
+    law, params, state = case_thrust_law(case, tether, np.linalg.norm(nodes[net.central] - a_point) - mt.natural_length, 0.0)
     h = fn.step if step is None else step
     h = sim.output_interval / np.ceil(sim.output_interval / h - 1e-9)
     ac = case.attitude_control
@@ -222,7 +222,7 @@ def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapp
         geometry=debris_geometry(case), contact_law=contact_law(case), mu=sim.mu,
         attitude=np.r_[float(ac.enabled), ac.k_gain, ac.gain,
                        sampled_boundary_layer(ac.boundary_layer, np.asarray(ac.gain, float), h)],
-        thrust_kind=kind, thrust_along_body_z=kind != 0, thrust_params=params, thrust_state=state,
+        thrust_law=law.NAME, thrust_along_body_z=law.ALONG_BODY_Z, thrust_params=params, thrust_state=state,
         positions=np.array([chaser, com[1]]), velocities=np.array([ch.velocity_inertial, de.velocity_inertial], float),
         body_to_inertial=rot, omega_body=np.array([ch.angular_velocity_body, omega], float),
         start_time=start, end_time=sim.end_time if end_time is None else end_time, step=h,

@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from multibody.control.thrust import KINDS
 from multibody.net_towing import FullNetModel, run_exudyn
 from multibody.net_towing_kernel import cylinder_distance
 from multibody.net_wrap import DrapeSchedule, drape_and_close, towing_net, wrap_summary
@@ -43,7 +42,7 @@ def _model(wrapped, mu=0.0, spin=0.0, thrust=(1e9, 1.0, 0.0), end=1.0, step=2e-3
         net=net, node_positions=com_d + x_body, node_velocities=v_d + np.cross(omega, x_body),
         masses=np.array([160.0, 900.0]), inertia_body=np.array([np.eye(3) * 26.7, np.diag([240.0, 240.0, 112.5])]),
         attach_chaser_body=np.array([0.0, -0.5, 0.0]), main_tether=np.array([3000.0, 300.0, 3.0]),
-        geometry=GEOMETRY, contact_law=LAW, mu=mu, attitude=np.zeros(8), thrust_kind=KINDS["ramp"],
+        geometry=GEOMETRY, contact_law=LAW, mu=mu, attitude=np.zeros(8), thrust_law="ramp",
         thrust_along_body_z=False, thrust_params=np.array(thrust, float), thrust_state=np.zeros(1),
         positions=np.array([chaser, com_d]), velocities=np.array([v_d, v_d]), body_to_inertial=np.array([np.eye(3)] * 2),
         omega_body=np.array([np.zeros(3), omega]), start_time=25.0, end_time=25.0 + end, step=step, substeps=substeps,

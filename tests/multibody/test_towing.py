@@ -16,7 +16,7 @@ def _model(positions, velocities, masses, tether, mu=0.0, thrust=(0.0, 1e-9, 0.0
     return TowingModel(
         masses=np.asarray(masses, float), inertia_body=np.array([np.eye(3), np.eye(3)]) * 10.0,
         attach_chaser_body=np.zeros(3), attach_debris_body=np.asarray(attach_debris, float),
-        tether=np.asarray(tether, float), mu=mu, attitude=np.zeros(8), thrust_kind=0, thrust_along_body_z=False,
+        tether=np.asarray(tether, float), mu=mu, attitude=np.zeros(8), thrust_law="ramp", thrust_along_body_z=False,
         thrust_params=np.asarray(thrust, float), thrust_state=np.zeros(1),
         positions=np.asarray(positions, float), velocities=np.asarray(velocities, float),
         body_to_inertial=np.array([np.eye(3), np.eye(3)]), omega_body=np.zeros((2, 3)),

@@ -44,7 +44,7 @@ DURATION = 24.0
 
 
 def test_fast_model_without_effect_is_the_towing_twin(zenit_tow):
-    """No effect: riskassess.diagnosis.towing_dynamics.integrate runs the twin's scheme (multibody.towing.run_twin)
+    """No effect: the fast model (multibody.towing_kernel.verlet_run with the effect hook) runs as the twin (multibody.towing.run_twin)
     with zero further forces: the same numbers up to round-off (1e-9 of each channel's range)."""
     plant = plant_of(zenit_tow)
     times = np.arange(0.0, 8.0 + 1e-9, 0.1)

@@ -1,0 +1,70 @@
+"""MRAC-1 main-tether elongation control (eqs. 9-16 of the MRAC tether-control seed paper,
+``towing-mrac-tether-control``): thrust along the chaser's body z; shared parts (abstracted model,
+reference model, parameter head) in :mod:`multibody.control.mrac`.
+
+``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``K_D``), then lambda_0 (1/s),
+k_s (N s/m), gamma, xi_h, xi_a (2) (-); ``state`` = [z_m (m), z_m rate (m/s), h (kg), a1 (N/m),
+a2 (N s/m)].
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from multibody.control.mrac import (A0, B, C_MT, K_MT, T_ON, U_MAX, ZM, ZM_RATE, advance_reference, common_params,
+                                    pulling, reference_acceleration)
+from multibody.control.thrust import THRUST_SIGNATURE
+
+NAME = "mrac1"
+ALONG_BODY_Z = True
+CASE_SECTIONS = ("mrac",)
+LAMBDA0, K_S, GAMMA, XI_H, XI_A1, XI_A2 = range(8, 14)
+
+
+@njit(THRUST_SIGNATURE, cache=True)
+def command(t, z, z_rate, params, state, step, advance):
+    """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16), saturated at u_max; 0 before t_on.
+
+    Parameters
+    ----------
+    t, z, z_rate, step, advance
+        As in the thrust-law interface (:mod:`multibody.control.thrust`): time (s), main-tether
+        elongation (m) and rate (m/s), sampling step (s), whether to advance the states.
+    params : (14,) float
+        The common head (:mod:`multibody.control.mrac`), then lambda_0 (1/s), k_s (N s/m), gamma, xi_h, xi_a (2) (-).
+    state : (5,) float
+        z_m (m), z_m rate (m/s), h (kg), a1 (N/m), a2 (N s/m); advanced in place when ``advance``.
+    """
+    if t < params[T_ON]:
+        return 0.0
+    zm_acc = reference_acceleration(params, state[ZM], state[ZM_RATE])
+    lam = params[LAMBDA0]
+    eta = zm_acc - lam * (z_rate - state[ZM_RATE])                          # eq. (12)
+    s = (z_rate - state[ZM_RATE]) + lam * (z - state[ZM])                   # eq. (14)
+    g = pulling(z, z_rate, params[K_MT], params[C_MT])
+    u = state[A0] * eta + g * (state[A0 + 1] * z + state[A0 + 2] * z_rate) - params[K_S] * s   # eq. (11)
+    force = min(max(u, -params[U_MAX]), params[U_MAX])                      # eq. (16)
+    if advance:
+        if abs(u) < params[U_MAX]:                                          # H(u_max - |u|)
+            gamma = params[GAMMA]
+            state[A0] += step * (-s * gamma * eta - s * s * params[XI_H] * state[A0])            # eq. (15a)
+            state[A0 + 1] += step * (-s * gamma * z - s * s * params[XI_A1] * state[A0 + 1])     # eq. (15b)
+            state[A0 + 2] += step * (-s * gamma * z_rate - s * s * params[XI_A2] * state[A0 + 2])
+        advance_reference(params, state, zm_acc, step)
+    return force
+
+
+def arrays(case, tether, z0, z_rate0) -> tuple[np.ndarray, np.ndarray]:
+    """``params`` from the case's ``[thrust]`` and ``[mrac]``; the reference model starts on the
+    measured state and the adaptive parameters at their ideal values for the abstracted model
+    (:math:`\\hat h = m_C`, :math:`\\hat a = [k, c]`).
+
+    Parameters
+    ----------
+    case, tether, z0, z_rate0
+        See :mod:`multibody.control.thrust_laws`; reads ``[thrust]``, ``[mrac]`` (MRAC-1 gains), the
+        chaser mass and k_MT, c_MT.
+    """
+    m = case.mrac
+    params = np.array(common_params(case, tether) + [m.lambda0, m.k_s, m.gamma, m.xi_h, *m.xi_a], float)
+    return params, np.array([z0, z_rate0, 1.0 / params[B], params[K_MT], params[C_MT]])

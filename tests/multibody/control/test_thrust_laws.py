@@ -1,0 +1,94 @@
+"""Thrust laws as plug-ins (multibody/control/thrust_laws): one file each, found by NAME, an unknown
+name refused with the known ones, and a new law's compiled command driving the towing kernel."""
+import importlib
+import pkgutil
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import multibody.control.thrust_laws as thrust_laws_package
+from multibody.control.thrust_laws import LAWS, thrust_law
+from multibody.towing import TowingModel, packed
+from multibody.towing_kernel import CHASER, THRUST, no_load, tow_kernel, verlet_run
+from riskassess.cases.impact import read_toml
+from riskassess.cases.towing import TowingCase
+
+CASE = Path(__file__).parents[3] / "cases" / "zenit2_towing.toml"
+
+#: A law written as a user would add one: a constant thrust params[0] (N) against the velocity.
+CONSTANT_LAW = '''
+import numpy as np
+from numba import njit
+
+from multibody.control.thrust import THRUST_SIGNATURE
+
+NAME = "constant"
+ALONG_BODY_Z = False
+CASE_SECTIONS = ()
+
+
+@njit(THRUST_SIGNATURE)
+def command(t, z, z_rate, params, state, step, advance):
+    return params[0]
+
+
+def arrays(case, tether, z0, z_rate0):
+    return np.array([case.thrust.max_force]), np.zeros(1)
+'''
+
+
+def test_every_law_file_is_discovered_by_its_name():
+    files = [m.name for m in pkgutil.iter_modules(thrust_laws_package.__path__)]
+    names = {importlib.import_module(f"multibody.control.thrust_laws.{f}").NAME: f for f in files}
+    assert set(LAWS) == set(names) >= {"ramp", "mrac1", "mrac2"}
+    for name, module in LAWS.items():
+        assert module.NAME == name and thrust_law(name) is module
+        assert callable(module.command) and callable(module.arrays) and isinstance(module.ALONG_BODY_Z, bool)
+
+
+def test_a_new_law_file_is_found_and_drives_the_towing_kernel(tmp_path, monkeypatch):
+    """Adding a law is adding one file: a package with the catalog's __init__ and one new file finds
+    it by NAME; its compiled command, passed to the twin as a first-class function, pushes a free
+    chaser (tethers without stiffness, no gravity) with exactly its constant force: Verlet
+    integrates a constant force exactly, so v_x(T) = v_x(0) + F T / m_C to round-off."""
+    package = tmp_path / "thrust_laws_plus"
+    package.mkdir()
+    shutil.copy(Path(thrust_laws_package.__file__), package / "__init__.py")
+    (package / "constant.py").write_text(CONSTANT_LAW)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    plus = importlib.import_module("thrust_laws_plus")
+    assert list(plus.LAWS) == ["constant"]
+    law = plus.LAWS["constant"]
+
+    force, m_c, speed, duration = 7.0, 4.0, -1000.0, 2.0
+    velocities = np.array([[speed, 0.0, 0.0]] * 3)
+    model = TowingModel(
+        masses=np.array([1.0, m_c, 1.0]), inertia_body=np.array([np.eye(3), np.eye(3)]) * 10.0,
+        attach_chaser_body=np.zeros(3), attach_debris_body=np.zeros((0, 3)),
+        tether=np.array([0.0, 0.0, 5.0, 0.0, 0.0, 1.0]), mu=0.0, attitude=np.zeros(8), thrust_law="ramp",
+        thrust_along_body_z=law.ALONG_BODY_Z, thrust_params=np.array([force]), thrust_state=np.zeros(1),
+        positions=np.array([[-4.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 100.0, 0.0]]), velocities=velocities,
+        body_to_inertial=np.array([np.eye(3), np.eye(3)]), omega_body=np.zeros((2, 3)),
+        start_time=0.0, end_time=duration, step=1e-2, output_interval=1e-2)
+    tow = tow_kernel(packed(model).work, law.command)
+    q, v = model.initial_state()
+    record = np.array([0, model.n_steps], dtype=np.int64)
+    out_q, out_v, out_diag = np.zeros((2, 15)), np.zeros((2, 15)), np.zeros((2, 10))
+    verlet_run(tow, no_load, np.zeros(1), q, v, 0.0, model.n_steps, np.zeros(1), record, out_q, out_v, out_diag,
+               np.zeros((2, 1)))
+    assert out_diag[1, THRUST] == force
+    assert out_v[1, CHASER] == pytest.approx(speed + force * duration / m_c, abs=1e-9)   # thrust against v: +x
+    assert out_v[1, 9] == pytest.approx(speed, abs=1e-12)                                 # the debris is not pushed
+
+
+def test_an_unknown_thrust_law_is_refused_listing_the_known_ones():
+    known = ", ".join(LAWS)
+    with pytest.raises(ValueError, match=f"unknown thrust law 'bang_bang'; the known laws are: {known}"):
+        thrust_law("bang_bang")
+    raw = read_toml(CASE)
+    raw["thrust"]["kind"] = "bang_bang"
+    with pytest.raises(ValueError) as refused:
+        TowingCase.model_validate(raw)
+    assert "thrust.kind" in str(refused.value) and all(f"'{name}'" in str(refused.value) for name in LAWS)
