@@ -254,7 +254,15 @@ class NetTowState:
 
     def reel(self, t):
         """Closing loop's natural lengths (m) and stiffnesses EA/l0 (N/m) at time ``t`` (s): open
-        before ``closing_time``, linear to closed over ``closing_duration``, closed after."""
+        before ``closing_time``, linear to closed over ``closing_duration``, closed after.
+
+        Parameters
+        ----------
+        t : float
+            Time (s, absolute), at or after ``model.closing_time``.
+
+        Updates ``rest`` and ``stiffness`` of the closing threads in place (the kernel holds views).
+        """
         m = self.model
         ramp = min(1.0, (t - m.closing_time) / m.closing_duration)
         k = len(self.rest_open)
@@ -263,6 +271,25 @@ class NetTowState:
         self.reeling = ramp < 1.0
 
     def forces(self, q, v, t, advance):
+        """Generalized forces (12,) on chaser and debris (:func:`step_forces`), the closing loop
+        reeled and the main tether switched on from ``closing_time``.
+
+        Parameters
+        ----------
+        q, v : (12,) float
+            Chaser and debris CoM displacements from their reference positions (m, inertial) and
+            rotation vectors body -> inertial (rad); CoM velocities (m/s, inertial) and angular
+            velocities (rad/s, body frames).
+        t : float
+            Time (s, absolute).
+        advance : bool
+            Sub-cycle the net to ``t`` and advance the thrust law (a new step time).
+
+        Returns
+        -------
+        (12,) float
+            Forces (N, inertial) and torques (N m, body frames), per body.
+        """
         m = self.model
         if self.reeling and t >= m.closing_time:
             self.reel(t)
@@ -270,7 +297,19 @@ class NetTowState:
         return step_forces(q, v, t, advance, tether, self.kernel)
 
     def momentum(self, v_bodies) -> np.ndarray:
-        """Total linear momentum (N s, inertial) of chaser, debris and net."""
+        """Total linear momentum (N s, inertial) of chaser, debris and net.
+
+        Parameters
+        ----------
+        v_bodies : (12,) float
+            Chaser and debris velocities: CoM velocity (m/s, inertial), angular velocity (rad/s,
+            body frame), per body (the net's velocities are the state's).
+
+        Returns
+        -------
+        (3,) float
+            Linear momentum (N s), inertial frame.
+        """
         m = self.model
         return (m.masses[0] * v_bodies[0:3] + m.masses[1] * v_bodies[6:9]
                 + (m.net.topology.masses[:, None] * self.v).sum(axis=0))
@@ -366,7 +405,21 @@ class _Sampler:
 
 
 def build_system(model: FullNetModel, forces: _Forces):
-    """Exudyn system: chaser and debris rigid bodies, one generic object carrying all forces."""
+    """Exudyn system: chaser and debris rigid bodies, one generic object carrying all forces.
+
+    Parameters
+    ----------
+    model : FullNetModel
+        The run (SI; positions and velocities inertial, rates and inertias in the body frames).
+    forces : _Forces
+        The generic object's force user function (net, tethers, contact, thrust, gravity).
+
+    Returns
+    -------
+    sc : exudyn.SystemContainer
+    mbs : exudyn.MainSystem
+        Assembled system (nodes: chaser 0, debris 1).
+    """
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
     nodes = []
@@ -385,7 +438,18 @@ def build_system(model: FullNetModel, forces: _Forces):
 
 
 def run_exudyn(model: FullNetModel) -> NetTowResult:
-    """Build and integrate ``model`` (VelocityVerlet at ``model.step``, net sub-cycled)."""
+    """Build and integrate ``model`` (VelocityVerlet at ``model.step``, net sub-cycled).
+
+    Parameters
+    ----------
+    model : FullNetModel
+        The run (SI; positions and velocities inertial, rates and inertias in the body frames).
+
+    Returns
+    -------
+    NetTowResult
+        Samples up to the end or to a failed health check (:func:`multibody.impact.solve_checked`).
+    """
     state = NetTowState(model)
     forces = _Forces(state)
     sc, mbs = build_system(model, forces)

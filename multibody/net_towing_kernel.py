@@ -93,7 +93,20 @@ class TetherEnd(NamedTuple):
 def cylinder_distance(px, py, pz, geometry):
     """Signed distance (m) from a point (debris frame, m) to a closed circular cylinder with axis
     z_body (``geometry``: radius, half length, axial centre) and the outward unit normal at the
-    nearest surface point (debris frame); negative inside."""
+    nearest surface point (debris frame); negative inside.
+
+    Parameters
+    ----------
+    px, py, pz : float
+        The point, debris body frame relative to its CoM (m).
+    geometry : (3,) float
+        Radius (m), half length (m), axial centre z_body (m): ``CYL_*``.
+
+    Returns
+    -------
+    distance, nx, ny, nz : float
+        Signed distance (m) and unit normal (-, debris body frame).
+    """
     radius, half, zc = geometry[CYL_RADIUS], geometry[CYL_HALF], geometry[CYL_Z]
     rho = math.sqrt(px * px + py * py)
     ex, ey = (px / rho, py / rho) if rho > 1e-12 else (1.0, 0.0)

@@ -192,7 +192,24 @@ def towing_forces(q, v, t, parts, thrust, step, advance, out_force, out_diag):
 @njit(cache=True)
 def accelerations(v, force, masses, inertia, inverse_inertia):
     """Accelerations of chaser and debris as Exudyn forms them: M^-1 (f - gyroscopic terms),
-    rotation-vector Lie-group nodes; zero for P (implicit, see the module doc)."""
+    rotation-vector Lie-group nodes; zero for P (implicit, see the module doc).
+
+    Parameters
+    ----------
+    v : (15,) float
+        Velocities, kernel layout: CoM velocities (m/s, inertial), angular velocities (rad/s, body frames).
+    force : (15,) float
+        Generalized forces, kernel layout (N, inertial; N m, body frames).
+    masses : (3,) float
+        m_P, m_C, m_D (kg).
+    inertia, inverse_inertia : (2, 3, 3) float
+        Chaser and debris inertia about the CoM (kg m^2) and its inverse, body frames.
+
+    Returns
+    -------
+    (15,) float
+        Accelerations, kernel layout (m/s^2, inertial; rad/s^2, body frames); zero for P.
+    """
     a = np.empty(N_COORDINATES)
     a[0:3] = 0.0  # P is advanced implicitly (multibody.connection_point), not by the Verlet kicks
     for b in range(2):
@@ -222,7 +239,42 @@ def pack(reference, masses, inertia, attach_chaser, attach_debris, tether, mu, a
     state at ``start_time`` (s), P moving with ``point_velocity`` (m/s, inertial). The last section
     (:data:`W_EXTRA`, zero here) holds further generalized forces (15,) in the kernel layout that
     other stages set between steps (:func:`extra_forces`; the diagnosis' effects): added to the
-    bodies' forces, and P's entries act inside its implicit step."""
+    bodies' forces, and P's entries act inside its implicit step.
+
+    Parameters
+    ----------
+    reference : (3, 3) float
+        Reference positions of P, chaser CoM, debris CoM (m, absolute, inertial).
+    masses : (3,) float
+        m_P, m_C, m_D (kg).
+    inertia : (2, 3, 3) float
+        Chaser and debris inertia about the CoM, body frames (kg m^2).
+    attach_chaser : (3,) float
+        MT attachment r_A/C, chaser body frame (m).
+    attach_debris : (n, 3) float
+        ST attachments r_i/D, debris body frame (m).
+    tether : (6,) float
+        k_MT (N/m), c_MT (N s/m), l_MT0 (m), k_ST, c_ST, l_ST0 (``K_MT`` ... ``L_ST``).
+    mu : float
+        Gravitational parameter (m^3/s^2).
+    attitude : (8,) float
+        Controller on (1/0), K (1/s), G (3,) (rad/s^2), width (3,) (rad/s) (``ATT_*``).
+    thrust_along_body_z : bool
+        Thrust along the chaser's body z (True) or against its inertial velocity.
+    thrust_params, thrust_state : (k,) and (j,) float
+        The thrust law's constants and initial state (:mod:`multibody.control.thrust`).
+    step : float
+        Time step (s): the controller's sampling step and P's integration step.
+    point_velocity : (3,) float
+        P's velocity at ``start_time`` (m/s, inertial).
+    start_time : float
+        Time of the initial state (s).
+
+    Returns
+    -------
+    (m,) float
+        The packed model (layout: ``W_*`` offsets and the section offsets in its first entries).
+    """
     n = len(attach_debris)
     sizes = [3 * n, len(thrust_params), len(thrust_state), ST_TENSION + n, N_COORDINATES, N_COORDINATES, STATE_SIZE,
              N_COORDINATES]
@@ -392,7 +444,18 @@ def packed_forces(q, v, t, tow, advance):
 
 @njit(cache=True, inline="always")
 def extra_forces(work):
-    """The packed model's further generalized forces (15,), kernel layout (a view: set them in place)."""
+    """The packed model's further generalized forces (15,), kernel layout (a view: set them in place).
+
+    Parameters
+    ----------
+    work : (m,) float
+        The packed model (:func:`pack`).
+
+    Returns
+    -------
+    (15,) float
+        View of its extra forces (N, inertial; N m, body frames), kernel layout.
+    """
     start = int(work[W_EXTRA])
     return work[start:start + N_COORDINATES]
 

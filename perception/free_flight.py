@@ -94,7 +94,21 @@ def _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_
 
 def normalized_energy_and_momentum(motion: FreeMotion) -> dict:
     """D = 2E/C, F = L^2/C^2 and the angular momentum direction (world) of a torque-free fit
-    (Tang et al. 2023, eqs. 20-22)."""
+    (Tang et al. 2023, eqs. 20-22).
+
+    Parameters
+    ----------
+    motion : FreeMotion
+        A free-flight fit (:func:`fit_free_motion`); its torque-free fit gives the normalized
+        principal moments (J1, J2, 1) (-, per smallest moment C) and the principal-frame rate
+        (rad/s), its ``spin_per_c`` the spin momentum per C (3,) (rad/s, world frame).
+
+    Returns
+    -------
+    dict
+        ``"D"`` : float, 2E/C (rad^2/s^2); ``"F"`` : float, L^2/C^2 (rad^2/s^2);
+        ``"direction_world"`` : (3,) float, unit angular momentum direction, world frame (-).
+    """
     moments, omega = motion.fit.moments_, motion.fit.omega0_principal_
     h = motion.spin_per_c
     return {"D": float(moments @ omega**2), "F": float(h @ h), "direction_world": h / np.linalg.norm(h)}

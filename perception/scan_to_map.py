@@ -99,14 +99,34 @@ def _transform(points, matrix) -> np.ndarray:
 
 
 def thinned_scan(points_world, voxel) -> np.ndarray:
-    """One point (the mean) per ``voxel`` (m) cell of a scan (n, 3) (m, world): the points ICP uses."""
+    """One point (the mean) per ``voxel`` (m) cell of a scan (n, 3) (m, world): the points ICP uses.
+
+    Parameters
+    ----------
+    points_world : (n, 3) float    Scan points, world frame (m).
+    voxel : float                  Voxel edge (m).
+
+    Returns
+    -------
+    (p, 3) float                   Voxel means, world frame (m), p <= n.
+    """
     return np.asarray(_cloud(points_world).voxel_down_sample(voxel).points)
 
 
 def surface_map(points_body, voxel) -> o3d.geometry.PointCloud:
     """Map cloud of surface points (n, 3) (m, frame B): one point (the mean) per ``voxel`` cell,
     normals from the 4-voxel neighbourhood. The mean over a cell averages the range noise of the
-    scans merged into it."""
+    scans merged into it.
+
+    Parameters
+    ----------
+    points_body : (n, 3) float     Registered surface points, frame B (m).
+    voxel : float                  Voxel edge (m); the normals use a radius of 4 voxels.
+
+    Returns
+    -------
+    open3d PointCloud              Voxel means with unit normals, frame B (m).
+    """
     cloud = _cloud(points_body).voxel_down_sample(voxel)
     cloud.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(radius=4 * voxel, max_nn=30))
     return cloud
@@ -203,7 +223,19 @@ def register_with_motion_prior(scan_world, map_points, map_normals, predicted_wo
 
 def map_fit(scan_world, world_to_body, map_tree, distance) -> tuple[float, float]:
     """Share of scan points (n, 3) (world) within ``distance`` (m) of a map point (KD-tree of the
-    map, frame B) at the pose world -> B (4, 4), and their RMS distance (m)."""
+    map, frame B) at the pose world -> B (4, 4), and their RMS distance (m).
+
+    Parameters
+    ----------
+    scan_world : (n, 3) float      Thinned scan points, world frame (m).
+    world_to_body : (4, 4) float   Pose world -> B (m for the translation).
+    map_tree : scipy cKDTree       KD-tree of the map points, frame B (m).
+    distance : float               Correspondence distance (m).
+
+    Returns
+    -------
+    fitness : float (-), rmse : float (m; NaN when no point is within ``distance``).
+    """
     gap, _ = map_tree.query(_transform(scan_world, world_to_body), distance_upper_bound=distance)
     inside = np.isfinite(gap)
     return float(inside.mean()), float(np.sqrt(np.mean(gap[inside] ** 2))) if inside.any() else np.nan
@@ -211,7 +243,17 @@ def map_fit(scan_world, world_to_body, map_tree, distance) -> tuple[float, float
 
 def predict_world_to_body(previous, before) -> np.ndarray:
     """world -> B at the next frame from the last two (4, 4) at constant rotation and translation
-    rates (equal frame spacing)."""
+    rates (equal frame spacing).
+
+    Parameters
+    ----------
+    previous : (4, 4) float   world -> B at the last frame (m for the translation).
+    before : (4, 4) float     world -> B at the frame before it.
+
+    Returns
+    -------
+    (4, 4) float              Predicted world -> B at the next frame.
+    """
     return previous @ np.linalg.inv(before) @ previous
 
 
@@ -231,7 +273,19 @@ def _turns(largest) -> list[np.ndarray]:
 def search_pose(scan_world, map_cloud, start_world_to_body, max_correspondence) -> tuple[np.ndarray, float, float]:
     """Pose of a scan without a motion prediction: ``start`` turned about the scan centroid by each
     of the seed turns (:data:`SEARCH_TURN`), each refined by ICP; the best fit (fitness, then RMS
-    distance) is kept. Arguments and returns as :func:`register_to_map`."""
+    distance) is kept. Arguments and returns as :func:`register_to_map`.
+
+    Parameters
+    ----------
+    scan_world : (n, 3) float            Thinned scan points, world frame (m).
+    map_cloud : open3d PointCloud        Map with normals, frame B (:func:`surface_map`).
+    start_world_to_body : (4, 4) float   Pose world -> B the seeds turn (last registered frame's).
+    max_correspondence : float           Coarse correspondence distance (m); the fine level uses a third.
+
+    Returns
+    -------
+    world_to_body : (4, 4) float, fitness : float (-), rmse : float (m) of the best seed's fine level.
+    """
     pivot = np.mean(scan_world, axis=0)
     best = None
     for turn in _turns(SEARCH_TURN):
@@ -247,7 +301,22 @@ def search_pose(scan_world, map_cloud, start_world_to_body, max_correspondence) 
 def map_information(scan_world, world_to_body, map_points, map_normals, max_correspondence, tree=None) -> np.ndarray:
     """Point-to-plane information (6, 6) of a registered scan (rotation first, frame B, 1/rad^2 and
     1/m^2): the scan points within a third of ``max_correspondence`` of the map, on the planes of
-    their nearest map points, residual scatter measured. ``tree``: KD-tree of ``map_points`` if built."""
+    their nearest map points, residual scatter measured. ``tree``: KD-tree of ``map_points`` if built.
+
+    Parameters
+    ----------
+    scan_world : (n, 3) float                 Thinned scan points, world frame (m).
+    world_to_body : (4, 4) float              Registered pose world -> B (m for the translation).
+    map_points, map_normals : (m, 3) float    Map points (m) and unit normals, frame B.
+    max_correspondence : float                Coarse correspondence distance (m); points within a
+                                              third of it count.
+    tree : scipy cKDTree, optional            KD-tree of ``map_points`` (built here when not given).
+
+    Returns
+    -------
+    (6, 6) float                              Information of (rotation, translation), frame B
+                                              (1/rad^2, 1/m^2, 1/(rad m)); zeros below 6 matches.
+    """
     body = _transform(scan_world, world_to_body)
     tree = cKDTree(map_points) if tree is None else tree
     gap, nearest = tree.query(body, distance_upper_bound=max_correspondence / 3)
@@ -339,6 +408,16 @@ def _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence
 def alignments(track: MapTrack, times) -> list[Alignment]:
     """The track's frames as :class:`perception.registration.Alignment` records (one per frame,
     times (k,) in s), the form the free-motion fits (:func:`perception.free_flight.fit_free_motion`)
-    and the stage read: pose world -> B, information, fitness as the tight fitness, online time."""
+    and the stage read: pose world -> B, information, fitness as the tight fitness, online time.
+
+    Parameters
+    ----------
+    track : MapTrack    Result of :func:`track_scans` (k frames).
+    times : (k,) float  Time of each frame (s).
+
+    Returns
+    -------
+    list of Alignment   k records, pose world -> B (m for the translation).
+    """
     return [Alignment(float(t), track.world_to_body[i], track.information[i], float(track.fitness[i]), 0.0, 0.0,
                       bool(track.ok[i]), False, float(track.seconds[i]), 0) for i, t in enumerate(times)]

@@ -30,7 +30,18 @@ SHAPES = discover()
 
 
 def shape_plugin(kind: str):
-    """The module of the contact shape named ``kind``; ValueError listing the known ones otherwise."""
+    """The module of the contact shape named ``kind``; ValueError listing the known ones otherwise.
+
+    Parameters
+    ----------
+    kind : str
+        A shape's ``NAME`` (a case's ``shapes`` table ``kind``).
+
+    Returns
+    -------
+    module
+        Its plug-in module (``NAME``, ``KEYS``, ``mesh_target_frame``; meshes in the target frame, m).
+    """
     if kind not in SHAPES:
         raise ValueError(f"unknown shape kind {kind!r}; the known kinds are {', '.join(SHAPES)}")
     return SHAPES[kind]

@@ -97,6 +97,22 @@ class Scene:
 
     @classmethod
     def from_case(cls, case: Case, base: Path, source: str = "case") -> "Scene":
+        """The scene of a perception case; a :class:`CaseError` when a section the stage needs is
+        missing or the target is not one rigid body.
+
+        Parameters
+        ----------
+        case : Case
+            A loaded impact case with ``[perception]`` and ``[chaser]`` sections.
+        base : Path
+            Folder the case's relative file paths (meshes) are resolved against.
+        source : str
+            Name of the case in error messages (its file path).
+
+        Returns
+        -------
+        Scene
+        """
         if case.perception is None:
             raise CaseError(f"{source}: perception: missing; `riskassess perceive` needs a [perception] section "
                             "(see cases/tang2023_debris_perception.toml)")
@@ -126,7 +142,24 @@ class Scene:
     def sensor_pose(self, chaser_com, chaser_to_world, aim_world=None) -> tuple[np.ndarray, np.ndarray]:
         """Sensor origin (3,) and sensor->world rotation (3, 3) for a chaser pose; with
         ``pointing = 'target'`` and an aim point (m, world), the boresight turns to it (the
-        mount's up axis kept as close to the chaser's as the new boresight allows)."""
+        mount's up axis kept as close to the chaser's as the new boresight allows).
+
+        Parameters
+        ----------
+        chaser_com : (3,) float
+            Chaser CoM, world (LVLH) frame (m).
+        chaser_to_world : (3, 3) float
+            Chaser body -> world rotation.
+        aim_world : (3,) float, optional
+            Point to aim the boresight at, world frame (m); None keeps the body-fixed mount.
+
+        Returns
+        -------
+        sensor_world : (3,) float
+            Sensor origin, world frame (m).
+        sensor_to_world : (3, 3) float
+            Sensor -> world rotation.
+        """
         origin = chaser_com + chaser_to_world @ self.sensor_in_chaser
         body_fixed = chaser_to_world @ self.sensor_to_chaser
         if aim_world is None or self.case.perception.lidar.pointing == "body":
@@ -134,6 +167,20 @@ class Scene:
         return origin, sensor_to_platform(np.asarray(aim_world) - origin, body_fixed[:, 2])
 
     def debris_vertices_world(self, target_to_world, target_origin_world) -> np.ndarray:
+        """The debris mesh's vertices placed in the world frame.
+
+        Parameters
+        ----------
+        target_to_world : (3, 3) float
+            Target (mesh) frame -> world (LVLH) rotation.
+        target_origin_world : (3,) float
+            Target frame origin, world frame (m).
+
+        Returns
+        -------
+        (v, 3) float
+            Vertices, world frame (m).
+        """
         return np.asarray(self.mesh_target.vertices) @ target_to_world.T + target_origin_world
 
 
@@ -189,7 +236,34 @@ def _crop_to_predicted(tracker: DebrisTracker, points_world) -> np.ndarray:
 # ------------------------------------------------------------------------------ phase 1
 def observe_tumble(scene: Scene, tracker: DebrisTracker, frames: Frames, symmetries, rng, progress=None):
     """Free tumble before the run in, scanned from the hold point. Returns the debris state at
-    time 0 (CoM, body->world, velocity, omega body) for the collision run."""
+    time 0 (CoM, body->world, velocity, omega body) for the collision run.
+
+    Parameters
+    ----------
+    scene : Scene
+        Sensor, debris model and truth of the case.
+    tracker : perception.registration.DebrisTracker
+        Known-shape tracker; every scan is registered into it.
+    frames : Frames
+        Per-frame record, appended to (time in s, truth in the world frame).
+    symmetries : list of (3, 3) float
+        Rotations of the mesh's indistinguishable attitudes (target frame), for the error figures.
+    rng : numpy.random.Generator
+        Range noise of the LiDAR.
+    progress : callable, optional
+        ``progress(phase, done, total)`` after each frame (``phase`` a str, counts in frames).
+
+    Returns
+    -------
+    com_world : (3,) float
+        Debris CoM at time 0, world (LVLH) frame (m).
+    body_to_world : (3, 3) float
+        Debris body -> world rotation at time 0.
+    velocity_world : (3,) float
+        CoM velocity, world frame (m/s).
+    omega_body : (3,) float
+        Angular velocity, body frame (rad/s).
+    """
     p = scene.case.perception
     debris = scene.debris
     count = int(round(p.observation_time * scene.spec.rate))
@@ -217,7 +291,29 @@ def observe_tumble_model_free(scene: Scene, frames: Frames, rng, progress=None):
     at before the track exists), every scan registered to a map built from the scans
     (:func:`perception.scan_to_map.track_scans`). Returns the debris state at time 0 as
     :func:`observe_tumble`, the tracker for the collision phase (the map as its frozen model) and the
-    target -> B transform (4, 4) of the truth, for the error figures only."""
+    target -> B transform (4, 4) of the truth, for the error figures only.
+
+    Parameters
+    ----------
+    scene : Scene
+        Sensor, debris model and truth of the case (the mesh only makes the scans).
+    frames : Frames
+        Per-frame record, appended to (time in s, truth in the world frame).
+    rng : numpy.random.Generator
+        Range noise of the LiDAR.
+    progress : callable, optional
+        ``progress(phase, done, total)`` after each frame (``phase`` a str, counts in frames).
+
+    Returns
+    -------
+    state : tuple of (3,), (3, 3), (3,), (3,) float
+        Debris CoM (m, world), body -> world rotation, CoM velocity (m/s, world) and angular
+        velocity (rad/s, body frame) at time 0, as :func:`observe_tumble`.
+    tracker : perception.registration.DebrisTracker
+        Tracker with the map (frame B, m) as its model and the track's alignments.
+    target_to_body : (4, 4) float
+        Truth's target -> B transform (m for the translation); identity when no frame registered.
+    """
     p = scene.case.perception
     debris = scene.debris
     count = int(round(p.observation_time * scene.spec.rate))
@@ -283,7 +379,30 @@ def _good(tracker, select) -> np.ndarray:
 # ------------------------------------------------------------------------------ phase 2
 def collision_case(case: Case, com_target, com, body_to_world, velocity, omega_body, rate) -> Case:
     """The case's collision run started from the observed tumble's end state (the debris CoM at
-    ``com_target`` in the target frame), the net snapshots at the LiDAR's frame rate."""
+    ``com_target`` in the target frame), the net snapshots at the LiDAR's frame rate.
+
+    Parameters
+    ----------
+    case : Case
+        The perception case.
+    com_target : (3,) float
+        Debris CoM, target frame (m).
+    com : (3,) float
+        Debris CoM at time 0, world (LVLH) frame (m).
+    body_to_world : (3, 3) float
+        Debris target -> world rotation at time 0.
+    velocity : (3,) float
+        CoM velocity, world frame (m/s).
+    omega_body : (3,) float
+        Angular velocity, target (body) frame (rad/s).
+    rate : float
+        LiDAR frame rate (Hz): net snapshot rate, lower bound of the output rate.
+
+    Returns
+    -------
+    Case
+        A copy of ``case`` with the target's start state and output rates replaced.
+    """
     origin = com - body_to_world @ com_target
     omega_world = body_to_world @ omega_body
     target = case.target.model_copy(update={
@@ -307,7 +426,36 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
                       target_to_body=np.eye(4)) -> NetTrack:
     """Scan debris and net from the chaser through the collision run; register the debris, fit
     the net's nodes, measure the gap between them. ``target_to_body`` (4, 4): the truth's
-    transform into the tracker's frame B, for the error figures."""
+    transform into the tracker's frame B, for the error figures.
+
+    Parameters
+    ----------
+    scene : Scene
+        Sensor, debris model and truth of the case.
+    tracker : perception.registration.DebrisTracker
+        Tracker of the observation phase; the collision scans are registered into it.
+    frames : Frames
+        Per-frame record, appended to (time in s, truth in the world frame).
+    symmetries : list of (3, 3) float
+        Rotations of the indistinguishable attitudes, for the error figures.
+    rng : numpy.random.Generator
+        Range noise of the LiDAR.
+    recorder : multibody.recorder.Recorder
+        The collision run's record: body series (``body_to_lvlh``, ``body_com_lvlh``; m, LVLH = world)
+        and net snapshots (``time`` in s, ``positions_lvlh`` (k, n, 3) in m).
+    assembly : multibody.assembly.ImpactAssembly
+        The collision run's bodies, chaser, net and mount (design values the estimator may use).
+    progress : callable, optional
+        ``progress(phase, done, total)`` after each frame (``phase`` a str, counts in frames).
+    target_to_body : (4, 4) float
+        Truth's target -> B transform (m for the translation).
+
+    Returns
+    -------
+    NetTrack
+        Per collision frame: time (s), fitted net nodes (n, 3) (m, world), returns used, gap
+        debris-net (m; NaN without a debris pose) and the true nodes (m, world).
+    """
     series, net_snapshots = recorder.series, recorder.net
     net = assembly.net
     chaser, mount = assembly.chaser, assembly.mount
@@ -369,7 +517,19 @@ def free_flight_start(track: NetTrack) -> int:
     when a measured frame next to it touches (during the contact the failures are the net
     covering the debris), as clear otherwise: a failure between two clear frames, with the net
     metres away, is a registration failure and says nothing about contact (one such frame 7 s
-    after the contact once cut the free flight from 10.5 s to 4.5 s)."""
+    after the contact once cut the free flight from 10.5 s to 4.5 s).
+
+    Parameters
+    ----------
+    track : NetTrack
+        Collision frames with the debris-net gap ``separation`` (m; NaN where unmeasured).
+
+    Returns
+    -------
+    int
+        Index of the first free-flight frame; :class:`NotObservable` when the debris never
+        touched the net or still touches it at the end.
+    """
     separation = np.asarray(track.separation, float)
     measured = np.flatnonzero(np.isfinite(separation))
     if len(measured) == 0 or separation[measured[-1]] <= SEPARATION:
@@ -398,7 +558,28 @@ def _touching_through_failures(separation) -> np.ndarray:
 # ------------------------------------------------------------------------------ momentum step
 def others_momentum_after(assembly, recorder, track, frame_times, origin):
     """Chaser (navigation) + net (tracked nodes) linear and angular momentum about ``origin`` at
-    each free-flight frame: (k, 3), (k, 3)."""
+    each free-flight frame: (k, 3), (k, 3).
+
+    Parameters
+    ----------
+    assembly : multibody.assembly.ImpactAssembly
+        Chaser (mass kg, inertia kg m^2 body frame) and net node masses (kg).
+    recorder : multibody.recorder.Recorder
+        The collision run's body series (the chaser's navigation; m, m/s, rad/s, LVLH = world).
+    track : NetTrack
+        Tracked net nodes per collision frame (m, world).
+    frame_times : (k,) float
+        Free-flight frame times (s).
+    origin : (3,) float
+        Point the angular momentum is taken about, world frame (m).
+
+    Returns
+    -------
+    linear : (k, 3) float
+        Linear momentum, world frame (N s).
+    angular : (k, 3) float
+        Angular momentum about ``origin``, world frame (N m s).
+    """
     series = recorder.series
     chaser = assembly.bodies[assembly.chaser]
     track_times = np.asarray(track.times)
@@ -418,7 +599,22 @@ def others_momentum_after(assembly, recorder, track, frame_times, origin):
 
 
 def others_momentum_before(assembly, origin):
-    """Chaser + net momentum at the start of the run in, from their design launch state."""
+    """Chaser + net momentum at the start of the run in, from their design launch state.
+
+    Parameters
+    ----------
+    assembly : multibody.assembly.ImpactAssembly
+        Chaser and net at launch (m, m/s, rad/s; LVLH = world frame).
+    origin : (3,) float
+        Point the angular momentum is taken about, world frame (m).
+
+    Returns
+    -------
+    linear : (3,) float
+        Linear momentum, world frame (N s).
+    angular : (3,) float
+        Angular momentum about ``origin``, world frame (N m s).
+    """
     chaser = assembly.bodies[assembly.chaser]
     p_c, l_c = rigid_body_momentum(chaser.mass, chaser.inertia_body, chaser.com_lvlh, chaser.velocity_lvlh,
                                    chaser.body_to_lvlh, chaser.omega_body, origin)
@@ -436,7 +632,30 @@ def estimates(scene: Scene, before: FreeMotion, after: FreeMotion | None, step: 
     """The perception answer: estimates with 1-sigma uncertainties and, since the case knows the
     truth, their errors. ``target_to_body`` (4, 4): the truth's transform into the tracker's frame B
     (identity with the known mesh; with ``perception.model = 'none'`` B is the first scan's frame and
-    the frame-dependent estimates are named ``..._first_scan_...``)."""
+    the frame-dependent estimates are named ``..._first_scan_...``).
+
+    Parameters
+    ----------
+    scene : Scene
+        The case's scene (its truth for the errors).
+    before : FreeMotion
+        Free-flight fit of the observation (CoM in frame B, normalized inertia, spin per C).
+    after : FreeMotion or None
+        Free-flight fit after the collision (unused here; the momentum step holds its result).
+    step : dict or None
+        :func:`perception.momentum_balance.momentum_step` result (``mass`` in kg, ``c`` the
+        smallest principal moment in kg m^2); None when not observable.
+    state_at_zero : tuple of (3,), (3, 3), (3,), (3,) float
+        True debris CoM (m, world), body -> world rotation, velocity (m/s, world) and angular
+        velocity (rad/s, body frame) at time 0.
+    target_to_body : (4, 4) float
+        Truth's target -> B transform (m for the translation).
+
+    Returns
+    -------
+    dict
+        The estimates, 1-sigma values and errors; each key names its unit and frame.
+    """
     fit = before.fit
     com_body = before.line.com_body
     truth = scene.truth
@@ -522,7 +741,29 @@ def perceive_case(case_path, out_dir, progress=None, case: Case | None = None, o
     """Run the perception stage of a case into ``out_dir`` (see module docstring; the folder is
     claimed by :func:`riskassess.products.outfolder.claim`, ``pending`` as in :func:`riskassess.stages.run.run_case`);
     returns the content of perception.json. A quantity the data cannot determine is reported under
-    ``not_observable`` with the reason, never as a number."""
+    ``not_observable`` with the reason, never as a number.
+
+    Parameters
+    ----------
+    case_path : str or Path
+        The case file (TOML).
+    out_dir : str or Path
+        Output folder (claimed; never overwrites a user's file).
+    progress : callable, optional
+        ``progress(phase, done, total)``: frames for ``observation``/``collision``, simulated
+        time (s) for ``simulation``.
+    case : Case, optional
+        The case already loaded from ``case_path``.
+    overwrite : bool
+        Replace a previous run's folder.
+    pending : sequence
+        As in :func:`riskassess.stages.run.run_case`.
+
+    Returns
+    -------
+    dict
+        The content of perception.json (SI units; frames named in the keys).
+    """
     case_path = Path(case_path)
     case = case or load_case(case_path)
     scene = Scene.from_case(case, case_path.parent, str(case_path))
