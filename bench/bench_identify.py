@@ -4,9 +4,14 @@ the whole 275 s tow; identified by pymoo's PSO (then polished by the pattern sea
 pattern search from the paper's s0 = [1, 6, 3, 0.25]. Simulations run on ``identification.workers``
 processes.
 
-    python bench/bench_identify.py [--optimizers pso pattern mads] [--swarm N] [--generations N]
-                                   [--polish N] [--pattern N] [--restart N] [--tolerance X]
-                                   [--truth S1 S2 S3 S4]
+    python bench/bench_identify.py [--optimizers pso pattern mads] [--cost f1 f2] [--starts s0|table6]
+                                   [--swarm N] [--generations N] [--polish N] [--pattern N] [--restart N]
+                                   [--tolerance X] [--mads N] [--truth S1 S2 S3 S4]
+
+``--cost f1 f2`` runs every optimizer on each cost; ``--starts table6`` starts MADS and the pattern search
+from each of the paper's Table 6 initial guesses (MADS 1-5) instead of the case's s0 (Sec. 4.3 uses s0 for
+the benchmark). At the end the paper's Tables 4 (converged cost per optimizer and cost) and 5 (converged s)
+are printed as markdown rows, with the evaluations and wall time of each run.
 
 (defaults: the case's ``[identification.optimizers]``). Prints the CPU time of one evaluation (its
 10 runs, one after the other, in this process), then per optimizer: s, cost, largest relative error
@@ -26,6 +31,10 @@ from riskassess.cases.impact import load_model
 from riskassess.stages.identify import benchmark, simulate
 from riskassess.cases.towing import Optimizers, TowingCase
 
+#: Boonrath, Singh & Botta 2024, Table 6: the initial guesses of MADS 1-5 (s1, s2 m, s3, s4).
+TABLE6_INITIAL_GUESSES = ([3.0, 9.0, 1.0, 0.5], [2.0, 9.0, 1.0, 0.5], [3.0, 8.0, 1.0, 0.5], [3.0, 9.0, 2.0, 0.5],
+                          [3.0, 9.0, 1.0, 0.75])
+
 
 def main():
     parser = argparse.ArgumentParser()
@@ -36,6 +45,11 @@ def main():
                             ("--restart", "restart_evaluations", int), ("--tolerance", "pattern_tolerance", float),
                             ("--mads", "mads_evaluations", int)):
         parser.add_argument(flag, dest=key, type=kind, default=None)
+    parser.add_argument("--cost", nargs="+", default=None, choices=["f1", "f2"],
+                        help="costs to run (default the case's identification.cost)")
+    parser.add_argument("--starts", choices=["s0", "table6"], default="s0",
+                        help="start of MADS and the pattern search: the case's s0 or each Table 6 initial guess")
+    parser.add_argument("--workers", type=int, default=None, help="worker processes (default identification.workers)")
     parser.add_argument("--truth", type=float, nargs=4, default=None,
                         help="s of the data instead of the case's benchmark_truth (a robustness check off the paper's s)")
     args = parser.parse_args()
@@ -44,23 +58,54 @@ def main():
     update = {key: value for key, value in vars(args).items() if key in Optimizers.model_fields and value is not None}
     settings = ident.optimizers.model_copy(update=update)
     truth = ident.benchmark_truth if args.truth is None else args.truth
-    ident = ident.model_copy(update=dict(optimizers=settings, benchmark_truth=truth))
+    ident = ident.model_copy(update=dict(optimizers=settings, benchmark_truth=truth,
+                                        workers=args.workers or ident.workers))
     case = case.model_copy(update=dict(identification=ident))
     print(f"settings: {settings.model_dump()}; load average {os.getloadavg()[0]:.1f}")
+    costs = args.cost or [ident.cost]
+    starts = {"s0": [("", ident.initial_guess)],
+              "table6": [(f" {k + 1}", guess) for k, guess in enumerate(TABLE6_INITIAL_GUESSES)]}[args.starts]
     simulate(case, case.rates.training_deg_s[0], ident.benchmark_truth)  # compiled code loaded
     cpu = time.process_time()
     for rate in case.rates.training_deg_s:
         simulate(case, rate, ident.benchmark_truth)
     print(f"one evaluation (10 runs of the twin, serial): {time.process_time() - cpu:.2f} s CPU")
     start = time.perf_counter()
-    out = benchmark(case, optimizers=tuple(args.optimizers))
-    print(f"data: {len(out['rates_deg_s'])} runs of {case.simulation.end_time - case.simulation.start_time:g} s "
-          f"(step {ident.step * 1e3:g} ms) in {out['data_wall_s']:.1f} s; s_true = {out['truth']}, cost {out['cost_function']}")
-    for name, run in out["runs"].items():
-        print(f"  {name:12s} s = {np.round(run['s'], 5).tolist()} cost {run['cost']:.3e} max rel. error "
-              f"{max(run['relative_error']):.2e} ({np.array(run['relative_error']).round(5).tolist()}) "
-              f"{run['evaluations']} evaluations {run['wall_s']:.0f} s wall")
+    rows = []
+    for cost in costs:
+        for name in args.optimizers:
+            for label, guess in (starts if name in ("mads", "pattern") else [("", ident.initial_guess)]):
+                run_case = case.model_copy(update=dict(identification=case.identification.model_copy(
+                    update=dict(cost=cost, initial_guess=list(guess)))))
+                out = benchmark(run_case, optimizers=(name,))
+                print(f"data: {len(out['rates_deg_s'])} runs of {case.simulation.end_time - case.simulation.start_time:g} s "
+                      f"(step {ident.step * 1e3:g} ms) in {out['data_wall_s']:.1f} s; s_true = {out['truth']}, cost "
+                      f"{cost}, start {list(guess)}; load average {os.getloadavg()[0]:.1f}")
+                for found, run in out["runs"].items():
+                    print(f"  {found:12s} s = {np.round(run['s'], 5).tolist()} cost {run['cost']:.3e} max rel. error "
+                          f"{max(run['relative_error']):.2e} ({np.array(run['relative_error']).round(5).tolist()}) "
+                          f"{run['evaluations']} evaluations {run['wall_s']:.0f} s wall", flush=True)
+                    rows.append((f"{found}{label}", cost, run))
+    print_tables(rows)
     print(f"total {time.perf_counter() - start:.0f} s wall; load average now {os.getloadavg()[0]:.1f}")
+
+
+def print_tables(rows):
+    """The paper's Tables 4 (converged cost) and 5 (converged s) as markdown rows, plus evaluations and wall time.
+
+    Parameters
+    ----------
+    rows : list of (str, str, dict)
+        (optimizer label, cost name, benchmark entry: ``s``, ``cost``, ``relative_error``, ``evaluations``, ``wall_s``).
+    """
+    print("\nTable 4 (converged cost, benchmark):\n| optimizer | cost | converged value | evaluations | wall (s) |")
+    print("|---|---|---|---|---|")
+    for label, cost, run in rows:
+        print(f"| {label} | {cost} | {run['cost']:.4g} | {run['evaluations']} | {run['wall_s']:.0f} |")
+    print("\nTable 5 (converged s, benchmark; truth [2, 7, 2, 1]):\n| optimizer, cost | s1 | s2 | s3 | s4 | max rel. error |")
+    print("|---|---|---|---|---|---|")
+    for label, cost, run in rows:
+        print(f"| {label} {cost} | " + " | ".join(f"{v:.7f}" for v in run["s"]) + f" | {max(run['relative_error']):.1e} |")
 
 
 if __name__ == "__main__":

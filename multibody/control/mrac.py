@@ -11,6 +11,17 @@ mass with saturated force. The adaptive states are integrated with the controlle
 step (forward Euler, the controller is digital with zero-order hold) and frozen while the
 command saturates (the :math:`H(u_{max}-|u|)` factor of eqs. 15 and 20).
 
+**Measured elongation rate.** Both laws take :math:`\\dot z` from :func:`elongation_rate_estimate`: with
+``RATE_TAU`` > 0 the band-limited difference quotient of the sampled elongation (a first-order
+"dirty derivative", time constant tau), with 0 the plant's instantaneous rate. On the full-net plant
+the tether's far end is the net's central node (9.5 g on Kevlar threads of ~35 kN/m): its velocity
+vibrates far above the control band, and the instantaneous rate sampled every step is that vibration
+aliased (measured: standard deviation 0.06-0.14 m/s at 2 ms samples while the elongation moves by
+millimetres per second), which the laws' rate gains (k_s, K_D ~ 2-5 kN s/m) turn into +-u_max
+chattering. tau is set one decade above the reference model's natural frequency
+:math:`\\omega_m = \\sqrt{b (k_{MT} + K_P)}` (:func:`rate_filter_time`), so the reference dynamics
+pass with < 6 deg of phase lag.
+
 This module holds what both laws share (parameter head, reference model); each law is a plug-in of
 :mod:`multibody.control.thrust_laws` (``mrac1.py``, ``mrac2.py``: its gains, ``command``, initial
 state); ``params`` and ``state`` are flat float arrays for the compiled towing kernels, the common
@@ -21,10 +32,10 @@ from __future__ import annotations
 from numba import njit
 
 # params indices common to both laws; each law appends its gains (thrust_laws/mrac1.py, mrac2.py)
-T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D = range(8)
-N_COMMON = 8
-# state: reference model z_m, z_m rate, then adaptive parameters
-ZM, ZM_RATE, A0 = 0, 1, 2
+T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU = range(9)
+N_COMMON = 9
+# state: reference model z_m, z_m rate, the rate estimate's last elongation and last rate, then adaptive parameters
+ZM, ZM_RATE, Z_LAST, RATE_LAST, A0 = 0, 1, 2, 3, 4
 
 
 def command_elongation(desired, k_mt, k_p, settle_at_desired) -> float:
@@ -46,11 +57,53 @@ def command_elongation(desired, k_mt, k_p, settle_at_desired) -> float:
     return desired * (k_mt + k_p) / k_p if settle_at_desired else desired
 
 
+def rate_filter_time(k_mt, k_p, chaser_mass, decades=1.0) -> float:
+    """Time constant (s) of the elongation-rate estimate that puts its corner ``decades`` above the
+    reference model's natural frequency :math:`\\omega_m = \\sqrt{(k_{MT} + K_P)/m_C}` (eq. 13 taut):
+    :math:`\\tau = 10^{-decades}/\\omega_m`; the phase lag at :math:`\\omega_m` is
+    :math:`\\arctan(\\omega_m\\tau)` (5.7 deg for one decade).
+
+    Parameters
+    ----------
+    k_mt, k_p : float
+        Main-tether stiffness and reference-model proportional gain (N/m).
+    chaser_mass : float
+        m_C (kg).
+    decades : float
+        Separation of the corner from omega_m (decades).
+    """
+    return 10.0 ** (-decades) / (((k_mt + k_p) / chaser_mass) ** 0.5)
+
+
+def abstracted_tether(case, tether) -> tuple[float, float]:
+    """Stiffness (N/m) and damping (N s/m) of the main tether as the abstracted model (eq. 9) sees it.
+
+    The paper's assumption (iv), m_C << m_D, fixes the tether's far end (a wall). Our chaser is
+    1600 kg against 9000 kg (m_C/m_D = 0.18): the far end accelerates with the debris, and the
+    elongation of two free masses on a tether obeys
+    :math:`\\ddot z = F_t/m_C - (1/m_C + 1/m_D)\\,T`, i.e. eq. (9) with the tether terms scaled by
+    :math:`1 + m_C/m_D`. With ``mrac.free_debris`` that scaled tether is the model (reference model,
+    the laws' ideal parameters, eq. 21a); in steady towing it puts the thrust at
+    :math:`F_t = (1 + m_C/m_D)\\,k_{MT} z` (the debris takes its share of the acceleration), where the wall
+    model predicts :math:`k_{MT} z`: 18 % too little thrust, which only the adaptation can make up.
+    Without it, the paper's wall (the tether as given).
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        The towing case (read: ``mrac.free_debris``, ``chaser.mass``, ``debris.nominal_mass``).
+    tether : (>= 2,) float
+        k_MT (N/m), c_MT (N s/m), ... of the model's main tether.
+    """
+    scale = 1.0 + case.chaser.mass / case.debris.nominal_mass if case.mrac.free_debris else 1.0
+    return scale * float(tether[0]), scale * float(tether[1])
+
+
 def common_params(case, tether) -> list:
-    """The parameters both laws share (indices ``T_ON`` ... ``K_D``) from a towing case (``thrust``,
+    """The parameters both laws share (indices ``T_ON`` ... ``RATE_TAU``) from a towing case (``thrust``,
     ``mrac``, ``chaser.mass``, ``main_tether.stiffness``) and its main tether ``tether`` = [k_MT (N/m),
     c_MT (N s/m), ...]: thrust-on time (s), saturation u_max (N), b = 1/m_C (1/kg), k_MT, c_MT,
-    z_d (m), K_P (N/m), K_D (N s/m).
+    z_d (m), K_P (N/m), K_D (N s/m), the rate estimate's time constant (s, 0: the measured rate).
 
     Parameters
     ----------
@@ -60,8 +113,22 @@ def common_params(case, tether) -> list:
         k_MT (N/m), c_MT (N s/m), ... of the model's main tether.
     """
     th, m = case.thrust, case.mrac
-    z_d = command_elongation(m.desired_elongation, case.main_tether.stiffness, m.k_p, m.settle_at_desired)
-    return [th.t_on, th.max_force, 1.0 / case.chaser.mass, tether[0], tether[1], z_d, m.k_p, m.k_d]
+    k_mt, c_mt = abstracted_tether(case, tether)
+    z_d = command_elongation(m.desired_elongation, k_mt, m.k_p, m.settle_at_desired)
+    return [th.t_on, th.max_force, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
+            m.rate_filter_time]
+
+
+def initial_state(z0, z_rate0) -> list:
+    """The shared head of a law's state: reference model on the measured state (z0 (m), z_rate0 (m/s)),
+    the rate estimate started on it.
+
+    Parameters
+    ----------
+    z0, z_rate0 : float
+        Elongation (m) and its rate (m/s) at the start.
+    """
+    return [z0, z_rate0, z0, z_rate0]
 
 
 def reference_steady_elongation(k_mt, k_p, z_d) -> float:
@@ -132,3 +199,42 @@ def advance_reference(params, state, zm_acc, step):
     """
     state[ZM] += step * state[ZM_RATE]
     state[ZM_RATE] += step * zm_acc
+
+
+@njit(cache=True)
+def elongation_rate_estimate(params, state, z, z_rate, step):
+    """The elongation rate the laws use (m/s): with ``params[RATE_TAU]`` = tau > 0 the band-limited
+    difference quotient of the sampled elongation (backward-Euler "dirty derivative",
+    :math:`r_k = (\\tau r_{k-1} + z_k - z_{k-1})/(\\tau + h)`: exact for a ramp, first-order low-pass
+    of the true rate with corner 1/tau), with tau = 0 the measured ``z_rate`` itself.
+
+    Parameters
+    ----------
+    params : (k,) float
+        The law's parameters (``RATE_TAU`` used).
+    state : (j,) float
+        The law's state (``Z_LAST``, ``RATE_LAST`` read; :func:`store_rate` writes them).
+    z, z_rate : float
+        Measured elongation (m) and instantaneous rate (m/s).
+    step : float
+        Sampling step (s).
+    """
+    tau = params[RATE_TAU]
+    if tau <= 0.0:
+        return z_rate
+    return (tau * state[RATE_LAST] + (z - state[Z_LAST])) / (tau + step)
+
+
+@njit(cache=True)
+def store_rate(state, z, rate):
+    """Keep this sample's elongation (m) and rate estimate (m/s) for the next one.
+
+    Parameters
+    ----------
+    state : (j,) float
+        The law's state, ``Z_LAST`` and ``RATE_LAST`` written.
+    z, rate : float
+        Elongation (m) and rate estimate (m/s).
+    """
+    state[Z_LAST] = z
+    state[RATE_LAST] = rate

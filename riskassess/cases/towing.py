@@ -96,6 +96,15 @@ class Mrac(Strict):
     gamma_theta: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = Field(description="MRAC-2 diagonal of Gamma_theta (-).")
     xi_2: NonNegative = Field(description="MRAC-2 e-modification gain xi_2 (-).")
     q: Annotated[list[Positive], Field(min_length=2, max_length=2)] = Field(description="MRAC-2 diagonal of Q in eq. (21a) (-).")
+    rate_filter_time: NonNegative = Field(
+        0.0, description="Time constant tau of the elongation-rate estimate both laws use (s): the band-limited "
+                         "difference quotient of the sampled elongation, corner 1/tau; 0: the plant's "
+                         "instantaneous elongation rate (on the full-net plant that is the net node's vibration, "
+                         "docs/towing.md). One decade above the reference model: 0.1 / sqrt((k_MT + K_P) / m_C).")
+    free_debris: bool = Field(
+        False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
+                           "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "
+                           "(assumption iv, m_C << m_D).")
     settle_at_desired: bool = Field(
         False, description="Command the reference model (eq. 13) with z_d (k_MT + K_P) / K_P so that it settles at "
                           "desired_elongation; false: the paper's command z_d, with which it settles at "

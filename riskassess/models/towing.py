@@ -13,7 +13,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from multibody.control.attitude import sampled_boundary_layer
 from multibody.rotations import quaternion_to_matrix
-from multibody.control.mrac import command_elongation
+from multibody.control.mrac import abstracted_tether, command_elongation
 from multibody.control.thrust_laws import thrust_law
 from multibody.towing import TowingModel
 from riskassess.cases.towing import TowingCase
@@ -118,8 +118,9 @@ def reference_command(case: TowingCase) -> float:
     float
         z_d (m).
     """
-    m = case.mrac
-    return command_elongation(m.desired_elongation, case.main_tether.stiffness, m.k_p, m.settle_at_desired)
+    m, mt = case.mrac, case.main_tether
+    k_mt, _ = abstracted_tether(case, [mt.stiffness, mt.damping])
+    return command_elongation(m.desired_elongation, k_mt, m.k_p, m.settle_at_desired)
 
 
 def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None, step: float | None = None,

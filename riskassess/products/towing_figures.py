@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from multibody.control.mrac import reference_steady_elongation
+from multibody.control.mrac import abstracted_tether, reference_steady_elongation
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing import reference_command
 
@@ -24,7 +24,9 @@ def reference_elongation(case: TowingCase) -> float | None:
     """
     if case.mrac is None:
         return None
-    return reference_steady_elongation(case.main_tether.stiffness, case.mrac.k_p, reference_command(case))
+    mt = case.main_tether
+    k_mt, _ = abstracted_tether(case, [mt.stiffness, mt.damping])
+    return reference_steady_elongation(k_mt, case.mrac.k_p, reference_command(case))
 
 
 def tautness(series: dict, target_elongation: float | None) -> dict:

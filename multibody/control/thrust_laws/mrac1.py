@@ -3,22 +3,24 @@
 reference model, parameter head) in :mod:`multibody.control.mrac`.
 
 ``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``K_D``), then lambda_0 (1/s),
-k_s (N s/m), gamma, xi_h, xi_a (2) (-); ``state`` = [z_m (m), z_m rate (m/s), h (kg), a1 (N/m),
-a2 (N s/m)].
+k_s (N s/m), gamma, xi_h, xi_a (2) (-); ``state`` = [z_m (m), z_m rate (m/s), last elongation (m), last
+rate estimate (m/s), h (kg), a1 (N/m), a2 (N s/m)]. The elongation rate is
+:func:`multibody.control.mrac.elongation_rate_estimate`'s.
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
-from multibody.control.mrac import (A0, B, C_MT, K_MT, T_ON, U_MAX, ZM, ZM_RATE, advance_reference, common_params,
-                                    pulling, reference_acceleration)
+from multibody.control.mrac import (A0, B, C_MT, K_MT, N_COMMON, T_ON, U_MAX, ZM, ZM_RATE, advance_reference,
+                                    common_params, elongation_rate_estimate, initial_state, pulling,
+                                    reference_acceleration, store_rate)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac1"
 ALONG_BODY_Z = True
 CASE_SECTIONS = ("mrac",)
-LAMBDA0, K_S, GAMMA, XI_H, XI_A1, XI_A2 = range(8, 14)
+LAMBDA0, K_S, GAMMA, XI_H, XI_A1, XI_A2 = range(N_COMMON, N_COMMON + 6)
 
 
 @njit(THRUST_SIGNATURE, cache=True)
@@ -30,11 +32,15 @@ def command(t, z, z_rate, params, state, step, advance):
     t, z, z_rate, step, advance
         As in the thrust-law interface (:mod:`multibody.control.thrust`): time (s), main-tether
         elongation (m) and rate (m/s), sampling step (s), whether to advance the states.
-    params : (14,) float
+    params : (15,) float
         The common head (:mod:`multibody.control.mrac`), then lambda_0 (1/s), k_s (N s/m), gamma, xi_h, xi_a (2) (-).
-    state : (5,) float
-        z_m (m), z_m rate (m/s), h (kg), a1 (N/m), a2 (N s/m); advanced in place when ``advance``.
+    state : (7,) float
+        z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), h (kg), a1 (N/m), a2 (N s/m);
+        advanced in place when ``advance``.
     """
+    z_rate = elongation_rate_estimate(params, state, z, z_rate, step)
+    if advance:
+        store_rate(state, z, z_rate)
     if t < params[T_ON]:
         return 0.0
     zm_acc = reference_acceleration(params, state[ZM], state[ZM_RATE])
@@ -67,4 +73,4 @@ def arrays(case, tether, z0, z_rate0) -> tuple[np.ndarray, np.ndarray]:
     """
     m = case.mrac
     params = np.array(common_params(case, tether) + [m.lambda0, m.k_s, m.gamma, m.xi_h, *m.xi_a], float)
-    return params, np.array([z0, z_rate0, 1.0 / params[B], params[K_MT], params[C_MT]])
+    return params, np.array(initial_state(z0, z_rate0) + [1.0 / params[B], params[K_MT], params[C_MT]])

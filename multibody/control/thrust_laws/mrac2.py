@@ -4,7 +4,8 @@ reference model, parameter head) in :mod:`multibody.control.mrac`.
 
 ``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``K_D``), then Gamma_z (2),
 gamma_r, Gamma_theta (2), xi_2 (-) and P (2x2 row-major, eq. 21a); ``state`` = [z_m (m), z_m rate
-(m/s), Kz1 (N/m), Kz2 (N s/m), kr (N/m), theta1 (N/m), theta2 (N s/m)].
+(m/s), last elongation (m), last rate estimate (m/s), Kz1 (N/m), Kz2 (N s/m), kr (N/m), theta1 (N/m),
+theta2 (N s/m)]. The elongation rate is :func:`multibody.control.mrac.elongation_rate_estimate`'s.
 """
 from __future__ import annotations
 
@@ -12,14 +13,17 @@ import numpy as np
 from numba import njit
 from scipy.linalg import solve_continuous_lyapunov
 
-from multibody.control.mrac import (B, C_MT, K_D, K_MT, K_P, T_ON, U_MAX, Z_D, ZM, ZM_RATE, advance_reference,
-                                    common_params, pulling, reference_acceleration)
+from multibody.control.mrac import (A0, B, C_MT, K_D, K_MT, K_P, N_COMMON, T_ON, U_MAX, Z_D, ZM, ZM_RATE,
+                                    advance_reference, common_params, elongation_rate_estimate, initial_state, pulling,
+                                    reference_acceleration, store_rate)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac2"
 ALONG_BODY_Z = True
 CASE_SECTIONS = ("mrac",)
-GZ1, GZ2, GAMMA_R, GT1, GT2, XI_2, P11, P12, P21, P22 = range(8, 18)
+GZ1, GZ2, GAMMA_R, GT1, GT2, XI_2, P11, P12, P21, P22 = range(N_COMMON, N_COMMON + 10)
+# state: the adaptive parameters after the common head
+KZ1, KZ2, KR, TH1, TH2 = range(A0, A0 + 5)
 
 
 @njit(THRUST_SIGNATURE, cache=True)
@@ -35,30 +39,34 @@ def command(t, z, z_rate, params, state, step, advance):
     ----------
     t, z, z_rate, step, advance
         As :func:`multibody.control.thrust_laws.mrac1.command` takes them (s, m, m/s, s, bool).
-    params : (18,) float
+    params : (19,) float
         The common head (:mod:`multibody.control.mrac`), then Gamma_z (2), gamma_r, Gamma_theta (2), xi_2, P (2x2).
-    state : (7,) float
-        z_m (m), z_m rate (m/s), Kz (2), kr, Theta (2); advanced in place when ``advance``.
+    state : (9,) float
+        z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), Kz (2), kr, Theta (2); advanced
+        in place when ``advance``.
     """
+    z_rate = elongation_rate_estimate(params, state, z, z_rate, step)
+    if advance:
+        store_rate(state, z, z_rate)
     if t < params[T_ON]:
         return 0.0
     zm_acc = reference_acceleration(params, state[ZM], state[ZM_RATE])
     g = pulling(z, z_rate, params[K_MT], params[C_MT])
     phi1, phi2 = (g - 1.0) * z, (g - 1.0) * z_rate                           # eq. (18c)
     z_d = params[Z_D]
-    u = (state[2] * z + state[3] * z_rate + state[4] * z_d
-         - (state[5] * phi1 + state[6] * phi2))                             # eq. (19)
+    u = (state[KZ1] * z + state[KZ2] * z_rate + state[KR] * z_d
+         - (state[TH1] * phi1 + state[TH2] * phi2))                             # eq. (19)
     force = min(max(u, -params[U_MAX]), params[U_MAX])
     if advance:
         if abs(u) < params[U_MAX]:
             e1, e2 = z - state[ZM], z_rate - state[ZM_RATE]
             epb = (e1 * params[P12] + e2 * params[P22]) * params[B]        # e^T P B, B = [0, b]
             damp = params[XI_2] * abs(epb)
-            state[2] += step * params[GZ1] * (-z * epb - damp * state[2])   # eq. (20a)
-            state[3] += step * params[GZ2] * (-z_rate * epb - damp * state[3])
-            state[4] += step * params[GAMMA_R] * (-z_d * epb - damp * z_d * state[4])   # eq. (20b)
-            state[5] += step * params[GT1] * (phi1 * epb - damp * state[5])  # eq. (20c), sign: see above
-            state[6] += step * params[GT2] * (phi2 * epb - damp * state[6])
+            state[KZ1] += step * params[GZ1] * (-z * epb - damp * state[KZ1])   # eq. (20a)
+            state[KZ2] += step * params[GZ2] * (-z_rate * epb - damp * state[KZ2])
+            state[KR] += step * params[GAMMA_R] * (-z_d * epb - damp * z_d * state[KR])   # eq. (20b)
+            state[TH1] += step * params[GT1] * (phi1 * epb - damp * state[TH1])  # eq. (20c), sign: see above
+            state[TH2] += step * params[GT2] * (phi2 * epb - damp * state[TH2])
         advance_reference(params, state, zm_acc, step)
     return force
 
@@ -81,5 +89,6 @@ def arrays(case, tether, z0, z_rate0) -> tuple[np.ndarray, np.ndarray]:
     a_m = np.array([[0.0, 1.0], [-b * (k_mt + k_p), -b * (c_mt + k_d)]])
     p = solve_continuous_lyapunov(a_m.T, -np.asarray(np.diag(m.q), float))  # eq. (21a): P A + A^T P = -Q
     params = np.array(head + [*m.gamma_z, m.gamma_r, *m.gamma_theta, m.xi_2, *p.ravel()], float)
-    return params, np.array([z0, z_rate0, -params[K_P], -params[K_D], params[K_P], -params[K_MT], -params[C_MT]])
+    return params, np.array(initial_state(z0, z_rate0) + [-params[K_P], -params[K_D], params[K_P], -params[K_MT],
+                                                          -params[C_MT]])
 

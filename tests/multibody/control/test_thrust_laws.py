@@ -92,3 +92,34 @@ def test_an_unknown_thrust_law_is_refused_listing_the_known_ones():
     with pytest.raises(ValueError) as refused:
         TowingCase.model_validate(raw)
     assert "thrust.kind" in str(refused.value) and all(f"'{name}'" in str(refused.value) for name in LAWS)
+
+
+def test_the_elongation_rate_estimate_is_the_backward_euler_dirty_derivative():
+    """multibody.control.mrac.elongation_rate_estimate: r_k = (tau r_{k-1} + z_k - z_{k-1}) / (tau + h) is
+    s / (tau s + 1) discretized with s = (1 - q^-1) / h: exact for a ramp from the first sample, and on a
+    sampled sine of frequency w its steady amplitude is |H| of that transfer function (both to round-off);
+    tau = 0 hands the measured rate through."""
+    from multibody.control.mrac import N_COMMON, RATE_TAU, Z_LAST, RATE_LAST, elongation_rate_estimate, store_rate
+
+    tau, h = 0.06, 2e-3
+    params, state = np.zeros(N_COMMON), np.zeros(4)
+    params[RATE_TAU] = tau
+    state[Z_LAST], state[RATE_LAST] = 0.01, 0.3                    # a ramp z = 0.01 + 0.3 t, started on it
+    for k in range(1, 50):
+        z = 0.01 + 0.3 * k * h
+        rate = elongation_rate_estimate(params, state, z, 99.0, h)   # the measured rate is not used
+        store_rate(state, z, rate)
+        assert rate == pytest.approx(0.3, rel=1e-12)
+    w = 20.0                                                       # rad/s, above the corner 1/tau = 16.7 rad/s
+    state[:] = 0.0
+    rates = []
+    for k in range(1, 20001):
+        z = np.sin(w * k * h)
+        rate = elongation_rate_estimate(params, state, z, 0.0, h)
+        store_rate(state, z, rate)
+        rates.append(rate)
+    s = (1.0 - np.exp(-1j * w * h)) / h
+    expected = abs(s / (tau * s + 1.0))
+    assert np.max(np.abs(rates[-2000:])) == pytest.approx(expected, rel=2e-3)   # sampled peak: (w h)^2/8 below
+    params[RATE_TAU] = 0.0
+    assert elongation_rate_estimate(params, state, 1.0, 0.123, h) == 0.123
