@@ -3,7 +3,11 @@
 (cases/zenit2_towing.toml).
 
     python bench/bench_tow_control.py [--case cases/zenit2_towing.toml] [--rates training|validation|all]
-                                      [--plant lower-order|full-net] [--max-rates N]
+                                      [--plant lower-order|full-net] [--max-rates N] [--plots DIR]
+
+``--plots DIR`` writes ``DIR/control_<plant>.png`` (tension, elongation with the target, debris rate of the
+three laws at the first rate; riskassess.products.towing_plots.plot_control) and ``DIR/control_<plant>.npz``
+(those series); DIR is created and an existing figure is not overwritten.
 
 The full-net plant (multibody/net_towing.py, from the wrapped start) takes ~40 s a run: use --max-rates.
 
@@ -12,19 +16,23 @@ sample with main-tether tension > 1 N: before it the sub-tethers are still slack
 on the main tether),
 the smallest main-tether tension after t_e (> 0: taut), the slack time after t_e, the peak
 tension, the final elongation and its RMS error over the last 100 s against the MRAC reference
-model's steady elongation (riskassess.products.towing_figures.reference_elongation); then the worst over the rates per law.
+model's steady elongation (riskassess.products.towing_figures.reference_elongation), the mean elongation over the last
+100 s and the fraction of the time after t_on the command sits at the saturation; then per law the range over the rates.
 """
 from __future__ import annotations
 
 import argparse
 import time
+from pathlib import Path
 
 import numpy as np
 
 from multibody.net_towing import run_exudyn as run_full_net
 from multibody.towing import run_exudyn
 from riskassess.cases.impact import load_model
+from riskassess.products import results
 from riskassess.products.towing_figures import reference_elongation, tautness
+from riskassess.products.towing_plots import plot_control
 from riskassess.models.towing import towing_model
 from riskassess.models.towing_fullnet import full_net_model, wrapped_net
 from riskassess.cases.towing import TowingCase
@@ -35,7 +43,10 @@ def main():
     parser.add_argument("--rates", choices=("training", "validation", "all"), default="training")
     parser.add_argument("--plant", choices=("lower-order", "full-net"), default="lower-order")
     parser.add_argument("--max-rates", type=int, default=None)
+    parser.add_argument("--plots", type=Path, default=None)
     args = parser.parse_args()
+    if args.plots is not None and (args.plots / f"control_{args.plant}.png").exists():
+        parser.error(f"--plots: {args.plots / f'control_{args.plant}.png'} exists; give another folder")
     case = load_model(args.case, TowingCase)
     rates = {"training": case.rates.training_deg_s, "validation": case.rates.validation_deg_s,
              "all": sorted(case.rates.training_deg_s + case.rates.validation_deg_s)}[args.rates][:args.max_rates]
@@ -50,23 +61,44 @@ def main():
     print(f"plant: {args.plant}; MRAC target: the reference model's steady elongation {desired:.4f} m (eq. 13, z_d = "
           f"{case.mrac.desired_elongation} m); the ramp has no target (its error shown for comparison)")
     print(f"{'law':6} {'rate deg/s':>10} {'t_e s':>7} {'min T N':>9} {'slack s':>8} {'peak T N':>9} "
-          f"{'z_end m':>8} {'rms(z-z_m) m':>12} {'wall s':>7}")
-    worst = {}
-    for kind in ("ramp", "mrac1", "mrac2"):
+          f"{'z_end m':>8} {'z_100 m':>8} {'rms(z-z_m) m':>12} {'sat':>5} {'cpu s':>7}")
+    figures = {kind: [] for kind in ("ramp", "mrac1", "mrac2")}
+    shown = {}
+    for kind in figures:
         law = case.model_copy(update=dict(thrust=case.thrust.model_copy(update=dict(kind=kind))))
         for rate in rates:
-            start = time.perf_counter()
-            f = tautness(run(law, rate), desired)
-            wall = time.perf_counter() - start
+            start = time.process_time()
+            series = run(law, rate)
+            cpu = time.process_time() - start
+            f = tautness(series, desired)
+            t, z = series["time"], series["main_tether_elongation"]
+            z_100 = float(z[t > t[-1] - 100.0].mean())
+            on = t >= case.thrust.t_on
+            saturated = float(np.mean(np.abs(series["thrust"][on]) >= case.thrust.max_force * (1 - 1e-9)))
             print(f"{kind:6} {rate:10.2f} {f['engaged_at_s']:7.1f} {f['min_tension_after_engagement_N']:9.3f} "
                   f"{f['slack_after_engagement_s']:8.1f} {f['peak_tension_N']:9.2f} {f['final_elongation_m']:8.4f} "
-                  f"{f['rms_elongation_error_m']:12.4f} {wall:7.2f}", flush=True)
-            w = worst.setdefault(kind, {"min_tension": np.inf, "slack_s": 0.0})
-            w["min_tension"] = min(w["min_tension"], f["min_tension_after_engagement_N"])
-            w["slack_s"] = max(w["slack_s"], f["slack_after_engagement_s"])
-    for kind, w in worst.items():
-        print(f"{kind}: over {len(rates)} rates, min tension after engagement {w['min_tension']:.3f} N, "
-              f"longest slack after engagement {w['slack_s']:.1f} s")
+                  f"{z_100:8.4f} {f['rms_elongation_error_m']:12.4f} {saturated:5.2f} {cpu:7.1f}", flush=True)
+            figures[kind].append((f, z_100, saturated))
+            if rate == rates[0]:
+                shown[kind] = series
+    print(f"\n| plant, law | final elongation (m) | mean elongation, last 100 s (m) | RMS error to {desired:.3f} m, "
+          f"last 100 s (m) | peak tension (N) | slack after engagement (s) | saturated |")
+    print("|---|---|---|---|---|---|---|")
+    for kind, rows in figures.items():
+        def span(values, fmt):
+            return f"{min(values):{fmt}}-{max(values):{fmt}}" if len(values) > 1 else f"{values[0]:{fmt}}"
+        print(f"| {args.plant}, {kind} | {span([f['final_elongation_m'] for f, _, _ in rows], '.4f')} | "
+              f"{span([z for _, z, _ in rows], '.4f')} | {span([f['rms_elongation_error_m'] for f, _, _ in rows], '.4f')} | "
+              f"{span([f['peak_tension_N'] for f, _, _ in rows], '.0f')} | "
+              f"{span([f['slack_after_engagement_s'] for f, _, _ in rows], '.1f')} | {span([s for _, _, s in rows], '.2f')} |")
+    if args.plots is not None:
+        args.plots.mkdir(parents=True, exist_ok=True)
+        keys = ("time", "main_tether_tension", "main_tether_elongation", "debris_omega_body", "thrust")
+        results.atomic_write_npz(args.plots / f"control_{args.plant}.npz",
+                                 {f"{kind}/{key}": series[key] for kind, series in shown.items() for key in keys})
+        plot_control(shown, args.plots / f"control_{args.plant}.png",
+                     f"{args.plant} plant, {rates[0]} deg/s: ramp, MRAC-1, MRAC-2", desired)
+        print(f"figure: {args.plots / f'control_{args.plant}.png'}")
 
 
 if __name__ == "__main__":

@@ -122,3 +122,38 @@ def plot_fit(data: dict, fitted: dict, path: Path, title: str) -> None:
         for ax in axes:
             legend(ax)
         _save(fig, path)
+
+
+def plot_control(runs: dict, path: Path, title: str, target_elongation: float | None) -> None:
+    """Thrust laws compared on one plant: main-tether tension, elongation (with the MRAC target dotted)
+    and debris angular rate against time, one line per law; written to ``path`` as PNG.
+
+    Parameters
+    ----------
+    runs : dict of str to dict
+        Law name -> a tow's series: ``time`` (k,) s, ``main_tether_tension`` (k,) N,
+        ``main_tether_elongation`` (k,) m, ``debris_omega_body`` (k, 3) rad/s (debris body frame).
+    path : Path
+        Output PNG.
+    title : str
+        Figure title (plant and spin rate).
+    target_elongation : float or None
+        The MRAC laws' target elongation (m), drawn dotted; None: not drawn.
+    """
+    with matplotlib.rc_context(STYLE):
+        fig, axes = panels(3, 1.8)
+        for law, s in runs.items():
+            t = s["time"]
+            axes[0].plot(t, s["main_tether_tension"], lw=0.8, label=plain(law))
+            axes[1].plot(t, s["main_tether_elongation"], lw=0.8, label=plain(law))
+            axes[2].plot(t, np.rad2deg(np.linalg.norm(s["debris_omega_body"], axis=1)), lw=0.8, label=plain(law))
+        if target_elongation is not None:
+            axes[1].axhline(target_elongation, color="k", ls=":", lw=1.0, label="MRAC target")
+        axes[0].set_title(plain(title))
+        axes[0].set_ylabel("T_MT (N)")
+        axes[1].set_ylabel("z (m)")
+        axes[2].set_ylabel("|omega_D| (deg/s)")
+        axes[2].set_xlabel("t (s)")
+        for ax in axes:
+            legend(ax)
+        _save(fig, path)
