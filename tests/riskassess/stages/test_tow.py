@@ -194,3 +194,21 @@ def test_mrac1_with_the_wall_model_falls_short_as_its_static_balance_says():
                                                    * case.main_tether.stiffness)
     assert abs(expected - 0.0316) < 1e-4
     assert abs(z_mean - expected) < 1e-3
+
+
+@pytest.mark.parametrize("kind", ["mrac1", "mrac2"])
+def test_mrac_drives_the_full_net_plant(kind):
+    """The laws as thrust laws of the full-net tow (7 x 7 net, 2 s from the wrapped start, thrust on at
+    once): the run completes, the command stays inside the saturation and acts (the reference model
+    starts on the measured, near-zero elongation and pulls towards z_d, so the thrust is positive)."""
+    from multibody.net_towing import run_exudyn as run_full_net
+    from riskassess.models.towing_fullnet import full_net_model
+
+    case = load_model(CASE, TowingCase)
+    case = case.model_copy(update=dict(thrust=case.thrust.model_copy(update=dict(kind=kind)),
+                                       full_net=case.full_net.model_copy(update=dict(nodes_per_side=7))))
+    series = run_full_net(full_net_model(case, end_time=27.0)).series()
+    thrust = series["thrust"]
+    assert series["time"][-1] == pytest.approx(27.0)
+    assert np.all(np.isfinite(thrust)) and np.all(np.abs(thrust) <= case.thrust.max_force)
+    assert thrust[1:].mean() > 0.0
