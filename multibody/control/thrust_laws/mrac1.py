@@ -2,7 +2,7 @@
 ``towing-mrac-tether-control``): thrust along the chaser's body z; shared parts (abstracted model,
 reference model, parameter head) in :mod:`multibody.control.mrac`.
 
-``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``K_D``), then lambda_0 (1/s),
+``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``RATE_TAU``), then lambda_0 (1/s),
 k_s (N s/m), gamma, xi_h, xi_a (2) (-); ``state`` = [z_m (m), z_m rate (m/s), last elongation (m), last
 rate estimate (m/s), h (kg), a1 (N/m), a2 (N s/m)]. The elongation rate is
 :func:`multibody.control.mrac.elongation_rate_estimate`'s.

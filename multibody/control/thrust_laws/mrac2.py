@@ -2,7 +2,7 @@
 ``towing-mrac-tether-control``): thrust along the chaser's body z; shared parts (abstracted model,
 reference model, parameter head) in :mod:`multibody.control.mrac`.
 
-``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``K_D``), then Gamma_z (2),
+``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``RATE_TAU``), then Gamma_z (2),
 gamma_r, Gamma_theta (2), xi_2 (-) and P (2x2 row-major, eq. 21a); ``state`` = [z_m (m), z_m rate
 (m/s), last elongation (m), last rate estimate (m/s), Kz1 (N/m), Kz2 (N s/m), kr (N/m), theta1 (N/m),
 theta2 (N s/m)]. The elongation rate is :func:`multibody.control.mrac.elongation_rate_estimate`'s.
