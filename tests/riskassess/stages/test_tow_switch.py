@@ -1,0 +1,98 @@
+"""Switch from the full-net to the lower-order towing model at quasi-steady state (multibody/tow_switch.py,
+riskassess/models/towing_fullnet.py::lower_order_after_switch): the switch happens when the criterion says,
+and the state is continuous across it (system momentum, main-tether elongation and rate)."""
+import numpy as np
+import pytest
+
+from multibody.net_towing import run_exudyn
+from multibody.towing import run_exudyn as run_lower_order
+from multibody.tow_switch import SwitchCriterion, net_internal_kinetic_energy, switch_time
+from riskassess.cases.impact import load_model
+from riskassess.cases.towing import TowingCase
+from riskassess.models.towing_fullnet import full_net_model, lower_order_after_switch, switch_criterion
+from riskassess.stages.tow_fullnet import joined_series
+
+CASE = "cases/zenit2_towing.toml"
+
+
+def test_criterion_needs_the_whole_window():
+    # samples every 0.5 s; the conditions hold from 26.0 s on except a slack sample at 27.0 s: the window of
+    # 2 s restarts at 27.5 s and is full at 29.5 s; before thrust-on (earliest 25.5 s) nothing counts
+    t = np.arange(25.0, 32.0, 0.5)
+    kinetic = np.where(t < 26.0, 5.0, 0.1)
+    tension = np.where(t == 27.0, 0.0, 100.0)
+    criterion = SwitchCriterion(earliest=25.5, window=2.0, kinetic_energy_max=0.2)
+    assert switch_time(t, kinetic, tension, criterion) == pytest.approx(29.5)
+    assert switch_time(t, kinetic + 1.0, tension, criterion) is None
+
+
+def test_internal_kinetic_energy_ignores_a_common_drift():
+    # two nodes of 1 and 3 kg moving apart at 4 m/s relative: CoM frame energy m1 m2 / (m1 + m2) dv^2 / 2 = 6 J
+    m = np.array([1.0, 3.0])
+    v = np.array([[7000.0, 3.0, 0.0], [7000.0, -1.0, 0.0]])
+    assert net_internal_kinetic_energy(m, v) == pytest.approx(6.0, rel=1e-9)
+
+
+@pytest.fixture(scope="module")
+def switched():
+    """The shipped case, wrapped start, a 7 x 7 net (same side, mass, threads), switch on: window 1 s,
+    net internal kinetic energy at most 0.05 J, from thrust-on (25 s); full-net run to at most 60 s."""
+    case = load_model(CASE, TowingCase)
+    fn = case.full_net.model_copy(update=dict(nodes_per_side=7, switch_to_lower_order=True, switch_window=1.0,
+                                              switch_kinetic_energy=0.05))
+    case = case.model_copy(update=dict(full_net=fn))
+    model = full_net_model(case, end_time=60.0)
+    return case, model, run_exudyn(model)
+
+
+def _first_quasi_steady(time, kinetic, tension, criterion):
+    """Brute force over the samples: the first t whose window [t - w, t] lies after ``earliest`` and holds
+    only samples with E <= E_max and T > 0 (independent of the watch's running count)."""
+    good = (kinetic <= criterion.kinetic_energy_max) & (tension > 0.0) & (time >= criterion.earliest)
+    for k, t in enumerate(time):
+        inside = (time >= t - criterion.window - 1e-9) & (time <= t)
+        if time[k] - criterion.window >= criterion.earliest - 1e-9 and good[inside].all():
+            return t
+    return None
+
+
+def test_switch_happens_when_the_criterion_says(switched):
+    case, model, result = switched
+    assert result.switch is not None, "the 7 x 7 tow never became quasi-steady by 60 s"
+    s = result.series()
+    t_switch = result.switch["time"]
+    # the run stopped at the switch: its last sample is the switch time
+    assert s["time"][-1] == pytest.approx(t_switch, abs=1e-9)
+    criterion = switch_criterion(case)
+    assert _first_quasi_steady(s["time"], s["net_internal_kinetic_energy"], s["main_tether_tension"], criterion) == \
+        pytest.approx(t_switch, abs=1e-9)
+
+
+def test_states_are_continuous_across_the_switch(switched):
+    case, model, result = switched
+    lower, balance = lower_order_after_switch(case, result, end_time=result.switch["time"] + 1.0)
+    sw = result.switch
+    # linear momentum of chaser + debris + net equals that of chaser + debris + P by construction (the debris
+    # takes the net's momentum that P does not carry); tolerance: round-off of sums of ~8e7 N s, 1e-6 N s
+    np.testing.assert_allclose(balance["momentum_lower_order_Ns"], balance["momentum_full_net_Ns"], rtol=0, atol=1e-6)
+    # that correction is small: the net's momentum relative to its central node over the debris mass
+    # (at most m_net |v_i - v_node|, bounded by the criterion's kinetic energy: sqrt(2 m_net E_max))
+    m_net = model.net.topology.masses.sum()
+    assert balance["net_relative_momentum_Ns"] <= np.sqrt(2.0 * m_net * 0.05) * (1 + 1e-9) + \
+        m_net * np.linalg.norm(sw["node_velocities"][model.net.central] - model.net.topology.masses @ sw["node_velocities"] / m_net)
+    assert balance["debris_velocity_change_m_s"] <= balance["net_relative_momentum_Ns"] / case.debris.nominal_mass * 1.01
+    # the lower-order model starts where the net was: chaser, debris attitude and rates copied, P at the
+    # central node with its velocity (main-tether elongation and rate continuous)
+    np.testing.assert_array_equal(lower.positions[0], sw["node_positions"][model.net.central])
+    np.testing.assert_array_equal(lower.velocities[0], sw["node_velocities"][model.net.central])
+    np.testing.assert_array_equal(lower.omega_body, [sw["v"][3:6], sw["v"][9:12]])
+    assert lower.start_time == sw["time"]
+    low = run_lower_order(lower).series()
+    full = result.series()
+    assert low["main_tether_elongation"][0] == pytest.approx(full["main_tether_elongation"][-1], abs=1e-9)
+    assert low["main_tether_elongation_rate"][0] == pytest.approx(full["main_tether_elongation_rate"][-1], abs=1e-6)
+    np.testing.assert_allclose(low["chaser_com_inertial"][0], full["chaser_com_inertial"][-1], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(low["debris_com_inertial"][0], full["debris_com_inertial"][-1], rtol=0, atol=1e-9)
+    joined = joined_series({k: v for k, v in full.items() if not k.startswith("net_") or k == "net_internal_kinetic_energy"},
+                           low)
+    assert np.all(np.diff(joined["time"]) > 0) and joined["lower_order"].sum() == len(low["time"]) - 1
