@@ -62,6 +62,9 @@ class FullNetModel(TowedBodies):
                                        [closing_time, closing_time + closing_duration] (capture start, Sec. 2.1).
     switch : SwitchCriterion or None   Stop the run at quasi-steady state (:mod:`multibody.tow_switch`);
                                        the result keeps the state there (``NetTowResult.switch``).
+    state_at : float or None           Keep the full state at the first sample at or after this time (s)
+                                       without stopping (``NetTowResult.state_at``): the start state of
+                                       lower-order runs compared with this one (identification, Sec. 4.1).
     """
 
     net: TowingNet
@@ -76,6 +79,7 @@ class FullNetModel(TowedBodies):
     closing_time: float = 15.0
     closing_duration: float | None = None
     switch: SwitchCriterion | None = None
+    state_at: float | None = None
 
     @property
     def net_every(self) -> int:
@@ -339,7 +343,8 @@ class NetTowResult:
     momentum and external impulse (k, 3) each, the net's internal kinetic energy (k,) (J); net snapshots
     (j, n, 3) at ``net_time``; wall time (s); ``switch``: None, or the full state where the run stopped at
     quasi-steady state (``model.switch``): ``time`` (s), ``q``, ``v`` (12,) (the Exudyn coordinates),
-    ``node_positions``, ``node_velocities`` (n, 3) (m, m/s, inertial), ``thrust_state`` (the law's)."""
+    ``node_positions``, ``node_velocities`` (n, 3) (m, m/s, inertial), ``thrust_state`` (the law's);
+    ``state_at``: the same at ``model.state_at``."""
 
     model: FullNetModel
     time: np.ndarray
@@ -354,6 +359,7 @@ class NetTowResult:
     wall_time: float
     kinetic: np.ndarray = None
     switch: dict | None = None
+    state_at: dict | None = None
 
     def series(self) -> dict:
         """The lower-order model's series names (:meth:`multibody.towing.TowResult.series`; the
@@ -393,7 +399,13 @@ class _Sampler:
         self.kinetic = np.zeros(k)
         self.sample = self.net_sample = 0
         self.watch = QuasiSteadyWatch(m.switch) if m.switch is not None else None
-        self.switch = None
+        self.switch = self.state_at = None
+
+    def full_state(self, t, q, v) -> dict:
+        """The whole state at ``t`` (s): time, body coordinates and velocities, nodes, thrust-law state."""
+        s = self.state
+        return {"time": s.model.start_time + t, "q": q.copy(), "v": v.copy(), "node_positions": s.reference + s.x,
+                "node_velocities": s.v.copy(), "thrust_state": s.thrust_state.copy()}
 
     def record(self, mbs, t):
         s = self.state
@@ -408,10 +420,10 @@ class _Sampler:
             self.momentum[k], self.impulse[k] = s.momentum(v), s.clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3]
             self.kinetic[k] = net_internal_kinetic_energy(m.net.topology.masses, s.v)
             self.sample += 1
+            if self.state_at is None and m.state_at is not None and m.start_time + t >= m.state_at - 1e-9:
+                self.state_at = self.full_state(t, q, v)
             if self.watch is not None and self.watch.update(m.start_time + t, self.kinetic[k], s.diag[D_TENSION]):
-                self.switch = {"time": m.start_time + t, "q": q.copy(), "v": v.copy(),
-                               "node_positions": s.reference + s.x, "node_velocities": s.v.copy(),
-                               "thrust_state": s.thrust_state.copy()}
+                self.switch = self.full_state(t, q, v)
                 self.count += 1
                 return False  # quasi-steady: the lower-order model takes over (multibody.tow_switch)
         if self.count % m.net_every == 0 and self.net_sample < len(self.net_time):
@@ -489,4 +501,5 @@ def run_exudyn(model: FullNetModel) -> NetTowResult:
     k = sampler.sample
     return NetTowResult(model, sampler.time[:k], sampler.q[:k], sampler.v[:k], sampler.node[:k], sampler.diag[:k],
                         sampler.momentum[:k], sampler.impulse[:k], sampler.net_time[:sampler.net_sample],
-                        sampler.net[:sampler.net_sample], wall, sampler.kinetic[:k], sampler.switch)
+                        sampler.net[:sampler.net_sample], wall, sampler.kinetic[:k], sampler.switch,
+                        sampler.state_at)

@@ -136,7 +136,7 @@ def switch_time(time, kinetic, tension, criterion: SwitchCriterion) -> float | N
     return None
 
 
-def lower_order_state(body_masses, node_masses, node_positions, node_velocities, central, chaser_velocity,
+def lower_order_state(body_masses, net_mass, net_momentum, node_position, node_velocity, chaser_velocity,
                       debris_velocity, mass_fraction):
     """P's position and velocity and the debris CoM velocity of the lower-order model at the switch
     (module doc), and the momentum balance.
@@ -145,12 +145,12 @@ def lower_order_state(body_masses, node_masses, node_positions, node_velocities,
     ----------
     body_masses : (2,) float
         m_C, m_D (kg).
-    node_masses : (n,) float
-        Net node masses (kg), m_net in all.
-    node_positions, node_velocities : (n, 3) float
-        Net nodes (m, m/s; inertial).
-    central : int
-        The node the main tether holds.
+    net_mass : float
+        m_net (kg).
+    net_momentum : (3,) float
+        sum_i m_i v_i of the net's nodes (N s, inertial).
+    node_position, node_velocity : (3,) float
+        The central node (m, m/s; inertial): P's start.
     chaser_velocity, debris_velocity : (3,) float
         CoM velocities (m/s, inertial) in the full-net model.
     mass_fraction : float
@@ -168,17 +168,14 @@ def lower_order_state(body_masses, node_masses, node_positions, node_velocities,
         relative to the central node, which P does not carry.
     """
     m_c, m_d = (float(x) for x in body_masses)
-    m = np.asarray(node_masses, float)
-    v = np.asarray(node_velocities, float)
-    m_net = m.sum()
-    p_net = m @ v
-    p_position = np.array(node_positions[central], float)
-    p_velocity = np.array(v[central], float)
-    m_p, m_debris = mass_fraction * m_net, m_d + (1.0 - mass_fraction) * m_net
-    debris_v = (m_d * np.asarray(debris_velocity, float) + p_net - m_p * p_velocity) / m_debris
-    before = m_c * np.asarray(chaser_velocity, float) + m_d * np.asarray(debris_velocity, float) + p_net
-    after = m_c * np.asarray(chaser_velocity, float) + m_debris * debris_v + m_p * p_velocity
+    p_net = np.asarray(net_momentum, float)
+    p_position, p_velocity = np.array(node_position, float), np.array(node_velocity, float)
+    v_c, v_d = np.asarray(chaser_velocity, float), np.asarray(debris_velocity, float)
+    m_p, m_debris = mass_fraction * net_mass, m_d + (1.0 - mass_fraction) * net_mass
+    debris_v = (m_d * v_d + p_net - m_p * p_velocity) / m_debris
+    before = m_c * v_c + m_d * v_d + p_net
+    after = m_c * v_c + m_debris * debris_v + m_p * p_velocity
     return p_position, p_velocity, debris_v, {
         "momentum_full_net_Ns": before.tolist(), "momentum_lower_order_Ns": after.tolist(),
-        "debris_velocity_change_m_s": float(np.linalg.norm(debris_v - np.asarray(debris_velocity, float))),
-        "net_relative_momentum_Ns": float(np.linalg.norm(p_net - m_net * p_velocity))}
+        "debris_velocity_change_m_s": float(np.linalg.norm(debris_v - v_d)),
+        "net_relative_momentum_Ns": float(np.linalg.norm(p_net - net_mass * p_velocity))}

@@ -263,11 +263,88 @@ def switch_criterion(case: TowingCase):
     return SwitchCriterion(earliest=float(earliest), window=fn.switch_window, kinetic_energy_max=fn.switch_kinetic_energy)
 
 
-def lower_order_after_switch(case: TowingCase, full, spin_rate_deg_s: float | None = None, s=None,
-                             end_time: float | None = None):
-    """The lower-order model that continues a full-net run stopped at quasi-steady state, from the net's
-    state there (:func:`multibody.tow_switch.lower_order_state`: chaser and debris copied, P at the central
-    node, debris velocity keeping the system's momentum), with the case's sub-tethers or ``s``.
+def net_start_state(full_model, state: dict) -> dict:
+    """What a lower-order run needs of a full-net state (``NetTowResult.switch`` or ``.state_at``), in
+    arrays (cacheable): time (s), chaser and debris CoM (m) and velocity (m/s), attitudes (body ->
+    inertial), angular velocities (2, 3) (rad/s, body frames), the central node's position (m) and velocity
+    (m/s), the net's mass (kg) and momentum (N s), the thrust law's state. Inertial frame.
+
+    Parameters
+    ----------
+    full_model : multibody.net_towing.FullNetModel
+        The full-net run's model.
+    state : dict
+        ``time``, ``q``, ``v`` (12,), ``node_positions``, ``node_velocities`` (n, 3), ``thrust_state``.
+
+    Returns
+    -------
+    dict
+    """
+    q, v, central = state["q"], state["v"], full_model.net.central
+    masses = full_model.net.topology.masses
+    return {"start_time": float(state["time"]), "body_masses": np.asarray(full_model.masses, float),
+            "chaser_com": full_model.positions[0] + q[0:3], "debris_com": full_model.positions[1] + q[6:9],
+            "chaser_velocity": v[0:3].copy(), "debris_velocity": v[6:9].copy(),
+            "body_to_inertial": np.array([rotation_matrix_from_rotation_vector(q[b:b + 3]) for b in (3, 9)]),
+            "omega_body": np.array([v[3:6], v[9:12]]),
+            "node_position": np.array(state["node_positions"][central], float),
+            "node_velocity": np.array(state["node_velocities"][central], float),
+            "net_mass": float(masses.sum()), "net_momentum": masses @ state["node_velocities"],
+            "thrust_state": np.array(state["thrust_state"], float)}
+
+
+def lower_order_from_net(case: TowingCase, start: dict, spin_rate_deg_s: float | None = None, s=None,
+                         end_time: float | None = None, step: float | None = None):
+    """The lower-order model started from a full-net state (:func:`net_start_state`;
+    :func:`multibody.tow_switch.lower_order_state`: chaser and debris copied, P at the central node with its
+    velocity, the debris velocity keeping the system's momentum), with the case's sub-tethers or ``s``.
+
+    Parameters
+    ----------
+    case : TowingCase
+        The towing case.
+    start : dict
+        :func:`net_start_state`.
+    spin_rate_deg_s : float or None
+        Only used to build the model before its state is replaced (deg/s).
+    s : (4,) float or None
+        Sub-tether decision vector (eq. 22); default the case's.
+    end_time : float or None
+        End of the lower-order run (s); default the case's.
+    step : float or None
+        Its step (s); default the case's.
+
+    Returns
+    -------
+    model : multibody.towing.TowingModel
+        Starting at ``start["start_time"]``.
+    balance : dict
+        The momentum balance of :func:`multibody.tow_switch.lower_order_state` plus the start time (s),
+        the main-tether elongation (m) and the sub-tether elongations (m) at the start.
+    """
+    s = case_decision_vector(case) if s is None else np.asarray(s, float)
+    model = towing_model(case, spin_rate_deg_s, s, end_time=end_time, step=step)
+    p_pos, p_vel, debris_v, balance = lower_order_state(
+        start["body_masses"], start["net_mass"], start["net_momentum"], start["node_position"], start["node_velocity"],
+        start["chaser_velocity"], start["debris_velocity"], s[3])
+    rot = np.asarray(start["body_to_inertial"], float)
+    model.positions = np.array([p_pos, start["chaser_com"], start["debris_com"]], float)
+    model.velocities = np.array([p_vel, start["chaser_velocity"], debris_v], float)
+    model.body_to_inertial = rot
+    model.omega_body = np.array(start["omega_body"], float)
+    model.start_time = float(start["start_time"])
+    model.thrust_state = np.array(start["thrust_state"], float)
+    a_point = model.positions[1] + rot[0] @ model.attach_chaser_body
+    points = model.positions[2] + model.attach_debris_body @ rot[1].T
+    balance = {**balance, "time_s": model.start_time,
+               "main_tether_elongation_m": float(np.linalg.norm(p_pos - a_point) - model.tether[2]),
+               "sub_tether_elongations_m": (np.linalg.norm(points - p_pos, axis=1) - model.tether[5]).tolist()}
+    return model, balance
+
+
+def lower_order_after_switch(case: TowingCase, full, s=None, end_time: float | None = None):
+    """The lower-order model that continues a full-net run stopped at quasi-steady state
+    (:func:`lower_order_from_net` of ``full.switch``).
 
     Parameters
     ----------
@@ -275,8 +352,6 @@ def lower_order_after_switch(case: TowingCase, full, spin_rate_deg_s: float | No
         The towing case.
     full : multibody.net_towing.NetTowResult
         The full-net run, stopped by its switch criterion (``full.switch`` set).
-    spin_rate_deg_s : float or None
-        Only used to build the model before its state is replaced (deg/s).
     s : (4,) float or None
         Sub-tether decision vector (eq. 22); default the case's.
     end_time : float or None
@@ -285,31 +360,9 @@ def lower_order_after_switch(case: TowingCase, full, spin_rate_deg_s: float | No
     Returns
     -------
     model : multibody.towing.TowingModel
-        Starting at the switch time.
     balance : dict
-        The momentum balance of :func:`multibody.tow_switch.lower_order_state` plus the switch time (s),
-        the main-tether elongation (m) and the sub-tether elongations (m) at the start.
+        :func:`lower_order_from_net`'s.
     """
-    sw, fm = full.switch, full.model
-    if sw is None:
+    if full.switch is None:
         raise ValueError("the full-net run did not reach quasi-steady state: nothing to switch from")
-    s = case_decision_vector(case) if s is None else np.asarray(s, float)
-    model = towing_model(case, spin_rate_deg_s, s, end_time=end_time)
-    q, v = sw["q"], sw["v"]
-    com = fm.positions + np.array([q[0:3], q[6:9]])
-    rot = np.array([rotation_matrix_from_rotation_vector(q[b:b + 3]) for b in (3, 9)])
-    p_pos, p_vel, debris_v, balance = lower_order_state(
-        fm.masses, fm.net.topology.masses, sw["node_positions"], sw["node_velocities"], fm.net.central, v[0:3],
-        v[6:9], s[3])
-    model.positions = np.array([p_pos, com[0], com[1]])
-    model.velocities = np.array([p_vel, v[0:3], debris_v])
-    model.body_to_inertial = rot
-    model.omega_body = np.array([v[3:6], v[9:12]])
-    model.start_time = float(sw["time"])
-    model.thrust_state = np.array(sw["thrust_state"], float)
-    a_point = com[0] + rot[0] @ model.attach_chaser_body
-    points = com[1] + model.attach_debris_body @ rot[1].T
-    balance = {**balance, "time_s": float(sw["time"]),
-               "main_tether_elongation_m": float(np.linalg.norm(p_pos - a_point) - model.tether[2]),
-               "sub_tether_elongations_m": (np.linalg.norm(points - p_pos, axis=1) - model.tether[5]).tolist()}
-    return model, balance
+    return lower_order_from_net(case, net_start_state(full.model, full.switch), s=s, end_time=end_time)
