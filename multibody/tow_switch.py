@@ -3,12 +3,14 @@
 model once the towing has settled).
 
 **Criterion** (:class:`QuasiSteadyWatch`, :func:`switch_time`): the run switches at the first output
-sample t at which, over the whole window [t - window, t] and from ``earliest`` on,
+sample t at which, over the whole window [t - window, t], all after ``earliest``,
 
+* the main tether stayed taut (tension > 0 at every sample) and its tension varied peak-to-peak by at
+  most ``tension_rel_tol`` of its window mean (:func:`multibody.quasi_steady.window_is_steady`, the
+  project's quasi-steady rule): the tow is engaged and no longer snaps, so the chaser pulls the debris
+  through the tether as the lower-order model's tether chain does;
 * the net's internal kinetic energy (about its own CoM, :func:`net_internal_kinetic_energy`) stayed
-  at or below ``kinetic_energy_max`` (J): the net no longer flaps, it moves as one bag with the tow;
-* the main tether stayed taut (tension > 0 at every sample): the tow is engaged, so the chaser pulls
-  the debris through the tether as the lower-order model's tether chain does.
+  at or below ``kinetic_energy_max`` (J): the net no longer flaps, it moves as one bag with the tow.
 
 **Start state of the lower-order model** (:func:`lower_order_state`): chaser and debris attitude and
 angular velocities, chaser CoM position and velocity and debris CoM position are copied; the connection
@@ -25,6 +27,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from multibody.quasi_steady import window_is_steady
 
 
 def net_internal_kinetic_energy(masses, velocities) -> float:
@@ -55,27 +59,15 @@ class SwitchCriterion:
     Attributes
     ----------
     earliest : float             No switch before this time (s, absolute; default thrust-on).
-    window : float               Time over which both conditions must hold (s).
+    window : float               Time over which the conditions must hold (s).
     kinetic_energy_max : float   Largest net internal kinetic energy (J).
+    tension_rel_tol : float      Largest peak-to-peak main-tether tension over its window mean (-).
     """
 
     earliest: float
     window: float
     kinetic_energy_max: float
-
-    def holds_at(self, t: float, kinetic: float, tension: float) -> bool:
-        """Whether one output sample satisfies both conditions.
-
-        Parameters
-        ----------
-        t : float
-            Sample time (s).
-        kinetic : float
-            Net internal kinetic energy (J).
-        tension : float
-            Main-tether tension (N).
-        """
-        return t >= self.earliest and kinetic <= self.kinetic_energy_max and tension > 0.0
+    tension_rel_tol: float
 
 
 class QuasiSteadyWatch:
@@ -83,10 +75,10 @@ class QuasiSteadyWatch:
 
     def __init__(self, criterion: SwitchCriterion):
         self.criterion = criterion
-        self.since = None
+        self.time, self.kinetic, self.tension = [], [], []
 
     def update(self, t: float, kinetic: float, tension: float) -> bool:
-        """Add the sample at ``t``; True when every sample in [t - window, t] satisfied the conditions.
+        """Add the sample at ``t``; True when the samples in [t - window, t] satisfy the criterion.
 
         Parameters
         ----------
@@ -101,13 +93,18 @@ class QuasiSteadyWatch:
         -------
         bool
         """
-        if not self.criterion.holds_at(t, kinetic, tension):
-            self.since = None
-            return False
-        if self.since is None:
-            self.since = t
-        # a hair of slack: sample times are sums of steps, t - since is window up to round-off
-        return t - self.since >= self.criterion.window - 1e-9
+        c = self.criterion
+        self.time.append(t)
+        self.kinetic.append(kinetic)
+        self.tension.append(tension)
+        # a hair of slack: sample times are sums of steps, so t - window is a sample time up to round-off
+        first = t - c.window - 1e-9
+        if first < c.earliest - 1e-9 or self.time[0] > first + 2e-9:
+            return False   # the window reaches before the earliest switch or before the first sample
+        k = int(np.searchsorted(self.time, first))
+        tension_window = np.asarray(self.tension[k:])
+        return bool(max(self.kinetic[k:]) <= c.kinetic_energy_max and tension_window.min() > 0.0
+                    and window_is_steady(tension_window, c.tension_rel_tol, 0.0))
 
 
 def switch_time(time, kinetic, tension, criterion: SwitchCriterion) -> float | None:

@@ -226,6 +226,9 @@ class FullNet(Strict):
         5.0, description="Quasi-steady criterion: both conditions must hold over this time (s).")
     switch_kinetic_energy: Positive = Field(
         0.5, description="Quasi-steady criterion: largest kinetic energy of the net relative to its CoM (J).")
+    switch_tension_variation: Positive = Field(
+        0.2, description="Quasi-steady criterion: largest peak-to-peak main-tether tension over its window mean (-); "
+                         "the tether must also stay taut over the window.")
     switch_earliest: NonNegative | None = Field(
         None, description="No switch before this time (s); default thrust.t_on.")
     launch_speed: Positive = Field(2.0, description="Capture start: speed of every net node relative to the chaser at "

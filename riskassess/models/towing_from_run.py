@@ -244,9 +244,9 @@ def lvlh_to_towing(case: TowingCase, n: float, positions_lvlh, velocities_lvlh):
     return r_c + x @ rot.T, v_c + v @ rot.T
 
 
-def impact_run_start(case: TowingCase, case_path) -> RunStart:
-    """Read and check the impact run of ``full_net.from_run`` and express its end state in the towing
-    frame (module doc).
+def impact_run_start(case: TowingCase, case_path, snapshot: int = -1) -> RunStart:
+    """Read and check the impact run of ``full_net.from_run`` and express its end state (or another net
+    snapshot) in the towing frame (module doc).
 
     Parameters
     ----------
@@ -254,6 +254,8 @@ def impact_run_start(case: TowingCase, case_path) -> RunStart:
         A towing case with ``full_net.start = "run"``.
     case_path : str or Path
         The towing case file (the folder is relative to it; named in errors).
+    snapshot : int
+        Index of the net snapshot (default the last: the run's end state).
 
     Returns
     -------
@@ -263,14 +265,15 @@ def impact_run_start(case: TowingCase, case_path) -> RunStart:
     impact, net, series = _read_run(case_path, folder)
     n = _check_case(case_path, case, impact)
     towing = run_net(case_path, case, net)
-    t = float(net["time"][-1])
+    t = float(net["time"][snapshot])
     if t >= case.full_net.closing_time:
-        _refuse(case_path, f"the impact run's last net snapshot is at {t:g} s, not before full_net.closing_time "
+        _refuse(case_path, f"the impact run's net snapshot is at {t:g} s, not before full_net.closing_time "
                            f"({case.full_net.closing_time:g} s): the closing would start inside the run")
     k = int(np.argmin(np.abs(series["time"] - t)))
     if abs(series["time"][k] - t) > 1e-6:
         _refuse(case_path, f"'{folder}': timeseries.npz has no sample at the last net snapshot ({t:g} s)")
-    nodes, velocities = lvlh_to_towing(case, n, net["positions_lvlh"][-1], net["velocities_lvlh"][-1])
+    nodes, velocities = lvlh_to_towing(case, n, net["positions_lvlh"][snapshot],
+                                       np.asarray(net["velocities_lvlh"][snapshot], float))
     com, com_v = lvlh_to_towing(case, n, series["body_com_lvlh"][k, 0], series["body_velocity_lvlh"][k, 0])
     to_lvlh = np.asarray(series["body_to_lvlh"][k, 0], float)
     rot = lvlh_frame(case)[2]

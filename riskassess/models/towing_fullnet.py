@@ -254,13 +254,15 @@ def switch_criterion(case: TowingCase):
     Returns
     -------
     multibody.tow_switch.SwitchCriterion or None
-        Earliest switch (s; default ``thrust.t_on``), window (s), net internal kinetic energy bound (J).
+        Earliest switch (s; default ``thrust.t_on``), window (s), net internal kinetic energy bound (J),
+        main-tether tension variation bound (-).
     """
     fn = case.full_net
     if not fn.switch_to_lower_order:
         return None
     earliest = case.thrust.t_on if fn.switch_earliest is None else fn.switch_earliest
-    return SwitchCriterion(earliest=float(earliest), window=fn.switch_window, kinetic_energy_max=fn.switch_kinetic_energy)
+    return SwitchCriterion(earliest=float(earliest), window=fn.switch_window, kinetic_energy_max=fn.switch_kinetic_energy,
+                           tension_rel_tol=fn.switch_tension_variation)
 
 
 def net_start_state(full_model, state: dict) -> dict:
