@@ -1,14 +1,18 @@
 """`riskassess identify CASE` (without --benchmark): sub-tether identification against full-net runs
 (Boonrath, Singh & Botta 2024, Sec. 4.1, 4.4).
 
-1. Full-net runs (:mod:`riskassess.stages.tow_fullnet`, wrapped start) at the training and validation spin
-   rates of Table 3 (``full_net.identification_training_runs`` / ``_validation_runs`` take the first k),
-   in parallel worker processes, each cached in ``OUT/fullnet/rate_<deg_s>.npz`` (a re-run reuses them).
+1. Full-net runs (:mod:`riskassess.stages.tow_fullnet`, wrapped or capture start) at the training and
+   validation spin rates of Table 3 (``full_net.identification_training_runs`` / ``_validation_runs`` take
+   the first k), in parallel worker processes, each cached in ``OUT/fullnet/rate_<deg_s>_end_<s>[_capture].npz``
+   (a re-run reuses them); the compared series from ``simulation.start_time`` on.
 2. The lower-order runs start from the full-net state at the start time, as the paper does (Sec. 4.1):
    debris and chaser states, P at the net node the main tether holds. With the wrapped start the debris
    has the case's Table 2 state, so this is the case with the chaser moved where the full-net run
    starts it and ``sub_tethers.connection_point_start_inertial`` at the central node
-   (:func:`lower_order_case`); P's velocity is the debris' rigid motion there, as the node's.
+   (:func:`lower_order_case`); P's velocity is the debris' rigid motion there, as the node's. With the
+   capture start every run has its own state at the start time (the net's capture moved chaser and
+   debris): it is kept with the run (:func:`start_state`) and each lower-order run starts from it
+   (:func:`riskassess.models.towing_fullnet.lower_order_from_net`, the switch's start state).
 3. s is identified on the training runs by each optimizer of ``identification.searches`` (PSO, then the
    pattern-search polish, and/or the pattern search; :func:`riskassess.stages.identify.run_optimizers`) on the
    case's cost, f1 or f2 (eqs. 18, 20), and each identified model is compared with the training runs and

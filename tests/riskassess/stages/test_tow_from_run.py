@@ -1,6 +1,6 @@
 """Full-net tow from the end state of an impact run (riskassess/models/towing_from_run.py): the checks of
 the run folder, the LVLH -> inertial transformation, and a short tow from it. The impact run is a reduced
-copy of cases/zenit2_capture.toml (7 x 7 net, 1.5 s), made once per module (~10-30 s)."""
+copy of cases/zenit2_capture.toml (7 x 7 net launched 3 m from the debris CoM, 0.8 s), made once per module."""
 import json
 import shutil
 
@@ -20,10 +20,11 @@ CAPTURE, TOWING = "cases/zenit2_capture.toml", "cases/zenit2_towing_from_capture
 
 @pytest.fixture(scope="module")
 def impact_run(tmp_path_factory):
-    """The capture case with a 7 x 7 net (node mass keeping m_net = 2.7326 kg), simulated to 1.5 s."""
+    """The capture case with a 7 x 7 net (node mass keeping m_net = 2.7326 kg) launched 3 m before the debris
+    CoM, simulated to 0.8 s (the net reaches the cylinder at ~0.5 s)."""
     tmp = tmp_path_factory.mktemp("capture")
     text = open(CAPTURE).read()
-    for old, new in (('end_time = 8.0 ', 'end_time = 1.5 '), ('nodes_per_side = 15', 'nodes_per_side = 7'),
+    for old, new in (('end_time = 8.0 ', 'end_time = 0.8 '), ('distance = 5.0 ', 'distance = 3.0 '), ('nodes_per_side = 15', 'nodes_per_side = 7'),
                      ('node_mass = 0.0094782 ', 'node_mass = 0.04352245 '), ('net_output_rate = 10.0', 'net_output_rate = 20.0')):
         assert old in text
         text = text.replace(old, new)
@@ -72,13 +73,13 @@ def test_run_folder_is_checked(impact_run, tmp_path):
 
 
 def test_tow_continues_from_the_run(impact_run):
-    # 0.5 s of full-net tow from the run's end (1.5 s): the start is the run's state, and the momentum of chaser,
+    # 0.5 s of full-net tow from the run's end (0.8 s): the start is the run's state, and the momentum of chaser,
     # debris and net changes only by the external impulse (gravity; no thrust before 25 s, tether slack before
     # 15 s) up to Verlet's owed half kick H/2 |F| (2 ms x 85 kN / 2 = 85 N s, docs/towing.md)
     case = _towing(impact_run)
     start = impact_run_start(case, TOWING)
     model = full_net_model(case, end_time=start.time + 0.5, run_start=start)
-    assert model.start_time == start.time == pytest.approx(1.5)
+    assert model.start_time == start.time == pytest.approx(0.8)
     np.testing.assert_array_equal(model.positions[1], start.debris_position)
     np.testing.assert_array_equal(model.positions[0], case.chaser.position_inertial)
     s = run_exudyn(model).series()
