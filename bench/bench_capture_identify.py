@@ -47,12 +47,16 @@ def main():
     print("| start | s | s1 | s2 (m) | s3 | s4 | training f1 | training f2 (N) | validation f1 | validation f2 (N) "
           "| validation mean RMSE r_D/C (m), omega_C, omega_D (rad/s), T_MT (N) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
+    printed = set()
     for arg in sys.argv[1:]:
         case_path, out = arg.split(":", 1)
         case, answer, rows = rows_for(case_path, out)
         start = f"{case.full_net.start}, {len(answer['training_rates_deg_s'])}+{len(answer['validation_rates_deg_s'])} runs, " \
                 f"to {answer['end_time_s']:g} s"
         for label, s, tr, va in rows:
+            if (start, label) in printed:
+                continue   # the references once per data set
+            printed.add((start, label))
             rmse = ", ".join(f"{va['mean_rmse_' + c]:.3g}" for c in ("relative_position", "chaser_omega_body",
                                                                       "debris_omega_body", "main_tether_tension"))
             print(f"| {start} | {label} | {s[0]:.4f} | {s[1]:.4f} | {s[2]:.4f} | {s[3]:.4f} | {tr['f1']:.3f} | "

@@ -133,3 +133,23 @@ def test_states_are_continuous_across_the_switch(switched):
     joined = joined_series({k: v for k, v in full.items() if not k.startswith("net_") or k == "net_internal_kinetic_energy"},
                            low)
     assert np.all(np.diff(joined["time"]) > 0) and joined["lower_order"].sum() == len(low["time"]) - 1
+
+
+def test_tow_stage_writes_the_joined_run(tmp_path):
+    # `riskassess tow` on the small tow with the switch: towing.npz holds the full-net samples, then the
+    # lower-order ones (lower_order says which); towing.json the switch record
+    import json
+
+    from riskassess.stages.tow import tow_case
+
+    case = small_tow(switch_to_lower_order=True, switch_window=0.5, switch_kinetic_energy=0.01,
+                     switch_tension_variation=0.5)
+    case = case.model_copy(update=dict(simulation=case.simulation.model_copy(update=dict(model="full-net", end_time=30.0))))
+    summary = tow_case(CASE, tmp_path / "tow", case=case)
+    record = json.loads((tmp_path / "tow" / "towing.json").read_text())["switch"]
+    assert record is not None and record["time_s"] == summary["switch"]["time_s"]
+    data = np.load(tmp_path / "tow" / "towing.npz")
+    switched_at = data["time"][np.argmax(data["lower_order"])]
+    assert data["time"][-1] == pytest.approx(30.0) and switched_at == pytest.approx(record["time_s"] + 0.1)
+    assert np.all(np.isnan(data["sub_tether_tension"][~data["lower_order"]]))
+    assert np.all(np.isfinite(data["main_tether_tension"]))
