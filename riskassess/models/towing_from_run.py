@@ -18,6 +18,20 @@ and ``debris.principal_inertia`` within 0.1 %, shaped as one cylinder of ``debri
 ``debris.length`` (1 mm) along the body z axis, centred where :func:`debris_geometry` puts it (1 mm); the
 snapshot's time is before ``full_net.closing_time`` and a time-series sample exists at it.
 
+**Contact surface.** The impact model's cylinder is a faceted mesh (32 facets: their middles lie
+r (1 - cos(pi/32)) = 9.4 mm inside the round cylinder of the towing model), so nodes resting on it are
+inside the towing model's analytic cylinder; left there, the Hertz contact (1.6e8 N/m^1.5) would push a
+9.5 g node out with ~100 kN and blow the net off the stage. Every node closer to the analytic surface than
+its contact radius is moved out along the surface normal until it just touches (:func:`lift_onto_cylinder`;
+velocities kept); ``RunStart.lift`` is the largest move (m).
+
+**Closing loop.** The impact model has none, so its lacing points end up wherever the capture left them,
+up to a few per cent farther apart than the flat net's straight lacing distances (1.7 % in
+cases/zenit2_capture.toml at 12 s); a loop appended at those open lengths would start stretched and jerk the
+0.15 kg corner masses with ~1 kN (it threw the net off the stage). Each closing thread's open natural length
+is therefore the larger of the flat distance and the distance at the start (:func:`slack_closing_loop`): the
+loop starts slack or just taut and is reeled in to ``closed_fraction`` of the flat lengths as usual.
+
 **Frames.** The impact run is in the chaser-centred LVLH frame (x radial, y along-track, z orbit
 normal), which rotates at the mean motion n of its circular orbit about z; the tow is in the
 Earth-centred inertial frame. The LVLH origin is put at the towing case's chaser (Table 2) and its axes
@@ -40,6 +54,7 @@ from pathlib import Path
 import numpy as np
 
 from multibody.net import NetTopology
+from multibody.net_towing_kernel import cylinder_distance
 from multibody.net_wrap import TowingNet, towing_net
 from multibody.orbit import R_EARTH, lvlh_to_eci, mean_motion
 from riskassess.cases.impact import CaseError
@@ -63,6 +78,7 @@ class RunStart:
     debris_position, debris_velocity : (3,) float   Debris CoM (m, m/s; inertial).
     debris_to_inertial : (3, 3) float
     debris_omega_body : (3,) float    Inertial angular velocity, debris body frame (rad/s).
+    lift : float                      Largest move of a node onto the analytic cylinder (m; module doc).
     """
 
     folder: Path
@@ -74,6 +90,7 @@ class RunStart:
     debris_velocity: np.ndarray
     debris_to_inertial: np.ndarray
     debris_omega_body: np.ndarray
+    lift: float = 0.0
 
 
 def run_folder(case: TowingCase, case_path) -> Path:
@@ -244,6 +261,56 @@ def lvlh_to_towing(case: TowingCase, n: float, positions_lvlh, velocities_lvlh):
     return r_c + x @ rot.T, v_c + v @ rot.T
 
 
+def lift_onto_cylinder(nodes_body, radii, geometry):
+    """Nodes moved out along the cylinder's normal where they are closer to its surface than their contact
+    radius (module doc, "Contact surface").
+
+    Parameters
+    ----------
+    nodes_body : (n, 3) float
+        Node positions relative to the debris CoM, debris body frame (m).
+    radii : (n,) float
+        Contact radii (m).
+    geometry : (3,) float
+        Cylinder radius, half length, axial centre z_body (m) (:func:`debris_geometry`).
+
+    Returns
+    -------
+    lifted : (n, 3) float
+        (m, debris body frame).
+    lift : float
+        Largest move (m).
+    """
+    lifted = np.array(nodes_body, float)
+    lift = 0.0
+    for i, (x, r) in enumerate(zip(lifted, radii)):
+        d, nx, ny, nz = cylinder_distance(x[0], x[1], x[2], geometry)
+        if d < r:
+            lifted[i] += (r - d) * np.array([nx, ny, nz])
+            lift = max(lift, r - d)
+    return lifted, float(lift)
+
+
+def slack_closing_loop(net: TowingNet, nodes) -> None:
+    """Open natural lengths of the closing loop: the larger of the flat net's straight lacing distances and
+    the distances at ``nodes`` (module doc, "Closing loop"); stiffness EA/l0 with them. In place.
+
+    Parameters
+    ----------
+    net : multibody.net_wrap.TowingNet
+        The net (its closing threads are the topology's last ones).
+    nodes : (n, 3) float
+        Node positions at the start (m, any frame).
+    """
+    top = net.topology
+    k = len(net.closing_rest_open)
+    pairs = top.threads[-k:]
+    reach = np.linalg.norm(nodes[pairs[:, 1]] - nodes[pairs[:, 0]], axis=1)
+    net.closing_rest_open[:] = np.maximum(net.closing_rest_open, reach)
+    top.rest_lengths[-k:] = net.closing_rest_open
+    top.stiffness[-k:] = net.closing_stiffness(net.closing_rest_open)
+
+
 def impact_run_start(case: TowingCase, case_path, snapshot: int = -1) -> RunStart:
     """Read and check the impact run of ``full_net.from_run`` and express its end state (or another net
     snapshot) in the towing frame (module doc).
@@ -278,5 +345,9 @@ def impact_run_start(case: TowingCase, case_path, snapshot: int = -1) -> RunStar
     to_lvlh = np.asarray(series["body_to_lvlh"][k, 0], float)
     rot = lvlh_frame(case)[2]
     omega = np.asarray(series["body_omega_body"][k, 0], float) + to_lvlh.T @ np.array([0.0, 0.0, n])
-    return RunStart(folder, t, towing, nodes, velocities, com, com_v, rot @ to_lvlh, omega)
+    debris_to_inertial = rot @ to_lvlh
+    slack_closing_loop(towing, nodes)
+    lifted, lift = lift_onto_cylinder((nodes - com) @ debris_to_inertial, towing.topology.radii, debris_geometry(case))
+    return RunStart(folder, t, towing, com + lifted @ debris_to_inertial.T, velocities, com, com_v, debris_to_inertial,
+                    omega, lift)
 

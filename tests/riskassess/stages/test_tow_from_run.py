@@ -24,7 +24,7 @@ def impact_run(tmp_path_factory):
     CoM, simulated to 0.8 s (the net reaches the cylinder at ~0.5 s)."""
     tmp = tmp_path_factory.mktemp("capture")
     text = open(CAPTURE).read()
-    for old, new in (('end_time = 8.0 ', 'end_time = 0.8 '), ('distance = 5.0 ', 'distance = 3.0 '), ('nodes_per_side = 15', 'nodes_per_side = 7'),
+    for old, new in (('end_time = 12.0 ', 'end_time = 0.8 '), ('distance = 17.7 ', 'distance = 3.0 '), ('nodes_per_side = 15', 'nodes_per_side = 7'),
                      ('node_mass = 0.0094782 ', 'node_mass = 0.04352245 '), ('net_output_rate = 10.0', 'net_output_rate = 20.0')):
         assert old in text
         text = text.replace(old, new)
