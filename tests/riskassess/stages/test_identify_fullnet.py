@@ -114,8 +114,9 @@ def _stand_in_capture_runs(case, out):
 
 
 def test_capture_start_runs_each_start_from_their_own_state(tmp_path):
-    """f2 by PSO + polish against capture-start stand-in runs (the budgets of the f2 test above)."""
-    case = _small_case("f2", swarm_size=10, pso_generations=6, polish_evaluations=150, pattern_tolerance=1e-4)
+    """f2 by PSO + polish against capture-start stand-in runs. With the budgets of the f2 test above (150
+    polish evaluations, tolerance 1e-4) seed 0 left c_ST 2.0 % off; 400 evaluations to 1e-5."""
+    case = _small_case("f2", swarm_size=10, pso_generations=6, polish_evaluations=400, pattern_tolerance=1e-5)
     case = case.model_copy(update=dict(full_net=case.full_net.model_copy(update=dict(start="capture"))))
     starts = _stand_in_capture_runs(case, tmp_path)
     data = full_net_runs(case, case.rates.validation_deg_s, tmp_path, END, 1)

@@ -12,7 +12,8 @@ from multibody.rotations import quaternion_to_matrix
 from riskassess.cases.impact import CaseError, load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing_from_run import impact_run_start
-from riskassess.models.towing_fullnet import full_net_model
+from multibody.net_towing_kernel import cylinder_distance
+from riskassess.models.towing_fullnet import debris_geometry, full_net_model
 from riskassess.stages.run import run_case
 
 CAPTURE, TOWING = "cases/zenit2_capture.toml", "cases/zenit2_towing_from_capture.toml"
@@ -78,6 +79,17 @@ def test_tow_continues_from_the_run(impact_run):
     # 15 s) up to Verlet's owed half kick H/2 |F| (2 ms x 85 kN / 2 = 85 N s, docs/towing.md)
     case = _towing(impact_run)
     start = impact_run_start(case, TOWING)
+    # the hand-over corrections (towing_from_run module doc): no node inside the round cylinder by more than
+    # round-off, the lift at most the facets' sag (1.95 (1 - cos(pi/32)) = 9.4 mm) plus a contact radius
+    # (20 mm); the closing loop at most just taut
+    geometry = debris_geometry(case)
+    body = (start.node_positions - start.debris_position) @ start.debris_to_inertial
+    gap = np.array([cylinder_distance(*x, geometry)[0] for x in body]) - start.net.topology.radii
+    assert gap.min() > -1e-9 and 0.0 <= start.lift <= 0.0094 + 0.02
+    top, k = start.net.topology, len(start.net.closing_rest_open)
+    pairs = top.threads[-k:]
+    reach = np.linalg.norm(start.node_positions[pairs[:, 1]] - start.node_positions[pairs[:, 0]], axis=1)
+    assert np.all(reach <= top.rest_lengths[-k:] * (1 + 1e-12))
     model = full_net_model(case, end_time=start.time + 0.5, run_start=start)
     assert model.start_time == start.time == pytest.approx(0.8)
     np.testing.assert_array_equal(model.positions[1], start.debris_position)
