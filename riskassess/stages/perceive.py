@@ -822,9 +822,12 @@ def _timing(tracker: DebrisTracker, frames: Frames) -> dict:
     """Registration time per frame of the tracked observation frames (the first frame's global
     search apart), and of the collision frames (re-acquisitions after contact included)."""
     seconds = np.array([a.seconds for a in tracker.alignments])
+    cpu = np.array([a.cpu_seconds for a in tracker.alignments])
     phase = np.array(frames.phase)
     tracked = (phase == 0) & (np.arange(len(phase)) > 0)
     return {"registration_ms_per_frame": float(1e3 * seconds[tracked].mean()),
+            "registration_cpu_ms_per_frame": float(1e3 * cpu[tracked].mean()),
+            "registration_cpu_ms_median": float(1e3 * np.median(cpu[tracked])),
             "registration_ms_p95": float(1e3 * np.percentile(seconds[tracked], 95)),
             "first_frame_search_s": float(seconds[0]),
             "collision_registration_ms_per_frame": float(1e3 * seconds[phase == 1].mean()) if (phase == 1).any() else None,
