@@ -139,7 +139,7 @@ def unseen_share(predicted_world, scan_world, gate_m) -> float:
 class ModelCheck:
     """The verdict on the model from a track's residuals (shares 0-1, gate in m)."""
 
-    frames: int                 # observation frames
+    frames: int                 # observation frames with returns to register
     registered: int             # frames the model registered
     checked: int                # frames whose residuals were taken
     unexplained_median: float
@@ -183,7 +183,7 @@ def model_check(frames: int, registered: int, unexplained, unseen, gate_m) -> Mo
     Parameters
     ----------
     frames : int
-        Observation frames.
+        Observation frames with returns to register.
     registered : int
         Frames the model registered.
     unexplained, unseen : sequence of float

@@ -48,7 +48,7 @@ from perception.momentum_balance import momentum_step
 from perception.model_mismatch import CHECK_EVERY, ModelCheck, SurfaceDistance, gate, model_check, unexplained_share, unseen_share
 from perception.motion import NotObservable
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
-from perception.registration import DebrisTracker, known_shape_model
+from perception.registration import MIN_POINTS, DebrisTracker, known_shape_model
 from perception.scan_to_map import alignments as map_alignments, track_scans
 from perception.shape import half_turn_symmetry_transforms, rotation_error
 from riskassess.products import results
@@ -439,7 +439,9 @@ def check_model(scene: Scene, tracker: DebrisTracker, frames: Frames) -> ModelCh
     vertices, faces = np.asarray(model.vertices), np.asarray(model.faces)
     distance = SurfaceDistance(vertices, faces)
     noiseless = dataclasses.replace(scene.spec, range_noise=0.0)
-    observed = [k for k, phase in enumerate(frames.phase) if phase == 0 and k < len(tracker.alignments)]
+    # frames without returns to register (debris out of range, an empty scan) say nothing of the model
+    observed = [k for k, phase in enumerate(frames.phase)
+                if phase == 0 and k < len(tracker.alignments) and frames.n_points[k] >= MIN_POINTS]
     registered = [k for k in observed if tracker.alignments[k].ok]
     unexplained, unseen = [], []
     for k in registered[::CHECK_EVERY]:
