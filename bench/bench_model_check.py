@@ -90,7 +90,7 @@ def main():
     parser.add_argument("--seeds", type=int, nargs="+", default=[0])
     parser.add_argument("--observation", type=float, default=20.0)
     args = parser.parse_args()
-    print("| variant | seed | registered with the model (checked at 30 frames) | returns off the model, median / p90 (%) "
+    print("| variant | seed | registered with the model / frames judged (30 when found wrong early, all otherwise) | returns off the model, median / p90 (%) "
           "| model surface unseen, median / p90 (%) | verdict | tracked with | frames registered | "
           "registration CPU ms/frame mean / median | attitude error mean (deg) | CoM error (mm) | inertia ratio errors (%) "
           "| D / F errors (%) | L direction (deg) | CoM vs model (mm) | CPU s |")
