@@ -10,7 +10,9 @@ principal-moment errors, and the observation time used.
 
 (each seed draws other LiDAR noise; one block of figures per model, observation time and seed,
 then the worst moment error over the seeds; ``--models known none`` runs each seed with the mesh
-given to the tracker and without it, perception.model)
+given to the tracker and without it, perception.model). At the end, the side-by-side table of the
+paper's figures (Tables 4-8, mass and moments) against the worst case over the seeds of each model
+(docs/perception.md, "Side by side").
 
 The paper (D2D-NDT, 300 s of data): 110 ms/frame, mass error < 0.72 %, principal moments < 0.59 %.
 """
@@ -41,17 +43,104 @@ def main():
     path = Path(args.case)
     raw = tomllib.loads(path.read_text())
     worst = {}
+    answers = []
     for model in args.models or [raw["perception"].get("model", "known")]:
         for observation in args.observation or [raw["perception"]["observation_time"]]:
             for seed in args.seeds or [raw["perception"]["seed"]]:
                 raw["perception"].update(observation_time=observation, seed=seed, model=model)
                 a = _run(path, raw)
+                answers.append((model, observation, a))
                 _report(a, observation, seed)
                 errors = a.get("principal_moments_error_percent") or [float("inf")]   # not observable
                 worst[model, observation] = max(worst.get((model, observation), 0.0), max(abs(e) for e in errors))
     for (model, observation), error in worst.items():
         print(f"worst principal-moment error over the seeds, model '{model}', {observation:g} s observation: "
               f"{error:.3f} % (goal < 0.5 %)")
+    print()
+    print(side_by_side(answers))
+
+
+#: The paper's figures (Tang et al. 2023, D2D-NDT, 300 s of data): table -> (row name, value as printed).
+PAPER = {
+    "T4": {50: "79.24 %", 100: "61.47 %", 150: "30.54 %", 200: "10.95 %", 250: "5.86 %", 300: "0.96 %", 350: "0.98 %"},
+    "registration time per frame": "110 ms (Table 5)",
+    "registration error": "8.49 % average (Table 5)",
+    "CoM error": "0.49 % mean, 1.02 % max before; 0.50 / 1.26 % after (Table 6)",
+    "inertia ratio error": "< 0.96 %, < 0.83 % (Fig. 10)",
+    "D error": "< 1.2 % (Sec. 4.3)",
+    "F error": "< 1.2 % (Sec. 4.3)",
+    "angular momentum direction": "1.28-1.81 % per axis (Table 7)",
+    "net node error": "3.98-5.12 % mean, 0.03-0.06 s (Table 8)",
+    "mass error": "< 0.72 % (Fig. 15a)",
+    "principal moment error": "< 0.59 % (Fig. 15b)",
+}
+
+
+def _worst(values, fmt):
+    values = [v for v in values if v is not None]
+    return fmt(max(values)) if values else "not observable"
+
+
+def side_by_side(answers) -> str:
+    """Markdown table: the paper's figures against the worst case over the seeds of each model
+    (and, for the data-length study, of each observation time).
+
+    Parameters
+    ----------
+    answers : list of (str, float, dict)
+        perception.model, observation time (s) and perception.json content of each run.
+
+    Returns
+    -------
+    str
+        The table (markdown).
+    """
+    models = sorted({m for m, _, _ in answers}, key=["known", "none"].index)
+    observations = sorted({o for _, o, _ in answers})
+    longest = observations[-1]
+    pick = (lambda model, key, obs=longest: [key(a) for m, o, a in answers if m == model and o == obs])
+    absmax = (lambda values: max(abs(v) for v in values) if values else None)
+    rows = [
+        ("registration CPU time per observation frame (mean, ms)", PAPER["registration time per frame"],
+         lambda a: a.get("registration_cpu_ms_per_frame"), lambda v: f"{v:.0f} ms"),
+        ("registration (rotation) error, observation mean (deg)", PAPER["registration error"],
+         lambda a: a["tracking"]["observation"]["rotation_error_mean_deg"], lambda v: f"{v:.2f} deg"),
+        ("CoM error before the collision (mm)", PAPER["CoM error"],
+         lambda a: 1e3 * a["center_of_mass_error_m"] if "center_of_mass_error_m" in a else None, lambda v: f"{v:.1f} mm"),
+        ("inertia ratio error (largest, %)", PAPER["inertia ratio error"],
+         lambda a: absmax(a.get("inertia_ratio_error_percent")), lambda v: f"{v:.2f} %"),
+        ("D error (%)", PAPER["D error"],
+         lambda a: abs(a["normalized_kinetic_energy_error_percent"]) if "normalized_kinetic_energy_error_percent" in a else None,
+         lambda v: f"{v:.2f} %"),
+        ("F error (%)", PAPER["F error"],
+         lambda a: abs(a["normalized_angular_momentum_error_percent"]) if "normalized_angular_momentum_error_percent" in a else None,
+         lambda v: f"{v:.2f} %"),
+        ("angular momentum direction (deg)", PAPER["angular momentum direction"],
+         lambda a: a.get("angular_momentum_direction_error_deg"), lambda v: f"{v:.2f} deg"),
+        ("net node error, mean over the collision frames (m)", PAPER["net node error"],
+         lambda a: a["net"]["node_position_error_mean_m"] if "net" in a else None, lambda v: f"{v:.3f} m"),
+        ("mass error (%)", PAPER["mass error"],
+         lambda a: a.get("mass_error_percent"), lambda v: f"{v:.3f} %"),
+        ("principal moment error (largest, %)", PAPER["principal moment error"],
+         lambda a: a.get("inertia_error_percent"), lambda v: f"{v:.3f} %"),
+    ]
+    header = "| figure (worst over the seeds) | paper (D2D-NDT, 300 s) | " + " | ".join(
+        f"model '{m}' ({longest:g} s)" for m in models) + " |"
+    lines = [header, "|" + "---|" * (2 + len(models))]
+    for name, paper, key, fmt in rows:
+        lines.append(f"| {name} | {paper} | " + " | ".join(_worst(pick(m, key), fmt) for m in models) + " |")
+    if len(observations) > 1:
+        lines += ["", "Data length (paper Table 4: identification error against data collected):", "",
+                  "| observation (s) | paper | " + " | ".join(f"model '{m}': ratios / moments (%)" for m in models) + " |",
+                  "|" + "---|" * (2 + len(models))]
+        for obs in observations:
+            cells = []
+            for m in models:
+                ratios = _worst(pick(m, lambda a: absmax(a.get("inertia_ratio_error_percent")), obs), lambda v: f"{v:.2f}")
+                moments = _worst(pick(m, lambda a: a.get("inertia_error_percent"), obs), lambda v: f"{v:.2f}")
+                cells.append(f"{ratios} / {moments}")
+            lines.append(f"| {obs:g} | {PAPER['T4'].get(int(obs), '-')} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
 
 
 def _run(path, raw) -> dict:

@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def hertz_hunt_crossley_normal_force(penetration, penetration_rate, stiffness, exponent, damping):
     """Normal contact force magnitude (N), never adhesive.
 
@@ -57,7 +57,7 @@ def _power(base, exponent):
     return base ** exponent
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def hollar_friction_coefficient(slip_speed, mu_static, mu_kinetic, transition_speed):
     """Friction coefficient (-) at tangential slip speed (m/s); eq. (7) of the seed paper.
 
@@ -80,7 +80,7 @@ def hollar_friction_coefficient(slip_speed, mu_static, mu_kinetic, transition_sp
     return mu
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def hollar_friction_coefficient_and_slope(slip_speed, mu_static, mu_kinetic, transition_speed):
     """:func:`hollar_friction_coefficient` (-) and its derivative with respect to the slip speed (s/m),
     for Newton iterations on friction laws; the slope is one-sided (from above) at the transition.
@@ -201,7 +201,7 @@ def signed_distance_to_mesh(px, py, pz, vertices, normals, first, last):
     return 0.0, fx, fy, fz
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _free_flight_substeps(delta, relative_velocities, normals, recoil, n_contacts, ux, uy, uz, ax, ay, az, t, dt,
                           remaining):
     """Whole sub-steps (at most ``remaining``) before any of the node's contacts can touch.

@@ -34,6 +34,8 @@ from multibody.net_wrap import TowingNet
 from multibody.towing import HEALTH_EVERY_STEPS, TowedBodies, tow_failure_cause
 from multibody.net_towing_kernel import D_SLIDING, D_THRUST, D_TORQUE
 from multibody.orbit import add_body_gravity
+from multibody.health import SimulationFailed
+from multibody.tow_switch import QuasiSteadyWatch, SwitchCriterion, net_internal_kinetic_energy
 
 #: Layout of the run state ``clock``: net time (s), external impulse (3, N s) since the start.
 CLOCK_TIME, CLOCK_IMPULSE, CLOCK_SIZE = 0, 1, 4
@@ -58,6 +60,11 @@ class FullNetModel(TowedBodies):
                                        (the wrapped start, already closed). Otherwise it starts open and is
                                        reeled in linearly to ``net.closing_rest_closed`` over
                                        [closing_time, closing_time + closing_duration] (capture start, Sec. 2.1).
+    switch : SwitchCriterion or None   Stop the run at quasi-steady state (:mod:`multibody.tow_switch`);
+                                       the result keeps the state there (``NetTowResult.switch``).
+    state_at : float or None           Keep the full state at the first sample at or after this time (s)
+                                       without stopping (``NetTowResult.state_at``): the start state of
+                                       lower-order runs compared with this one (identification, Sec. 4.1).
     """
 
     net: TowingNet
@@ -71,6 +78,8 @@ class FullNetModel(TowedBodies):
     net_output_interval: float
     closing_time: float = 15.0
     closing_duration: float | None = None
+    switch: SwitchCriterion | None = None
+    state_at: float | None = None
 
     @property
     def net_every(self) -> int:
@@ -331,7 +340,11 @@ class _Forces:
 @dataclass
 class NetTowResult:
     """Samples of one full-net run: body states (k, 12), central node (k, 6), diagnostics (k, D_SIZE),
-    momentum and external impulse (k, 3) each; net snapshots (j, n, 3) at ``net_time``; wall time (s)."""
+    momentum and external impulse (k, 3) each, the net's internal kinetic energy (k,) (J); net snapshots
+    (j, n, 3) at ``net_time``; wall time (s); ``switch``: None, or the full state where the run stopped at
+    quasi-steady state (``model.switch``): ``time`` (s), ``q``, ``v`` (12,) (the Exudyn coordinates),
+    ``node_positions``, ``node_velocities`` (n, 3) (m, m/s, inertial), ``thrust_state`` (the law's);
+    ``state_at``: the same at ``model.state_at``."""
 
     model: FullNetModel
     time: np.ndarray
@@ -344,6 +357,9 @@ class NetTowResult:
     net_time: np.ndarray
     net_positions: np.ndarray
     wall_time: float
+    kinetic: np.ndarray = None
+    switch: dict | None = None
+    state_at: dict | None = None
 
     def series(self) -> dict:
         """The lower-order model's series names (:meth:`multibody.towing.TowResult.series`; the
@@ -365,6 +381,7 @@ class NetTowResult:
             "net_contacts": self.diag[:, D_CONTACTS], "net_contact_force": self.diag[:, D_CONTACT_F],
             "closing_thread_peak_tension": self.diag[:, D_CLOSING],
             "total_momentum_inertial": self.momentum, "external_impulse_inertial": self.external_impulse,
+            "net_internal_kinetic_energy": self.kinetic,
             "net_time": self.net_time, "net_nodes_inertial": self.net_positions,
         }
 
@@ -379,7 +396,16 @@ class _Sampler:
         self.time, self.q, self.v, self.node = np.zeros(k), np.zeros((k, 12)), np.zeros((k, 12)), np.zeros((k, 6))
         self.diag, self.momentum, self.impulse = np.zeros((k, D_SIZE)), np.zeros((k, 3)), np.zeros((k, 3))
         self.net_time, self.net = np.zeros(j), np.zeros((j, len(state.x), 3))
+        self.kinetic = np.zeros(k)
         self.sample = self.net_sample = 0
+        self.watch = QuasiSteadyWatch(m.switch) if m.switch is not None else None
+        self.switch = self.state_at = None
+
+    def full_state(self, t, q, v) -> dict:
+        """The whole state at ``t`` (s): time, body coordinates and velocities, nodes, thrust-law state."""
+        s = self.state
+        return {"time": s.model.start_time + t, "q": q.copy(), "v": v.copy(), "node_positions": s.reference + s.x,
+                "node_velocities": s.v.copy(), "thrust_state": s.thrust_state.copy()}
 
     def record(self, mbs, t):
         s = self.state
@@ -392,7 +418,14 @@ class _Sampler:
             self.diag[k] = s.diag  # of the last force evaluation: this step's (Exudyn's initial one at t = 0)
             self.node[k] = np.r_[s.reference + s.x[m.net.central], s.v[m.net.central]]
             self.momentum[k], self.impulse[k] = s.momentum(v), s.clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3]
+            self.kinetic[k] = net_internal_kinetic_energy(m.net.topology.masses, s.v)
             self.sample += 1
+            if self.state_at is None and m.state_at is not None and m.start_time + t >= m.state_at - 1e-9:
+                self.state_at = self.full_state(t, q, v)
+            if self.watch is not None and self.watch.update(m.start_time + t, self.kinetic[k], s.diag[D_TENSION]):
+                self.switch = self.full_state(t, q, v)
+                self.count += 1
+                return False  # quasi-steady: the lower-order model takes over (multibody.tow_switch)
         if self.count % m.net_every == 0 and self.net_sample < len(self.net_time):
             self.net_time[self.net_sample] = m.start_time + t
             self.net[self.net_sample] = s.reference + s.x
@@ -458,9 +491,15 @@ def run_exudyn(model: FullNetModel) -> NetTowResult:
     mbs.SetPostStepUserFunction(checked_post_step(watch, sampler, HEALTH_EVERY_STEPS))
     settings = explicit_settings(model.step, model.n_steps)
     start = time.perf_counter()
-    solve_checked(mbs, settings, exu.DynamicSolverType.VelocityVerlet, watch)
+    try:
+        solve_checked(mbs, settings, exu.DynamicSolverType.VelocityVerlet, watch)
+    except SimulationFailed:
+        if sampler.switch is None or watch.failure is not None:
+            raise
+        # stopped by the switch: the solver reports the early end, nothing failed
     wall = time.perf_counter() - start
     k = sampler.sample
     return NetTowResult(model, sampler.time[:k], sampler.q[:k], sampler.v[:k], sampler.node[:k], sampler.diag[:k],
                         sampler.momentum[:k], sampler.impulse[:k], sampler.net_time[:sampler.net_sample],
-                        sampler.net[:sampler.net_sample], wall)
+                        sampler.net[:sampler.net_sample], wall, sampler.kinetic[:k], sampler.switch,
+                        sampler.state_at)

@@ -51,14 +51,29 @@ def quasi_steady_time(t: np.ndarray, signals: dict[str, np.ndarray], window: flo
         i_start = int(np.searchsorted(t, t[i_end] - window, side="left"))
         if t[i_end] - t[0] < window:
             continue
-        if all(_window_is_steady(x[i_start:i_end + 1], rel_tol, floors.get(name, 0.0))
+        if all(window_is_steady(x[i_start:i_end + 1], rel_tol, floors.get(name, 0.0))
                for name, x in arrays.items()):
             return float(t[i_end])
     return None
 
 
-def _window_is_steady(x: np.ndarray, rel_tol: float, floor: float) -> bool:
-    """Peak-to-peak variation within rel_tol of the mean magnitude (plus an absolute floor)."""
+def window_is_steady(x: np.ndarray, rel_tol: float, floor: float) -> bool:
+    """Peak-to-peak variation within rel_tol of the mean magnitude (plus an absolute floor).
+
+    Parameters
+    ----------
+    x : (k,) float
+        One signal's samples over the window (any unit).
+    rel_tol : float
+        Allowed peak-to-peak variation as a fraction of the window's mean |x| (-).
+    floor : float
+        Absolute allowance, in x's unit.
+
+    Returns
+    -------
+    bool
+        False for a window with a non-finite sample.
+    """
     if not np.all(np.isfinite(x)):
         return False  # a diverged signal is never steady
     return float(np.ptp(x)) <= rel_tol * float(np.mean(np.abs(x))) + floor

@@ -148,6 +148,7 @@ class Alignment:
     global_init: bool
     seconds: float
     n_points: int
+    cpu_seconds: float = 0.0   # process time of the registration (s; all threads, at least the one-core time)
 
     @property
     def body_to_world(self) -> np.ndarray:
@@ -432,7 +433,7 @@ class DebrisTracker:
             The frame's pose (world -> B), information and check figures; also appended to
             ``alignments``.
         """
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), time.process_time()
         scan = _cloud(points_world).voxel_down_sample(self.voxel)
         if self._model is None:   # the first scan starts the model and defines the frame B
             alignment = self._start_model(time_s, np.asarray(scan.points))
@@ -443,6 +444,7 @@ class DebrisTracker:
             alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
             self._frame_spacing = None
         alignment.seconds = time.perf_counter() - start
+        alignment.cpu_seconds = time.process_time() - cpu_start
         self.alignments.append(alignment)
         self._grow_model(alignment, np.asarray(scan.points))
         return alignment

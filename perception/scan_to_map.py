@@ -78,6 +78,8 @@ class MapTrack:
     seconds : (k,) float              Registration time of each frame (s), online pass.
     map_points : (n, 3) float         The debris surface map, frame B (m), one point per voxel.
     map_normals : (n, 3) float        Its unit normals (frame B), estimated from the map.
+    cpu_seconds : (k,) float          CPU time of each frame's registration (s, process time: all
+                                      threads, so at least the one-core time).
     """
 
     world_to_body: np.ndarray
@@ -88,6 +90,7 @@ class MapTrack:
     seconds: np.ndarray
     map_points: np.ndarray
     map_normals: np.ndarray
+    cpu_seconds: np.ndarray | None = None
 
 
 def _cloud(points) -> o3d.geometry.PointCloud:
@@ -357,11 +360,11 @@ def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA,
     k = len(thin)
     poses = np.tile(np.eye(4), (k, 1, 1))
     ok = np.zeros(k, bool)
-    fitness, rmse, seconds = np.zeros(k), np.full(k, np.nan), np.zeros(k)
+    fitness, rmse, seconds, cpu = np.zeros(k), np.full(k, np.nan), np.zeros(k), np.zeros(k)
     map_cloud = tree = None
     pending, built = [], 0
     for i, scan in enumerate(thin):
-        tic = time.perf_counter()
+        tic, cpu_tic = time.perf_counter(), time.process_time()
         if len(scan) < MIN_POINTS:
             seconds[i] = time.perf_counter() - tic
             continue
@@ -390,19 +393,20 @@ def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA,
                 map_cloud = surface_map(np.vstack([np.asarray(map_cloud.points)] + pending), voxel)
                 tree, pending, built = cKDTree(np.asarray(map_cloud.points)), [], i
         seconds[i] = time.perf_counter() - tic
+        cpu[i] = time.process_time() - cpu_tic
     if map_cloud is None:
-        return MapTrack(poses, ok, fitness, rmse, np.zeros((k, 6, 6)), seconds, np.zeros((0, 3)), np.zeros((0, 3)))
-    return _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence)
+        return MapTrack(poses, ok, fitness, rmse, np.zeros((k, 6, 6)), seconds, np.zeros((0, 3)), np.zeros((0, 3)), cpu)
+    return _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence, cpu)
 
 
-def _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence) -> MapTrack:
+def _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence, cpu=None) -> MapTrack:
     """The track with the map rebuilt from all registered scans and each frame's information."""
     cloud = surface_map(np.vstack([_transform(thin[i], poses[i]) for i in np.flatnonzero(ok)]), voxel)
     points, normals = np.asarray(cloud.points), np.asarray(cloud.normals)
     tree = cKDTree(points)
     information = np.array([map_information(thin[i], poses[i], points, normals, max_correspondence, tree) if ok[i]
                             else np.zeros((6, 6)) for i in range(len(thin))])
-    return MapTrack(poses, ok, fitness, rmse, information, seconds, points, normals)
+    return MapTrack(poses, ok, fitness, rmse, information, seconds, points, normals, cpu)
 
 
 def alignments(track: MapTrack, times) -> list[Alignment]:
@@ -420,4 +424,6 @@ def alignments(track: MapTrack, times) -> list[Alignment]:
     list of Alignment   k records, pose world -> B (m for the translation).
     """
     return [Alignment(float(t), track.world_to_body[i], track.information[i], float(track.fitness[i]), 0.0, 0.0,
-                      bool(track.ok[i]), False, float(track.seconds[i]), 0) for i, t in enumerate(times)]
+                      bool(track.ok[i]), False, float(track.seconds[i]), 0,
+                      float(track.cpu_seconds[i]) if track.cpu_seconds is not None else 0.0)
+            for i, t in enumerate(times)]

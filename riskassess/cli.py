@@ -340,6 +340,9 @@ def print_perception(answer: dict, out: Path, console=None) -> None:
     _print_table(console, f"{escape(answer['case'])}: debris mass and inertia from LiDAR and the net collision",
                  ("quantity", "estimate", "1 sigma", "error vs truth"), perception_rows(answer),
                  {"estimate": "right", "1 sigma": "right", "error vs truth": "right"})
+    for key in ("model_mismatch", "model_mass_mismatch"):
+        if answer.get(key):
+            console.print(f"[yellow]wrong model[/yellow]: {escape(str(answer[key]))}")
     if answer["not_observable"]:
         console.print(f"[red]not observable[/red]: {escape(str(answer['not_observable']))}")
     console.print(f"results: {escape(str(out))}")

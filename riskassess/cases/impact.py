@@ -347,6 +347,35 @@ class Registration(Strict):
     max_correspondence: Positive = Field(0.1, description="ICP correspondence distance (m).")
 
 
+class Bend(Strict):
+    """One shape of the real target turned about a hinge line, against the drawings (a bent array)."""
+    shape: Annotated[int, Field(ge=0)] = Field(description="Index (from 0) of the bent shape in target.bodies[0].shapes (-).")
+    hinge_point: Vector3 = Field(description="A point of the hinge line, target frame (m).")
+    hinge_axis: Vector3 = Field(description="Hinge line direction, target frame (-); any non-zero length.")
+    angle: Annotated[float, Field(ge=-np.pi, le=np.pi)] = Field(description="Turn of the shape about the hinge, "
+                                                                             "right-handed about hinge_axis (rad).")
+
+    @model_validator(mode="after")
+    def _axis(self):
+        if np.linalg.norm(self.hinge_axis) == 0:
+            raise ValueError("hinge_axis must be a non-zero vector")
+        return self
+
+
+class TruthDamage(Strict):
+    """How the real target, which the LiDAR scans and the collision run simulates, differs from the
+    target of [target], which is the model given to the tracker (perception.model = 'known'). The
+    real body's mass properties follow from the model's: uniform density over the shapes, the stated
+    mass spread over their volumes; a missing shape takes its mass away, a bent shape moves its own."""
+    description: Text = Field("", description="What the damage stands for (free text).")
+    missing_shapes: list[Annotated[int, Field(ge=0)]] = Field(
+        [], description="Indices (from 0) of shapes of target.bodies[0].shapes the real target has lost (-).")
+    bends: list[Bend] = Field([], description="Shapes of the real target turned about a hinge line.")
+    center_of_mass_shift: Vector3 = Field(
+        [0.0, 0.0, 0.0], description="Real CoM minus the one the shapes give, target frame (m): mass moved inside the "
+                                     "body (e.g. propellant); the inertia about the CoM is kept.")
+
+
 class Perception(Strict):
     observation_time: Positive = Field(description="LiDAR tracking of the free tumble before the chaser moves in (s).")
     hold_distance: Positive = Field(10.0, description="Chaser CoM to debris CoM while it observes, back along the launch direction (m).")
@@ -357,6 +386,9 @@ class Perception(Strict):
                              "(perception/scan_to_map.py); the body frame is then the first scan's.")
     lidar: Lidar
     registration: Registration = Registration()
+    truth_damage: TruthDamage | None = Field(
+        None, description="Optional: the scanned (real) target differs from the model of [target] "
+                          "(riskassess/cases/truth_damage.py).")
 
 
 # ---------------------------------------------------------------------------- structures
@@ -493,6 +525,28 @@ class Case(Strict):
             if loc.joint not in joints:
                 raise ValueError(f"structures: weak location '{loc.name}': joint '{loc.joint}' is not in "
                                  f"target.joints {joints}")
+        return self
+
+    @model_validator(mode="after")
+    def _truth_damage_shapes(self):
+        damage = self.perception.truth_damage if self.perception is not None else None
+        if damage is None:
+            return self
+        count = len(self.target.bodies[0].shapes)
+        bent = [b.shape for b in damage.bends]
+        for key, indices in (("missing_shapes", damage.missing_shapes), ("bends[].shape", bent)):
+            for index in indices:
+                if index >= count:
+                    raise ValueError(f"perception.truth_damage.{key}: shape {index} does not exist; "
+                                     f"target.bodies[0] has shapes 0 to {count - 1}")
+        if len(set(damage.missing_shapes)) == count:
+            raise ValueError("perception.truth_damage.missing_shapes: removes every shape of target.bodies[0]; "
+                             "at least one must remain")
+        if set(damage.missing_shapes) & set(bent):
+            raise ValueError(f"perception.truth_damage: shapes {sorted(set(damage.missing_shapes) & set(bent))} are "
+                             "both missing and bent")
+        if len(set(bent)) != len(bent):
+            raise ValueError("perception.truth_damage.bends: a shape is bent at most once")
         return self
 
     @model_validator(mode="after")
@@ -692,7 +746,10 @@ def _fill_perceived(body: dict, source: str, base: Path) -> str | None:
     if missing:
         reason = answer.get("not_observable") or (
             "estimated without the debris mesh (perception.model = 'none'): the CoM and inertia are in the first "
-            "scan's frame, not the target frame" if answer.get("perception_model") == "none" else "keys missing")
+            "scan's frame, not the target frame" if answer.get("perception_model") == "none" else
+            "tracked without the debris mesh after the mesh was found not to match the scans (model_check): the CoM "
+            "and inertia are in the first scan's frame, not the target frame" if answer.get("body_frame") == "first_scan"
+            else "keys missing")
         return f"'{source}' has no estimate of {missing}: {reason}"
     for source_key, body_key in PERCEIVED_KEYS.items():
         body[body_key] = answer[source_key]

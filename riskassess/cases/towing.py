@@ -219,10 +219,27 @@ class FullNetContact(Strict):
 class FullNet(Strict):
     """The wrapped net of the full-net towing model (multibody/net_towing.py; docs/towing.md)."""
 
-    start: Literal["wrapped", "capture"] = Field(
+    start: Literal["wrapped", "capture", "run"] = Field(
         "wrapped", description="'wrapped': prepared wrapped state at simulation.start_time; 'capture': the open net "
                                "ejected from the chaser at t = 0 s towards the debris (Table 2 states), closed from "
-                               "closing_time on (Sec. 2.1, 4.1; docs/towing.md).")
+                               "closing_time on (Sec. 2.1, 4.1); 'run': the end state of the impact run folder "
+                               "from_run (docs/towing.md).")
+    from_run: Text | None = Field(
+        None, description="start = 'run': the impact stage's run folder (riskassess run), relative to this case "
+                           "file's folder or absolute; its manifest must say complete, its net and target must be "
+                           "this case's (docs/towing.md, 'Tow from an impact run').")
+    switch_to_lower_order: bool = Field(
+        False, description="Stop the full-net run at quasi-steady state and continue with the lower-order model "
+                           "from the net's state there (multibody/tow_switch.py, docs/towing.md).")
+    switch_window: Positive = Field(
+        5.0, description="Quasi-steady criterion: both conditions must hold over this time (s).")
+    switch_kinetic_energy: Positive = Field(
+        0.5, description="Quasi-steady criterion: largest kinetic energy of the net relative to its CoM (J).")
+    switch_tension_variation: Positive = Field(
+        0.2, description="Quasi-steady criterion: largest peak-to-peak main-tether tension over its window mean (-); "
+                         "the tether must also stay taut over the window.")
+    switch_earliest: NonNegative | None = Field(
+        None, description="No switch before this time (s); default thrust.t_on.")
     launch_speed: Positive = Field(2.0, description="Capture start: speed of every net node relative to the chaser at "
                                                     "t = 0, along r_D/C (m/s) [assumed: the authors' launch data are "
                                                     "not available].")
@@ -260,6 +277,9 @@ class FullNet(Strict):
     def _odd(self):
         if self.nodes_per_side % 2 == 0:
             raise ValueError(f"nodes_per_side must be odd (the main tether needs a central node). Got {self.nodes_per_side}")
+        if (self.start == "run") != (self.from_run is not None):
+            raise ValueError("from_run (the impact run folder) goes with start = 'run', and only with it. "
+                             f"Got start = '{self.start}', from_run = {self.from_run!r}")
         return self
 
 

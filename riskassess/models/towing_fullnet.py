@@ -16,10 +16,11 @@ from __future__ import annotations
 import numpy as np
 
 from multibody.control.attitude import sampled_boundary_layer
-from multibody.rotations import quaternion_to_matrix
+from multibody.rotations import quaternion_to_matrix, rotation_matrix_from_rotation_vector
 from multibody.net_towing import FullNetModel
 from multibody.net_wrap import drape_and_close, towing_net
-from riskassess.models.towing import case_thrust_law
+from multibody.tow_switch import SwitchCriterion, lower_order_state
+from riskassess.models.towing import case_decision_vector, case_thrust_law, towing_model
 from riskassess.cases.towing import TowingCase
 
 #: Height of the flat net above the cylinder before draping (m).
@@ -173,7 +174,7 @@ def capture_start(case: TowingCase, spin_rate_deg_s: float):
 
 
 def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapped=None, end_time=None, step=None,
-                   substeps=None) -> FullNetModel:
+                   substeps=None, run_start=None) -> FullNetModel:
     """The full-net model of ``case`` at ``spin_rate_deg_s`` (default: the case's): from the wrapped
     state at ``simulation.start_time`` (``wrapped`` = (net, x_body) of :func:`wrapped_net`, computed
     if not given) or, with ``full_net.start = "capture"``, from the net's ejection at t = 0
@@ -193,6 +194,9 @@ def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapp
         Integration step (s); default ``full_net.step``; reduced to a divisor of the output interval.
     substeps : int or None
         Net substeps per step; default ``full_net.substeps``.
+    run_start : riskassess.models.towing_from_run.RunStart or None
+        With ``full_net.start = "run"``: the impact run's end state in the towing frame (net, nodes, debris
+        state; ``spin_rate_deg_s`` is then not used: the debris turns as the run left it).
 
     Returns
     -------
@@ -200,14 +204,21 @@ def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapp
     """
     fn, sim, ch, de = case.full_net, case.simulation, case.chaser, case.debris
     rate = de.spin_rate_deg_s if spin_rate_deg_s is None else spin_rate_deg_s
+    rot, com = _bodies(case)
+    debris_v = np.asarray(de.velocity_inertial, float)
     if fn.start == "capture":
         net, nodes, velocities, chaser, omega = capture_start(case, rate)
         start, closing_duration = 0.0, fn.closing_duration
+    elif fn.start == "run":
+        if run_start is None:
+            raise ValueError("full_net.start = 'run' needs the impact run's end state (towing_from_run.impact_run_start)")
+        net, nodes, velocities = run_start.net, run_start.node_positions, run_start.node_velocities
+        chaser, omega, start, closing_duration = com[0], run_start.debris_omega_body, run_start.time, fn.closing_duration
+        rot[1], com[1], debris_v = run_start.debris_to_inertial, run_start.debris_position, run_start.debris_velocity
     else:
         net, x_body = wrapped if wrapped is not None else wrapped_net(case)
         nodes, velocities, chaser, omega = wrapped_start(case, net, x_body, rate)
         start, closing_duration = sim.start_time, None
-    rot, com = _bodies(case)
     mt = case.main_tether
     tether = np.array([mt.stiffness, mt.damping, mt.natural_length])
     a_point = chaser + rot[0] @ np.asarray(ch.tether_attachment_body, float)
@@ -223,8 +234,137 @@ def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapp
         attitude=np.r_[float(ac.enabled), ac.k_gain, ac.gain,
                        sampled_boundary_layer(ac.boundary_layer, np.asarray(ac.gain, float), h)],
         thrust_law=law.NAME, thrust_along_body_z=law.ALONG_BODY_Z, thrust_params=params, thrust_state=state,
-        positions=np.array([chaser, com[1]]), velocities=np.array([ch.velocity_inertial, de.velocity_inertial], float),
+        positions=np.array([chaser, com[1]]), velocities=np.array([ch.velocity_inertial, debris_v], float),
         body_to_inertial=rot, omega_body=np.array([ch.angular_velocity_body, omega], float),
         start_time=start, end_time=sim.end_time if end_time is None else end_time, step=h,
         substeps=fn.substeps if substeps is None else substeps, output_interval=sim.output_interval,
-        net_output_interval=fn.net_output_interval, closing_time=fn.closing_time, closing_duration=closing_duration)
+        net_output_interval=fn.net_output_interval, closing_time=fn.closing_time, closing_duration=closing_duration,
+        switch=switch_criterion(case))
+
+
+def switch_criterion(case: TowingCase):
+    """The case's quasi-steady criterion (:class:`multibody.tow_switch.SwitchCriterion`), or None when
+    ``full_net.switch_to_lower_order`` is off.
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with a ``[full_net]`` table.
+
+    Returns
+    -------
+    multibody.tow_switch.SwitchCriterion or None
+        Earliest switch (s; default ``thrust.t_on``), window (s), net internal kinetic energy bound (J),
+        main-tether tension variation bound (-).
+    """
+    fn = case.full_net
+    if not fn.switch_to_lower_order:
+        return None
+    earliest = case.thrust.t_on if fn.switch_earliest is None else fn.switch_earliest
+    return SwitchCriterion(earliest=float(earliest), window=fn.switch_window, kinetic_energy_max=fn.switch_kinetic_energy,
+                           tension_rel_tol=fn.switch_tension_variation)
+
+
+def net_start_state(full_model, state: dict) -> dict:
+    """What a lower-order run needs of a full-net state (``NetTowResult.switch`` or ``.state_at``), in
+    arrays (cacheable): time (s), chaser and debris CoM (m) and velocity (m/s), attitudes (body ->
+    inertial), angular velocities (2, 3) (rad/s, body frames), the central node's position (m) and velocity
+    (m/s), the net's mass (kg) and momentum (N s), the thrust law's state. Inertial frame.
+
+    Parameters
+    ----------
+    full_model : multibody.net_towing.FullNetModel
+        The full-net run's model.
+    state : dict
+        ``time``, ``q``, ``v`` (12,), ``node_positions``, ``node_velocities`` (n, 3), ``thrust_state``.
+
+    Returns
+    -------
+    dict
+    """
+    q, v, central = state["q"], state["v"], full_model.net.central
+    masses = full_model.net.topology.masses
+    return {"start_time": float(state["time"]), "body_masses": np.asarray(full_model.masses, float),
+            "chaser_com": full_model.positions[0] + q[0:3], "debris_com": full_model.positions[1] + q[6:9],
+            "chaser_velocity": v[0:3].copy(), "debris_velocity": v[6:9].copy(),
+            "body_to_inertial": np.array([rotation_matrix_from_rotation_vector(q[b:b + 3]) for b in (3, 9)]),
+            "omega_body": np.array([v[3:6], v[9:12]]),
+            "node_position": np.array(state["node_positions"][central], float),
+            "node_velocity": np.array(state["node_velocities"][central], float),
+            "net_mass": float(masses.sum()), "net_momentum": masses @ state["node_velocities"],
+            "thrust_state": np.array(state["thrust_state"], float)}
+
+
+def lower_order_from_net(case: TowingCase, start: dict, spin_rate_deg_s: float | None = None, s=None,
+                         end_time: float | None = None, step: float | None = None):
+    """The lower-order model started from a full-net state (:func:`net_start_state`;
+    :func:`multibody.tow_switch.lower_order_state`: chaser and debris copied, P at the central node with its
+    velocity, the debris velocity keeping the system's momentum), with the case's sub-tethers or ``s``.
+
+    Parameters
+    ----------
+    case : TowingCase
+        The towing case.
+    start : dict
+        :func:`net_start_state`.
+    spin_rate_deg_s : float or None
+        Only used to build the model before its state is replaced (deg/s).
+    s : (4,) float or None
+        Sub-tether decision vector (eq. 22); default the case's.
+    end_time : float or None
+        End of the lower-order run (s); default the case's.
+    step : float or None
+        Its step (s); default the case's.
+
+    Returns
+    -------
+    model : multibody.towing.TowingModel
+        Starting at ``start["start_time"]``.
+    balance : dict
+        The momentum balance of :func:`multibody.tow_switch.lower_order_state` plus the start time (s),
+        the main-tether elongation (m) and the sub-tether elongations (m) at the start.
+    """
+    s = case_decision_vector(case) if s is None else np.asarray(s, float)
+    model = towing_model(case, spin_rate_deg_s, s, end_time=end_time, step=step)
+    p_pos, p_vel, debris_v, balance = lower_order_state(
+        start["body_masses"], start["net_mass"], start["net_momentum"], start["node_position"], start["node_velocity"],
+        start["chaser_velocity"], start["debris_velocity"], s[3])
+    rot = np.asarray(start["body_to_inertial"], float)
+    model.positions = np.array([p_pos, start["chaser_com"], start["debris_com"]], float)
+    model.velocities = np.array([p_vel, start["chaser_velocity"], debris_v], float)
+    model.body_to_inertial = rot
+    model.omega_body = np.array(start["omega_body"], float)
+    model.start_time = float(start["start_time"])
+    model.thrust_state = np.array(start["thrust_state"], float)
+    a_point = model.positions[1] + rot[0] @ model.attach_chaser_body
+    points = model.positions[2] + model.attach_debris_body @ rot[1].T
+    balance = {**balance, "time_s": model.start_time,
+               "main_tether_elongation_m": float(np.linalg.norm(p_pos - a_point) - model.tether[2]),
+               "sub_tether_elongations_m": (np.linalg.norm(points - p_pos, axis=1) - model.tether[5]).tolist()}
+    return model, balance
+
+
+def lower_order_after_switch(case: TowingCase, full, s=None, end_time: float | None = None):
+    """The lower-order model that continues a full-net run stopped at quasi-steady state
+    (:func:`lower_order_from_net` of ``full.switch``).
+
+    Parameters
+    ----------
+    case : TowingCase
+        The towing case.
+    full : multibody.net_towing.NetTowResult
+        The full-net run, stopped by its switch criterion (``full.switch`` set).
+    s : (4,) float or None
+        Sub-tether decision vector (eq. 22); default the case's.
+    end_time : float or None
+        End of the lower-order run (s); default the case's.
+
+    Returns
+    -------
+    model : multibody.towing.TowingModel
+    balance : dict
+        :func:`lower_order_from_net`'s.
+    """
+    if full.switch is None:
+        raise ValueError("the full-net run did not reach quasi-steady state: nothing to switch from")
+    return lower_order_from_net(case, net_start_state(full.model, full.switch), s=s, end_time=end_time)

@@ -32,6 +32,7 @@ from multibody.towing_kernel import MT_TENSION
 from riskassess.products import results
 from riskassess.products.outfolder import OutputFolder, claim
 from riskassess.models.towing import towing_model
+from riskassess.models.towing_fullnet import lower_order_from_net
 from riskassess.cases.towing import TowingCase
 from riskassess.cases.impact import load_model
 from riskassess.products.towing_plots import plot_convergence
@@ -122,9 +123,9 @@ def cost_f2(model: dict, data: dict, weights=None) -> float:
 COSTS = {"f1": cost_f1, "f2": cost_f2}
 
 
-def simulate(case: TowingCase, rate_deg_s: float, s, end_time=None) -> dict:
+def simulate(case: TowingCase, rate_deg_s: float, s, end_time=None, start=None) -> dict:
     """The compared series of one lower-order run (twin, step ``identification.step``) at spin rate
-    ``rate_deg_s`` with sub-tethers ``s``.
+    ``rate_deg_s`` with sub-tethers ``s``, from the case's start state or from the full-net state ``start``.
 
     Parameters
     ----------
@@ -136,12 +137,18 @@ def simulate(case: TowingCase, rate_deg_s: float, s, end_time=None) -> dict:
         Sub-tether decision vector [log10 k_ST, l_ST0 (m), log10 c_ST, m_P/m_net] (eq. 22).
     end_time : float or None
         End of the run (s); default the case's.
+    start : dict or None
+        A full-net state (:func:`riskassess.models.towing_fullnet.net_start_state`): the run starts there
+        (the capture-start identification, Sec. 4.1).
 
     Returns
     -------
     dict
         :func:`compared_series` of the run.
     """
+    if start is not None:
+        model = lower_order_from_net(case, start, rate_deg_s, s, end_time=end_time, step=case.identification.step)[0]
+        return compared_series(run_twin(model))
     return compared_series(run_twin(towing_model(case, rate_deg_s, s, step=case.identification.step,
                                                   end_time=end_time)))
 
@@ -161,7 +168,8 @@ def _run_term(task) -> float:
     w = _WORKER
     rate = w["data"][j]["rate_deg_s"]
     try:
-        term = w["cost"](simulate(w["case"], rate, s, w["end_time"]), w["data"][j], w["weights"])
+        term = w["cost"](simulate(w["case"], rate, s, w["end_time"], w["data"][j].get("start")), w["data"][j],
+                         w["weights"])
     except (ValueError, ZeroDivisionError, FloatingPointError):
         return np.inf
     return term if np.isfinite(term) else np.inf

@@ -1,14 +1,18 @@
 """`riskassess identify CASE` (without --benchmark): sub-tether identification against full-net runs
 (Boonrath, Singh & Botta 2024, Sec. 4.1, 4.4).
 
-1. Full-net runs (:mod:`riskassess.stages.tow_fullnet`, wrapped start) at the training and validation spin
-   rates of Table 3 (``full_net.identification_training_runs`` / ``_validation_runs`` take the first k),
-   in parallel worker processes, each cached in ``OUT/fullnet/rate_<deg_s>.npz`` (a re-run reuses them).
+1. Full-net runs (:mod:`riskassess.stages.tow_fullnet`, wrapped or capture start) at the training and
+   validation spin rates of Table 3 (``full_net.identification_training_runs`` / ``_validation_runs`` take
+   the first k), in parallel worker processes, each cached in ``OUT/fullnet/rate_<deg_s>_end_<s>[_capture].npz``
+   (a re-run reuses them); the compared series from ``simulation.start_time`` on.
 2. The lower-order runs start from the full-net state at the start time, as the paper does (Sec. 4.1):
    debris and chaser states, P at the net node the main tether holds. With the wrapped start the debris
    has the case's Table 2 state, so this is the case with the chaser moved where the full-net run
    starts it and ``sub_tethers.connection_point_start_inertial`` at the central node
-   (:func:`lower_order_case`); P's velocity is the debris' rigid motion there, as the node's.
+   (:func:`lower_order_case`); P's velocity is the debris' rigid motion there, as the node's. With the
+   capture start every run has its own state at the start time (the net's capture moved chaser and
+   debris): it is kept with the run (:func:`start_state`) and each lower-order run starts from it
+   (:func:`riskassess.models.towing_fullnet.lower_order_from_net`, the switch's start state).
 3. s is identified on the training runs by each optimizer of ``identification.searches`` (PSO, then the
    pattern-search polish, and/or the pattern search; :func:`riskassess.stages.identify.run_optimizers`) on the
    case's cost, f1 or f2 (eqs. 18, 20), and each identified model is compared with the training runs and
@@ -29,7 +33,7 @@ from riskassess.stages.identify import COSTS, claim_identify_folder, rmse, simul
 from riskassess.products.outfolder import OutputFolder
 from riskassess.cases.towing import TowingCase
 from multibody.net_towing import run_exudyn
-from riskassess.models.towing_fullnet import full_net_model
+from riskassess.models.towing_fullnet import full_net_model, net_start_state
 from riskassess.models.towing_fullnet import wrapped_net
 from riskassess.stages.identify import run_optimizers
 from riskassess.products.towing_plots import plot_convergence
@@ -37,17 +41,45 @@ from riskassess.products.towing_plots import plot_convergence
 CHANNELS = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
 
 
+#: Prefix of the start-state entries of a cached capture-start run (:func:`start_state`).
+START = "start_"
+
+
 def _run_full_net(task):
-    """One full-net run in a worker: (case, wrapped net, rate, end) -> compared series (+ start state)."""
+    """One full-net run in a worker: (case, wrapped net, rate, end) -> compared series from
+    ``simulation.start_time`` on (+ start state; the capture start's full state there, prefixed ``start_``)."""
     case, wrapped, rate, end = task
     model = full_net_model(case, rate, wrapped=wrapped, end_time=end)
+    capture = case.full_net.start == "capture"
+    if capture:
+        model.state_at = case.simulation.start_time   # the lower-order runs start there (Sec. 4.1)
     result = run_exudyn(model)
     s = result.series()
+    keep = s["time"] >= case.simulation.start_time - 1e-9
     series = {"relative_position": s["debris_com_inertial"] - s["chaser_com_inertial"],
               "chaser_omega_body": s["chaser_omega_body"], "debris_omega_body": s["debris_omega_body"],
               "main_tether_tension": s["main_tether_tension"]}   # the channels of identify.compared_series
-    return {**series, "rate_deg_s": rate, "chaser_start_inertial": model.positions[0],
+    series = {k: v[keep] for k, v in series.items()}
+    start = {START + k: v for k, v in net_start_state(model, result.state_at).items()} if capture else {}
+    return {**series, **start, "rate_deg_s": rate, "chaser_start_inertial": model.positions[0],
             "node_start_inertial": model.node_positions[model.net.central], "wall_s": result.wall_time}
+
+
+def start_state(run: dict) -> dict | None:
+    """The full-net start state of a cached capture-start run (None for the wrapped start).
+
+    Parameters
+    ----------
+    run : dict
+        A cached full-net run (:func:`full_net_runs`).
+
+    Returns
+    -------
+    dict or None
+        :func:`riskassess.models.towing_fullnet.net_start_state`.
+    """
+    state = {k[len(START):]: v for k, v in run.items() if k.startswith(START)}
+    return state or None
 
 
 def full_net_runs(case: TowingCase, rates, out: Path, end, workers, record=None) -> list[dict]:
@@ -78,17 +110,21 @@ def full_net_runs(case: TowingCase, rates, out: Path, end, workers, record=None)
     """
     cache = out / "fullnet"
     cache.mkdir(parents=True, exist_ok=True)
-    path = {rate: cache / f"rate_{rate:.2f}_end_{end:g}.npz" for rate in rates}
+    tag = "" if case.full_net.start == "wrapped" else f"_{case.full_net.start}"
+    path = {rate: cache / f"rate_{rate:.2f}_end_{end:g}{tag}.npz" for rate in rates}
     missing = [rate for rate in rates if not path[rate].exists()]
     if missing:
-        wrapped = wrapped_net(case)
+        wrapped = wrapped_net(case) if case.full_net.start == "wrapped" else None
         with multiprocessing.get_context("fork").Pool(min(workers, len(missing))) as pool:
             # each run cached as soon as it is done: an interrupted call keeps the finished ones
             for run in pool.imap_unordered(_run_full_net, [(case, wrapped, r, end) for r in missing]):
                 results.atomic_write_npz(path[run["rate_deg_s"]], run)
                 if record:
                     record(path[run["rate_deg_s"]].relative_to(out).as_posix())
-    return [{k: (float(v) if v.ndim == 0 else v) for k, v in np.load(path[rate]).items()} for rate in rates]
+    runs = [{k: (float(v) if v.ndim == 0 else v) for k, v in np.load(path[rate]).items()} for rate in rates]
+    for run in runs:
+        run["start"] = start_state(run)   # None: the wrapped start (the case's own start state)
+    return runs
 
 
 def lower_order_case(case: TowingCase, run: dict) -> TowingCase:
@@ -134,7 +170,7 @@ def comparison_rows(case: TowingCase, s, data: list[dict], end) -> list[dict]:
     """
     rows = []
     for run in data:
-        model = simulate(case, run["rate_deg_s"], s, end)
+        model = simulate(case, run["rate_deg_s"], s, end, run.get("start"))
         rows.append({"rate_deg_s": run["rate_deg_s"], **{f"rmse_{c}": rmse(model[c], run[c]) for c in CHANNELS},
                      "f1": COSTS["f1"](model, run, case.identification.weights), "f2": COSTS["f2"](model, run)})
     return rows
@@ -182,10 +218,10 @@ def identify_full_net(case_path, out_dir, case: TowingCase, optimizers=None, ove
     fn = case.full_net
     if fn is None:
         raise CaseError(f"{case_path}: identification against full-net runs needs a [full_net] section")
-    if fn.start == "capture":
-        raise CaseError(f"{case_path}: full_net.start = 'capture' is not supported by 'riskassess identify': its "
-                         f"lower-order runs would each need their own start state (the full-net state at "
-                         f"simulation.start_time, Sec. 4.1), which riskassess.stages.identify does not take; use 'wrapped'")
+    if fn.start == "run":
+        raise CaseError(f"{case_path}: full_net.start = 'run' is not supported by 'riskassess identify': every "
+                         f"training and validation rate would need its own impact run; use 'capture' (the capture "
+                         f"simulated by the towing model) or 'wrapped'")
     folder = claim_identify_folder(out_dir, case_path, case.name, overwrite)
     with folder.recording():
         answer = _identify(case, folder, optimizers)

@@ -26,6 +26,7 @@ from riskassess.stages.run import software_versions
 from riskassess.models.towing import case_decision_vector, towing_model
 from riskassess.products.towing_figures import run_figures
 from riskassess.stages.tow_fullnet import run_full_net
+from riskassess.models.towing_from_run import impact_run_start
 from riskassess.cases.towing import TowingCase
 from riskassess.products.towing_plots import plot_tow
 
@@ -79,13 +80,16 @@ def tow_case(case_path: str | Path, out_dir: str | Path, case: TowingCase | None
     case_path = Path(case_path)
     case = case or load_model(case_path, TowingCase)
     model = towing_model(case)
+    run_start = None
+    if case.simulation.model == "full-net" and case.full_net.start == "run":
+        run_start = impact_run_start(case, case_path)   # checked before the folder is claimed
     folder = claim(out_dir, case.name, "tow", overwrite, stage="tow", software=software_versions())
     out = folder.path
     with folder.recording():
         results.atomic_write_bytes(out / "case.toml", case_path.read_bytes())
         folder.add_files("case.toml")
         if case.simulation.model == "full-net":
-            summary, series = run_full_net(case, out)
+            summary, series = run_full_net(case, out, run_start)
             return _finish(case, folder, series, summary, ["towing.json", "towing.npz", "net.npz", "tow.png"])
         result = run_exudyn(model)
         summary = summarize(case, result, case_decision_vector(case))

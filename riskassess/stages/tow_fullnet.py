@@ -8,9 +8,10 @@ from pathlib import Path
 import numpy as np
 
 from multibody.net_towing import run_exudyn
+from multibody.towing import run_exudyn as run_lower_order
 from multibody.net_wrap import wrap_summary
 from riskassess.products import results
-from riskassess.models.towing_fullnet import debris_geometry, full_net_model, wrapped_net
+from riskassess.models.towing_fullnet import debris_geometry, full_net_model, lower_order_after_switch, wrapped_net
 from riskassess.products.towing_figures import run_figures
 from riskassess.cases.towing import TowingCase
 
@@ -64,9 +65,63 @@ def summarize_full_net(case: TowingCase, result, wrap: dict) -> dict:
     }
 
 
-def run_full_net(case: TowingCase, out: Path) -> tuple[dict, dict]:
-    """Run the case's full-net tow; write towing.npz, net.npz, towing.json to ``out``. Returns
-    (summary, series).
+def joined_series(full: dict, lower: dict) -> dict:
+    """One series across the switch: the full-net samples up to the switch time, then the lower-order
+    samples after it (its first sample, the switch state itself, is the full-net run's last one).
+    A series only one model has is NaN where the other ran; ``lower_order`` (k,) bool says which ran.
+
+    Parameters
+    ----------
+    full : dict
+        Full-net series (:meth:`multibody.net_towing.NetTowResult.series`, without the net snapshots).
+    lower : dict
+        Lower-order series (:meth:`multibody.towing.TowResult.series`), starting at the switch.
+
+    Returns
+    -------
+    dict
+        SI, frames in the names.
+    """
+    k_full, k_lower = len(full["time"]), len(lower["time"]) - 1
+    out = {}
+    for key in dict.fromkeys([*full, *lower]):
+        a = full.get(key)
+        b = lower[key][1:] if key in lower else None
+        if a is None:
+            a = np.full((k_full, *b.shape[1:]), np.nan)
+        if b is None:
+            b = np.full((k_lower, *a.shape[1:]), np.nan)
+        out[key] = np.concatenate([a, b])
+    out["lower_order"] = np.r_[np.zeros(k_full, bool), np.ones(k_lower, bool)]
+    return out
+
+
+def full_net_start(case: TowingCase, run_start=None):
+    """The full-net model of the case's start (wrapped, capture or an impact run's end state) and the
+    wrapped-state summary (None unless wrapped).
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with a ``[full_net]`` table.
+    run_start : riskassess.models.towing_from_run.RunStart or None
+        The impact run's end state (``full_net.start = "run"``).
+
+    Returns
+    -------
+    model : multibody.net_towing.FullNetModel
+    wrap : dict or None
+    """
+    if case.full_net.start in ("capture", "run"):
+        return full_net_model(case, run_start=run_start), None
+    net, x_body = wrapped_net(case)
+    return full_net_model(case, wrapped=(net, x_body)), wrap_summary(x_body, net, debris_geometry(case))
+
+
+def run_full_net(case: TowingCase, out: Path, run_start=None) -> tuple[dict, dict]:
+    """Run the case's full-net tow, switching to the lower-order model at quasi-steady state when
+    ``full_net.switch_to_lower_order`` (:mod:`multibody.tow_switch`); write towing.npz (the joined
+    series, :func:`joined_series`), net.npz, towing.json to ``out``. Returns (summary, series).
 
     Parameters
     ----------
@@ -74,22 +129,30 @@ def run_full_net(case: TowingCase, out: Path) -> tuple[dict, dict]:
         A towing case with a ``[full_net]`` table.
     out : Path
         The claimed run folder.
+    run_start : riskassess.models.towing_from_run.RunStart or None
+        The impact run's end state (``full_net.start = "run"``).
     """
-    if case.full_net.start == "capture":
-        model = full_net_model(case)
-        net, wrap = model.net, None
-    else:
-        net, x_body = wrapped_net(case)
-        model = full_net_model(case, wrapped=(net, x_body))
-        wrap = wrap_summary(x_body, net, debris_geometry(case))
+    model, wrap = full_net_start(case, run_start)
+    net = model.net
     result = run_exudyn(model)
     series = result.series()
     summary = summarize_full_net(case, result, wrap)
+    if run_start is not None:
+        summary["start"] = {"from_run": str(run_start.folder), "time_s": run_start.time}
     net_keys = ("net_time", "net_nodes_inertial")
-    results.atomic_write_npz(out / "towing.npz", {k: v for k, v in series.items() if k not in net_keys})
+    written = {k: v for k, v in series.items() if k not in net_keys}
+    if model.switch is not None:
+        summary["switch"] = None  # never quasi-steady: the full-net model ran to the end
+        if result.switch is not None:
+            lower, balance = lower_order_after_switch(case, result)
+            lower_result = run_lower_order(lower)
+            written = joined_series(written, lower_result.series())
+            summary = {**summary, **run_figures(case, written, model), "switch": balance,
+                       "wall_time_s": result.wall_time + lower_result.wall_time}
+    results.atomic_write_npz(out / "towing.npz", written)
     top = net.topology
     results.atomic_write_npz(out / "net.npz", {"time": series["net_time"], "nodes_inertial": series["net_nodes_inertial"],
                                                "threads": top.threads, "rest_lengths": top.rest_lengths,
                                                "stiffness": top.stiffness, "closing_threads": len(net.closing_rest_closed)})
     results.atomic_write_json(out / "towing.json", summary)
-    return summary, series
+    return summary, written

@@ -32,6 +32,9 @@ def perception_section(run: RunFolder) -> Section | None:
                     "the net collision)")]
     if answer["not_observable"]:
         blocks.append(Note(f"Not observable: {answer['not_observable']}", "alarm"))
+    for key in ("model_mismatch", "model_mass_mismatch"):
+        if answer.get(key):
+            blocks.append(Note(f"Wrong model: {answer[key]}", "warning"))
     blocks.append(_tracking_figure(answer, frames))
     tracking = answer["tracking"]
     blocks.append(Table(["phase", "frames", "registered (checked ok)", "rotation error mean (deg)", "p95 (deg)"],
