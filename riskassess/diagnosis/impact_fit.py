@@ -13,7 +13,9 @@ Every model evaluation is the coupled impact simulation itself (:mod:`riskassess
    deterministic momentum exchange much.
 2. **One-parameter fits.** Each catalog effect's parameter is fitted alone (the rest at the case's
    values): ``fit.grid`` simulations across its range, two at half the spacing around the best, then
-   one at the vertex of a parabola through the points near the best. chi^2 is not smooth in the
+   one at the vertex of a parabola through the points near the best; the effects still in contention
+   (best chi^2 within the decisive threshold of the best effect's) then get two more points at 1/4,
+   1/8 and 1/16 of the spacing around their best (:data:`NARROWING`). chi^2 is not smooth in the
    parameter (each run is one chaotic draw): the effect's value and chi^2 are its best run's, its
    1-sigma the half-width over which the parabola through the best point and its neighbours rises by
    the larger of 1 and the scatter of chi^2 between draws. The nominal model's chi^2 is its
@@ -47,6 +49,9 @@ WORKERS = 2
 NUMERICAL_FLOOR = 1e-3
 #: Scatters of chi^2 between chaotic draws added to the decisive BIC difference (decisive_threshold).
 CHAOS_SIGMAS = 3.0
+#: Further rounds for the contending effects: two points at these fractions of the grid spacing around
+#: the best point so far (after the refinement at 1/2 and the parabola's vertex).
+NARROWING = (0.25, 0.125, 0.0625)
 #: Points of an effect's fit added around the best grid point, at this fraction of the grid spacing.
 REFINE_FRACTION = 0.5
 
@@ -307,6 +312,14 @@ class EffectScan:
             return None
         return p2, -p1 / (2.0 * p2), p0 - p1 ** 2 / (4.0 * p2)
 
+    def narrowing_points(self, fraction: float) -> list[float]:
+        """Two points at ``fraction`` of the grid spacing on each side of the best point so far (inside the
+        range), leaving out any within a quarter of that of an evaluated point."""
+        best = self.u[int(np.argmin(self.chi2))]
+        h = fraction * self.spacing
+        return [u for u in (best - h, best + h)
+                if self.low <= u <= self.high and np.min(np.abs(np.array(self.u) - u)) > 0.25 * h]
+
     def vertex_point(self) -> list[float]:
         """The parabola's vertex, kept inside the bracket; none when it is already evaluated."""
         fitted = self.parabola()
@@ -426,9 +439,26 @@ def diagnose_impact(case, measured, workers: int = WORKERS, progress=None, candi
             scans[key].add(results[k:k + len(us)], [chi2(normalized(r, sigma), measured_n, problem.train)
                                                     for r in results[k:k + len(us)]])
             k += len(us)
-    n_data = int(sum(np.isfinite(measured_n[c][problem.train]).sum() for c in problem.channels))
     nominal_chi2 = [c for c in chi2s[:1 + len(ensemble)] if np.isfinite(c)]
     scatter = chi2_scatter(nominal_chi2)
+    threshold = decisive_threshold(case.diagnosis.decisive_delta_bic, scatter)
+    for fraction in NARROWING:
+        # the contenders only (best chi^2 within the decisive threshold of the best effect's): a coarse
+        # grid point next to the truth can mispredict the held-out windows of a well-determined parameter
+        lowest = min(min(s.chi2) for s in scans.values())
+        points = {key: s.narrowing_points(fraction) for key, s in scans.items() if min(s.chi2) <= lowest + threshold}
+        batch = [scans[key].overrides(u, base) for key, us in points.items() for u in us]
+        if not batch:
+            break
+        results = simulate_all(problem.run, batch, workers, progress, done, done + len(batch))
+        done += len(batch)
+        k = 0
+        for key, us in points.items():
+            scans[key].u += us
+            scans[key].add(results[k:k + len(us)], [chi2(normalized(r, sigma), measured_n, problem.train)
+                                                    for r in results[k:k + len(us)]])
+            k += len(us)
+    n_data = int(sum(np.isfinite(measured_n[c][problem.train]).sum() for c in problem.channels))
     seconds = clock.perf_counter() - wall[0]
     fits = {"nominal": FitResult("nominal", [], [], np.zeros(0), np.zeros(0), 0, float(chi2s[0]), 0.0, n_data,
                                  seconds, 1, "the unperturbed nominal run")}
