@@ -24,7 +24,8 @@ Every model evaluation is the coupled impact simulation itself (:mod:`riskassess
 3. **Selection** by the shared rules (:func:`riskassess.diagnosis.selection.decide`: BIC decisive
    against the nominal and the runner-up, adequacy, no structure left, material gain) on the
    normalized window values (each divided by its sigma, so that the RMS and whiteness tests read in
-   sigmas). The runs of every effect's points go to the worker processes together (three rounds).
+   sigmas). The runs of every effect's points go to the worker processes together (three rounds, then
+   up to three narrowing rounds).
 """
 from __future__ import annotations
 
