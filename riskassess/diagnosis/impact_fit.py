@@ -30,6 +30,7 @@ Every model evaluation is the coupled impact simulation itself (:mod:`riskassess
 from __future__ import annotations
 
 import multiprocessing
+import resource
 import time as clock
 from dataclasses import dataclass
 
@@ -482,8 +483,6 @@ def cpu_seconds() -> float:
     -------
     seconds : float
     """
-    import resource
-
     own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 

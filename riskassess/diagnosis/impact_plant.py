@@ -24,7 +24,8 @@ from multibody.impact import ImpactSimulation
 from riskassess.cases.impact import read_toml, validate_case
 from riskassess.diagnosis.channels import OMEGA, QUATERNION, REL, VELOCITY
 from riskassess.diagnosis.impact_effects.base import case_with_overrides
-from riskassess.models.impact import model_inputs
+from riskassess.cases.target_geometry import body_meshes_target_frame
+from riskassess.models.impact import mass_properties_target_frame, model_inputs
 
 #: The fitted channels (window means).
 FIT_CHANNELS = VELOCITY + OMEGA
@@ -254,9 +255,6 @@ def simulate_record(impact_path, overrides: dict, end_time: float, rate: float) 
         (s, from the launch).
     channels : dict of str to (k,) float
     """
-    from riskassess.cases.target_geometry import body_meshes_target_frame
-    from riskassess.models.impact import mass_properties_target_frame
-
     raw = case_with_overrides(read_toml(impact_path), {**overrides, "simulation.end_time": float(end_time),
                                                        "simulation.output_rate": float(rate),
                                                        "simulation.net_output_rate": NET_OUTPUT_RATE})

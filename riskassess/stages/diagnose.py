@@ -5,6 +5,8 @@ Steps: read the case (:mod:`riskassess.cases.diagnosis`) and the measured CSV
 on the training part (:mod:`riskassess.diagnosis.fit`, two worker processes); score every model on the
 held-out part and select (:mod:`riskassess.diagnosis.selection`); analyse the residuals before and after
 (:mod:`riskassess.diagnosis.residuals`) and hint at the form of what is left (:mod:`riskassess.diagnosis.hint`).
+The impact scenario (the net capture, ``scenario = "impact"``) has its own fit and catalog
+(:mod:`riskassess.diagnosis.impact_fit`); its answer is selected by the same rules.
 
 Writes into the output folder (default ``runs/<case name>-diagnosis``), each file atomically:
 ``diagnosis.json`` (the answer), ``diagnosis.npz`` (time series behind the plots), PNG plots,
