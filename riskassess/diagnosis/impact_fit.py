@@ -24,7 +24,7 @@ Every model evaluation is the coupled impact simulation itself (:mod:`riskassess
 3. **Selection** by the shared rules (:func:`riskassess.diagnosis.selection.decide`: BIC decisive
    against the nominal and the runner-up, adequacy, no structure left, material gain) on the
    normalized window values (each divided by its sigma, so that the RMS and whiteness tests read in
-   sigmas). The runs of every effect's points go to the worker processes together (three rounds, then
+   sigmas); a channel whose sigma is mostly chaos is not tested for whiteness (:func:`chaos_share`). The runs of every effect's points go to the worker processes together (three rounds, then
    up to three narrowing rounds).
 """
 from __future__ import annotations
@@ -475,6 +475,27 @@ def diagnose_impact(case, measured, workers: int = WORKERS, progress=None, candi
     return _answer(case, problem, fits, predictions, diverged, scans, sigma, spread, nominal_chi2, measured_n, wall)
 
 
+def chaos_share(problem: ImpactProblem, sigma: dict, spread: dict) -> dict:
+    """Per channel: the RMS over the training windows of the chaotic part of the normalized residual's
+    sigma, sqrt(2) s / sigma (-, at most 1). The selection takes it as the model's own structured error
+    (its ``step_error_sigma``, :mod:`riskassess.diagnosis.selection`): a channel where it is above 0.5
+    sigma is not tested for structure (two chaotic draws differ smoothly from window to window, not as
+    white noise), and its adequacy bound widens to sqrt(adequate_rms^2 + share^2).
+
+    Parameters
+    ----------
+    problem : ImpactProblem
+    sigma, spread : dict of str to (w,) float
+        Window sigmas and ensemble spreads (channel units).
+
+    Returns
+    -------
+    share : dict of str to float
+    """
+    return {c: float(np.sqrt(np.mean((np.sqrt(2.0) * spread[c] / sigma[c])[problem.train] ** 2)))
+            for c in problem.channels}
+
+
 def cpu_seconds() -> float:
     """CPU time (s) of this process and its finished children (the worker processes): the wall time
     the diagnosis would take on idle cores is about this over the workers, whatever the machine's load.
@@ -526,7 +547,8 @@ def _answer(case, problem, fits, predictions, diverged, scans, sigma, spread, no
     """The decision and the answer dict (keys shared with the other scenarios where they mean the same)."""
     scoring = Problem(case, None, problem.centers, measured_n, {c: 1.0 for c in problem.channels}, problem.train,
                       [], np.zeros(0), np.zeros(0))
-    scores = score(scoring, predictions)
+    share = chaos_share(problem, sigma, spread)
+    scores = score(scoring, predictions, {k: share for k in predictions})
     threshold = decisive_threshold(case.diagnosis.decisive_delta_bic, chi2_scatter(nominal_chi2))
     decision = decide(fits, scores, threshold, case.diagnosis.adequate_rms, scoring)
     chosen = decision["model"]
@@ -556,7 +578,8 @@ def _answer(case, problem, fits, predictions, diverged, scans, sigma, spread, no
                     "split_time_s": float(problem.centers[problem.train][-1])},
         "chaos": {"ensemble_runs": case.fit.ensemble, "perturbation": case.fit.perturbation,
                   "spread_median": {c: float(np.median(spread[c])) for c in problem.channels},
-                  "sigma_median": {c: float(np.median(sigma[c])) for c in problem.channels}},
+                  "sigma_median": {c: float(np.median(sigma[c])) for c in problem.channels},
+                  "share_of_sigma": share},
         "decisive_delta_bic": case.diagnosis.decisive_delta_bic, "decisive_with_chaos": threshold,
         "chi2_scatter": chi2_scatter(nominal_chi2), "adequate_rms": case.diagnosis.adequate_rms,
         "simulations": int(sum(len(s.u) for s in scans.values()) + 1 + case.fit.ensemble),
