@@ -464,6 +464,8 @@ def _cmd_diagnose(args) -> int:
                                overwrite=args.overwrite)
     if args.json:
         print(json.dumps(answer, indent=2, default=float))
+    elif answer["scenario"] == "impact":
+        _print_impact_diagnosis(answer, args.out)
     else:
         confidence = "" if answer["confidence"] is None else f" (confidence {answer['confidence']:.3f})"
         print(f"{answer['case']}: cause = {answer['cause']}{confidence}\n{answer['statement']}")
@@ -484,6 +486,24 @@ def _cmd_diagnose(args) -> int:
                 print(f"{label}: {', '.join(answer['channels'][key])}")
         print(f"results: {args.out or default_out(answer['case'], '-diagnosis')}")
     return 0
+
+
+def _print_impact_diagnosis(answer: dict, out) -> None:
+    """The impact scenario's answer as text: cause, why, the fitted parameter and every candidate."""
+    confidence = "" if answer["confidence"] is None else f" (confidence {answer['confidence']:.3f})"
+    print(f"{answer['case']}: cause = {answer['cause']}{confidence}\n{answer['statement']}")
+    for name, p in answer["parameters"].items():
+        print(f"  {name} = {p['value']:.4g} +- {p['std']:.2g} {p['unit']}")
+    print("candidates (delta BIC over the nominal model, fitted value, training / held-out RMS in sigmas):")
+    for row in answer["candidates"]:
+        (name, p), = row["parameters"].items()
+        print(f"  {row['id']:<24s} {row['delta_bic']:10.1f}  {name} = {p['value']:.4g} {p['unit']}  "
+              f"{row['train_rms_sigma']:.2f} / {row['holdout_rms_sigma']:.2f}")
+    print(f"nominal: {answer['nominal']['train_rms_sigma']:.2f} / {answer['nominal']['holdout_rms_sigma']:.2f} sigma; "
+          f"{answer['simulations']} simulations in {answer['wall_s']:.0f} s")
+    if answer["extended_case"]:
+        print(f"extended case: {answer['extended_case']}")
+    print(f"results: {out or default_out(answer['case'], '-diagnosis')}")
 
 
 def _cmd_approach(args) -> int:
@@ -652,7 +672,8 @@ def build_parser() -> argparse.ArgumentParser:
     tow.add_argument("--force", action="store_true", help="run even when the estimated work is above the limit")
     diagnose = sub.add_parser("diagnose", help="compare a simulated scenario with measured data, name the missing "
                                                "effect, fit it and report the prediction gain")
-    diagnose.add_argument("case", help="diagnosis case file (TOML, kind tumbling_rigid or hinged_appendage)")
+    diagnose.add_argument("case", help="diagnosis case file (TOML, kind = \"diagnosis\", scenario tumbling_rigid, "
+                                          "hinged_appendage, towing or impact)")
     diagnose.add_argument("--measured", required=True, help="measured data (CSV: time, then named channels, SI)")
     diagnose.add_argument("--out", help="output folder (default runs/<case name>-diagnosis)")
     diagnose.add_argument("--overwrite", action="store_true", help=OVERWRITE_HELP)

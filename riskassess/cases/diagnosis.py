@@ -9,6 +9,9 @@ picked by the top-level ``kind``:
 * ``"towing"``: post-capture towing, the lower-order tethered model (:mod:`multibody.towing`) of a
   towing case file that the diagnosis case names (``towing = "zenit2_towing.toml"``, relative to
   the diagnosis case; its tethers, masses, thrust law and initial state are the nominal model).
+* ``"impact"``: the net capture, the coupled Exudyn impact simulation of an impact case file that
+  the diagnosis case names (``impact = "envisat_small.toml"``); the record is the debris main
+  body's motion after the capture, its times from the impact case's t = 0 (the launch).
 
 Frames: **target frame** = the main body's reference frame; the main body frame has the same
 axes and its origin at the main body's CoM. **LVLH** is chaser-centred (x radial, y along-track,
@@ -243,7 +246,69 @@ class TowingDiagnosisCase(Strict):
         return self._towing_case
 
 
-DiagnosisCase = Union[TumblingRigidCase, HingedAppendageCase, TowingDiagnosisCase]
+class ImpactFit(Strict):
+    """How the impact scenario compares the record with the coupled simulation (docs/diagnosis.md,
+    "Impact scenario")."""
+    window: Annotated[float, Field(gt=0, le=10.0)] = Field(
+        0.5, description="Length of the windows over which the record and the simulation are averaged (s): the "
+                         "fit compares window means of the main body's CoM velocity and body rates.")
+    ensemble: Annotated[int, Field(ge=2, le=16)] = Field(
+        4, description="Runs of the nominal model with the launch speed perturbed by +-k x 'perturbation' "
+                       "(k = 1, 2, ...): their spread is the model's chaotic run-to-run error, added to the noise.")
+    perturbation: Annotated[float, Field(gt=0, le=1e-3)] = Field(
+        1e-7, description="Relative launch-speed perturbation of the ensemble runs (-).")
+    grid: Annotated[int, Field(ge=3, le=15)] = Field(
+        5, description="Simulations per effect on the first pass over its parameter range (-); three more refine it.")
+
+
+class ImpactDiagnosisCase(Strict):
+    """The net capture: the coupled impact simulation of the impact case ``impact`` is the nominal."""
+    kind: Literal["impact"]
+    name: CaseName = Field(description="Case name; default output folder runs/<name>-diagnosis.")
+    description: Text = ""
+    impact: RelativeFile = Field(description="Impact case file (riskassess/cases/impact.py), relative to this file, in "
+                                             "its folder or below: net, launch, contact law and debris.")
+    fit: ImpactFit = ImpactFit()
+    diagnosis: Diagnosis = Diagnosis()
+    effects: list[EffectEntry] = Field([], description="Impact-model effects set in this model (an extended case): "
+                                                       "their parameters replace the impact case's values.")
+    _impact_case: object = PrivateAttr(None)
+    _impact_path: object = PrivateAttr(None)
+
+    @field_validator("effects")
+    @classmethod
+    def _unique(cls, effects):
+        return unique_names(effects, "effect", "id")
+
+    @model_validator(mode="after")
+    def _load_impact(self, info: ValidationInfo):
+        base = Path((info.context or {}).get("case_dir", "."))
+        try:
+            path = resolve_reference(base, self.impact, CASE_FILE_LIMIT)
+        except ValueError as exc:
+            raise ValueError(f"impact: impact case {exc}") from None
+        try:
+            self._impact_case = impact.load_case(path)
+        except CaseError as exc:
+            raise ValueError(f"impact: the impact case cannot be loaded: {exc}") from None
+        if self._impact_case.simulation.coupling != "coupled":
+            raise ValueError("impact: the diagnosis simulates the net and the debris together; the impact case "
+                             "needs simulation.coupling = 'coupled'")
+        self._impact_path = path
+        return _check_effects(self, info)
+
+    @property
+    def impact_case(self):
+        """The validated :class:`riskassess.cases.impact.Case`."""
+        return self._impact_case
+
+    @property
+    def impact_path(self) -> Path:
+        """The impact case file's path."""
+        return self._impact_path
+
+
+DiagnosisCase = Union[TumblingRigidCase, HingedAppendageCase, TowingDiagnosisCase, ImpactDiagnosisCase]
 
 
 #: The scenario kinds, as a file names them in ``scenario`` (or, written before case kinds, in ``kind``).
@@ -309,7 +374,7 @@ def diagnosis_case_from_dict(raw: dict, case_dir=".", effect_catalog=None) -> Di
     Returns
     -------
     DiagnosisCase
-        The scenario model (tumbling_rigid, hinged_appendage or towing).
+        The scenario model (tumbling_rigid, hinged_appendage, towing or impact).
 
     Raises
     ------

@@ -29,7 +29,7 @@ KINDS = """## Case kinds
 
 Every case file starts with its kind: `kind = "impact"` (run, assess, perceive, sweep), `"towing"` (tow,
 identify), `"approach"` or `"diagnosis"`; a diagnosis file adds its scenario: `scenario = "tumbling_rigid"`,
-`"hinged_appendage"` or `"towing"` (docs/diagnosis.md). Files written before the kind was explicit (no
+`"hinged_appendage"`, `"towing"` or `"impact"` (docs/diagnosis.md). Files written before the kind was explicit (no
 `kind`; a diagnosis file with its scenario in `kind`) are read as before: the kind is told from their tables.
 An unknown kind is refused with the list of kinds.
 """
@@ -52,7 +52,7 @@ on load, before any work; each error names the file, the key and what is allowed
   name as an index. Each body, joint, weak location and (diagnosis) effect id appears once.
 - **Text** (`description`, `reference.source`): at most {limits.MAX_TEXT} characters, no control characters
   other than newline and tab.
-- **Files a case names** (a mesh `file`, `mass_properties_from`, a diagnosis case's `towing`): a path
+- **Files a case names** (a mesh `file`, `mass_properties_from`, a diagnosis case's `towing` or `impact`): a path
   relative to the case file, in its folder or below: no absolute path and no `..` component. The file must
   be a regular file (a directory, a device such as /dev/zero or a pipe is refused), at most
   {limits.MESH_FILE_LIMIT:,} bytes for a mesh, {limits.JSON_FILE_LIMIT:,} bytes for a perception.json and

@@ -5,6 +5,10 @@ from __future__ import annotations
 
 from riskassess.cases import diagnosis as schema
 from riskassess.diagnosis.effects import CATALOG
+from riskassess.diagnosis.impact_effects import IMPACT_CATALOG
+
+#: Every effect a case's ``[[effects]]`` may name: the attitude and towing catalog and the impact one.
+ALL_EFFECTS = {**CATALOG, **IMPACT_CATALOG}
 
 
 def load_diagnosis_case(path) -> schema.DiagnosisCase:
@@ -20,7 +24,7 @@ def load_diagnosis_case(path) -> schema.DiagnosisCase:
     -------
     case : DiagnosisCase
     """
-    return schema.load_diagnosis_case(path, CATALOG)
+    return schema.load_diagnosis_case(path, ALL_EFFECTS)
 
 
 def diagnosis_case_from_dict(raw: dict, case_dir=".") -> schema.DiagnosisCase:
@@ -37,4 +41,4 @@ def diagnosis_case_from_dict(raw: dict, case_dir=".") -> schema.DiagnosisCase:
     -------
     case : DiagnosisCase
     """
-    return schema.diagnosis_case_from_dict(raw, case_dir, CATALOG)
+    return schema.diagnosis_case_from_dict(raw, case_dir, ALL_EFFECTS)

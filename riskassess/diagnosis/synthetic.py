@@ -13,8 +13,8 @@ from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn
 
 #: Default 1-sigma noise per channel group (channel units): a MEMS gyro at 10 Hz (2e-4 rad/s), a
 #: star tracker (~1e-3 per quaternion component, ~7 arcmin), an encoder (1e-3 rad), its rate
-#: (1e-3 rad/s), relative navigation (1 cm), a tether load cell (0.5 N: 0.25 % of a 200 N range).
-NOISE = {"omega": 2e-4, "q": 1e-3, "hinge_angle": 1e-3, "hinge_rate": 1e-3, "rel": 0.01, "tether": 0.5}
+#: (1e-3 rad/s), relative navigation (1 cm; its velocity 1 mm/s), a tether load cell (0.5 N: 0.25 % of a 200 N range).
+NOISE = {"omega": 2e-4, "q": 1e-3, "hinge_angle": 1e-3, "hinge_rate": 1e-3, "rel": 0.01, "tether": 0.5, "vel": 1e-3}
 
 
 def channel_noise(channel: str, scale: float = 1.0) -> float:

@@ -5,6 +5,8 @@ Steps: read the case (:mod:`riskassess.cases.diagnosis`) and the measured CSV
 on the training part (:mod:`riskassess.diagnosis.fit`, two worker processes); score every model on the
 held-out part and select (:mod:`riskassess.diagnosis.selection`); analyse the residuals before and after
 (:mod:`riskassess.diagnosis.residuals`) and hint at the form of what is left (:mod:`riskassess.diagnosis.hint`).
+The impact scenario (the net capture, ``scenario = "impact"``) has its own fit and catalog
+(:mod:`riskassess.diagnosis.impact_fit`); its answer is selected by the same rules.
 
 Writes into the output folder (default ``runs/<case name>-diagnosis``), each file atomically:
 ``diagnosis.json`` (the answer), ``diagnosis.npz`` (time series behind the plots), PNG plots,
@@ -28,6 +30,7 @@ from riskassess.diagnosis.forward import make_pairs, pair_candidates, selection_
 from riskassess.diagnosis.fit import (CandidateFit, FitResult, Problem, first_unpredicted_time, prediction,
                            step_error_sigma)
 from multibody.health import SimulationFailed
+from riskassess.diagnosis.impact_fit import diagnose_impact
 from riskassess.diagnosis.hint import describe_terms, library, sparse_terms
 from riskassess.diagnosis.channels import CHANNELS
 from riskassess.diagnosis.measured import read_measured
@@ -285,6 +288,9 @@ def diagnose_case(case_path, measured_path, out_dir=None, noise: dict | None = N
     case_path = Path(case_path)
     case = load_diagnosis_case(case_path)
     measured = read_measured(measured_path, noise)
+    if case.kind == "impact":
+        return _diagnose_impact_case(case, case_path, measured, measured_path, out_dir, workers, progress, candidates,
+                                     overwrite)
     problem = Problem.build(case, measured, case.diagnosis.holdout_fraction)
     if not problem.channels:
         raise ValueError(f"{measured_path}: none of its channels ({', '.join(measured.channels)}) is predicted by the "
@@ -399,15 +405,64 @@ def _unfitted(problem: Problem) -> FitResult:
 
 
 def _copy_towing_reference(out: Path, case_path: Path) -> list[str]:
-    """Copy a towing diagnosis case's towing case into ``out`` at the same relative path, so that
-    ``case.toml`` and the extended case there load; the copied names (none for other kinds)."""
+    """Copy a towing (impact) diagnosis case's towing (impact) case into ``out`` at the same relative
+    path, so that ``case.toml`` and the extended case there load; the copied names (none for other kinds)."""
     raw = read_toml(case_path)
-    if scenario_form(raw).get("kind") != "towing":
+    kind = scenario_form(raw).get("kind")
+    if kind not in ("towing", "impact"):
         return []
-    name = raw["towing"]        # validated on load: relative, in the case's folder or below
+    name = raw[kind]            # validated on load: relative, in the case's folder or below
     (out / name).parent.mkdir(parents=True, exist_ok=True)
     results.atomic_write_bytes(out / name, (case_path.parent / name).read_bytes())
     return [name]
+
+
+def _diagnose_impact_case(case, case_path: Path, measured, measured_path, out_dir, workers, progress, candidates,
+                          overwrite) -> dict:
+    """:func:`diagnose_case` of the impact scenario (:mod:`riskassess.diagnosis.impact_fit`): the answer into
+    ``diagnosis.json``, the window values into ``diagnosis.npz``, the case, its impact case and, when a
+    cause is named, the extended case (its ``[[effects]]`` entry) into the output folder."""
+    folder = claim(out_dir or default_out(case.name, "-diagnosis"), case.name, "diagnose", overwrite, stage="diagnose")
+    with folder.recording():
+        results.atomic_write_bytes(folder.path / "case.toml", case_path.read_bytes())
+        folder.add_files("case.toml", *_copy_towing_reference(folder.path, case_path))
+        answer, arrays = diagnose_impact(case, measured, workers, progress, candidates)
+        answer["measured"] = str(measured_path)
+        answer["extended_case"] = None
+        files = ["diagnosis.json", "diagnosis.npz"]
+        if answer["cause"] == answer["model"] and answer["model"] != "nominal":
+            target = folder.path / f"{safe_name(case_path.stem)}.extended.toml"
+            results.atomic_write_bytes(target, impact_extended_case(case_path, answer).encode())
+            answer["extended_case"] = str(target)
+            files.append(target.name)
+        results.atomic_write_npz(folder.path / "diagnosis.npz", arrays)
+        results.atomic_write_json(folder.path / "diagnosis.json", answer)
+        folder.add_files(*files)
+    folder.finish("complete")
+    return answer
+
+
+def impact_extended_case(case_path: Path, answer: dict) -> str:
+    """The impact diagnosis case with the named effect and its fitted parameter in ``[[effects]]``.
+
+    Parameters
+    ----------
+    case_path : Path
+        The diagnosis case file.
+    answer : dict
+        The impact diagnosis answer (its ``cause`` and ``parameters``, SI).
+
+    Returns
+    -------
+    str
+        TOML text with a comment header.
+    """
+    raw = read_toml(case_path)
+    entry = {"id": answer["cause"], "parameters": {n: p["value"] for n, p in answer["parameters"].items()}}
+    raw["effects"] = [e for e in raw.get("effects", []) if e.get("id") != entry["id"]] + [entry]
+    header = (f"# Extended by 'riskassess diagnose' from {case_path.name}: impact effect '{entry['id']}' set to its\n"
+              f"# fitted value; the impact case is referenced relative to this file (a copy sits beside it).\n")
+    return header + toml_text(raw) + "\n"
 
 
 def _write(folder: OutputFolder, case_path: Path, answer, data: tuple, figures: bool = True) -> None:

@@ -153,7 +153,7 @@ def test_shipped_case_and_item_names_conform():
     names = [re.findall(r'^name = "([^"]*)"', (path.read_text()), re.M) for path in CASES.glob("*.toml")]
     assert all(re.fullmatch(CASE_NAME_PATTERN, n[0]) and all(re.fullmatch(ITEM_NAME_PATTERN, m) for m in n[1:])
                for n in names), names
-    assert len(names) == 20       # every shipped case was read
+    assert len(names) == 21       # every shipped case was read
 
 
 def test_control_characters_in_description_are_refused(tmp_path):
