@@ -30,21 +30,20 @@ def _euler_rate(omega, j):
 
 
 @njit(cache=True)
-def _quaternion_rate(q, omega):
-    """dq/dt = q ⊗ (0, ω)/2 for q = [w, x, y, z] (body->world), ω in the body frame."""
-    w, x, y, z = q
-    a, b, c = omega
-    return 0.5 * np.array([-x * a - y * b - z * c, w * a + y * c - z * b, w * b + z * a - x * c, w * c + x * b - y * a])
-
-
-@njit(cache=True)
 def _torque_free_rate(t, x, j):
-    """d/dt of the state x = [q (4), ω (3)] (quaternion principal->world, rate rad/s principal frame)
-    of a torque-free body with principal moments ``j``; ``t`` (s) is not read (autonomous)."""
-    q, omega = x[0:4], x[4:7]
+    """d/dt of the state x = [q (4), ω (3)] of a torque-free body with principal moments ``j``: dq/dt =
+    q ⊗ (0, ω)/2 (q = [w, x, y, z] principal->world, ω rad/s principal frame) and Euler's equations
+    (:func:`_euler_rate`, written out: one allocation per evaluation); ``t`` (s) is not read."""
+    w, a, b, c = x[0], x[1], x[2], x[3]
+    o0, o1, o2 = x[4], x[5], x[6]
     out = np.empty(7)
-    out[0:4] = _quaternion_rate(q, omega)
-    out[4:7] = _euler_rate(omega, j)
+    out[0] = 0.5 * (-a * o0 - b * o1 - c * o2)
+    out[1] = 0.5 * (w * o0 + b * o2 - c * o1)
+    out[2] = 0.5 * (w * o1 + c * o0 - a * o2)
+    out[3] = 0.5 * (w * o2 + a * o1 - b * o0)
+    out[4] = (j[1] - j[2]) * o1 * o2 / j[0]
+    out[5] = (j[2] - j[0]) * o2 * o0 / j[1]
+    out[6] = (j[0] - j[1]) * o0 * o1 / j[2]
     return out
 
 
