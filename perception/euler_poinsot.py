@@ -17,6 +17,7 @@ from numba import njit
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
+from multibody.rk4 import rk4_at_times
 from perception.motion import integrated_autocorrelation_time
 
 
@@ -29,18 +30,29 @@ def _euler_rate(omega, j):
 
 
 @njit(cache=True)
-def _quaternion_rate(q, omega):
-    """dq/dt = q ⊗ (0, ω)/2 for q = [w, x, y, z] (body->world), ω in the body frame."""
-    w, x, y, z = q
-    a, b, c = omega
-    return 0.5 * np.array([-x * a - y * b - z * c, w * a + y * c - z * b, w * b + z * a - x * c, w * c + x * b - y * a])
+def _torque_free_rate(t, x, j):
+    """d/dt of the state x = [q (4), ω (3)] of a torque-free body with principal moments ``j``: dq/dt =
+    q ⊗ (0, ω)/2 (q = [w, x, y, z] principal->world, ω rad/s principal frame) and Euler's equations
+    (:func:`_euler_rate`, written out: one allocation per evaluation); ``t`` (s) is not read."""
+    w, a, b, c = x[0], x[1], x[2], x[3]
+    o0, o1, o2 = x[4], x[5], x[6]
+    out = np.empty(7)
+    out[0] = 0.5 * (-a * o0 - b * o1 - c * o2)
+    out[1] = 0.5 * (w * o0 + b * o2 - c * o1)
+    out[2] = 0.5 * (w * o1 + c * o0 - a * o2)
+    out[3] = 0.5 * (w * o2 + a * o1 - b * o0)
+    out[4] = (j[1] - j[2]) * o1 * o2 / j[0]
+    out[5] = (j[2] - j[0]) * o2 * o0 / j[1]
+    out[6] = (j[0] - j[1]) * o0 * o1 / j[2]
+    return out
 
 
 @njit(cache=True)
 def propagate_torque_free(q0, omega0, principal_moments, times, max_step):
     """Attitude quaternions (k, 4) [w, x, y, z] principal->world and rates (k, 3) (rad/s,
-    principal frame) at ``times`` (s, increasing, ``times[0]`` the initial time), by RK4
-    with steps no longer than ``max_step`` (s).
+    principal frame) at ``times`` (s, increasing, ``times[0]`` the initial time), by the shared RK4
+    (:func:`multibody.rk4.rk4_at_times`) with steps no longer than ``max_step`` (s), the quaternion
+    renormalised every step.
 
     Parameters
     ----------
@@ -62,32 +74,10 @@ def propagate_torque_free(q0, omega0, principal_moments, times, max_step):
     omegas : (k, 3) float
         Angular rates (rad/s, principal frame) at ``times``.
     """
-    k = times.shape[0]
-    qs = np.empty((k, 4))
-    ws = np.empty((k, 3))
-    q = q0.copy()
-    w = omega0.copy()
-    qs[0] = q
-    ws[0] = w
-    for i in range(1, k):
-        span = times[i] - times[i - 1]
-        n = max(1, int(np.ceil(span / max_step)))
-        h = span / n
-        for _ in range(n):
-            k1q = _quaternion_rate(q, w)
-            k1w = _euler_rate(w, principal_moments)
-            k2q = _quaternion_rate(q + 0.5 * h * k1q, w + 0.5 * h * k1w)
-            k2w = _euler_rate(w + 0.5 * h * k1w, principal_moments)
-            k3q = _quaternion_rate(q + 0.5 * h * k2q, w + 0.5 * h * k2w)
-            k3w = _euler_rate(w + 0.5 * h * k2w, principal_moments)
-            k4q = _quaternion_rate(q + h * k3q, w + h * k3w)
-            k4w = _euler_rate(w + h * k3w, principal_moments)
-            q = q + h / 6.0 * (k1q + 2 * k2q + 2 * k3q + k4q)
-            w = w + h / 6.0 * (k1w + 2 * k2w + 2 * k3w + k4w)
-            q = q / np.sqrt(q @ q)
-        qs[i] = q
-        ws[i] = w
-    return qs, ws
+    x0 = np.empty(7)
+    x0[0:4], x0[4:7] = q0, omega0
+    states = rk4_at_times(_torque_free_rate, (principal_moments,), x0, times[0], times, max_step, 0)
+    return np.ascontiguousarray(states[:, 0:4]), np.ascontiguousarray(states[:, 4:7])
 
 
 def rotations_from_wxyz(q) -> Rotation:

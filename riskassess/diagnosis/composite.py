@@ -4,8 +4,9 @@
 applying both effects: parameters concatenated (the first effect's, then the second's), plant
 modifications, sample times and sensor models chained, and the two numba load laws called in turn
 by one compiled law (:func:`paired_law`), so the pair runs in the same fast model, towing model and
-Exudyn builder as a single effect. Two effects that both carry extra states (the fast model has one
-slot for them) cannot be paired (:func:`can_pair`).
+Exudyn builder as a single effect. The pair's own states are both effects' blocks, the first's then
+the second's (``extra_states`` and ``towing_extra_states`` add up); the pair law hands each law its
+own block, so two effects with states pair like any others.
 """
 from __future__ import annotations
 
@@ -13,14 +14,14 @@ import numpy as np
 from numba import njit
 
 from riskassess.diagnosis.dynamics import LAW_SIGNATURE
-from riskassess.diagnosis.effects.base import Effect, Parameter, switched_off
+from riskassess.diagnosis.effects.base import Effect, Parameter, own_states, switched_off
 from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
 
-_COMPILED: dict = {}     # (law, law, split) -> compiled pair law: each pair compiles once per process
+_COMPILED: dict = {}     # (law, law, splits, towing) -> compiled pair law: each pair compiles once per process
 
 
 def can_pair(first: Effect, second: Effect) -> bool:
-    """Whether the two effects can be fitted together (different effects, not both with extra states).
+    """Whether the two effects can be fitted together: two different effects (each keeps its own states).
 
     Parameters
     ----------
@@ -31,12 +32,13 @@ def can_pair(first: Effect, second: Effect) -> bool:
     -------
     ok : bool
     """
-    return first.id != second.id and not (first.extra_state and second.extra_state)
+    return first.id != second.id
 
 
-def paired_law(law_a, law_b, split: int, towing: bool = False):
-    """One compiled load law that calls ``law_a`` with ``p[:split]`` and ``law_b`` with ``p[split:]``
-    (the fast model's signature, or the towing model's with ``towing``).
+def paired_law(law_a, law_b, split: int, states_split: int = 0, towing: bool = False):
+    """One compiled load law that calls ``law_a`` with ``p[:split]`` and its own states (the first
+    ``states_split`` entries of the pair's block) and ``law_b`` with ``p[split:]`` and the rest (the
+    fast model's signature, or the towing model's with ``towing``).
 
     Parameters
     ----------
@@ -44,26 +46,28 @@ def paired_law(law_a, law_b, split: int, towing: bool = False):
         The two effects' laws (``LAW_SIGNATURE`` or ``TOWING_LAW_SIGNATURE``).
     split : int
         Length of ``law_a``'s parameter array.
+    states_split : int
+        Number of ``law_a``'s own states (its effect's ``extra_states`` or ``towing_extra_states``).
     towing : bool
         Whether the laws are towing laws.
 
     Returns
     -------
     law : compiled function
-        Same signature; cached per (laws, split, towing).
+        Same signature; cached per (laws, splits, towing).
     """
-    key = (law_a, law_b, split, towing)
+    key = (law_a, law_b, split, states_split, towing)
     if key not in _COMPILED:
         if towing:
             @njit(TOWING_LAW_SIGNATURE)
             def law(t, x, v, p, env, state, step, load):
-                law_a(t, x, v, np.ascontiguousarray(p[:split]), env, state, step, load)
-                law_b(t, x, v, np.ascontiguousarray(p[split:]), env, state, step, load)
+                law_a(t, x, v, np.ascontiguousarray(p[:split]), env, state[:states_split], step, load)
+                law_b(t, x, v, np.ascontiguousarray(p[split:]), env, state[states_split:], step, load)
         else:
             @njit(LAW_SIGNATURE)
-            def law(t, x, p, env, load):
-                law_a(t, x, np.ascontiguousarray(p[:split]), env, load)
-                law_b(t, x, np.ascontiguousarray(p[split:]), env, load)
+            def law(t, x, p, env, load, xe, xe_rate):
+                law_a(t, x, np.ascontiguousarray(p[:split]), env, load, xe[:states_split], xe_rate[:states_split])
+                law_b(t, x, np.ascontiguousarray(p[split:]), env, load, xe[states_split:], xe_rate[states_split:])
         _COMPILED[key] = law
     return _COMPILED[key]
 
@@ -79,7 +83,8 @@ class EffectPair(Effect):
         self.id = f"{first.id}+{second.id}"
         self.title = f"{first.title}, and {second.title}"
         self.scenarios = tuple(s for s in first.scenarios if s in second.scenarios)
-        self.extra_state = first.extra_state or second.extra_state
+        self.extra_states = first.extra_states + second.extra_states
+        self.towing_extra_states = first.towing_extra_states + second.towing_extra_states
         self._specs = (first.parameter_specs(case, channels), second.parameter_specs(case, channels))
         self._start_values = start_values
         self.n_first = len(self._specs[0])
@@ -89,12 +94,42 @@ class EffectPair(Effect):
     def law(self):
         """The fast model's pair law (compiled on first use: ~1 s)."""
         split = len(self.first.law_parameters(self._plant, switched_off(self._specs[0])))
-        return paired_law(self.first.law, self.second.law, split)
+        return paired_law(self.first.law, self.second.law, split, self.first.extra_states)
 
     @property
     def towing_law(self):
+        """The towing model's pair law (compiled on first use)."""
         split = len(self.first.towing_law_parameters(self._plant, switched_off(self._specs[0])))
-        return paired_law(self.first.towing_law, self.second.towing_law, split, towing=True)
+        return paired_law(self.first.towing_law, self.second.towing_law, split, self.first.towing_extra_states,
+                          towing=True)
+
+    def initial_extra_states(self, plant):
+        """Both effects' own states in the fast model, the first's block then the second's.
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant the laws run on.
+
+        Returns
+        -------
+        xe0 : (extra_states,) float
+        """
+        return np.r_[own_states(self.first, plant), own_states(self.second, plant)]
+
+    def initial_towing_states(self, model):
+        """Both effects' own states in the towing model, the first's block then the second's.
+
+        Parameters
+        ----------
+        model : TowingModel
+            The built towing model.
+
+        Returns
+        -------
+        xe0 : (towing_extra_states,) float
+        """
+        return np.r_[own_states(self.first, model, towing=True), own_states(self.second, model, towing=True)]
 
     def _split(self, values):
         values = np.asarray(values, float)

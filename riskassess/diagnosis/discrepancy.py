@@ -42,17 +42,17 @@ def _legendre(t, t0, t1):
 
 
 @njit(LAW_SIGNATURE, cache=True)
-def law(t, x, p, env, load):
+def law(t, x, p, env, load, xe, xe_rate):
     """``p`` = [t0, t1, hinged (0/1), body torque coefficients (3 axes x 3, B), hinge torque (3)].
 
     Parameters
     ----------
     t : float
         Time (s) from the record's t = 0.
-    x : (STATE_SIZE,) float
+    x : (BASE_STATE_SIZE + e,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
-        states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
+        the effects' own states.
     p : (3 + 3 TERMS [+ TERMS],) float
         t0, t1 (s), hinged flag, Legendre coefficients of the body torque (N m, B) and of the hinge
         torque (N m).
@@ -61,6 +61,8 @@ def law(t, x, p, env, load):
     load : (LOAD_SIZE,) float
         Loads, layout ``L_*``, added to in place: the torque on the main body (``L_TM``, B, N m) and the
         hinge torque (``L_TH``, N m).
+    xe, xe_rate : (0,) float
+        The law's own states and their rates: none (the effect declares no ``extra_states``).
     """
     b0, b1, b2 = _legendre(t, p[0], p[1])
     for axis in range(3):

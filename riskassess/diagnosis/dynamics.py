@@ -22,36 +22,40 @@ t = 0): :math:`\\ddot\\rho = n^2 (3 (\\hat r\\cdot\\rho)\\hat r - \\rho) + F/M`,
 :math:`\\hat r = (\\cos nt, \\sin nt, 0)` the chaser's radial direction; this is the
 Clohessy-Wiltshire equation (seed paper eq. (9)) written in non-rotating axes.
 
-State x (``STATE_SIZE``): quaternion B->I [w, x, y, z], omega_B (rad/s), hinge angle (rad),
-hinge rate (rad/s), system CoM rho_I (m), its velocity (m/s), three extra states for effects
-(a nutation damper's rate, B (rad/s)), and the hinge friction's stick anchor (rad; the angle a
-sticking hinge is held at, :mod:`riskassess.diagnosis.effects.hinge_coulomb_friction`).
+State x: the base state (``BASE_STATE_SIZE``): quaternion B->I [w, x, y, z], omega_B (rad/s),
+hinge angle (rad), hinge rate (rad/s), system CoM rho_I (m), its velocity (m/s); then the effects' own
+states, allocated when the model is built (:func:`initial_state`): each effect declares how many it
+needs and their values at t = 0 (``Effect.extra_states``, ``Effect.initial_extra_states``), and its
+block follows the base state (a pair's second effect's block follows the first's,
+:mod:`riskassess.diagnosis.composite`). The core knows nothing of what they mean.
 
-Effect laws are numba functions ``law(t, x, p, env, load)`` that ADD to ``load``
+Effect laws are numba functions ``law(t, x, p, env, load, xe, xe_rate)`` that ADD to ``load``
 (``LOAD_SIZE``): torque on the main body (B, N m), torque on the appendage (B, N m), hinge
-torque on the appendage about the axis (N m), force on the system CoM (I, N), the rates of
-the extra states and the stick anchor's rate (rad/s). ``env`` holds the plant's constants (layout ``ENV_*``).
+torque on the appendage about the axis (N m), force on the system CoM (I, N). ``xe`` is the law's
+own block of the state (a view, index 0 its first state) and ``xe_rate`` the same block of the
+derivative, to which it adds its states' rates. ``env`` holds the plant's constants (layout ``E_*``).
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit, types
 
+from multibody.rk4 import rk4_at_times
 from multibody.rotations import quaternion_from_matrix, quaternion_to_matrix
 from riskassess.diagnosis.plant import Plant
 
 _VECTOR = types.float64[::1]
-#: numba signature of an effect law ``law(t, x, p, env, load)``; laws are compiled eagerly with it so
-#: that one compiled integrator (taking the law as a first-class function) serves every effect.
-LAW_SIGNATURE = types.void(types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR)
+#: numba signature of an effect law ``law(t, x, p, env, load, xe, xe_rate)``; laws are compiled eagerly
+#: with it so that one compiled integrator (taking the law as a first-class function) serves every effect.
+LAW_SIGNATURE = types.void(types.float64, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR, _VECTOR)
 _LAW = types.FunctionType(LAW_SIGNATURE)
 
-# state layout
-X_Q, X_W, X_TH, X_THD, X_R, X_V, X_E, X_ANCHOR = 0, 4, 7, 8, 9, 12, 15, 18
-STATE_SIZE = 19
+# state layout: the base state; the effects' own states follow from BASE_STATE_SIZE (X_EXTRA)
+X_Q, X_W, X_TH, X_THD, X_R, X_V, X_EXTRA = 0, 4, 7, 8, 9, 12, 15
+BASE_STATE_SIZE = X_EXTRA
 # load layout
-L_TM, L_TA, L_TH, L_F, L_E, L_ANCHOR = 0, 3, 6, 7, 10, 13
-LOAD_SIZE = 14
+L_TM, L_TA, L_TH, L_F = 0, 3, 6, 7
+LOAD_SIZE = 10
 # env layout
 E_N, E_INC, E_U0, E_RADIUS, E_MM, E_MA, E_JM, E_JA, E_AXIS, E_HINGE, E_S0, E_K, E_C, E_HINGED = (
     0, 1, 2, 3, 4, 5, 6, 15, 24, 27, 30, 33, 34, 35)
@@ -85,22 +89,27 @@ def environment(plant: Plant) -> np.ndarray:
     return env
 
 
-def initial_state(plant: Plant) -> np.ndarray:
-    """State at t = 0: the tracked point and the CoM velocity in LVLH give the system CoM in I.
+def initial_state(plant: Plant, extra_states=()) -> np.ndarray:
+    """State at t = 0: the tracked point and the CoM velocity in LVLH give the system CoM in I; the
+    effects' own states follow the base state.
 
     Parameters
     ----------
     plant : Plant
         The scenario's plant (initial attitude B -> I, omega_B, hinge angle and rate, tracked point
         and CoM velocity in LVLH at t = 0).
+    extra_states : (e,) float, optional
+        The effect's own states at t = 0 (``Effect.initial_extra_states``; a pair's: the first
+        effect's, then the second's), each in its own unit; default none.
 
     Returns
     -------
-    x0 : (STATE_SIZE,) float
-        Layout ``X_*``; the CoM velocity is the inertial one, v_LVLH + n z x rho (m/s, I); the
-        damper turns with the body and the stick anchor is at the initial hinge angle.
+    x0 : (BASE_STATE_SIZE + e,) float
+        Layout ``X_*``, then ``extra_states`` from ``X_EXTRA``; the CoM velocity is the inertial one,
+        v_LVLH + n z x rho (m/s, I).
     """
-    x = np.zeros(STATE_SIZE)
+    extra_states = np.asarray(extra_states, float)
+    x = np.zeros(BASE_STATE_SIZE + extra_states.size)
     x[X_Q:X_Q + 4] = quaternion_from_matrix(np.ascontiguousarray(plant.attitude0))
     x[X_W:X_W + 3] = plant.omega0
     x[X_TH], x[X_THD] = plant.hinge_angle0, plant.hinge_rate0
@@ -110,8 +119,7 @@ def initial_state(plant: Plant) -> np.ndarray:
     rho = main_com + plant.attitude0 @ (share * offset)
     x[X_R:X_R + 3] = rho
     x[X_V:X_V + 3] = plant.velocity0 + np.cross([0.0, 0.0, plant.mean_motion], rho)
-    x[X_E:X_E + 3] = plant.omega0
-    x[X_ANCHOR] = plant.hinge_angle0
+    x[X_EXTRA:] = extra_states
     return x
 
 
@@ -123,8 +131,8 @@ def observe(states, times, env, origin_main):
 
     Parameters
     ----------
-    states : (k, STATE_SIZE) float
-        Fast-model states, layout ``X_*``.
+    states : (k, n) float
+        Fast-model states, layout ``X_*`` (the effects' states after the base state are not read).
     times : (k,) float
         Their times (s) from t = 0.
     env : (ENV_SIZE,) float
@@ -485,16 +493,18 @@ def _rotation_rates(t, x, env, load, rot):
 
 @njit(_VECTOR(types.float64, _VECTOR, _LAW, _VECTOR, _VECTOR), cache=True)
 def derivative(t, x, law, p, env):
-    """dx/dt of the state (layout ``X_*``) with the effect ``law`` and its parameters ``p``.
+    """dx/dt of the state (layout ``X_*``, then the effect's own states) with the effect ``law`` and its
+    parameters ``p``.
 
     Parameters
     ----------
     t : float
         Time (s) from t = 0.
-    x : (STATE_SIZE,) float
-        State, layout ``X_*`` (see the module doc).
+    x : (BASE_STATE_SIZE + e,) float
+        State, layout ``X_*`` (see the module doc), then the effect's ``e`` own states.
     law : compiled function
-        Effect load law ``law(t, x, p, env, load)`` (``LAW_SIGNATURE``).
+        Effect load law ``law(t, x, p, env, load, xe, xe_rate)`` (``LAW_SIGNATURE``); it is handed the
+        state's and the derivative's blocks from ``X_EXTRA`` as ``xe`` and ``xe_rate``.
     p : (j,) float
         The law's parameters.
     env : (ENV_SIZE,) float
@@ -502,13 +512,13 @@ def derivative(t, x, law, p, env):
 
     Returns
     -------
-    dx : (STATE_SIZE,) float
+    dx : (BASE_STATE_SIZE + e,) float
         Time derivative of every state, in its unit per second.
     """
     load = np.zeros(LOAD_SIZE)
-    law(t, x, p, env, load)
+    dx = np.zeros(x.shape[0])
+    law(t, x, p, env, load, x[X_EXTRA:], dx[X_EXTRA:])
     q = x[X_Q:X_Q + 4]
-    dx = np.zeros(STATE_SIZE)
     w = (x[X_W], x[X_W + 1], x[X_W + 2])
     dx[0] = -0.5 * (q[1] * w[0] + q[2] * w[1] + q[3] * w[2])
     dx[1] = 0.5 * (q[0] * w[0] + q[2] * w[2] - q[3] * w[1])
@@ -526,15 +536,14 @@ def derivative(t, x, law, p, env):
     for i in range(3):
         dx[X_R + i] = x[X_V + i]
         dx[X_V + i] = tidal[i] + load[L_F + i] / mass
-        dx[X_E + i] = load[L_E + i]
-    dx[X_ANCHOR] = load[L_ANCHOR]
     return dx
 
 
 @njit(types.float64[:, ::1](_LAW, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64), cache=True)
 def integrate(law, p, env, x0, times, max_step):
-    """States (k, STATE_SIZE) at ``times`` (s, non-decreasing, >= 0) from ``x0`` at t = 0, by
-    RK4 with steps no longer than ``max_step`` (s); the quaternion is renormalised every step.
+    """States at ``times`` (s, non-decreasing, >= 0) from ``x0`` at t = 0, by the shared RK4
+    (:func:`multibody.rk4.rk4_at_times`) with steps no longer than ``max_step`` (s); the quaternion is
+    renormalised every step.
 
     Parameters
     ----------
@@ -544,8 +553,8 @@ def integrate(law, p, env, x0, times, max_step):
         The law's parameters (at least one entry).
     env : (ENV_SIZE,) float
         Plant constants, layout ``E_*``.
-    x0 : (STATE_SIZE,) float
-        State at t = 0 (:func:`initial_state`).
+    x0 : (BASE_STATE_SIZE + e,) float
+        State at t = 0 (:func:`initial_state`, with the effect's own states).
     times : (k,) float
         Output times (s).
     max_step : float
@@ -553,61 +562,46 @@ def integrate(law, p, env, x0, times, max_step):
 
     Returns
     -------
-    states : (k, STATE_SIZE) float
-        Layout ``X_*``.
+    states : (k, BASE_STATE_SIZE + e) float
+        Layout ``X_*``, then the effect's states.
     """
-    out = np.empty((times.shape[0], STATE_SIZE))
-    x = x0.copy()
-    t = 0.0
-    for i in range(times.shape[0]):
-        span = times[i] - t
-        steps = int(np.ceil(span / max_step - 1e-9)) if span > 0 else 0
-        for _ in range(steps):
-            h = span / steps
-            k1 = derivative(t, x, law, p, env)
-            k2 = derivative(t + 0.5 * h, x + 0.5 * h * k1, law, p, env)
-            k3 = derivative(t + 0.5 * h, x + 0.5 * h * k2, law, p, env)
-            k4 = derivative(t + h, x + h * k3, law, p, env)
-            x = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-            x[X_Q:X_Q + 4] /= np.sqrt(x[X_Q:X_Q + 4] @ x[X_Q:X_Q + 4])
-            t += h
-        t = times[i]
-        out[i] = x
-    return out
+    return rk4_at_times(derivative, (law, p, env), x0, 0.0, times, max_step, X_Q)
 
 
 @njit(LAW_SIGNATURE, cache=True)
-def no_load(t, x, p, env, load):
+def no_load(t, x, p, env, load, xe, xe_rate):
     """The nominal model: no effect.
 
     Parameters
     ----------
     t : float
         Time (s) from the record's t = 0.
-    x : (STATE_SIZE,) float
+    x : (BASE_STATE_SIZE + e,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
-        states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
+        the effects' own states.
     p : (j,) float
         Not used.
     env : (ENV_SIZE,) float
         Plant constants, layout ``E_*``.
     load : (LOAD_SIZE,) float
         Loads, layout ``L_*``, added to in place: nothing.
+    xe, xe_rate : (0,) float
+        The law's own states and their rates: none.
     """
     return
 
 
 def angular_momentum_inertial(plant: Plant, states) -> np.ndarray:
     """Angular momentum of the bodies about the system CoM, I (kg m^2/s), (k, 3); without the
-    extra states (a damper's momentum is added by its effect's tests).
+    effects' states (a damper's momentum is added by its effect's tests).
 
     Parameters
     ----------
     plant : Plant
         The scenario's plant.
-    states : (k, STATE_SIZE) or (STATE_SIZE,) float
-        States, layout ``X_*``.
+    states : (k, n) or (n,) float
+        States, layout ``X_*`` (the effects' states, after the base state, are not read).
 
     Returns
     -------

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.diagnosis.dynamics import environment, initial_state, integrate, no_load
-from riskassess.diagnosis.effects.base import Effect
+from riskassess.diagnosis.effects.base import Effect, own_states
 from riskassess.diagnosis.observation import outputs
 from riskassess.diagnosis.plant import Plant, is_towing
 from riskassess.diagnosis.towing_plant import simulate as simulate_towing
@@ -65,13 +65,14 @@ def predict(plant: Plant, times, effect: Effect | None = None, values=(), names=
     if is_towing(plant):
         return _predict_towing(plant, times, effect, values, names, step)
     if effect is None:
-        law, p, sample_times = no_load, np.zeros(1), times
+        law, p, sample_times, x0 = no_load, np.zeros(1), times, initial_state(plant)
     else:
         plant = effect.modify_plant(plant, values)
         law, p, sample_times = effect.law, effect.law_parameters(plant, values), effect.sample_times(times, values)
+        x0 = initial_state(plant, own_states(effect, plant))     # the effect's states after the base state
     step = step or max_step(plant, effect.parameter_free_stiffness_rate(plant) if effect is not None else 0.0)
     states = integrate(law, np.ascontiguousarray(p if p.size else np.zeros(1), float), environment(plant),
-                       initial_state(plant), np.ascontiguousarray(sample_times, float), step)
+                       x0, np.ascontiguousarray(sample_times, float), step)
     out = outputs(plant, sample_times, states)
     return effect.measure(out, values, names) if effect is not None else out
 
@@ -82,5 +83,6 @@ def _predict_towing(plant, times, effect, values, names, step) -> dict:
         return simulate_towing(plant, times, step=step)
     plant = effect.modify_plant(plant, values)
     out = simulate_towing(plant, effect.sample_times(times, values), effect.towing_law,
-                          effect.towing_law_parameters(plant, values), step)
+                          effect.towing_law_parameters(plant, values), step,
+                          lambda model: own_states(effect, model, towing=True))
     return effect.measure(out, values, names)

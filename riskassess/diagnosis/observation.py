@@ -53,7 +53,7 @@ def lvlh_from_inertial(n: float, times) -> Rotation:
 
 
 def outputs(plant: Plant, times, states) -> dict[str, np.ndarray]:
-    """Every channel of ``scenario_channels(plant)`` at ``times`` (s) from states (k, STATE_SIZE).
+    """Every channel of ``scenario_channels(plant)`` at ``times`` (s) from states (k, n).
 
     Parameters
     ----------
@@ -61,7 +61,7 @@ def outputs(plant: Plant, times, states) -> dict[str, np.ndarray]:
         The scenario's plant.
     times : (k,) float
         Times (s) from t = 0.
-    states : (k, STATE_SIZE) float
+    states : (k, n) float
         Fast-model states (layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics`).
 
     Returns

@@ -16,10 +16,11 @@ A towing law has the signature ``law(t, q, v, p, work, xe, h, load)``:
   (P's entries are stale: read P from :func:`point_position`);
 * ``p`` the effect's law parameters, ``work`` the packed model (geometry, masses, the last
   evaluation's diagnostics: main-tether elongation and rate, thrust);
-* ``xe`` (``EXTRA_STATES``,) the effects' own states (``XE_MAXWELL``: Maxwell-branch tension (N),
-  ``XE_ELONGATION``: the elongation it was last advanced at (m); ``XE_DAMPER``: a nutation damper's
-  angular velocity, debris frame (rad/s)), advanced in place by the law over ``h`` (s; 0: do not
-  advance);
+* ``xe`` the law's own states, advanced in place by the law over ``h`` (s; 0: do not advance): a view
+  of the effect's block (index 0 its first state) of the model's effect states, allocated when the
+  model is built: each effect declares how many it needs and their values at t = 0
+  (``Effect.towing_extra_states``, ``Effect.initial_towing_states``), and a pair's second effect's
+  block follows the first's (:mod:`riskassess.diagnosis.composite`);
 * ``load`` (15,) the generalized forces it ADDS, kernel layout: force on P (N, inertial), chaser
   and debris force (N, inertial) and torque (N m, body frame).
 
@@ -41,29 +42,6 @@ from multibody.towing_kernel import (CHASER, DEBRIS, LOAD_LAW_SIGNATURE, ST_TENS
 TOWING_LAW_SIGNATURE = LOAD_LAW_SIGNATURE
 #: The nominal towing model: no effect.
 no_towing_load = no_load
-#: Effects' own states: Maxwell-branch tension (N), the main tether's elongation when it was last
-#: advanced (m), damper angular velocity (3, debris frame, rad/s).
-XE_MAXWELL, XE_ELONGATION, XE_DAMPER, EXTRA_STATES = 0, 1, 2, 5
-
-
-def initial_extra_states(omega_debris_body) -> np.ndarray:
-    """``xe`` at t = 0: no Maxwell tension, elongation not yet seen (NaN), the damper turning with the
-    debris (rad/s, debris frame).
-
-    Parameters
-    ----------
-    omega_debris_body : (3,) float
-        Debris inertial angular velocity at t = 0, debris body frame (rad/s).
-
-    Returns
-    -------
-    xe : (EXTRA_STATES,) float
-        Layout ``XE_*``.
-    """
-    xe = np.zeros(EXTRA_STATES)
-    xe[XE_ELONGATION] = np.nan
-    xe[XE_DAMPER:XE_DAMPER + 3] = omega_debris_body
-    return xe
 
 
 @njit(cache=True, inline="always")
@@ -168,5 +146,5 @@ def diagnostics_size(work) -> int:
     return ST_TENSION + int(work[W_N_ATTACH])
 
 
-__all__ = ["DEBRIS", "EXTRA_STATES", "TOWING_LAW_SIGNATURE", "W_INERTIA", "W_MASSES", "W_TETHER", "XE_DAMPER",
-           "XE_MAXWELL", "main_tether_direction", "no_towing_load", "point_position"]
+__all__ = ["DEBRIS", "TOWING_LAW_SIGNATURE", "W_INERTIA", "W_MASSES", "W_TETHER", "main_tether_direction",
+           "no_towing_load", "point_position"]

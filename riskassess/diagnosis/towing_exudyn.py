@@ -12,7 +12,8 @@ from __future__ import annotations
 import exudyn as exu
 import numpy as np
 
-from riskassess.diagnosis.towing_dynamics import initial_extra_states, no_towing_load
+from riskassess.diagnosis.effects.base import own_states
+from riskassess.diagnosis.towing_dynamics import no_towing_load
 from riskassess.diagnosis.towing_plant import TowingPlant, channels
 from multibody.impact import _object_state_index, explicit_settings
 from multibody.towing import build_towing_system, packed
@@ -30,12 +31,12 @@ RECORD_INTERVAL = EXUDYN_STEP
 class _EffectForces:
     """Force user function: the effect's loads, then :func:`multibody.towing_kernel.body_forces`."""
 
-    def __init__(self, model, law, p):
+    def __init__(self, model, law, p, xe):
         self.model, self.law = model, law
         self.p = np.zeros(1) if len(p) == 0 else np.ascontiguousarray(p, float)
         self.tow = packed(model)
         self.work = self.tow.work      # the same array (the effect laws read it)
-        self.xe = initial_extra_states(model.omega_body[1])
+        self.xe = np.ascontiguousarray(xe, float)     # the effect's own states, advanced by its law
         self.load = np.zeros(N_COORDINATES)
         self.last_time = None
 
@@ -81,7 +82,7 @@ def simulate_towing_exudyn(plant: TowingPlant, times, effect=None, values=(), na
         law, p = effect.towing_law, effect.towing_law_parameters(plant, values)
     every = int(round(RECORD_INTERVAL / step))
     model = plant.model(float(sample_times.max()) + 2 * RECORD_INTERVAL, step)
-    forces = _EffectForces(model, law, p)
+    forces = _EffectForces(model, law, p, np.zeros(0) if effect is None else own_states(effect, model, towing=True))
     sc, mbs, nodes = build_towing_system(model, forces)
     index = _object_state_index(mbs, nodes, [6, 6])
     rows = []

@@ -23,7 +23,7 @@ from numba import njit
 from scipy.spatial.transform import Rotation
 
 from riskassess.diagnosis.channels import OMEGA, QUATERNION, REL, TENSION
-from riskassess.diagnosis.towing_dynamics import EXTRA_STATES, diagnostics_size, initial_extra_states, no_towing_load
+from riskassess.diagnosis.towing_dynamics import diagnostics_size, no_towing_load
 from multibody.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing import packed
 from multibody.towing_kernel import MT_TENSION, verlet_run
@@ -238,7 +238,7 @@ def model_step(plant: TowingPlant, times, step: float | None = None) -> float:
     return dt / np.ceil(dt / h - 1e-9)
 
 
-def simulate(plant: TowingPlant, times, law=no_towing_load, p=None, step: float | None = None) -> dict:
+def simulate(plant: TowingPlant, times, law=no_towing_load, p=None, step: float | None = None, states=None) -> dict:
     """Channels (dict of (k,) arrays) at ``times`` (s from the record's t = 0, non-decreasing) of the
     fast model with the towing ``law`` at parameters ``p``; linear between the steps around a time.
 
@@ -254,6 +254,10 @@ def simulate(plant: TowingPlant, times, law=no_towing_load, p=None, step: float 
         The law's parameters.
     step : float, optional
         Longest step (s); default the plant's ``fit_step``.
+    states : callable, optional
+        ``states(model) -> (e,) float``: the law's own states at t = 0 from the built
+        :class:`multibody.towing.TowingModel` (an effect's, :func:`riskassess.diagnosis.effects.base.own_states`);
+        default none.
 
     Returns
     -------
@@ -271,8 +275,8 @@ def simulate(plant: TowingPlant, times, law=no_towing_load, p=None, step: float 
     record = np.unique(np.r_[lower, lower[weight > 0] + 1]).astype(np.int64)
     q, v = model.initial_state()
     tow = packed(model)
-    xe = initial_extra_states(model.omega_body[1])
-    out = [np.zeros((len(record), n)) for n in (15, 15, diagnostics_size(tow.work), EXTRA_STATES)]
+    xe = np.zeros(0) if states is None else np.ascontiguousarray(states(model), float)
+    out = [np.zeros((len(record), n)) for n in (15, 15, diagnostics_size(tow.work), xe.size)]
     p = np.zeros(1) if p is None or len(p) == 0 else np.ascontiguousarray(p, float)
     verlet_run(tow, law, p, q, v, model.start_time, int(record[-1]), xe, record, *out)
     if not all(np.isfinite(a).all() for a in out[:3]):      # a run that blew up (a parameter far off)
@@ -337,8 +341,8 @@ def channels(plant: TowingPlant, model, q, v, diag, xe) -> dict:
         States, kernel layout (:mod:`multibody.towing_kernel`).
     diag : (k, n_diag) float
         Diagnostics rows (main-tether tension in column ``MT_TENSION``, N).
-    xe : (k, EXTRA_STATES) float
-        Effect states (not used: a branch's tension is in the kernel's).
+    xe : (k, e) float
+        The effect's own states (not used: a branch's tension is in the kernel's).
 
     Returns
     -------

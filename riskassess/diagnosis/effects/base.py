@@ -3,14 +3,23 @@
 An effect is a physical extension of the nominal model with named SI parameters. It changes
 the model in one or more of four ways, each a pure function:
 
-* ``law``: a numba load law ``law(t, x, p, env, load)`` adding torques / forces / extra-state
-  rates to the fast model (:mod:`riskassess.diagnosis.dynamics`), from the physical parameters ``p``;
+* ``law``: a numba load law ``law(t, x, p, env, load, xe, xe_rate)`` adding torques / forces to the
+  fast model (:mod:`riskassess.diagnosis.dynamics`), from the physical parameters ``p``, and the rates
+  of its own states;
 * ``modify_plant``: new mass properties or geometry (e.g. a CoM offset);
 * ``sample_times`` / ``measure``: a sensor effect (time shift, bias) on the simulated channels;
 * ``add_to_exudyn``: the same physics on the Exudyn builder (:mod:`riskassess.diagnosis.exudyn_model`),
   through user-function loads that call the same pure force law;
 * ``towing_law``: the same physics on the towing model (:mod:`riskassess.diagnosis.towing_dynamics`; the fast
   model and its Exudyn reference both call it), for effects that apply to the towing scenario.
+
+An effect with states of its own (a damper's rotor rate, a stick anchor, a relaxing branch's
+tension) declares them here and nowhere else: how many (``extra_states`` in the fast model,
+``towing_extra_states`` in the towing model) and their values at t = 0 (:meth:`Effect.initial_extra_states`,
+:meth:`Effect.initial_towing_states`). The models allocate the blocks after their base state when they
+are built (:func:`riskassess.diagnosis.model.predict`; a pair's second block after the first's) and
+hand each law its own block as ``xe`` (and, in the fast model, the same block of the derivative as
+``xe_rate``), indexed from 0. Adding an effect with states is adding its file.
 """
 from __future__ import annotations
 
@@ -66,9 +75,12 @@ class Effect:
     scenarios: tuple[str, ...] = ("tumbling_rigid", "hinged_appendage")
     #: It is seen only if one of these channels is measured.
     channels: tuple[str, ...] = ()
-    #: Whether its laws use the models' extra-state slot (the fast model's X_E, the towing model's
-    #: effect states): two such effects cannot be fitted together (riskassess.diagnosis.composite).
-    extra_state: bool = False
+    #: Number of its own states in the fast model (its law's ``xe``; values at t = 0:
+    #: :meth:`initial_extra_states`).
+    extra_states: int = 0
+    #: Number of its own states in the towing model (its towing law's ``xe``; values at t = 0:
+    #: :meth:`initial_towing_states`).
+    towing_extra_states: int = 0
     #: numba load law of the fast model (``no_load``: none).
     law = staticmethod(no_load)
     #: numba load law of the towing model (:mod:`riskassess.diagnosis.towing_dynamics`; ``no_towing_load``: none).
@@ -113,6 +125,37 @@ class Effect:
         if self.channels and not set(self.channels) & set(channels):
             return f"needs one of the channels {', '.join(self.channels)}"
         return None
+
+    def initial_extra_states(self, plant: Plant) -> np.ndarray:
+        """Values at t = 0 of the effect's own states in the fast model (none by default).
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant the law runs on (after :meth:`modify_plant`; SI, its initial state).
+
+        Returns
+        -------
+        xe0 : (extra_states,) float
+            In the layout and units the effect's :attr:`law` reads them.
+        """
+        return np.zeros(self.extra_states)
+
+    def initial_towing_states(self, model) -> np.ndarray:
+        """Values at t = 0 of the effect's own states in the towing model (none by default).
+
+        Parameters
+        ----------
+        model : TowingModel
+            The built lower-order towing model (:class:`multibody.towing.TowingModel`: initial state,
+            ``omega_body`` (rad/s, body frames), ...).
+
+        Returns
+        -------
+        xe0 : (towing_extra_states,) float
+            In the layout and units the effect's :attr:`towing_law` reads them.
+        """
+        return np.zeros(self.towing_extra_states)
 
     def law_parameters(self, plant: Plant, values: np.ndarray) -> np.ndarray:
         """Parameters ``p`` of the numba law from the physical values (same order by default).
@@ -265,6 +308,40 @@ class Effect:
         names : sequence of str, length m
             The parameter names of ``values``.
         """
+
+
+def own_states(effect: Effect, model, towing: bool = False) -> np.ndarray:
+    """The effect's own states at t = 0, checked against the number it declares: the block the model
+    allocates for it after its base state.
+
+    Parameters
+    ----------
+    effect : Effect
+        The effect (a pair: both blocks, the first effect's then the second's).
+    model : Plant or TowingModel
+        The plant of the fast model (after :meth:`Effect.modify_plant`), or the built towing model.
+    towing : bool
+        Whether the towing model's states are asked for.
+
+    Returns
+    -------
+    xe0 : (e,) float
+        :meth:`Effect.initial_extra_states` or :meth:`Effect.initial_towing_states`.
+
+    Raises
+    ------
+    ValueError
+        When the values do not match the declared ``extra_states`` / ``towing_extra_states``.
+    """
+    if towing:
+        values, count, names = effect.initial_towing_states(model), effect.towing_extra_states, "towing_extra_states"
+    else:
+        values, count, names = effect.initial_extra_states(model), effect.extra_states, "extra_states"
+    values = np.asarray(values, float).ravel()
+    if values.size != count:
+        raise ValueError(f"effect '{effect.id}': {values.size} initial state value(s) for its {count} declared "
+                         f"{names}; the two must agree")
+    return values
 
 
 def torque_scale(plant: Plant) -> float:

@@ -67,23 +67,25 @@ def eddy_torque(omega_body, field_body, coefficient):
 
 
 @njit(LAW_SIGNATURE, cache=True)
-def law(t, x, p, env, load):
+def law(t, x, p, env, load, xe, xe_rate):
     """Eddy-current torque on the main body.
 
     Parameters
     ----------
     t : float
         Time (s) from the record's t = 0.
-    x : (STATE_SIZE,) float
+    x : (BASE_STATE_SIZE + e,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
-        states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
+        the effects' own states.
     p : (3,) float
         [c (N m s), field azimuth (rad), field elevation (rad)], I.
     env : (ENV_SIZE,) float
         Plant constants, layout ``E_*``.
     load : (LOAD_SIZE,) float
         Loads, layout ``L_*``, added to in place: the torque on the main body (``L_TM``, B, N m).
+    xe, xe_rate : (0,) float
+        The law's own states and their rates: none (the effect declares no ``extra_states``).
     """
     field = tmtv(quaternion_rows(x[X_Q:X_Q + 4]), field_direction(p[1], p[2]))
     torque = eddy_torque((x[X_W], x[X_W + 1], x[X_W + 2]), field, p[0])
@@ -109,8 +111,8 @@ def towing_law(t, q, v, p, work, xe, h, load):
         -> ECI rotation (9, row-major, -).
     work : (w,) float
         Packed towing model (:func:`multibody.towing.packed`).
-    xe : (EXTRA_STATES,) float
-        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); not used.
+    xe : (0,) float
+        The law's own states: none (the effect declares no ``towing_extra_states``).
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float

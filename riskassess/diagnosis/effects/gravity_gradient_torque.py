@@ -48,17 +48,17 @@ def gravity_gradient(radial_body, inertia_times_radial, mean_motion):
 
 
 @njit(LAW_SIGNATURE, cache=True)
-def law(t, x, p, env, load):
+def law(t, x, p, env, load, xe, xe_rate):
     """Gravity-gradient torque on the main body and, hinged, on the appendage.
 
     Parameters
     ----------
     t : float
         Time (s) from the record's t = 0.
-    x : (STATE_SIZE,) float
+    x : (BASE_STATE_SIZE + e,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
-        states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
+        the effects' own states.
     p : (1,) float
         [n (rad/s)], the mean motion the torque sees.
     env : (ENV_SIZE,) float
@@ -66,6 +66,8 @@ def law(t, x, p, env, load):
     load : (LOAD_SIZE,) float
         Loads, layout ``L_*``, added to in place: torques on the main body (``L_TM``) and the appendage
         (``L_TA``), B (N m).
+    xe, xe_rate : (0,) float
+        The law's own states and their rates: none (the effect declares no ``extra_states``).
     """
     n = env[E_N]
     r_b = tmtv(quaternion_rows(x[X_Q:X_Q + 4]), (np.cos(n * t), np.sin(n * t), 0.0))
@@ -96,8 +98,8 @@ def towing_law(t, q, v, p, work, xe, h, load):
         [n (rad/s)].
     work : (w,) float
         Packed towing model (:func:`multibody.towing.packed`).
-    xe : (EXTRA_STATES,) float
-        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); not used.
+    xe : (0,) float
+        The law's own states: none (the effect declares no ``towing_extra_states``).
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float

@@ -37,23 +37,25 @@ def backlash_torque(angle, stiffness, half_gap):
 
 
 @njit(LAW_SIGNATURE, cache=True)
-def law(t, x, p, env, load):
+def law(t, x, p, env, load, xe, xe_rate):
     """Backlash: cancels the hinge spring inside the gap.
 
     Parameters
     ----------
     t : float
         Time (s) from the record's t = 0.
-    x : (STATE_SIZE,) float
+    x : (BASE_STATE_SIZE + e,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
-        states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
+        the effects' own states.
     p : (1,) float
         [half gap b (rad)].
     env : (ENV_SIZE,) float
         Plant constants, layout ``E_*``.
     load : (LOAD_SIZE,) float
         Loads, layout ``L_*``, added to in place: the hinge torque (``L_TH``, N m, about the axis).
+    xe, xe_rate : (0,) float
+        The law's own states and their rates: none (the effect declares no ``extra_states``).
     """
     load[L_TH] += backlash_torque(x[X_TH], env[E_K], p[0])
 

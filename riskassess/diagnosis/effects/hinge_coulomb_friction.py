@@ -21,9 +21,9 @@ thousandth of a period; the fit's RK4 step is shortened by :meth:`stiffness_rate
 integrated stably (the Exudyn reference's explicit RK4 step, 4 ms, keeps lambda_s h < 2.78 for motion rates up
 to 7 rad/s).
 Torques on the hinge other than the spring (coupling to the main body's rotation) are held by a
-critically damped hold about a stick anchor (an extra state, ``X_ANCHOR``, that follows the hinge
-while it slides and stays where it stopped), up to the break-away limit; without the anchor the
-stuck panel crept under the tumble's coupling torques by ~3e-3 rad in 50 s. Checked against the analytic stick-slip
+critically damped hold about a stick anchor (the effect's own state ``ANCHOR``, one slot of the
+fast model starting at the initial hinge angle, that follows the hinge while it slides and stays
+where it stopped), up to the break-away limit; without the anchor the stuck panel crept under the tumble's coupling torques by ~3e-3 rad in 50 s. Checked against the analytic stick-slip
 ring-down in tests/riskassess/diagnosis/test_stiction.py.
 """
 from __future__ import annotations
@@ -31,9 +31,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from riskassess.diagnosis.dynamics import LAW_SIGNATURE, E_K, L_ANCHOR, L_TH, X_ANCHOR, X_TH, X_THD
+from riskassess.diagnosis.dynamics import LAW_SIGNATURE, E_K, L_TH, X_TH, X_THD
 from riskassess.diagnosis.effects.base import Effect, Parameter, torque_scale
 from riskassess.diagnosis.plant import Plant
+
+#: The effect's own state (fast model): the stick anchor theta_a (rad).
+ANCHOR, STATES = 0, 1
 
 #: Stick rate lambda_s (1/s) per fastest motion rate (rad/s) of the plant: the stick transient lasts
 #: 1/(100 omega), 1/600 of a period. Measured against an independent elasto-plastic (bristle) stiction
@@ -154,29 +157,32 @@ def stick_gains(plant: Plant) -> tuple[float, float]:
 
 
 @njit(LAW_SIGNATURE, cache=True)
-def law(t, x, p, env, load):
+def law(t, x, p, env, load, xe, xe_rate):
     """Coulomb friction with stiction on the hinge, and the stick anchor's rate.
 
     Parameters
     ----------
     t : float
         Time (s) from the record's t = 0.
-    x : (STATE_SIZE,) float
+    x : (BASE_STATE_SIZE + e,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
-        states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
+        the effects' own states.
     p : (4,) float
         [T_c (N m), c_s (N m s/rad), k_s (N m/rad), anchor follow rate (1/s)]
         (:meth:`HingeCoulombFriction.law_parameters`).
     env : (ENV_SIZE,) float
         Plant constants, layout ``E_*``.
     load : (LOAD_SIZE,) float
-        Loads, layout ``L_*``, added to in place: the hinge torque (``L_TH``, N m, about the axis) and
-        the anchor's rate (``L_ANCHOR``, rad/s).
+        Loads, layout ``L_*``, added to in place: the hinge torque (``L_TH``, N m, about the axis).
+    xe : (1,) float
+        The stick anchor theta_a (``ANCHOR``, rad).
+    xe_rate : (1,) float
+        The anchor's rate (rad/s), added to in place.
     """
-    hold = holding_torque(x[X_TH], x[X_THD], x[X_ANCHOR], env[E_K], p[1], p[2])
+    hold = holding_torque(x[X_TH], x[X_THD], xe[ANCHOR], env[E_K], p[1], p[2])
     load[L_TH] += friction_torque(hold, p[0])
-    load[L_ANCHOR] += anchor_rate(x[X_TH], x[X_ANCHOR], hold, p[0], p[3])
+    xe_rate[ANCHOR] += anchor_rate(x[X_TH], xe[ANCHOR], hold, p[0], p[3])
 
 
 class _StickAnchor:
@@ -200,6 +206,7 @@ class _StickAnchor:
 
 class HingeCoulombFriction(Effect):
     id = "hinge_coulomb_friction"
+    extra_states = STATES
     title = "Coulomb (dry) friction in the hinge, sliding and sticking"
     scenarios = ("hinged_appendage",)
     channels = ("hinge_angle", "hinge_rate", "omega_x", "omega_y", "omega_z", "q_w")
@@ -218,6 +225,21 @@ class HingeCoulombFriction(Effect):
         scale = torque_scale(Plant.from_case(case))
         return [Parameter("friction_torque", "N m", "Coulomb friction torque magnitude (sliding and break-away)",
                           0.1 * scale, 0.0, 2.0 * scale)]
+
+    def initial_extra_states(self, plant):
+        """The stick anchor starts at the initial hinge angle.
+
+        Parameters
+        ----------
+        plant : Plant
+            A hinged plant (its hinge angle at t = 0, rad).
+
+        Returns
+        -------
+        xe0 : (1,) float
+            [theta_a (rad)].
+        """
+        return np.array([plant.hinge_angle0], float)
 
     def law_parameters(self, plant, values):
         """[T_c, c_s, k_s, lambda_s]: the friction limit and the plant's stick gains.

@@ -8,7 +8,9 @@ isotropic inertia J_d at the main body's CoM, coupled to it by a viscous torque.
     J_d(\\dot\\omega_d + \\omega\\times\\omega_d) = -c\\,(\\omega_d - \\omega),\\qquad c = J_d / T_d
 
 Body and damper together conserve the angular momentum; the energy decays, the tumble drifts
-towards the major axis. Parameters: the damper inertia J_d and its time constant T_d.
+towards the major axis. Parameters: the damper inertia J_d and its time constant T_d. The rotor's
+angular velocity omega_d (B, rad/s) is the effect's own state, three slots in the fast model and in
+the towing model, starting with the body's rate (the rotor turns with the body at t = 0).
 """
 from __future__ import annotations
 
@@ -16,11 +18,14 @@ import numpy as np
 from numba import njit
 
 from multibody.linalg3 import cross3
-from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_E, L_TM, X_E, X_W
+from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_W
 from riskassess.diagnosis.effects.base import Effect, Parameter
 from riskassess.diagnosis.scenario import plant_of
-from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, XE_DAMPER
+from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
 from multibody.towing_kernel import DEBRIS
+
+#: The effect's own states (fast and towing models): the rotor's angular velocity (3, rad/s, body frame).
+ROTOR_RATE, STATES = 0, 3
 
 
 @njit(cache=True)
@@ -47,35 +52,38 @@ def damper_torque(omega_body, omega_damper, inertia, time_constant):
 
 
 @njit(LAW_SIGNATURE, cache=True)
-def law(t, x, p, env, load):
+def law(t, x, p, env, load, xe, xe_rate):
     """The damper's torque on the main body and the damper's angular acceleration.
 
     Parameters
     ----------
     t : float
         Time (s) from the record's t = 0.
-    x : (STATE_SIZE,) float
+    x : (BASE_STATE_SIZE + e,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
-        states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
+        the effects' own states.
     p : (2,) float
         [J_d (kg m^2), T_d (s)].
     env : (ENV_SIZE,) float
         Plant constants, layout ``E_*``.
     load : (LOAD_SIZE,) float
-        Loads, layout ``L_*``, added to in place: the torque on the main body (``L_TM``, B, N m) and the
-        rate of the damper's angular velocity (``L_E``, B, rad/s^2).
+        Loads, layout ``L_*``, added to in place: the torque on the main body (``L_TM``, B, N m).
+    xe : (3,) float
+        The rotor's angular velocity omega_d (``ROTOR_RATE``, B, rad/s).
+    xe_rate : (3,) float
+        Its rate (B, rad/s^2), added to in place.
     """
     w = x[X_W:X_W + 3]
-    wd = x[X_E:X_E + 3]
+    wd = xe[ROTOR_RATE:ROTOR_RATE + 3]
     torque = damper_torque(w, wd, p[0], p[1])
     load[L_TM:L_TM + 3] += torque
-    load[L_E:L_E + 3] += -torque / p[0] - cross3(w, wd) if p[0] > 0 else -cross3(w, wd)
+    xe_rate[ROTOR_RATE:ROTOR_RATE + 3] += -torque / p[0] - cross3(w, wd) if p[0] > 0 else -cross3(w, wd)
 
 
 @njit(TOWING_LAW_SIGNATURE, cache=True)
 def towing_law(t, q, v, p, work, xe, h, load):
-    """The damper in the towed debris; its rate (``XE_DAMPER``, debris frame) advanced by explicit
+    """The damper in the towed debris; its rate (``ROTOR_RATE``, debris frame) advanced by explicit
     Euler over the step (h / T_d <= 0.05 at the fit's 50 ms limit and T_d >= 1 s).
 
     Parameters
@@ -91,9 +99,9 @@ def towing_law(t, q, v, p, work, xe, h, load):
         [J_d (kg m^2), T_d (s)].
     work : (w,) float
         Packed towing model (:func:`multibody.towing.packed`).
-    xe : (EXTRA_STATES,) float
-        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); ``XE_DAMPER``,
-        the rotor's angular velocity (rad/s, debris frame), advanced in place.
+    xe : (3,) float
+        The effect's own states: the rotor's angular velocity (``ROTOR_RATE``, rad/s, debris frame),
+        advanced in place.
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float
@@ -101,16 +109,17 @@ def towing_law(t, q, v, p, work, xe, h, load):
         frame).
     """
     w = v[DEBRIS + 3:DEBRIS + 6]
-    wd = xe[XE_DAMPER:XE_DAMPER + 3]
+    wd = xe[ROTOR_RATE:ROTOR_RATE + 3]
     torque = damper_torque(w, wd, p[0], p[1])
     load[DEBRIS + 3:DEBRIS + 6] += torque
     if h > 0.0 and p[0] > 0.0:
-        xe[XE_DAMPER:XE_DAMPER + 3] += h * (-torque / p[0] - cross3(w, wd))
+        xe[ROTOR_RATE:ROTOR_RATE + 3] += h * (-torque / p[0] - cross3(w, wd))
 
 
 class InternalEnergyDissipation(Effect):
     id = "internal_energy_dissipation"
-    extra_state = True
+    extra_states = STATES
+    towing_extra_states = STATES
     title = "nutation damping by internal energy dissipation (spherical viscous damper)"
     channels = ("omega_x", "omega_y", "omega_z", "q_w")
     scenarios = ("tumbling_rigid", "hinged_appendage", "towing")
@@ -130,6 +139,36 @@ class InternalEnergyDissipation(Effect):
         j_min = float(np.linalg.eigvalsh(plant_of(case).inertia_main)[0])
         return [Parameter("damper_inertia", "kg m^2", "inertia of the damper rotor", 0.01 * j_min, 0.0, 0.2 * j_min),
                 Parameter("time_constant", "s", "damper time constant J_d / c", 30.0, 1.0, 3000.0)]
+
+    def initial_extra_states(self, plant):
+        """The rotor turns with the main body at t = 0.
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant (its omega_B at t = 0, rad/s).
+
+        Returns
+        -------
+        xe0 : (3,) float
+            omega_d = omega_B (rad/s, B).
+        """
+        return np.array(plant.omega0, float)
+
+    def initial_towing_states(self, model):
+        """The rotor turns with the debris at t = 0.
+
+        Parameters
+        ----------
+        model : TowingModel
+            The built towing model (its debris angular velocity at t = 0, ``omega_body[1]``, rad/s, D).
+
+        Returns
+        -------
+        xe0 : (3,) float
+            omega_d (rad/s, D).
+        """
+        return np.array(model.omega_body[1], float)
 
     def starts(self, specs):
         """Two starts at the typical J_d: T_d = 10 s and 100 s.

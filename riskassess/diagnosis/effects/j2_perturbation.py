@@ -104,23 +104,25 @@ def differential_j2(t, rho_inertial, j2, mean_motion, radius, inclination, latit
 
 
 @njit(LAW_SIGNATURE, cache=True)
-def law(t, x, p, env, load):
+def law(t, x, p, env, load, xe, xe_rate):
     """The differential J2 force on the system CoM.
 
     Parameters
     ----------
     t : float
         Time (s) from the record's t = 0.
-    x : (STATE_SIZE,) float
+    x : (BASE_STATE_SIZE + e,) float
         Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
-        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s), extra
-        states).
+        omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
+        the effects' own states.
     p : (1,) float
         [J2 (-)].
     env : (ENV_SIZE,) float
         Plant constants, layout ``E_*``.
     load : (LOAD_SIZE,) float
         Loads, layout ``L_*``, added to in place: the force on the system CoM (``L_F``, I, N).
+    xe, xe_rate : (0,) float
+        The law's own states and their rates: none (the effect declares no ``extra_states``).
     """
     a = differential_j2(t, x[X_R:X_R + 3], p[0], env[E_N], env[E_RADIUS], env[E_INC], env[E_U0])
     load[L_F:L_F + 3] += (env[E_MM] + env[E_MA]) * a
@@ -143,8 +145,8 @@ def towing_law(t, q, v, p, work, xe, h, load):
         [J2 (-)].
     work : (w,) float
         Packed towing model (:func:`multibody.towing.packed`).
-    xe : (EXTRA_STATES,) float
-        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); not used.
+    xe : (0,) float
+        The law's own states: none (the effect declares no ``towing_extra_states``).
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float

@@ -22,7 +22,8 @@ connection point's implicit step (an explicit branch force, tried first, made th
 the step by a factor 2 at 4 ms: P hangs on stiff, heavily damped tethers). The tension the kernel
 reports is T, the ``tether_tension`` channel. (With an MRAC thrust law the controller's elongation
 would include the preload's shift; the sample case uses the ramp.) Parameters: k_m and tau_m.
-Towing scenario only.
+Towing scenario only. Its own states, two slots of the towing model: T_m (``MAXWELL``, N, zero at
+t = 0) and the elongation it was last advanced at (``ELONGATION``, m; NaN at t = 0: not yet seen).
 """
 from __future__ import annotations
 
@@ -32,8 +33,12 @@ import numpy as np
 from numba import njit
 
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, W_TETHER, XE_ELONGATION, XE_MAXWELL, last_diagnostics
+from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, W_TETHER, last_diagnostics
 from multibody.towing_kernel import K_MT, L_MT, MT_ELONGATION
+
+#: The effect's own states (towing model): Maxwell-branch tension T_m (N), and the main tether's
+#: elongation when the branch was last advanced (m).
+MAXWELL, ELONGATION, STATES = 0, 1, 2
 
 
 @njit(cache=True)
@@ -103,9 +108,8 @@ def towing_law(t, q, v, p, work, xe, h, load):
         [k_m (N/m), tau_m (s), the case's main-tether stiffness k (N/m) and rest length l0 (m)].
     work : (w,) float
         Packed towing model (:func:`multibody.towing.packed`).
-    xe : (EXTRA_STATES,) float
-        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); ``XE_MAXWELL``
-        (N) and ``XE_ELONGATION`` (m), advanced in place.
+    xe : (2,) float
+        The effect's own states, ``MAXWELL`` (N) and ``ELONGATION`` (m), advanced in place.
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float
@@ -117,22 +121,37 @@ def towing_law(t, q, v, p, work, xe, h, load):
     k_m, tau, k, rest = p[0], p[1], p[2], p[3]
     # the last evaluation's elongation, against the tether's true rest length
     e = last_diagnostics(work)[MT_ELONGATION] + work[W_TETHER + L_MT] - rest
-    if not math.isnan(xe[XE_ELONGATION]):
-        xe[XE_MAXWELL] = branch_after(xe[XE_MAXWELL], xe[XE_ELONGATION], e, k_m, tau, h)
-    xe[XE_ELONGATION] = e
+    if not math.isnan(xe[ELONGATION]):
+        xe[MAXWELL] = branch_after(xe[MAXWELL], xe[ELONGATION], e, k_m, tau, h)
+    xe[ELONGATION] = e
     b = k_m * step_gain(tau, h)
-    preload = xe[XE_MAXWELL] * math.exp(-h / tau) - b * max(e, 0.0)
+    preload = xe[MAXWELL] * math.exp(-h / tau) - b * max(e, 0.0)
     work[W_TETHER + K_MT] = k + b
     work[W_TETHER + L_MT] = rest - preload / (k + b)
 
 
 class TetherViscoelasticity(Effect):
     id = "tether_viscoelasticity"
-    extra_state = True
+    towing_extra_states = STATES
     title = "viscoelastic main tether (standard linear solid: a relaxing Maxwell branch)"
     scenarios = ("towing",)
     channels = ("tether_tension", "rel_x", "rel_y", "rel_z", "omega_x", "omega_y", "omega_z", "q_w")
     towing_law = staticmethod(towing_law)
+
+    def initial_towing_states(self, model):
+        """No Maxwell tension at t = 0; the elongation not yet seen (NaN: the first step only records it).
+
+        Parameters
+        ----------
+        model : TowingModel
+            The built towing model (not read).
+
+        Returns
+        -------
+        xe0 : (2,) float
+            [T_m (N), e (m)] = [0, NaN].
+        """
+        return np.array([0.0, np.nan])
 
     def towing_law_parameters(self, plant, values):
         """[k_m, tau_m] followed by the case's main-tether stiffness and rest length.

@@ -96,8 +96,8 @@ def towing_law(t, q, v, p, work, xe, h, load):
         [tilt_x, tilt_y] (rad), about the chaser's body x and y.
     work : (w,) float
         Packed towing model (:func:`multibody.towing.packed`).
-    xe : (EXTRA_STATES,) float
-        Effects' own states (``XE_*`` of :mod:`riskassess.diagnosis.towing_dynamics`); not used.
+    xe : (0,) float
+        The law's own states: none (the effect declares no ``towing_extra_states``).
     h : float
         Step (s) over which ``xe`` is advanced; 0: do not advance.
     load : (15,) float

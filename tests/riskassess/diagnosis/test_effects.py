@@ -4,8 +4,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from riskassess.diagnosis.dynamics import X_E, X_W, angular_momentum_inertial, environment, initial_state, integrate
+from riskassess.diagnosis.dynamics import X_EXTRA, X_W, angular_momentum_inertial, environment, initial_state, integrate
 from riskassess.diagnosis.effects import CATALOG
+from riskassess.diagnosis.effects.base import own_states
 from riskassess.diagnosis.effects.gravity_gradient_torque import gravity_gradient
 from riskassess.diagnosis.model import max_step
 from multibody.rotations import quaternion_to_matrix
@@ -46,7 +47,7 @@ def _run(case, effect_id, values, duration=200.0):
     specs = effect.parameter_specs(case)
     times = np.linspace(0.0, duration, 201)
     p = np.asarray(values, float)
-    states = integrate(effect.law, p, environment(plant), initial_state(plant), times,
+    states = integrate(effect.law, p, environment(plant), initial_state(plant, own_states(effect, plant)), times,
                        max_step(plant, effect.stiffness_rate(plant, specs)))
     return plant, states
 
@@ -56,10 +57,11 @@ def test_nutation_damper_keeps_total_momentum_and_dissipates_energy():
     damper_inertia = 20.0
     plant, states = _run(case, "internal_energy_dissipation", [damper_inertia, 20.0])
     rot = [quaternion_to_matrix(x[:4]) for x in states]
+    rotor = states[:, X_EXTRA:X_EXTRA + 3]         # the damper's own states, the first after the base state
     total = angular_momentum_inertial(plant, states) + damper_inertia * np.array(
-        [r @ x[X_E:X_E + 3] for r, x in zip(rot, states)])
+        [r @ w for r, w in zip(rot, rotor)])
     energy = np.array([0.5 * x[X_W:X_W + 3] @ plant.inertia_main @ x[X_W:X_W + 3]
-                       + 0.5 * damper_inertia * x[X_E:X_E + 3] @ x[X_E:X_E + 3] for x in states])
+                       + 0.5 * damper_inertia * w @ w for x, w in zip(states, rotor)])
     # Internal torques only: total momentum constant to the RK4 error (1e-6 of |H|, as torque-free).
     assert np.abs(total - total[0]).max() < 1e-6 * np.linalg.norm(total[0])
     assert np.all(np.diff(energy) <= 1e-9 * energy[0]) and energy[-1] < (1 - 1e-3) * energy[0]

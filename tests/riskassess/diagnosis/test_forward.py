@@ -36,10 +36,58 @@ def test_a_pair_with_its_second_effect_off_is_the_first_effect(panel_on_hinge):
         assert np.allclose(both[c], alone[c], rtol=1e-12, atol=1e-15), c
 
 
-def test_effects_with_extra_states_are_not_paired():
-    assert not can_pair(CATALOG["internal_energy_dissipation"], CATALOG["tether_viscoelasticity"])
+def test_effects_with_states_of_their_own_are_paired():
+    # each effect of a pair keeps its own block of states: only an effect with itself is refused
+    assert can_pair(CATALOG["internal_energy_dissipation"], CATALOG["tether_viscoelasticity"])
+    assert can_pair(CATALOG["internal_energy_dissipation"], CATALOG["hinge_coulomb_friction"])
     assert not can_pair(CATALOG["sensor_bias"], CATALOG["sensor_bias"])
     assert can_pair(CATALOG["hinge_coulomb_friction"], CATALOG["sensor_bias"])
+
+
+@pytest.mark.parametrize("order", [("internal_energy_dissipation", "hinge_coulomb_friction"),
+                                   ("hinge_coulomb_friction", "internal_energy_dissipation")])
+def test_a_pair_of_effects_with_states_gives_each_its_own_block(panel_on_hinge, order):
+    """The damper (3 states: the rotor's rate) and the stick-slip friction (1 state: the anchor) in one
+    fast model, in either order: with one switched off (J_d = 0: no torque; T_c = 0: no friction, its
+    anchor still moving) the pair predicts what the other does alone, to round-off (same law, same step).
+    A law reading the other's block (the rotor's rate as the anchor, or the reverse) would not."""
+    case, times = panel_on_hinge, sample_times(20.0, 10.0)
+    plant = plant_of(case)
+    channels = list(predict(plant, times[:3]))
+    pair = _pair(case, *order, channels)
+    assert pair.extra_states == 4
+    names = [p.name for p in pair.parameter_specs(case, channels)]
+    on = {"internal_energy_dissipation": [5.0, 20.0], "hinge_coulomb_friction": [3.0]}
+    off = {"internal_energy_dissipation": [0.0, 20.0], "hinge_coulomb_friction": [0.0]}
+    step = 0.02
+    for kept in order:
+        values = np.concatenate([on[e] if e == kept else off[e] for e in order])
+        both = predict(plant, times, pair, values, names, step)
+        alone = predict(plant, times, CATALOG[kept], on[kept], [p.name for p in CATALOG[kept].parameter_specs(case)],
+                        step)
+        for c in alone:
+            assert np.allclose(both[c], alone[c], rtol=1e-12, atol=1e-15), (kept, c)
+
+
+def test_a_towing_pair_of_effects_with_states_gives_each_its_own_block(zenit_tow):
+    """The viscoelastic tether (2 states: branch tension, last elongation) and the damper (3 states) in one
+    towing model: with the damper off (J_d = 0) the pair predicts the tether alone, with the branch off
+    (k_m = 0) the damper alone, to round-off."""
+    case, times = zenit_tow, sample_times(20.0, 2.0)
+    plant = plant_of(case)
+    channels = list(predict(plant, times[:3]))
+    pair = _pair(case, "tether_viscoelasticity", "internal_energy_dissipation", channels)
+    assert pair.towing_extra_states == 5
+    names = [p.name for p in pair.parameter_specs(case, channels)]
+    tether, damper = CATALOG["tether_viscoelasticity"], CATALOG["internal_energy_dissipation"]
+    k = case.towing_case.main_tether.stiffness
+    for values, alone_effect, alone_values in (([k, 20.0, 0.0, 20.0], tether, [k, 20.0]),
+                                               ([0.0, 20.0, 50.0, 20.0], damper, [50.0, 20.0])):
+        both = predict(plant, times, pair, np.array(values), names)
+        alone = predict(plant, times, alone_effect, np.array(alone_values),
+                        [p.name for p in alone_effect.parameter_specs(case)])
+        for c in alone:
+            assert np.allclose(both[c], alone[c], rtol=1e-12, atol=1e-12), (alone_effect.id, c)
 
 
 @pytest.mark.parametrize("first, second, seed", [("hinge_coulomb_friction", "sensor_bias", 1),
