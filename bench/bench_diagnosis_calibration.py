@@ -133,21 +133,23 @@ def main() -> None:
     start, load = time.perf_counter(), os.getloadavg()[0]
     false_claims, misses = [], []
     with tempfile.TemporaryDirectory() as tmp:
-        rng = np.random.default_rng(args.seed)
+        # the two parts interleaved (each with its own generator, so the draws are those of running them
+        # one after the other): a run stopped early has both rates over the same number of draws
+        rng_out, rng_in = np.random.default_rng(args.seed), np.random.default_rng(args.seed + 10_000)
         for k in range(args.draws):
-            path, times, measured, what = out_of_catalog_record(rng, args.duration)
+            path, times, measured, what = out_of_catalog_record(rng_out, args.duration)
             answer = diagnose(path, times, measured, Path(tmp) / f"out-of-catalog-{k}")
             claimed = answer["cause"] not in ("none", "unexplained") and (answer["confidence"] or 0) >= 0.5
             if claimed:
                 false_claims.append(f"{what}: named {answer['cause']} ({answer['confidence']:.2f})")
-            print(f"out-of-catalog {k + 1}/{args.draws}: {what} -> {answer['cause']}", flush=True)
-        rng = np.random.default_rng(args.seed + 10_000)
-        for k in range(args.draws):
-            path, times, measured, effect_id = catalog_record(rng, args.duration)
+            print(f"out-of-catalog {k + 1}/{args.draws}: {what} -> {answer['cause']}"
+                  f"{' CLAIMED' if claimed else ''} [{len(false_claims)} claims]", flush=True)
+            path, times, measured, effect_id = catalog_record(rng_in, args.duration)
             answer = diagnose(path, times, measured, Path(tmp) / f"catalog-{k}")
             if answer["cause"] != effect_id:
                 misses.append(f"{effect_id} on {path.stem}: answered {answer['cause']}")
-            print(f"catalog {k + 1}/{args.draws}: {effect_id} -> {answer['cause']}", flush=True)
+            print(f"catalog {k + 1}/{args.draws}: {effect_id} on {path.stem} -> {answer['cause']}"
+                  f"{'' if answer['cause'] == effect_id else ' MISS'} [{len(misses)} misses]", flush=True)
     n = args.draws
     print(f"\n{2 * n} diagnoses of {args.duration:g} s records in {time.perf_counter() - start:.0f} s, "
           f"load average {load:.1f} -> {os.getloadavg()[0]:.1f}")
