@@ -124,6 +124,16 @@ def diagnose(path, times, measured, workdir: Path) -> dict:
     return diagnose_case(case, data, workdir / "out", figures=False)
 
 
+def generic_margin(answer: dict) -> str:
+    """The best catalog model's BIC margin over the best generic form, when every form was fitted (a
+    cause was named by the catalog selection), as text for the log."""
+    entry = answer.get("none_of_these") or {}
+    if len(entry.get("forms", {})) < 2 or not answer["candidates"]:
+        return ""
+    best = max(answer["candidates"], key=lambda c: c["delta_bic"])
+    return f" (catalog {best['id']} vs generic {entry['best']}: {best['delta_bic'] - entry['delta_bic']:+.1f} in BIC)"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--draws", type=int, default=100)
@@ -143,13 +153,14 @@ def main() -> None:
             if claimed:
                 false_claims.append(f"{what}: named {answer['cause']} ({answer['confidence']:.2f})")
             print(f"out-of-catalog {k + 1}/{args.draws}: {what} -> {answer['cause']}"
-                  f"{' CLAIMED' if claimed else ''} [{len(false_claims)} claims]", flush=True)
+                  f"{' CLAIMED' if claimed else ''}{generic_margin(answer)} [{len(false_claims)} claims]", flush=True)
             path, times, measured, effect_id = catalog_record(rng_in, args.duration)
             answer = diagnose(path, times, measured, Path(tmp) / f"catalog-{k}")
             if answer["cause"] != effect_id:
                 misses.append(f"{effect_id} on {path.stem}: answered {answer['cause']}")
             print(f"catalog {k + 1}/{args.draws}: {effect_id} on {path.stem} -> {answer['cause']}"
-                  f"{'' if answer['cause'] == effect_id else ' MISS'} [{len(misses)} misses]", flush=True)
+                  f"{'' if answer['cause'] == effect_id else ' MISS'}{generic_margin(answer)} [{len(misses)} misses]",
+                  flush=True)
     n = args.draws
     print(f"\n{2 * n} diagnoses of {args.duration:g} s records in {time.perf_counter() - start:.0f} s, "
           f"load average {load:.1f} -> {os.getloadavg()[0]:.1f}")

@@ -23,8 +23,9 @@ the body rates, the attitude, and a force on the centre of mass:
 
 Why several small forms, not one big one: a catalog effect is a *specific structure* (the eddy-current
 brake, say, is a linear rate damping whose null direction is a field fixed in inertial space). It is
-named only when that structure explains the data better than every generic form (:func:`none_of_these`),
-each penalized for its own freedom. One large generic model would pay for all its terms at once (21
+named only when that structure explains the data decisively better than every generic form (by the
+case's ``decisive_delta_bic``, as against a catalog runner-up; :func:`none_of_these`), each penalized for
+its own freedom. One large generic model would pay for all its terms at once (21
 parameters cost ~170 in BIC on a 40 s record) and lose to any 3-parameter catalog member that happens to
 fit; a damping quadratic in the rates, at the nearly constant spin of a 40 s record, acts as a linear
 one, which the eddy-current law with its field normal to the spin reproduces exactly: the data then say
@@ -419,10 +420,11 @@ def is_generic(model_id: str) -> bool:
     return model_id == DISCREPANCY_ID or model_id.startswith(DISCREPANCY_ID + "_")
 
 
-def none_of_these(decision: dict, fits: dict, weights: dict) -> dict:
+def none_of_these(decision: dict, fits: dict, weights: dict, decisive: float = 0.0) -> dict:
     """The decision with the "none of these" alternative: a named cause whose BIC is not lower than
-    every generic form's becomes "unexplained"; the confidence is the cause's posterior weight among
-    every model including the generic forms (``weights``).
+    every generic form's by more than ``decisive`` becomes "unexplained" (the data do not single out its
+    own structure: the same rule as against a catalog runner-up); the confidence is the cause's posterior
+    weight among every model including the generic forms (``weights``).
 
     Parameters
     ----------
@@ -432,6 +434,8 @@ def none_of_these(decision: dict, fits: dict, weights: dict) -> dict:
         Fitted models by id, the generic forms' among them.
     weights : dict of str to float
         Posterior weights over every model including the generic forms (-).
+    decisive : float
+        BIC margin the cause needs over the best generic form (-; the case's ``decisive_delta_bic``).
 
     Returns
     -------
@@ -450,11 +454,13 @@ def none_of_these(decision: dict, fits: dict, weights: dict) -> dict:
     margin = fits[best].bic - fits[cause].bic
     what = f"a generic alternative outside the catalog ('{best}', {len(fits[best].names) - fits[best].nominal_count} " \
            f"parameters)"
-    if margin <= 0.0:
+    if margin <= decisive:
+        how = f"better (BIC lower by {-margin:.1f})" if margin <= 0 else \
+            f"about as well (BIC higher by only {margin:.1f}, not more than {decisive:g})"
         return {**decision, "cause": "unexplained", "confidence": None,
-                "reason": f"{cause} is the best catalog candidate, but {what} explains the data as well or better "
-                          f"(BIC lower by {-margin:.1f}): the data do not single out {cause}'s own structure, the "
-                          f"cause may be outside the catalog. {decision['reason']}"}
+                "reason": f"{cause} is the best catalog candidate, but {what} explains the data {how}: the data do "
+                          f"not single out {cause}'s own structure, the cause may be outside the catalog. "
+                          f"{decision['reason']}"}
     return {**decision, "confidence": weights[cause],
             "reason": decision["reason"] + f"; better than the best generic alternative outside the catalog "
                                            f"({best}) by {margin:.1f} in BIC"}

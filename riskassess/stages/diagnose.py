@@ -325,7 +325,8 @@ def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, 
             decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms, problem)
     alternatives = _none_of_these_fits(problem, fits, workers, every_form=decision["cause"] not in ("none", "unexplained"))
     if alternatives:
-        decision = none_of_these(decision, {**fits, **alternatives}, posterior_weights({**fits, **alternatives}))
+        decision = none_of_these(decision, {**fits, **alternatives}, posterior_weights({**fits, **alternatives}),
+                                 case.diagnosis.decisive_delta_bic)
     chosen = decision["model"]
     before = analyse(problem.time, predictions["nominal"], problem.values, problem.noise)
     after = analyse(problem.time, predictions[chosen], problem.values, problem.noise)
