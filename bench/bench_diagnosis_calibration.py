@@ -11,8 +11,12 @@ panel of cases/diagnose_*.toml, scaled so that the largest channel departs from 
 confidence >= 0.5 (goal <= 5 %).
 (b) ``N`` records with one catalog effect (the fast tests' draw, tests/riskassess/diagnosis/test_diagnose.py):
 the rate at which the right cause is named (goal >= 95 %).
-Prints both rates with the number of draws, every miss, the wall time and the load. The data come
-from the Exudyn model (riskassess.diagnosis.exudyn_model), the fit from the compiled model.
+Prints both rates with the number of draws, every miss, the wall time and the load. The two parts run
+interleaved (one draw of each in turn, each part with its own generator: the same draws as one part
+after the other), so a run stopped early has both rates over the same number of draws; each line gives
+the running count and, when the catalog selection named a cause, its BIC margin over the best generic
+"none of these" form (riskassess.diagnosis.discrepancy). The data come from the Exudyn model
+(riskassess.diagnosis.exudyn_model), the fit from the compiled model.
 """
 from __future__ import annotations
 

@@ -105,19 +105,23 @@ def _fit(model_id, bic, parameters):
 
 def test_a_cause_is_named_only_when_it_beats_every_generic_form():
     # the rule of riskassess.diagnosis.discrepancy.none_of_these, on made-up BICs: the cause's BIC must be
-    # lower than the best generic form's; its confidence is then its weight among every model
+    # lower than the best generic form's by more than the decisive margin (10); its confidence is then its
+    # weight among every model
     decision = {"cause": "eddy_current_damping", "model": "eddy_current_damping", "confidence": 1.0, "reason": "r"}
     fits = {"nominal": _fit("nominal", 1000.0, 0), "eddy_current_damping": _fit("eddy_current_damping", 100.0, 3),
             "none_of_these": _fit("none_of_these", 150.0, 9),
             "none_of_these_rate_damping": _fit("none_of_these_rate_damping", 90.0, 2)}
-    answer = none_of_these(decision, fits, posterior_weights(fits))
+    answer = none_of_these(decision, fits, posterior_weights(fits), 10.0)
     assert answer["cause"] == "unexplained" and answer["confidence"] is None
     assert "none_of_these_rate_damping" in answer["reason"]
     fits["none_of_these_rate_damping"] = _fit("none_of_these_rate_damping", 104.0, 2)
-    answer = none_of_these(decision, fits, posterior_weights(fits))
-    # weight exp(-100/2) / (exp(-100/2) + exp(-104/2) + ...) = 1 / (1 + e^-2) = 0.881
+    answer = none_of_these(decision, fits, posterior_weights(fits), 10.0)
+    assert answer["cause"] == "unexplained"                    # better, but not decisively
+    fits["none_of_these_rate_damping"] = _fit("none_of_these_rate_damping", 114.0, 2)
+    answer = none_of_these(decision, fits, posterior_weights(fits), 10.0)
+    # weight exp(-100/2) / (exp(-100/2) + exp(-114/2) + ...) = 1 / (1 + e^-7) = 0.99909
     assert answer["cause"] == "eddy_current_damping"
-    assert answer["confidence"] == pytest.approx(1.0 / (1.0 + np.exp(-2.0)), rel=1e-6)
+    assert answer["confidence"] == pytest.approx(1.0 / (1.0 + np.exp(-7.0)), rel=1e-6)
 
 
 def _exudyn_record(case_path, torque, seed):
