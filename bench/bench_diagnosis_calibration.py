@@ -143,6 +143,8 @@ def main() -> None:
     parser.add_argument("--draws", type=int, default=100)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--duration", type=float, default=40.0)
+    parser.add_argument("--skip", type=int, default=0, help="draw but do not diagnose the first SKIP pairs "
+                        "(to continue a stopped run: the rates then count the remaining draws only)")
     args = parser.parse_args()
     start, load = time.perf_counter(), os.getloadavg()[0]
     false_claims, misses = [], []
@@ -152,6 +154,9 @@ def main() -> None:
         rng_out, rng_in = np.random.default_rng(args.seed), np.random.default_rng(args.seed + 10_000)
         for k in range(args.draws):
             path, times, measured, what = out_of_catalog_record(rng_out, args.duration)
+            if k < args.skip:
+                catalog_record(rng_in, args.duration)
+                continue
             answer = diagnose(path, times, measured, Path(tmp) / f"out-of-catalog-{k}")
             claimed = answer["cause"] not in ("none", "unexplained") and (answer["confidence"] or 0) >= 0.5
             if claimed:
@@ -165,7 +170,7 @@ def main() -> None:
             print(f"catalog {k + 1}/{args.draws}: {effect_id} on {path.stem} -> {answer['cause']}"
                   f"{'' if answer['cause'] == effect_id else ' MISS'}{generic_margin(answer)} [{len(misses)} misses]",
                   flush=True)
-    n = args.draws
+    n = args.draws - args.skip
     print(f"\n{2 * n} diagnoses of {args.duration:g} s records in {time.perf_counter() - start:.0f} s, "
           f"load average {load:.1f} -> {os.getloadavg()[0]:.1f}")
     print(f"out of catalog: a catalog cause named with confidence >= 0.5 in {len(false_claims)} of {n} "

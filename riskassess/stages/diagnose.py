@@ -379,15 +379,21 @@ def _predicted_and_scored(problem: Problem, fits: dict, effects: dict, predictio
     return fits, predictions, score(problem, predictions, step_errors)
 
 
-def _fit_form(task) -> FitResult:
+def _fit_form(task) -> FitResult | None:
+    """One generic form's fit, in a worker; None when the fit fails numerically (a form driven to a
+    load that makes the motion blow up: its Jacobian overflows)."""
     form, nominal = task
-    return CandidateFit(_PROBLEM, form).fit(nominal)
+    try:
+        with np.errstate(all="ignore"):
+            return CandidateFit(_PROBLEM, form).fit(nominal)
+    except (np.linalg.LinAlgError, FloatingPointError, ValueError, SimulationFailed):
+        return None
 
 
 def _none_of_these_fits(problem: Problem, fits: dict, workers: int = WORKERS, every_form: bool = True) -> dict:
     """The "none of these" alternatives (:mod:`riskassess.diagnosis.discrepancy`: the generic forms that
     apply) fitted from the nominal fit, in the worker processes; id -> fit, without the forms whose
-    prediction diverges; empty for the towing scenario. ``every_form`` False: only the first form (the
+    fit fails numerically or whose prediction diverges (they cannot then stand against a cause); empty for the towing scenario. ``every_form`` False: only the first form (the
     smooth torque in time), for an answer that names no cause (the forms can only take a named cause
     away; the time form's delta BIC is still reported)."""
     global _PROBLEM
@@ -405,6 +411,8 @@ def _none_of_these_fits(problem: Problem, fits: dict, workers: int = WORKERS, ev
             fitted = pool.map(_fit_form, tasks, chunksize=1)
     out = {}
     for form, fit in zip(forms, fitted):
+        if fit is None:
+            continue
         predicted = prediction(problem, form, fit, problem.time)
         if first_unpredicted_time(problem.time, predicted, problem.values) is None:
             out[form.id] = fit
