@@ -11,6 +11,8 @@ the body rates, the attitude, and a force on the centre of mass:
 
   .. math:: \\tau_j(t) = \\sum_{k=0}^{2} c_{jk} P_k(s),\\qquad s = 2 (t - t_0) / (t_1 - t_0) - 1;
 
+* ``none_of_these_body_torque``: a constant torque fixed in the body (B; 3 parameters: a venting jet or
+  a thruster leak fixed on the body);
 * ``none_of_these_rate_damping``: a damping of unknown law along the body rates,
   :math:`\\tau = -c\\,(|\\omega| / \\omega_0)^{e - 1}\\,\\omega` (B; 2 parameters: c and the exponent e,
   0 to 4: Coulomb-like, viscous, aerodynamic-like quadratic ...; omega_0 the case's initial rate);
@@ -292,6 +294,46 @@ class Discrepancy(GenericForm):
         return specs
 
 
+class BodyTorque(GenericForm):
+    """A constant torque fixed in the main body (B): the time series' constant terms alone."""
+
+    id = f"{DISCREPANCY_ID}_body_torque"
+    title = "none of these: a constant torque fixed in the body"
+    model = "a constant torque fixed in the body"
+
+    def parameter_specs(self, case, channels=None) -> list[Parameter]:
+        """The torque's B components (N m).
+
+        Parameters
+        ----------
+        case : TumblingRigidCase or HingedAppendageCase
+            Validated diagnosis case; its plant sizes the torque.
+        channels : sequence of str, optional
+            Not used.
+        """
+        return _coefficients([f"body_torque_{a}" for a in "xyz"], "N m", lambda n: f"torque along B {n[-1]}",
+                             body_torque_scale(Plant.from_case(case)))
+
+    def law_parameters(self, plant: Plant, values: np.ndarray) -> np.ndarray:
+        """The components as the Legendre series' P0 terms, the other terms zero.
+
+        Parameters
+        ----------
+        plant : Plant
+            The plant.
+        values : (3,) float
+            The torque (N m, B).
+
+        Returns
+        -------
+        p : (P_SIZE,) float
+            The law's parameters.
+        """
+        series = np.zeros(3 * TERMS)
+        series[::TERMS] = np.asarray(values, float)
+        return super().law_parameters(plant, series)
+
+
 class RateDamping(GenericForm):
     """A damping of the body rates with a free power law: -c (|omega| / omega_0)^(e - 1) omega (B)."""
 
@@ -387,7 +429,7 @@ class ComForce(GenericForm):
 
 
 #: The generic forms, in the order they are fitted.
-FORMS = (Discrepancy, RateDamping, DampingMatrix, InertialTorque, ComForce)
+FORMS = (Discrepancy, BodyTorque, RateDamping, DampingMatrix, InertialTorque, ComForce)
 
 
 def generic_forms(t0: float, t1: float) -> list[GenericForm]:
