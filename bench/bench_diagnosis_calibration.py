@@ -11,8 +11,12 @@ panel of cases/diagnose_*.toml, scaled so that the largest channel departs from 
 confidence >= 0.5 (goal <= 5 %).
 (b) ``N`` records with one catalog effect (the fast tests' draw, tests/riskassess/diagnosis/test_diagnose.py):
 the rate at which the right cause is named (goal >= 95 %).
-Prints both rates with the number of draws, every miss, the wall time and the load. The data come
-from the Exudyn model (riskassess.diagnosis.exudyn_model), the fit from the compiled model.
+Prints both rates with the number of draws, every miss, the wall time and the load. The two parts run
+interleaved (one draw of each in turn, each part with its own generator: the same draws as one part
+after the other), so a run stopped early has both rates over the same number of draws; each line gives
+the running count and, when the catalog selection named a cause, its BIC margin over the best generic
+"none of these" form (riskassess.diagnosis.discrepancy). The data come from the Exudyn model
+(riskassess.diagnosis.exudyn_model), the fit from the compiled model.
 """
 from __future__ import annotations
 
@@ -124,31 +128,49 @@ def diagnose(path, times, measured, workdir: Path) -> dict:
     return diagnose_case(case, data, workdir / "out", figures=False)
 
 
+def generic_margin(answer: dict) -> str:
+    """The best catalog model's BIC margin over the best generic form, when every form was fitted (a
+    cause was named by the catalog selection), as text for the log."""
+    entry = answer.get("none_of_these") or {}
+    if len(entry.get("forms", {})) < 2 or not answer["candidates"]:
+        return ""
+    best = max(answer["candidates"], key=lambda c: c["delta_bic"])
+    return f" (catalog {best['id']} vs generic {entry['best']}: {best['delta_bic'] - entry['delta_bic']:+.1f} in BIC)"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--draws", type=int, default=100)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--duration", type=float, default=40.0)
+    parser.add_argument("--skip", type=int, default=0, help="draw but do not diagnose the first SKIP pairs "
+                        "(to continue a stopped run: the rates then count the remaining draws only)")
     args = parser.parse_args()
     start, load = time.perf_counter(), os.getloadavg()[0]
     false_claims, misses = [], []
     with tempfile.TemporaryDirectory() as tmp:
-        rng = np.random.default_rng(args.seed)
+        # the two parts interleaved (each with its own generator, so the draws are those of running them
+        # one after the other): a run stopped early has both rates over the same number of draws
+        rng_out, rng_in = np.random.default_rng(args.seed), np.random.default_rng(args.seed + 10_000)
         for k in range(args.draws):
-            path, times, measured, what = out_of_catalog_record(rng, args.duration)
+            path, times, measured, what = out_of_catalog_record(rng_out, args.duration)
+            if k < args.skip:
+                catalog_record(rng_in, args.duration)
+                continue
             answer = diagnose(path, times, measured, Path(tmp) / f"out-of-catalog-{k}")
             claimed = answer["cause"] not in ("none", "unexplained") and (answer["confidence"] or 0) >= 0.5
             if claimed:
                 false_claims.append(f"{what}: named {answer['cause']} ({answer['confidence']:.2f})")
-            print(f"out-of-catalog {k + 1}/{args.draws}: {what} -> {answer['cause']}", flush=True)
-        rng = np.random.default_rng(args.seed + 10_000)
-        for k in range(args.draws):
-            path, times, measured, effect_id = catalog_record(rng, args.duration)
+            print(f"out-of-catalog {k + 1}/{args.draws}: {what} -> {answer['cause']}"
+                  f"{' CLAIMED' if claimed else ''}{generic_margin(answer)} [{len(false_claims)} claims]", flush=True)
+            path, times, measured, effect_id = catalog_record(rng_in, args.duration)
             answer = diagnose(path, times, measured, Path(tmp) / f"catalog-{k}")
             if answer["cause"] != effect_id:
                 misses.append(f"{effect_id} on {path.stem}: answered {answer['cause']}")
-            print(f"catalog {k + 1}/{args.draws}: {effect_id} -> {answer['cause']}", flush=True)
-    n = args.draws
+            print(f"catalog {k + 1}/{args.draws}: {effect_id} on {path.stem} -> {answer['cause']}"
+                  f"{'' if answer['cause'] == effect_id else ' MISS'}{generic_margin(answer)} [{len(misses)} misses]",
+                  flush=True)
+    n = args.draws - args.skip
     print(f"\n{2 * n} diagnoses of {args.duration:g} s records in {time.perf_counter() - start:.0f} s, "
           f"load average {load:.1f} -> {os.getloadavg()[0]:.1f}")
     print(f"out of catalog: a catalog cause named with confidence >= 0.5 in {len(false_claims)} of {n} "

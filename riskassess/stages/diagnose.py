@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from riskassess.diagnosis.composite import EffectPair
-from riskassess.diagnosis.discrepancy import DISCREPANCY_ID, Discrepancy, none_of_these
+from riskassess.diagnosis.discrepancy import generic_forms, none_of_these
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.forward import make_pairs, pair_candidates, selection_steps
 from riskassess.diagnosis.fit import (CandidateFit, FitResult, Problem, first_unpredicted_time, prediction,
@@ -329,10 +329,10 @@ def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, 
             fits, predictions, scores = _predicted_and_scored(problem, fits, effects, predictions, step_errors,
                                                               diverged, [p.id for p in pairs])
             decision = decide(fits, scores, case.diagnosis.decisive_delta_bic, case.diagnosis.adequate_rms, problem)
-    alternative = _none_of_these_fit(problem, fits)
-    if alternative is not None:
-        decision = none_of_these(decision, {**fits, DISCREPANCY_ID: alternative},
-                                 posterior_weights({**fits, DISCREPANCY_ID: alternative}))
+    alternatives = _none_of_these_fits(problem, fits, workers, every_form=decision["cause"] not in ("none", "unexplained"))
+    if alternatives:
+        decision = none_of_these(decision, {**fits, **alternatives}, posterior_weights({**fits, **alternatives}),
+                                 case.diagnosis.decisive_delta_bic)
     chosen = decision["model"]
     before = analyse(problem.time, predictions["nominal"], problem.values, problem.noise)
     after = analyse(problem.time, predictions[chosen], problem.values, problem.noise)
@@ -346,10 +346,7 @@ def _diagnose(case, case_path: Path, measured, measured_path, problem: Problem, 
         "nominal_parameters": _parameters(fits[chosen], nominal=True),
         "rmse_before": rmse_before, "rmse_after": rmse_after, "gain_percent": gain,
         "rmse_case_as_given": None, "candidates": _candidate_rows(fits, scores, decision),
-        "none_of_these": None if alternative is None else {
-            "delta_bic": float(fits["nominal"].bic - alternative.bic), "parameters": len(alternative.names)
-            - alternative.nominal_count, "fit_seconds": alternative.seconds,
-            "model": "a smooth torque on the body (and hinge), quadratic in time: effects outside the catalog"},
+        "none_of_these": _none_of_these_entry(fits["nominal"], alternatives),
         "not_applicable": not_applicable,
         "diverged": {k: f"prediction not finite from t = {t:g} s" for k, t in diverged.items()},
         "nominal": {"bic": fits["nominal"].bic, "train_rms_sigma": scores["nominal"]["train_rms_sigma"],
@@ -388,15 +385,57 @@ def _predicted_and_scored(problem: Problem, fits: dict, effects: dict, predictio
     return fits, predictions, score(problem, predictions, step_errors)
 
 
-def _none_of_these_fit(problem: Problem, fits: dict) -> FitResult | None:
-    """The "none of these" alternative (:mod:`riskassess.diagnosis.discrepancy`) fitted from the nominal
-    fit, for the attitude scenarios; None for the towing scenario or when its prediction diverges."""
-    discrepancy = Discrepancy(problem.time[0], problem.time[-1])
-    if discrepancy.not_applicable(problem.case, problem.channels):
+def _fit_form(task) -> FitResult | None:
+    """One generic form's fit, in a worker; None when the fit fails numerically (a form driven to a
+    load that makes the motion blow up: its Jacobian overflows)."""
+    form, nominal = task
+    try:
+        with np.errstate(all="ignore"):
+            return CandidateFit(_PROBLEM, form).fit(nominal)
+    except (np.linalg.LinAlgError, FloatingPointError, ValueError, SimulationFailed):
         return None
-    fit = CandidateFit(problem, discrepancy).fit(fits["nominal"])
-    predicted = prediction(problem, discrepancy, fit, problem.time)
-    return None if first_unpredicted_time(problem.time, predicted, problem.values) is not None else fit
+
+
+def _none_of_these_fits(problem: Problem, fits: dict, workers: int = WORKERS, every_form: bool = True) -> dict:
+    """The "none of these" alternatives (:mod:`riskassess.diagnosis.discrepancy`: the generic forms that
+    apply) fitted from the nominal fit, in the worker processes; id -> fit, without the forms whose
+    fit fails numerically or whose prediction diverges (they cannot then stand against a cause); empty for the towing scenario. ``every_form`` False: only the first form (the
+    smooth torque in time), for an answer that names no cause (the forms can only take a named cause
+    away; the time form's delta BIC is still reported)."""
+    global _PROBLEM
+    forms = [f for f in generic_forms(problem.time[0], problem.time[-1]) if not f.not_applicable(problem.case,
+                                                                                                  problem.channels)]
+    forms = forms if every_form else forms[:1]
+    if not forms:
+        return {}
+    _PROBLEM = problem
+    tasks = [(f, fits["nominal"]) for f in forms]
+    if workers <= 1 or "fork" not in multiprocessing.get_all_start_methods():
+        fitted = [_fit_form(t) for t in tasks]
+    else:
+        with multiprocessing.get_context("fork").Pool(workers, initializer=single_threaded_blas) as pool:
+            fitted = pool.map(_fit_form, tasks, chunksize=1)
+    out = {}
+    for form, fit in zip(forms, fitted):
+        if fit is None:
+            continue
+        predicted = prediction(problem, form, fit, problem.time)
+        if first_unpredicted_time(problem.time, predicted, problem.values) is None:
+            out[form.id] = fit
+    return out
+
+
+def _none_of_these_entry(nominal: FitResult, alternatives: dict) -> dict | None:
+    """The answer's ``none_of_these``: the best generic form's delta BIC against the nominal model, its
+    parameter count, fit time and description, and every form's delta BIC."""
+    if not alternatives:
+        return None
+    models = {f.id: f.model for f in generic_forms(0.0, 1.0)}
+    best = min(alternatives, key=lambda k: alternatives[k].bic)
+    fit = alternatives[best]
+    return {"delta_bic": float(nominal.bic - fit.bic), "parameters": len(fit.names) - fit.nominal_count,
+            "fit_seconds": fit.seconds, "best": best, "model": models[best],
+            "forms": {k: float(nominal.bic - f.bic) for k, f in alternatives.items()}}
 
 
 def _unfitted(problem: Problem) -> FitResult:
