@@ -432,15 +432,7 @@ def diagnose_impact(case, measured, workers: int = WORKERS, progress=None, candi
     done = len(first)
     for stage in ("refine_points", "vertex_point"):
         points = {key: getattr(s, stage)() for key, s in scans.items()}
-        batch = [scans[key].overrides(u, base) for key, us in points.items() for u in us]
-        results = simulate_all(problem.run, batch, workers, progress, done, total)
-        done += len(batch)
-        k = 0
-        for key, us in points.items():
-            scans[key].u += us
-            scans[key].add(results[k:k + len(us)], [chi2(normalized(r, sigma), measured_n, problem.train)
-                                                    for r in results[k:k + len(us)]])
-            k += len(us)
+        done = _scan_points(points, scans, base, problem, sigma, measured_n, workers, progress, done, total)
     nominal_chi2 = [c for c in chi2s[:1 + len(ensemble)] if np.isfinite(c)]
     scatter = chi2_scatter(nominal_chi2)
     threshold = decisive_threshold(case.diagnosis.decisive_delta_bic, scatter)
@@ -449,17 +441,11 @@ def diagnose_impact(case, measured, workers: int = WORKERS, progress=None, candi
         # grid point next to the truth can mispredict the held-out windows of a well-determined parameter
         lowest = min(min(s.chi2) for s in scans.values())
         points = {key: s.narrowing_points(fraction) for key, s in scans.items() if min(s.chi2) <= lowest + threshold}
-        batch = [scans[key].overrides(u, base) for key, us in points.items() for u in us]
-        if not batch:
+        n_points = sum(len(us) for us in points.values())
+        if not n_points:
             break
-        results = simulate_all(problem.run, batch, workers, progress, done, done + len(batch))
-        done += len(batch)
-        k = 0
-        for key, us in points.items():
-            scans[key].u += us
-            scans[key].add(results[k:k + len(us)], [chi2(normalized(r, sigma), measured_n, problem.train)
-                                                    for r in results[k:k + len(us)]])
-            k += len(us)
+        done = _scan_points(points, scans, base, problem, sigma, measured_n, workers, progress, done,
+                            done + n_points)
     n_data = int(sum(np.isfinite(measured_n[c][problem.train]).sum() for c in problem.channels))
     seconds = clock.perf_counter() - wall[0]
     fits = {"nominal": FitResult("nominal", [], [], np.zeros(0), np.zeros(0), 0, float(chi2s[0]), 0.0, n_data,
@@ -473,6 +459,39 @@ def diagnose_impact(case, measured, workers: int = WORKERS, progress=None, candi
         fits[key], index = s.result(n_data, seconds, scatter)
         predictions[key] = normalized(s.runs[index], sigma)
     return _answer(case, problem, fits, predictions, diverged, scans, sigma, spread, nominal_chi2, measured_n, wall)
+
+
+def _scan_points(points, scans, base, problem, sigma, measured_n, workers, progress, done, total) -> int:
+    """Simulate each effect's new parameter values ``points`` (effect id -> list of u) and add the runs
+    and their chi^2 to its :class:`EffectScan`; returns the number of simulations done so far.
+
+    Parameters
+    ----------
+    points : dict of str to list of float
+        New values of each effect's parameter (its fit variable u).
+    scans : dict of str to EffectScan
+        The effects' scans, extended in place.
+    base : dict
+        The nominal run's overrides.
+    problem : ImpactProblem
+    sigma, measured_n : dict
+        Window sigmas and the normalized measured windows (:func:`normalized`).
+    workers : int
+        Worker processes.
+    progress : callable or None
+        ``progress(stage, done, total)``.
+    done, total : int
+        Simulations done before this batch, and the total announced to ``progress``.
+    """
+    batch = [scans[key].overrides(u, base) for key, us in points.items() for u in us]
+    results = simulate_all(problem.run, batch, workers, progress, done, total)
+    k = 0
+    for key, us in points.items():
+        scans[key].u += us
+        scans[key].add(results[k:k + len(us)], [chi2(normalized(r, sigma), measured_n, problem.train)
+                                                for r in results[k:k + len(us)]])
+        k += len(us)
+    return done + len(batch)
 
 
 def chaos_share(problem: ImpactProblem, sigma: dict, spread: dict) -> dict:
