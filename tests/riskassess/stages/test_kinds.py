@@ -8,6 +8,9 @@ from riskassess.stages.kinds import case_kind, load_any_case
 
 CASES = Path(__file__).resolve().parents[3] / "cases"
 SHIPPED = sorted(CASES.glob("*.toml"))
+# The legacy form (a diagnosis file's scenario in ``kind``) predates the impact diagnosis scenario, whose
+# scenario name is also the impact case kind: no file of that form can exist, so it is not converted.
+LEGACY_SHIPPED = [p for p in SHIPPED if read_toml(p).get("scenario") != "impact"]
 
 
 @pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.name)
@@ -26,7 +29,7 @@ def _legacy(raw: dict) -> dict:
     return raw
 
 
-@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.name)
+@pytest.mark.parametrize("path", LEGACY_SHIPPED, ids=lambda p: p.name)
 def test_files_without_the_explicit_kind_read_the_same(path, tmp_path):
     from riskassess.cases.diagnosis import toml_text
 
