@@ -41,8 +41,10 @@ def test_discrepancy_torque_is_its_legendre_series(tumbling_rocket_body):
         assert np.abs(fast[c] - reference[c]).max() < 0.02 * change   # ... and both models agree
 
 
+# the hinged record takes ~20 s: slow suite (the tumbling one keeps an out-of-catalog family by default)
 @pytest.mark.parametrize("family, case_path", [("inertial_torque", TUMBLING_CASE),
-                                               ("quadratic_hinge_damping", HINGED_CASE)])
+                                               pytest.param("quadratic_hinge_damping", HINGED_CASE,
+                                                            marks=pytest.mark.slow)])
 def test_out_of_catalog_effects_get_no_confident_catalog_cause(tmp_path, family, case_path, request):
     """A torque fixed in inertial space (a solar-pressure-like load) and a quadratic hinge damping are
     in no catalog entry: 20 sigma of departure, default noise."""

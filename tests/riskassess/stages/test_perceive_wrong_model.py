@@ -92,6 +92,8 @@ def test_a_shifted_center_of_mass_is_stated_not_tracked_around():
     assert np.allclose(offset["model_center_of_mass_offset_m"], [0.0, 0.0, 0.05], atol=0.005)
 
 
+# the whole stage on the shipped damaged case (~20 s): slow suite; the detection itself is tested above
+@pytest.mark.slow
 def test_perceive_says_the_model_is_wrong_and_tracks_without_it(tmp_path, capsys, monkeypatch):
     # The shipped damaged case, 1.5 s of observation: the model is found wrong after 10 frames, the
     # scans are tracked again without it; 1.5 s of model-free track does not fix the inertia ratios,
