@@ -59,6 +59,46 @@ def mass_properties_target_frame(case: Case, meshes):
     return props
 
 
+def thread_area(thread) -> float:
+    """Cross-section of a thread (m^2), a solid circle of the thread's diameter.
+
+    Parameters
+    ----------
+    thread : riskassess.cases.impact.Thread
+        The case's thread.
+    """
+    return np.pi * thread.diameter**2 / 4.0
+
+
+def solid_bending_rigidity(modulus: float, diameter: float) -> float:
+    """EI = E pi d^4 / 64 (N m^2) of a solid circular thread.
+
+    Parameters
+    ----------
+    modulus : float
+        Young's modulus E (Pa).
+    diameter : float
+        Thread diameter d (m).
+    """
+    return modulus * np.pi * diameter**4 / 64.0
+
+
+def thread_bending_rigidity(thread) -> float:
+    """The thread's bending rigidity EI (N m^2) as the net is built: 0 when ``bending`` is off, else
+    ``bending_rigidity`` or the solid thread's from its modulus.
+
+    Parameters
+    ----------
+    thread : riskassess.cases.impact.Thread
+        The case's thread.
+    """
+    if not thread.bending:
+        return 0.0
+    if thread.bending_rigidity is not None:
+        return thread.bending_rigidity
+    return solid_bending_rigidity(thread.modulus, thread.diameter)
+
+
 def build_net(case: Case):
     """Net topology (LVLH) and initial node velocities for the case's launch.
 
@@ -78,12 +118,9 @@ def build_net(case: Case):
     net, launch, bullets = case.net, case.launch, case.bullets
     thread = net.thread
     mesh = net.mesh_size
-    area = np.pi * thread.diameter**2 / 4.0
+    area = thread_area(thread)
     axial_rigidity = thread.stiffness * mesh if thread.stiffness is not None else thread.modulus * area
-    bending_rigidity = 0.0
-    if thread.bending:
-        bending_rigidity = (thread.bending_rigidity if thread.bending_rigidity is not None
-                            else thread.modulus * np.pi * thread.diameter**4 / 64.0)
+    bending_rigidity = thread_bending_rigidity(thread)
     node_mass = (net.node_mass if net.node_mass is not None
                  else thread_node_mass(net.side_length, net.nodes_per_side, thread.diameter, thread.density))
     direction = np.asarray(launch.direction, float) / np.linalg.norm(launch.direction)

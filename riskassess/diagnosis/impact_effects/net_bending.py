@@ -3,11 +3,10 @@ each thread line, :mod:`multibody.net`), with a rigidity EI other than the case'
 Envisat case has none: ``bending = false``, as the seed paper)."""
 from __future__ import annotations
 
-import numpy as np
-
 from riskassess.diagnosis.effects.base import Parameter
 from riskassess.diagnosis.impact_effects.base import ImpactEffect
-from riskassess.diagnosis.impact_effects.thread_stiffness import bending_rigidity, mesh_thread_stiffness, thread_area
+from riskassess.diagnosis.impact_effects.thread_stiffness import mesh_thread_stiffness
+from riskassess.models.impact import solid_bending_rigidity, thread_area, thread_bending_rigidity
 
 #: Range of EI (-) relative to the solid thread's E pi d^4 / 64: a braided line bends far more easily
 #: than a solid rod of its modulus (1/10), a coated or stiffened one less (up to 1000 x).
@@ -26,8 +25,9 @@ def solid_thread_rigidity(impact_case) -> float:
     -------
     rigidity : float
     """
-    modulus = mesh_thread_stiffness(impact_case) * impact_case.net.mesh_size / thread_area(impact_case)
-    return float(modulus * np.pi * impact_case.net.thread.diameter ** 4 / 64.0)
+    thread = impact_case.net.thread
+    modulus = mesh_thread_stiffness(impact_case) * impact_case.net.mesh_size / thread_area(thread)
+    return float(solid_bending_rigidity(modulus, thread.diameter))
 
 
 class NetBending(ImpactEffect):
@@ -36,13 +36,13 @@ class NetBending(ImpactEffect):
 
     def parameter(self, impact_case) -> Parameter:
         """EI (N m^2), fitted as ln(EI / typical); typical the case's EI, or the solid thread's when off."""
-        reference = bending_rigidity(impact_case) or solid_thread_rigidity(impact_case)
+        reference = float(thread_bending_rigidity(impact_case.net.thread)) or solid_thread_rigidity(impact_case)
         return Parameter("bending_rigidity", "N m^2", "thread bending rigidity EI", reference,
                          LOWER_FACTOR * reference, UPPER_FACTOR * reference, log=True)
 
     def case_value(self, impact_case) -> float:
         """The case's EI (N m^2): 0 when bending is off (outside the fitted range: the nominal model)."""
-        return bending_rigidity(impact_case)
+        return float(thread_bending_rigidity(impact_case.net.thread))
 
     def overrides(self, impact_case, value: float) -> dict:
         """``net.thread.bending`` on, ``net.thread.bending_rigidity`` = value (N m^2)."""

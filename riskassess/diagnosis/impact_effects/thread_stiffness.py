@@ -1,29 +1,13 @@
 """Thread stiffness: the axial stiffness of the net's threads differs from the case's."""
 from __future__ import annotations
 
-import numpy as np
-
 from riskassess.diagnosis.effects.base import Parameter
 from riskassess.diagnosis.impact_effects.base import ImpactEffect, relative_bounds
+from riskassess.models.impact import thread_area, thread_bending_rigidity
 
 #: Range of the fit (-): a factor 5 either way. Stiffer than 5x, the net's highest thread mode
 #: (2.4e3 rad/s for envisat_small) times the case's 1e-4 s step nears the Verlet limit.
 FACTOR = 5.0
-
-
-def thread_area(impact_case) -> float:
-    """Cross-section of a thread (m^2), from its diameter.
-
-    Parameters
-    ----------
-    impact_case : riskassess.cases.impact.Case
-        The validated impact case.
-
-    Returns
-    -------
-    area : float
-    """
-    return float(np.pi * impact_case.net.thread.diameter ** 2 / 4.0)
 
 
 def mesh_thread_stiffness(impact_case) -> float:
@@ -41,27 +25,7 @@ def mesh_thread_stiffness(impact_case) -> float:
     thread = impact_case.net.thread
     if thread.stiffness is not None:
         return float(thread.stiffness)
-    return float(thread.modulus * thread_area(impact_case) / impact_case.net.mesh_size)
-
-
-def bending_rigidity(impact_case) -> float:
-    """The case's thread bending rigidity EI (N m^2): 0 when bending is off.
-
-    Parameters
-    ----------
-    impact_case : riskassess.cases.impact.Case
-        The validated impact case.
-
-    Returns
-    -------
-    rigidity : float
-    """
-    thread = impact_case.net.thread
-    if not thread.bending:
-        return 0.0
-    if thread.bending_rigidity is not None:
-        return float(thread.bending_rigidity)
-    return float(thread.modulus * np.pi * thread.diameter ** 4 / 64.0)
+    return float(thread.modulus * thread_area(thread) / impact_case.net.mesh_size)
 
 
 class ThreadStiffness(ImpactEffect):
@@ -85,9 +49,9 @@ class ThreadStiffness(ImpactEffect):
         thread = impact_case.net.thread
         if thread.stiffness is not None:
             return {"net.thread.stiffness": float(value)}
-        out = {"net.thread.modulus": float(value * impact_case.net.mesh_size / thread_area(impact_case))}
+        out = {"net.thread.modulus": float(value * impact_case.net.mesh_size / thread_area(thread))}
         if thread.bending and thread.bending_rigidity is None:
-            out["net.thread.bending_rigidity"] = bending_rigidity(impact_case)
+            out["net.thread.bending_rigidity"] = float(thread_bending_rigidity(thread))
         return out
 
 
