@@ -8,17 +8,27 @@ import pkgutil
 from riskassess.diagnosis.effects.base import Effect, Parameter
 
 
-def _discover() -> dict[str, Effect]:
+def discover_effects(package_path, package_name: str) -> dict:
+    """id -> ``EFFECT`` of every module of a plug-in package except ``base``, in module order (this
+    catalog's and the impact scenario's, :mod:`riskassess.diagnosis.impact_effects`).
+
+    Parameters
+    ----------
+    package_path : list of str
+        The package's ``__path__``.
+    package_name : str
+        The package's ``__name__``.
+    """
     catalog = {}
-    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+    for info in sorted(pkgutil.iter_modules(package_path), key=lambda m: m.name):
         if info.name == "base":
             continue
-        effect = importlib.import_module(f"{__name__}.{info.name}").EFFECT
+        effect = importlib.import_module(f"{package_name}.{info.name}").EFFECT
         catalog[effect.id] = effect
     return catalog
 
 
 #: id -> effect, in module order.
-CATALOG: dict[str, Effect] = _discover()
+CATALOG: dict[str, Effect] = discover_effects(__path__, __name__)
 
 __all__ = ["CATALOG", "Effect", "Parameter"]

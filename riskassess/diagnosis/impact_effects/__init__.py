@@ -5,23 +5,10 @@ deviations of the impact model's own physical parameters, not loads added to the
 towing models (docs/diagnosis.md, "Impact scenario")."""
 from __future__ import annotations
 
-import importlib
-import pkgutil
-
+from riskassess.diagnosis.effects import discover_effects
 from riskassess.diagnosis.impact_effects.base import ImpactEffect
 
-
-def _discover() -> dict[str, ImpactEffect]:
-    catalog = {}
-    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        if info.name == "base":
-            continue
-        effect = importlib.import_module(f"{__name__}.{info.name}").EFFECT
-        catalog[effect.id] = effect
-    return catalog
-
-
 #: id -> effect, in module order.
-IMPACT_CATALOG: dict[str, ImpactEffect] = _discover()
+IMPACT_CATALOG: dict[str, ImpactEffect] = discover_effects(__path__, __name__)
 
 __all__ = ["IMPACT_CATALOG", "ImpactEffect"]
