@@ -82,7 +82,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     folder = Path(args.keep or tempfile.mkdtemp(prefix="bench_impact_"))
     folder.mkdir(parents=True, exist_ok=True)
-    t0, cpu0 = time.perf_counter(), time.process_time()
+    t0 = time.perf_counter()
     record, truth = make_record(folder, args.truth, args.start, args.duration, args.rate, args.seed)
     record_s = time.perf_counter() - t0
     case = write_case(folder, args.window, args.grid, args.ensemble)

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import open3d as o3d
 
-from perception.free_flight import fit_free_motion, normalized_energy_and_momentum
+from perception.free_flight import fit_free_motion
 from perception.motion import NotObservable
 from perception.registration import DebrisTracker, known_shape_model
 from perception.shape import half_turn_symmetry_transforms

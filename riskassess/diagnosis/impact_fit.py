@@ -40,7 +40,7 @@ from riskassess.diagnosis.fit import FitResult, Problem
 from riskassess.diagnosis.impact_effects import IMPACT_CATALOG
 from riskassess.diagnosis.impact_plant import (FIT_CHANNELS, ImpactRun, run_spec, simulate, window_edges,
                                                window_statistics)
-from riskassess.diagnosis.selection import decide, gain_percent, posterior_weights, score
+from riskassess.diagnosis.selection import decide, gain_percent, score
 from riskassess.diagnosis.threads import single_threaded_blas
 
 #: Worker processes (the issue's 2-core machine).

@@ -1,5 +1,4 @@
 """[perception.truth_damage]: the real target's shapes and mass properties, and the case checks."""
-import re
 from pathlib import Path
 
 import numpy as np
