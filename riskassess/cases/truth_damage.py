@@ -56,17 +56,18 @@ def hinge_turn(shape, hinge_point, hinge_axis, angle):
     return shape.model_copy(update=update)
 
 
-def _inertia_about_origin(inertia, mass, com):
-    """Inertia tensor (kg m^2) about the target origin of a body with ``inertia`` about its ``com`` (m)."""
+def _parallel_axis_term(mass, com):
+    """m (|c|^2 E - c c^T) (kg m^2): what a body of ``mass`` (kg) with its CoM at ``com`` (m, target
+    frame) adds to its inertia about its CoM to give the inertia about the target origin."""
     com = np.asarray(com, float)
-    return np.asarray(inertia, float) + mass * (com @ com * np.eye(3) - np.outer(com, com))
+    return mass * (com @ com * np.eye(3) - np.outer(com, com))
 
 
 def _shape_part(mesh, density):
     """Mass (kg), first moment (kg m) and inertia about the target origin (kg m^2) of one shape."""
     mass = density * mesh.volume
     own = uniform_density_inertia([mesh], mass, mesh.center_mass)
-    return mass, mass * np.asarray(mesh.center_mass), _inertia_about_origin(own, mass, mesh.center_mass)
+    return mass, mass * np.asarray(mesh.center_mass), own + _parallel_axis_term(mass, mesh.center_mass)
 
 
 def damaged_case(case, base: Path):
@@ -94,7 +95,7 @@ def damaged_case(case, base: Path):
     com = np.asarray(body.center_of_mass if body.center_of_mass is not None else geometric_center_of_mass(meshes))
     inertia = np.asarray(body.inertia) if body.inertia is not None else uniform_density_inertia(meshes, body.mass, com)
     density = body.mass / sum(m.volume for m in meshes)
-    mass, first, about_origin = body.mass, body.mass * com, _inertia_about_origin(inertia, body.mass, com)
+    mass, first, about_origin = body.mass, body.mass * com, inertia + _parallel_axis_term(body.mass, com)
     shapes = list(body.shapes)
     bent = {}
     for bend in damage.bends:
@@ -108,7 +109,7 @@ def damaged_case(case, base: Path):
         part_mass, part_first, part_inertia = _shape_part(new_meshes[index], density)
         mass, first, about_origin = mass + part_mass, first + part_first, about_origin + part_inertia
     com = first / mass
-    inertia = about_origin - mass * (com @ com * np.eye(3) - np.outer(com, com))
+    inertia = about_origin - _parallel_axis_term(mass, com)
     inertia = 0.5 * (inertia + inertia.T)
     com = com + np.asarray(damage.center_of_mass_shift, float)
     kept = [bent.get(k, s) for k, s in enumerate(shapes) if k not in damage.missing_shapes]
