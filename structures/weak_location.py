@@ -176,8 +176,9 @@ def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0
     Returns
     -------
     dict
-        ``name``, ``criteria`` (per criterion: peak, its time (s), allowable, margin, likelihood,
-        first exceedance (s), ...), ``fails``, ``fails_normal``, ``fails_shear``, ``judged``,
+        ``name``, ``reading`` (:func:`reading`), ``criteria`` (per criterion: peak, its time (s), allowable,
+        margin, likelihood, first exceedance (s), ...; read through structural modes also ``recorded_peak`` and
+        ``recorded_peak_time_s``, the stiff joint's own), ``fails``, ``fails_normal``, ``fails_shear``, ``judged``,
         ``likelihood`` (None when not judged), ``first_exceedance_s`` and, with a section,
         ``peak_von_mises_stress_Pa``.
     """
@@ -185,8 +186,15 @@ def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0
     series = judged_demands(location, time, force_joint, moment_joint)
     judged = time >= skip_until
     result = {"name": location.name, "criteria": {}}
+    recorded = demands(location, force_joint, moment_joint) if location.structural_modes_hz else series
     for name, allowable in location.criteria().items():
         result["criteria"][name] = _criterion_verdict(name, allowable, time, series[name], judged, skip_until, policy)
+        # beside a modal reading, the stiff joint's own peak, so a reader sees what the mode took out
+        values = recorded[name][judged]
+        if location.structural_modes_hz and values.size and np.isfinite(values).all():
+            k = int(np.flatnonzero(judged)[np.argmax(values)])
+            result["criteria"][name].update(recorded_peak=float(recorded[name][k]), recorded_peak_time_s=float(time[k]))
+    result["reading"] = reading(location)
     crit = result["criteria"].values()
     result["fails_normal"] = any(c["fails"] for c in crit if c["mode"] == "normal")
     result["fails_shear"] = any(c["fails"] for c in crit if c["mode"] == "shear")
@@ -200,6 +208,15 @@ def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0
         vm = series["von_mises_stress"][judged]
         result["peak_von_mises_stress_Pa"] = float(vm.max()) if vm.size and np.isfinite(vm).all() else None
     return result
+
+
+def reading(location: WeakLocation) -> str:
+    """How the location's loads are read, in words (``reading`` in structures.json)."""
+    modes = location.structural_modes_hz
+    if not modes:
+        return "as recorded (the stiff joint's reaction)"
+    span = f"{modes[0]:.3g} Hz" if len(modes) == 1 else f"every first mode in {modes[0]:.3g}-{modes[-1]:.3g} Hz (envelope)"
+    return f"through the structure's first mode: {span}, damping {location.structural_damping_ratio:.3g} of critical"
 
 
 def _criterion_verdict(name, allowable, time, demand, judged, skip_until, policy) -> dict:
