@@ -4,7 +4,7 @@ and through the structure's first mode.
 
     python3 bench/bench_peak_convergence.py [CASE] [--end-time T] [--replicas R] [--first-mode HZ]
                                             [--mode HZ | --mode LOW,HIGH ...] [--skip S] [--cache DIR]
-                                            [--workers N]
+                                            [--workers N] [--markdown]
 
 Runs the case (default ``cases/envisat_small.toml``) with joint release off (every peak is then the
 demand the intact joint carries, not cut at a release) at a baseline and one change at a time:
@@ -149,15 +149,23 @@ def verdict(change: float, low: float, high: float) -> str:
     return "unresolved"
 
 
-def report(results: dict, replicas: int, locations, readings: dict, skip: float) -> None:
+def report(results: dict, replicas: int, locations, readings: dict, skip: float, markdown: bool = False) -> None:
     """Per reading, window, location and criterion: baseline median [range], spread, each variant's
-    change of the median with its bootstrap interval and verdict."""
+    change of the median with its bootstrap interval and verdict (``markdown``: one table, the
+    judged window and the first one, for docs/structures.md)."""
     rng = np.random.default_rng(0)
     ran = {v: [results[(v, r)] for r in range(replicas) if not isinstance(results[(v, r)], str)] for v in VARIANTS}
     names = [v for v in VARIANTS if v != "baseline" and ran[v]]
+    if markdown:
+        print("\n| reading | window | location / criterion | baseline median [range] | spread | "
+              + " | ".join(names) + " |")
+        print("|" + "---|" * (5 + len(names)))
     for reading, (modes, damping) in readings.items():
         table = {v: [peaks(locations, run, modes, damping, skip) for run in ran[v]] for v in VARIANTS if ran[v]}
         base = table["baseline"]
+        if markdown:
+            markdown_rows(reading, table, names, rng)
+            continue
         counts = {"ok": 0, "unresolved": 0, "NOT CONVERGED": 0}
         print(f"\n=== reading: {reading}")
         for window in base[0][next(iter(base[0]))]:
@@ -180,6 +188,23 @@ def report(results: dict, replicas: int, locations, readings: dict, skip: float)
               f"spread = (max - min) / median over the replicas, [90 % bootstrap interval]")
 
 
+def markdown_rows(reading: str, table: dict, names: list, rng) -> None:
+    """The rows of one reading in the markdown table (windows other than the whole run)."""
+    base = table["baseline"]
+    for window in [w for w in base[0][next(iter(base[0]))] if w != "whole run" or len(base[0][next(iter(base[0]))]) == 1]:
+        for key in base[0]:
+            values = np.array([run[key][window] for run in base])
+            med = np.median(values)
+            cells = []
+            for n in names:
+                change, low, high = median_change(values, np.array([run[key][window] for run in table[n]]), rng)
+                state = verdict(change, low, high)
+                mark = {"ok": "", "unresolved": " ?", "NOT CONVERGED": " **x**"}[state]
+                cells.append(f"{change:+.0%} [{low:+.0%}, {high:+.0%}]{mark}")
+            print(f"| {reading} | {window} | {key} | {med:.3g} [{values.min():.3g}, {values.max():.3g}] | "
+                  f"{(values.max() - values.min()) / med:.0%} | " + " | ".join(cells) + " |")
+
+
 def parse_mode(text: str) -> tuple[str, np.ndarray]:
     """'2' or '0.5,2' -> (label, grid of modes in Hz)."""
     values = [float(v) for v in text.split(",")]
@@ -200,6 +225,7 @@ def main() -> None:
     parser.add_argument("--skip", type=float, default=None, help="first window (s); default: the case's skip_initial")
     parser.add_argument("--cache", default=None, help="folder of the runs' raw joint reactions")
     parser.add_argument("--workers", type=int, default=1)
+    parser.add_argument("--markdown", action="store_true", help="one markdown table (docs/structures.md)")
     args = parser.parse_args()
     case_path = Path(args.case).resolve()
     text = case_path.read_text()
@@ -235,7 +261,7 @@ def main() -> None:
     skip = case.structures.skip_initial if args.skip is None else args.skip
     readings = {"as recorded": ((), 0.0)}
     readings.update({label: (tuple(grid), args.mode_damping) for label, grid in map(parse_mode, args.mode)})
-    report(results, args.replicas, locations, readings, skip)
+    report(results, args.replicas, locations, readings, skip, args.markdown)
 
 
 if __name__ == "__main__":
