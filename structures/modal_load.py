@@ -19,6 +19,8 @@ converged?") states when this reading is conservative.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from scipy.signal import cont2discrete, lfilter, lfilter_zi, ss2tf
 
@@ -31,6 +33,7 @@ SAMPLES_PER_MODE_PERIOD = 20
 UNIFORM_SAMPLING_TOLERANCE = 1e-6
 
 
+@lru_cache(maxsize=1024)          # a range's grid is filtered for every component and location alike
 def modal_filter_coefficients(frequency_hz: float, damping_ratio: float, interval_s: float):
     """Discrete transfer function (b, a) of the mode ``omega^2 / (s^2 + 2 zeta omega s + omega^2)``
     for samples ``interval_s`` apart, exact for a load linear between samples (first-order hold).
@@ -92,7 +95,7 @@ def modal_load(time, load, frequency_hz: float, damping_ratio: float) -> np.ndar
     if np.any(np.abs(steps[:-1] - interval) > UNIFORM_SAMPLING_TOLERANCE * interval + 1e-12) or steps[-1] > interval * (
             1 + UNIFORM_SAMPLING_TOLERANCE):
         raise ValueError("modal_load needs uniformly spaced samples (a fixed output rate)")
-    b, a = modal_filter_coefficients(frequency_hz, damping_ratio, interval)
+    b, a = modal_filter_coefficients(float(frequency_hz), float(damping_ratio), interval)
     initial = lfilter_zi(b, a).reshape((-1,) + (1,) * (load.ndim - 1)) * load[:1]
     out, _ = lfilter(b, a, load, axis=0, zi=initial)
     return out
@@ -161,7 +164,7 @@ class OnlineModalLoad:
     """
 
     def __init__(self, modes_hz, damping_ratio: float, interval_s: float):
-        coeffs = [modal_filter_coefficients(f, damping_ratio, interval_s) for f in modes_hz]
+        coeffs = [modal_filter_coefficients(float(f), float(damping_ratio), float(interval_s)) for f in modes_hz]
         self._b = np.array([np.pad(b, (0, 3 - len(b))) for b, _ in coeffs])      # (n_modes, 3)
         self._a = np.array([a / a[0] for _, a in coeffs])
         self._b = self._b / np.array([a[0] for _, a in coeffs])[:, None]
