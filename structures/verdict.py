@@ -200,6 +200,8 @@ def condition_sentence(result: dict, policy: str) -> str:
     peak = _quantity(c["peak"], unit)
     when = f"this run's peak, at {c['peak_time_s']:.3g} s" + (", up to its release" if result["released_at_s"] is not None
                                                        else "")
+    if result.get("reading", "").startswith("through"):     # a modal reading says so where the number is read
+        when += f", read {result['reading']}"
     verb = "fails" if result["state"] == "fails" else "holds"
     if high > low:
         bound = ">=" if result["released_at_s"] is not None else "="
