@@ -101,9 +101,10 @@ def modal_load(time, load, frequency_hz: float, damping_ratio: float) -> np.ndar
     return out
 
 
-#: Largest ratio between neighbouring modes of a range's grid: a mode between two grid points
-#: responds to any load within ~1 % of the larger of its neighbours at 2 % damping (the response
-#: spectrum moves by ~(ratio - 1) / 2 between them; measured in tests/structures/test_modal_load.py).
+#: Largest ratio between neighbouring modes of a range's grid: a mode between two grid points reads an
+#: impulse (J omega) at most 5 % above its lower neighbour and never above its upper one, and a slow or
+#: suddenly applied load alike at every mode; near a resonance of a periodic load the response between
+#: grid points can be higher (not bounded here; the envelope is a grid, stated as such).
 MODE_GRID_RATIO = 1.05
 
 
