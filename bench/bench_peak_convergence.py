@@ -1,49 +1,70 @@
 """Are the judged load peaks physics or numerics? Each weak location's peak demands against the
-joint penalty stiffness and damping, the step and the output rate, over replicas.
+joint penalty stiffness and damping, the step and the output rate, over replicas, read as recorded
+and through the structure's first mode.
 
     python3 bench/bench_peak_convergence.py [CASE] [--end-time T] [--replicas R] [--first-mode HZ]
-                                            [--workers N]
+                                            [--mode HZ | --mode LOW,HIGH ...] [--skip S] [--cache DIR]
+                                            [--workers N] [--markdown]
 
 Runs the case (default ``cases/envisat_small.toml``) with joint release off (every peak is then the
 demand the intact joint carries, not cut at a release) at a baseline and one change at a time:
 
 - step halved (the automatic penalty stiffness follows the step: its modes sit at 0.5 / step rad/s,
-  so this is also 4x stiffer joints; with ``--first-mode`` the joints keep the structure's mode);
-- penalty stiffness / 4 at the same step (modes at 0.25 / step rad/s; ``multibody.hinge.PENALTY_STEP_FACTOR``
-  changed in the worker only), or, with ``--first-mode``, the structure's first mode / 2;
-- penalty damping 0.2 of critical instead of 0.05 (every joint's ``penalty_damping_ratio``);
+  so this is also 4x stiffer joints where the stiffness is not capped; with ``--first-mode`` the joints
+  keep the structure's mode);
+- penalty stiffness / 4 at the same step (``multibody.hinge.PENALTY_STEP_FACTOR`` halved and both
+  stiffness caps / 4, in the worker only: every automatic joint axis rings at half its frequency), or,
+  with ``--first-mode``, the structure's first mode / 2;
+- penalty damping 0.1 of critical instead of 0.05 (every joint's ``penalty_damping_ratio``; 0.2 makes
+  the explicit run diverge with the automatic penalty);
 - output rate doubled (the peak between samples).
 
 Each configuration runs ``R`` replicas whose launch velocity differs by k x 1e-7 (k = 0..R-1), far
 below any physical uncertainty: the net's contacts make the capture sensitive to its initial state,
-so a single run's peak is one sample of a spread, and the spread is printed beside the change.
-``--first-mode HZ`` gives every joint ``first_mode_hz = HZ`` (the structure's compliance instead of a
-penalty tuned to the step). Prints, per location and criterion and per window (the skipped initial
-impact, and the judged rest), the baseline's median peak over the replicas and its range, and each
-variant's change of the median; a change above 5 % is flagged. Prints the wall time and the load.
+so a single run's peak is one sample of a spread. The raw joint reactions of every run are kept in
+``--cache`` (default: a folder under the system's temporary directory named for the case), so
+readings can be compared without running again.
+
+Readings: "as recorded" (the stiff joint's reaction, as the verdict judges a location without
+``structural_mode_hz``) and, for each ``--mode``, the reaction read through the structure's first mode
+(:mod:`structures.modal_load`, damping ``--mode-damping``; a range LOW,HIGH is judged by the envelope
+over it, as a location with ``structural_mode_hz = [LOW, HIGH]``). Windows: the first ``--skip`` s
+(default: the case's ``skip_initial``) and the rest, and the whole run. Prints, per reading, window,
+location and criterion, the baseline's median peak over the replicas, its spread (max - min) / median,
+and each variant's change of the median with a 90 % bootstrap interval (replicas resampled): "ok" when
+the change and its interval are within +-5 %, "NOT CONVERGED" when the interval lies beyond, "unresolved"
+when the interval straddles 5 % (more replicas needed). Prints the CPU time per run and the load.
 """
 from __future__ import annotations
 
 import argparse
-import json
+import hashlib
 import os
 import re
 import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 import multibody.hinge as hinge
 from multibody.health import SimulationFailed
+from riskassess.cases.impact import load_case
+from riskassess.models.impact import model_inputs, weak_locations
 from riskassess.stages.run import run_case
+from structures.modal_load import mode_grid
+from structures.weak_location import judged_demands
 
 ROOT = Path(__file__).resolve().parents[1]
 TOLERANCE = 0.05
 #: Relative launch-velocity offset between replicas: far below any physical uncertainty.
 REPLICA_OFFSET = 1e-7
-VARIANTS = ("baseline", "step/2", "stiffness/4", "damping 0.2", "output 2x")
+VARIANTS = ("baseline", "step/2", "stiffness/4", "damping 0.1", "output 2x")
+#: Automatic penalty of the shipped model, restored in each worker before a variant changes it.
+AUTOMATIC_PENALTY = (hinge.PENALTY_STEP_FACTOR, hinge.PENALTY_TRANSLATIONAL_CAP, hinge.PENALTY_ROTATIONAL_CAP)
+BOOTSTRAP_DRAWS = 2000
 
 
 def _sub(pattern: str, change, text: str) -> str:
@@ -58,8 +79,8 @@ def case_text(text: str, variant: str, replica: int, first_mode: float | None) -
     joint_extra = []
     if first_mode:
         joint_extra.append(f"first_mode_hz = {first_mode / 2 if variant == 'stiffness/4' else first_mode:g}")
-    if variant == "damping 0.2":
-        joint_extra.append("penalty_damping_ratio = 0.2")
+    if variant == "damping 0.1":
+        joint_extra.append("penalty_damping_ratio = 0.1")
     if joint_extra:
         text = re.sub(r'^(kind = "(revolute|clamped)".*)$', lambda m: "\n".join([m.group(1)] + joint_extra), text,
                       flags=re.M)
@@ -71,27 +92,125 @@ def case_text(text: str, variant: str, replica: int, first_mode: float | None) -
                 lambda m: f"velocity = {float(m.group(1)) * (1 + replica * REPLICA_OFFSET)!r}", text)
 
 
-def peaks(text: str, base_dir: str, penalty_factor: float) -> dict | str:
-    """{"location / criterion": {window: peak}} of one run, or the failure message."""
-    hinge.PENALTY_STEP_FACTOR = penalty_factor
+def simulate(text: str, base_dir: str, stiffness_scale: float, out: str) -> str:
+    """Run one case text and keep its raw joint reactions in ``out`` (.npz: time, force, moment, cpu);
+    returns ``out``, or the failure message of a run the model cannot finish."""
+    if Path(out).exists():
+        return out
+    factor, cap_t, cap_r = AUTOMATIC_PENALTY          # every automatic joint axis scaled, capped or not
+    hinge.PENALTY_STEP_FACTOR = factor * np.sqrt(stiffness_scale)
+    hinge.PENALTY_TRANSLATIONAL_CAP, hinge.PENALTY_ROTATIONAL_CAP = cap_t * stiffness_scale, cap_r * stiffness_scale
+    start = time.process_time()
     with tempfile.TemporaryDirectory(dir=base_dir) as tmp:      # mesh and data paths stay relative
         case = Path(tmp) / "case.toml"
         case.write_text(text)
         try:
             run_case(case, Path(tmp) / "run")
         except SimulationFailed as exc:     # a variant the model cannot run is a finding, not a crash
-            return str(exc)
-        skip = json.loads((Path(tmp) / "run" / "structures.json").read_text())["skip_initial_s"]
-        series = np.load(Path(tmp) / "run" / "structures.npz")
-        t = series["time"]
-        windows = {"first impact": t < skip, "judged": t >= skip} if skip > 0 else {"judged": t >= 0}
-        out = {}
-        for key in series.files:
-            if key == "time" or key.split("/")[1] not in ("moment", "normal_stress", "shear_stress"):
-                continue
-            out[key.replace("/", " / ")] = {w: float(np.abs(series[key][m]).max()) for w, m in windows.items()
-                                           if m.any()}
-        return out
+            return f"failed: {exc}"
+        with np.load(Path(tmp) / "run" / "timeseries.npz") as data:
+            np.savez(out + ".tmp.npz", time=data["time"], force=data["joint_force_joint"],
+                     moment=data["joint_moment_joint"], cpu=time.process_time() - start)
+    os.replace(out + ".tmp.npz", out)
+    return out
+
+
+def peaks(locations, run, modes, damping: float, skip: float) -> dict:
+    """{"location / criterion": {window: peak}} of one run's joint reactions, read through ``modes``
+    (Hz; empty: as recorded)."""
+    t, force, moment = run["time"], run["force"], run["moment"]
+    windows = {f"first {skip:g} s": t < skip, "judged": t >= skip, "whole run": t >= 0} if skip > 0 else {
+        "whole run": t >= 0}
+    out = {}
+    for loc in locations:
+        loc = replace(loc, structural_modes_hz=tuple(modes), structural_damping_ratio=damping)
+        series = judged_demands(loc, t, force[:, loc.joint], moment[:, loc.joint])
+        for criterion in loc.criteria():
+            out[f"{loc.name} / {criterion}"] = {w: float(series[criterion][m].max()) for w, m in windows.items()}
+    return out
+
+
+def median_change(base: np.ndarray, variant: np.ndarray, rng) -> tuple[float, float, float]:
+    """Change of the median (variant / baseline - 1) and its 90 % bootstrap interval."""
+    change = np.median(variant) / np.median(base) - 1.0
+    b = rng.choice(base, (BOOTSTRAP_DRAWS, base.size))
+    v = rng.choice(variant, (BOOTSTRAP_DRAWS, variant.size))
+    draws = np.median(v, axis=1) / np.median(b, axis=1) - 1.0
+    low, high = np.percentile(draws, [5, 95])
+    return change, low, high
+
+
+def verdict(change: float, low: float, high: float) -> str:
+    """'ok' within the tolerance, 'NOT CONVERGED' beyond it, 'unresolved' when the interval straddles it."""
+    if max(abs(low), abs(high), abs(change)) <= TOLERANCE:
+        return "ok"
+    if low > TOLERANCE or high < -TOLERANCE:
+        return "NOT CONVERGED"
+    return "unresolved"
+
+
+def report(results: dict, replicas: int, locations, readings: dict, skip: float, markdown: bool = False) -> None:
+    """Per reading, window, location and criterion: baseline median [range], spread, each variant's
+    change of the median with its bootstrap interval and verdict (``markdown``: one table, the
+    judged window and the first one, for docs/structures.md)."""
+    rng = np.random.default_rng(0)
+    ran = {v: [results[(v, r)] for r in range(replicas) if not isinstance(results[(v, r)], str)] for v in VARIANTS}
+    names = [v for v in VARIANTS if v != "baseline" and ran[v]]
+    if markdown:
+        print("\n| reading | window | location / criterion | baseline median [range] | spread | "
+              + " | ".join(names) + " |")
+        print("|" + "---|" * (5 + len(names)))
+    for reading, (modes, damping) in readings.items():
+        table = {v: [peaks(locations, run, modes, damping, skip) for run in ran[v]] for v in VARIANTS if ran[v]}
+        base = table["baseline"]
+        if markdown:
+            markdown_rows(reading, table, names, rng)
+            continue
+        counts = {"ok": 0, "unresolved": 0, "NOT CONVERGED": 0}
+        print(f"\n=== reading: {reading}")
+        for window in base[0][next(iter(base[0]))]:
+            print(f"\n  window: {window}")
+            print(f"  {'location / criterion':36s} {'baseline median [range]':>30s} {'spread':>7s} "
+                  + " ".join(f"{n:>28s}" for n in names))
+            for key in base[0]:
+                values = np.array([run[key][window] for run in base])
+                med = np.median(values)
+                cells = []
+                for n in names:
+                    change, low, high = median_change(values, np.array([run[key][window] for run in table[n]]), rng)
+                    state = verdict(change, low, high)
+                    counts[state] += 1
+                    cells.append(f"{change:+6.1%} [{low:+.0%},{high:+.0%}] {'ok' if state == 'ok' else state[:5]:>5s}")
+                print(f"  {key:36s} {f'{med:.4g} [{values.min():.3g}, {values.max():.3g}]':>30s} "
+                      f"{(values.max() - values.min()) / med:7.0%} " + " ".join(f"{c:>28s}" for c in cells))
+        print(f"\n  {reading}: {counts['ok']} changes within {TOLERANCE:.0%}, {counts['unresolved']} unresolved "
+              f"(interval straddles {TOLERANCE:.0%}), {counts['NOT CONVERGED']} beyond; "
+              f"spread = (max - min) / median over the replicas, [90 % bootstrap interval]")
+
+
+def markdown_rows(reading: str, table: dict, names: list, rng) -> None:
+    """The rows of one reading in the markdown table (windows other than the whole run)."""
+    base = table["baseline"]
+    for window in [w for w in base[0][next(iter(base[0]))] if w != "whole run" or len(base[0][next(iter(base[0]))]) == 1]:
+        for key in base[0]:
+            values = np.array([run[key][window] for run in base])
+            med = np.median(values)
+            cells = []
+            for n in names:
+                change, low, high = median_change(values, np.array([run[key][window] for run in table[n]]), rng)
+                state = verdict(change, low, high)
+                mark = {"ok": "", "unresolved": " ?", "NOT CONVERGED": " **x**"}[state]
+                cells.append(f"{change:+.0%} [{low:+.0%}, {high:+.0%}]{mark}")
+            print(f"| {reading} | {window} | {key} | {med:.3g} [{values.min():.3g}, {values.max():.3g}] | "
+                  f"{(values.max() - values.min()) / med:.0%} | " + " | ".join(cells) + " |")
+
+
+def parse_mode(text: str) -> tuple[str, np.ndarray]:
+    """'2' or '0.5,2' -> (label, grid of modes in Hz)."""
+    values = [float(v) for v in text.split(",")]
+    low, high = values[0], values[-1]
+    label = f"through a {low:g} Hz mode" if low == high else f"envelope over first modes {low:g}-{high:g} Hz"
+    return label, mode_grid(low, high)
 
 
 def main() -> None:
@@ -100,63 +219,49 @@ def main() -> None:
     parser.add_argument("--end-time", type=float, default=None)
     parser.add_argument("--replicas", type=int, default=4)
     parser.add_argument("--first-mode", type=float, default=None, help="every joint's first_mode_hz (Hz)")
-    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--mode", action="append", default=[], help="read the loads through this first mode (Hz) "
+                                                                     "or the envelope over LOW,HIGH (Hz)")
+    parser.add_argument("--mode-damping", type=float, default=0.02, help="damping ratio of --mode (-)")
+    parser.add_argument("--skip", type=float, default=None, help="first window (s); default: the case's skip_initial")
+    parser.add_argument("--cache", default=None, help="folder of the runs' raw joint reactions")
+    parser.add_argument("--workers", type=int, default=1)
+    parser.add_argument("--markdown", action="store_true", help="one markdown table (docs/structures.md)")
     args = parser.parse_args()
-    text = Path(args.case).read_text()
+    case_path = Path(args.case).resolve()
+    text = case_path.read_text()
     if 'release = "low"' not in text:      # otherwise the peaks would be cut at each joint's release
         raise SystemExit(f"{args.case}: expected release = \"low\" in [structures] to switch it off")
     text = text.replace('release = "low"', 'release = "never"', 1)
     if args.end_time:
         text = _sub(r"^end_time = [0-9.e]+", f"end_time = {args.end_time:g}", text)
-    factor = hinge.PENALTY_STEP_FACTOR
-    jobs = {(v, r): (case_text(text, v, r, args.first_mode), str(Path(args.case).resolve().parent),
-                     factor / 2 if v == "stiffness/4" and not args.first_mode else factor)
+    tag = hashlib.sha256(f"{text}{args.first_mode}".encode()).hexdigest()[:12]
+    cache = Path(args.cache or Path(tempfile.gettempdir()) / f"peak-convergence-{case_path.stem}-{tag}")
+    cache.mkdir(parents=True, exist_ok=True)
+    jobs = {(v, r): (case_text(text, v, r, args.first_mode), str(case_path.parent),
+                     0.25 if v == "stiffness/4" and not args.first_mode else 1.0,
+                     str(cache / f"{v.replace('/', '_').replace(' ', '_')}-{r}.npz"))
             for v in VARIANTS for r in range(args.replicas)}
     start, load = time.perf_counter(), os.getloadavg()[0]
     with ProcessPoolExecutor(args.workers) as pool:
-        futures = {key: pool.submit(peaks, *job) for key, job in jobs.items()}
+        futures = {key: pool.submit(simulate, *job) for key, job in jobs.items()}
         results = {key: f.result() for key, f in futures.items()}
+    results = {k: (v if v.startswith("failed") else dict(np.load(v))) for k, v in results.items()}
+    cpu = [float(v["cpu"]) for v in results.values() if not isinstance(v, str)]
     print(f"{args.case}, release off, joints: "
           + (f"first_mode_hz = {args.first_mode:g}" if args.first_mode else "automatic penalty")
-          + f"; {len(jobs)} runs ({args.replicas} replicas each) in {time.perf_counter() - start:.0f} s on "
-          f"{args.workers} workers, load average {load:.1f} -> {os.getloadavg()[0]:.1f}")
+          + f"; {len(jobs)} runs ({args.replicas} replicas each; cache {cache}) in "
+          f"{time.perf_counter() - start:.0f} s wall on {args.workers} workers, load average {load:.1f} -> "
+          f"{os.getloadavg()[0]:.1f}; CPU per run {np.median(cpu) if cpu else float('nan'):.1f} s (median, "
+          f"as measured when each run was made)")
     for key, value in results.items():
         if isinstance(value, str):
             print(f"{key[0]} replica {key[1]}: {value}")
-    report(results, args.replicas)
-
-
-def report(results: dict, replicas: int) -> None:
-    """Per window, location and criterion: baseline median [range], each variant's median change."""
-    def finished(variant):
-        """The replicas of ``variant`` that ran (a failed one holds its message)."""
-        return [results[(variant, r)] for r in range(replicas) if not isinstance(results[(variant, r)], str)]
-    base = finished("baseline")
-    names = [v for v in VARIANTS if v != "baseline"]
-    unconverged = total = 0
-    for window in base[0][next(iter(base[0]))]:
-        print(f"\nwindow: {window}")
-        print(f"{'location / criterion':40s} {'baseline median [range]':>30s} {'spread':>7s} "
-              + " ".join(f"{n:>12s}" for n in names))
-        for key in base[0]:
-            values = np.array([run[key][window] for run in base])
-            med = np.median(values)
-            cells = []
-            for n in names:
-                runs = finished(n)
-                if not runs:
-                    cells.append(f"{'failed':>12s}")
-                    continue
-                change = np.median([run[key][window] for run in runs]) / med - 1.0 if med else float("nan")
-                cells.append(f"{change:+12.1%}")
-                unconverged += abs(change) > TOLERANCE
-                total += 1
-            spread = (values.max() - values.min()) / med if med else float("nan")
-            print(f"{key:40s} {f'{med:.4g} [{values.min():.3g}, {values.max():.3g}]':>30s} {spread:7.0%} "
-                  + " ".join(cells))
-    print(f"\n{unconverged} of {total} median changes above {TOLERANCE:.0%}: "
-          + ("NOT CONVERGED" if unconverged else "converged")
-          + "; spread = (max - min) / median over the replicas")
+    case = load_case(case_path)
+    locations = weak_locations(case, model_inputs(case, case_path.parent).assembly)
+    skip = case.structures.skip_initial if args.skip is None else args.skip
+    readings = {"as recorded": ((), 0.0)}
+    readings.update({label: (tuple(grid), args.mode_damping) for label, grid in map(parse_mode, args.mode)})
+    report(results, args.replicas, locations, readings, skip, args.markdown)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ import numpy as np
 import trimesh
 
 from multibody.assembly import subtree_bodies
-from structures.weak_location import WeakLocation, exceeds_now
+from structures.weak_location import WeakLocation, exceeds_now, online_modal_loads
 
 
 @dataclass
@@ -35,12 +35,17 @@ class ReleaseEvent:
 class ReleaseMonitor:
     """Releases joints whose weak location fails; see the module docstring."""
 
-    def __init__(self, locations: list[WeakLocation], system, skip_until=0.0, policy="low"):
+    def __init__(self, locations: list[WeakLocation], system, skip_until=0.0, policy="low", interval_s=None):
         self.locations = locations
         self.system = system
         self.skip_until = skip_until
         self.policy = policy
         self.events: list[ReleaseEvent] = []
+        if interval_s is None and any(loc.structural_modes_hz for loc in locations):
+            raise ValueError("a location read through structural modes needs the output interval (interval_s)")
+        # a location read through its structure's modes is released on the modal loads, filtered as
+        # the samples arrive (the filter is causal: the same loads the verdict judges afterwards)
+        self._modal = {loc.name: online_modal_loads(loc, interval_s) for loc in locations}
 
     def released_joints(self) -> set:
         return {e.joint for e in self.events}
@@ -63,13 +68,20 @@ class ReleaseMonitor:
         joint_energies : (nj,) float
             Elastic energy stored in each penalty joint at the sample (J).
         """
+        modal = {}      # every sample feeds the modal filters, also those before skip_until
+        for loc in self.locations:
+            if self._modal[loc.name] is not None:
+                modal[loc.name] = self._modal[loc.name].update(np.stack([force_joint[loc.joint], moment_joint[loc.joint]]))
         if t < self.skip_until:
             return
         released = self.released_joints()
         for loc in self.locations:
             if loc.joint in released:
                 continue
-            hit = exceeds_now(loc, force_joint[loc.joint], moment_joint[loc.joint], self.policy)
+            if loc.name in modal:
+                hit = exceeds_now(loc, modal[loc.name][:, 0], modal[loc.name][:, 1], self.policy)
+            else:
+                hit = exceeds_now(loc, force_joint[loc.joint], moment_joint[loc.joint], self.policy)
             if hit is not None:
                 self.release(loc, t, *hit, stored_energy=float(joint_energies[loc.joint]))
                 released.add(loc.joint)

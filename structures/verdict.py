@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from structures.release import ReleaseEvent, released_pieces
-from structures.weak_location import WeakLocation, assess, demands
+from structures.weak_location import WeakLocation, assess, judged_demands
 
 #: The three answers to "does this capture create secondary debris?" (``debris_state`` in
 #: structures.json, the CLI, the report and the sweep store). ``secondary_debris`` carries the
@@ -200,6 +200,8 @@ def condition_sentence(result: dict, policy: str) -> str:
     peak = _quantity(c["peak"], unit)
     when = f"this run's peak, at {c['peak_time_s']:.3g} s" + (", up to its release" if result["released_at_s"] is not None
                                                        else "")
+    if result.get("reading", "").startswith("through"):     # a modal reading says so where the number is read
+        when += f", read {result['reading']}"
     verb = "fails" if result["state"] == "fails" else "holds"
     if high > low:
         bound = ">=" if result["released_at_s"] is not None else "="
@@ -212,7 +214,8 @@ def condition_sentence(result: dict, policy: str) -> str:
 
 
 def demand_series(locations: list[WeakLocation], series: dict) -> dict:
-    """Per location and demand, the time series (SI), keyed ``<location>/<demand>``, for the run folder.
+    """Per location and demand, the judged time series (SI; through the location's structural modes when it
+    has them, :func:`structures.weak_location.judged_demands`), keyed ``<location>/<demand>``, for the run folder.
 
     Parameters
     ----------
@@ -229,7 +232,7 @@ def demand_series(locations: list[WeakLocation], series: dict) -> dict:
     """
     out = {"time": series["time"]}
     for loc in locations:
-        for name, values in demands(loc, series["joint_force_joint"][:, loc.joint],
-                                    series["joint_moment_joint"][:, loc.joint]).items():
+        for name, values in judged_demands(loc, series["time"], series["joint_force_joint"][:, loc.joint],
+                                           series["joint_moment_joint"][:, loc.joint]).items():
             out[f"{loc.name}/{name}"] = np.asarray(values)
     return out

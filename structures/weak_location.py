@@ -16,6 +16,10 @@ Each location has one or more criteria, each a demand time series against an
   ``moment_axes`` (the seed paper judges the hinge-panel interface by M_h1 and M_h3
   against 200-1000 N m, Sec. 3.3.3);
 * ``force`` (N, mode "shear"): resultant joint force.
+
+With the structure's first mode given (``structural_modes_hz``, a value or a range), the judged loads are
+the recorded (stiff-joint) reaction passed through that mode (:mod:`structures.modal_load`); a range is
+judged by the envelope over its modes, so the verdict holds for any first mode in it.
 """
 from __future__ import annotations
 
@@ -24,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from structures.criteria import Allowable, combined_likelihood, first_exceedance_time
+from structures.modal_load import OnlineModalLoad, modal_loads
 from structures.sections import SectionProperties, section_stresses
 
 CRITERION_MODE = {"normal_stress": "normal", "shear_stress": "shear", "moment": "normal", "force": "shear"}
@@ -44,6 +49,8 @@ class WeakLocation:
     allowable_moment: Allowable | None = None
     allowable_force: Allowable | None = None
     moment_axes: tuple = (0, 1, 2)       # joint-frame components judged by allowable_moment
+    structural_modes_hz: tuple = ()      # modes (Hz) the loads are read through; empty: as recorded
+    structural_damping_ratio: float = 0.02   # their damping, fraction of critical (-)
 
     def criteria(self) -> dict:
         """Criterion name -> allowable, for the criteria this location has."""
@@ -112,6 +119,37 @@ def demands(location: WeakLocation, force_joint, moment_joint) -> dict:
     return out
 
 
+def judged_demands(location: WeakLocation, time, force_joint, moment_joint) -> dict:
+    """The demands the location is judged by: :func:`demands` of the recorded loads or, with
+    ``structural_modes_hz``, the envelope (largest value at each sample) over those modes of the demands of
+    the loads each mode carries (:func:`structures.modal_load.modal_loads`).
+
+    Parameters
+    ----------
+    location : WeakLocation
+        The location.
+    time : (k,) float
+        Sample times (s), uniformly spaced when the location has modes.
+    force_joint : (k, 3) float
+        Recorded joint reaction force (N), joint frame.
+    moment_joint : (k, 3) float
+        Recorded joint reaction moment (N m), joint frame.
+
+    Returns
+    -------
+    dict of (k,) float
+        As :func:`demands`.
+    """
+    if not location.structural_modes_hz:
+        return demands(location, force_joint, moment_joint)
+    modes, zeta = location.structural_modes_hz, location.structural_damping_ratio
+    force = modal_loads(time, force_joint, modes, zeta)
+    moment = modal_loads(time, moment_joint, modes, zeta)
+    n, k = force.shape[:2]
+    stacked = demands(location, force.reshape(n * k, 3), moment.reshape(n * k, 3))
+    return {name: values.reshape(n, k).max(axis=0) for name, values in stacked.items()}
+
+
 def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0.0, policy="low") -> dict:
     """Verdict of one location over a load history.
 
@@ -138,17 +176,25 @@ def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0
     Returns
     -------
     dict
-        ``name``, ``criteria`` (per criterion: peak, its time (s), allowable, margin, likelihood,
-        first exceedance (s), ...), ``fails``, ``fails_normal``, ``fails_shear``, ``judged``,
+        ``name``, ``reading`` (:func:`reading`), ``criteria`` (per criterion: peak, its time (s), allowable,
+        margin, likelihood, first exceedance (s), ...; read through structural modes also ``recorded_peak`` and
+        ``recorded_peak_time_s``, the stiff joint's own), ``fails``, ``fails_normal``, ``fails_shear``, ``judged``,
         ``likelihood`` (None when not judged), ``first_exceedance_s`` and, with a section,
         ``peak_von_mises_stress_Pa``.
     """
     time = np.asarray(time, float)
-    series = demands(location, force_joint, moment_joint)
+    series = judged_demands(location, time, force_joint, moment_joint)
     judged = time >= skip_until
     result = {"name": location.name, "criteria": {}}
+    recorded = demands(location, force_joint, moment_joint) if location.structural_modes_hz else series
     for name, allowable in location.criteria().items():
         result["criteria"][name] = _criterion_verdict(name, allowable, time, series[name], judged, skip_until, policy)
+        # beside a modal reading, the stiff joint's own peak, so a reader sees what the mode took out
+        values = recorded[name][judged]
+        if location.structural_modes_hz and values.size and np.isfinite(values).all():
+            k = int(np.flatnonzero(judged)[np.argmax(values)])
+            result["criteria"][name].update(recorded_peak=float(recorded[name][k]), recorded_peak_time_s=float(time[k]))
+    result["reading"] = reading(location)
     crit = result["criteria"].values()
     result["fails_normal"] = any(c["fails"] for c in crit if c["mode"] == "normal")
     result["fails_shear"] = any(c["fails"] for c in crit if c["mode"] == "shear")
@@ -162,6 +208,15 @@ def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0
         vm = series["von_mises_stress"][judged]
         result["peak_von_mises_stress_Pa"] = float(vm.max()) if vm.size and np.isfinite(vm).all() else None
     return result
+
+
+def reading(location: WeakLocation) -> str:
+    """How the location's loads are read, in words (``reading`` in structures.json)."""
+    modes = location.structural_modes_hz
+    if not modes:
+        return "as recorded (the stiff joint's reaction)"
+    span = f"{modes[0]:.3g} Hz" if len(modes) == 1 else f"every first mode in {modes[0]:.3g}-{modes[-1]:.3g} Hz (envelope)"
+    return f"through the structure's first mode: {span}, damping {location.structural_damping_ratio:.3g} of critical"
 
 
 def _criterion_verdict(name, allowable, time, demand, judged, skip_until, policy) -> dict:
@@ -222,15 +277,16 @@ def history_around_peak(time, demand, k: int) -> dict:
 
 def exceeds_now(location: WeakLocation, force_joint, moment_joint, policy="low"):
     """The first criterion (name, demand) whose demand reaches its decisive allowable for one
-    sample of joint loads ((3,) each), or None: what a run checks to release a joint.
+    sample of joint loads ((3,) each, or (n, 3): the loads of n modes, judged by their largest
+    demand), or None: what a run checks to release a joint.
 
     Parameters
     ----------
     location : WeakLocation
         The location to check.
-    force_joint : (3,) float
+    force_joint : (3,) or (n, 3) float
         Joint reaction force at this sample (N), joint frame.
-    moment_joint : (3,) float
+    moment_joint : (3,) or (n, 3) float
         Joint reaction moment at this sample (N m), joint frame.
     policy : {"low", "nominal", "high"}
         Value of a range allowable that decides.
@@ -240,8 +296,29 @@ def exceeds_now(location: WeakLocation, force_joint, moment_joint, policy="low")
     tuple of (str, float) or None
         Criterion name and its demand (Pa, N m or N).
     """
-    series = demands(location, np.reshape(force_joint, (1, 3)), np.reshape(moment_joint, (1, 3)))
+    series = demands(location, np.reshape(force_joint, (-1, 3)), np.reshape(moment_joint, (-1, 3)))
     for name, allowable in location.criteria().items():
-        if series[name][0] >= allowable.threshold(policy):
-            return name, float(series[name][0])
+        demand = float(np.max(series[name]))
+        if demand >= allowable.threshold(policy):
+            return name, demand
     return None
+
+
+def online_modal_loads(location: WeakLocation, interval_s: float) -> OnlineModalLoad | None:
+    """The per-sample modal filter a run feeds with this location's joint loads ([force, moment] as one
+    (2, 3) sample), or None when the location judges the loads as recorded.
+
+    Parameters
+    ----------
+    location : WeakLocation
+        The location.
+    interval_s : float
+        The run's output interval (s).
+
+    Returns
+    -------
+    OnlineModalLoad or None
+    """
+    if not location.structural_modes_hz:
+        return None
+    return OnlineModalLoad(location.structural_modes_hz, location.structural_damping_ratio, interval_s)

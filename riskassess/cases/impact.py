@@ -28,6 +28,7 @@ from riskassess.cases.inputs import (JSON_FILE_LIMIT, KIND_NOTE, MESH_FILE_LIMIT
                                     unique_names)
 from riskassess.cases.target_geometry import target_points_lvlh, target_vertices_lvlh
 from riskassess.cases.uncertain import parse_uncertain
+from structures.modal_load import SAMPLES_PER_MODE_PERIOD
 from structures.section_shapes import SHAPES
 from structures.sections import SECTIONS
 
@@ -449,6 +450,14 @@ class WeakLocationSpec(Strict):
         None, description="Joint-frame moment components judged by allowable_moment; default: all but the hinge "
                           "axis h2 of a revolute joint (carried by its spring), all three for a clamped joint.")
     allowable_force: ValueOrRange | None = Field(None, description="Allowable resultant joint force (N), value or [low, high].")
+    structural_mode_hz: ValueOrRange | None = Field(
+        None, description="First mode of the structure this location belongs to (Hz), a value or [low, high]: the "
+                          "judged loads are the joint's (stiff, automatic-penalty) reaction passed through that mode, "
+                          "and a range is judged by the envelope over it (docs/structures.md, 'Are the judged peaks "
+                          "converged?'); omitted: the reaction as recorded. Not with the joint's own first_mode_hz "
+                          "(the compliance would count twice).")
+    structural_damping_ratio: Annotated[float, Field(ge=0, lt=1)] = Field(
+        0.02, description="Damping of that mode, fraction of critical (-); low damping reads higher loads.")
 
     @field_validator("allowable_moment", "allowable_force")
     @classmethod
@@ -456,6 +465,12 @@ class WeakLocationSpec(Strict):
         if isinstance(v, list) and v[0] > v[1]:
             raise ValueError(f"a range is [low, high] with low <= high. Got {v} instead")
         return v
+
+    @model_validator(mode="after")
+    def _mode_range(self):
+        if isinstance(self.structural_mode_hz, list) and self.structural_mode_hz[0] > self.structural_mode_hz[1]:
+            raise ValueError(f"structural_mode_hz is [low, high] with low <= high. Got {self.structural_mode_hz} instead")
+        return self
 
     @model_validator(mode="after")
     def _criteria(self):
@@ -525,7 +540,28 @@ class Case(Strict):
             if loc.joint not in joints:
                 raise ValueError(f"structures: weak location '{loc.name}': joint '{loc.joint}' is not in "
                                  f"target.joints {joints}")
+            if loc.structural_mode_hz is not None:
+                self._check_structural_mode(loc)
         return self
+
+    def _check_structural_mode(self, loc):
+        """A location read through its structure's mode: the joint stays stiff (its own first_mode_hz
+        would count the compliance twice) and the samples resolve the mode."""
+        joint = next(j for j in self.target.joints if j.name == loc.joint)
+        if joint.first_mode_hz is not None:
+            raise ValueError(f"structures: weak location '{loc.name}': structural_mode_hz reads the loads of joint "
+                             f"'{joint.name}' through a mode, but that joint already has first_mode_hz = "
+                             f"{joint.first_mode_hz:g} Hz in the dynamics; give the structure's mode in one place")
+        high = max(np.atleast_1d(loc.structural_mode_hz))
+        if self.simulation.output_rate < SAMPLES_PER_MODE_PERIOD * high:
+            raise ValueError(f"structures: weak location '{loc.name}': structural_mode_hz up to {high:g} Hz needs "
+                             f"simulation.output_rate >= {SAMPLES_PER_MODE_PERIOD * high:g} Hz "
+                             f"({SAMPLES_PER_MODE_PERIOD} samples per period); got {self.simulation.output_rate:g} Hz")
+        steps_per_sample = 1.0 / (self.simulation.output_rate * self.simulation.step)
+        if abs(steps_per_sample - round(steps_per_sample)) > 1e-6 * steps_per_sample:
+            raise ValueError(f"structures: weak location '{loc.name}': structural_mode_hz filters samples taken at a "
+                             f"fixed interval, so 1 / simulation.output_rate must be a whole number of steps; got "
+                             f"{steps_per_sample:g} steps per sample")
 
     @model_validator(mode="after")
     def _truth_damage_shapes(self):

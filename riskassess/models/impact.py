@@ -21,6 +21,7 @@ from multibody.orbit import mean_motion
 from riskassess.cases.impact import Case, CircularOrbit, section_properties
 from riskassess.cases.target_geometry import body_meshes_target_frame, target_points_lvlh, target_pose_lvlh
 from structures.criteria import Allowable
+from structures.modal_load import mode_grid
 from structures.weak_location import WeakLocation
 
 
@@ -343,5 +344,13 @@ def weak_locations(case: Case, assembly) -> list:
             ultimate_shear=Allowable.of(material.ultimate_shear) if material else None,
             allowable_moment=Allowable.of(spec.allowable_moment) if spec.allowable_moment is not None else None,
             allowable_force=Allowable.of(spec.allowable_force) if spec.allowable_force is not None else None,
-            moment_axes=axes))
+            moment_axes=axes, **_structural_modes(spec)))
     return out
+
+
+def _structural_modes(spec) -> dict:
+    """WeakLocation keys of a location read through its structure's first mode (a value or a range)."""
+    if spec.structural_mode_hz is None:
+        return {}
+    low, high = np.atleast_1d(np.asarray(spec.structural_mode_hz, float))[[0, -1]]
+    return {"structural_modes_hz": tuple(mode_grid(low, high)), "structural_damping_ratio": spec.structural_damping_ratio}

@@ -91,7 +91,7 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
         monitor = None
         if locations and case.structures.release != "never":
             monitor = ReleaseMonitor(locations, simulation.system, case.structures.skip_initial,
-                                     case.structures.release)
+                                     case.structures.release, interval_s=1.0 / case.simulation.output_rate)
         driven_progress = _scaled(progress, 0.5 * case.simulation.end_time) if sequential else progress
         recorder = run_recorded(simulation, folder, progress=driven_progress, monitor=monitor)
         if sequential:
