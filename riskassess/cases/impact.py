@@ -29,7 +29,6 @@ from riskassess.cases.inputs import (JSON_FILE_LIMIT, KIND_NOTE, MESH_FILE_LIMIT
 from riskassess.cases.target_geometry import target_points_lvlh, target_vertices_lvlh
 from riskassess.cases.uncertain import parse_uncertain
 from structures.section_shapes import SHAPES
-from structures.sections import SECTIONS
 
 Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Positive = Annotated[float, Field(gt=0)]
@@ -413,8 +412,8 @@ Section = Annotated[Union[tuple(SECTION_MODELS.values())], Field(discriminator="
 
 
 def section_properties(spec):
-    """Section properties (:mod:`structures.sections`) from a case section table (raises ValueError
-    for impossible dimensions).
+    """Section properties (the plug-in of :mod:`structures.section_shapes` named by ``kind``) from a case
+    section table (raises ValueError for impossible dimensions).
 
     Parameters
     ----------
@@ -426,7 +425,7 @@ def section_properties(spec):
     structures.section_base.SectionProperties
     """
     params = spec.model_dump()
-    return SECTIONS[params.pop("kind")](**params)
+    return SHAPES[params.pop("kind")].properties(**params)
 
 
 class Material(Strict):
