@@ -54,7 +54,7 @@ def springs_package(tmp_path, monkeypatch):
 
 def test_a_file_dropped_into_the_package_is_a_new_plug_in(springs_package):
     probe = importlib.import_module("springs_probe")
-    assert list(probe.SPRINGS) == ["linear"]
+    assert isinstance(probe.SPRINGS, Family) and list(probe.SPRINGS) == ["linear"]
     (springs_package / "cubic.py").write_text(CUBIC)            # adding one is adding one file
     found = discover("springs_probe", probe.__path__, "spring", probe.Spring, skip=("base",))
     assert list(found) == ["cubic", "linear"]                     # module-name order
