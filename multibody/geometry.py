@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
-from multibody.shapes import shape_plugin
+from multibody.shapes import SHAPES
 
 
 def shape_mesh(kind: str, **keys) -> trimesh.Trimesh:
@@ -24,7 +24,7 @@ def shape_mesh(kind: str, **keys) -> trimesh.Trimesh:
     **keys       Its keys (SI, target frame), as its ``KEYS`` name them, e.g. ``size`` (3,) (m) and
                  ``center`` (3,) (m) of a box; see the shape file's ``mesh_target_frame``.
     """
-    return shape_plugin(kind).mesh_target_frame(**keys)
+    return SHAPES[kind].mesh_target_frame(**keys)
 
 
 def uniform_density_inertia(meshes, mass, com_target):

@@ -4,6 +4,7 @@ of a case, in which every shape is placed)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import trimesh
@@ -40,6 +41,34 @@ class Key:
         if self.value not in VALUES:
             raise ValueError(f"shape key {self.name!r}: value kind must be one of {sorted(VALUES)}. "
                              f"Got {self.value!r} instead")
+
+
+class ContactShape(Protocol):
+    """The interface of a contact shape: a module of :mod:`multibody.shapes` (one file each) defines
+
+    Attributes
+    ----------
+    NAME : str                  The ``kind`` a case's ``shapes`` table gives.
+    KEYS : tuple of Key         Its keys, in file order; the case schema (:mod:`riskassess.cases.impact`)
+                                is built from them.
+    """
+
+    NAME: str
+    KEYS: tuple[Key, ...]
+
+    def mesh_target_frame(self, **keys) -> trimesh.Trimesh:
+        """The closed triangle mesh of the shape in the target frame (m), taking its ``KEYS`` as keywords.
+
+        Parameters
+        ----------
+        **keys
+            The shape's keys (:attr:`KEYS`), in the units their descriptions give.
+
+        Returns
+        -------
+        trimesh.Trimesh
+            Vertices in the target frame (m).
+        """
 
 
 def rotated_and_moved(mesh: trimesh.Trimesh, center, rotation_vector) -> trimesh.Trimesh:

@@ -26,7 +26,7 @@ from scipy.spatial.transform import Rotation
 from multibody.health import HealthWatch
 from multibody.impact import _object_state_index, checked_post_step, explicit_settings, solve_checked
 from multibody.rotations import rotation_matrix_from_rotation_vector
-from multibody.control.thrust_laws import thrust_law
+from multibody.control.thrust_laws import LAWS
 from multibody.towing_kernel import (N_COORDINATES, ST_TENSION, TowKernel, body_forces, no_load, pack, sampled_state,
                                      tow_kernel, verlet_run)
 from multibody.towing_kernel import MT_ELONGATION, MT_ELONGATION_RATE, MT_TENSION, SLIDING, THRUST, TORQUE
@@ -74,12 +74,12 @@ class TowedBodies:
 
     def __post_init__(self):
         self.inverse_inertia = np.linalg.inv(self.inertia_body)
-        thrust_law(self.thrust_law)     # an unknown law is refused here, listing the known ones
+        LAWS[self.thrust_law]     # an unknown law is refused here, listing the known ones
 
     @property
     def thrust_command(self):
         """The thrust law's compiled ``command`` (:data:`multibody.control.thrust.THRUST_SIGNATURE`)."""
-        return thrust_law(self.thrust_law).command
+        return LAWS[self.thrust_law].command
 
     @property
     def n_steps(self) -> int:

@@ -17,7 +17,7 @@ from numba import njit
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from multibody.rk4 import rk4_at_times
+from multibody.rk4 import rk4_integrator
 from perception.motion import integrated_autocorrelation_time
 
 
@@ -47,11 +47,15 @@ def _torque_free_rate(t, x, j):
     return out
 
 
+#: The shared RK4 (multibody/rk4.py) with :func:`_torque_free_rate` bound in.
+_rk4 = rk4_integrator(_torque_free_rate, 0)
+
+
 @njit(cache=True)
 def propagate_torque_free(q0, omega0, principal_moments, times, max_step):
     """Attitude quaternions (k, 4) [w, x, y, z] principal->world and rates (k, 3) (rad/s,
     principal frame) at ``times`` (s, increasing, ``times[0]`` the initial time), by the shared RK4
-    (:func:`multibody.rk4.rk4_at_times`) with steps no longer than ``max_step`` (s), the quaternion
+    (:func:`multibody.rk4.rk4_integrator`) with steps no longer than ``max_step`` (s), the quaternion
     renormalised every step.
 
     Parameters
@@ -76,7 +80,7 @@ def propagate_torque_free(q0, omega0, principal_moments, times, max_step):
     """
     x0 = np.empty(7)
     x0[0:4], x0[4:7] = q0, omega0
-    states = rk4_at_times(_torque_free_rate, (principal_moments,), x0, times[0], times, max_step, 0)
+    states = _rk4((principal_moments,), x0, times[0], times, max_step)
     return np.ascontiguousarray(states[:, 0:4]), np.ascontiguousarray(states[:, 4:7])
 
 

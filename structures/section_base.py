@@ -4,6 +4,7 @@ properties a stress check needs, per unit load (SI, section frame: axis 1 along 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 
 @dataclass(frozen=True)
@@ -20,6 +21,39 @@ class SectionProperties:
     shear_per_force2: float     # (1/m^2)
     shear_per_force3: float     # (1/m^2)
     round: bool = False         # bending peaks combine as a resultant (circular tube)
+
+
+class SectionShape(Protocol):
+    """The interface of a cross-section shape: a module of :mod:`structures.section_shapes` (one file
+    each) defines
+
+    Attributes
+    ----------
+    NAME : str                  The ``kind`` a case's ``section`` table gives.
+    DIMENSIONS : dict           Dimension name -> meaning (m), in the order :meth:`properties` takes
+                                them; the case schema is built from it (every dimension > 0 and <= 20 m).
+    """
+
+    NAME: str
+    DIMENSIONS: dict[str, str]
+
+    def properties(self, **dimensions) -> SectionProperties:
+        """The section's properties from its dimensions.
+
+        Parameters
+        ----------
+        **dimensions : float
+            Its :attr:`DIMENSIONS` (m).
+
+        Returns
+        -------
+        SectionProperties
+
+        Raises
+        ------
+        ValueError
+            Impossible dimensions (a wall thicker than half the section).
+        """
 
 
 def bending_properties(area, i2, i3, c2, c3, torsion, shear2, shear3, round_=False) -> SectionProperties:

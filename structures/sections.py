@@ -23,10 +23,6 @@ from __future__ import annotations
 import numpy as np
 
 from structures.section_base import SectionProperties
-from structures.section_shapes import SHAPES
-
-#: Shape name -> its properties function (one file each in :mod:`structures.section_shapes`).
-SECTIONS = {name: shape.properties for name, shape in SHAPES.items()}
 
 
 def section_stresses(section: SectionProperties, force_section, moment_section) -> dict:

@@ -13,10 +13,13 @@ integration step (a digital controller with zero-order hold over the step):
 * returns the thrust magnitude (N) along the chaser's thrust direction.
 
 The towing kernels take the law as a numba first-class function (:data:`THRUST_LAW`), so adding a
-law is adding one module to :mod:`multibody.control.thrust_laws` (its contents are listed there).
+law is adding one module to :mod:`multibody.control.thrust_laws` implementing :class:`ThrustLaw`.
 """
 from __future__ import annotations
 
+from typing import Protocol
+
+import numpy as np
 from numba import types
 
 _VECTOR = types.float64[::1]
@@ -26,3 +29,44 @@ THRUST_SIGNATURE = types.float64(types.float64, types.float64, types.float64, _V
                                  types.boolean)
 #: numba type of a thrust law passed to a compiled kernel (first-class function).
 THRUST_LAW = types.FunctionType(THRUST_SIGNATURE)
+
+
+class ThrustLaw(Protocol):
+    """The interface of a thrust law: a module of :mod:`multibody.control.thrust_laws` (one file each)
+    defines
+
+    Attributes
+    ----------
+    NAME : str                   The ``thrust.kind`` a towing case gives.
+    ALONG_BODY_Z : bool          True: the thrust acts along the chaser's body z; False: against its
+                                 velocity (inertial).
+    CASE_SECTIONS : tuple of str The case tables it reads besides ``[thrust]`` (the schema requires them).
+    command                      The compiled law (see the module doc), ``@njit(THRUST_SIGNATURE, cache=True)``.
+    """
+
+    NAME: str
+    ALONG_BODY_Z: bool
+    CASE_SECTIONS: tuple[str, ...]
+    command: object
+
+    def arrays(self, case, tether, z0, z_rate0) -> tuple[np.ndarray, np.ndarray]:
+        """The law's constants and initial states from a towing case.
+
+        Parameters
+        ----------
+        case : riskassess.cases.towing.TowingCase
+            Read: ``thrust``, the law's ``CASE_SECTIONS`` and ``chaser.mass``.
+        tether : (3,) or (6,) float
+            Main tether first: k_MT (N/m), c_MT (N s/m), ...
+        z0 : float
+            Main-tether elongation at the start (m).
+        z_rate0 : float
+            Its rate (m/s).
+
+        Returns
+        -------
+        params : (k,) float
+            Constants of ``command``.
+        state : (j,) float
+            Its states at the start.
+        """

@@ -1,6 +1,6 @@
 """Contact shapes of the debris bodies, one plug-in file each, found by name.
 
-A shape is a module of this package that defines
+A shape is a module of this package implementing :class:`multibody.shape_base.ContactShape`:
 
 - ``NAME``: the ``kind`` a case's ``shapes`` table gives;
 - ``KEYS``: its keys (:class:`multibody.shape_base.Key`: name, kind of value, meaning with unit,
@@ -8,40 +8,15 @@ A shape is a module of this package that defines
 - ``mesh_target_frame(**keys) -> trimesh.Trimesh``: the closed triangle mesh of the shape in the
   target frame (m), taking the keys as keywords.
 
-Adding a shape is adding one file here.
+Adding a shape is adding one file here; ``SHAPES[kind]`` of an unknown kind is a ``ValueError``
+listing the known ones (:mod:`multibody.plugins`).
 """
 from __future__ import annotations
 
-import importlib
-import pkgutil
+from multibody.plugins import Family, discover
+from multibody.shape_base import ContactShape
 
+#: Shape name -> its module, in module-name order.
+SHAPES: Family = discover(__name__, __path__, "contact shape", ContactShape)
 
-def discover() -> dict:
-    """Shape name -> its module, for every module of this package, in module-name order."""
-    shapes = {}
-    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        module = importlib.import_module(f"{__name__}.{info.name}")
-        shapes[module.NAME] = module
-    return shapes
-
-
-#: Shape name -> its module.
-SHAPES = discover()
-
-
-def shape_plugin(kind: str):
-    """The module of the contact shape named ``kind``; ValueError listing the known ones otherwise.
-
-    Parameters
-    ----------
-    kind : str
-        A shape's ``NAME`` (a case's ``shapes`` table ``kind``).
-
-    Returns
-    -------
-    module
-        Its plug-in module (``NAME``, ``KEYS``, ``mesh_target_frame``; meshes in the target frame, m).
-    """
-    if kind not in SHAPES:
-        raise ValueError(f"unknown shape kind {kind!r}; the known kinds are {', '.join(SHAPES)}")
-    return SHAPES[kind]
+__all__ = ["SHAPES"]

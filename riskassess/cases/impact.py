@@ -30,7 +30,6 @@ from riskassess.cases.target_geometry import target_points_lvlh, target_vertices
 from riskassess.cases.uncertain import parse_uncertain
 from structures.modal_load import SAMPLES_PER_MODE_PERIOD
 from structures.section_shapes import SHAPES
-from structures.sections import SECTIONS
 
 Vector3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Positive = Annotated[float, Field(gt=0)]
@@ -414,8 +413,8 @@ Section = Annotated[Union[tuple(SECTION_MODELS.values())], Field(discriminator="
 
 
 def section_properties(spec):
-    """Section properties (:mod:`structures.sections`) from a case section table (raises ValueError
-    for impossible dimensions).
+    """Section properties (the plug-in of :mod:`structures.section_shapes` named by ``kind``) from a case
+    section table (raises ValueError for impossible dimensions).
 
     Parameters
     ----------
@@ -427,7 +426,7 @@ def section_properties(spec):
     structures.section_base.SectionProperties
     """
     params = spec.model_dump()
-    return SECTIONS[params.pop("kind")](**params)
+    return SHAPES[params.pop("kind")].properties(**params)
 
 
 class Material(Strict):

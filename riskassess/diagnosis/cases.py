@@ -3,12 +3,13 @@
 (:data:`riskassess.diagnosis.effects.CATALOG`) so ``[[effects]]`` entries are checked too."""
 from __future__ import annotations
 
+from multibody.plugins import Family
 from riskassess.cases import diagnosis as schema
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.impact_effects import IMPACT_CATALOG
 
 #: Every effect a case's ``[[effects]]`` may name: the attitude and towing catalog and the impact one.
-ALL_EFFECTS = {**CATALOG, **IMPACT_CATALOG}
+ALL_EFFECTS = Family("effect", {**CATALOG, **IMPACT_CATALOG})
 
 
 def load_diagnosis_case(path) -> schema.DiagnosisCase:

@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, types
 
-from multibody.rk4 import rk4_at_times
+from multibody.rk4 import rk4_integrator
 from multibody.rotations import quaternion_from_matrix, quaternion_to_matrix
 from riskassess.diagnosis.plant import Plant
 
@@ -539,11 +539,15 @@ def derivative(t, x, law, p, env):
     return dx
 
 
+#: The shared RK4 (multibody/rk4.py) with :func:`derivative` bound in: a direct call per stage.
+_rk4 = rk4_integrator(derivative, X_Q)
+
+
 @njit(types.float64[:, ::1](_LAW, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64), cache=True)
 def integrate(law, p, env, x0, times, max_step):
     """States at ``times`` (s, non-decreasing, >= 0) from ``x0`` at t = 0, by the shared RK4
-    (:func:`multibody.rk4.rk4_at_times`) with steps no longer than ``max_step`` (s); the quaternion is
-    renormalised every step.
+    (:func:`multibody.rk4.rk4_integrator` of :func:`derivative`) with steps no longer than ``max_step`` (s);
+    the quaternion is renormalised every step.
 
     Parameters
     ----------
@@ -565,7 +569,7 @@ def integrate(law, p, env, x0, times, max_step):
     states : (k, BASE_STATE_SIZE + e) float
         Layout ``X_*``, then the effect's states.
     """
-    return rk4_at_times(derivative, (law, p, env), x0, 0.0, times, max_step, X_Q)
+    return _rk4((law, p, env), x0, 0.0, times, max_step)
 
 
 @njit(LAW_SIGNATURE, cache=True)

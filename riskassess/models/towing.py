@@ -14,7 +14,7 @@ from scipy.optimize import brentq, minimize_scalar
 from multibody.control.attitude import sampled_boundary_layer
 from multibody.rotations import quaternion_to_matrix
 from multibody.control.mrac import abstracted_tether, command_elongation
-from multibody.control.thrust_laws import thrust_law
+from multibody.control.thrust_laws import LAWS
 from multibody.towing import TowingModel
 from riskassess.cases.towing import TowingCase
 
@@ -98,7 +98,7 @@ def case_thrust_law(case: TowingCase, tether, z0, z_rate0):
     state : (q,) float
         Its initial state.
     """
-    law = thrust_law(case.thrust.kind)
+    law = LAWS[case.thrust.kind]
     params, state = law.arrays(case, tether, z0, z_rate0)
     return law, params, state
 

@@ -36,7 +36,7 @@ from riskassess.models.towing_fullnet import lower_order_from_net
 from riskassess.cases.towing import TowingCase
 from riskassess.cases.impact import load_model
 from riskassess.products.towing_plots import plot_convergence
-from riskassess.stages.optimizers import optimizer_search
+from riskassess.stages.optimizers import OPTIMIZERS
 
 #: The quantities the costs compare, from :meth:`multibody.towing.TowResult.series`.
 COMPARED = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
@@ -211,7 +211,7 @@ def identify(case: TowingCase, data: list[dict], optimizer: str, end_time=None, 
              initial_guess=None) -> Identified:
     """Minimize the case's cost (``identification.cost``) against ``data`` (one dict per run: the
     compared series and ``rate_deg_s``) with ``optimizer``, a name of
-    :data:`riskassess.stages.optimizers.OPTIMIZERS` ('pso', 'pattern', 'polish'; one file each), from
+    :data:`riskassess.stages.optimizers.OPTIMIZERS` ('pso', 'pattern', 'polish', 'mads'; one file each), from
     ``initial_guess`` (default the case's s0). ``ValueError`` listing the known names for another.
 
     Parameters
@@ -233,7 +233,7 @@ def identify(case: TowingCase, data: list[dict], optimizer: str, end_time=None, 
     -------
     Identified
     """
-    search = optimizer_search(optimizer)        # an unknown name fails here, before any run
+    search = OPTIMIZERS[optimizer].search        # an unknown name fails here, before any run
     ident = case.identification
     settings = ident.optimizers
     x0 = ident.initial_guess if initial_guess is None else initial_guess

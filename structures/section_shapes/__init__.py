@@ -1,6 +1,6 @@
 """Cross-section shapes, one plug-in file each, found by name.
 
-A shape is a module of this package that defines
+A shape is a module of this package implementing :class:`structures.section_base.SectionShape`:
 
 - ``NAME``: the ``kind`` a case's ``section`` table gives;
 - ``DIMENSIONS``: its dimensions (m) with their meaning, in the order ``properties`` takes them (the
@@ -8,15 +8,15 @@ A shape is a module of this package that defines
 - ``properties(**dimensions) -> SectionProperties`` (:mod:`structures.section_base`), raising
   ``ValueError`` for impossible dimensions.
 
-Adding a shape is adding one file here.
+Adding a shape is adding one file here; ``SHAPES[kind]`` of an unknown kind is a ``ValueError``
+listing the known ones (:mod:`multibody.plugins`).
 """
 from __future__ import annotations
 
-import importlib
-import pkgutil
+from multibody.plugins import Family, discover
+from structures.section_base import SectionShape
 
-#: Shape name -> its module.
-SHAPES = {}
-for _info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-    _module = importlib.import_module(f"{__name__}.{_info.name}")
-    SHAPES[_module.NAME] = _module
+#: Shape name -> its module, in module-name order.
+SHAPES: Family = discover(__name__, __path__, "section shape", SectionShape)
+
+__all__ = ["SHAPES"]

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from multibody.rk4 import rk4_at_times
+from multibody.rk4 import rk4_integrator
 
 
 @njit(cache=True)
@@ -27,19 +27,23 @@ def _forced_rate(t, x, amplitude):
     return np.array([amplitude * np.cos(t)])
 
 
+_oscillator_rk4 = rk4_integrator(_oscillator_rate)
+_spin_rk4 = rk4_integrator(_spin_rate, 0)
+_forced_rk4 = rk4_integrator(_forced_rate)
+
+
 @njit(cache=True)
 def _oscillator(omega, x0, t0, times, max_step):
-    return rk4_at_times(_oscillator_rate, (omega,), x0, t0, times, max_step, -1)
+    return _oscillator_rk4((omega,), x0, t0, times, max_step)
 
 
-@njit(cache=True)
 def _spin(omega_body, q0, times, max_step):
-    return rk4_at_times(_spin_rate, (omega_body,), q0, 0.0, times, max_step, 0)
+    return _spin_rk4((omega_body,), q0, 0.0, times, max_step)      # called from Python as well
 
 
 @njit(cache=True)
 def _forced(amplitude, t0, times, max_step):
-    return rk4_at_times(_forced_rate, (amplitude,), np.zeros(1), t0, times, max_step, -1)
+    return _forced_rk4((amplitude,), np.zeros(1), t0, times, max_step)
 
 
 def test_rk4_is_fourth_order_on_the_harmonic_oscillator():
@@ -75,3 +79,9 @@ def test_rk4_keeps_the_quaternion_unit_and_on_the_analytic_spin():
     exact = np.column_stack([np.cos(0.5 * rate * times), np.sin(0.5 * rate * times)[:, None] * axis])
     # RK4 phase error ~ (|omega| h / 2)^4 / 120 per step over 1200 steps: about 1e-10
     assert np.abs(qs - exact).max() < 1e-8
+
+
+def test_one_integrator_per_derivative_and_quaternion_index():
+    # rk4_integrator binds the derivative into the compiled loop once; asked again, it gives the same one
+    assert rk4_integrator(_spin_rate, 0) is _spin_rk4
+    assert rk4_integrator(_spin_rate, -1) is not _spin_rk4

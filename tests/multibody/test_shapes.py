@@ -10,6 +10,8 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from multibody import shapes
+from multibody.plugins import discover
+from multibody.shape_base import ContactShape
 from multibody.geometry import shape_mesh
 from riskassess.cases.impact import SHAPE_MODELS, CaseError, _shape_model, load_case
 
@@ -41,7 +43,7 @@ def test_a_new_shape_file_is_found_by_its_name(tmp_path, monkeypatch):
     monkeypatch.setattr(shapes, "__path__", [*shapes.__path__, str(tmp_path)])
     monkeypatch.delitem(sys.modules, "multibody.shapes.tetrahedron", raising=False)
     try:
-        found = shapes.discover()
+        found = discover(shapes.__name__, shapes.__path__, "contact shape", ContactShape)
     finally:
         sys.modules.pop("multibody.shapes.tetrahedron", None)
     assert list(found) == ["box", "cylinder", "ellipsoid", "mesh", "sphere", "tetrahedron"]
@@ -66,7 +68,8 @@ def test_shipped_shapes_and_case_schema_agree():
 def test_unknown_kind_is_refused_with_the_known_ones():
     with pytest.raises(ValueError) as info:
         shape_mesh("cone", radius=1.0)
-    assert str(info.value) == "unknown shape kind 'cone'; the known kinds are box, cylinder, ellipsoid, mesh, sphere"
+    assert str(info.value) == ("unknown contact shape 'cone'; the known contact shapes are: "
+                               "box, cylinder, ellipsoid, mesh, sphere")
 
 
 def test_unknown_kind_in_a_case_names_file_key_and_kinds(tmp_path):

@@ -96,3 +96,13 @@ def test_section_shapes_are_plug_ins_found_by_name():
     assert set(SECTION_MODELS) == set(SHAPES)
     for name, shape in SHAPES.items():
         assert list(SECTION_MODELS[name].model_fields) == ["kind", *shape.DIMENSIONS]
+
+
+def test_an_unknown_section_shape_is_refused_listing_the_known_ones():
+    """Issue 21: every plug-in family refuses an unknown name with the known ones (multibody/plugins.py)."""
+    from structures.section_shapes import SHAPES
+
+    with pytest.raises(ValueError) as unknown:
+        SHAPES["t_section"]
+    assert str(unknown.value) == ("unknown section shape 't_section'; the known section shapes are: "
+                                  "circular_tube, hollow_rectangle, i_section, solid_rectangle, thin_walled_box")

@@ -1,6 +1,6 @@
 """Thrust laws of the towing chaser, one plug-in module each, found by name.
 
-A law is a module of this package that defines
+A law is a module of this package implementing :class:`multibody.control.thrust.ThrustLaw`:
 
 - ``NAME``: the ``thrust.kind`` a towing case gives;
 - ``ALONG_BODY_Z``: True if the thrust acts along the chaser's body z, False if against its
@@ -12,32 +12,15 @@ A law is a module of this package that defines
   ``CASE_SECTIONS`` and ``chaser.mass``), the main tether ``tether`` = [k_MT (N/m), c_MT (N s/m), ...]
   and the elongation z0 (m) and its rate z_rate0 (m/s) at the start.
 
-Adding a law is adding one file here.
+Adding a law is adding one file here; ``LAWS[name]`` of an unknown name is a ``ValueError`` listing
+the known ones (:mod:`multibody.plugins`).
 """
 from __future__ import annotations
 
-import importlib
-import pkgutil
-from types import ModuleType
+from multibody.control.thrust import ThrustLaw
+from multibody.plugins import Family, discover
 
-#: Law name -> its module, in module order.
-LAWS: dict[str, ModuleType] = {}
-for _info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-    _module = importlib.import_module(f"{__name__}.{_info.name}")
-    LAWS[_module.NAME] = _module
+#: Law name -> its module, in module-name order.
+LAWS: Family = discover(__name__, __path__, "thrust law", ThrustLaw)
 
-
-def thrust_law(name: str) -> ModuleType:
-    """The law module called ``name``; a ValueError listing the known laws otherwise.
-
-    Parameters
-    ----------
-    name : str
-        A case's ``thrust.kind``.
-    """
-    if name not in LAWS:
-        raise ValueError(f"thrust.kind: unknown thrust law '{name}'; the known laws are: {', '.join(LAWS)}")
-    return LAWS[name]
-
-
-__all__ = ["LAWS", "thrust_law"]
+__all__ = ["LAWS"]

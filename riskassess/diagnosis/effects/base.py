@@ -75,6 +75,9 @@ class Effect:
     scenarios: tuple[str, ...] = ("tumbling_rigid", "hinged_appendage")
     #: It is seen only if one of these channels is measured.
     channels: tuple[str, ...] = ()
+    #: What it reads of a circular orbit outside the towing scenario (e.g. ``"its altitude"``), for the
+    #: reason it gives when the case has none; "" for an effect that needs no orbit.
+    needs_orbit: str = ""
     #: Number of its own states in the fast model (its law's ``xe``; values at t = 0:
     #: :meth:`initial_extra_states`).
     extra_states: int = 0
@@ -114,12 +117,15 @@ class Effect:
             Validated diagnosis case; its ``kind`` must be one of :attr:`scenarios`.
         channels : sequence of str
             Measured channel names; at least one of :attr:`channels` must be among them.
+            A circular orbit is needed outside the towing scenario if :attr:`needs_orbit` says so.
 
         Returns
         -------
         reason : str or None
             A sentence for the report, or None when the effect applies.
         """
+        if self.needs_orbit and case.kind != "towing" and case.orbit.kind != "circular":
+            return f"the case has no orbit ([orbit] kind = 'circular' with {self.needs_orbit})"
         if case.kind not in self.scenarios:
             return f"applies to the {' / '.join(self.scenarios)} scenario(s), not to '{case.kind}'"
         if self.channels and not set(self.channels) & set(channels):

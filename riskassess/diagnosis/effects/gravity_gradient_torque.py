@@ -123,20 +123,7 @@ class GravityGradientTorque(Effect):
     scenarios = ("tumbling_rigid", "hinged_appendage", "towing")
     law = staticmethod(law)
     towing_law = staticmethod(towing_law)
-
-    def not_applicable(self, case, channels):
-        """Needs an orbit outside the towing scenario; otherwise as the base class.
-
-        Parameters
-        ----------
-        case : DiagnosisCase
-            Validated diagnosis case.
-        channels : sequence of str
-            Measured channel names.
-        """
-        if case.kind != "towing" and case.orbit.kind != "circular":
-            return "the case has no orbit ([orbit] kind = 'circular' with its altitude)"
-        return super().not_applicable(case, channels)
+    needs_orbit = "its altitude"
 
     def parameter_specs(self, case, channels=None):
         """The mean motion n (rad/s), expected at the case orbit's, bounded by 10 n.

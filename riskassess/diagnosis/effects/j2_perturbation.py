@@ -168,20 +168,7 @@ class J2Perturbation(Effect):
     scenarios = ("tumbling_rigid", "hinged_appendage", "towing")
     law = staticmethod(law)
     towing_law = staticmethod(towing_law)
-
-    def not_applicable(self, case, channels):
-        """Needs an orbit outside the towing scenario; otherwise as the base class.
-
-        Parameters
-        ----------
-        case : DiagnosisCase
-            Validated diagnosis case.
-        channels : sequence of str
-            Measured channel names.
-        """
-        if case.kind != "towing" and case.orbit.kind != "circular":
-            return "the case has no orbit ([orbit] kind = 'circular' with altitude and inclination)"
-        return super().not_applicable(case, channels)
+    needs_orbit = "altitude and inclination"
 
     def parameter_specs(self, case, channels=None):
         """J2 (-), expected at Earth's, bounded by 20 times it.

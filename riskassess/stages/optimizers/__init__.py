@@ -1,39 +1,22 @@
 """Optimizers of the towing identification, one plug-in file each, found by name.
 
-A plug-in is a module of this package that defines
+A plug-in is a module of this package implementing :class:`riskassess.stages.optimizers.base.Optimizer`:
 
 - ``NAME``: the name a case (``identification.searches``) and the CLI (``--optimizers``) use;
 - ``search(problem, x0, settings) -> (s, cost)``: minimize the pymoo ``problem``
   (:class:`riskassess.stages.identify.TowingFit`, bounded, 4 variables) from ``x0`` with the case's
   ``identification.optimizers`` ``settings``; returns the best s (4,) and its cost.
 
-Adding an optimizer is adding one file here (and its name to the case schema's ``searches``).
+Adding an optimizer is adding one file here (and its name to the case schema's ``searches``);
+``OPTIMIZERS[name]`` of an unknown name is a ``ValueError`` listing the known ones
+(:mod:`multibody.plugins`).
 """
 from __future__ import annotations
 
-import importlib
-import pkgutil
+from multibody.plugins import Family, discover
+from riskassess.stages.optimizers.base import Optimizer
 
-#: Optimizer name -> its module (``NAME``, ``search``).
-OPTIMIZERS = {}
-for _info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-    _module = importlib.import_module(f"{__name__}.{_info.name}")
-    OPTIMIZERS[_module.NAME] = _module
+#: Optimizer name -> its module (``NAME``, ``search``), in module-name order.
+OPTIMIZERS: Family = discover(__name__, __path__, "optimizer", Optimizer, skip=("base",))
 
-
-def optimizer_search(name: str):
-    """The ``search`` function of optimizer ``name``; ``ValueError`` listing the known names.
-
-    Parameters
-    ----------
-    name : str
-        An optimizer name (:data:`OPTIMIZERS`).
-
-    Returns
-    -------
-    callable
-        ``search(problem, x0, settings) -> (s, cost)``.
-    """
-    if name not in OPTIMIZERS:
-        raise ValueError(f"unknown optimizer '{name}'; the optimizers are: {', '.join(sorted(OPTIMIZERS))}")
-    return OPTIMIZERS[name].search
+__all__ = ["OPTIMIZERS", "Optimizer"]

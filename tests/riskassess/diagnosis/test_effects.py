@@ -29,6 +29,14 @@ def test_catalog_has_every_required_effect_with_units_and_bounds(path):
             assert p.unit and p.lower <= p.typical <= p.upper, (effect.id, p)
 
 
+def test_catalog_refuses_an_unknown_effect_listing_the_known_ones():
+    """Issue 21: every plug-in family refuses an unknown name with the known ones (multibody/plugins.py)."""
+    with pytest.raises(ValueError) as unknown:
+        CATALOG["solar_pressure"]
+    assert str(unknown.value) == f"unknown effect 'solar_pressure'; the known effects are: {', '.join(sorted(CATALOG))}"
+    assert REQUIRED <= set(str(unknown.value).split(": ")[1].split(", "))
+
+
 def test_towing_effects_are_not_applicable_to_the_free_scenarios(tumbling_rocket_body):
     for effect_id in ("tether_viscoelasticity", "thrust_misalignment"):
         assert "towing" in CATALOG[effect_id].not_applicable(tumbling_rocket_body, ["omega_x"])

@@ -24,6 +24,15 @@ REQUIRED = {"contact_stiffness", "contact_exponent", "contact_damping", "contact
             "thread_damping", "net_bending", "launch_velocity_error"}
 
 
+def test_catalog_refuses_an_unknown_impact_effect_listing_the_known_ones():
+    """Issue 21: every plug-in family refuses an unknown name with the known ones (multibody/plugins.py)."""
+    with pytest.raises(ValueError) as unknown:
+        IMPACT_CATALOG["net_porosity"]
+    assert str(unknown.value) == ("unknown impact effect 'net_porosity'; the known impact effects are: "
+                                  f"{', '.join(sorted(IMPACT_CATALOG))}")
+    assert REQUIRED <= set(str(unknown.value).split(": ")[1].split(", "))
+
+
 def test_catalog_parameters_set_the_impact_case():
     impact = load_case(SMALL)
     raw = read_toml(SMALL)
