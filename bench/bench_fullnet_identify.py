@@ -72,7 +72,7 @@ def searches(optimizers, mads_starts, s0):
 
 def run_one(case: TowingCase, data, label, name, guess, cost, workers, end) -> dict:
     """One search on the training runs and the identified model's scores; returns the entries per reported
-    optimizer ('pso' gives 'pso' and 'pso+pattern')."""
+    optimizer ('pso' gives 'pso' and 'pso+pattern'; ``wall_s`` is each one's own, ``cpu_s`` the whole search's)."""
     ident = case.identification.model_copy(update=dict(cost=cost, initial_guess=guess, workers=workers))
     lower = lower_order_case(case.model_copy(update=dict(identification=ident)), data[0])
     n_train = case.full_net.identification_training_runs
@@ -84,8 +84,8 @@ def run_one(case: TowingCase, data, label, name, guess, cost, workers, end) -> d
     for reported, answer in found.items():
         entry = _entry(lower, answer, train, valid, end)
         entry.pop("history")
-        entry.update(cpu_s=cpu, wall_s=wall, load_before=load, load_after=os.getloadavg()[0],
-                     start_guess=guess)
+        entry.update(cpu_s=cpu, search_wall_s=wall, load_before=load, load_after=os.getloadavg()[0],
+                     start_guess=guess)   # CPU and wall of the whole search ('pso' and 'pso+pattern' alike)
         out[label if reported == name else label.replace(name, reported)] = entry
     return out
 
