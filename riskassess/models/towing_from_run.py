@@ -21,9 +21,13 @@ snapshot's time is before ``full_net.closing_time`` and a time-series sample exi
 **Contact surface.** The impact model's cylinder is a faceted mesh (32 facets: their middles lie
 r (1 - cos(pi/32)) = 9.4 mm inside the round cylinder of the towing model), so nodes resting on it are
 inside the towing model's analytic cylinder; left there, the Hertz contact (1.6e8 N/m^1.5) would push a
-9.5 g node out with ~100 kN and blow the net off the stage. Every node closer to the analytic surface than
-its contact radius is moved out along the surface normal until it just touches (:func:`lift_onto_cylinder`;
-velocities kept); ``RunStart.lift`` is the largest move (m).
+9.5 g node out with ~100 kN and blow the net off the stage. Moving those nodes out along the surface normal
+(:func:`lift_onto_cylinder`) is not enough by itself: it lengthens the threads round the surface (by up to
+lift / radius, 0.5 %: 300 N in a Kevlar thread) and put 12.5 J of elastic energy into a net that held 1e-4 J
+(cases/zenit2_capture.toml at 12 s), which threw the net off the stage within 10 s of towing. The nodes are
+therefore draped onto the round cylinder (:func:`drape_on_cylinder`): lifted, then every thread the lift
+lengthened is brought back to its length in the run, the nodes sliding along the surface (up to 15 mm there;
+the net's CoM moves by 2 mm; velocities kept); ``RunStart.lift`` is the largest move (m).
 
 **Closing loop.** The impact model has none, so its lacing points end up wherever the capture left them,
 up to a few per cent farther apart than the flat net's straight lacing distances (1.7 % in
@@ -291,6 +295,65 @@ def lift_onto_cylinder(nodes_body, radii, geometry):
     return lifted, float(lift)
 
 
+def drape_on_cylinder(nodes_body, masses, radii, threads, targets, geometry, tolerance=1e-6, max_sweeps=20000):
+    """Nodes lifted onto the analytic cylinder (:func:`lift_onto_cylinder`) with no thread longer than its
+    target (module doc, "Contact surface"): a lift along the normal lengthens every thread whose ends are
+    lifted unequally or that runs round the surface (by up to lift / radius of its length), so each sweep
+    shortens every thread above its target to it, moving its two ends towards each other in inverse
+    proportion to their masses (a node's corrections averaged over its threads), and lifts the nodes again;
+    the nodes slide along the surface until both hold.
+
+    Parameters
+    ----------
+    nodes_body : (n, 3) float
+        Node positions relative to the debris CoM, debris body frame (m).
+    masses, radii : (n,) float
+        Node masses (kg) and contact radii (m).
+    threads : (k, 2) int
+        Node pairs.
+    targets : (k,) float
+        Largest length of each thread (m): its length before the lift or its natural length, the larger.
+    geometry : (3,) float
+        Cylinder radius, half length, axial centre z_body (m) (:func:`debris_geometry`).
+    tolerance : float
+        Largest thread excess over its target left (m).
+    max_sweeps : int
+        Most sweeps; ``RuntimeError`` if the excess is still above ``tolerance`` then.
+
+    Returns
+    -------
+    draped : (n, 3) float
+        (m, debris body frame).
+    lift : float
+        Largest move of a node (m).
+    excess : float
+        Largest thread excess over its target left (m).
+    """
+    start = np.array(nodes_body, float)
+    x, _ = lift_onto_cylinder(start, radii, geometry)
+    i, j = np.asarray(threads).T
+    inverse = 1.0 / np.asarray(masses, float)
+    share_i = (inverse[i] / (inverse[i] + inverse[j]))[:, None]
+    for _ in range(max_sweeps):
+        d = x[j] - x[i]
+        length = np.linalg.norm(d, axis=1)
+        excess = length - targets
+        if excess.max() <= tolerance:
+            break
+        pull = np.where(excess > 0, excess / length, 0.0)[:, None] * d
+        move, count = np.zeros_like(x), np.zeros(len(x))
+        np.add.at(move, i, share_i * pull)
+        np.add.at(move, j, -(1.0 - share_i) * pull)
+        np.add.at(count, i, excess > 0)
+        np.add.at(count, j, excess > 0)
+        x += move / np.maximum(count, 1.0)[:, None]
+        x, _ = lift_onto_cylinder(x, radii, geometry)
+    else:
+        raise RuntimeError(f"the net could not be draped on the round cylinder: a thread is still {excess.max():.3g} m "
+                           f"longer than before the lift after {max_sweeps} sweeps")
+    return x, float(np.linalg.norm(x - start, axis=1).max()), float(max(excess.max(), 0.0))
+
+
 def slack_closing_loop(net: TowingNet, nodes) -> None:
     """Open natural lengths of the closing loop: the larger of the flat net's straight lacing distances and
     the distances at ``nodes`` (module doc, "Closing loop"); stiffness EA/l0 with them. In place.
@@ -346,8 +409,12 @@ def impact_run_start(case: TowingCase, case_path, snapshot: int = -1) -> RunStar
     rot = lvlh_frame(case)[2]
     omega = np.asarray(series["body_omega_body"][k, 0], float) + to_lvlh.T @ np.array([0.0, 0.0, n])
     debris_to_inertial = rot @ to_lvlh
+    top, k = towing.topology, len(towing.closing_rest_open)
+    body = (nodes - com) @ debris_to_inertial
+    threads = top.threads[:-k]                    # the run's own threads (the loop is set slack below)
+    targets = np.maximum(np.linalg.norm(body[threads[:, 1]] - body[threads[:, 0]], axis=1), top.rest_lengths[:-k])
+    draped, lift, _ = drape_on_cylinder(body, top.masses, top.radii, threads, targets, debris_geometry(case))
+    nodes = com + draped @ debris_to_inertial.T
     slack_closing_loop(towing, nodes)
-    lifted, lift = lift_onto_cylinder((nodes - com) @ debris_to_inertial, towing.topology.radii, debris_geometry(case))
-    return RunStart(folder, t, towing, com + lifted @ debris_to_inertial.T, velocities, com, com_v, debris_to_inertial,
-                    omega, lift)
+    return RunStart(folder, t, towing, nodes, velocities, com, com_v, debris_to_inertial, omega, lift)
 

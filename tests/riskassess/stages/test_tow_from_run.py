@@ -11,7 +11,7 @@ from multibody.net_towing import run_exudyn
 from multibody.rotations import quaternion_to_matrix
 from riskassess.cases.impact import CaseError, load_model
 from riskassess.cases.towing import TowingCase
-from riskassess.models.towing_from_run import impact_run_start
+from riskassess.models.towing_from_run import drape_on_cylinder, impact_run_start, lift_onto_cylinder
 from multibody.net_towing_kernel import cylinder_distance
 from riskassess.models.towing_fullnet import debris_geometry, full_net_model
 from riskassess.stages.run import run_case
@@ -98,3 +98,29 @@ def test_tow_continues_from_the_run(impact_run):
     p, j = s["total_momentum_inertial"], s["external_impulse_inertial"]
     assert np.linalg.norm(p - p[0] - (j - j[0]), axis=1).max() < 85.0
     assert np.all(np.isfinite(s["net_nodes_inertial"]))
+
+
+def test_drape_on_cylinder_keeps_the_threads_lengths():
+    # An arc of 9 nodes resting on the middles of the impact model's 32 facets (radius R cos(pi/32) + r for a
+    # contact radius r), each thread at its natural length (a chord). Lifted along the normal onto the round
+    # cylinder every thread is stretched by exactly (R + r) / (R cos(pi/32) + r) - 1 (similar triangles: 0.48 %,
+    # the ~300 N in a Kevlar thread of the towing case); draped, no node is inside the surface and no thread
+    # longer than its natural length (tolerance 1e-6 m), the arc's angle shrinking by that ratio instead.
+    radius, r, n = 1.95, 0.005, 9
+    angles = np.arange(n) * 2 * np.pi / 32                      # one node per facet middle
+    faceted = (radius * np.cos(np.pi / 32) + r) * np.c_[np.cos(angles), np.sin(angles), np.zeros(n)]
+    threads = np.c_[np.arange(n - 1), np.arange(1, n)]
+    rest = np.linalg.norm(faceted[1:] - faceted[:-1], axis=1)
+    geometry = np.array([radius, 5.5, 0.0])
+    lifted, _ = lift_onto_cylinder(faceted, np.full(n, r), geometry)
+    stretch = np.linalg.norm(lifted[1:] - lifted[:-1], axis=1) / rest - 1
+    np.testing.assert_allclose(stretch, (radius + r) / (radius * np.cos(np.pi / 32) + r) - 1, rtol=1e-9)
+    draped, lift, excess = drape_on_cylinder(faceted, np.full(n, 0.01), np.full(n, r), threads, rest, geometry)
+    gap = np.array([cylinder_distance(*x, geometry)[0] for x in draped]) - r
+    length = np.linalg.norm(draped[1:] - draped[:-1], axis=1)
+    assert gap.min() > -1e-12 and excess <= 1e-6 and np.all(length <= rest + 1e-6)
+    assert np.all(length >= rest - 1e-5)                       # not pulled slack either
+    arc = np.arctan2(draped[-1, 1], draped[-1, 0]) - np.arctan2(draped[0, 1], draped[0, 0])
+    chord_angle = 2 * np.arcsin(rest[0] / (2 * (radius + r)))   # the same chords on the round cylinder
+    assert arc == pytest.approx((n - 1) * chord_angle, abs=1e-5)
+    assert 0.0094 <= lift < 0.1
