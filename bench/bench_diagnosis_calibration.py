@@ -34,7 +34,7 @@ sys.path.insert(0, str(ROOT))
 
 from riskassess.diagnosis.exudyn_model import ExudynScenario  # noqa: E402
 from riskassess.diagnosis.model import predict  # noqa: E402
-from riskassess.diagnosis.plant import Plant  # noqa: E402
+from riskassess.diagnosis.plants.plant import Plant  # noqa: E402
 from riskassess.diagnosis.synthetic import channel_noise, sample_times  # noqa: E402
 from riskassess.products.measured import write_measured  # noqa: E402
 from riskassess.stages.diagnose import diagnose_case  # noqa: E402

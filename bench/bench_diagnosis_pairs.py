@@ -16,7 +16,7 @@ import numpy as np
 from riskassess.diagnosis.composite import EffectPair
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.exudyn_model import simulate_exudyn
-from riskassess.diagnosis.scenario import plant_of
+from riskassess.diagnosis.plants.scenario import plant_of
 from riskassess.diagnosis.synthetic import channel_noise, sample_times
 from tests.riskassess.diagnosis.conftest import HINGED_CASE, case_with
 from tests.riskassess.diagnosis.test_diagnose import DURATION, _diagnose, draw_effect

@@ -1,5 +1,5 @@
-"""CPU time of the models integrated by the shared RK4 (multibody/rk4.py): the diagnosis' fast model
-(riskassess.diagnosis.dynamics.integrate; a 300 s prediction at 10 Hz of the sample tumbling and
+"""CPU time of the models integrated by the shared RK4 (multibody/maths/rk4.py): the diagnosis' fast model
+(riskassess.diagnosis.plants.dynamics.integrate; a 300 s prediction at 10 Hz of the sample tumbling and
 hinged cases, nominal and with the nutation damper at its typical parameters) and perception's
 torque-free propagation (30 s, 0.01 s steps).
 
@@ -21,12 +21,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from perception.euler_poinsot import propagate_torque_free  # noqa: E402
-from riskassess.diagnosis import dynamics  # noqa: E402
+from riskassess.diagnosis.plants import dynamics  # noqa: E402
 from riskassess.diagnosis.cases import load_diagnosis_case  # noqa: E402
 from riskassess.diagnosis.effects import CATALOG  # noqa: E402
 from riskassess.diagnosis.effects.base import own_states  # noqa: E402
 from riskassess.diagnosis.model import max_step  # noqa: E402
-from riskassess.diagnosis.plant import Plant  # noqa: E402
+from riskassess.diagnosis.plants.plant import Plant  # noqa: E402
 
 
 def fast_model_loads() -> dict:

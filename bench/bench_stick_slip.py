@@ -29,7 +29,7 @@ from riskassess.diagnosis.effects.hinge_coulomb_friction import (ElastoPlasticFr
                                                                  analytic_turning_points, turning_points)
 from riskassess.diagnosis.exudyn_model import ExudynScenario, simulate_exudyn  # noqa: E402
 from riskassess.diagnosis.model import predict  # noqa: E402
-from riskassess.diagnosis.plant import Plant  # noqa: E402
+from riskassess.diagnosis.plants.plant import Plant  # noqa: E402
 from riskassess.diagnosis.synthetic import noisy, sample_times  # noqa: E402
 from riskassess.products.measured import write_measured  # noqa: E402
 from riskassess.stages.diagnose import diagnose_case  # noqa: E402

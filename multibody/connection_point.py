@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
-from multibody.linalg3 import solve3
+from multibody.maths.linalg3 import solve3
 from multibody.net import tension_only_kelvin_voigt
 from multibody.orbit import two_body_acceleration_xyz
 

@@ -14,7 +14,7 @@ from multibody.assembly import RigidBodySpec
 from multibody.hinge import add_penalty_joint
 from multibody.health import HealthWatch
 from multibody.impact import add_rigid_bodies, checked_post_step, explicit_settings, solve_checked
-from multibody.rotations import rotation_matrix_from_rotation_vector
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 
 
 def free_motion(bodies: list[RigidBodySpec], joints, sample_times, step: float = 1e-3,

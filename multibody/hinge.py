@@ -13,7 +13,7 @@ import exudyn as exu
 from exudyn.itemInterface import MarkerBodyRigid, ObjectConnectorRigidBodySpringDamper
 
 from multibody.assembly import JointSpec, RigidBodySpec
-from multibody.rotations import rotation_vector_from_matrix
+from multibody.maths.rotations import rotation_vector_from_matrix
 
 
 def hinge_frame_lvlh(axis_lvlh, point_lvlh, child_com_lvlh) -> np.ndarray:

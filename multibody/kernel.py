@@ -33,7 +33,7 @@ from multibody.orbit import (
     clohessy_wiltshire_acceleration,
     clohessy_wiltshire_acceleration_xyz,
 )
-from multibody.rotations import compose_rotation_vectors, rotation_matrix_from_rotation_vector
+from multibody.maths.rotations import compose_rotation_vectors, rotation_matrix_from_rotation_vector
 
 #: Indices into the kernel's scalar output buffer.
 THREAD_ELASTIC, BENDING_ELASTIC, CONTACT_ELASTIC, THREAD_DISSIPATED, CONTACT_DISSIPATED, N_CONTACTS = range(6)

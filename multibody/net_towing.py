@@ -24,7 +24,7 @@ from scipy.spatial.transform import Rotation
 
 from multibody.health import HealthWatch
 from multibody.impact import checked_post_step, explicit_settings, solve_checked
-from multibody.rotations import rotation_matrix_from_rotation_vector
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING, ACC_CONTACT_F, ACC_CONTACTS,
                                          ACC_DEBRIS_F, ACC_DEBRIS_T, ACC_EXTERNAL, ACC_SIZE, ACC_TENSION, D_CLOSING,
                                          D_CONTACT_F, D_CONTACTS, D_ELONGATION, D_RATE, D_SIZE, D_TENSION, advance_net,

@@ -33,7 +33,7 @@ from multibody.control.thrust import THRUST_LAW
 from multibody.connection_point import implicit_point_step
 from multibody.contact import contact_over_step
 from multibody.contact_kernel import _effective_mass_along_normal, _substeps_to_resolve_contact
-from multibody.rotations import rotation_matrix_from_rotation_vector
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.net import add_thread_forces, tension_only_kelvin_voigt
 from multibody.orbit import two_body_acceleration_xyz
 

@@ -12,8 +12,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from multibody.linalg3 import matmat3, mattmat3, mattvec3, matvec3
-from multibody.rotations import rotation_matrix_from_rotation_vector, rotation_vector_from_matrix_into
+from multibody.maths.linalg3 import matmat3, mattmat3, mattvec3, matvec3
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector, rotation_vector_from_matrix_into
 
 
 @njit(cache=True)

@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from multibody.health import HealthWatch
 from multibody.impact import _object_state_index, checked_post_step, explicit_settings, solve_checked
-from multibody.rotations import rotation_matrix_from_rotation_vector
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.control.thrust_laws import LAWS
 from multibody.towing_kernel import (N_COORDINATES, ST_TENSION, TowKernel, body_forces, no_load, pack, sampled_state,
                                      tow_kernel, verlet_run)

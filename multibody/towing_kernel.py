@@ -31,7 +31,7 @@ from multibody.control.attitude import desired_attitude, sliding_mode_torque
 from multibody.control.thrust import THRUST_LAW
 from multibody.connection_point import STATE_SIZE, TIME, V_N, X_N, advance_point, initial_point_state
 from multibody.kernel import verlet_evaluation_state
-from multibody.rotations import rotation_matrix_from_rotation_vector
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.net import tension_only_kelvin_voigt
 from multibody.orbit import add_body_gravity
 

@@ -17,7 +17,7 @@ from numba import njit
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from multibody.rk4 import rk4_integrator
+from multibody.maths.rk4 import rk4_integrator
 from perception.motion import integrated_autocorrelation_time
 
 
@@ -47,7 +47,7 @@ def _torque_free_rate(t, x, j):
     return out
 
 
-#: The shared RK4 (multibody/rk4.py) with :func:`_torque_free_rate` bound in.
+#: The shared RK4 (multibody/maths/rk4.py) with :func:`_torque_free_rate` bound in.
 _rk4 = rk4_integrator(_torque_free_rate, 0)
 
 
@@ -55,7 +55,7 @@ _rk4 = rk4_integrator(_torque_free_rate, 0)
 def propagate_torque_free(q0, omega0, principal_moments, times, max_step):
     """Attitude quaternions (k, 4) [w, x, y, z] principal->world and rates (k, 3) (rad/s,
     principal frame) at ``times`` (s, increasing, ``times[0]`` the initial time), by the shared RK4
-    (:func:`multibody.rk4.rk4_integrator`) with steps no longer than ``max_step`` (s), the quaternion
+    (:func:`multibody.maths.rk4.rk4_integrator`) with steps no longer than ``max_step`` (s), the quaternion
     renormalised every step.
 
     Parameters

@@ -12,8 +12,8 @@ import math
 import numpy as np
 from numba import njit
 
-from multibody.linalg3 import cross3, dot3, matvec3
-from multibody.rotations import quaternion_from_matrix_tuple
+from multibody.maths.linalg3 import cross3, dot3, matvec3
+from multibody.maths.rotations import quaternion_from_matrix_tuple
 
 
 @njit(cache=True)

@@ -1,22 +1,22 @@
 """Contact shapes of the debris bodies, one plug-in file each, found by name.
 
-A shape is a module of this package implementing :class:`multibody.shape_base.ContactShape`:
+A shape is a module of this package implementing :class:`multibody.shapes.base.ContactShape`:
 
 - ``NAME``: the ``kind`` a case's ``shapes`` table gives;
-- ``KEYS``: its keys (:class:`multibody.shape_base.Key`: name, kind of value, meaning with unit,
+- ``KEYS``: its keys (:class:`multibody.shapes.base.Key`: name, kind of value, meaning with unit,
   default), in file order; the case schema (:mod:`riskassess.cases.impact`) is built from them;
 - ``mesh_target_frame(**keys) -> trimesh.Trimesh``: the closed triangle mesh of the shape in the
   target frame (m), taking the keys as keywords.
 
 Adding a shape is adding one file here; ``SHAPES[kind]`` of an unknown kind is a ``ValueError``
-listing the known ones (:mod:`multibody.plugins`).
+listing the known ones (:mod:`multibody.maths.plugins`).
 """
 from __future__ import annotations
 
-from multibody.plugins import Family, discover
-from multibody.shape_base import ContactShape
+from multibody.maths.plugins import Family, discover
+from multibody.shapes.base import ContactShape
 
 #: Shape name -> its module, in module-name order.
-SHAPES: Family = discover(__name__, __path__, "contact shape", ContactShape)
+SHAPES: Family = discover(__name__, __path__, "contact shape", ContactShape, skip=("base",))
 
 __all__ = ["SHAPES"]

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import trimesh
 
-from multibody.shape_base import Key, rotated_and_moved
+from multibody.shapes.base import Key, rotated_and_moved
 
 #: The name a case gives (``kind = "box"``).
 NAME = "box"

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from multibody.shape_base import Key
+from multibody.shapes.base import Key
 
 #: The name a case gives (``kind = "cylinder"``).
 NAME = "cylinder"

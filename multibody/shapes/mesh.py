@@ -5,7 +5,7 @@ from pathlib import Path
 
 import trimesh
 
-from multibody.shape_base import Key, rotated_and_moved
+from multibody.shapes.base import Key, rotated_and_moved
 
 #: The name a case gives (``kind = "mesh"``).
 NAME = "mesh"

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import trimesh
 
-from multibody.shape_base import Key
+from multibody.shapes.base import Key
 
 #: The name a case gives (``kind = "sphere"``).
 NAME = "sphere"

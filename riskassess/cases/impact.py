@@ -191,7 +191,7 @@ class Contact(Strict):
 
 
 # ---------------------------------------------------------------------------- target
-#: Kind of value of a contact shape's key (:data:`multibody.shape_base.VALUES`) -> its checked type.
+#: Kind of value of a contact shape's key (:data:`multibody.shapes.base.VALUES`) -> its checked type.
 SHAPE_VALUE_TYPES = {
     "positive": Positive,
     "positive_vector3": Annotated[list[Positive], Field(min_length=3, max_length=3)],

@@ -3,7 +3,7 @@
 (:data:`riskassess.diagnosis.effects.CATALOG`) so ``[[effects]]`` entries are checked too."""
 from __future__ import annotations
 
-from multibody.plugins import Family
+from multibody.maths.plugins import Family
 from riskassess.cases import diagnosis as schema
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.impact_effects import IMPACT_CATALOG

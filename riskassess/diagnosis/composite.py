@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from riskassess.diagnosis.dynamics import LAW_SIGNATURE
+from riskassess.diagnosis.plants.dynamics import LAW_SIGNATURE
 from riskassess.diagnosis.effects.base import Effect, Parameter, own_states, switched_off
-from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
+from riskassess.diagnosis.plants.towing_dynamics import TOWING_LAW_SIGNATURE
 
 _COMPILED: dict = {}     # (law, law, splits, towing) -> compiled pair law: each pair compiles once per process
 

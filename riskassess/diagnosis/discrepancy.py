@@ -46,9 +46,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_F, L_TH, L_TM, X_Q, X_W, quaternion_rows, tmtv
+from riskassess.diagnosis.plants.dynamics import LAW_SIGNATURE, L_F, L_TH, L_TM, X_Q, X_W, quaternion_rows, tmtv
 from riskassess.diagnosis.effects.base import Effect, Parameter, torque_scale
-from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.plants.plant import Plant
 
 #: Legendre terms per torque component (degrees 0-2: a constant, a drift and a curvature over the record).
 TERMS = 3
@@ -137,7 +137,7 @@ def law(t, x, p, env, load, xe, xe_rate):
     t : float
         Time (s) from the record's t = 0.
     x : (BASE_STATE_SIZE + e,) float
-        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.plants.dynamics` (quaternion B -> I,
         omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
         the effects' own states.
     p : (P_SIZE,) float

@@ -7,7 +7,7 @@ user function adds the effects' hinge torques to its springs; every body carries
 tidal force on its CoM (Clohessy-Wiltshire in inertial axes) and the effects' torques and
 accelerations; a nutation damper is a real rotor body coupled by a rotational damper. Sensor
 effects act on the recorded channels. This is the reference the fast model
-(:mod:`riskassess.diagnosis.dynamics`) is checked against, and the generator of the tests' measured data.
+(:mod:`riskassess.diagnosis.plants.dynamics`) is checked against, and the generator of the tests' measured data.
 """
 from __future__ import annotations
 
@@ -17,12 +17,12 @@ from exudyn.itemInterface import (LoadForceVector, LoadTorqueVector, MarkerBodyR
                                   ObjectConnectorRigidBodySpringDamper)
 from scipy.spatial.transform import Rotation
 
-from riskassess.diagnosis.channels import HINGE, OMEGA, QUATERNION, REL
-from riskassess.diagnosis.dynamics import axis_rotation, initial_state, radial_inertial
+from riskassess.diagnosis.plants.channels import HINGE, OMEGA, QUATERNION, REL
+from riskassess.diagnosis.plants.dynamics import axis_rotation, initial_state, radial_inertial
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.observation import lvlh_from_inertial
-from riskassess.diagnosis.plant import Plant
-from riskassess.diagnosis.scenario import plant_of
+from riskassess.diagnosis.plants.plant import Plant
+from riskassess.diagnosis.plants.scenario import plant_of
 from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn
 from multibody.assembly import JointSpec, RigidBodySpec
 from multibody.hinge import add_penalty_joint, hinge_frame_lvlh
@@ -218,7 +218,7 @@ class ExudynScenario:
         Returns
         -------
         channels : dict of str to (k,) float
-            Units and frames of :mod:`riskassess.diagnosis.channels`.
+            Units and frames of :mod:`riskassess.diagnosis.plants.channels`.
         """
         times = np.asarray(times, float)
         sc, mbs, nodes = self._build()
@@ -316,7 +316,7 @@ def simulate_exudyn(plant: Plant, times, effect=None, values=(), names=(), step:
     Returns
     -------
     channels : dict of str to (k,) float
-        Units and frames of :mod:`riskassess.diagnosis.channels`.
+        Units and frames of :mod:`riskassess.diagnosis.plants.channels`.
     """
     values = np.asarray(values, float)
     sample_times = np.asarray(times, float)
@@ -347,7 +347,7 @@ def simulate_case(case, times, step: float | None = None) -> dict:
     Returns
     -------
     channels : dict of str to (k,) float
-        Units and frames of :mod:`riskassess.diagnosis.channels`.
+        Units and frames of :mod:`riskassess.diagnosis.plants.channels`.
     """
     if case.kind == "towing":
         return _simulate_towing_case(case, times, CATALOG)

@@ -24,12 +24,12 @@ from scipy.optimize import least_squares
 
 from riskassess.diagnosis.effects.base import Effect, Parameter, switched_off
 from riskassess.diagnosis.model import max_step, predict
-from riskassess.diagnosis.channels import QUATERNION
+from riskassess.diagnosis.plants.channels import QUATERNION
 from riskassess.diagnosis.observation import scenario_channels
-from riskassess.diagnosis.plant import (NOMINAL_PARAMETERS, Plant, is_towing, nominal_parameter_names, nominal_vector,
+from riskassess.diagnosis.plants.plant import (NOMINAL_PARAMETERS, Plant, is_towing, nominal_parameter_names, nominal_vector,
                                         prior_sigmas, with_nominal)
 from riskassess.diagnosis.residuals import aligned_quaternion
-from riskassess.diagnosis.scenario import plant_of
+from riskassess.diagnosis.plants.scenario import plant_of
 
 #: Share of the training span fitted first (continuation).
 FIRST_SPAN = 0.35
@@ -245,7 +245,7 @@ class CandidateFit:
         Returns
         -------
         nominal : (n_nominal,) float
-            Nominal parameter values (units and frames of :func:`riskassess.diagnosis.plant.nominal_vector`).
+            Nominal parameter values (units and frames of :func:`riskassess.diagnosis.plants.plant.nominal_vector`).
         values : (m,) float
             The effect's physical parameters (SI).
         """
@@ -315,7 +315,7 @@ class CandidateFit:
         Returns
         -------
         channels : dict of str to (k,) float
-            Units and frames of :mod:`riskassess.diagnosis.channels`.
+            Units and frames of :mod:`riskassess.diagnosis.plants.channels`.
         """
         nominal, values = self.unpack(z)
         plant = with_nominal(self.problem.plant, self.problem.nominal_names, nominal)
@@ -654,7 +654,7 @@ def prediction(problem: Problem, effect: Effect | None, fit: FitResult, times) -
     Returns
     -------
     channels : dict of str to (k,) float
-        Units and frames of :mod:`riskassess.diagnosis.channels`.
+        Units and frames of :mod:`riskassess.diagnosis.plants.channels`.
     """
     candidate, z = _fitted(problem, effect, fit)
     return candidate.predict(z, times)

@@ -22,7 +22,7 @@ from scipy.spatial.transform import Rotation
 from multibody.health import SimulationFailed
 from multibody.impact import ImpactSimulation
 from riskassess.cases.impact import read_toml, validate_case
-from riskassess.diagnosis.channels import OMEGA, QUATERNION, REL, VELOCITY
+from riskassess.diagnosis.plants.channels import OMEGA, QUATERNION, REL, VELOCITY
 from riskassess.diagnosis.impact_effects.base import case_with_overrides
 from riskassess.cases.target_geometry import body_meshes_target_frame
 from riskassess.models.impact import mass_properties_target_frame, model_inputs

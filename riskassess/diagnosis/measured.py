@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from riskassess.diagnosis.channels import CHANNELS, QUATERNION
+from riskassess.diagnosis.plants.channels import CHANNELS, QUATERNION
 from riskassess.cases.inputs import MEASURED_FILE_LIMIT, read_text
 
 #: Fewest samples a record must have: the noise estimate and a held-out part need a few dozen.
@@ -66,7 +66,7 @@ def read_measured(path, noise: dict | None = None) -> MeasuredData:
     path : str or Path
         Measured-data CSV file (format in the module doc).
     noise : dict of str to float, optional
-        1-sigma noise per channel (channel units, :data:`riskassess.diagnosis.channels.UNITS`).
+        1-sigma noise per channel (channel units, :data:`riskassess.diagnosis.plants.channels.UNITS`).
 
     Returns
     -------

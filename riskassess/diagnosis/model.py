@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from riskassess.diagnosis.dynamics import environment, initial_state, integrate, no_load
+from riskassess.diagnosis.plants.dynamics import environment, initial_state, integrate, no_load
 from riskassess.diagnosis.effects.base import Effect, own_states
 from riskassess.diagnosis.observation import outputs
-from riskassess.diagnosis.plant import Plant, is_towing
-from riskassess.diagnosis.towing_plant import simulate as simulate_towing
+from riskassess.diagnosis.plants.plant import Plant, is_towing
+from riskassess.diagnosis.plants.towing_plant import simulate as simulate_towing
 
 #: RK4 step as a fraction of the fastest motion's period / 2 pi (rad): 0.1 rad per step keeps the
 #: RK4 error of a 300 s record near 1e-4 of the signal's range, a tenth of typical sensor noise
@@ -58,7 +58,7 @@ def predict(plant: Plant, times, effect: Effect | None = None, values=(), names=
     Returns
     -------
     channels : dict of str to (k,) float
-        Units and frames of :mod:`riskassess.diagnosis.channels`.
+        Units and frames of :mod:`riskassess.diagnosis.plants.channels`.
     """
     times = np.asarray(times, float)
     values = np.asarray(values, float)
@@ -78,7 +78,7 @@ def predict(plant: Plant, times, effect: Effect | None = None, values=(), names=
 
 
 def _predict_towing(plant, times, effect, values, names, step) -> dict:
-    """:func:`predict` of the towing scenario (:func:`riskassess.diagnosis.towing_plant.simulate`)."""
+    """:func:`predict` of the towing scenario (:func:`riskassess.diagnosis.plants.towing_plant.simulate`)."""
     if effect is None:
         return simulate_towing(plant, times, step=step)
     plant = effect.modify_plant(plant, values)

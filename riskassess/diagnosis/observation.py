@@ -4,16 +4,16 @@ Channels (SI): ``omega_x..z`` inertial angular velocity of the main body, its ow
 (rad/s, a gyro); ``q_w..q_z`` attitude B->LVLH (unit quaternion, scalar first);
 ``hinge_angle`` (rad) and ``hinge_rate`` (rad/s); ``rel_x..z`` the target-frame origin
 relative to the chaser, LVLH (m); ``tether_tension`` (N, towing only). Their names and units are
-in :mod:`riskassess.diagnosis.channels`.
+in :mod:`riskassess.diagnosis.plants.channels`.
 """
 from __future__ import annotations
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from riskassess.diagnosis.channels import HINGE, OMEGA, QUATERNION, REL, TENSION
-from riskassess.diagnosis.dynamics import environment, observe
-from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.plants.channels import HINGE, OMEGA, QUATERNION, REL, TENSION
+from riskassess.diagnosis.plants.dynamics import environment, observe
+from riskassess.diagnosis.plants.plant import Plant
 
 
 def scenario_channels(plant: Plant) -> tuple[str, ...]:
@@ -27,7 +27,7 @@ def scenario_channels(plant: Plant) -> tuple[str, ...]:
     Returns
     -------
     channels : tuple of str
-        Names from :mod:`riskassess.diagnosis.channels`.
+        Names from :mod:`riskassess.diagnosis.plants.channels`.
     """
     if getattr(plant, "kind", None) == "towing":
         return OMEGA + QUATERNION + REL + TENSION
@@ -62,12 +62,12 @@ def outputs(plant: Plant, times, states) -> dict[str, np.ndarray]:
     times : (k,) float
         Times (s) from t = 0.
     states : (k, n) float
-        Fast-model states (layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics`).
+        Fast-model states (layout ``X_*`` of :mod:`riskassess.diagnosis.plants.dynamics`).
 
     Returns
     -------
     channels : dict of str to (k,) float
-        Units and frames of :mod:`riskassess.diagnosis.channels`.
+        Units and frames of :mod:`riskassess.diagnosis.plants.channels`.
     """
     values = observe(np.ascontiguousarray(states), np.ascontiguousarray(times, float), environment(plant),
                      np.ascontiguousarray(plant.origin_main, float))

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal, stats
 
-from riskassess.diagnosis.channels import QUATERNION
+from riskassess.diagnosis.plants.channels import QUATERNION
 
 #: Ljung-Box lags: 20 samples (2 s at 10 Hz) cover the correlation of a slowly drifting residual.
 LJUNG_BOX_LAGS = 20

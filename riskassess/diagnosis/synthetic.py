@@ -7,8 +7,8 @@ import numpy as np
 
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.exudyn_model import ExudynScenario, simulate_exudyn
-from riskassess.diagnosis.plant import Plant, is_towing
-from riskassess.diagnosis.scenario import plant_of
+from riskassess.diagnosis.plants.plant import Plant, is_towing
+from riskassess.diagnosis.plants.scenario import plant_of
 from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn
 
 #: Default 1-sigma noise per channel group (channel units): a MEMS gyro at 10 Hz (2e-4 rad/s), a
@@ -23,7 +23,7 @@ def channel_noise(channel: str, scale: float = 1.0) -> float:
     Parameters
     ----------
     channel : str
-        Channel name (:mod:`riskassess.diagnosis.channels`).
+        Channel name (:mod:`riskassess.diagnosis.plants.channels`).
     scale : float
         Factor on the defaults of ``NOISE`` (-).
 
@@ -95,7 +95,7 @@ def simulate_effect(case, times, effect_id: str | None = None, values=None) -> d
     Returns
     -------
     channels : dict of str to (k,) float
-        Units and frames of :mod:`riskassess.diagnosis.channels`.
+        Units and frames of :mod:`riskassess.diagnosis.plants.channels`.
     """
     plant = plant_of(case)
     simulate = simulate_exudyn
@@ -124,7 +124,7 @@ def simulate_constant_body_torque(case, times, torque_body) -> dict:
     Returns
     -------
     channels : dict of str to (k,) float
-        Units and frames of :mod:`riskassess.diagnosis.channels`.
+        Units and frames of :mod:`riskassess.diagnosis.plants.channels`.
     """
     scenario = ExudynScenario(Plant.from_case(case))
     torque = np.asarray(torque_body, float)

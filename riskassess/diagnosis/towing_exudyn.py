@@ -13,8 +13,8 @@ import exudyn as exu
 import numpy as np
 
 from riskassess.diagnosis.effects.base import own_states
-from riskassess.diagnosis.towing_dynamics import no_towing_load
-from riskassess.diagnosis.towing_plant import TowingPlant, channels
+from riskassess.diagnosis.plants.towing_dynamics import no_towing_load
+from riskassess.diagnosis.plants.towing_plant import TowingPlant, channels
 from multibody.impact import _object_state_index, explicit_settings
 from multibody.towing import build_towing_system, packed
 from multibody.towing_kernel import N_COORDINATES, apply_loads, body_forces, sampled_state
@@ -71,7 +71,7 @@ def simulate_towing_exudyn(plant: TowingPlant, times, effect=None, values=(), na
     Returns
     -------
     channels : dict of str to (k,) float
-        See :mod:`riskassess.diagnosis.towing_plant` (rad/s, D; D -> LVLH; m, LVLH; N).
+        See :mod:`riskassess.diagnosis.plants.towing_plant` (rad/s, D; D -> LVLH; m, LVLH; N).
     """
     values = np.asarray(values, float)
     sample_times = np.asarray(times, float)

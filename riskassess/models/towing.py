@@ -12,7 +12,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from multibody.control.attitude import sampled_boundary_layer
-from multibody.rotations import quaternion_to_matrix
+from multibody.maths.rotations import quaternion_to_matrix
 from multibody.control.mrac import abstracted_tether, command_elongation
 from multibody.control.thrust_laws import LAWS
 from multibody.towing import TowingModel

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from multibody.control.attitude import sampled_boundary_layer
-from multibody.rotations import quaternion_to_matrix, rotation_matrix_from_rotation_vector
+from multibody.maths.rotations import quaternion_to_matrix, rotation_matrix_from_rotation_vector
 from multibody.net_towing import FullNetModel
 from multibody.net_wrap import drape_and_close, towing_net
 from multibody.tow_switch import SwitchCriterion, lower_order_state

@@ -32,7 +32,7 @@ from riskassess.diagnosis.fit import (CandidateFit, FitResult, Problem, first_un
 from multibody.health import SimulationFailed
 from riskassess.diagnosis.impact_fit import diagnose_impact
 from riskassess.diagnosis.hint import describe_terms, library, sparse_terms
-from riskassess.diagnosis.channels import CHANNELS
+from riskassess.diagnosis.plants.channels import CHANNELS
 from riskassess.diagnosis.measured import read_measured
 from riskassess.diagnosis.observation import scenario_channels
 from riskassess.diagnosis.residuals import analyse, describe

@@ -9,11 +9,11 @@ A shape is a module of this package implementing :class:`structures.section_base
   ``ValueError`` for impossible dimensions.
 
 Adding a shape is adding one file here; ``SHAPES[kind]`` of an unknown kind is a ``ValueError``
-listing the known ones (:mod:`multibody.plugins`).
+listing the known ones (:mod:`multibody.maths.plugins`).
 """
 from __future__ import annotations
 
-from multibody.plugins import Family, discover
+from multibody.maths.plugins import Family, discover
 from structures.section_base import SectionShape
 
 #: Shape name -> its module, in module-name order.

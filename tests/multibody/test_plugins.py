@@ -1,4 +1,4 @@
-"""The one plug-in discovery (multibody/plugins.py) every family uses: adding a plug-in is adding one
+"""The one plug-in discovery (multibody/maths/plugins.py) every family uses: adding a plug-in is adding one
 file, an unknown name is an error listing the known ones, a module that does not implement the
 family's interface or repeats a name is refused naming its module. Each family's own unknown-name
 test sits with the family (tests/multibody/test_shapes.py, control/test_thrust_laws.py,
@@ -13,14 +13,14 @@ from types import SimpleNamespace
 
 import pytest
 
-from multibody.plugins import Family, PluginError, UnknownPlugin, discover
+from multibody.maths.plugins import Family, PluginError, UnknownPlugin, discover
 
 #: A family's package as a user would write one: its interface and the one discovery call.
 PACKAGE_INIT = textwrap.dedent('''
     """A plug-in family of springs, one file each."""
     from typing import Protocol
 
-    from multibody.plugins import discover
+    from multibody.maths.plugins import discover
 
 
     class Spring(Protocol):

@@ -1,10 +1,10 @@
-"""The shared fixed-step RK4 (multibody/rk4.py) against analytic solutions."""
+"""The shared fixed-step RK4 (multibody/maths/rk4.py) against analytic solutions."""
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
-from multibody.rk4 import rk4_integrator
+from multibody.maths.rk4 import rk4_integrator
 
 
 @njit(cache=True)

@@ -10,8 +10,8 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from multibody import shapes
-from multibody.plugins import discover
-from multibody.shape_base import ContactShape
+from multibody.maths.plugins import discover
+from multibody.shapes.base import ContactShape
 from multibody.geometry import shape_mesh
 from riskassess.cases.impact import SHAPE_MODELS, CaseError, _shape_model, load_case
 
@@ -23,7 +23,7 @@ TETRAHEDRON = textwrap.dedent('''
     import numpy as np
     import trimesh
 
-    from multibody.shape_base import Key
+    from multibody.shapes.base import Key
 
     NAME = "tetrahedron"
     KEYS = (Key("leg", "positive", "Leg length (m)."),

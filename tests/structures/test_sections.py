@@ -99,7 +99,7 @@ def test_section_shapes_are_plug_ins_found_by_name():
 
 
 def test_an_unknown_section_shape_is_refused_listing_the_known_ones():
-    """Issue 21: every plug-in family refuses an unknown name with the known ones (multibody/plugins.py)."""
+    """Issue 21: every plug-in family refuses an unknown name with the known ones (multibody/maths/plugins.py)."""
     from structures.section_shapes import SHAPES
 
     with pytest.raises(ValueError) as unknown:

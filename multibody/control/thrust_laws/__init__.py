@@ -13,12 +13,12 @@ A law is a module of this package implementing :class:`multibody.control.thrust.
   and the elongation z0 (m) and its rate z_rate0 (m/s) at the start.
 
 Adding a law is adding one file here; ``LAWS[name]`` of an unknown name is a ``ValueError`` listing
-the known ones (:mod:`multibody.plugins`).
+the known ones (:mod:`multibody.maths.plugins`).
 """
 from __future__ import annotations
 
 from multibody.control.thrust import ThrustLaw
-from multibody.plugins import Family, discover
+from multibody.maths.plugins import Family, discover
 
 #: Law name -> its module, in module-name order.
 LAWS: Family = discover(__name__, __path__, "thrust law", ThrustLaw)

@@ -4,13 +4,13 @@ An effect is a physical extension of the nominal model with named SI parameters.
 the model in one or more of four ways, each a pure function:
 
 * ``law``: a numba load law ``law(t, x, p, env, load, xe, xe_rate)`` adding torques / forces to the
-  fast model (:mod:`riskassess.diagnosis.dynamics`), from the physical parameters ``p``, and the rates
+  fast model (:mod:`riskassess.diagnosis.plants.dynamics`), from the physical parameters ``p``, and the rates
   of its own states;
 * ``modify_plant``: new mass properties or geometry (e.g. a CoM offset);
 * ``sample_times`` / ``measure``: a sensor effect (time shift, bias) on the simulated channels;
 * ``add_to_exudyn``: the same physics on the Exudyn builder (:mod:`riskassess.diagnosis.exudyn_model`),
   through user-function loads that call the same pure force law;
-* ``towing_law``: the same physics on the towing model (:mod:`riskassess.diagnosis.towing_dynamics`; the fast
+* ``towing_law``: the same physics on the towing model (:mod:`riskassess.diagnosis.plants.towing_dynamics`; the fast
   model and its Exudyn reference both call it), for effects that apply to the towing scenario.
 
 An effect with states of its own (a damper's rotor rate, a stick anchor, a relaxing branch's
@@ -27,9 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from riskassess.diagnosis.dynamics import no_load
-from riskassess.diagnosis.plant import Plant
-from riskassess.diagnosis.towing_dynamics import no_towing_load
+from riskassess.diagnosis.plants.dynamics import no_load
+from riskassess.diagnosis.plants.plant import Plant
+from riskassess.diagnosis.plants.towing_dynamics import no_towing_load
 
 
 @dataclass(frozen=True)
@@ -86,7 +86,7 @@ class Effect:
     towing_extra_states: int = 0
     #: numba load law of the fast model (``no_load``: none).
     law = staticmethod(no_load)
-    #: numba load law of the towing model (:mod:`riskassess.diagnosis.towing_dynamics`; ``no_towing_load``: none).
+    #: numba load law of the towing model (:mod:`riskassess.diagnosis.plants.towing_dynamics`; ``no_towing_load``: none).
     towing_law = staticmethod(no_towing_load)
 
     def parameter_specs(self, case, channels=None) -> list[Parameter]:
@@ -98,7 +98,7 @@ class Effect:
             Validated diagnosis case (:mod:`riskassess.cases.diagnosis`); its plant sizes the typical
             values and bounds (inertia, hinge spring, orbit).
         channels : sequence of str, optional
-            Measured channel names (:mod:`riskassess.diagnosis.channels`); None: every channel. Only an
+            Measured channel names (:mod:`riskassess.diagnosis.plants.channels`); None: every channel. Only an
             effect whose parameters follow the channels (``sensor_bias``) reads it.
 
         Returns
@@ -203,8 +203,8 @@ class Effect:
         Parameters
         ----------
         plant : Plant or TowingPlant
-            The nominal plant (SI; frames in :mod:`riskassess.diagnosis.plant`,
-            :mod:`riskassess.diagnosis.towing_plant`).
+            The nominal plant (SI; frames in :mod:`riskassess.diagnosis.plants.plant`,
+            :mod:`riskassess.diagnosis.plants.towing_plant`).
         values : (m,) float
             Physical parameter values, SI, in the order of :meth:`parameter_specs`.
 
@@ -238,7 +238,7 @@ class Effect:
         Parameters
         ----------
         outputs : dict of str to (k,) float
-            Simulated channels by name, units and frames of :mod:`riskassess.diagnosis.channels`.
+            Simulated channels by name, units and frames of :mod:`riskassess.diagnosis.plants.channels`.
         values : (m,) float
             Physical parameter values, SI, in the order of :meth:`parameter_specs`.
         names : sequence of str, length m

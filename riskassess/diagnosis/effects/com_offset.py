@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.channels import REL
-from riskassess.diagnosis.plant import is_towing as plant_is_towing
-from riskassess.diagnosis.scenario import plant_of
+from riskassess.diagnosis.plants.channels import REL
+from riskassess.diagnosis.plants.plant import is_towing as plant_is_towing
+from riskassess.diagnosis.plants.scenario import plant_of
 
 
 class ComOffset(Effect):

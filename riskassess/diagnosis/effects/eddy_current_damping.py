@@ -16,11 +16,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_Q, X_W, quaternion_rows, tdot, tmtv, tmv
+from riskassess.diagnosis.plants.dynamics import LAW_SIGNATURE, L_TM, X_Q, X_W, quaternion_rows, tdot, tmtv, tmv
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.scenario import plant_of
-from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
-from multibody.rotations import rotation_matrix_from_rotation_vector
+from riskassess.diagnosis.plants.scenario import plant_of
+from riskassess.diagnosis.plants.towing_dynamics import TOWING_LAW_SIGNATURE
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import DEBRIS
 
 
@@ -75,7 +75,7 @@ def law(t, x, p, env, load, xe, xe_rate):
     t : float
         Time (s) from the record's t = 0.
     x : (BASE_STATE_SIZE + e,) float
-        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.plants.dynamics` (quaternion B -> I,
         omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
         the effects' own states.
     p : (3,) float
@@ -104,7 +104,7 @@ def towing_law(t, q, v, p, work, xe, h, load):
     q, v : (15,) float
         Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
         displacements from their reference positions (m, ECI; P's are stale, see
-        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
+        :func:`~riskassess.diagnosis.plants.towing_dynamics.point_position`) and rotation vectors body -> ECI
         (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
     p : (12,) float
         c (N m s), field azimuth and elevation (rad) in I (the chaser's LVLH at the record's t = 0), I

@@ -14,13 +14,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from riskassess.diagnosis.dynamics import (LAW_SIGNATURE, E_AXIS, E_HINGED, E_JA, E_JM, E_N, L_TA, L_TM, X_Q, X_TH, axis_rows,
+from riskassess.diagnosis.plants.dynamics import (LAW_SIGNATURE, E_AXIS, E_HINGED, E_JA, E_JM, E_N, L_TA, L_TM, X_Q, X_TH, axis_rows,
                                 quaternion_rows, radial_inertial, sandwich, tcross, tmtv, tmv)
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, W_INERTIA, body_position
-from multibody.rotations import rotation_matrix_from_rotation_vector
+from riskassess.diagnosis.plants.towing_dynamics import TOWING_LAW_SIGNATURE, W_INERTIA, body_position
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import CHASER, DEBRIS
-from riskassess.diagnosis.scenario import plant_of
+from riskassess.diagnosis.plants.scenario import plant_of
 
 
 @njit(cache=True)
@@ -56,7 +56,7 @@ def law(t, x, p, env, load, xe, xe_rate):
     t : float
         Time (s) from the record's t = 0.
     x : (BASE_STATE_SIZE + e,) float
-        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.plants.dynamics` (quaternion B -> I,
         omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
         the effects' own states.
     p : (1,) float
@@ -92,7 +92,7 @@ def towing_law(t, q, v, p, work, xe, h, load):
     q, v : (15,) float
         Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
         displacements from their reference positions (m, ECI; P's are stale, see
-        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
+        :func:`~riskassess.diagnosis.plants.towing_dynamics.point_position`) and rotation vectors body -> ECI
         (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
     p : (1,) float
         [n (rad/s)].

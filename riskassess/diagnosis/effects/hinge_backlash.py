@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from numba import njit
 
-from riskassess.diagnosis.dynamics import LAW_SIGNATURE, E_K, L_TH, X_TH
+from riskassess.diagnosis.plants.dynamics import LAW_SIGNATURE, E_K, L_TH, X_TH
 from riskassess.diagnosis.effects.base import Effect, Parameter, reference_angle
-from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.plants.plant import Plant
 
 
 @njit(cache=True)
@@ -45,7 +45,7 @@ def law(t, x, p, env, load, xe, xe_rate):
     t : float
         Time (s) from the record's t = 0.
     x : (BASE_STATE_SIZE + e,) float
-        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.plants.dynamics` (quaternion B -> I,
         omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
         the effects' own states.
     p : (1,) float

@@ -31,9 +31,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from riskassess.diagnosis.dynamics import LAW_SIGNATURE, E_K, L_TH, X_TH, X_THD
+from riskassess.diagnosis.plants.dynamics import LAW_SIGNATURE, E_K, L_TH, X_TH, X_THD
 from riskassess.diagnosis.effects.base import Effect, Parameter, torque_scale
-from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.plants.plant import Plant
 
 #: The effect's own state (fast model): the stick anchor theta_a (rad).
 ANCHOR, STATES = 0, 1
@@ -165,7 +165,7 @@ def law(t, x, p, env, load, xe, xe_rate):
     t : float
         Time (s) from the record's t = 0.
     x : (BASE_STATE_SIZE + e,) float
-        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.plants.dynamics` (quaternion B -> I,
         omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
         the effects' own states.
     p : (4,) float

@@ -17,11 +17,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from multibody.linalg3 import cross3
-from riskassess.diagnosis.dynamics import LAW_SIGNATURE, L_TM, X_W
+from multibody.maths.linalg3 import cross3
+from riskassess.diagnosis.plants.dynamics import LAW_SIGNATURE, L_TM, X_W
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.scenario import plant_of
-from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE
+from riskassess.diagnosis.plants.scenario import plant_of
+from riskassess.diagnosis.plants.towing_dynamics import TOWING_LAW_SIGNATURE
 from multibody.towing_kernel import DEBRIS
 
 #: The effect's own states (fast and towing models): the rotor's angular velocity (3, rad/s, body frame).
@@ -60,7 +60,7 @@ def law(t, x, p, env, load, xe, xe_rate):
     t : float
         Time (s) from the record's t = 0.
     x : (BASE_STATE_SIZE + e,) float
-        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.plants.dynamics` (quaternion B -> I,
         omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
         the effects' own states.
     p : (2,) float
@@ -93,7 +93,7 @@ def towing_law(t, q, v, p, work, xe, h, load):
     q, v : (15,) float
         Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
         displacements from their reference positions (m, ECI; P's are stale, see
-        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
+        :func:`~riskassess.diagnosis.plants.towing_dynamics.point_position`) and rotation vectors body -> ECI
         (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
     p : (2,) float
         [J_d (kg m^2), T_d (s)].

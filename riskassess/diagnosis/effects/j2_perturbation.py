@@ -17,9 +17,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from riskassess.diagnosis.dynamics import LAW_SIGNATURE, E_INC, E_MA, E_MM, E_N, E_RADIUS, E_U0, L_F, X_R
+from riskassess.diagnosis.plants.dynamics import LAW_SIGNATURE, E_INC, E_MA, E_MM, E_N, E_RADIUS, E_U0, L_F, X_R
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, W_MASSES, W_REFERENCE, body_position, point_position
+from riskassess.diagnosis.plants.towing_dynamics import TOWING_LAW_SIGNATURE, W_MASSES, W_REFERENCE, body_position, point_position
 from multibody.towing_kernel import CHASER, DEBRIS
 from multibody.orbit import MU_EARTH, R_EARTH
 
@@ -112,7 +112,7 @@ def law(t, x, p, env, load, xe, xe_rate):
     t : float
         Time (s) from the record's t = 0.
     x : (BASE_STATE_SIZE + e,) float
-        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.plants.dynamics` (quaternion B -> I,
         omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
         the effects' own states.
     p : (1,) float
@@ -139,7 +139,7 @@ def towing_law(t, q, v, p, work, xe, h, load):
     q, v : (15,) float
         Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
         displacements from their reference positions (m, ECI; P's are stale, see
-        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
+        :func:`~riskassess.diagnosis.plants.towing_dynamics.point_position`) and rotation vectors body -> ECI
         (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
     p : (1,) float
         [J2 (-)].

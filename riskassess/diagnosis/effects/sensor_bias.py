@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.channels import OMEGA, REL, UNITS
+from riskassess.diagnosis.plants.channels import OMEGA, REL, UNITS
 
 #: Channels that may carry a bias, with a typical bias size (their units): a MEMS gyro's
 #: 1e-3 rad/s, an encoder's 0.01 rad, a relative-navigation 0.05 m, a load cell's 1 N.
@@ -65,7 +65,7 @@ class SensorBias(Effect):
         Parameters
         ----------
         outputs : dict of str to (k,) float
-            Simulated channels (units of :mod:`riskassess.diagnosis.channels`).
+            Simulated channels (units of :mod:`riskassess.diagnosis.plants.channels`).
         values : (m,) float
             The biases (channel units: rad/s, rad, m, N).
         names : sequence of str, length m

@@ -33,7 +33,7 @@ import numpy as np
 from numba import njit
 
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, W_TETHER, last_diagnostics
+from riskassess.diagnosis.plants.towing_dynamics import TOWING_LAW_SIGNATURE, W_TETHER, last_diagnostics
 from multibody.towing_kernel import K_MT, L_MT, MT_ELONGATION
 
 #: The effect's own states (towing model): Maxwell-branch tension T_m (N), and the main tether's
@@ -102,7 +102,7 @@ def towing_law(t, q, v, p, work, xe, h, load):
     q, v : (15,) float
         Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
         displacements from their reference positions (m, ECI; P's are stale, see
-        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
+        :func:`~riskassess.diagnosis.plants.towing_dynamics.point_position`) and rotation vectors body -> ECI
         (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
     p : (4,) float
         [k_m (N/m), tau_m (s), the case's main-tether stiffness k (N/m) and rest length l0 (m)].

@@ -21,11 +21,11 @@ import math
 import numpy as np
 from numba import njit
 
-from multibody.linalg3 import cross3
-from riskassess.diagnosis.dynamics import axis_rotation
+from multibody.maths.linalg3 import cross3
+from riskassess.diagnosis.plants.dynamics import axis_rotation
 from riskassess.diagnosis.effects.base import Effect, Parameter
-from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, last_diagnostics
-from multibody.rotations import rotation_matrix_from_rotation_vector
+from riskassess.diagnosis.plants.towing_dynamics import TOWING_LAW_SIGNATURE, last_diagnostics
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import CHASER, THRUST, W_ALONG_Z
 
 
@@ -90,7 +90,7 @@ def towing_law(t, q, v, p, work, xe, h, load):
     q, v : (15,) float
         Evaluation state, kernel layout (:mod:`multibody.towing_kernel`): P, chaser and debris
         displacements from their reference positions (m, ECI; P's are stale, see
-        :func:`~riskassess.diagnosis.towing_dynamics.point_position`) and rotation vectors body -> ECI
+        :func:`~riskassess.diagnosis.plants.towing_dynamics.point_position`) and rotation vectors body -> ECI
         (rad); velocities (m/s, ECI) and angular velocities (rad/s, body frames).
     p : (2,) float
         [tilt_x, tilt_y] (rad), about the chaser's body x and y.

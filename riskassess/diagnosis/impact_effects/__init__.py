@@ -3,10 +3,10 @@
 effect is adding one module. A separate catalog from :mod:`riskassess.diagnosis.effects`: these are
 deviations of the impact model's own physical parameters, not loads added to the tumbling or
 towing models (docs/diagnosis.md, "Impact scenario"). ``IMPACT_CATALOG[id]`` of an unknown id is a
-``ValueError`` listing the known ones (:mod:`multibody.plugins`)."""
+``ValueError`` listing the known ones (:mod:`multibody.maths.plugins`)."""
 from __future__ import annotations
 
-from multibody.plugins import Family, discover
+from multibody.maths.plugins import Family, discover
 from riskassess.diagnosis.impact_effects.base import ImpactEffect
 
 #: id -> effect, in module order.

@@ -9,11 +9,11 @@ A plug-in is a module of this package implementing :class:`riskassess.stages.opt
 
 Adding an optimizer is adding one file here (and its name to the case schema's ``searches``);
 ``OPTIMIZERS[name]`` of an unknown name is a ``ValueError`` listing the known ones
-(:mod:`multibody.plugins`).
+(:mod:`multibody.maths.plugins`).
 """
 from __future__ import annotations
 
-from multibody.plugins import Family, discover
+from multibody.maths.plugins import Family, discover
 from riskassess.stages.optimizers.base import Optimizer
 
 #: Optimizer name -> its module (``NAME``, ``search``), in module-name order.

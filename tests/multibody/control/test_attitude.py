@@ -4,7 +4,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from multibody.control.attitude import kinematics_matrix, sampled_boundary_layer, sliding_mode_torque
-from multibody.rotations import quaternion_from_matrix, quaternion_to_matrix
+from multibody.maths.rotations import quaternion_from_matrix, quaternion_to_matrix
 
 J = np.diag([266.67, 266.67, 266.67]) + np.array([[0, 5.0, -3.0], [5.0, 0, 2.0], [-3.0, 2.0, 0]])  # kg m^2
 K, G, EPS = 24.0, np.ones(3), 1e-3      # Sec. 4.1

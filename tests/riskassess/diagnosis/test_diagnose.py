@@ -2,7 +2,7 @@
 no effect must give "none"; an effect outside the catalog must not be pinned on a catalog cause.
 
 The measured data come from the Exudyn model (riskassess.diagnosis.exudyn_model), the fit uses the compiled
-model (riskassess.diagnosis.dynamics): each test also checks that the two implementations agree.
+model (riskassess.diagnosis.plants.dynamics): each test also checks that the two implementations agree.
 Effect, parameters and noise are drawn from ``rng``; the seed is ``DIAGNOSIS_SEED`` (default 0)
 and the slow test runs seeds 0-9.
 """
@@ -17,7 +17,7 @@ import pytest
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.products.measured import write_measured
 from riskassess.diagnosis.model import predict
-from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.plants.plant import Plant
 from riskassess.diagnosis.synthetic import channel_noise, sample_times, simulate_constant_body_torque, simulate_effect
 from riskassess.cli import main
 from riskassess.stages.diagnose import diagnose_case

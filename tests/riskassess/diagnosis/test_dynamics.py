@@ -3,10 +3,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from riskassess.diagnosis.dynamics import (X_W, angular_momentum_inertial, appendage_state, environment, initial_state, integrate,
+from riskassess.diagnosis.plants.dynamics import (X_W, angular_momentum_inertial, appendage_state, environment, initial_state, integrate,
                                 no_load)
 from riskassess.diagnosis.model import max_step, predict
-from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.plants.plant import Plant
 from tests.riskassess.diagnosis.conftest import HINGED_CASE, TUMBLING_CASE, case_with
 
 NO_ORBIT = {"kind": "none"}

@@ -4,13 +4,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from riskassess.diagnosis.dynamics import X_EXTRA, X_W, angular_momentum_inertial, environment, initial_state, integrate
+from riskassess.diagnosis.plants.dynamics import X_EXTRA, X_W, angular_momentum_inertial, environment, initial_state, integrate
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.effects.base import own_states
 from riskassess.diagnosis.effects.gravity_gradient_torque import gravity_gradient
 from riskassess.diagnosis.model import max_step
-from multibody.rotations import quaternion_to_matrix
-from riskassess.diagnosis.plant import Plant
+from multibody.maths.rotations import quaternion_to_matrix
+from riskassess.diagnosis.plants.plant import Plant
 from tests.riskassess.diagnosis.conftest import HINGED_CASE, TOWING_CASE, TUMBLING_CASE, case_with
 
 REQUIRED = {"hinge_coulomb_friction", "hinge_stiffness_hardening", "hinge_backlash", "internal_energy_dissipation",
@@ -30,7 +30,7 @@ def test_catalog_has_every_required_effect_with_units_and_bounds(path):
 
 
 def test_catalog_refuses_an_unknown_effect_listing_the_known_ones():
-    """Issue 21: every plug-in family refuses an unknown name with the known ones (multibody/plugins.py)."""
+    """Issue 21: every plug-in family refuses an unknown name with the known ones (multibody/maths/plugins.py)."""
     with pytest.raises(ValueError) as unknown:
         CATALOG["solar_pressure"]
     assert str(unknown.value) == f"unknown effect 'solar_pressure'; the known effects are: {', '.join(sorted(CATALOG))}"

@@ -7,7 +7,7 @@ import pytest
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.exudyn_model import simulate_case, simulate_exudyn
 from riskassess.diagnosis.model import predict
-from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.plants.plant import Plant
 from riskassess.cases.diagnosis import toml_text
 from riskassess.diagnosis.cases import load_diagnosis_case
 from riskassess.cases.impact import read_toml

@@ -10,7 +10,7 @@ from riskassess.diagnosis.composite import EffectPair, can_pair
 from riskassess.diagnosis.effects import CATALOG
 from riskassess.diagnosis.exudyn_model import simulate_exudyn
 from riskassess.diagnosis.model import predict
-from riskassess.diagnosis.scenario import plant_of
+from riskassess.diagnosis.plants.scenario import plant_of
 from riskassess.diagnosis.synthetic import channel_noise, sample_times
 from tests.riskassess.diagnosis.conftest import HINGED_CASE
 from tests.riskassess.diagnosis.test_diagnose import DURATION, _diagnose, draw_effect

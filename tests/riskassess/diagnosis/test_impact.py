@@ -25,7 +25,7 @@ REQUIRED = {"contact_stiffness", "contact_exponent", "contact_damping", "contact
 
 
 def test_catalog_refuses_an_unknown_impact_effect_listing_the_known_ones():
-    """Issue 21: every plug-in family refuses an unknown name with the known ones (multibody/plugins.py)."""
+    """Issue 21: every plug-in family refuses an unknown name with the known ones (multibody/maths/plugins.py)."""
     with pytest.raises(ValueError) as unknown:
         IMPACT_CATALOG["net_porosity"]
     assert str(unknown.value) == ("unknown impact effect 'net_porosity'; the known impact effects are: "

@@ -12,7 +12,7 @@ from riskassess.products.measured import write_measured
 from riskassess.stages.diagnose import diagnose_case
 from riskassess.diagnosis.exudyn_model import ExudynScenario
 from riskassess.diagnosis.model import predict
-from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.plants.plant import Plant
 from riskassess.diagnosis.synthetic import channel_noise, sample_times
 from tests.riskassess.diagnosis.conftest import HINGED_CASE, TUMBLING_CASE, case_with
 from tests.riskassess.diagnosis.test_diagnose import DURATION, _diagnose

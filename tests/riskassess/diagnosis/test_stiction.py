@@ -18,7 +18,7 @@ from riskassess.diagnosis.effects.hinge_coulomb_friction import (ElastoPlasticFr
                                                              turning_points)
 from riskassess.diagnosis.exudyn_model import ExudynScenario, simulate_exudyn
 from riskassess.diagnosis.model import predict
-from riskassess.diagnosis.plant import Plant
+from riskassess.diagnosis.plants.plant import Plant
 from riskassess.diagnosis.synthetic import channel_noise, sample_times
 from riskassess.products.measured import write_measured
 from riskassess.stages.diagnose import diagnose_case

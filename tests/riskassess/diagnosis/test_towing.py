@@ -22,12 +22,12 @@ from riskassess.diagnosis.effects.tether_viscoelasticity import branch_after, st
 from riskassess.diagnosis.effects.thrust_misalignment import misaligned_thrust, thrust_direction_eci
 from riskassess.products.measured import write_measured
 from riskassess.diagnosis.model import predict
-from riskassess.diagnosis.scenario import plant_of
+from riskassess.diagnosis.plants.scenario import plant_of
 from riskassess.diagnosis.synthetic import channel_noise, sample_times
-from riskassess.diagnosis.towing_dynamics import TOWING_LAW_SIGNATURE, last_diagnostics
+from riskassess.diagnosis.plants.towing_dynamics import TOWING_LAW_SIGNATURE, last_diagnostics
 from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn
 from multibody.orbit import lvlh_to_eci
-from riskassess.diagnosis.towing_plant import simulate
+from riskassess.diagnosis.plants.towing_plant import simulate
 from multibody.towing import run_twin
 from multibody.towing_kernel import CHASER, THRUST
 from riskassess.cases.impact import read_toml

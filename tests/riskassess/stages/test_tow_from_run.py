@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from multibody.net_towing import run_exudyn
-from multibody.rotations import quaternion_to_matrix
+from multibody.maths.rotations import quaternion_to_matrix
 from riskassess.cases.impact import CaseError, load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing_from_run import drape_on_cylinder, impact_run_start, lift_onto_cylinder

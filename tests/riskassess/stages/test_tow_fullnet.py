@@ -3,7 +3,7 @@ initial state and its free flight towards the debris."""
 import numpy as np
 import pytest
 
-from multibody.rotations import quaternion_to_matrix
+from multibody.maths.rotations import quaternion_to_matrix
 from multibody.net_towing import NetTowState, run_exudyn
 from riskassess.cases.impact import load_model
 from riskassess.models.towing_fullnet import capture_start, full_net_model

@@ -1,7 +1,7 @@
 """The classical fixed-step Runge-Kutta scheme (RK4), compiled, for any compiled state derivative.
 
 One implementation for the small models whose right-hand side runs inside numba, where SciPy's
-integrators cannot: the diagnosis' fast model (:mod:`riskassess.diagnosis.dynamics`, with the
+integrators cannot: the diagnosis' fast model (:mod:`riskassess.diagnosis.plants.dynamics`, with the
 effects' load laws) and the torque-free propagation inside the perception fit
 (:mod:`perception.euler_poinsot`). Imports nothing of ours, so every package may use it.
 

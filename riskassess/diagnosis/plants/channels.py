@@ -1,5 +1,5 @@
 """Names and units of the measured channels, shared by the models that predict them
-(:mod:`riskassess.diagnosis.observation`, :mod:`riskassess.diagnosis.towing_plant`) and the
+(:mod:`riskassess.diagnosis.observation`, :mod:`riskassess.diagnosis.plants.towing_plant`) and the
 readers and fits that compare them.
 
 Channels (SI): ``omega_x..z`` inertial angular velocity of the main body, its own frame B

@@ -22,13 +22,13 @@ import numpy as np
 from numba import njit
 from scipy.spatial.transform import Rotation
 
-from riskassess.diagnosis.channels import OMEGA, QUATERNION, REL, TENSION
-from riskassess.diagnosis.towing_dynamics import diagnostics_size, no_towing_load
-from multibody.rotations import rotation_matrix_from_rotation_vector
+from riskassess.diagnosis.plants.channels import OMEGA, QUATERNION, REL, TENSION
+from riskassess.diagnosis.plants.towing_dynamics import diagnostics_size, no_towing_load
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing import packed
 from multibody.towing_kernel import MT_TENSION, verlet_run
 from multibody.orbit import lvlh_to_eci
-from multibody.rotations import quaternion_from_matrix
+from multibody.maths.rotations import quaternion_from_matrix
 from riskassess.models.towing import towing_model
 
 #: Nominal parameters of the towing scenario: name -> (size, unit), the fitted vector's order.

@@ -32,7 +32,7 @@ import numpy as np
 from numba import njit
 
 from multibody.connection_point import V_N, X_N
-from multibody.rotations import rotation_matrix_from_rotation_vector
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.towing_kernel import (CHASER, DEBRIS, LOAD_LAW_SIGNATURE, ST_TENSION, W_ATTACH_CHASER, W_DIAG,
                                      W_INERTIA, W_MASSES, W_N_ATTACH, W_POINT, W_REFERENCE, W_TETHER, no_load)
 

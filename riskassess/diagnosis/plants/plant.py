@@ -143,7 +143,7 @@ class Plant:
 
     def effective_hinge_inertia(self) -> float:
         """Inertia of the hinge mode with the main body free (kg m^2): the Schur complement
-        c - b^T A^-1 b of the Kane mass matrix at the initial angle (riskassess.diagnosis.dynamics)."""
+        c - b^T A^-1 b of the Kane mass matrix at the initial angle (riskassess.diagnosis.plants.dynamics)."""
         a = self.axis
         s = Rotation.from_rotvec(self.hinge_angle0 * a).apply(self.appendage_from_hinge)
         d = self.hinge_main + s
@@ -164,7 +164,7 @@ class Plant:
 
 
 def is_towing(plant) -> bool:
-    """Whether ``plant`` is the towing scenario's (:class:`riskassess.diagnosis.towing_plant.TowingPlant`).
+    """Whether ``plant`` is the towing scenario's (:class:`riskassess.diagnosis.plants.towing_plant.TowingPlant`).
 
     Parameters
     ----------

@@ -40,9 +40,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, types
 
-from multibody.rk4 import rk4_integrator
-from multibody.rotations import quaternion_from_matrix, quaternion_to_matrix
-from riskassess.diagnosis.plant import Plant
+from multibody.maths.rk4 import rk4_integrator
+from multibody.maths.rotations import quaternion_from_matrix, quaternion_to_matrix
+from riskassess.diagnosis.plants.plant import Plant
 
 _VECTOR = types.float64[::1]
 #: numba signature of an effect law ``law(t, x, p, env, load, xe, xe_rate)``; laws are compiled eagerly
@@ -539,14 +539,14 @@ def derivative(t, x, law, p, env):
     return dx
 
 
-#: The shared RK4 (multibody/rk4.py) with :func:`derivative` bound in: a direct call per stage.
+#: The shared RK4 (multibody/maths/rk4.py) with :func:`derivative` bound in: a direct call per stage.
 _rk4 = rk4_integrator(derivative, X_Q)
 
 
 @njit(types.float64[:, ::1](_LAW, _VECTOR, _VECTOR, _VECTOR, _VECTOR, types.float64), cache=True)
 def integrate(law, p, env, x0, times, max_step):
     """States at ``times`` (s, non-decreasing, >= 0) from ``x0`` at t = 0, by the shared RK4
-    (:func:`multibody.rk4.rk4_integrator` of :func:`derivative`) with steps no longer than ``max_step`` (s);
+    (:func:`multibody.maths.rk4.rk4_integrator` of :func:`derivative`) with steps no longer than ``max_step`` (s);
     the quaternion is renormalised every step.
 
     Parameters
@@ -581,7 +581,7 @@ def no_load(t, x, p, env, load, xe, xe_rate):
     t : float
         Time (s) from the record's t = 0.
     x : (BASE_STATE_SIZE + e,) float
-        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.dynamics` (quaternion B -> I,
+        Fast-model state, layout ``X_*`` of :mod:`riskassess.diagnosis.plants.dynamics` (quaternion B -> I,
         omega_B (rad/s), hinge angle (rad) and rate (rad/s), CoM rho_I (m) and velocity (m/s)), then
         the effects' own states.
     p : (j,) float
