@@ -16,7 +16,10 @@ from __future__ import annotations
 from multibody.maths.plugins import Family, discover
 from multibody.shapes.base import ContactShape
 
-#: Shape name -> its module, in module-name order.
-SHAPES: Family = discover(__name__, __path__, "contact shape", ContactShape, skip=("base",))
+#: Modules of this folder that are not shapes: the interface itself.
+NOT_SHAPES = ("base",)
 
-__all__ = ["SHAPES"]
+#: Shape name -> its module, in module-name order.
+SHAPES: Family = discover(__name__, __path__, "contact shape", ContactShape, skip=NOT_SHAPES)
+
+__all__ = ["NOT_SHAPES", "SHAPES"]
