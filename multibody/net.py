@@ -9,6 +9,7 @@ between consecutive collinear threads.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -280,6 +281,157 @@ def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
         force[b, 0] -= tension * ex
         force[b, 1] -= tension * ey
         force[b, 2] -= tension * ez
+    return elastic, power
+
+
+#: Longest gap (threads) bridged by padding when runs of :func:`thread_runs` are merged: a square grid's
+#: rows of threads along the second index end one node short of the next row's start.
+MAX_RUN_GAP = 8
+#: Rest length (m) of a padding thread: never taut (its square, 1e300, stays finite), so it adds an exact zero.
+PADDING_REST_LENGTH = 1e150
+
+
+class ThreadRuns(NamedTuple):
+    """The thread list regrouped for a vectorized pass (:func:`add_thread_forces_runs`), padded threads
+    included (P of them in all, >= m).
+
+    A run is a stretch of threads whose two nodes both advance by one node per thread (a grid's
+    column or row of threads), so the run's node coordinates are contiguous slices of coordinate-major
+    (3, n) arrays. Short gaps between runs of the same node offset are filled with padding threads that
+    never pull (rest length :data:`PADDING_REST_LENGTH`, no stiffness, no damping), so a square net is
+    two runs and the four bullet tethers.
+    """
+
+    runs: np.ndarray          # (R, 4) int64: first padded thread, its node a, threads in the run, b - a
+    rest_lengths: np.ndarray  # (P,) (m)
+    stiffness: np.ndarray     # (P,) (N/m)
+    damping: np.ndarray       # (P,) (N s/m)
+
+
+def thread_runs(threads, rest_lengths, stiffness, damping) -> ThreadRuns:
+    """:class:`ThreadRuns` of a thread list, in the list's order (so the forces a node receives add up
+    in the same order as in :func:`add_thread_forces`, and the results are the same to the bit).
+
+    Parameters
+    ----------
+    threads : (m, 2) int
+        Node pairs joined by a thread.
+    rest_lengths, stiffness, damping : (m,) float
+        Natural length (m), stiffness (N/m) and damping (N s/m) of each thread.
+    """
+    threads = np.asarray(threads, np.int64).reshape(-1, 2)
+    runs, rest, k, c = [], [], [], []
+    for t, (a, b) in enumerate(threads):
+        if runs:
+            first, a0, count, offset = runs[-1]
+            gap = a - (a0 + count)
+            if b - a == offset and 0 <= gap <= MAX_RUN_GAP and offset != 0:
+                rest += [PADDING_REST_LENGTH] * gap
+                k += [0.0] * gap
+                c += [0.0] * gap
+                runs[-1][2] = count + gap + 1
+                rest.append(rest_lengths[t])
+                k.append(stiffness[t])
+                c.append(damping[t])
+                continue
+        runs.append([len(rest), int(a), 1, int(b - a)])
+        rest.append(rest_lengths[t])
+        k.append(stiffness[t])
+        c.append(damping[t])
+    return ThreadRuns(np.array(runs, np.int64).reshape(-1, 4), np.array(rest, float), np.array(k, float),
+                      np.array(c, float))
+
+
+@njit(cache=True, inline="always")
+def _run_tensions(xa0, xa1, xa2, xb0, xb1, xb2, va0, va1, va2, vb0, vb1, vb2, rest, stiffness, damping,
+                  g0, g1, g2, elastic, power):
+    """The law of :func:`add_thread_forces` on one run, branch-free so that it vectorizes: the force on
+    node a (N, ``g``), the elastic energy (J) and damping power (W) of each thread, exact zeros for
+    a slack one (inputs: the run's contiguous slices, a and b ends)."""
+    for j in range(rest.shape[0]):
+        dx = xb0[j] - xa0[j]
+        dy = xb1[j] - xa1[j]
+        dz = xb2[j] - xa2[j]
+        squared = dx * dx + dy * dy + dz * dz
+        rest_j = rest[j]
+        taut = squared > rest_j * rest_j
+        length = np.sqrt(squared)
+        divisor = length if taut else 1.0  # a slack thread's direction is not used (and may be 0 / 0)
+        ex = dx / divisor
+        ey = dy / divisor
+        ez = dz / divisor
+        stretch = length - rest_j
+        rate = (vb0[j] - va0[j]) * ex + (vb1[j] - va1[j]) * ey + (vb2[j] - va2[j]) * ez
+        pulling = taut & (stretch > 0.0)
+        tension = max(0.0, stiffness[j] * stretch + damping[j] * rate)  # tension_only_kelvin_voigt
+        tension = tension if pulling else 0.0
+        g0[j] = tension * ex
+        g1[j] = tension * ey
+        g2[j] = tension * ez
+        elastic[j] = 0.5 * stiffness[j] * stretch * stretch if pulling else 0.0
+        power[j] = damping[j] * rate * rate if tension > 0.0 else 0.0
+
+
+@njit(cache=True, inline="always")
+def _scatter(force, g, sign):
+    """force += sign * g, elementwise (one end of a run's threads)."""
+    if sign > 0.0:
+        for j in range(g.shape[0]):
+            force[j] += g[j]
+    else:
+        for j in range(g.shape[0]):
+            force[j] -= g[j]
+
+
+# error_model="numpy": with Python's, every division checks for zero and the loop stays scalar
+@njit(cache=True, error_model="numpy")
+def add_thread_forces_runs(x, v, runs, force, work):
+    """:func:`add_thread_forces` on coordinate-major arrays, run by run (:class:`ThreadRuns`): the same
+    forces and energies to the bit, about three times faster (the tension loop vectorizes).
+
+    Parameters
+    ----------
+    x, v : (3, n) float
+        Node positions (m) and velocities (m/s), coordinate-major, one frame.
+    runs : ThreadRuns
+    force : (3, n) float
+        Accumulator (N), coordinate-major.
+    work : (5, P) float
+        Work space: per padded thread the force on its node a (3 rows), elastic energy, damping power.
+
+    Returns
+    -------
+    elastic_energy, damping_power : float
+        As :func:`add_thread_forces` (J, W).
+    """
+    run_table = runs.runs
+    for r in range(run_table.shape[0]):
+        first, a0, count, offset = run_table[r, 0], run_table[r, 1], run_table[r, 2], run_table[r, 3]
+        b0 = a0 + offset
+        last = first + count
+        _run_tensions(x[0, a0:a0 + count], x[1, a0:a0 + count], x[2, a0:a0 + count],
+                      x[0, b0:b0 + count], x[1, b0:b0 + count], x[2, b0:b0 + count],
+                      v[0, a0:a0 + count], v[1, a0:a0 + count], v[2, a0:a0 + count],
+                      v[0, b0:b0 + count], v[1, b0:b0 + count], v[2, b0:b0 + count],
+                      runs.rest_lengths[first:last], runs.stiffness[first:last], runs.damping[first:last],
+                      work[0, first:last], work[1, first:last], work[2, first:last], work[3, first:last],
+                      work[4, first:last])
+        # A node meets a run at most twice: as end b of an earlier thread than the one it is end a of
+        # when the offset is positive. Adding the run's b ends first (a later pass the a ends) keeps
+        # each node's sum in the thread list's order, so it equals the sequential loop's to the bit.
+        for d in range(3):
+            if offset > 0:
+                _scatter(force[d, b0:b0 + count], work[d, first:last], -1.0)
+                _scatter(force[d, a0:a0 + count], work[d, first:last], 1.0)
+            else:
+                _scatter(force[d, a0:a0 + count], work[d, first:last], 1.0)
+                _scatter(force[d, b0:b0 + count], work[d, first:last], -1.0)
+    # the energies in the thread list's order (padding adds exact zeros)
+    elastic = 0.0
+    power = 0.0
+    for t in range(work.shape[1]):
+        elastic += work[3, t]
+        power += work[4, t]
     return elastic, power
 
 
