@@ -321,9 +321,7 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
     out_scalars[CONTACT_ELASTIC] = contact_energy
     out_scalars[N_CONTACTS] = n_contacts
     out_scalars[CONTACT_DISSIPATED] += contact_dissipated
-    for i in range(n):
-        for d in range(3):
-            out_force[3 * i + d] = net_force_lvlh[i, d]
+    out_force[:3 * n] = net_force_lvlh.reshape(3 * n)
     return out_force
 
 
