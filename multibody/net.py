@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, uint64
 
 
 @dataclass(frozen=True)
@@ -343,51 +343,58 @@ def thread_runs(threads, rest_lengths, stiffness, damping) -> ThreadRuns:
 
 
 @njit(cache=True, inline="always")
-def _run_tensions(xa0, xa1, xa2, xb0, xb1, xb2, va0, va1, va2, vb0, vb1, vb2, rest, stiffness, damping,
-                  g0, g1, g2, elastic, power):
-    """The law of :func:`add_thread_forces` on one run, branch-free so that it vectorizes: the force on
-    node a (N, ``g``), the elastic energy (J) and damping power (W) of each thread, exact zeros for
-    a slack one (inputs: the run's contiguous slices, a and b ends)."""
-    for j in range(rest.shape[0]):
-        dx = xb0[j] - xa0[j]
-        dy = xb1[j] - xa1[j]
-        dz = xb2[j] - xa2[j]
+def _run_tensions(x, v, a0, b0, first, count, rest, stiffness, damping, work):
+    """The law of :func:`add_thread_forces` on one run, branch-free so that it vectorizes: per thread the
+    force on its node a (N, ``work[0:3]``), its elastic energy (J, ``work[3]``) and damping power (W,
+    ``work[4]``), exact zeros for a slack one. Unsigned indices: numba adds no negative-index
+    wrap-around to them, which would keep the loop scalar."""
+    a_start, b_start, t_start = uint64(a0), uint64(b0), uint64(first)
+    for j_signed in range(count):
+        j = uint64(j_signed)
+        a, b, t = a_start + j, b_start + j, t_start + j
+        dx = x[0, b] - x[0, a]
+        dy = x[1, b] - x[1, a]
+        dz = x[2, b] - x[2, a]
         squared = dx * dx + dy * dy + dz * dz
-        rest_j = rest[j]
-        taut = squared > rest_j * rest_j
+        rest_t = rest[t]
+        taut = squared > rest_t * rest_t
         length = np.sqrt(squared)
         divisor = length if taut else 1.0  # a slack thread's direction is not used (and may be 0 / 0)
         ex = dx / divisor
         ey = dy / divisor
         ez = dz / divisor
-        stretch = length - rest_j
-        rate = (vb0[j] - va0[j]) * ex + (vb1[j] - va1[j]) * ey + (vb2[j] - va2[j]) * ez
+        stretch = length - rest_t
+        rate = (v[0, b] - v[0, a]) * ex + (v[1, b] - v[1, a]) * ey + (v[2, b] - v[2, a]) * ez
         pulling = taut & (stretch > 0.0)
-        tension = max(0.0, stiffness[j] * stretch + damping[j] * rate)  # tension_only_kelvin_voigt
+        tension = max(0.0, stiffness[t] * stretch + damping[t] * rate)  # tension_only_kelvin_voigt
         tension = tension if pulling else 0.0
-        g0[j] = tension * ex
-        g1[j] = tension * ey
-        g2[j] = tension * ez
-        elastic[j] = 0.5 * stiffness[j] * stretch * stretch if pulling else 0.0
-        power[j] = damping[j] * rate * rate if tension > 0.0 else 0.0
+        work[0, t] = tension * ex
+        work[1, t] = tension * ey
+        work[2, t] = tension * ez
+        work[3, t] = 0.5 * stiffness[t] * stretch * stretch if pulling else 0.0
+        work[4, t] = damping[t] * rate * rate if tension > 0.0 else 0.0
 
 
 @njit(cache=True, inline="always")
-def _scatter(force, g, sign):
-    """force += sign * g, elementwise (one end of a run's threads)."""
-    if sign > 0.0:
-        for j in range(g.shape[0]):
-            force[j] += g[j]
-    else:
-        for j in range(g.shape[0]):
-            force[j] -= g[j]
+def _scatter(force, node0, work, first, count, sign):
+    """force[:, node0 + j] += sign * work[0:3, first + j] for the run's threads j (one end of the run)."""
+    node_start, t_start = uint64(node0), uint64(first)
+    for d in range(3):
+        if sign > 0.0:
+            for j_signed in range(count):
+                j = uint64(j_signed)
+                force[d, node_start + j] += work[d, t_start + j]
+        else:
+            for j_signed in range(count):
+                j = uint64(j_signed)
+                force[d, node_start + j] -= work[d, t_start + j]
 
 
 # error_model="numpy": with Python's, every division checks for zero and the loop stays scalar
 @njit(cache=True, error_model="numpy")
 def add_thread_forces_runs(x, v, runs, force, work):
     """:func:`add_thread_forces` on coordinate-major arrays, run by run (:class:`ThreadRuns`): the same
-    forces and energies to the bit, about three times faster (the tension loop vectorizes).
+    forces and energies to the bit, faster (the tension loop vectorizes).
 
     Parameters
     ----------
@@ -405,27 +412,20 @@ def add_thread_forces_runs(x, v, runs, force, work):
         As :func:`add_thread_forces` (J, W).
     """
     run_table = runs.runs
+    rest, stiffness, damping = runs.rest_lengths, runs.stiffness, runs.damping
     for r in range(run_table.shape[0]):
         first, a0, count, offset = run_table[r, 0], run_table[r, 1], run_table[r, 2], run_table[r, 3]
         b0 = a0 + offset
-        last = first + count
-        _run_tensions(x[0, a0:a0 + count], x[1, a0:a0 + count], x[2, a0:a0 + count],
-                      x[0, b0:b0 + count], x[1, b0:b0 + count], x[2, b0:b0 + count],
-                      v[0, a0:a0 + count], v[1, a0:a0 + count], v[2, a0:a0 + count],
-                      v[0, b0:b0 + count], v[1, b0:b0 + count], v[2, b0:b0 + count],
-                      runs.rest_lengths[first:last], runs.stiffness[first:last], runs.damping[first:last],
-                      work[0, first:last], work[1, first:last], work[2, first:last], work[3, first:last],
-                      work[4, first:last])
+        _run_tensions(x, v, a0, b0, first, count, rest, stiffness, damping, work)
         # A node meets a run at most twice: as end b of an earlier thread than the one it is end a of
         # when the offset is positive. Adding the run's b ends first (a later pass the a ends) keeps
         # each node's sum in the thread list's order, so it equals the sequential loop's to the bit.
-        for d in range(3):
-            if offset > 0:
-                _scatter(force[d, b0:b0 + count], work[d, first:last], -1.0)
-                _scatter(force[d, a0:a0 + count], work[d, first:last], 1.0)
-            else:
-                _scatter(force[d, a0:a0 + count], work[d, first:last], 1.0)
-                _scatter(force[d, b0:b0 + count], work[d, first:last], -1.0)
+        if offset > 0:
+            _scatter(force, b0, work, first, count, -1.0)
+            _scatter(force, a0, work, first, count, 1.0)
+        else:
+            _scatter(force, a0, work, first, count, 1.0)
+            _scatter(force, b0, work, first, count, -1.0)
     # the energies in the thread list's order (padding adds exact zeros)
     elastic = 0.0
     power = 0.0
