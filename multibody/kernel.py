@@ -273,11 +273,12 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
     x, net_force_lvlh = work[0], work[1]
     # the threads' pass runs on coordinate-major copies (multibody.net.add_thread_forces_runs: it vectorizes)
     x_soa, v_soa, thread_force_soa = buffers.work_soa[0], buffers.work_soa[1], buffers.work_soa[2]
-    for i in range(n):
-        for d in range(3):
-            position = net_reference[i, d] + q[3 * i + d]
-            x[i, d] = position
-            x_soa[d, i] = position
+    x_flat, reference_flat = x.reshape(3 * n), net_reference.reshape(3 * n)
+    for k in range(3 * n):
+        x_flat[k] = reference_flat[k] + q[k]
+    for d in range(3):
+        for i in range(n):
+            x_soa[d, i] = x[i, d]
             v_soa[d, i] = qt[3 * i + d]
     v = qt[: 3 * n].reshape(n, 3)
     thread_force_soa[:] = 0.0

@@ -147,19 +147,21 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
     step = m.step
     half = 0.5 * step
     for k in range(n3):
-        v_half = qt[k] + half * qtt[k]
-        qt_eval[k] = v_half
-        q_eval[k] = q[k] + step * v_half
+        qt_eval[k] = qt[k] + half * qtt[k]
+    for k in range(n3):
+        q_eval[k] = q[k] + step * qt_eval[k]
     q_next, v_half_bodies = verlet_evaluation_state(q_bodies, qt_bodies, qtt_bodies, step, 0, nb)
     q_eval[n3:] = q_next
     qt_eval[n3:] = v_half_bodies
     force = _forces(m, time, m.n_substeps if time > 0.0 else 1)
-    inverse_mass = m.inverse_mass  # per coordinate: one flat loop, which vectorizes
+    # flat loops over the coordinates with few arrays each: the compiler vectorizes them (with more
+    # arrays in one loop its run-time overlap checks give up and the loop stays scalar)
+    inverse_mass = m.inverse_mass
     for k in range(n3):
-        a = force[k] * inverse_mass[k]
-        qtt[k] = a
-        qt[k] = qt_eval[k] + half * a
-        q[k] = q_eval[k]
+        qtt[k] = force[k] * inverse_mass[k]
+    for k in range(n3):
+        qt[k] = qt_eval[k] + half * qtt[k]
+    q[:] = q_eval[:n3]
     return force[n3:].copy()
 
 
