@@ -83,114 +83,22 @@ def box_signed_distance(px, py, pz, lo, hi):
     return 0.0, fx, fy, fz
 
 
-#: Extra margin (m) of the candidate flags beyond what nodes and shapes can close within the step at
-#: which they are built: the flags stay a superset of the per-step flags (and the exact test in the
-#: contact pass keeps the same contacts) until nodes and bodies have used that margin up, so the box
-#: pass over all nodes runs every few steps instead of every step (nodes move < 2 mm a step).
-CANDIDATE_SKIN = 0.02
-
-
 @njit(cache=True)
-def update_candidates(x_cm, reach, body_to_lvlh, com_lvlh, shape_body, box_min, box_max, shape_reach, flags,
-                      built_positions, built_bodies, built_grow):
-    """Keep the candidate ``flags`` of :func:`flag_candidates` valid for this step, rebuilding them only when
-    the margin they were built with may no longer cover the motion since (a Verlet list's skin).
-
-    Flags built with growth G (m) around every shape's box cover this step's test (growth
-    ``reach[i] + shape_reach[s]``) as long as, for every node and shape, the node's body-frame position
-    moved by less than G minus that growth. It moved by at most |x - x_0| + |c - c_0| + ||R - R_0||_F
-    |x_0 - c_0| (node, body CoM and attitude now and at the build), bounded here by the L1 norm of the
-    node's move and the farthest node from the body's CoM at the build. A node the flags keep in excess
-    only costs the exact test, which it fails: the contacts are the same as with per-step flags.
+def flag_candidates(x_lvlh, reach, body_to_lvlh, com_lvlh, shape_body, box_min, box_max, shape_reach, flags):
+    """``flags[s, i]`` = 1 where node ``i`` (LVLH position ``x_lvlh[i]`` (m)) is inside shape ``s``'s body-frame
+    bounding box grown by ``reach[i] + shape_reach[s]`` (m: what node and shape can close within the
+    step), else 0; ``flags[ns, i]`` (the row after the ns shapes' rows) = 1 where any shape's flag is,
+    so the contact pass skips a far node with one read. Branch-free over the nodes, so the compiler
+    vectorizes it: the positions are first copied coordinate-major (3, n), since strided loads from
+    (n, 3) kept the loop scalar (12 us against 3 us a pass for the reference case's 1229 nodes and
+    5 shapes).
 
     Parameters
     ----------
-    x_cm : (3, n) float
-        Net node positions, LVLH (m), coordinate-major.
+    x_lvlh : (n, 3) float
+        Net node positions, LVLH (m).
     reach : (n,) float
         Each node's contact radius plus the distance it can travel within the step (m).
-    body_to_lvlh, com_lvlh : (nb, 3, 3), (nb, 3) float
-        Body attitudes and CoMs (m), LVLH.
-    shape_body : (ns,) int
-        Body carrying each shape.
-    box_min, box_max : (ns, 3) float
-        Bounds of each shape, body frame (m).
-    shape_reach : (ns,) float
-        Distance each shape's surface can travel within the step (m).
-    flags : (ns + 1, n) uint8
-        The candidate flags (:func:`flag_candidates`), kept or rebuilt.
-    built_positions : (3, n) float
-        Node positions at the last build (m), updated at a rebuild.
-    built_bodies : (nb, 13) float
-        Per body at the last build: attitude (9, row-major), CoM (3, m), the farthest node from the CoM (m).
-    built_grow : (1,) float
-        The growth G of the last build (m); 0 forces a rebuild.
-
-    Returns
-    -------
-    bool
-        True when the flags were rebuilt.
-    """
-    n = x_cm.shape[1]
-    grow = built_grow[0]
-    if grow > 0.0:
-        node_bound = 0.0
-        for i in range(n):
-            moved = (abs(x_cm[0, i] - built_positions[0, i]) + abs(x_cm[1, i] - built_positions[1, i])
-                     + abs(x_cm[2, i] - built_positions[2, i])) + reach[i]
-            node_bound = moved if moved > node_bound else node_bound
-        shape_bound = 0.0
-        for s in range(shape_body.shape[0]):
-            b = shape_body[s]
-            turned = 0.0
-            for r in range(3):
-                for c in range(3):
-                    turned += (body_to_lvlh[b, r, c] - built_bodies[b, 3 * r + c]) ** 2
-            shifted = ((com_lvlh[b, 0] - built_bodies[b, 9]) ** 2 + (com_lvlh[b, 1] - built_bodies[b, 10]) ** 2
-                       + (com_lvlh[b, 2] - built_bodies[b, 11]) ** 2)
-            bound = math.sqrt(shifted) + math.sqrt(turned) * built_bodies[b, 12] + shape_reach[s]
-            shape_bound = bound if bound > shape_bound else shape_bound
-        # 1e-9: the bounds' own round-off
-        if node_bound + shape_bound <= (1.0 - 1e-9) * grow:
-            return False
-    largest_reach = 0.0
-    for i in range(n):
-        largest_reach = max(largest_reach, reach[i])
-    largest_shape_reach = 0.0
-    for s in range(shape_body.shape[0]):
-        largest_shape_reach = max(largest_shape_reach, shape_reach[s])
-    grow = largest_reach + largest_shape_reach + CANDIDATE_SKIN
-    flag_candidates(x_cm, grow, body_to_lvlh, com_lvlh, shape_body, box_min, box_max, flags)
-    built_positions[:] = x_cm
-    for b in range(com_lvlh.shape[0]):
-        for r in range(3):
-            for c in range(3):
-                built_bodies[b, 3 * r + c] = body_to_lvlh[b, r, c]
-            built_bodies[b, 9 + r] = com_lvlh[b, r]
-        farthest = 0.0
-        for i in range(n):
-            d2 = ((x_cm[0, i] - com_lvlh[b, 0]) ** 2 + (x_cm[1, i] - com_lvlh[b, 1]) ** 2
-                  + (x_cm[2, i] - com_lvlh[b, 2]) ** 2)
-            farthest = d2 if d2 > farthest else farthest
-        built_bodies[b, 12] = math.sqrt(farthest)
-    built_grow[0] = grow
-    return True
-
-
-@njit(cache=True)
-def flag_candidates(x_cm, grow, body_to_lvlh, com_lvlh, shape_body, box_min, box_max, flags):
-    """``flags[s, i]`` = 1 where node ``i`` (LVLH position ``x_cm[:, i]`` (m)) is inside shape ``s``'s body-frame
-    bounding box grown by ``grow`` (m), else 0; ``flags[ns, i]`` (the row after the ns shapes' rows) = 1
-    where any shape's flag is, so the contact pass skips a far node with one read. Branch-free over the
-    nodes on coordinate-major positions, so the compiler vectorizes it (strided loads from (n, 3) kept
-    the loop scalar: 12 us against 3 us a pass for the reference case's 1229 nodes and 5 shapes).
-
-    Parameters
-    ----------
-    x_cm : (3, n) float
-        Net node positions, LVLH (m), coordinate-major.
-    grow : float
-        Growth of every box (m): at least what any node and shape can close before the flags are rebuilt.
     body_to_lvlh : (nb, 3, 3) float
         Body attitudes (columns: body axes in LVLH).
     com_lvlh : (nb, 3) float
@@ -199,11 +107,18 @@ def flag_candidates(x_cm, grow, body_to_lvlh, com_lvlh, shape_body, box_min, box
         Body carrying each shape.
     box_min, box_max : (ns, 3) float
         Bounds of each shape, body frame (m).
+    shape_reach : (ns,) float
+        Distance each shape's surface can travel within the step (m).
     flags : (ns + 1, n) int
         Output, overwritten: one row per shape, then the "near any shape" row.
     """
-    n = x_cm.shape[1]
-    x0, x1, x2 = x_cm[0], x_cm[1], x_cm[2]
+    n = x_lvlh.shape[0]
+    xs = np.empty((3, n))
+    for i in range(n):
+        xs[0, i] = x_lvlh[i, 0]
+        xs[1, i] = x_lvlh[i, 1]
+        xs[2, i] = x_lvlh[i, 2]
+    x0, x1, x2 = xs[0], xs[1], xs[2]
     n_shapes = shape_body.shape[0]
     near_any = flags[n_shapes]
     near_any[:] = 0
@@ -216,9 +131,9 @@ def flag_candidates(x_cm, grow, body_to_lvlh, com_lvlh, shape_body, box_min, box
         cx = com_lvlh[b, 0] + body_to_lvlh_b[0, 0] * mx + body_to_lvlh_b[0, 1] * my + body_to_lvlh_b[0, 2] * mz
         cy = com_lvlh[b, 1] + body_to_lvlh_b[1, 0] * mx + body_to_lvlh_b[1, 1] * my + body_to_lvlh_b[1, 2] * mz
         cz = com_lvlh[b, 2] + body_to_lvlh_b[2, 0] * mx + body_to_lvlh_b[2, 1] * my + body_to_lvlh_b[2, 2] * mz
-        hx = 0.5 * (box_max[s, 0] - box_min[s, 0]) + grow
-        hy = 0.5 * (box_max[s, 1] - box_min[s, 1]) + grow
-        hz = 0.5 * (box_max[s, 2] - box_min[s, 2]) + grow
+        hx = 0.5 * (box_max[s, 0] - box_min[s, 0]) + shape_reach[s]
+        hy = 0.5 * (box_max[s, 1] - box_min[s, 1]) + shape_reach[s]
+        hz = 0.5 * (box_max[s, 2] - box_min[s, 2]) + shape_reach[s]
         r00, r01, r02 = body_to_lvlh_b[0, 0], body_to_lvlh_b[0, 1], body_to_lvlh_b[0, 2]
         r10, r11, r12 = body_to_lvlh_b[1, 0], body_to_lvlh_b[1, 1], body_to_lvlh_b[1, 2]
         r20, r21, r22 = body_to_lvlh_b[2, 0], body_to_lvlh_b[2, 1], body_to_lvlh_b[2, 2]
@@ -228,5 +143,6 @@ def flag_candidates(x_cm, grow, body_to_lvlh, com_lvlh, shape_body, box_min, box
             px = r00 * dx + r10 * dy + r20 * dz
             py = r01 * dx + r11 * dy + r21 * dz
             pz = r02 * dx + r12 * dy + r22 * dz
-            row[i] = (abs(px) <= hx) & (abs(py) <= hy) & (abs(pz) <= hz)
+            grow = reach[i]
+            row[i] = (abs(px) <= hx + grow) & (abs(py) <= hy + grow) & (abs(pz) <= hz + grow)
             near_any[i] |= row[i]

@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit
 
-from multibody.broad_phase import box_signed_distance, update_candidates
+from multibody.broad_phase import box_signed_distance, flag_candidates
 from multibody.contact import (
     contact_over_step,
     hertz_elastic_energy,
@@ -129,8 +129,7 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
     stage_weight : float
         Weight of the accumulated impulses and energies (1 / force evaluations per step).
     buffers : KernelBuffers
-        Impulse accumulators, the carried velocity lag and work space (:mod:`multibody.kernel`);
-        ``work_soa[0]`` holds ``x`` coordinate-major (the kernel's copy, for the broad phase).
+        Impulse accumulators, the carried velocity lag and work space (:mod:`multibody.kernel`).
     net_force_lvlh : (n, 3) float
         Enters holding every non-contact force on the nodes (N, LVLH); the contact forces are added.
     body_force_lvlh, torque_lvlh : (nb, 3) float
@@ -194,11 +193,9 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
                                hi[0] * hi[0] + hi[1] * hi[1] + hi[2] * hi[2]))
         shape_speed[s] = (math.sqrt(velocity_lvlh[b, 0] ** 2 + velocity_lvlh[b, 1] ** 2 + velocity_lvlh[b, 2] ** 2)
                           + math.sqrt(omega_lvlh[b, 0] ** 2 + omega_lvlh[b, 1] ** 2 + omega_lvlh[b, 2] ** 2) * extent)
-    # candidate flags, rebuilt when their margin is used up (multibody.broad_phase); the box test below
-    # stays the exact filter
-    update_candidates(buffers.work_soa[0], reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max,
-                      step * shape_speed, candidates, buffers.candidate_positions, buffers.candidate_bodies,
-                      buffers.candidate_grow)
+    # bounding-sphere pass (multibody.broad_phase); the box test below stays the exact filter
+    flag_candidates(x, reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max, step * shape_speed,
+                    candidates)
     # per-node contact lists and sub-cycle work space, reused
     c_body = np.empty(n_shapes, np.int64)
     c_pen = np.empty(n_shapes)

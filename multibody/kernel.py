@@ -151,9 +151,6 @@ class KernelBuffers(NamedTuple):
     candidates: np.ndarray         # (ns + 1, n) uint8 node near shape; last row: near any
     work_soa: np.ndarray           # (3, 3, n) positions, velocities, thread forces, coordinate-major
     work_thread: np.ndarray        # (5, P) per padded thread: force on its node a, energy, power
-    candidate_positions: np.ndarray  # (3, n) node positions (m) when the candidate flags were built
-    candidate_bodies: np.ndarray     # (nb, 13) attitude, CoM (m), farthest node (m) then (multibody.broad_phase)
-    candidate_grow: np.ndarray       # (1,) the flags' growth (m); 0: rebuild at the next evaluation
 
 
 def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffers:
@@ -172,9 +169,7 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffer
                          lag_body=np.full(n, -1, dtype=np.int64), scalars=np.zeros(N_SCALARS),
                          work=np.zeros((4, n, 3)), work_node=work_node,
                          candidates=np.zeros((n_shapes + 1, n), np.uint8), work_soa=np.zeros((3, 3, n)),
-                         work_thread=np.zeros((5, len(net.thread_runs.rest_lengths))),
-                         candidate_positions=np.zeros((3, n)), candidate_bodies=np.zeros((n_bodies, 13)),
-                         candidate_grow=np.zeros(1))
+                         work_thread=np.zeros((5, len(net.thread_runs.rest_lengths))))
 
 
 class BodyStates(NamedTuple):
