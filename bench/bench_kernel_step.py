@@ -44,7 +44,7 @@ def captured_state_model():
 def time_frozen_steps(t0: float, steps: int, repeat: int) -> tuple[float, str]:
     """Fastest CPU time (s) of ``steps`` kernel steps from the state at ``t0`` (s), and an end-state hash."""
     captured = captured_state_model()
-    case, inputs = sized_inputs(ROOT / "cases" / "envisat_net_impact.toml", 35, t0, "kernel")
+    _, inputs = sized_inputs(ROOT / "cases" / "envisat_net_impact.toml", 35, t0, "kernel")
     sim = ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
     sim.run()
     net = sim.system.kernel_net

@@ -323,7 +323,7 @@ def thread_runs(threads, rest_lengths, stiffness, damping) -> ThreadRuns:
     runs, rest, k, c = [], [], [], []
     for t, (a, b) in enumerate(threads):
         if runs:
-            first, a0, count, offset = runs[-1]
+            _, a0, count, offset = runs[-1]
             gap = a - (a0 + count)
             if b - a == offset and 0 <= gap <= MAX_RUN_GAP and offset != 0:
                 rest += [PADDING_REST_LENGTH] * gap
