@@ -34,6 +34,7 @@ from multibody.kernel import (
 )
 from multibody.kernel_net import KernelNet, kernel_net_start, kernel_net_step
 from multibody.recorded_loads import add_recorded_loads
+from multibody.net import thread_runs
 from multibody.recorder import Recorder
 from multibody.solver_output import solver_chatter_captured
 
@@ -117,7 +118,8 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
         reference_lvlh=np.ascontiguousarray(net.positions, float), mass=np.asarray(net.masses, float),
         radius=np.asarray(net.radii, float), threads=net.threads, rest_lengths=net.rest_lengths,
         thread_stiffness=net.stiffness, thread_damping=net.damping,
-        bending_triples=net.bending_triples, bending_stiffness=net.bending_stiffness)
+        bending_triples=net.bending_triples, bending_stiffness=net.bending_stiffness,
+        thread_runs=thread_runs(net.threads, net.rest_lengths, net.stiffness, net.damping))
     bodies = BodyArrays(
         reference_com_lvlh=np.array([b.com_lvlh for b in assembly.bodies], float).reshape(-1, 3),
         mass=np.array([b.mass for b in assembly.bodies], float),

@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from multibody.contact_kernel import add_contact_forces
-from multibody.net import add_bending_forces, add_thread_forces
+from multibody.net import ThreadRuns, add_bending_forces, add_thread_forces_runs
 from multibody.orbit import (
     clohessy_wiltshire_acceleration,
     clohessy_wiltshire_acceleration_xyz,
@@ -83,6 +83,7 @@ class NetArrays(NamedTuple):
     thread_damping: np.ndarray     # (m,) (N s/m)
     bending_triples: np.ndarray    # (k, 3) int64 node triples (end, middle, end)
     bending_stiffness: np.ndarray  # (k,) (N m/rad)
+    thread_runs: ThreadRuns        # the threads regrouped for the vectorized pass (multibody.net.thread_runs)
 
 
 class BodyArrays(NamedTuple):
@@ -148,6 +149,8 @@ class KernelBuffers(NamedTuple):
     work: np.ndarray               # (4, n, 3) positions, forces, non-contact forces, start velocities
     work_node: np.ndarray          # (4, n) speed, acceleration bound, reach; 1 / mass
     candidates: np.ndarray         # (ns + 1, n) uint8 node near shape; last row: near any
+    work_soa: np.ndarray           # (3, 3, n) positions, velocities, thread forces, coordinate-major
+    work_thread: np.ndarray        # (5, P) per padded thread: force on its node a, energy, power
 
 
 def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffers:
@@ -165,7 +168,8 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffer
                          node_impulse_lvlh=np.zeros((n, 3)), velocity_lag=np.zeros((n, 3)),
                          lag_body=np.full(n, -1, dtype=np.int64), scalars=np.zeros(N_SCALARS),
                          work=np.zeros((4, n, 3)), work_node=work_node,
-                         candidates=np.zeros((n_shapes + 1, n), np.uint8))
+                         candidates=np.zeros((n_shapes + 1, n), np.uint8), work_soa=np.zeros((3, 3, n)),
+                         work_thread=np.zeros((5, len(net.thread_runs.rest_lengths))))
 
 
 class BodyStates(NamedTuple):
@@ -262,14 +266,21 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
     n = net_mass.shape[0]
     nb = bodies.mass.shape[0]
     x, net_force_lvlh = work[0], work[1]
+    # the threads' pass runs on coordinate-major copies (multibody.net.add_thread_forces_runs: it vectorizes)
+    x_soa, v_soa, thread_force_soa = buffers.work_soa[0], buffers.work_soa[1], buffers.work_soa[2]
+    x_flat, reference_flat = x.reshape(3 * n), net_reference.reshape(3 * n)
+    for k in range(3 * n):
+        x_flat[k] = reference_flat[k] + q[k]
+    for d in range(3):
+        for i in range(n):
+            x_soa[d, i] = x[i, d]
+            v_soa[d, i] = qt[3 * i + d]
+    v = qt[: 3 * n].reshape(n, 3)
+    thread_force_soa[:] = 0.0
+    elastic, power = add_thread_forces_runs(x_soa, v_soa, net.thread_runs, thread_force_soa, buffers.work_thread)
     for i in range(n):
         for d in range(3):
-            x[i, d] = net_reference[i, d] + q[3 * i + d]
-            net_force_lvlh[i, d] = 0.0
-    v = qt[: 3 * n].reshape(n, 3)
-
-    elastic, power = add_thread_forces(x, v, net.threads, net.rest_lengths, net.thread_stiffness,
-                                       net.thread_damping, net_force_lvlh)
+            net_force_lvlh[i, d] = thread_force_soa[d, i]
     out_scalars[THREAD_ELASTIC] = elastic
     out_scalars[BENDING_ELASTIC] = add_bending_forces(x, net.bending_triples, net.bending_stiffness, net_force_lvlh)
     out_scalars[THREAD_DISSIPATED] += power * step * stage_weight
@@ -306,9 +317,7 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
     out_scalars[CONTACT_ELASTIC] = contact_energy
     out_scalars[N_CONTACTS] = n_contacts
     out_scalars[CONTACT_DISSIPATED] += contact_dissipated
-    for i in range(n):
-        for d in range(3):
-            out_force[3 * i + d] = net_force_lvlh[i, d]
+    out_force[:3 * n] = net_force_lvlh.reshape(3 * n)
     return out_force
 
 

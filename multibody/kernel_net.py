@@ -58,7 +58,7 @@ class NetStepModelType(types.StructRef):
 #: (same names, same buffers: what the kernel accumulates there, the recorder reads there), then the
 #: net's state and the work vectors of this module.
 KERNEL_FIELDS = ("net", "bodies", "shapes", "law", "mounts", "mean_motion", "step", "stage_weight", "buffers")
-STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "q_eval", "qt_eval")
+STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "q_eval", "qt_eval", "inverse_mass")
 
 
 class NetStepModel(structref.StructRefProxy):
@@ -67,7 +67,7 @@ class NetStepModel(structref.StructRefProxy):
     Fields: those of :class:`multibody.kernel.KernelData` (:data:`KERNEL_FIELDS`, the same arrays)
     and ``n_substeps`` (int, contact sub-steps per step), ``q``, ``qt``, ``qtt`` ((3 n,) the net's
     state, module doc), ``q_eval``, ``qt_eval`` ((3 n + 6 nb,) the kernel's coordinates at the
-    evaluation state, work space).
+    evaluation state, work space), ``inverse_mass`` ((3 n,) 1 / node mass per coordinate (1/kg)).
     """
 
 
@@ -90,7 +90,8 @@ def net_step_model(kernel: KernelData, net_velocity) -> tuple:
     values = [getattr(kernel, name) for name in KERNEL_FIELDS]
     values = [float(v) if isinstance(v, (float, np.floating, int)) else v for v in values]
     state = [n_substeps, np.zeros(3 * n), np.ascontiguousarray(net_velocity, float).reshape(3 * n).copy(),
-             np.zeros(3 * n), np.zeros(3 * n + 6 * nb), np.zeros(3 * n + 6 * nb)]
+             np.zeros(3 * n), np.zeros(3 * n + 6 * nb), np.zeros(3 * n + 6 * nb),
+             np.repeat(1.0 / np.asarray(kernel.net.mass, float), 3)]
     return NetStepModel(*values, *state), state[1], state[2]
 
 
@@ -146,21 +147,21 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
     step = m.step
     half = 0.5 * step
     for k in range(n3):
-        v_half = qt[k] + half * qtt[k]
-        qt_eval[k] = v_half
-        q_eval[k] = q[k] + step * v_half
+        qt_eval[k] = qt[k] + half * qtt[k]
+    for k in range(n3):
+        q_eval[k] = q[k] + step * qt_eval[k]
     q_next, v_half_bodies = verlet_evaluation_state(q_bodies, qt_bodies, qtt_bodies, step, 0, nb)
     q_eval[n3:] = q_next
     qt_eval[n3:] = v_half_bodies
     force = _forces(m, time, m.n_substeps if time > 0.0 else 1)
-    inverse_mass = m.buffers.work_node[3]  # (n,) 1 / node mass (multibody.kernel.KernelBuffers)
-    for i in range(n3 // 3):
-        for d in range(3):
-            k = 3 * i + d
-            a = force[k] * inverse_mass[i]
-            qtt[k] = a
-            qt[k] = qt_eval[k] + half * a
-            q[k] = q_eval[k]
+    # flat loops over the coordinates with few arrays each: the compiler vectorizes them (with more
+    # arrays in one loop its run-time overlap checks give up and the loop stays scalar)
+    inverse_mass = m.inverse_mass
+    for k in range(n3):
+        qtt[k] = force[k] * inverse_mass[k]
+    for k in range(n3):
+        qt[k] = qt_eval[k] + half * qtt[k]
+    q[:] = q_eval[:n3]
     return force[n3:].copy()
 
 
