@@ -27,11 +27,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import open3d as o3d
+
 from multibody.rotations import rotation_vector_from_matrix
 from perception.nearest_grid import CellList
 from perception.normals import surface_normals
-from perception.registration import Alignment, _rigid_inverse, _turn_candidates, _twist
 from perception.point_to_plane import point_to_plane_information, tukey_normal_equations
+from perception.registration import Alignment, _rigid_inverse, _turn_candidates, _twist
 
 #: Largest turn between the first two frames searched without a motion prediction (rad): 3 rad/s at
 #: 10 Hz (Tang et al. 2023, Sec. 2, the tumble rates considered).
