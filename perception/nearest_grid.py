@@ -134,3 +134,102 @@ def _nearest(points, low, cell, shape, table, model, neighbours, upper, steps):
 def _distance2(points, k, model, j):
     return ((points[k, 0] - model[j, 0]) ** 2 + (points[k, 1] - model[j, 1]) ** 2
             + (points[k, 2] - model[j, 2]) ** 2)
+
+
+#: Largest number of cells of a :class:`CellList` (its start table: 8 bytes a cell); larger cells
+#: beyond (the answer stays exact, the query looks at more points).
+MAX_LIST_CELLS = 2**24
+
+
+class CellList:
+    """Exact nearest point within a bound, for a model that changes: points sorted into cubic cells.
+
+    A scan-to-map track rebuilds its map every few frames, too often for :class:`NearestPointGrid`'s
+    distance transform (0.3-1 s on a 3 m map at 1 cm cells), and on its ~20 000 points a KD-tree
+    query of 3000 points took ~2.5 ms, 36 times per frame. Here the build is one sort of the points
+    by cell (a few ms). A query looks at the cells around the query point's in growing shells
+    (3 x 3 x 3 cells, then 5 x 5 x 5, ...): once the nearest point found lies within r cell edges
+    after shell r, no point outside the shell can be nearer, so the answer is exactly the KD-tree's
+    (the same point but for exact ties). Scan points near the surface end after the first shell.
+
+    Parameters
+    ----------
+    points : (n, 3) float   Model points (m, any fixed frame).
+    cell : float            Cell edge (m): about the usual query distance (larger bounds take more
+                            shells); enlarged when the grid would exceed :data:`MAX_LIST_CELLS`.
+    reach : float           Largest ``distance_upper_bound`` the queries will ask for (m), >= ``cell``:
+                            the grid's margin around the points.
+    """
+
+    def __init__(self, points, cell, reach=None):
+        self.points = np.ascontiguousarray(points, dtype=float)
+        reach = float(cell if reach is None else max(reach, cell))
+        self.low = self.points.min(axis=0) - reach
+        extent = self.points.max(axis=0) + reach - self.low
+        self.cell = max(float(cell), float(np.prod(extent) / MAX_LIST_CELLS) ** (1 / 3))
+        self.shape = np.ceil(extent / self.cell).astype(np.int64) + 1
+        keys = np.ravel_multi_index(np.floor((self.points - self.low) / self.cell).astype(np.int64).T, self.shape)
+        self.order = np.argsort(keys, kind="stable")
+        self.sorted_points = self.points[self.order]
+        self.starts = np.searchsorted(keys[self.order], np.arange(int(np.prod(self.shape)) + 1))
+
+    def query(self, points, distance_upper_bound=np.inf) -> tuple[np.ndarray, np.ndarray]:
+        """Distance (m) to and index of the nearest point within ``distance_upper_bound`` for
+        points (k, 3) (m), like ``scipy.spatial.cKDTree.query``: no match gives distance inf and
+        index n (the number of points).
+
+        Parameters
+        ----------
+        points : (k, 3) float
+            Query points (m), in the frame of the model points.
+        distance_upper_bound : float
+            Largest distance looked for (m); an unbounded query searches the whole grid.
+
+        Returns
+        -------
+        distance : (k,) float
+            Distance to the nearest point (m); inf without a match.
+        index : (k,) int
+            Row of the nearest point; n without a match.
+        """
+        upper = float(distance_upper_bound)
+        shells = int(self.shape.max()) if not np.isfinite(upper) else int(np.ceil(upper / self.cell))
+        gap, index = _nearest_in_cells(np.ascontiguousarray(points, dtype=float), self.low, self.cell, self.shape,
+                                       self.starts, self.sorted_points, upper, max(shells, 1))
+        found = index < len(self.points)
+        index[found] = self.order[index[found]]
+        return gap, index
+
+
+@njit(cache=True)
+def _nearest_in_cells(points, low, cell, shape, starts, sorted_points, upper, shells):
+    """Nearest of ``sorted_points`` within ``upper`` of each query point: cell shells 1..``shells``
+    around its cell, stopping once the best distance is within the searched shell's radius."""
+    n = len(points)
+    gap = np.full(n, np.inf)
+    index = np.full(n, len(sorted_points), np.int64)
+    upper2 = upper * upper
+    for k in range(n):
+        c0 = int(np.floor((points[k, 0] - low[0]) / cell))
+        c1 = int(np.floor((points[k, 1] - low[1]) / cell))
+        c2 = int(np.floor((points[k, 2] - low[2]) / cell))
+        best, best_d2 = -1, upper2
+        for r in range(1, shells + 1):
+            for a in range(max(c0 - r, 0), min(c0 + r + 1, shape[0])):
+                for b in range(max(c1 - r, 0), min(c1 + r + 1, shape[1])):
+                    row = (a * shape[1] + b) * shape[2]
+                    inner = abs(a - c0) < r and abs(b - c1) < r   # only the two end cells are new
+                    lo, hi = max(c2 - r, 0), min(c2 + r + 1, shape[2])
+                    for c in range(lo, hi):
+                        if inner and abs(c - c2) < r and r > 1:
+                            continue
+                        for j in range(starts[row + c], starts[row + c + 1]):
+                            d2 = _distance2(points, k, sorted_points, j)
+                            if d2 <= best_d2:
+                                best, best_d2 = j, d2
+            if best >= 0 and best_d2 <= (r * cell) ** 2:
+                break
+        if best >= 0:
+            gap[k] = np.sqrt(best_d2)
+            index[k] = best
+    return gap, index

@@ -334,6 +334,7 @@ class DebrisTracker:
         self.symmetries_body = [np.eye(4)] if symmetries_body is None else [np.asarray(s, float) for s in symmetries_body]
         self.seed = seed
         self._frame_spacing = None   # scan sample spacing (m) of the frame being registered
+        self._frame_returns = None   # all returns of the frame being registered (m, world), for the free-space check
         self.max_correspondence = max_correspondence
         self.model_frames = model_frames
         self.alignments: list[Alignment] = []
@@ -411,7 +412,7 @@ class DebrisTracker:
         self._nearest = NearestPointGrid(self._model_points, self.voxel / 3, self.max_correspondence)
 
     # -- one frame -------------------------------------------------------------------
-    def update(self, time_s, points_world, sensor_world, gate=None) -> Alignment:
+    def update(self, time_s, points_world, sensor_world, gate=None, all_returns_world=None) -> Alignment:
         """Register one scan (n, 3) (m, world frame) taken from ``sensor_world`` (3,) (m).
 
         Parameters
@@ -426,6 +427,14 @@ class DebrisTracker:
             With a motion prediction, register only the scan points within ``gate`` (m) of the
             model at the predicted pose (to the nearest model point, ``voxel`` apart): returns of
             other objects, e.g. net threads in front of the debris, are dropped.
+        all_returns_world : (m, 3) float, optional
+            Every return of the frame (m, world), when ``points_world`` is a selection of them (the
+            debris' returns without those taken as net): the free-space check needs all of them.
+            A return of anything shows free space up to it; without the returns dropped as net, a
+            bin where the net lies on the debris keeps only deeper returns and the debris surface
+            in front of them counts as a contradiction. Measured on the featured debris at the first
+            collision frame (net 7 cm off the bus): correct pose (0.2 deg from the prediction,
+            tight fitness 0.99) rejected with 7.4 % of the bins violated (limit 5 %).
 
         Returns
         -------
@@ -434,6 +443,7 @@ class DebrisTracker:
             ``alignments``.
         """
         start, cpu_start = time.perf_counter(), time.process_time()
+        self._frame_returns = None if all_returns_world is None else np.asarray(all_returns_world, float)
         scan = _cloud(points_world).voxel_down_sample(self.voxel)
         if self._model is None:   # the first scan starts the model and defines the frame B
             alignment = self._start_model(time_s, np.asarray(scan.points))
@@ -443,6 +453,7 @@ class DebrisTracker:
                 scan = self._gated(scan, predicted, gate)
             alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
             self._frame_spacing = None
+        self._frame_returns = None
         alignment.seconds = time.perf_counter() - start
         alignment.cpu_seconds = time.process_time() - cpu_start
         self.alignments.append(alignment)
@@ -576,7 +587,8 @@ class DebrisTracker:
         body_to_world = _rigid_inverse(pose)
         model_world = _transform(self._coarse_points, body_to_world)
         range_scale = np.median(np.linalg.norm(points_world - sensor_world, axis=1))
-        violation = free_space_violation(points_world, model_world, sensor_world, 2 * self.voxel / range_scale,
+        returns = points_world if self._frame_returns is None or not len(self._frame_returns) else self._frame_returns
+        violation = free_space_violation(returns, model_world, sensor_world, 2 * self.voxel / range_scale,
                                          3 * sigma + self.voxel, self._coarse_normals @ body_to_world[:3, :3].T,
                                          self._frame_spacing or _sample_spacing(points_world))
         innovation = _turn_angle(pose[:3, :3], predicted[:3, :3])

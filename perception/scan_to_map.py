@@ -4,23 +4,21 @@ Without the debris mesh, the body frame **B** is defined by the first scan: axes
 frame at that scan, origin at its centroid (the CoM is unknown; it is found later as the one point
 of B that moves on a straight line, :func:`perception.motion.center_of_mass_line`). Each scan is
 registered to a map of the debris surface in B, built from the scans already registered and
-thinned to one point per voxel (Open3D point-to-plane ICP with a Tukey kernel,
-``open3d.pipelines.registration``), starting from the pose predicted at constant rotation and
-translation rates. The map grows with every registered scan, so a frame is registered to all the
+thinned to one point per voxel (point-to-plane Gauss-Newton ICP with a Tukey kernel, on an exact
+cell-list nearest-point index of the map, :class:`perception.nearest_grid.CellList`), starting
+from the pose predicted at constant rotation and translation rates. The map grows with every registered scan, so a frame is registered to all the
 surface seen before, not to its predecessor alone: the error does not accumulate from frame to
 frame once the body has shown all its sides (one tumble period).
 
 Drift while the map grows: the first frames are registered to a map made of a few partial views,
-and their errors are frozen into the map. :func:`refine_track` removes them: the map is rebuilt
-from every scan at its current pose and every scan is registered again to the rebuilt map
-(alternating, a few passes; a map-based form of bundle adjustment). Each pass averages the
-per-frame errors of all scans into the map instead of those of the first few.
+and their errors are frozen into the map; the motion prior (:func:`register_with_motion_prior`)
+keeps later frames from sliding along what the partial map hardly constrains.
 
 The first pose change (frame 1 against frame 0) has no motion prediction: seed turns up to
 :data:`SEARCH_TURN` are tried (ICP on a smooth near-spheroid has a basin of only a few degrees) and
 the one whose ICP leaves the scan closest to the map is kept.
 
-Functions here are pure (arrays in, arrays out); Open3D point clouds stay inside.
+Functions here are pure (arrays in, arrays out); Open3D point clouds (thinning, normals) stay inside.
 """
 from __future__ import annotations
 
@@ -29,13 +27,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import open3d as o3d
-from scipy.spatial import cKDTree
-from scipy.spatial.transform import Rotation
 
-from perception.registration import Alignment
+from multibody.rotations import rotation_vector_from_matrix
+from perception.nearest_grid import CellList
+from perception.normals import surface_normals
 from perception.point_to_plane import point_to_plane_information, tukey_normal_equations
-
-reg = o3d.pipelines.registration
+from perception.registration import Alignment, _rigid_inverse, _turn_candidates, _twist
 
 #: Largest turn between the first two frames searched without a motion prediction (rad): 3 rad/s at
 #: 10 Hz (Tang et al. 2023, Sec. 2, the tumble rates considered).
@@ -43,8 +40,9 @@ SEARCH_TURN = np.radians(30.0)
 #: A registration whose share of scan points within the correspondence distance of the map is below
 #: this is a failed frame (a correct pose leaves only outliers such as net returns and noise tails).
 MIN_FITNESS = 0.8
-#: ICP iterations per level (coarse, fine); from a good prediction a level settles in a few.
-ICP_ITERATIONS = 20
+#: ICP iterations per level, at most (coarse, fine); from a good prediction a level settles in a few.
+COARSE_ITERATIONS = 20
+FINE_ITERATIONS = 20
 #: Scan points of the coarse and fine ICP levels (every k-th point of the thinned scan): the fine
 #: level's 3000 points pin a frame's attitude to a tenth of a degree on a featured body, more cost little.
 COARSE_POINTS = 1000
@@ -131,51 +129,62 @@ def surface_map(points_body, voxel) -> o3d.geometry.PointCloud:
     open3d PointCloud              Voxel means with unit normals, frame B (m).
     """
     cloud = _cloud(points_body).voxel_down_sample(voxel)
-    cloud.estimate_normals(o3d.geometry.KDTreeSearchParamHybrid(radius=4 * voxel, max_nn=30))
+    # Open3D's estimate_normals(KDTreeSearchParamHybrid(4 voxel, 30)) gives the same normals, in
+    # 1.3-1.5 times the CPU time (perception/normals.py)
+    cloud.normals = o3d.utility.Vector3dVector(surface_normals(np.asarray(cloud.points), 4 * voxel, 30))
     return cloud
 
 
-def register_to_map(scan_world, map_cloud, initial_world_to_body, max_correspondence) -> tuple[np.ndarray, float, float]:
-    """Point-to-plane ICP (Tukey kernel) of a thinned scan to the map, coarse then fine.
+def map_index(map_points, max_correspondence) -> CellList:
+    """Nearest-point index of a map (n, 3) (m, frame B) for the ICP's correspondence distances
+    (coarse ``max_correspondence``, fine a third of it; m): exact, cells of the fine distance, rebuilt
+    with the map in a few ms (:class:`perception.nearest_grid.CellList`).
 
     Parameters
     ----------
-    scan_world : (n, 3) float          Thinned scan points, world frame (m).
-    map_cloud : open3d PointCloud      Map with normals, frame B (:func:`surface_map`).
-    initial_world_to_body : (4, 4)     Starting pose, world -> B.
-    max_correspondence : float         Coarse correspondence distance (m); the fine level uses a third.
+    map_points : (n, 3) float      Map points, frame B (m).
+    max_correspondence : float     Coarse correspondence distance (m).
 
     Returns
     -------
-    world_to_body : (4, 4) float, fitness : float (-), rmse : float (m) of the fine level.
+    perception.nearest_grid.CellList
     """
-    source = _cloud(scan_world)
-    pose = np.asarray(initial_world_to_body, float)
-    result = None
-    for distance in (max_correspondence, max_correspondence / 3):
-        estimation = reg.TransformationEstimationPointToPlane(reg.TukeyLoss(k=distance / 2))
-        result = reg.registration_icp(source, map_cloud, distance, pose, estimation,
-                                      reg.ICPConvergenceCriteria(1e-7, 1e-7, ICP_ITERATIONS))
-        pose = np.asarray(result.transformation)
-    return pose, float(result.fitness), float(result.inlier_rmse)
+    return CellList(map_points, max_correspondence / 3, max_correspondence)
 
 
-def _twist(step) -> np.ndarray:
-    """Transform (4, 4) of a (rotation vector, translation) step (6,) (rad, m)."""
-    matrix = np.eye(4)
-    matrix[:3, :3] = Rotation.from_rotvec(step[:3]).as_matrix()
-    matrix[:3, 3] = step[3:]
-    return matrix
+def register_to_map(scan_world, map_points, map_normals, initial_world_to_body, max_correspondence,
+                    index=None) -> tuple[np.ndarray, float, float]:
+    """Point-to-plane ICP (Tukey kernel) of a thinned scan to the map, coarse then fine, without a
+    motion prior (:func:`register_with_motion_prior` with a zero prior information).
+
+    Parameters
+    ----------
+    scan_world : (n, 3) float                 Thinned scan points, world frame (m).
+    map_points, map_normals : (m, 3) float    Map and unit normals, frame B (m).
+    initial_world_to_body : (4, 4)            Starting pose, world -> B.
+    max_correspondence : float                Coarse correspondence distance (m); the fine level uses a third.
+    index : CellList, optional              :func:`map_index` of the map (built here when not given).
+
+    Returns
+    -------
+    world_to_body : (4, 4) float, fitness : float (-), rmse : float (m): the share of scan points
+    within the fine distance of a map point and their RMS distance (m), as Open3D's ICP reports them.
+    """
+    index = map_index(map_points, max_correspondence) if index is None else index
+    pose = register_with_motion_prior(scan_world, map_points, map_normals, initial_world_to_body, max_correspondence,
+                                      None, index)
+    fitness, rmse = map_fit(scan_world, pose, index, max_correspondence / 3)
+    return pose, fitness, rmse
 
 
-def _pose_difference(pose, reference) -> np.ndarray:
+def _pose_difference(pose, reference_inverse) -> np.ndarray:
     """(rotation vector, translation) (6,) of ``pose @ reference^-1`` (left, frame B): rad, m."""
-    delta = pose @ np.linalg.inv(reference)
-    return np.r_[Rotation.from_matrix(delta[:3, :3]).as_rotvec(), delta[:3, 3]]
+    delta = pose @ reference_inverse
+    return np.r_[rotation_vector_from_matrix(np.ascontiguousarray(delta[:3, :3])), delta[:3, 3]]
 
 
 def register_with_motion_prior(scan_world, map_points, map_normals, predicted_world_to_body, max_correspondence,
-                               prior_sigma, tree=None) -> np.ndarray:
+                               prior_sigma, index=None) -> np.ndarray:
     """Point-to-plane ICP (Tukey kernel) of a thinned scan to the map, regularized towards the
     pose predicted from the motion: the Gauss-Newton steps minimize
     ``sum w r^2 / s^2 + d^T P d`` with r the point-to-plane residuals (Tukey weights w, cut-off
@@ -195,29 +204,35 @@ def register_with_motion_prior(scan_world, map_points, map_normals, predicted_wo
     map_points, map_normals : (m, 3) float    Map and unit normals, frame B (m).
     predicted_world_to_body : (4, 4) float    Predicted pose, world -> B.
     max_correspondence : float                Coarse correspondence distance (m); fine level a third.
-    prior_sigma : (6,) float                  1-sigma of the prediction: rotation (rad), translation (m).
-    tree : scipy cKDTree, optional            KD-tree of ``map_points`` (built here when not given).
+    prior_sigma : (6,) float or None          1-sigma of the prediction: rotation (rad), translation (m);
+                                              None: no prior (plain ICP from the given pose).
+    index : CellList, optional              :func:`map_index` of the map (built here when not given).
 
     Returns
     -------
     world_to_body : (4, 4) float
     """
-    tree = cKDTree(map_points) if tree is None else tree
+    index = map_index(map_points, max_correspondence) if index is None else index
     pose = np.asarray(predicted_world_to_body, float)
-    prior_information = 1.0 / np.asarray(prior_sigma, float) ** 2
+    reference_inverse = _rigid_inverse(pose)
+    prior_information = np.zeros(6) if prior_sigma is None else 1.0 / np.asarray(prior_sigma, float) ** 2
     coarse = scan_world[::max(1, len(scan_world) // COARSE_POINTS)]
     fine = scan_world[::max(1, len(scan_world) // FINE_POINTS)]
-    for points, distance in ((coarse, max_correspondence), (fine, max_correspondence / 3)):
+    for points, distance, iterations in ((coarse, max_correspondence, COARSE_ITERATIONS),
+                                         (fine, max_correspondence / 3, FINE_ITERATIONS)):
         scatter2 = (distance / 6) ** 2    # Tukey cut-off distance/2 at 3 scatters
-        for _ in range(ICP_ITERATIONS):
+        for _ in range(iterations):
             body = _transform(points, pose)
-            _, nearest = tree.query(body, distance_upper_bound=distance)
+            _, nearest = index.query(body, distance_upper_bound=distance)
             hessian, gradient, _, count = tukey_normal_equations(body, nearest, map_points, map_normals, distance / 2)
             if count < 6:
                 break
-            difference = _pose_difference(pose, predicted_world_to_body)
-            step = np.linalg.solve(hessian / scatter2 + np.diag(prior_information),
-                                   -(gradient / scatter2 + prior_information * difference))
+            difference = _pose_difference(pose, reference_inverse) if prior_sigma is not None else np.zeros(6)
+            try:
+                step = np.linalg.solve(hessian / scatter2 + np.diag(prior_information),
+                                       -(gradient / scatter2 + prior_information * difference))
+            except np.linalg.LinAlgError:   # degenerate matches (all on one plane) and no prior
+                break
             pose = _twist(step) @ pose
             if np.linalg.norm(step[:3]) * BODY_SIZE + np.linalg.norm(step[3:]) < SETTLED:
                 break
@@ -225,14 +240,14 @@ def register_with_motion_prior(scan_world, map_points, map_normals, predicted_wo
 
 
 def map_fit(scan_world, world_to_body, map_tree, distance) -> tuple[float, float]:
-    """Share of scan points (n, 3) (world) within ``distance`` (m) of a map point (KD-tree of the
+    """Share of scan points (n, 3) (world) within ``distance`` (m) of a map point (index of the
     map, frame B) at the pose world -> B (4, 4), and their RMS distance (m).
 
     Parameters
     ----------
     scan_world : (n, 3) float      Thinned scan points, world frame (m).
     world_to_body : (4, 4) float   Pose world -> B (m for the translation).
-    map_tree : scipy cKDTree       KD-tree of the map points, frame B (m).
+    map_tree : CellList or cKDTree   Nearest-point index of the map points, frame B (m).
     distance : float               Correspondence distance (m).
 
     Returns
@@ -260,51 +275,41 @@ def predict_world_to_body(previous, before) -> np.ndarray:
     return previous @ np.linalg.inv(before) @ previous
 
 
-def _turns(largest) -> list[np.ndarray]:
-    """Identity and turns of largest/3, 2 largest/3, largest about 13 axes (a cube's faces, edges,
-    corners), both senses: the seeds of a frame without a motion prediction."""
-    axes = [np.array(a, float) for a in ((1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 0), (1, -1, 0), (1, 0, 1),
-                                          (1, 0, -1), (0, 1, 1), (0, 1, -1), (1, 1, 1), (1, 1, -1), (1, -1, 1), (-1, 1, 1))]
-    turns = [np.eye(3)]
-    for axis in axes:
-        for angle in (largest / 3, 2 * largest / 3, largest):
-            for sign in (1, -1):
-                turns.append(Rotation.from_rotvec(sign * angle * axis / np.linalg.norm(axis)).as_matrix())
-    return turns
-
-
-def search_pose(scan_world, map_cloud, start_world_to_body, max_correspondence) -> tuple[np.ndarray, float, float]:
+def search_pose(scan_world, map_points, map_normals, start_world_to_body, max_correspondence,
+                index=None) -> tuple[np.ndarray, float, float]:
     """Pose of a scan without a motion prediction: ``start`` turned about the scan centroid by each
-    of the seed turns (:data:`SEARCH_TURN`), each refined by ICP; the best fit (fitness, then RMS
-    distance) is kept. Arguments and returns as :func:`register_to_map`.
+    of the seed turns (:data:`SEARCH_TURN`), each refined by ICP (:func:`register_to_map`); the best
+    fit (fitness, then RMS distance) is kept.
 
     Parameters
     ----------
-    scan_world : (n, 3) float            Thinned scan points, world frame (m).
-    map_cloud : open3d PointCloud        Map with normals, frame B (:func:`surface_map`).
-    start_world_to_body : (4, 4) float   Pose world -> B the seeds turn (last registered frame's).
-    max_correspondence : float           Coarse correspondence distance (m); the fine level uses a third.
+    scan_world : (n, 3) float                 Thinned scan points, world frame (m).
+    map_points, map_normals : (m, 3) float    Map and unit normals, frame B (m).
+    start_world_to_body : (4, 4) float        Pose world -> B the seeds turn (last registered frame's).
+    max_correspondence : float                Coarse correspondence distance (m); the fine level uses a third.
+    index : CellList, optional              :func:`map_index` of the map (built here when not given).
 
     Returns
     -------
     world_to_body : (4, 4) float, fitness : float (-), rmse : float (m) of the best seed's fine level.
     """
+    index = map_index(map_points, max_correspondence) if index is None else index
     pivot = np.mean(scan_world, axis=0)
     best = None
-    for turn in _turns(SEARCH_TURN):
+    for turn in _turn_candidates(SEARCH_TURN):
         seed = np.array(start_world_to_body, float)
         seed[:3, :3] = turn @ start_world_to_body[:3, :3]
         seed[:3, 3] = start_world_to_body[:3, :3] @ pivot + start_world_to_body[:3, 3] - seed[:3, :3] @ pivot
-        pose, fitness, rmse = register_to_map(scan_world, map_cloud, seed, max_correspondence)
+        pose, fitness, rmse = register_to_map(scan_world, map_points, map_normals, seed, max_correspondence, index)
         if best is None or (round(fitness, 2), -rmse) > (round(best[1], 2), -best[2]):
             best = (pose, fitness, rmse)
     return best
 
 
-def map_information(scan_world, world_to_body, map_points, map_normals, max_correspondence, tree=None) -> np.ndarray:
+def map_information(scan_world, world_to_body, map_points, map_normals, max_correspondence, index=None) -> np.ndarray:
     """Point-to-plane information (6, 6) of a registered scan (rotation first, frame B, 1/rad^2 and
     1/m^2): the scan points within a third of ``max_correspondence`` of the map, on the planes of
-    their nearest map points, residual scatter measured. ``tree``: KD-tree of ``map_points`` if built.
+    their nearest map points, residual scatter measured. ``index``: :func:`map_index` of the map if built.
 
     Parameters
     ----------
@@ -313,7 +318,7 @@ def map_information(scan_world, world_to_body, map_points, map_normals, max_corr
     map_points, map_normals : (m, 3) float    Map points (m) and unit normals, frame B.
     max_correspondence : float                Coarse correspondence distance (m); points within a
                                               third of it count.
-    tree : scipy cKDTree, optional            KD-tree of ``map_points`` (built here when not given).
+    index : CellList, optional              :func:`map_index` of the map (built here when not given).
 
     Returns
     -------
@@ -321,8 +326,8 @@ def map_information(scan_world, world_to_body, map_points, map_normals, max_corr
                                               (1/rad^2, 1/m^2, 1/(rad m)); zeros below 6 matches.
     """
     body = _transform(scan_world, world_to_body)
-    tree = cKDTree(map_points) if tree is None else tree
-    gap, nearest = tree.query(body, distance_upper_bound=max_correspondence / 3)
+    index = map_index(map_points, max_correspondence) if index is None else index
+    gap, nearest = index.query(body, distance_upper_bound=max_correspondence / 3)
     matched = np.isfinite(gap)
     if matched.sum() < 6:
         return np.zeros((6, 6))
@@ -361,50 +366,55 @@ def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA,
     poses = np.tile(np.eye(4), (k, 1, 1))
     ok = np.zeros(k, bool)
     fitness, rmse, seconds, cpu = np.zeros(k), np.full(k, np.nan), np.zeros(k), np.zeros(k)
-    map_cloud = tree = None
+    points = normals = index = None
     pending, built = [], 0
     for i, scan in enumerate(thin):
         tic, cpu_tic = time.perf_counter(), time.process_time()
         if len(scan) < MIN_POINTS:
             seconds[i] = time.perf_counter() - tic
             continue
-        if map_cloud is None:   # the first scan defines B: world axes, origin at its centroid
+        if points is None:   # the first scan defines B: world axes, origin at its centroid
             poses[i, :3, 3] = -scan.mean(axis=0)
-            map_cloud, built = surface_map(_transform(scan, poses[i]), voxel), i
-            tree = cKDTree(np.asarray(map_cloud.points))
+            points, normals, index = _built_map(_transform(scan, poses[i]), voxel, max_correspondence)
+            built = i
             ok[i], fitness[i], rmse[i] = True, 1.0, 0.0
             seconds[i] = time.perf_counter() - tic
             continue
         good = np.flatnonzero(ok[:i])
         if len(good) >= 2 and good[-1] == i - 1 and good[-2] == i - 2:
-            pose = register_with_motion_prior(scan, np.asarray(map_cloud.points), np.asarray(map_cloud.normals),
-                                              predict_world_to_body(poses[i - 1], poses[i - 2]),
-                                              max_correspondence, prior_sigma, tree)
+            pose = register_with_motion_prior(scan, points, normals, predict_world_to_body(poses[i - 1], poses[i - 2]),
+                                              max_correspondence, prior_sigma, index)
         elif second_pose is not None and len(good) == 1:
-            pose, _, _ = register_to_map(scan, map_cloud, second_pose, max_correspondence)
+            pose, _, _ = register_to_map(scan, points, normals, second_pose, max_correspondence, index)
         else:
-            pose, _, _ = search_pose(scan, map_cloud, poses[good[-1]], max_correspondence)
-        fitness[i], rmse[i] = map_fit(scan, pose, tree, max_correspondence / 3)
+            pose, _, _ = search_pose(scan, points, normals, poses[good[-1]], max_correspondence, index)
+        fitness[i], rmse[i] = map_fit(scan, pose, index, max_correspondence / 3)
         poses[i] = pose
         ok[i] = fitness[i] >= MIN_FITNESS
         if ok[i]:
             pending.append(_transform(scan, pose))
             if fitness[i] < MAP_COVERED or i - built >= MAP_INTERVAL:
-                map_cloud = surface_map(np.vstack([np.asarray(map_cloud.points)] + pending), voxel)
-                tree, pending, built = cKDTree(np.asarray(map_cloud.points)), [], i
+                points, normals, index = _built_map(np.vstack([points] + pending), voxel, max_correspondence)
+                pending, built = [], i
         seconds[i] = time.perf_counter() - tic
         cpu[i] = time.process_time() - cpu_tic
-    if map_cloud is None:
+    if points is None:
         return MapTrack(poses, ok, fitness, rmse, np.zeros((k, 6, 6)), seconds, np.zeros((0, 3)), np.zeros((0, 3)), cpu)
     return _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence, cpu)
 
 
+def _built_map(points_body, voxel, max_correspondence):
+    """Map points (n, 3) and normals (n, 3) (frame B, m) of registered surface points, and their index."""
+    cloud = surface_map(points_body, voxel)
+    points, normals = np.asarray(cloud.points), np.asarray(cloud.normals)
+    return points, normals, map_index(points, max_correspondence)
+
+
 def _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence, cpu=None) -> MapTrack:
     """The track with the map rebuilt from all registered scans and each frame's information."""
-    cloud = surface_map(np.vstack([_transform(thin[i], poses[i]) for i in np.flatnonzero(ok)]), voxel)
-    points, normals = np.asarray(cloud.points), np.asarray(cloud.normals)
-    tree = cKDTree(points)
-    information = np.array([map_information(thin[i], poses[i], points, normals, max_correspondence, tree) if ok[i]
+    points, normals, index = _built_map(np.vstack([_transform(thin[i], poses[i]) for i in np.flatnonzero(ok)]),
+                                        voxel, max_correspondence)
+    information = np.array([map_information(thin[i], poses[i], points, normals, max_correspondence, index) if ok[i]
                             else np.zeros((6, 6)) for i in range(len(thin))])
     return MapTrack(poses, ok, fitness, rmse, information, seconds, points, normals, cpu)
 

@@ -467,11 +467,13 @@ def _record(frames, t, phase, points, true_rot, true_com):
     frames.true_com_world.append(true_com)
 
 
-def _register(tracker, frames, t, phase, points, sensor_world, true_rot, true_com, symmetries, target_to_body=np.eye(3)):
+def _register(tracker, frames, t, phase, points, sensor_world, true_rot, true_com, symmetries, target_to_body=np.eye(3),
+              all_returns=None):
     """Register a scan (a tiny one is recorded as failed by the tracker) and score it against the
     true attitude (target -> world ``true_rot``; ``target_to_body`` (3, 3) the truth's rotation into
-    the tracker's frame B: identity when B is the target frame)."""
-    alignment = tracker.update(t, points, sensor_world)
+    the tracker's frame B: identity when B is the target frame). ``all_returns`` (m, 3) (m, world):
+    every return of the frame when ``points`` is the debris' share of them, for the free-space check."""
+    alignment = tracker.update(t, points, sensor_world, all_returns_world=all_returns)
     _record(frames, t, phase, points, true_rot, true_com)
     frames.rotation_error.append(rotation_error(alignment.body_to_world[:3, :3], true_rot @ target_to_body.T, symmetries)
                                  if alignment.ok else np.nan)
@@ -594,7 +596,7 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         predicted = carried_by_chaser(estimate, start_pose, chaser_pose)
         on_net = nearest_segments(points, predicted, net.threads)[2] < NET_GATE if len(points) else np.zeros(0, bool)
         _register(tracker, frames, t, 1, _crop_to_predicted(tracker, points[~on_net]), sensor_world, rot, com,
-                  symmetries, target_to_body[:3, :3])
+                  symmetries, target_to_body[:3, :3], all_returns=points)
         # The net's nodes are fitted to the returns the debris does not explain, the rim held at
         # the rod tips.
         alignment = tracker.alignments[-1]

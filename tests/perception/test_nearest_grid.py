@@ -3,7 +3,7 @@ import numpy as np
 import trimesh
 from scipy.spatial import cKDTree
 
-from perception.nearest_grid import NearestPointGrid
+from perception.nearest_grid import CellList, NearestPointGrid
 from perception.registration import known_shape_model
 
 VOXEL = 0.03
@@ -41,3 +41,22 @@ def test_grid_finds_nothing_beyond_reach():
     far = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.7 + 0.2], [5.0, 0.0, 0.0]])   # centre, 0.2 m out, outside the grid
     gap, index = grid.query(far, distance_upper_bound=0.1)
     assert np.all(np.isinf(gap)) and np.all(index == len(points))
+
+
+def test_cell_list_is_the_kd_tree_within_any_bound():
+    # The cell list (perception.nearest_grid.CellList, the scan-to-map track's map index) searches
+    # shells of cells until no point outside them can be nearer: the same nearest point and distance
+    # as scipy's exact KD-tree for every bound (ties aside: random points have none), whether the
+    # query is near the surface (2 cm noise), far off it, or outside the grid.
+    points, _ = _sphere_model()
+    cells = CellList(points, 0.1 / 3, 0.1)
+    tree = cKDTree(points)
+    rng = np.random.default_rng(2)
+    near = points[rng.choice(len(points), 2000)] + rng.normal(0.0, 0.02, (2000, 3))
+    far = rng.uniform(-1.2, 1.2, (500, 3))
+    for queries in (near, far):
+        for bound in (0.1 / 3, 0.05, 0.1, 0.3):
+            gap, index = cells.query(queries, distance_upper_bound=bound)
+            exact_gap, exact_index = tree.query(queries, distance_upper_bound=bound)
+            assert np.array_equal(index, exact_index), bound
+            assert np.array_equal(gap, exact_gap), bound
