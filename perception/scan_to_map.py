@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import open3d as o3d
 
-from multibody.rotations import rotation_vector_from_matrix
+from multibody.maths.rotations import rotation_vector_from_matrix
 from perception.nearest_grid import CellList
 from perception.normals import surface_normals
 from perception.point_to_plane import point_to_plane_information, tukey_normal_equations
