@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -28,7 +29,8 @@ from riskassess.cases.towing import TowingCase
 from riskassess.products import results
 from riskassess.stages.identify import run_optimizers
 from riskassess.stages.identify_fullnet import _entry, full_net_runs, lower_order_case
-from bench_identify import TABLE6_INITIAL_GUESSES
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+from bench_identify import TABLE6_INITIAL_GUESSES  # noqa: E402
 
 #: Boonrath et al. 2024 Sec. 4.4 (10 training + 10 validation runs, 275 s of towing): per cost, per optimizer
 #: run, (training cost, validation cost): Tables 7 and 10 (f1), 8 and 10 (f2).

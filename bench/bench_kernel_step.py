@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -23,7 +24,8 @@ import numpy as np
 import multibody.kernel_net as kernel_net_module
 from multibody.impact import ImpactSimulation
 
-from bench_impact import sized_inputs
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+from bench_impact import sized_inputs  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
