@@ -39,10 +39,12 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import json
 import os
 import re
 import tempfile
 import time
+import tomllib
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
 from pathlib import Path
@@ -81,15 +83,38 @@ def case_text(text: str, variant: str, replica: int, first_mode: float | None) -
         joint_extra.append(f"first_mode_hz = {first_mode / 2 if variant == 'stiffness/4' else first_mode:g}")
     if variant == "damping 0.1":
         joint_extra.append("penalty_damping_ratio = 0.1")
-    if joint_extra:
-        text = re.sub(r'^(kind = "(revolute|clamped)".*)$', lambda m: "\n".join([m.group(1)] + joint_extra), text,
-                      flags=re.M)
+    if joint_extra:         # numerical joints only: a member's springs and damping are the structure's
+        blocks = text.split("[[target.joints]]")
+        text = "[[target.joints]]".join(blocks[:1] + [
+            b if re.search(r"^member\s*=", b, flags=re.M) else
+            re.sub(r'^(kind = "(revolute|clamped)".*)$', lambda m: "\n".join([m.group(1)] + joint_extra), b,
+                   count=1, flags=re.M)
+            for b in blocks[1:]])
     if variant == "step/2":
         text = _sub(r"^step = ([0-9.e-]+)", lambda m: f"step = {float(m.group(1)) / 2:g}", text)
     if variant == "output 2x":
         text = _sub(r"^output_rate = ([0-9.e]+)", lambda m: f"output_rate = {2 * float(m.group(1)):g}", text)
     return _sub(r"^velocity = ([0-9.e+-]+)",
                 lambda m: f"velocity = {float(m.group(1)) * (1 + replica * REPLICA_OFFSET)!r}", text)
+
+
+def with_members(text: str, specs: list[str], modulus: float, shear_modulus: float, damping: float) -> str:
+    """The case text with each ``JOINT:LENGTH`` joint carrying its member's compliance (``member`` on the joint):
+    the section and beam axis of the weak location on that joint, ``LENGTH`` (m), the moduli (Pa) and the
+    member's damping ratio."""
+    locations = tomllib.loads(text)["structures"]["weak_locations"]
+    for spec in specs:
+        joint, length = spec.split(":")
+        location = next((loc for loc in locations if loc["joint"] == joint and "section" in loc), None)
+        if location is None:
+            raise SystemExit(f"--member {spec}: no weak location with a section on joint '{joint}'")
+        section = ", ".join(f"{k} = {json.dumps(v)}" for k, v in location["section"].items())
+        member = (f'member = {{ length = {float(length)!r}, section = {{ {section} }}, modulus = {modulus!r}, '
+                  f'shear_modulus = {shear_modulus!r}, beam_axis = {json.dumps(location["beam_axis"])}, '
+                  f'source = "bench --member {spec}: the weak location\'s section" }}\n'
+                  f'penalty_damping_ratio = {damping!r}')
+        text = _sub(rf'^name = "{re.escape(joint)}".*$', lambda m: m.group(0) + "\n" + member, text)
+    return text
 
 
 def simulate(text: str, base_dir: str, stiffness_scale: float, out: str) -> str:
@@ -226,12 +251,23 @@ def main() -> None:
     parser.add_argument("--cache", default=None, help="folder of the runs' raw joint reactions")
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--markdown", action="store_true", help="one markdown table (docs/structures.md)")
+    parser.add_argument("--member", action="append", default=[], metavar="JOINT:LENGTH",
+                        help="give this clamped joint its member's compliance: the section of its weak location, "
+                             "LENGTH (m) and --member-moduli (docs/structures.md)")
+    parser.add_argument("--member-moduli", default="114e9,44e9", help="E,G of --member (Pa); default Ti-6Al-4V")
+    parser.add_argument("--member-damping", type=float, default=0.02, help="damping ratio of --member (-)")
+    parser.add_argument("--output-rate", type=float, default=None, help="baseline output rate (Hz)")
     args = parser.parse_args()
     case_path = Path(args.case).resolve()
     text = case_path.read_text()
     if 'release = "low"' not in text:      # otherwise the peaks would be cut at each joint's release
         raise SystemExit(f"{args.case}: expected release = \"low\" in [structures] to switch it off")
     text = text.replace('release = "low"', 'release = "never"', 1)
+    if args.member:
+        modulus, shear_modulus = (float(v) for v in args.member_moduli.split(","))
+        text = with_members(text, args.member, modulus, shear_modulus, args.member_damping)
+    if args.output_rate:
+        text = _sub(r"^output_rate = [0-9.e]+", f"output_rate = {args.output_rate:g}", text)
     if args.end_time:
         text = _sub(r"^end_time = [0-9.e]+", f"end_time = {args.end_time:g}", text)
     tag = hashlib.sha256(f"{text}{args.first_mode}".encode()).hexdigest()[:12]

@@ -67,6 +67,10 @@ class JointSpec:
     first_mode_hz : float or None     The structure's own first mode on this joint (Hz): the
                                       penalty springs not given explicitly are set from it instead
                                       of from the step (multibody.hinge.joint_stiffness_joint_frame).
+    structural_stiffness : (6,) float or None   The structure's own springs on [x, y, z] (N/m) and
+                                      [rot h1, rot h2, rot h3] (N m/rad), joint frame, e.g. a member's
+                                      compliance lumped at its root (structures.member); replaces
+                                      every penalty spring of the joint.
     """
 
     name: str
@@ -81,6 +85,7 @@ class JointSpec:
     penalty_rotational: float | None = None
     penalty_damping_ratio: float = 0.05
     first_mode_hz: float | None = None
+    structural_stiffness: np.ndarray | None = None
 
 
 def subtree_bodies(joints: list[JointSpec], root: int, cut_joints=()) -> list[int]:

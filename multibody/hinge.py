@@ -173,6 +173,8 @@ def joint_stiffness_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: 
         Spring stiffness on [x, y, z] (N/m) and [rot h1, rot h2, rot h3] (N m/rad), hinge frame.
     """
     inertia = effective_mass_joint_frame(joint, parent, child)
+    if joint.structural_stiffness is not None:
+        return _resolved_structural_stiffness(joint, parent, child, step)
     if joint.first_mode_hz is not None:
         omega = 2.0 * np.pi * joint.first_mode_hz
         if omega * step > 2.0 * np.pi / STRUCTURAL_STEPS_PER_PERIOD:
@@ -198,6 +200,42 @@ def joint_stiffness_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: 
             f"{omega_step.max() / step:.3g} rad/s, too fast for the step {step:g} s (limit 1/step); "
             f"lower the penalty stiffness (or omit it for the automatic value) or reduce simulation.step")
     return k
+
+
+def _resolved_structural_stiffness(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec,
+                                   step: float) -> np.ndarray:
+    """The joint's own structural springs, refused when a mode they make has fewer than
+    ``STRUCTURAL_STEPS_PER_PERIOD`` steps per period (each axis alone, the others rigid)."""
+    k = np.asarray(joint.structural_stiffness, float).copy()
+    frequency_hz = np.sqrt(k / coupled_mode_inertia_joint_frame(joint, parent, child)) / (2.0 * np.pi)
+    if frequency_hz.max() * step * STRUCTURAL_STEPS_PER_PERIOD > 1.0:
+        axis = ["x", "y", "z", "rot h1", "rot h2", "rot h3"][int(frequency_hz.argmax())]
+        raise ValueError(
+            f"joint '{joint.name}': its structural stiffness {k[frequency_hz.argmax()]:.3g} on {axis} rings at "
+            f"{frequency_hz.max():.3g} Hz, fewer than {STRUCTURAL_STEPS_PER_PERIOD} steps of {step:g} s per period; "
+            f"reduce simulation.step below {1.0 / (STRUCTURAL_STEPS_PER_PERIOD * frequency_hz.max()):.3g} s")
+    return k
+
+
+def structural_modes_hz(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec, step: float) -> np.ndarray:
+    """The frequencies (Hz) at which each joint axis alone rings with the springs the run uses.
+
+    Parameters
+    ----------
+    joint : JointSpec
+        The joint.
+    parent, child : RigidBodySpec
+        The two bodies it connects.
+    step : float
+        The run's step (s), which sets the automatic penalty springs.
+
+    Returns
+    -------
+    (6,) float
+        [x, y, z, rot h1, rot h2, rot h3] (Hz), each axis alone, the other five rigid, both bodies free.
+    """
+    k = joint_stiffness_joint_frame(joint, parent, child, step)
+    return np.sqrt(k / coupled_mode_inertia_joint_frame(joint, parent, child)) / (2.0 * np.pi)
 
 
 def joint_damping_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec,

@@ -21,6 +21,7 @@ class SectionProperties:
     shear_per_force2: float     # (1/m^2)
     shear_per_force3: float     # (1/m^2)
     round: bool = False         # bending peaks combine as a resultant (circular tube)
+    torsion_constant: float | None = None   # Saint-Venant J (m^4), where the shape gives it (member stiffness)
 
 
 class SectionShape(Protocol):
@@ -56,7 +57,8 @@ class SectionShape(Protocol):
         """
 
 
-def bending_properties(area, i2, i3, c2, c3, torsion, shear2, shear3, round_=False) -> SectionProperties:
+def bending_properties(area, i2, i3, c2, c3, torsion, shear2, shear3, round_=False,
+                       torsion_constant=None) -> SectionProperties:
     """Section properties from the area (m^2), second moments I2, I3 (m^4), extreme-fibre distances
     c2, c3 (m), and the peak shear stresses per unit torque (1/m^3) and per unit shear force along
     axes 2 and 3 (1/m^2); ``round_``: bending peaks combine as a resultant.
@@ -75,6 +77,9 @@ def bending_properties(area, i2, i3, c2, c3, torsion, shear2, shear3, round_=Fal
         Peak transverse shear stress per unit shear force along axes 2 and 3 (Pa per N = 1/m^2).
     round_ : bool
         True for a circular section: the bending peaks combine as a resultant.
+    torsion_constant : float or None
+        Saint-Venant torsion constant J (m^4), the twist stiffness GJ per unit length; None where the
+        shape does not give it (a member's stiffness then cannot be derived from it).
 
     Returns
     -------
@@ -84,4 +89,4 @@ def bending_properties(area, i2, i3, c2, c3, torsion, shear2, shear3, round_=Fal
     return SectionProperties(area=area, second_moment_2=i2, second_moment_3=i3,
                              normal_per_axial=1.0 / area, normal_per_moment2=c3 / i2, normal_per_moment3=c2 / i3,
                              shear_per_torque=torsion, shear_per_force2=shear2, shear_per_force3=shear3,
-                             round=round_)
+                             round=round_, torsion_constant=torsion_constant)

@@ -237,6 +237,63 @@ class Body(Strict):
         return j if j is None else check_physical_inertia(j)
 
 
+#: A dimension of a cross-section (m): a cut through a spacecraft member. The widest rocket bodies in
+#: orbit are about 4-5 m across; 20 m bounds every member while the section formulas (fourth powers of
+#: the dimensions) stay far from float overflow.
+SectionLength = Annotated[float, Field(gt=0, le=20.0)]
+
+
+def _section_model(shape) -> type[Strict]:
+    """The case schema of one cross-section shape (:mod:`structures.section_shapes`): its ``kind`` and
+    its dimensions, each a :data:`SectionLength` described as the shape describes it."""
+    fields = {"kind": (Literal[shape.NAME], ...)}
+    fields.update({name: (SectionLength, Field(description=text)) for name, text in shape.DIMENSIONS.items()})
+    return create_model(_model_class_name(shape.NAME), __base__=Strict, __module__=__name__, **fields)
+
+
+#: Section kind -> its schema, one per shape file of structures/section_shapes.
+SECTION_MODELS = {name: _section_model(shape) for name, shape in SHAPES.items()}
+Section = Annotated[Union[tuple(SECTION_MODELS.values())], Field(discriminator="kind")]
+
+
+def section_properties(spec):
+    """Section properties (the plug-in of :mod:`structures.section_shapes` named by ``kind``) from a case
+    section table (raises ValueError for impossible dimensions).
+
+    Parameters
+    ----------
+    spec : Section
+        A validated ``section`` table: ``kind`` and the shape's dimensions (m).
+
+    Returns
+    -------
+    structures.section_base.SectionProperties
+    """
+    params = spec.model_dump()
+    return SHAPES[params.pop("kind")].properties(**params)
+
+
+class Member(Strict):
+    """The structural member behind a clamped joint: its compliance becomes the joint's springs."""
+
+    length: SectionLength = Field(description="Member length from the joint to the body it carries (m).")
+    section: Section = Field(description="The member's cross-section (a circular_tube: its torsion constant is known).")
+    modulus: Positive = Field(description="Young's modulus E (Pa).")
+    shear_modulus: Positive = Field(description="Shear modulus G (Pa).")
+    beam_axis: Vector3 = Field(description="Direction of the member, target frame (-): along one of the joint's "
+                                           "axes h1, h2, h3.")
+    source: Text = Field(description="Where the values come from (a drawing, an FE model, an assumption and why): "
+                                     "the joint's loads rest on them.")
+
+    @field_validator("section")
+    @classmethod
+    def _torsion_known(cls, section):
+        if section_properties(section).torsion_constant is None:
+            raise ValueError(f"a member's section must give its torsion constant; '{section.kind}' does not "
+                             f"(use circular_tube)")
+        return section
+
+
 class Joint(Strict):
     name: ItemName = Field(description="Joint name; weak locations name it.")
     kind: Literal["revolute", "clamped"] = Field(description="Hinge with torsional spring-damper, or clamped.")
@@ -258,6 +315,11 @@ class Joint(Strict):
         None, description="The structure's own first mode on this joint (Hz), from its FE model or a test: the "
                           "penalty springs not given explicitly then carry the structure's compliance instead of a "
                           "stiffness tuned to the step (needs at least 20 steps per period).")
+    member: Member | None = Field(
+        None, description="The member behind a clamped joint (its section, length and moduli): its axial, shear, "
+                          "torsion and bending compliance, lumped at the root, become the joint's six springs, so its "
+                          "loads no longer rest on a penalty stiffness (docs/structures.md); penalty_damping_ratio is "
+                          "then the member's damping. Not with first_mode_hz or the penalty keys.")
 
     @model_validator(mode="after")
     def _revolute_fields(self):
@@ -265,6 +327,13 @@ class Joint(Strict):
             raise ValueError("axis must be a non-zero vector")
         if self.kind == "clamped" and (self.torsional_stiffness or self.initial_angle or self.initial_rate):
             raise ValueError("a clamped joint takes no torsional_stiffness, initial_angle or initial_rate")
+        if self.member is not None:
+            if self.kind != "clamped":
+                raise ValueError("'member' is for a clamped joint (a revolute joint's hinge axis is its spring)")
+            given = [k for k in ("first_mode_hz", "penalty_translational", "penalty_rotational")
+                     if getattr(self, k) is not None]
+            if given:
+                raise ValueError(f"'member' sets all six springs of the joint; remove {', '.join(given)}")
         return self
 
 
@@ -393,42 +462,6 @@ class Perception(Strict):
 
 # ---------------------------------------------------------------------------- structures
 ValueOrRange = Union[Positive, Annotated[list[Positive], Field(min_length=2, max_length=2)]]
-#: A dimension of a cross-section (m): a cut through a spacecraft member. The widest rocket bodies in
-#: orbit are about 4-5 m across; 20 m bounds every member while the section formulas (fourth powers of
-#: the dimensions) stay far from float overflow.
-SectionLength = Annotated[float, Field(gt=0, le=20.0)]
-
-
-def _section_model(shape) -> type[Strict]:
-    """The case schema of one cross-section shape (:mod:`structures.section_shapes`): its ``kind`` and
-    its dimensions, each a :data:`SectionLength` described as the shape describes it."""
-    fields = {"kind": (Literal[shape.NAME], ...)}
-    fields.update({name: (SectionLength, Field(description=text)) for name, text in shape.DIMENSIONS.items()})
-    return create_model(_model_class_name(shape.NAME), __base__=Strict, __module__=__name__, **fields)
-
-
-#: Section kind -> its schema, one per shape file of structures/section_shapes.
-SECTION_MODELS = {name: _section_model(shape) for name, shape in SHAPES.items()}
-Section = Annotated[Union[tuple(SECTION_MODELS.values())], Field(discriminator="kind")]
-
-
-def section_properties(spec):
-    """Section properties (the plug-in of :mod:`structures.section_shapes` named by ``kind``) from a case
-    section table (raises ValueError for impossible dimensions).
-
-    Parameters
-    ----------
-    spec : Section
-        A validated ``section`` table: ``kind`` and the shape's dimensions (m).
-
-    Returns
-    -------
-    structures.section_base.SectionProperties
-    """
-    params = spec.model_dump()
-    return SHAPES[params.pop("kind")].properties(**params)
-
-
 class Material(Strict):
     modulus: Positive | None = Field(None, description="Young's modulus (Pa); informational, stresses do not need it.")
     ultimate_normal: ValueOrRange = Field(description="Ultimate normal stress (Pa), a value or [low, high].")
@@ -547,6 +580,10 @@ class Case(Strict):
         """A location read through its structure's mode: the joint stays stiff (its own first_mode_hz
         would count the compliance twice) and the samples resolve the mode."""
         joint = next(j for j in self.target.joints if j.name == loc.joint)
+        if joint.member is not None:
+            raise ValueError(f"structures: weak location '{loc.name}': structural_mode_hz reads the loads of joint "
+                             f"'{joint.name}' through a mode, but that joint already has its member's compliance in "
+                             f"the dynamics; give the structure's compliance in one place")
         if joint.first_mode_hz is not None:
             raise ValueError(f"structures: weak location '{loc.name}': structural_mode_hz reads the loads of joint "
                              f"'{joint.name}' through a mode, but that joint already has first_mode_hz = "

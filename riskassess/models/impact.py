@@ -21,6 +21,7 @@ from multibody.orbit import mean_motion
 from riskassess.cases.impact import Case, CircularOrbit, section_properties
 from riskassess.cases.target_geometry import body_meshes_target_frame, target_points_lvlh, target_pose_lvlh
 from structures.criteria import Allowable
+from structures.member import member_stiffness_joint_frame
 from structures.modal_load import mode_grid
 from structures.weak_location import WeakLocation
 
@@ -187,10 +188,24 @@ def build_bodies_and_joints(case: Case, base: Path):
             name=j.name, kind=j.kind, parent=parent, child=child, point_lvlh=point, hinge_to_lvlh=frame,
             torsional_stiffness=j.torsional_stiffness, torsional_damping=j.torsional_damping,
             penalty_translational=j.penalty_translational, penalty_rotational=j.penalty_rotational,
-            penalty_damping_ratio=j.penalty_damping_ratio, first_mode_hz=j.first_mode_hz))
+            penalty_damping_ratio=j.penalty_damping_ratio, first_mode_hz=j.first_mode_hz,
+            structural_stiffness=_member_springs(j, frame, target_to_lvlh)))
         if j.initial_angle or j.initial_rate:
             _apply_initial_hinge_state(bodies, joints, len(joints) - 1, j.initial_angle, j.initial_rate)
     return bodies, joints, rest_attitudes, rest_coms
+
+
+def _member_springs(joint, hinge_to_lvlh, target_to_lvlh):
+    """The joint's six springs from its member's compliance (structures.member), or None."""
+    if joint.member is None:
+        return None
+    m = joint.member
+    beam_axis_joint = hinge_to_lvlh.T @ (target_to_lvlh @ np.asarray(m.beam_axis, float))
+    try:
+        return member_stiffness_joint_frame(section_properties(m.section), m.length, m.modulus, m.shear_modulus,
+                                            beam_axis_joint)
+    except ValueError as exc:
+        raise ValueError(f"target.joints '{joint.name}'.member: {exc}") from None
 
 
 def _apply_initial_hinge_state(bodies, joints, index, angle, rate):

@@ -43,7 +43,8 @@ def circular_tube(outer_diameter: float, wall: float) -> SectionProperties:
     area = math.pi * (d_out**2 - d_in**2) / 4.0
     i = math.pi * (d_out**4 - d_in**4) / 64.0
     shear = ((d_out**3 - d_in**3) / 12.0) / (i * (d_out - d_in))
-    return bending_properties(area, i, i, d_out / 2.0, d_out / 2.0, (d_out / 2.0) / (2.0 * i), shear, shear, round_=True)
+    return bending_properties(area, i, i, d_out / 2.0, d_out / 2.0, (d_out / 2.0) / (2.0 * i), shear, shear, round_=True,
+                              torsion_constant=2.0 * i)
 
 
 #: The shape's section properties from its dimensions (m); ValueError for impossible ones.
