@@ -45,7 +45,7 @@ import re
 import tempfile
 import time
 import tomllib
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import replace
 from pathlib import Path
 
@@ -53,7 +53,7 @@ import numpy as np
 
 import multibody.hinge as hinge
 from multibody.health import SimulationFailed
-from riskassess.cases.impact import load_case
+from riskassess.cases.impact import validate_case
 from riskassess.models.impact import model_inputs, weak_locations
 from riskassess.stages.run import run_case
 from structures.modal_load import mode_grid
@@ -140,19 +140,37 @@ def simulate(text: str, base_dir: str, stiffness_scale: float, out: str) -> str:
     return out
 
 
-def peaks(locations, run, modes, damping: float, skip: float) -> dict:
-    """{"location / criterion": {window: peak}} of one run's joint reactions, read through ``modes``
-    (Hz; empty: as recorded)."""
+def histories(locations, run, modes, damping: float, in_dynamics: set) -> dict:
+    """{"location / criterion": demand history} of one run's joint reactions, read through ``modes`` (Hz;
+    empty: as recorded); a location whose joint carries its member (``in_dynamics``, joint indices) is
+    always read as recorded (its compliance is already in the run)."""
     t, force, moment = run["time"], run["force"], run["moment"]
-    windows = {f"first {skip:g} s": t < skip, "judged": t >= skip, "whole run": t >= 0} if skip > 0 else {
-        "whole run": t >= 0}
     out = {}
     for loc in locations:
-        loc = replace(loc, structural_modes_hz=tuple(modes), structural_damping_ratio=damping)
+        own = () if loc.joint in in_dynamics else tuple(modes)
+        loc = replace(loc, structural_modes_hz=own, structural_damping_ratio=damping)
         series = judged_demands(loc, t, force[:, loc.joint], moment[:, loc.joint])
         for criterion in loc.criteria():
-            out[f"{loc.name} / {criterion}"] = {w: float(series[criterion][m].max()) for w, m in windows.items()}
+            out[f"{loc.name} / {criterion}"] = series[criterion]
     return out
+
+
+def parting_time(time: np.ndarray, replicas: list[np.ndarray]) -> float:
+    """When replicas of one demand part (s): the first sample at which their peaks so far (running maxima)
+    differ from the median's by more than ``TOLERANCE``; past the end of the run if they never do. Before it,
+    every replica's peak is the same within the tolerance (a phase drift of a ringing load that leaves its
+    peaks alone does not count)."""
+    running = np.maximum.accumulate(np.array(replicas), axis=1)
+    median = np.median(running, axis=0)
+    apart = np.flatnonzero(np.abs(running - median).max(axis=0) > TOLERANCE * np.maximum(np.abs(median), 1e-300))
+    return float(time[apart[0]]) if apart.size else float(time[-1]) + 1.0
+
+
+def window_peaks(time, series, skip: float, parting: float) -> dict:
+    """The peak of one demand in each window (``nan`` for an empty one): before the replicas part
+    (deterministic; from t = 0), after they part and after ``skip`` (chaotic), after ``skip`` (judged)."""
+    windows = {"deterministic": time < parting, "chaotic": time >= max(skip, parting), "judged": time >= skip}
+    return {w: float(series[m].max()) if m.any() else float("nan") for w, m in windows.items()}
 
 
 def median_change(base: np.ndarray, variant: np.ndarray, rng) -> tuple[float, float, float]:
@@ -165,69 +183,89 @@ def median_change(base: np.ndarray, variant: np.ndarray, rng) -> tuple[float, fl
     return change, low, high
 
 
+def median_precision(base: np.ndarray, rng) -> float:
+    """Half-width of the 90 % bootstrap interval of the baseline's median, relative to it: how well the
+    replicas know the median at all."""
+    draws = np.median(rng.choice(base, (BOOTSTRAP_DRAWS, base.size)), axis=1) / np.median(base) - 1.0
+    low, high = np.percentile(draws, [5, 95])
+    return float(max(-low, high))
+
+
 def verdict(change: float, low: float, high: float) -> str:
-    """'ok' within the tolerance, 'NOT CONVERGED' beyond it, 'unresolved' when the interval straddles it."""
+    """'ok' within the tolerance; 'within statistical error' when the interval holds 0 but not the
+    tolerance (the replicas do not resolve a change of that size, none is seen); 'NOT CONVERGED' when the
+    interval lies beyond the tolerance; 'unresolved' otherwise (a change is seen, smaller than or straddling
+    the tolerance)."""
     if max(abs(low), abs(high), abs(change)) <= TOLERANCE:
         return "ok"
     if low > TOLERANCE or high < -TOLERANCE:
         return "NOT CONVERGED"
+    if low <= 0.0 <= high:
+        return "within statistical error"
     return "unresolved"
 
 
-def report(results: dict, replicas: int, locations, readings: dict, skip: float, markdown: bool = False) -> None:
-    """Per reading, window, location and criterion: baseline median [range], spread, each variant's
-    change of the median with its bootstrap interval and verdict (``markdown``: one table, the
-    judged window and the first one, for docs/structures.md)."""
-    rng = np.random.default_rng(0)
+MARKS = {"ok": "", "within statistical error": " ~", "unresolved": " ?", "NOT CONVERGED": " **x**"}
+
+
+def reading_table(results: dict, replicas: int, locations, modes, damping, skip: float, in_dynamics: set) -> dict:
+    """{key: {"parting": s, "peaks": {variant: [{window: peak} per replica]}}} for one reading."""
     ran = {v: [results[(v, r)] for r in range(replicas) if not isinstance(results[(v, r)], str)] for v in VARIANTS}
-    names = [v for v in VARIANTS if v != "baseline" and ran[v]]
+    runs = {v: [histories(locations, run, modes, damping, in_dynamics) for run in ran[v]] for v in VARIANTS if ran[v]}
+    base_time = ran["baseline"][0]["time"]
+    table = {}
+    for key in runs["baseline"][0]:
+        parting = parting_time(base_time, [h[key] for h in runs["baseline"]])
+        table[key] = {"parting": parting, "peaks": {
+            v: [window_peaks(run["time"], h[key], skip, parting) for run, h in zip(ran[v], runs[v])] for v in runs}}
+    return table
+
+
+def report(results: dict, replicas: int, locations, readings: dict, skip: float, in_dynamics: set,
+           markdown: bool = False) -> None:
+    """Per reading, location and criterion: when the replicas part, and in each window the baseline's
+    median peak [range], its spread and precision, each variant's change of the median with its bootstrap
+    interval and verdict (``markdown``: one table for docs/structures.md)."""
+    rng = np.random.default_rng(0)
+    names = [v for v in VARIANTS if v != "baseline"
+             and any(not isinstance(results[(v, r)], str) for r in range(replicas))]
     if markdown:
-        print("\n| reading | window | location / criterion | baseline median [range] | spread | "
+        print("\n| reading | location / criterion | window | baseline median [range] | spread | median known to | "
               + " | ".join(names) + " |")
-        print("|" + "---|" * (5 + len(names)))
+        print("|" + "---|" * (6 + len(names)))
     for reading, (modes, damping) in readings.items():
-        table = {v: [peaks(locations, run, modes, damping, skip) for run in ran[v]] for v in VARIANTS if ran[v]}
-        base = table["baseline"]
-        if markdown:
-            markdown_rows(reading, table, names, rng)
-            continue
-        counts = {"ok": 0, "unresolved": 0, "NOT CONVERGED": 0}
-        print(f"\n=== reading: {reading}")
-        for window in base[0][next(iter(base[0]))]:
-            print(f"\n  window: {window}")
-            print(f"  {'location / criterion':36s} {'baseline median [range]':>30s} {'spread':>7s} "
-                  + " ".join(f"{n:>28s}" for n in names))
-            for key in base[0]:
-                values = np.array([run[key][window] for run in base])
+        table = reading_table(results, replicas, locations, modes, damping, skip, in_dynamics)
+        counts = dict.fromkeys(MARKS, 0)
+        if not markdown:
+            print(f"\n=== reading: {reading} (locations whose joint carries its member: as recorded)")
+        for key, row in table.items():
+            for window in ("deterministic", "chaotic", "judged"):
+                values = np.array([p[window] for p in row["peaks"]["baseline"]])
+                if np.isnan(values).any():
+                    continue
                 med = np.median(values)
                 cells = []
                 for n in names:
-                    change, low, high = median_change(values, np.array([run[key][window] for run in table[n]]), rng)
+                    variant = np.array([p[window] for p in row["peaks"][n]])
+                    change, low, high = median_change(values, variant, rng)
                     state = verdict(change, low, high)
                     counts[state] += 1
-                    cells.append(f"{change:+6.1%} [{low:+.0%},{high:+.0%}] {'ok' if state == 'ok' else state[:5]:>5s}")
-                print(f"  {key:36s} {f'{med:.4g} [{values.min():.3g}, {values.max():.3g}]':>30s} "
-                      f"{(values.max() - values.min()) / med:7.0%} " + " ".join(f"{c:>28s}" for c in cells))
-        print(f"\n  {reading}: {counts['ok']} changes within {TOLERANCE:.0%}, {counts['unresolved']} unresolved "
-              f"(interval straddles {TOLERANCE:.0%}), {counts['NOT CONVERGED']} beyond; "
-              f"spread = (max - min) / median over the replicas, [90 % bootstrap interval]")
-
-
-def markdown_rows(reading: str, table: dict, names: list, rng) -> None:
-    """The rows of one reading in the markdown table (windows other than the whole run)."""
-    base = table["baseline"]
-    for window in [w for w in base[0][next(iter(base[0]))] if w != "whole run" or len(base[0][next(iter(base[0]))]) == 1]:
-        for key in base[0]:
-            values = np.array([run[key][window] for run in base])
-            med = np.median(values)
-            cells = []
-            for n in names:
-                change, low, high = median_change(values, np.array([run[key][window] for run in table[n]]), rng)
-                state = verdict(change, low, high)
-                mark = {"ok": "", "unresolved": " ?", "NOT CONVERGED": " **x**"}[state]
-                cells.append(f"{change:+.0%} [{low:+.0%}, {high:+.0%}]{mark}")
-            print(f"| {reading} | {window} | {key} | {med:.3g} [{values.min():.3g}, {values.max():.3g}] | "
-                  f"{(values.max() - values.min()) / med:.0%} | " + " | ".join(cells) + " |")
+                    cells.append(f"{change:+.0%} [{low:+.0%}, {high:+.0%}]{MARKS[state]}")
+                label = {"deterministic": f"deterministic, t < {row['parting']:.2f} s",
+                         "chaotic": f"chaotic, t >= {max(skip, row['parting']):.2f} s",
+                         "judged": f"judged, t >= {skip:g} s"}[window]
+                spread = (values.max() - values.min()) / med if med else float("nan")
+                known = median_precision(values, rng) if med else float("nan")
+                if markdown:
+                    print(f"| {reading} | {key} | {label} | {med:.3g} [{values.min():.3g}, {values.max():.3g}] | "
+                          f"{spread:.0%} | +-{known:.0%} | " + " | ".join(cells) + " |")
+                else:
+                    print(f"  {key:36s} {label:26s} {f'{med:.4g} [{values.min():.3g}, {values.max():.3g}]':>30s} "
+                          f"{spread:6.0%} +-{known:4.0%}  " + "  ".join(f"{n}: {c}" for n, c in zip(names, cells)))
+        if not markdown:
+            print(f"  {reading}: " + ", ".join(f"{c} {s}" for s, c in counts.items())
+                  + f" (tolerance {TOLERANCE:.0%}; spread = (max - min) / median over the replicas; "
+                    "[90 % bootstrap interval]; 'median known to': half-width of the baseline median's interval)")
 
 
 def parse_mode(text: str) -> tuple[str, np.ndarray]:
@@ -257,6 +295,7 @@ def main() -> None:
     parser.add_argument("--member-moduli", default="114e9,44e9", help="E,G of --member (Pa); default Ti-6Al-4V")
     parser.add_argument("--member-damping", type=float, default=0.02, help="damping ratio of --member (-)")
     parser.add_argument("--output-rate", type=float, default=None, help="baseline output rate (Hz)")
+    parser.add_argument("--report-only", action="store_true", help="report the runs the cache holds, run nothing")
     args = parser.parse_args()
     case_path = Path(args.case).resolve()
     text = case_path.read_text()
@@ -278,13 +317,23 @@ def main() -> None:
                      str(cache / f"{v.replace('/', '_').replace(' ', '_')}-{r}.npz"))
             for v in VARIANTS for r in range(args.replicas)}
     start, load = time.perf_counter(), os.getloadavg()[0]
-    with ProcessPoolExecutor(args.workers) as pool:
-        futures = {key: pool.submit(simulate, *job) for key, job in jobs.items()}
-        results = {key: f.result() for key, f in futures.items()}
-    results = {k: (v if v.startswith("failed") else dict(np.load(v))) for k, v in results.items()}
+    if args.report_only:        # what the cache holds so far (a partial table while the runs go on)
+        results = {key: job[3] if Path(job[3]).exists() else "missing: not run yet" for key, job in jobs.items()}
+    else:
+        with ProcessPoolExecutor(args.workers) as pool:
+            futures = {pool.submit(simulate, *job): key for key, job in jobs.items()}
+            results = {}
+            for future in as_completed(futures):
+                results[futures[future]] = future.result()
+                print(f"{len(results)}/{len(jobs)} {futures[future]} done, {time.perf_counter() - start:.0f} s wall, "
+                      f"load {os.getloadavg()[0]:.1f}", flush=True)
+    results = {k: (v if v.startswith(("failed", "missing")) else dict(np.load(v))) for k, v in results.items()}
     cpu = [float(v["cpu"]) for v in results.values() if not isinstance(v, str)]
     print(f"{args.case}, release off, joints: "
           + (f"first_mode_hz = {args.first_mode:g}" if args.first_mode else "automatic penalty")
+          + (f", members {', '.join(args.member)} (E, G = {args.member_moduli} Pa, damping {args.member_damping:g})"
+             if args.member else "")
+          + (f", output {args.output_rate:g} Hz" if args.output_rate else "")
           + f"; {len(jobs)} runs ({args.replicas} replicas each; cache {cache}) in "
           f"{time.perf_counter() - start:.0f} s wall on {args.workers} workers, load average {load:.1f} -> "
           f"{os.getloadavg()[0]:.1f}; CPU per run {np.median(cpu) if cpu else float('nan'):.1f} s (median, "
@@ -292,12 +341,13 @@ def main() -> None:
     for key, value in results.items():
         if isinstance(value, str):
             print(f"{key[0]} replica {key[1]}: {value}")
-    case = load_case(case_path)
+    case = validate_case(tomllib.loads(text), case_path)      # the case as run (with any --member)
     locations = weak_locations(case, model_inputs(case, case_path.parent).assembly)
     skip = case.structures.skip_initial if args.skip is None else args.skip
     readings = {"as recorded": ((), 0.0)}
     readings.update({label: (tuple(grid), args.mode_damping) for label, grid in map(parse_mode, args.mode)})
-    report(results, args.replicas, locations, readings, skip, args.markdown)
+    in_dynamics = {i for i, j in enumerate(case.target.joints) if j.member is not None}
+    report(results, args.replicas, locations, readings, skip, in_dynamics, args.markdown)
 
 
 if __name__ == "__main__":

@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 from multibody.assembly import (ContactLaw, ImpactAssembly, JointSpec, NetMount, RigidBodySpec, SolverSpec,
                                 subtree_bodies)
 from multibody.geometry import geometric_center_of_mass, uniform_density_inertia
-from multibody.hinge import hinge_frame_lvlh
+from multibody.hinge import hinge_frame_lvlh, structural_modes_hz
 from multibody.net import flat_square_net, thread_node_mass
 from multibody.orbit import mean_motion
 from riskassess.cases.impact import Case, CircularOrbit, section_properties
@@ -195,6 +195,25 @@ def build_bodies_and_joints(case: Case, base: Path):
     return bodies, joints, rest_attitudes, rest_coms
 
 
+#: Fewest output samples per period of the fastest mode a member's springs make: the recorded reaction of a
+#: ringing member is read at samples, and a sinusoid sampled n times per period shows at least cos(pi / n) of
+#: its peak (95 % at 10).
+MEMBER_SAMPLES_PER_PERIOD = 10
+
+
+def _check_member_sampling(joints, bodies, step: float, output_rate: float) -> None:
+    """Refuse a member whose modes the output rate does not resolve (its peaks would be read low)."""
+    for joint in joints:
+        if joint.structural_stiffness is None:
+            continue
+        fastest = structural_modes_hz(joint, bodies[joint.parent], bodies[joint.child], step).max()
+        if output_rate < MEMBER_SAMPLES_PER_PERIOD * fastest:
+            raise ValueError(f"target.joints '{joint.name}'.member: its springs ring at up to {fastest:.3g} Hz; "
+                             f"simulation.output_rate must be at least {MEMBER_SAMPLES_PER_PERIOD * fastest:.3g} Hz "
+                             f"({MEMBER_SAMPLES_PER_PERIOD} samples per period, peaks read within 5 %); got "
+                             f"{output_rate:g} Hz")
+
+
 def _member_springs(joint, hinge_to_lvlh, target_to_lvlh):
     """The joint's six springs from its member's compliance (structures.member), or None."""
     if joint.member is None:
@@ -300,6 +319,7 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
         rest_com.append(chaser.com_lvlh.copy())
     law = case.contact
     sim = case.simulation
+    _check_member_sampling(joints, bodies, sim.step, sim.output_rate)
     assembly = ImpactAssembly(
         net=net, net_velocity=velocity, bodies=bodies, joints=joints,
         contact=ContactLaw(stiffness=law.stiffness, exponent=law.exponent,

@@ -96,6 +96,7 @@ def test_a_member_too_stiff_for_the_step_is_refused():
 
 
 DISH_JOINT = 'position = [3.1875, 0.0, -3.0]\n'
+FAST_OUTPUT = ("output_rate = 1000.0", "output_rate = 5000.0")      # resolves the member's modes
 MEMBER = ('member = { length = 0.45, section = { kind = "circular_tube", outer_diameter = 0.04, wall = 0.001 }, '
           'modulus = 114e9, shear_modulus = 44e9, beam_axis = [1.0, 0.0, 0.0], source = "test" }\n')
 
@@ -107,7 +108,7 @@ def _write(tmp_path, text):
 
 
 def test_a_case_member_becomes_the_joints_springs(tmp_path):
-    case = load_case(_write(tmp_path, SMALL.replace(DISH_JOINT, DISH_JOINT + MEMBER)))
+    case = load_case(_write(tmp_path, SMALL.replace(DISH_JOINT, DISH_JOINT + MEMBER).replace(*FAST_OUTPUT)))
     joint = model_inputs(case, CASES).assembly.joints[3]
     assert joint.name == "ka_band_dish_root"
     # beam along target x = -h1 of the joint (h1 points from the dish towards the root)
@@ -123,7 +124,7 @@ def test_a_case_member_becomes_the_joints_springs(tmp_path):
 ])
 def test_bad_members_are_refused(tmp_path, change, expected):
     with pytest.raises((CaseError, ValueError)) as info:
-        case = load_case(_write(tmp_path, SMALL.replace(DISH_JOINT, DISH_JOINT + change)))
+        case = load_case(_write(tmp_path, SMALL.replace(DISH_JOINT, DISH_JOINT + change).replace(*FAST_OUTPUT)))
         model_inputs(case, CASES)
     assert expected in str(info.value)
 
@@ -135,3 +136,12 @@ def test_a_member_and_a_modal_reading_of_the_same_joint_are_refused(tmp_path):
     with pytest.raises(CaseError) as info:
         load_case(_write(tmp_path, text))
     assert "already has its member's compliance in the dynamics" in str(info.value)
+
+
+def test_a_member_needs_samples_that_resolve_its_modes(tmp_path):
+    # the bracket's axial spring with the 10 kg dish rings at ~360 Hz: 1 kHz samples would read its peaks low
+    case = load_case(_write(tmp_path, SMALL.replace(DISH_JOINT, DISH_JOINT + MEMBER)))
+    with pytest.raises(ValueError, match="simulation.output_rate must be at least"):
+        model_inputs(case, CASES)
+    fine = SMALL.replace(DISH_JOINT, DISH_JOINT + MEMBER).replace(*FAST_OUTPUT)
+    assert model_inputs(load_case(_write(tmp_path, fine)), CASES).assembly.joints[3].structural_stiffness is not None
