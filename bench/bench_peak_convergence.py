@@ -57,12 +57,13 @@ from riskassess.cases.impact import validate_case
 from riskassess.models.impact import model_inputs, weak_locations
 from riskassess.stages.run import run_case
 from structures.modal_load import mode_grid
+from structures.reproducibility import REPRODUCIBLE_TOLERANCE, TWIN_OFFSET, parting_time
 from structures.weak_location import judged_demands
 
 ROOT = Path(__file__).resolve().parents[1]
-TOLERANCE = 0.05
+TOLERANCE = REPRODUCIBLE_TOLERANCE
 #: Relative launch-velocity offset between replicas: far below any physical uncertainty.
-REPLICA_OFFSET = 1e-7
+REPLICA_OFFSET = TWIN_OFFSET
 VARIANTS = ("baseline", "step/2", "stiffness/4", "damping 0.1", "output 2x")
 #: Automatic penalty of the shipped model, restored in each worker before a variant changes it.
 AUTOMATIC_PENALTY = (hinge.PENALTY_STEP_FACTOR, hinge.PENALTY_TRANSLATIONAL_CAP, hinge.PENALTY_ROTATIONAL_CAP)
@@ -155,17 +156,6 @@ def histories(locations, run, modes, damping: float, in_dynamics: set) -> dict:
     return out
 
 
-def parting_time(time: np.ndarray, replicas: list[np.ndarray]) -> float:
-    """When replicas of one demand part (s): the first sample at which their peaks so far (running maxima)
-    differ from the median's by more than ``TOLERANCE``; past the end of the run if they never do. Before it,
-    every replica's peak is the same within the tolerance (a phase drift of a ringing load that leaves its
-    peaks alone does not count)."""
-    running = np.maximum.accumulate(np.array(replicas), axis=1)
-    median = np.median(running, axis=0)
-    apart = np.flatnonzero(np.abs(running - median).max(axis=0) > TOLERANCE * np.maximum(np.abs(median), 1e-300))
-    return float(time[apart[0]]) if apart.size else float(time[-1]) + 1.0
-
-
 def window_peaks(time, series, skip: float, parting: float) -> dict:
     """The peak of one demand in each window (``nan`` for an empty one): before the replicas part
     (deterministic; from t = 0), after they part and after ``skip`` (chaotic), after ``skip`` (judged)."""
@@ -215,7 +205,7 @@ def reading_table(results: dict, replicas: int, locations, modes, damping, skip:
     base_time = ran["baseline"][0]["time"]
     table = {}
     for key in runs["baseline"][0]:
-        parting = parting_time(base_time, [h[key] for h in runs["baseline"]])
+        parting = min(parting_time(base_time, [h[key] for h in runs["baseline"]]), float(base_time[-1]) + 1.0)
         table[key] = {"parting": parting, "peaks": {
             v: [window_peaks(run["time"], h[key], skip, parting) for run, h in zip(ran[v], runs[v])] for v in runs}}
     return table

@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from structures.release import ReleaseEvent, released_pieces
+from structures.reproducibility import TWIN_OFFSET, twin_label
 from structures.weak_location import WeakLocation, assess, judged_demands
 
 #: The three answers to "does this capture create secondary debris?" (``debris_state`` in
@@ -141,6 +142,81 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
             "indeterminate_reasons": sorted({r["indeterminate_reason"] for r in rows if r["indeterminate_reason"]})}
 
 
+def apply_twin(verdict: dict, locations: list[WeakLocation], series: dict, twin_series: dict | None,
+               skip_until: float, policy: str, note: str = "") -> dict:
+    """Label every judged peak of ``verdict`` deterministic or chaotic against a twin run (the same case, launch
+    speed x (1 + :data:`structures.reproducibility.TWIN_OFFSET`)), and never let a chaotic peak read as safe: a
+    location that holds on a peak its twin does not reproduce, or that its twin exceeds, is indeterminate (one
+    draw of a chaotic capture answers nothing; ``assess --monte-carlo`` gives P(secondary debris)).
+
+    Parameters
+    ----------
+    verdict : dict
+        :func:`structures_verdict` of the run (updated in place and returned).
+    locations : list of WeakLocation
+        The weak locations it judged.
+    series, twin_series : dict
+        Recorded series of the run and of its twin (``time``, ``joint_force_joint``, ``joint_moment_joint``);
+        ``twin_series`` None when the twin did not run (``note`` says why): holding locations are then
+        indeterminate, since their peaks could not be checked.
+    skip_until : float
+        Loads before this time are not judged (s).
+    policy : str
+        The release policy the run judged at ("low", "nominal", "high"; "never" judges at "low").
+    note : str
+        Why the twin did not run (when ``twin_series`` is None).
+
+    Returns
+    -------
+    dict
+        ``verdict`` with ``twin`` (whether it ran, its launch-speed factor, a note), per criterion ``twin``
+        (``reproduced``, ``parting_time_s``, ``twin_peak``, ``window``) and per location ``peak_window``.
+    """
+    verdict["twin"] = {"ran": twin_series is not None, "launch_velocity_factor": 1.0 + TWIN_OFFSET, "note": note}
+    judged_at = policy if policy != "never" else "low"
+    for loc, row in zip(locations, verdict["locations"]):
+        reasons, windows = [], []
+        if twin_series is not None:
+            mine = judged_demands(loc, series["time"], series["joint_force_joint"][:, loc.joint],
+                                  series["joint_moment_joint"][:, loc.joint])
+            theirs = judged_demands(loc, twin_series["time"], twin_series["joint_force_joint"][:, loc.joint],
+                                    twin_series["joint_moment_joint"][:, loc.joint])
+        for name, criterion in row["criteria"].items():
+            if criterion["peak"] is None:
+                continue
+            if twin_series is None:
+                criterion["twin"] = None
+                windows.append("unchecked")
+                continue
+            label = twin_label(series["time"], mine[name], theirs[name], skip_until)
+            criterion["twin"] = label
+            windows.append(label["window"])
+            if label["twin_peak"] >= criterion["decisive_allowable"]:
+                reasons.append(f"its twin run exceeds its {name.replace('_', ' ')} allowable")
+            elif not label["reproduced"]:
+                reasons.append(f"its {name.replace('_', ' ')} peak at {criterion['peak_time_s']:.3g} s is one draw of "
+                               f"a chaotic capture (a twin run {TWIN_OFFSET:g} apart in launch speed parts at "
+                               f"{label['parting_time_s']:.3g} s and peaks {label['twin_peak'] / criterion['peak'] - 1:+.0%}"
+                               f" from it)")
+        row["peak_window"] = ("unchecked" if "unchecked" in windows else "chaotic" if "chaotic" in windows
+                              else "deterministic" if windows else None)
+        if row["state"] != "holds":
+            row["condition"] = condition_sentence(row, judged_at)
+            continue
+        if twin_series is None:
+            reasons.append(f"its peaks could not be checked against a twin run ({note})")
+        if reasons:
+            row["state"] = "indeterminate"
+            row["indeterminate_reason"] = ("; ".join(reasons) + "; P(secondary debris) needs assess --monte-carlo")
+        row["condition"] = condition_sentence(row, judged_at)
+    states = [r["state"] for r in verdict["locations"]]
+    if verdict["debris_state"] == NO_DEBRIS and "indeterminate" in states:
+        verdict["debris_state"], verdict["secondary_debris"] = INDETERMINATE, None
+    verdict["indeterminate_reasons"] = sorted({r["indeterminate_reason"] for r in verdict["locations"]
+                                               if r["indeterminate_reason"]})
+    return verdict
+
+
 def _display_unit(unit: str) -> tuple[float, str]:
     """(divisor, unit) people read a quantity in: stresses in MPa, loads in their SI unit."""
     return (1e6, "MPa") if unit == "Pa" else (1.0, unit)
@@ -202,6 +278,8 @@ def condition_sentence(result: dict, policy: str) -> str:
                                                        else "")
     if result.get("reading", "").startswith("through"):     # a modal reading says so where the number is read
         when += f", read {result['reading']}"
+    if (c.get("twin") or {}).get("reproduced"):
+        when += f", reproduced by a twin run {TWIN_OFFSET:g} apart in launch speed"
     verb = "fails" if result["state"] == "fails" else "holds"
     if high > low:
         bound = ">=" if result["released_at_s"] is not None else "="

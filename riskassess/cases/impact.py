@@ -524,6 +524,11 @@ class Structures(Strict):
         "low", description="Which value of a range allowable releases a failed joint during the run "
                            "('low': conservative, most debris), or 'never' to judge without releasing.")
     weak_locations: Annotated[list[WeakLocationSpec], Field(min_length=1)]
+    twin: bool = Field(
+        False, description="Run the case a second time with the launch speed x (1 + 1e-7) and label each judged peak "
+                           "deterministic (both runs' peaks so far agree within 5 % up to it) or chaotic (one draw of "
+                           "the capture's late strikes); a location that holds on a chaotic peak is indeterminate "
+                           "(docs/structures.md). Doubles the run time unless the run already shows debris.")
 
     @field_validator("weak_locations")
     @classmethod
@@ -619,6 +624,13 @@ class Case(Strict):
                              "both missing and bent")
         if len(set(bent)) != len(bent):
             raise ValueError("perception.truth_damage.bends: a shape is bent at most once")
+        return self
+
+    @model_validator(mode="after")
+    def _twin_coupled(self):
+        if self.structures is not None and self.structures.twin and self.simulation.coupling == "sequential":
+            raise ValueError("structures.twin checks the peaks of a coupled run; a sequential run (the seed paper's "
+                             "method) drives the debris with recorded loads: use coupling = 'coupled' or twin = false")
         return self
 
     @model_validator(mode="after")

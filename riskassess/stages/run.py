@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from multibody.health import SimulationFailed
 from multibody.impact import ImpactSimulation
 from riskassess.products import results
 from riskassess.models.impact import model_inputs, weak_locations
@@ -19,7 +20,8 @@ from riskassess.cases.impact import Case, load_case
 from riskassess.products.outfolder import OutputFolder, claim
 from riskassess.products.summary import run_summary, sequential_summary
 from structures.release import ReleaseMonitor
-from structures.verdict import INDETERMINATE, demand_series, structures_verdict
+from structures.reproducibility import TWIN_OFFSET
+from structures.verdict import DEBRIS, INDETERMINATE, apply_twin, demand_series, structures_verdict
 
 
 @dataclass
@@ -108,6 +110,8 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
             verdict = structures_verdict(
                 locations, recorder.series, simulation.assembly, monitor.events if monitor else [],
                 net_positions_final, case.structures.skip_initial, case.structures.release)
+            if case.structures.twin:
+                verdict = _with_twin(verdict, locations, recorder.series, case, case_path)
             results.atomic_write_npz(folder.path / "structures.npz", demand_series(locations, recorder.series))
             results.atomic_write_json(folder.path / "structures.json", verdict)
         except BaseException as exc:
@@ -116,6 +120,22 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
         folder.add_files("structures.json", "structures.npz")
     folder.finish("complete", pending)
     return RunOutput(folder.path, summary, verdict)
+
+
+def _with_twin(verdict: dict, locations, series: dict, case: Case, case_path: Path) -> dict:
+    """The verdict with every judged peak labelled against a twin run (launch speed x (1 + TWIN_OFFSET), no
+    release, no products: :func:`structures.verdict.apply_twin`); the twin is not run when the run already
+    shows debris."""
+    skip, policy = case.structures.skip_initial, case.structures.release
+    if verdict["debris_state"] == DEBRIS:
+        return apply_twin(verdict, locations, series, None, skip, policy, "not run: the run shows debris")
+    launch = case.launch.model_copy(update={"velocity": case.launch.velocity * (1.0 + TWIN_OFFSET)})
+    twin = _simulation(model_inputs(case.model_copy(update={"launch": launch}), case_path.parent))
+    try:
+        twin_series = twin.run().series
+    except SimulationFailed as exc:
+        return apply_twin(verdict, locations, series, None, skip, policy, f"the twin run failed: {exc}")
+    return apply_twin(verdict, locations, series, twin_series, skip, policy)
 
 
 def _scaled(progress, offset: float):
