@@ -127,6 +127,7 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
         # covers the loads up to the release: a lower bound of what the intact joint would see.
         result["likelihood_is_lower_bound"] = event is not None
         result["state"], result["indeterminate_reason"] = location_state(result, gaps)
+        result["peak_window"] = "unchecked"        # deterministic or chaotic once a twin run checks it (apply_twin)
         result["condition"] = condition_sentence(result, judged_at)
         rows.append(result)
     pieces = released_pieces(events, assembly, series, net_positions_final)
@@ -281,14 +282,17 @@ def condition_sentence(result: dict, policy: str) -> str:
     if (c.get("twin") or {}).get("reproduced"):
         when += f", reproduced by a twin run {TWIN_OFFSET:g} apart in launch speed"
     verb = "fails" if result["state"] == "fails" else "holds"
+    # a hold resting on one run's peak: say that a late peak may be one draw of a chaotic capture
+    caveat = (" Unchecked for chaos: a late peak of one run is one draw (structures.twin checks it; assess "
+              "--monte-carlo gives P)." if verb == "holds" and result.get("peak_window") == "unchecked" else "")
     if high > low:
         bound = ">=" if result["released_at_s"] is not None else "="
         return (f"{name} breaks if its {criterion.replace('_', ' ')} allowable is below {peak} ({when}): "
                 f"P {bound} {c['likelihood']:.0%} for an allowable uniform over {_span(low, high, unit)}; "
                 f"this run judges at the {policy} end "
-                f"({_quantity(c['decisive_allowable'], unit)}): {verb}.")
+                f"({_quantity(c['decisive_allowable'], unit)}): {verb}.{caveat}")
     return (f"{name} {verb}: its {criterion.replace('_', ' ')} reached {peak} ({when}) against an allowable of "
-            f"{_quantity(low, unit)} (margin {c['margin_of_safety']:+.2f}).")
+            f"{_quantity(low, unit)} (margin {c['margin_of_safety']:+.2f}).{caveat}")
 
 
 def demand_series(locations: list[WeakLocation], series: dict) -> dict:

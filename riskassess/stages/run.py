@@ -125,10 +125,12 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
 def _with_twin(verdict: dict, locations, series: dict, case: Case, case_path: Path) -> dict:
     """The verdict with every judged peak labelled against a twin run (launch speed x (1 + TWIN_OFFSET), no
     release, no products: :func:`structures.verdict.apply_twin`); the twin is not run when the run already
-    shows debris."""
+    shows debris (the answer stands; its holding locations keep ``peak_window = "unchecked"``)."""
     skip, policy = case.structures.skip_initial, case.structures.release
-    if verdict["debris_state"] == DEBRIS:
-        return apply_twin(verdict, locations, series, None, skip, policy, "not run: the run shows debris")
+    if verdict["debris_state"] == DEBRIS:       # the answer stands; holding locations stay "unchecked"
+        verdict["twin"] = {"ran": False, "launch_velocity_factor": 1.0 + TWIN_OFFSET,
+                           "note": "not run: the run shows debris"}
+        return verdict
     launch = case.launch.model_copy(update={"velocity": case.launch.velocity * (1.0 + TWIN_OFFSET)})
     twin = _simulation(model_inputs(case.model_copy(update={"launch": launch}), case_path.parent))
     try:

@@ -39,3 +39,14 @@ def test_a_range_stress_location_reads_in_mpa_with_an_equal_sign():
     text = condition_sentence(_result(164.8e6, (950e6, 3500e6), "holds", unit="Pa"), "low")
     assert "below 164.8 MPa" in text and "P = 0% for an allowable uniform over 950-3500 MPa" in text
     assert text.endswith("this run judges at the low end (950 MPa): holds.")
+
+
+def test_a_hold_unchecked_for_chaos_says_so():
+    # structures_verdict marks every location "unchecked" until a twin run (structures.twin) labels its peaks
+    result = _result(30e6, (50e6, 50e6), "holds", unit="Pa")
+    result["peak_window"] = "unchecked"
+    assert condition_sentence(result, "low").endswith(
+        "(margin +0.67). Unchecked for chaos: a late peak of one run is one draw (structures.twin checks it; "
+        "assess --monte-carlo gives P).")
+    result["state"] = "fails"
+    assert "Unchecked" not in condition_sentence(result, "low")
