@@ -223,13 +223,17 @@ def report(results: dict, replicas: int, locations, readings: dict, skip: float,
         print("\n| reading | location / criterion | window | baseline median [range] | spread | median known to | "
               + " | ".join(names) + " |")
         print("|" + "---|" * (6 + len(names)))
-    for reading, (modes, damping) in readings.items():
+    members = {f"{loc.name} / " for loc in locations if loc.joint in in_dynamics}
+    for index, (reading, (modes, damping)) in enumerate(readings.items()):
         table = reading_table(results, replicas, locations, modes, damping, skip, in_dynamics)
         counts = dict.fromkeys(MARKS, 0)
         if not markdown:
             print(f"\n=== reading: {reading} (locations whose joint carries its member: as recorded)")
         for key, row in table.items():
-            for window in ("deterministic", "chaotic", "judged"):
+            member = any(key.startswith(m) for m in members)
+            if markdown and member and index > 0:       # a member's location reads the same in every reading
+                continue
+            for window in ("deterministic", "chaotic") if markdown else ("deterministic", "chaotic", "judged"):
                 values = np.array([p[window] for p in row["peaks"]["baseline"]])
                 if np.isnan(values).any():
                     continue
@@ -247,7 +251,7 @@ def report(results: dict, replicas: int, locations, readings: dict, skip: float,
                 spread = (values.max() - values.min()) / med if med else float("nan")
                 known = median_precision(values, rng) if med else float("nan")
                 if markdown:
-                    print(f"| {reading} | {key} | {label} | {med:.3g} [{values.min():.3g}, {values.max():.3g}] | "
+                    print(f"| {'member in the dynamics' if member else reading} | {key} | {label} | {med:.3g} [{values.min():.3g}, {values.max():.3g}] | "
                           f"{spread:.0%} | +-{known:.0%} | " + " | ".join(cells) + " |")
                 else:
                     print(f"  {key:36s} {label:26s} {f'{med:.4g} [{values.min():.3g}, {values.max():.3g}]':>30s} "
