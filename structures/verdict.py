@@ -5,6 +5,7 @@ import numpy as np
 
 from structures.release import ReleaseEvent, released_pieces
 from structures.reproducibility import TWIN_OFFSET, twin_label
+from structures.thread_gaps import pass_through_check, pass_through_reason
 from structures.weak_location import WeakLocation, assess, judged_demands
 
 #: The three answers to "does this capture create secondary debris?" (``debris_state`` in
@@ -83,7 +84,8 @@ def location_state(result: dict, gaps: list[str]) -> tuple[str, str | None]:
 
 
 def structures_verdict(locations: list[WeakLocation], series: dict, assembly, events: list[ReleaseEvent],
-                       net_positions_final, skip_until: float, policy: str) -> dict:
+                       net_positions_final, skip_until: float, policy: str, pass_throughs=None,
+                       judge_pass_throughs: bool = True) -> dict:
     """JSON-ready verdict: per location the criteria, margins, likelihood and any release, and the
     answer ``debris_state`` (:data:`DEBRIS_STATES`) with the reasons when it is indeterminate.
 
@@ -105,6 +107,13 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
         Loads before this time are not judged (s).
     policy : {"low", "nominal", "high", "never"}
         The case's release policy; "never" judges range allowables at their low end.
+    pass_throughs : list of multibody.thread_crossing.PassThroughSnapshot, optional
+        Threads that passed through the bodies (:func:`multibody.thread_crossing.pass_through_history`):
+        a location that holds is indeterminate when their load could have taken it past its allowable
+        (:mod:`structures.thread_gaps`); each location's figures go to ``thread_pass_through``.
+    judge_pass_throughs : bool, optional
+        False: report ``thread_pass_through`` without changing any state (the case's
+        ``structures.thread_pass_through = "ignore"``).
 
     Returns
     -------
@@ -127,6 +136,11 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
         # covers the loads up to the release: a lower bound of what the intact joint would see.
         result["likelihood_is_lower_bound"] = event is not None
         result["state"], result["indeterminate_reason"] = location_state(result, gaps)
+        check = (pass_through_check(loc, result, pass_throughs, assembly, series, skip_until)
+                 if pass_throughs and result["judged"] else None)
+        result["thread_pass_through"] = check
+        if judge_pass_throughs and result["state"] == "holds" and check and check["could_exceed"]:
+            result["state"], result["indeterminate_reason"] = "indeterminate", pass_through_reason(check)
         result["peak_window"] = "unchecked"        # deterministic or chaotic once a twin run checks it (apply_twin)
         result["condition"] = condition_sentence(result, judged_at)
         rows.append(result)
@@ -138,7 +152,8 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
         answer = INDETERMINATE
     else:
         answer = NO_DEBRIS
-    return {"skip_initial_s": skip_until, "release_policy": policy, "locations": rows, "released_pieces": pieces,
+    return {"skip_initial_s": skip_until, "release_policy": policy,
+            "thread_pass_through": "bound" if judge_pass_throughs else "ignore", "locations": rows, "released_pieces": pieces,
             "debris_state": answer, "secondary_debris": {DEBRIS: True, NO_DEBRIS: False}.get(answer),
             "indeterminate_reasons": sorted({r["indeterminate_reason"] for r in rows if r["indeterminate_reason"]})}
 

@@ -523,6 +523,12 @@ class Structures(Strict):
     release: Literal["low", "nominal", "high", "never"] = Field(
         "low", description="Which value of a range allowable releases a failed joint during the run "
                            "('low': conservative, most debris), or 'never' to judge without releasing.")
+    thread_pass_through: Literal["bound", "ignore"] = Field(
+        "bound", description="Net threads that pass through a part (contact acts on nodes only): 'bound' keeps a "
+                             "location's 'holds' only if its margin absorbs twice the passing threads' tension at "
+                             "their crossings (otherwise indeterminate; docs/structures.md); 'ignore' judges the "
+                             "node-contact loads alone, as the seed paper's model, and reports the threads without "
+                             "judging them.")
     weak_locations: Annotated[list[WeakLocationSpec], Field(min_length=1)]
     twin: bool = Field(
         False, description="Run the case a second time with the launch speed x (1 + 1e-7) and label each judged peak "

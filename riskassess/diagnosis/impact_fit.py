@@ -569,7 +569,9 @@ def _answer(case, problem, fits, predictions, diverged, scans, sigma, spread, no
     share = chaos_share(problem, sigma, spread)
     scores = score(scoring, predictions, {k: share for k in predictions})
     threshold = decisive_threshold(case.diagnosis.decisive_delta_bic, chi2_scatter(nominal_chi2))
-    decision = decide(fits, scores, threshold, case.diagnosis.adequate_rms, scoring)
+    # the confidence on the decision's scale: BIC differences counted in units of the chaos-widened threshold
+    decision = decide(fits, scores, threshold, case.diagnosis.adequate_rms, scoring,
+                      temper=min(1.0, case.diagnosis.decisive_delta_bic / threshold))
     chosen = decision["model"]
     nominal = fits["nominal"]
     rows = [{"id": k, "delta_bic": float(nominal.bic - fits[k].bic), "weight": decision["weights"][k],

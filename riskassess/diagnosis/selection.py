@@ -65,22 +65,31 @@ STRUCTURE_STEP_ERROR = 0.5
 PRIOR_PULL_LIMIT = 3.5
 
 
-def posterior_weights(fits: dict[str, FitResult]) -> dict[str, float]:
-    """BIC posterior weight of every model, equal prior odds: exp(-BIC/2) normalized.
+def posterior_weights(fits: dict[str, FitResult], temper: float = 1.0) -> dict[str, float]:
+    """BIC posterior weight of every model, equal prior odds: exp(-temper BIC/2) normalized.
+
+    ``temper`` < 1 widens the weights where BIC differences are inflated by something the likelihood
+    does not hold, as chaotic draws of the same model are: with a decisive threshold raised from D to T
+    by the chaos, a difference of T carries the evidence a difference of D carries without it, so the
+    differences are scaled by D/T and "decisive" keeps meaning odds of exp(D/2) on either scale.
 
     Parameters
     ----------
     fits : dict of str to FitResult
         Fitted models by id ("nominal", effect ids, pairs "a+b").
+    temper : float, optional
+        Factor on every BIC difference, in (0, 1] (-); 1 is the plain BIC weight.
 
     Returns
     -------
     weights : dict of str to float
         Per model id, summing to 1 (-).
     """
+    if not 0.0 < temper <= 1.0:
+        raise ValueError(f"temper must be in (0, 1], got {temper}")
     bic = {k: f.bic for k, f in fits.items()}
     low = min(bic.values())
-    w = {k: np.exp(-0.5 * (b - low)) for k, b in bic.items()}
+    w = {k: np.exp(-0.5 * temper * (b - low)) for k, b in bic.items()}
     total = sum(w.values())
     return {k: float(v / total) for k, v in w.items()}
 
@@ -298,7 +307,7 @@ def _rms_adequate(model_scores: dict, adequate_rms: float) -> bool:
 
 
 def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float, adequate_rms: float,
-           problem: Problem | None = None) -> dict:
+           problem: Problem | None = None, temper: float = 1.0) -> dict:
     """The answer: cause (an effect id, "none" or "unexplained"), confidence, and why (module
     docstring). ``problem`` gives the priors for the pull check (3b); without it the check is off.
 
@@ -314,6 +323,9 @@ def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float,
         Largest training residual RMS of an adequate model (noise sigmas, -).
     problem : Problem, optional
         The priors of the nominal parameters.
+    temper : float, optional
+        :func:`posterior_weights`' factor on BIC differences, so that the confidence is on the same
+        scale as ``decisive`` (the impact scenario passes its case threshold over the chaos-widened one).
 
     Returns
     -------
@@ -321,7 +333,7 @@ def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float,
         ``cause``, ``model``, ``confidence`` (-, or None), ``reason`` and the figures behind them
         (``weights``, ``ranked``, ``adequate``, ``structure``, ``prior_pulls``).
     """
-    weights = posterior_weights(fits)
+    weights = posterior_weights(fits, temper)
     nominal = fits["nominal"]
     ranked = sorted((k for k in fits if k != "nominal"), key=lambda k: fits[k].bic)
     structure_left = {k: structured_channels(s) for k, s in scores.items()}

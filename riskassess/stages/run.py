@@ -13,6 +13,7 @@ import trimesh
 
 from multibody.health import SimulationFailed
 from multibody.impact import ImpactSimulation
+from multibody.thread_crossing import pass_through_history
 from riskassess.products import results
 from riskassess.models.impact import model_inputs, weak_locations
 from riskassess.models.impact_sequential import applied_contact_series, driven_inputs, recorded_loads, wall_inputs
@@ -107,9 +108,15 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
     if locations:
         # A later stage that fails leaves the finished simulation results and says so.
         try:
+            # the sequential run's net hit a wall, not the debris: no thread can have passed through it
+            pass_throughs = None if sequential else pass_through_history(
+                recorder.net["time"], recorder.net["positions_lvlh"], recorder.series["time"],
+                recorder.series["body_com_lvlh"], recorder.series["body_to_lvlh"], simulation.assembly.net,
+                [b.meshes_body for b in simulation.assembly.bodies])
             verdict = structures_verdict(
                 locations, recorder.series, simulation.assembly, monitor.events if monitor else [],
-                net_positions_final, case.structures.skip_initial, case.structures.release)
+                net_positions_final, case.structures.skip_initial, case.structures.release, pass_throughs,
+                judge_pass_throughs=case.structures.thread_pass_through == "bound")
             if case.structures.twin:
                 verdict = _with_twin(verdict, locations, recorder.series, case, case_path)
             results.atomic_write_npz(folder.path / "structures.npz", demand_series(locations, recorder.series))

@@ -24,7 +24,9 @@ TIMING_KEYS = {"wall_time_s", "steps_per_second"}
 @pytest.fixture(scope="module")
 def short_case(tmp_path_factory):
     path = tmp_path_factory.mktemp("sweep_case") / "small_short.toml"
-    path.write_text(shortened_case(END_TIME))
+    # the sweep's mechanics need decided runs: judge the node-contact loads alone (threads pass through the
+    # array and ASAR; under the default "bound" a holding location can turn indeterminate, exit code 5)
+    path.write_text(shortened_case(END_TIME).replace('release = "low"', 'release = "low"\nthread_pass_through = "ignore"', 1))
     return path
 
 
@@ -203,7 +205,9 @@ def test_assess_monte_carlo_probability_has_the_known_answer(tmp_path, capsys):
     case = tmp_path / "small_never.toml"
     text = shortened_case(0.6)
     assert 'release = "low"' in text
-    case.write_text(text.replace('release = "low"', 'release = "never"', 1))
+    # node-contact loads alone: threads pass through the array, and under the default "bound" their load
+    # would make its holding runs indeterminate (tests/structures/test_thread_gaps.py), not the known answer
+    case.write_text(text.replace('release = "low"', 'release = "never"\nthread_pass_through = "ignore"', 1))
     assert main(["assess", str(case), "--out", str(tmp_path / "one"), "--json"]) in (0, 1)
     capsys.readouterr()
     verdict = json.loads((tmp_path / "one" / "structures.json").read_text())

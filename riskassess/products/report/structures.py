@@ -67,10 +67,39 @@ def verdict_section(run: RunFolder) -> Section:
     conditions = [loc["condition"] for loc in verdict["locations"] if loc.get("condition")]
     if conditions:
         blocks.append(Note("What each verdict rests on: " + " ".join(conditions)))
+    passed = [pass_through_text(loc) for loc in verdict["locations"] if loc.get("thread_pass_through")]
+    if passed:
+        blocks.append(Note("Net threads through the structure (contact acts on the net's nodes only, so a thread "
+                           "whose nodes lie either side of a thin part passes through it without a force; bound: "
+                           "twice each such thread's tension at its crossing, at the 'net_output_rate' snapshots): "
+                           + " ".join(passed), "warning"))
     blocks.append(Note("Likelihood: probability of failure with the allowable uniformly distributed over its "
                        "range. For a released location it is a lower bound ('>='), because the joint carries "
                        "nothing after its release."))
     return Section("verdict", "Verdict: secondary debris", blocks)
+
+
+def pass_through_text(loc: dict) -> str:
+    """One sentence on the threads that passed through what a location carries, and what their load could do.
+
+    Parameters
+    ----------
+    loc : dict
+        The location's verdict entry, with ``thread_pass_through`` (:func:`structures.thread_gaps.pass_through_check`).
+
+    Returns
+    -------
+    str
+    """
+    check = loc["thread_pass_through"]
+    effect = (f"could take {', '.join(check['could_exceed'])} past the allowable" if check["could_exceed"] else
+              "is absorbed by its margin")
+    if check["could_exceed"] and loc["state"] == "holds":
+        effect += " (not judged: structures.thread_pass_through = \"ignore\")"
+    return (f"{loc['name']}: up to {check['most_threads']} threads through {', '.join(check['bodies'])} from "
+            f"{check['first_s']:.2f} to {check['last_s']:.2f} s, their load at most {check['force_bound_N']:.3g} N and "
+            f"{check['moment_bound_Nm']:.3g} N m about the joint, {effect} (demand plus bound up to "
+            f"{check['worst_ratio']:.2f} of the allowable).")
 
 
 def _mpa(value) -> str:

@@ -26,6 +26,28 @@ def test_weights_are_the_bic_posterior():
     assert w["a"] / w["nominal"] == pytest.approx(np.sqrt(N)) and sum(w.values()) == pytest.approx(1.0)
 
 
+def test_tempered_weights_put_the_threshold_at_the_case_odds():
+    # a chaos-widened threshold T = 150 against the case's D = 10: a BIC difference of exactly T, tempered
+    # by D/T, gives the odds exp(D/2) a difference of D gives without chaos
+    fits = {"nominal": _fit("nominal", 3000.0, 2), "a": _fit("a", 3000.0 - 150.0 - np.log(N), 3)}
+    w = posterior_weights(fits, temper=10.0 / 150.0)
+    assert w["a"] / w["nominal"] == pytest.approx(np.exp(5.0), rel=1e-12)
+    with pytest.raises(ValueError, match="temper"):
+        posterior_weights(fits, temper=0.0)
+
+
+def test_a_none_under_chaos_keeps_a_readable_confidence():
+    # a candidate better by 40 in BIC, below a chaos-widened threshold of 150: the answer stays "none";
+    # plain weights give the nominal exp(-20) ~ 2e-9, tempered by 10/150 the odds are exp(-40/2 * 10/150)
+    fits = {"nominal": _fit("nominal", 3000.0, 2), "a": _fit("a", 3000.0 - 40.0 - np.log(N), 3)}
+    scores = {"nominal": _score(1.0, 1.01), "a": _score(0.99, 1.0)}
+    plain = decide(fits, scores, 150.0, 1.25)
+    tempered = decide(fits, scores, 150.0, 1.25, temper=10.0 / 150.0)
+    assert plain["cause"] == tempered["cause"] == "none"
+    assert plain["confidence"] == pytest.approx(1.0 / (1.0 + np.exp(20.0)), rel=1e-9)
+    assert tempered["confidence"] == pytest.approx(1.0 / (1.0 + np.exp(20.0 / 15.0)), rel=1e-9)
+
+
 def test_decisive_adequate_effect_is_named():
     fits = {"nominal": _fit("nominal", 9000.0, 2), "a": _fit("a", 3000.0, 3), "b": _fit("b", 8000.0, 3)}
     scores = {"nominal": _score(1.7, 1.8), "a": _score(1.0, 1.0), "b": _score(1.6, 1.7)}
