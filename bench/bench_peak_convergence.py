@@ -290,6 +290,8 @@ def main() -> None:
     parser.add_argument("--member-damping", type=float, default=0.02, help="damping ratio of --member (-)")
     parser.add_argument("--output-rate", type=float, default=None, help="baseline output rate (Hz)")
     parser.add_argument("--report-only", action="store_true", help="report the runs the cache holds, run nothing")
+    parser.add_argument("--variants", default=",".join(VARIANTS),
+                        help="comma list of the configurations to run (default: all); the others are reported missing")
     args = parser.parse_args()
     case_path = Path(args.case).resolve()
     text = case_path.read_text()
@@ -311,7 +313,14 @@ def main() -> None:
                      str(cache / f"{v.replace('/', '_').replace(' ', '_')}-{r}.npz"))
             for v in VARIANTS for r in range(args.replicas)}
     start, load = time.perf_counter(), os.getloadavg()[0]
-    if args.report_only:        # what the cache holds so far (a partial table while the runs go on)
+    chosen = set(args.variants.split(","))
+    if not chosen <= set(VARIANTS) or "baseline" not in chosen:
+        raise SystemExit(f"--variants: a comma list of {', '.join(VARIANTS)}, with baseline")
+    if args.report_only or chosen != set(VARIANTS):   # what the cache holds (a partial table while runs go on)
+        if not args.report_only:
+            with ProcessPoolExecutor(args.workers) as pool:
+                for key in [k for k in jobs if k[0] in chosen]:
+                    print(f"{key} {pool.submit(simulate, *jobs[key]).result()}", flush=True)
         results = {key: job[3] if Path(job[3]).exists() else "missing: not run yet" for key, job in jobs.items()}
     else:
         with ProcessPoolExecutor(args.workers) as pool:
