@@ -7,7 +7,8 @@ Table 3 (2 cm noise). For each seed the same scans are tracked
 * without the mesh: :func:`perception.scan_to_map.track_scans` (perception.model = "none");
 * with it: :class:`perception.registration.DebrisTracker` on the mesh (perception.model = "known"),
 
-and the figures printed per seed: registration time per frame, frames registered, attitude error
+and the figures printed per seed: registration CPU time per frame (process time, the first two
+frames apart), frames registered, attitude error
 (mean, worst; for the model-free track also after removing the map's constant turn), CoM error in
 the world at t = 0, and the inertia-ratio errors of the torque-free fit.
 
@@ -64,7 +65,7 @@ def _figures(times, body_to_world_true, world_to_body, ok, information, seconds)
     except NotObservable as exc:
         com, ratios = float("nan"), f"not observable: {exc}"
     ms = 1e3 * np.asarray(seconds)[2:]
-    return (f"{ms.mean():6.1f} ms/frame mean, {np.median(ms):5.1f} median; {ok.sum()}/{len(ok)} frames; attitude "
+    return (f"{ms.mean():6.1f} ms/frame CPU mean, {np.median(ms):5.1f} median; {ok.sum()}/{len(ok)} frames; attitude "
             f"{error.mean():.2f} / {error.max():.2f} deg (constant turn removed {relative.mean():.2f} / {relative.max():.2f}); "
             f"CoM {com:.1f} mm; ratios {np.round(ratios, 3) if not isinstance(ratios, str) else ratios} %")
 
@@ -91,7 +92,7 @@ def main():
             records = alignments(free, times)
             # B of the model-free track is the first scan's frame; the truth in it: R_k R_0^T (R_0 = I here)
             print(f"seed {seed} none : " + _figures(times, body_to_world, free.world_to_body, free.ok,
-                                                   np.array([a.information for a in records]), free.seconds))
+                                                   np.array([a.information for a in records]), free.cpu_seconds))
         if "known" not in args.models:
             continue
         known = DebrisTracker(VOXEL, CORRESPONDENCE, 30, *known_shape_model(mesh, VOXEL, seed), seed=seed)
@@ -101,7 +102,7 @@ def main():
         poses = np.array([a.world_to_body for a in known.alignments])
         print(f"seed {seed} known: " + _figures(times, body_to_world, poses, ok,
                                                np.array([a.information for a in known.alignments]),
-                                               [a.seconds for a in known.alignments]))
+                                               [a.cpu_seconds for a in known.alignments]))
     print(f"load {os.getloadavg()[0]:.2f}")
 
 
