@@ -480,7 +480,7 @@ class DebrisTracker:
         else:
             # No pose yet, or the track was lost for frames (a collision may have changed the spin a lot).
             alignment = self._search(time_s, scan, self._acquisition_start(points, predicted),
-                                     _orientation_candidates(), sensor_world, visible_side=True)
+                                     _orientation_candidates(), sensor_world)
         if not alignment.ok:
             alignment = self._retry_from_global(time_s, scan, alignment, predicted, has_motion, sensor_world)
         return alignment
@@ -514,18 +514,15 @@ class DebrisTracker:
         start[:3, 3] = self._model_points.mean(axis=0) - start[:3, :3] @ points.mean(axis=0)
         return start
 
-    def _search(self, time_s, scan, start, turns, sensor_world, visible_side=False) -> Alignment:
+    def _search(self, time_s, scan, start, turns, sensor_world) -> Alignment:
         """Without a motion prediction: ``start`` turned by each of ``turns`` about the scan
         centroid (a smooth body, the paper's ellipsoid, gives ICP a basin of only a few degrees),
         each seed ranked by one coarse ICP level on a heavily thinned scan; the best SEARCH_REFINED
-        distinct results are refined and checked, the best-checked kept. With ``visible_side`` each
-        seed puts the scan centroid on the centroid of the model's side facing the sensor at that
-        attitude (:meth:`_visible_side_seeds`) instead of keeping ``start``'s."""
+        distinct results are refined and checked, the best-checked kept."""
         points = np.asarray(scan.points)
         thin = np.asarray(scan.voxel_down_sample(SEARCH_VOXELS * self.voxel).points)
-        seeds = (self._visible_side_seeds(start, points, sensor_world, turns) if visible_side
-                 else _seeds(start, points.mean(axis=0), turns))
-        fits = [self._icp_level(thin, seed, self.max_correspondence, SEARCH_SETTLED) for seed in seeds]
+        fits = [self._icp_level(thin, seed, self.max_correspondence, SEARCH_SETTLED)
+                for seed in _seeds(start, points.mean(axis=0), turns)]
         fits.sort(key=lambda fit: -fit[1])
         best = None
         for pose in _distinct([pose for pose, _ in fits], SEARCH_REFINED):
@@ -534,25 +531,6 @@ class DebrisTracker:
             if best is None or _score(candidate) > _score(best):
                 best = candidate
         return best
-
-    def _visible_side_seeds(self, start, points, sensor_world, turns) -> list[np.ndarray]:
-        """world_to_body seeds: ``start``'s attitude turned by each of ``turns``, placed so that the
-        scan centroid lands on the centroid of the model points whose normals face the sensor at
-        that attitude. A scan shows one side: its centroid lies about half the body's depth in front
-        of the model centroid, beyond the coarse ICP's reach (``max_correspondence``) on a 1-2 m body
-        seen from 2-6 m (the featured debris re-acquired after the net contact: no seed converged).
-        Self-occlusion is ignored: a rough centre, the ICP does the rest."""
-        centroid = points.mean(axis=0)
-        towards_sensor = (sensor_world - centroid) / max(np.linalg.norm(sensor_world - centroid), 1e-9)
-        seeds = []
-        for turn in turns:
-            seed = np.eye(4)
-            seed[:3, :3] = turn @ start[:3, :3]
-            facing = self._coarse_normals @ (seed[:3, :3] @ towards_sensor) > 0.0
-            side = self._coarse_points[facing].mean(axis=0) if facing.any() else self._coarse_points.mean(axis=0)
-            seed[:3, 3] = side - seed[:3, :3] @ centroid
-            seeds.append(seed)
-        return seeds
 
     def _nearest_variant(self, pose, reference) -> np.ndarray:
         """Of the poses S @ ``pose`` (world -> B) the surface cannot tell apart, the one whose

@@ -648,7 +648,7 @@ def _debris_returns(tracker: DebrisTracker, pointing: Pointing, time_s, points_w
     on the featured debris: tight fitness 0.4-0.7 in the search of 20 000-36 000 returns)."""
     if tracker.prediction()[1] or not len(points_world):
         return _crop_to_predicted(tracker, points_world), None
-    centre, inside = debris_blob(points_world, pointing.predicted_com(time_s), radius)
+    centre, inside = debris_blob(points_world, (pointing.predicted_com(time_s), pointing.seen_world), radius)
     return points_world[inside], centre
 
 
