@@ -48,6 +48,7 @@ from perception.momentum_balance import momentum_step
 from perception.model_mismatch import CHECK_EVERY, ModelCheck, SurfaceDistance, gate, model_check, unexplained_share, unseen_share
 from perception.motion import NotObservable
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
+from perception.pointing import Pointing, debris_blob
 from perception.registration import MIN_POINTS, DebrisTracker, known_shape_model
 from perception.scan_to_map import alignments as map_alignments, track_scans
 from perception.shape import half_turn_symmetry_transforms, rotation_error
@@ -76,6 +77,9 @@ MAX_MODEL_FREE_RATIO_SIGMA = 0.05
 NET_GATE = 0.1
 #: The debris flies free once no tracked net thread comes closer to its surface than this (m).
 SEPARATION = 0.1
+#: With its track lost, the debris is looked for in a ball of its reach about its CoM plus this (m):
+#: the map's and the CoM line's errors (cm) and the range noise.
+BLOB_MARGIN = 0.2
 
 
 def _pose(rotation, translation) -> np.ndarray:
@@ -532,10 +536,12 @@ class NetTrack:
 
 
 def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembly, progress=None,
-                      target_to_body=np.eye(4)) -> NetTrack:
+                      target_to_body=np.eye(4), com_body=None) -> NetTrack:
     """Scan debris and net from the chaser through the collision run; register the debris, fit
     the net's nodes, measure the gap between them. ``target_to_body`` (4, 4): the truth's
-    transform into the tracker's frame B, for the error figures.
+    transform into the tracker's frame B, for the error figures. The pan-tilt mount aims at the
+    debris CoM ``com_body`` predicted from the track, carried by its velocity through a lost track
+    and widened into a search when nothing is seen (:class:`perception.pointing.Pointing`).
 
     Parameters
     ----------
@@ -558,6 +564,8 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         ``progress(phase, done, total)`` after each frame (``phase`` a str, counts in frames).
     target_to_body : (4, 4) float
         Truth's target -> B transform (m for the translation).
+    com_body : (3,) float, optional
+        Debris CoM in frame B (m), from the observation's CoM line; default the model's centroid.
 
     Returns
     -------
@@ -576,6 +584,9 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
     previous_chaser = None
     estimate = net.positions.copy()
     times = net_snapshots["time"]
+    pointing = _pointing(tracker, frames, com_body)
+    # the debris' reach about its CoM (m), plus a margin for the map's and the scan's errors
+    radius_body = float(np.max(np.linalg.norm(tracker.model_points_body - pointing.com_body, axis=1))) + BLOB_MARGIN
     for k, t in enumerate(times):
         if t <= 0.0:
             continue   # the observation's last frame is this instant
@@ -583,7 +594,9 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         chaser_pose = _pose(series["body_to_lvlh"][i, chaser], series["body_com_lvlh"][i, chaser])
         rot, com = series["body_to_lvlh"][i, 0], series["body_com_lvlh"][i, 0]
         true_net = net_snapshots["positions_lvlh"][k]
-        sensor_world, sensor_to_world = scene.sensor_pose(chaser_pose[:3, 3], chaser_pose[:3, :3], _aim_point(tracker))
+        sensor_world, body_fixed = scene.sensor_pose(chaser_pose[:3, 3], chaser_pose[:3, :3])
+        sensor_world, sensor_to_world = scene.sensor_pose(chaser_pose[:3, 3], chaser_pose[:3, :3],
+                                                          pointing.aim(t, sensor_world, body_fixed[:, 2]))
         tic = time.perf_counter()
         points, _ = _scan_world(scene, [(scene.debris_vertices_world(rot, com - rot @ com_target), scene.mesh_target.faces),
                                         thread_mesh(true_net, net.threads, radius)],
@@ -595,14 +608,21 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         start_pose = previous_chaser if previous_chaser is not None else _pose(np.eye(3), assembly.bodies[chaser].com_lvlh)
         predicted = carried_by_chaser(estimate, start_pose, chaser_pose)
         on_net = nearest_segments(points, predicted, net.threads)[2] < NET_GATE if len(points) else np.zeros(0, bool)
-        _register(tracker, frames, t, 1, _crop_to_predicted(tracker, points[~on_net]), sensor_world, rot, com,
+        debris_points, blob = _debris_returns(tracker, pointing, t, points[~on_net], radius_body)
+        _register(tracker, frames, t, 1, debris_points, sensor_world, rot, com,
                   symmetries, target_to_body[:3, :3], all_returns=points)
-        # The net's nodes are fitted to the returns the debris does not explain, the rim held at
-        # the rod tips.
         alignment = tracker.alignments[-1]
+        pointing.record(t, alignment.body_to_world if alignment.ok else None, len(debris_points) >= MIN_POINTS, blob)
+        # The net's nodes are fitted to the returns the debris does not explain, the rim held at
+        # the rod tips; with the debris lost, to those outside the ball its returns were found in
+        # (all returns went into the net fit before, which pulled the net onto the debris and
+        # the next frames' net gate then took the debris' returns for net).
         debris_world = model_sample @ alignment.body_to_world[:3, :3].T + alignment.body_to_world[:3, 3]
         near_debris = cKDTree(debris_world).query(points, distance_upper_bound=2 * tracker.voxel)[0]
-        candidates = points[~np.isfinite(near_debris)] if alignment.ok else points
+        if alignment.ok:
+            candidates = points[~np.isfinite(near_debris)]
+        else:
+            candidates = points if blob is None else points[np.linalg.norm(points - blob, axis=1) > radius_body]
         tips = mount.points_body @ chaser_pose[:3, :3].T + chaser_pose[:3, 3]
         fit = fit_net_nodes(candidates, predicted, net.threads, NetPrior(point=max(scene.spec.range_noise, radius)),
                             anchors=(mount.nodes, tips))
@@ -617,6 +637,31 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         if progress:
             progress("collision", k, len(times) - 1)
     return track
+
+
+def _debris_returns(tracker: DebrisTracker, pointing: Pointing, time_s, points_world, radius):
+    """The returns offered to the debris registration (m, world) and, when its track is lost, the
+    centre of the ball they were taken from (m, world; else None). With a motion prediction: the
+    returns near the predicted surface (:func:`_crop_to_predicted`). Without: the densest ball of
+    the debris' ``radius`` (m) about its predicted CoM and where it was last seen
+    (:func:`perception.pointing.debris_blob`), so that the search and the next frame's aim take the
+    debris, not net threads the net prediction missed (featured debris, 1.0-2.0 s after the start of
+    the run in: 91-97 % of the returns in the ball are the debris')."""
+    if tracker.prediction()[1] or not len(points_world):
+        return _crop_to_predicted(tracker, points_world), None
+    centre, inside = debris_blob(points_world, (pointing.predicted_com(time_s), pointing.seen_world), radius)
+    return points_world[inside], centre
+
+
+def _pointing(tracker: DebrisTracker, frames: Frames, com_body=None) -> Pointing:
+    """The collision phase's mount aim, started with the observation's good frames (their CoM
+    track gives the velocity the debris has when the run in starts)."""
+    com_body = tracker.model_points_body.mean(axis=0) if com_body is None else np.asarray(com_body, float)
+    pointing = Pointing(com_body)
+    for t, alignment in zip(frames.time, tracker.alignments):
+        if alignment.ok:
+            pointing.record(t, alignment.body_to_world, True)
+    return pointing
 
 
 def free_flight_start(track: NetTrack) -> int:
@@ -998,7 +1043,8 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
     write_simulation(folder, recorder, simulation, collision)
     assembly = simulation.assembly
     with o3d.utility.VerbosityContextManager(o3d.utility.VerbosityLevel.Error):
-        track = observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembly, progress, target_to_body)
+        track = observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembly, progress, target_to_body,
+                                  before.line.com_body)
     times = np.array(frames.time)
     try:
         start_time = track.times[free_flight_start(track)]
