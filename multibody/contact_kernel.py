@@ -119,7 +119,8 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
     Parameters
     ----------
     x, v : (n, 3) float
-        Node positions (m) and velocities (m/s) at the evaluation state, LVLH.
+        Node positions (m) and velocities (m/s) at the evaluation state, LVLH (the positions also in
+        ``buffers.work_soa[0]``, coordinate-major, for the broad phase).
     net, states, bodies, shapes, law : NetArrays, BodyStates, BodyArrays, ShapeArrays, ContactLaw
         (:mod:`multibody.kernel`).
     step : float
@@ -194,7 +195,7 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
         shape_speed[s] = (math.sqrt(velocity_lvlh[b, 0] ** 2 + velocity_lvlh[b, 1] ** 2 + velocity_lvlh[b, 2] ** 2)
                           + math.sqrt(omega_lvlh[b, 0] ** 2 + omega_lvlh[b, 1] ** 2 + omega_lvlh[b, 2] ** 2) * extent)
     # bounding-sphere pass (multibody.broad_phase); the box test below stays the exact filter
-    flag_candidates(x, reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max, step * shape_speed,
+    flag_candidates(buffers.work_soa[0], reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max, step * shape_speed,
                     candidates)
     # per-node contact lists and sub-cycle work space, reused
     c_body = np.empty(n_shapes, np.int64)

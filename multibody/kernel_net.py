@@ -187,6 +187,8 @@ class KernelNet:
         self.kernel = kernel
         self.state_index = state_index
         self.model, self.q, self.qt = net_step_model(kernel, net_velocity)
+        self._views = None
+        self._last_time = -np.inf
         # The solver's initial acceleration uses the force at the initial state.
         data = mbs.systemData
         q, qt = self._bodies(data.GetODE2Coordinates()), self._bodies(data.GetODE2Coordinates_t())
@@ -195,11 +197,22 @@ class KernelNet:
     def _bodies(self, vector):
         return vector if self.state_index is None else np.asarray(vector)[self.state_index]
 
+    def _state_views(self, mbs, t):
+        """Views of Exudyn's current coordinates, velocities and accelerations (no copies: three copying
+        calls were about 2 us of every step). Exudyn keeps these vectors in place through a solve (checked
+        against copies at every step of a run while this was built); they are taken again at the first step
+        of a solve, recognised by a time that does not follow the previous step's."""
+        if self._views is None or not (self._last_time < t <= self._last_time + 1.5 * self.kernel.step):
+            data = mbs.systemData
+            self._views = (data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False),
+                           data.GetODE2Coordinates_tt(copy=False))
+        self._last_time = t
+        return self._views
+
     def __call__(self, mbs, t):
-        data = mbs.systemData
+        q, qt, qtt = self._state_views(mbs, t)
         # t is the time of the evaluation state (see multibody.impact.VerletForces)
-        force = kernel_net_step(self.model, self._bodies(data.GetODE2Coordinates()),
-                                self._bodies(data.GetODE2Coordinates_t()), self._bodies(data.GetODE2Coordinates_tt()), t)
+        force = kernel_net_step(self.model, self._bodies(q), self._bodies(qt), self._bodies(qtt), t)
         mbs.SetObjectParameter(self.coupled_object, "forceVector", force)
         return True
 
