@@ -22,13 +22,16 @@ from riskassess.products.summary import contact_totals_debris
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def figures(case_path, step, end_time, joint_tuning_step):
+def figures(case_path, step, end_time, joint_tuning_step, launch_scale=1.0):
+    """The study's quantities for one run; ``launch_scale`` multiplies the net's initial velocity (a
+    perturbation of round-off size shows how far round-off alone moves them: bench/roundoff_spread.py)."""
     case = load_case(case_path)
     inputs = model_inputs(case, Path(case_path).parent)
     a = inputs.assembly
     # The automatic penalty joints are tuned to one step for every run, so all runs integrate
     # the same model and the deviations measure the integration error alone.
     a.solver = dataclasses.replace(a.solver, step=step, end_time=end_time, joint_tuning_step=joint_tuning_step)
+    a.net_velocity = np.asarray(a.net_velocity, float) * launch_scale
     sim = ImpactSimulation(a, inputs.rest_attitudes, inputs.rest_coms)
     t0 = time.perf_counter()
     rec = sim.run()

@@ -84,19 +84,19 @@ def box_signed_distance(px, py, pz, lo, hi):
 
 
 @njit(cache=True)
-def flag_candidates(x_lvlh, reach, body_to_lvlh, com_lvlh, shape_body, box_min, box_max, shape_reach, flags):
+def flag_candidates(x_lvlh_soa, reach, body_to_lvlh, com_lvlh, shape_body, box_min, box_max, shape_reach, flags):
     """``flags[s, i]`` = 1 where node ``i`` (LVLH position ``x_lvlh[i]`` (m)) is inside shape ``s``'s body-frame
     bounding box grown by ``reach[i] + shape_reach[s]`` (m: what node and shape can close within the
     step), else 0; ``flags[ns, i]`` (the row after the ns shapes' rows) = 1 where any shape's flag is,
     so the contact pass skips a far node with one read. Branch-free over the nodes, so the compiler
-    vectorizes it: the positions are first copied coordinate-major (3, n), since strided loads from
-    (n, 3) kept the loop scalar (12 us against 3 us a pass for the reference case's 1229 nodes and
-    5 shapes).
+    vectorizes it: the positions come coordinate-major (3, n), since strided loads from (n, 3) kept the
+    loop scalar (12 us against 3 us a pass for the reference case's 1229 nodes and 5 shapes); the kernel
+    has them so already, for the threads.
 
     Parameters
     ----------
-    x_lvlh : (n, 3) float
-        Net node positions, LVLH (m).
+    x_lvlh_soa : (3, n) float
+        Net node positions, LVLH (m), coordinate-major.
     reach : (n,) float
         Each node's contact radius plus the distance it can travel within the step (m).
     body_to_lvlh : (nb, 3, 3) float
@@ -112,13 +112,8 @@ def flag_candidates(x_lvlh, reach, body_to_lvlh, com_lvlh, shape_body, box_min, 
     flags : (ns + 1, n) int
         Output, overwritten: one row per shape, then the "near any shape" row.
     """
-    n = x_lvlh.shape[0]
-    xs = np.empty((3, n))
-    for i in range(n):
-        xs[0, i] = x_lvlh[i, 0]
-        xs[1, i] = x_lvlh[i, 1]
-        xs[2, i] = x_lvlh[i, 2]
-    x0, x1, x2 = xs[0], xs[1], xs[2]
+    n = x_lvlh_soa.shape[1]
+    x0, x1, x2 = x_lvlh_soa[0], x_lvlh_soa[1], x_lvlh_soa[2]
     n_shapes = shape_body.shape[0]
     near_any = flags[n_shapes]
     near_any[:] = 0

@@ -46,15 +46,15 @@ def _apply_contact_pair(i, b, fx, fy, fz, com_lvlh, weight, x, net_force_lvlh, b
                         out_node_impulse):
     """Force (fx, fy, fz) on node ``i`` and its reaction on body ``b`` on the same line of action; the
     impulses (times ``weight``) accumulate per body and per node."""
-    net_force_lvlh[i, 0] += fx
-    net_force_lvlh[i, 1] += fy
-    net_force_lvlh[i, 2] += fz
+    net_force_lvlh[0, i] += fx
+    net_force_lvlh[1, i] += fy
+    net_force_lvlh[2, i] += fz
     body_force_lvlh[b, 0] -= fx
     body_force_lvlh[b, 1] -= fy
     body_force_lvlh[b, 2] -= fz
-    ax = x[i, 0] - com_lvlh[b, 0]
-    ay = x[i, 1] - com_lvlh[b, 1]
-    az = x[i, 2] - com_lvlh[b, 2]
+    ax = x[0, i] - com_lvlh[b, 0]
+    ay = x[1, i] - com_lvlh[b, 1]
+    az = x[2, i] - com_lvlh[b, 2]
     # moment of the reaction -f about the body CoM: a x (-f)
     mx = -(ay * fz - az * fy)
     my = -(az * fx - ax * fz)
@@ -118,8 +118,9 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
 
     Parameters
     ----------
-    x, v : (n, 3) float
-        Node positions (m) and velocities (m/s) at the evaluation state, LVLH.
+    x, v : (3, n) float
+        Node positions (m) and velocities (m/s) at the evaluation state, LVLH, coordinate-major (the
+        kernel's layout: the thread pass and the box test vectorize over nodes).
     net, states, bodies, shapes, law : NetArrays, BodyStates, BodyArrays, ShapeArrays, ContactLaw
         (:mod:`multibody.kernel`).
     step : float
@@ -130,8 +131,9 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
         Weight of the accumulated impulses and energies (1 / force evaluations per step).
     buffers : KernelBuffers
         Impulse accumulators, the carried velocity lag and work space (:mod:`multibody.kernel`).
-    net_force_lvlh : (n, 3) float
-        Enters holding every non-contact force on the nodes (N, LVLH); the contact forces are added.
+    net_force_lvlh : (3, n) float
+        Enters holding every non-contact force on the nodes (N, LVLH), coordinate-major; the contact
+        forces are added.
     body_force_lvlh, torque_lvlh : (nb, 3) float
         The reactions are added: force (N) and torque about the CoM (N m), LVLH.
 
@@ -181,8 +183,8 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
         speed_bound = 0.0
         push_bound = 0.0
         for d in range(3):
-            speed_bound += abs(v[i, d] + velocity_lag[i, d] + half_kick * net_force_lvlh[i, d] * inverse_mass)
-            push_bound += abs(net_force_lvlh[i, d])
+            speed_bound += abs(v[d, i] + velocity_lag[i, d] + half_kick * net_force_lvlh[d, i] * inverse_mass)
+            push_bound += abs(net_force_lvlh[d, i])
         reach[i] = 1.001 * (net_radius[i] + step * speed_bound + 0.5 * step * step * push_bound * inverse_mass)
     n_shapes = shape_body.shape[0]
     shape_speed = np.empty(n_shapes)
@@ -212,12 +214,12 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
             continue  # far from every shape and nothing carried: no contact work for this node
         # the node's non-contact force and its velocity at the evaluation time (see the doc above)
         for d in range(3):
-            non_contact_force_lvlh[i, d] = net_force_lvlh[i, d]
-            start_velocity_lvlh[i, d] = v[i, d] + velocity_lag[i, d] + half_kick * net_force_lvlh[i, d] / net_mass[i]
+            non_contact_force_lvlh[i, d] = net_force_lvlh[d, i]
+            start_velocity_lvlh[i, d] = v[d, i] + velocity_lag[i, d] + half_kick * net_force_lvlh[d, i] / net_mass[i]
         speed[i] = math.sqrt(start_velocity_lvlh[i, 0] ** 2 + start_velocity_lvlh[i, 1] ** 2
                              + start_velocity_lvlh[i, 2] ** 2)
-        push[i] = math.sqrt(net_force_lvlh[i, 0] ** 2 + net_force_lvlh[i, 1] ** 2
-                            + net_force_lvlh[i, 2] ** 2) / net_mass[i]
+        push[i] = math.sqrt(net_force_lvlh[0, i] ** 2 + net_force_lvlh[1, i] ** 2
+                            + net_force_lvlh[2, i] ** 2) / net_mass[i]
         k = 0
         for s in range(n_shapes):
             if not candidates[s, i]:
@@ -225,9 +227,9 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
             b = shape_body[s]
             # Broad phase in scalars: node in the body frame against the shape's box, grown by
             # the node radius and the distance the pair can close within one step.
-            ax = x[i, 0] - com_lvlh[b, 0]
-            ay = x[i, 1] - com_lvlh[b, 1]
-            az = x[i, 2] - com_lvlh[b, 2]
+            ax = x[0, i] - com_lvlh[b, 0]
+            ay = x[1, i] - com_lvlh[b, 1]
+            az = x[2, i] - com_lvlh[b, 2]
             px = body_to_lvlh[b, 0, 0] * ax + body_to_lvlh[b, 1, 0] * ay + body_to_lvlh[b, 2, 0] * az
             py = body_to_lvlh[b, 0, 1] * ax + body_to_lvlh[b, 1, 1] * ay + body_to_lvlh[b, 2, 1] * az
             pz = body_to_lvlh[b, 0, 2] * ax + body_to_lvlh[b, 1, 2] * ay + body_to_lvlh[b, 2, 2] * az

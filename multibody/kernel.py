@@ -146,10 +146,11 @@ class KernelBuffers(NamedTuple):
     velocity_lag: np.ndarray       # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s), LVLH
     lag_body: np.ndarray           # (n,) int64 body of the node's last contact, -1 for none
     scalars: np.ndarray            # (N_SCALARS,) energies (J) and contact count, indices above
-    work: np.ndarray               # (4, n, 3) positions, forces, non-contact forces, start velocities
+    work: np.ndarray               # (4, n, 3) positions, forces (bending's node-major copies), non-contact
+                                   # forces, start velocities of contact nodes
     work_node: np.ndarray          # (4, n) speed, acceleration bound, reach; 1 / mass
     candidates: np.ndarray         # (ns + 1, n) uint8 node near shape; last row: near any
-    work_soa: np.ndarray           # (3, 3, n) positions, velocities, thread forces, coordinate-major
+    work_soa: np.ndarray           # (3, 3, n) positions, velocities, node forces, coordinate-major
     work_thread: np.ndarray        # (5, P) per padded thread: force on its node a, energy, power
 
 
@@ -242,6 +243,9 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
                                buffers):
     """Fill ``buffers.force`` with the generalized forces of the coupled system (see module doc); returns it.
 
+    The net's part goes through :func:`coupled_forces_soa` on coordinate-major copies of the net's
+    coordinates (the layout the kernel path keeps its state in, :mod:`multibody.kernel_net`).
+
     Parameters
     ----------
     q, qt : (3 n + 6 nb,) float
@@ -261,38 +265,66 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
         (N m s) in LVLH, per net node the contact impulse (N s, LVLH), the dissipated energies, and
         sets the current elastic energies (``scalars``).
     """
-    out_force, out_scalars, work = buffers.force, buffers.scalars, buffers.work
-    net_reference, net_mass = net.reference_lvlh, net.mass
-    n = net_mass.shape[0]
-    nb = bodies.mass.shape[0]
-    x, net_force_lvlh = work[0], work[1]
-    # the threads' pass runs on coordinate-major copies (multibody.net.add_thread_forces_runs: it vectorizes)
-    x_soa, v_soa, thread_force_soa = buffers.work_soa[0], buffers.work_soa[1], buffers.work_soa[2]
-    x_flat, reference_flat = x.reshape(3 * n), net_reference.reshape(3 * n)
-    for k in range(3 * n):
-        x_flat[k] = reference_flat[k] + q[k]
+    out_force = buffers.force
+    net_reference = net.reference_lvlh
+    n = net.mass.shape[0]
+    x_soa, v_soa, force_soa = buffers.work_soa[0], buffers.work_soa[1], buffers.work_soa[2]
     for d in range(3):
         for i in range(n):
-            x_soa[d, i] = x[i, d]
+            x_soa[d, i] = net_reference[i, d] + q[3 * i + d]
             v_soa[d, i] = qt[3 * i + d]
-    v = qt[: 3 * n].reshape(n, 3)
-    thread_force_soa[:] = 0.0
-    elastic, power = add_thread_forces_runs(x_soa, v_soa, net.thread_runs, thread_force_soa, buffers.work_thread)
+    coupled_forces_soa(x_soa, v_soa, q[3 * n:], qt[3 * n:], net, bodies, shapes, law, mounts, n_orbit, step,
+                       n_substeps, stage_weight, buffers, force_soa, out_force[3 * n:])
     for i in range(n):
         for d in range(3):
-            net_force_lvlh[i, d] = thread_force_soa[d, i]
+            out_force[3 * i + d] = force_soa[d, i]
+    return out_force
+
+
+@njit(cache=True)
+def coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, net, bodies, shapes, law, mounts, n_orbit, step,
+                       n_substeps, stage_weight, buffers, force_soa, body_force):
+    """The coupled forces with the net coordinate-major: ``force_soa`` (3, n) on the nodes (N, LVLH),
+    ``body_force`` (6 nb,) on the bodies (module doc's layout: force, LVLH; torque, body frame).
+
+    Coordinate-major (3, n) arrays let the passes over all nodes vectorize (threads, orbit terms, the
+    contact's reach and box tests) without copies in and out of the node-major layout, about 10 us a
+    step for the reference net; :mod:`multibody.kernel_net` keeps the net's state so.
+
+    Parameters
+    ----------
+    x_soa, v_soa : (3, n) float
+        Node positions (m) and velocities (m/s), LVLH, coordinate-major; read only.
+    q_bodies, qt_bodies : (6 nb,) float
+        The bodies' coordinates and velocities (module doc's layout).
+    net, bodies, shapes, law, mounts, n_orbit, step, n_substeps, stage_weight, buffers
+        As :func:`coupled_generalized_forces`.
+    force_soa : (3, n) float
+        Output, overwritten: the forces on the nodes (N, LVLH).
+    body_force : (6 nb,) float
+        Output, overwritten: the bodies' generalized forces.
+    """
+    out_scalars = buffers.scalars
+    net_mass = net.mass
+    n = net_mass.shape[0]
+    nb = bodies.mass.shape[0]
+    force_soa[:] = 0.0
+    elastic, power = add_thread_forces_runs(x_soa, v_soa, net.thread_runs, force_soa, buffers.work_thread)
     out_scalars[THREAD_ELASTIC] = elastic
-    out_scalars[BENDING_ELASTIC] = add_bending_forces(x, net.bending_triples, net.bending_stiffness, net_force_lvlh)
+    out_scalars[BENDING_ELASTIC] = _add_bending_forces_soa(x_soa, net.bending_triples, net.bending_stiffness,
+                                                           force_soa, buffers.work[0], buffers.work[1])
     out_scalars[THREAD_DISSIPATED] += power * step * stage_weight
 
     if n_orbit != 0.0:
+        x0, x2, v0, v1 = x_soa[0], x_soa[2], v_soa[0], v_soa[1]
+        f0, f1, f2 = force_soa[0], force_soa[1], force_soa[2]
         for i in range(n):
-            ax, ay, az = clohessy_wiltshire_acceleration_xyz(x[i, 0], x[i, 2], v[i, 0], v[i, 1], n_orbit)
-            net_force_lvlh[i, 0] += net_mass[i] * ax
-            net_force_lvlh[i, 1] += net_mass[i] * ay
-            net_force_lvlh[i, 2] += net_mass[i] * az
+            ax, ay, az = clohessy_wiltshire_acceleration_xyz(x0[i], x2[i], v0[i], v1[i], n_orbit)
+            f0[i] += net_mass[i] * ax
+            f1[i] += net_mass[i] * ay
+            f2[i] += net_mass[i] * az
 
-    states = body_states(q, qt, n, bodies.reference_com_lvlh)
+    states = body_states(q_bodies, qt_bodies, 0, bodies.reference_com_lvlh)
     body_to_lvlh, com_lvlh, velocity_lvlh = states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh
     body_force_lvlh = np.zeros((nb, 3))
     if n_orbit != 0.0:
@@ -300,25 +332,49 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
             body_force_lvlh[b] += bodies.mass[b] * clohessy_wiltshire_acceleration(com_lvlh[b], velocity_lvlh[b],
                                                                                    n_orbit)
     torque_lvlh = np.zeros((nb, 3))
-    mount_elastic, mount_power = add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torque_lvlh)
+    mount_elastic, mount_power = add_mount_forces(x_soa, v_soa, states, mounts, force_soa, body_force_lvlh,
+                                                  torque_lvlh)
     # Mounts are the rods that hold the net's rim on the chaser: booked with the threads.
     out_scalars[THREAD_ELASTIC] += mount_elastic
     out_scalars[THREAD_DISSIPATED] += mount_power * step * stage_weight
     contact_energy, n_contacts, contact_dissipated = add_contact_forces(
-        x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, net_force_lvlh,
+        x_soa, v_soa, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, force_soa,
         body_force_lvlh, torque_lvlh)
     for b in range(nb):
-        base = 3 * n + 6 * b
-        out_force[base:base + 3] = body_force_lvlh[b]
+        base = 6 * b
+        body_force[base:base + 3] = body_force_lvlh[b]
         for r in range(3):  # body-frame torque R^T t, in scalars (no BLAS call)
-            out_force[base + 3 + r] = (body_to_lvlh[b, 0, r] * torque_lvlh[b, 0]
-                                       + body_to_lvlh[b, 1, r] * torque_lvlh[b, 1]
-                                       + body_to_lvlh[b, 2, r] * torque_lvlh[b, 2])
+            body_force[base + 3 + r] = (body_to_lvlh[b, 0, r] * torque_lvlh[b, 0]
+                                        + body_to_lvlh[b, 1, r] * torque_lvlh[b, 1]
+                                        + body_to_lvlh[b, 2, r] * torque_lvlh[b, 2])
     out_scalars[CONTACT_ELASTIC] = contact_energy
     out_scalars[N_CONTACTS] = n_contacts
     out_scalars[CONTACT_DISSIPATED] += contact_dissipated
-    out_force[:3 * n] = net_force_lvlh.reshape(3 * n)
-    return out_force
+
+
+@njit(cache=True)
+def _add_bending_forces_soa(x_soa, triples, bending_stiffness, force_soa, x_work, force_work):
+    """:func:`multibody.net.add_bending_forces` on coordinate-major arrays, through node-major copies
+    (``x_work``, ``force_work``: (n, 3) work space), so each node's sum is the same to the bit; nothing
+    to do, and no copy, when every bending stiffness is zero (bending off, the default). Returns the
+    bending energy (J)."""
+    active = False
+    for t in range(bending_stiffness.shape[0]):
+        if bending_stiffness[t] != 0.0:
+            active = True
+            break
+    if not active:
+        return 0.0
+    n = x_soa.shape[1]
+    for i in range(n):
+        for d in range(3):
+            x_work[i, d] = x_soa[d, i]
+            force_work[i, d] = force_soa[d, i]
+    energy = add_bending_forces(x_work, triples, bending_stiffness, force_work)
+    for d in range(3):
+        for i in range(n):
+            force_soa[d, i] = force_work[i, d]
+    return energy
 
 
 @njit(cache=True)
@@ -331,12 +387,12 @@ def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torq
 
     Parameters
     ----------
-    x, v : (n, 3) float
-        Node positions (m) and velocities (m/s), LVLH.
+    x, v : (3, n) float
+        Node positions (m) and velocities (m/s), LVLH, coordinate-major.
     states : BodyStates
     mounts : Mounts
-    net_force_lvlh : (n, 3) float
-        Node force accumulator (N), LVLH.
+    net_force_lvlh : (3, n) float
+        Node force accumulator (N), LVLH, coordinate-major.
     body_force_lvlh, torque_lvlh : (nb, 3) float
         Body force (N) and torque about the CoM (N m) accumulators, LVLH.
     """
@@ -345,14 +401,20 @@ def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torq
     velocity_lvlh, omega_lvlh = states.velocity_lvlh, states.omega_lvlh
     elastic = 0.0
     power = 0.0
+    node_x = np.empty(3)
+    node_v = np.empty(3)
     for m in range(mounts.node.shape[0]):
         i = mounts.node[m]
         b = mounts.body[m]
+        for c in range(3):
+            node_x[c] = x[c, i]
+            node_v[c] = v[c, i]
         arm = body_to_lvlh[b] @ mounts.point_body[m]
-        gap = x[i] - (com_lvlh[b] + arm)
-        rate = v[i] - (velocity_lvlh[b] + np.cross(omega_lvlh[b], arm))
+        gap = node_x - (com_lvlh[b] + arm)
+        rate = node_v - (velocity_lvlh[b] + np.cross(omega_lvlh[b], arm))
         f = -k * gap - d * rate
-        net_force_lvlh[i] += f
+        for c in range(3):
+            net_force_lvlh[c, i] += f[c]
         body_force_lvlh[b] -= f
         torque_lvlh[b] -= np.cross(arm, f)
         elastic += 0.5 * k * (gap @ gap)

@@ -20,7 +20,9 @@ to the bodies within the step it acts in. ``tests/multibody/test_kernel_net.py``
 paths on a small case and compares them.
 
 Layout of the net state: ``q`` (3 n,) node displacement from the reference position (m),
-``qt`` (3 n,) velocity (m/s), ``qtt`` (3 n,) acceleration (m/s^2), all LVLH, node-major.
+``qt`` (3 n,) velocity (m/s), ``qtt`` (3 n,) acceleration (m/s^2), all LVLH, coordinate-major (all x,
+then all y, then all z: the layout of :func:`multibody.kernel.coupled_forces_soa`, so that the passes
+over the nodes vectorize and nothing is copied between layouts; :meth:`KernelNet.positions` gives (n, 3)).
 
 Speed: the whole pre-step is one compiled call (:func:`kernel_net_step`) on a numba structref
 (:class:`NetStepModel`) that holds the kernel's groups of arrays and the net's state: a call with the
@@ -35,7 +37,7 @@ from numba.experimental import structref
 
 from multibody.kernel import (
     KernelData,
-    coupled_generalized_forces,
+    coupled_forces_soa,
     verlet_evaluation_state,
 )
 
@@ -58,7 +60,7 @@ class NetStepModelType(types.StructRef):
 #: (same names, same buffers: what the kernel accumulates there, the recorder reads there), then the
 #: net's state and the work vectors of this module.
 KERNEL_FIELDS = ("net", "bodies", "shapes", "law", "mounts", "mean_motion", "step", "stage_weight", "buffers")
-STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "q_eval", "qt_eval", "inverse_mass")
+STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "q_eval", "qt_eval", "inverse_mass", "reference_soa")
 
 
 class NetStepModel(structref.StructRefProxy):
@@ -66,8 +68,10 @@ class NetStepModel(structref.StructRefProxy):
 
     Fields: those of :class:`multibody.kernel.KernelData` (:data:`KERNEL_FIELDS`, the same arrays)
     and ``n_substeps`` (int, contact sub-steps per step), ``q``, ``qt``, ``qtt`` ((3 n,) the net's
-    state, module doc), ``q_eval``, ``qt_eval`` ((3 n + 6 nb,) the kernel's coordinates at the
-    evaluation state, work space), ``inverse_mass`` ((3 n,) 1 / node mass per coordinate (1/kg)).
+    state, coordinate-major, module doc), ``q_eval``, ``qt_eval`` ((3 n + 6 nb,) work space: the net's
+    coordinates at the evaluation state (first 3 n)), ``inverse_mass`` ((3 n,) 1 / node mass per
+    coordinate (1/kg)), ``reference_soa`` ((3 n,) the nodes' reference positions (m), LVLH), both
+    coordinate-major.
     """
 
 
@@ -89,17 +93,32 @@ def net_step_model(kernel: KernelData, net_velocity) -> tuple:
         kernel.contact_substep) else 1
     values = [getattr(kernel, name) for name in KERNEL_FIELDS]
     values = [float(v) if isinstance(v, (float, np.floating, int)) else v for v in values]
-    state = [n_substeps, np.zeros(3 * n), np.ascontiguousarray(net_velocity, float).reshape(3 * n).copy(),
+    coordinate_major = np.ascontiguousarray(np.asarray(net_velocity, float).reshape(n, 3).T).reshape(3 * n)
+    state = [n_substeps, np.zeros(3 * n), coordinate_major,
              np.zeros(3 * n), np.zeros(3 * n + 6 * nb), np.zeros(3 * n + 6 * nb),
-             np.repeat(1.0 / np.asarray(kernel.net.mass, float), 3)]
+             np.tile(1.0 / np.asarray(kernel.net.mass, float), 3),
+             np.ascontiguousarray(np.asarray(kernel.net.reference_lvlh, float).T).reshape(3 * n)]
     return NetStepModel(*values, *state), state[1], state[2]
 
 
 @njit(cache=True)
-def _forces(m, time, n_substeps):
-    """The kernel at (m.q_eval, m.qt_eval): :meth:`multibody.kernel.KernelData.evaluate` on the structref."""
-    return coupled_generalized_forces(m.q_eval, m.qt_eval, m.net, m.bodies, m.shapes, m.law, m.mounts,
-                                      m.mean_motion, m.step, n_substeps, m.stage_weight, m.buffers)
+def _forces(m, q_bodies, qt_bodies, n_substeps):
+    """The coupled forces at the net's evaluation state (``m.q_eval``, ``m.qt_eval``, coordinate-major) and
+    the bodies' (``q_bodies``, ``qt_bodies``): :func:`multibody.kernel.coupled_forces_soa` on the structref.
+    Returns the nodes' forces (3 n,) coordinate-major (N, LVLH; the kernel's work space) and the bodies'
+    generalized forces (6 nb,) (a view of the kernel's force buffer)."""
+    buffers = m.buffers
+    n3 = m.q.shape[0]
+    n = n3 // 3
+    x_soa, force_soa = buffers.work_soa[0], buffers.work_soa[2]
+    x_flat, q_eval, reference = x_soa.reshape(n3), m.q_eval, m.reference_soa
+    for k in range(n3):
+        x_flat[k] = reference[k] + q_eval[k]
+    v_soa = m.qt_eval[:n3].reshape(3, n)
+    body_force = buffers.force[buffers.force.shape[0] - q_bodies.shape[0]:]
+    coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, m.net, m.bodies, m.shapes, m.law, m.mounts,
+                       m.mean_motion, m.step, n_substeps, m.stage_weight, buffers, force_soa, body_force)
+    return force_soa.reshape(n3), body_force
 
 
 @njit(cache=True)
@@ -115,14 +134,13 @@ def kernel_net_start(m, q_bodies, qt_bodies):
         The bodies' initial coordinates and velocities (Exudyn's layout, :mod:`multibody.kernel`).
     """
     n3 = m.q.shape[0]
+    n = n3 // 3
     m.q_eval[:n3] = m.q
     m.qt_eval[:n3] = m.qt
-    m.q_eval[n3:] = q_bodies
-    m.qt_eval[n3:] = qt_bodies
-    force = _forces(m, 0.0, 1)
+    force, body_force = _forces(m, q_bodies, qt_bodies, 1)
     for k in range(n3):
-        m.qtt[k] = force[k] / m.net.mass[k // 3]
-    return force[n3:].copy()
+        m.qtt[k] = force[k] / m.net.mass[k % n]
+    return body_force.copy()
 
 
 @njit(cache=True)
@@ -151,9 +169,7 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
     for k in range(n3):
         q_eval[k] = q[k] + step * qt_eval[k]
     q_next, v_half_bodies = verlet_evaluation_state(q_bodies, qt_bodies, qtt_bodies, step, 0, nb)
-    q_eval[n3:] = q_next
-    qt_eval[n3:] = v_half_bodies
-    force = _forces(m, time, m.n_substeps if time > 0.0 else 1)
+    force, body_force = _forces(m, q_next, v_half_bodies, m.n_substeps if time > 0.0 else 1)
     # flat loops over the coordinates with few arrays each: the compiler vectorizes them (with more
     # arrays in one loop its run-time overlap checks give up and the loop stays scalar)
     inverse_mass = m.inverse_mass
@@ -162,7 +178,7 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
     for k in range(n3):
         qt[k] = qt_eval[k] + half * qtt[k]
     q[:] = q_eval[:n3]
-    return force[n3:].copy()
+    return body_force.copy()
 
 
 class KernelNet:
@@ -187,6 +203,8 @@ class KernelNet:
         self.kernel = kernel
         self.state_index = state_index
         self.model, self.q, self.qt = net_step_model(kernel, net_velocity)
+        self._views = None
+        self._last_time = -np.inf
         # The solver's initial acceleration uses the force at the initial state.
         data = mbs.systemData
         q, qt = self._bodies(data.GetODE2Coordinates()), self._bodies(data.GetODE2Coordinates_t())
@@ -195,18 +213,30 @@ class KernelNet:
     def _bodies(self, vector):
         return vector if self.state_index is None else np.asarray(vector)[self.state_index]
 
+    def _state_views(self, mbs, t):
+        """Views of Exudyn's current coordinates, velocities and accelerations (no copies: three copying
+        calls were about 2 us of every step). Exudyn keeps these vectors in place through a solve (checked
+        against copies at every step of a run while this was built); they are taken again at the first step
+        of a solve, recognised by a time that does not follow the previous step's."""
+        if self._views is None or not (self._last_time < t <= self._last_time + 1.5 * self.kernel.step):
+            data = mbs.systemData
+            self._views = (data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False),
+                           data.GetODE2Coordinates_tt(copy=False))
+        self._last_time = t
+        return self._views
+
     def __call__(self, mbs, t):
-        data = mbs.systemData
+        q, qt, qtt = self._state_views(mbs, t)
         # t is the time of the evaluation state (see multibody.impact.VerletForces)
-        force = kernel_net_step(self.model, self._bodies(data.GetODE2Coordinates()),
-                                self._bodies(data.GetODE2Coordinates_t()), self._bodies(data.GetODE2Coordinates_tt()), t)
+        force = kernel_net_step(self.model, self._bodies(q), self._bodies(qt), self._bodies(qtt), t)
         mbs.SetObjectParameter(self.coupled_object, "forceVector", force)
         return True
 
     def positions(self) -> np.ndarray:
         """(n, 3) node positions (m), LVLH, at the end of the last step."""
-        return self.kernel.net.reference_lvlh + self.q.reshape(-1, 3)
+        return self.kernel.net.reference_lvlh + self.q.reshape(3, -1).T
 
     def velocities(self) -> np.ndarray:
-        """(n, 3) node velocities (m/s), LVLH, at the end of the last step (a view)."""
-        return self.qt.reshape(-1, 3)
+        """(n, 3) node velocities (m/s), LVLH, at the end of the last step (a copy: the state is
+        coordinate-major)."""
+        return np.ascontiguousarray(self.qt.reshape(3, -1).T)

@@ -56,12 +56,13 @@ def _cmd_run(args) -> int:
 
 
 #: Said on stderr before a run whose force kernels are not in numba's disk cache yet.
-COMPILING = ("compiling the simulation kernels, once: ~30 s (numba keeps them in __pycache__; "
-             "later runs start at once)")
+COMPILING = ("compiling the simulation kernels, once: about 1-2 min on one core (numba keeps them in its "
+             "cache, ~/.cache/adr-riskassess/numba; later runs start at once)")
 
 
 def _announce_compilation(needed: bool) -> None:
-    """The first run after an install sits ~30 s at t = 0 while numba compiles: say so (stderr)."""
+    """The first run after an install (or an edit of the compiled packages) sits at t = 0 while numba compiles,
+    100 s measured on the shared 2-core machine at load 2-3: say so (stderr)."""
     if needed:
         print(COMPILING, file=sys.stderr, flush=True)
 
