@@ -1,0 +1,10 @@
+#!/bin/sh
+# The session's benchmark queue (issue 27): MADS from Table 6 starts 2-5, then the pattern search from starts 1-5,
+# cost f1, one worker; every finished run is appended to bench/results/identify_benchmark.jsonl (resumable).
+cd "$(dirname "$0")/../.." || exit 1
+PY=/work/main/.venv/bin/python
+export PYTHONPATH=$PWD
+$PY -u bench/bench_identify.py --optimizers mads --cost f1 --starts table6 --only-start 2 3 4 5 --workers 1 \
+    --results bench/results/identify_benchmark.jsonl
+$PY -u bench/bench_identify.py --optimizers pattern --cost f1 --starts table6 --workers 1 \
+    --results bench/results/identify_benchmark.jsonl
