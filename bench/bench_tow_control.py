@@ -41,7 +41,7 @@ from multibody.towing import run_exudyn
 from riskassess.cases.impact import load_model
 from riskassess.products import results
 from riskassess.products.towing_figures import reference_elongation, tautness
-from riskassess.products.towing_plots import plot_control
+from riskassess.products.towing_plots import plot_control, plot_control_plants
 from riskassess.models.towing import towing_model
 from riskassess.models.towing_fullnet import full_net_model, wrapped_net
 from riskassess.cases.towing import TowingCase
@@ -57,6 +57,9 @@ def main():
     parser.add_argument("--desired", type=float, default=None, help="MRAC desired elongation z_d (m)")
     parser.add_argument("--laws", nargs="+", choices=("ramp", "mrac1", "mrac2"), default=("ramp", "mrac1", "mrac2"))
     parser.add_argument("--results", default=None, help="JSON-lines file of finished runs (resumable)")
+    parser.add_argument("--side-by-side", action="store_true",
+                        help="only draw DIR/control_plants_<rate>.png from the lower-order and full-net series in "
+                             "--plots DIR (written by earlier runs of this bench with the same --rate/--desired)")
     args = parser.parse_args()
     case = load_model(args.case, TowingCase)
     if args.desired is not None:
@@ -66,6 +69,10 @@ def main():
     rates = rates if args.rate is None else args.rate
     tag = args.plant + (f"_{rates[0]:g}deg_s" if args.rate is not None or args.desired is not None else "") + \
         (f"_zd{args.desired:g}" if args.desired is not None else "")
+    if args.side_by_side:
+        side_by_side(args.plots, tag.split("_", 1)[1], f"{rates[0]:g} deg/s, z_d = {case.mrac.desired_elongation:g} m",
+                     reference_elongation(case))
+        return
     if args.plots is not None and (args.plots / f"control_{tag}.png").exists():
         parser.error(f"--plots: {args.plots / f'control_{tag}.png'} exists; give another folder")
     done = {}
@@ -137,6 +144,32 @@ def main():
         plot_control(shown, args.plots / f"control_{tag}.png",
                      f"{args.plant} plant, {rates[0]} deg/s, z_d = {z_d:g} m: " + ", ".join(shown), desired)
         print(f"figure: {args.plots / f'control_{tag}.png'}")
+
+
+def side_by_side(folder: Path, tag: str, title: str, target: float) -> None:
+    """``folder/control_plants_<tag>.png``: the lower-order and the full-net runs of one rate and z_d next to
+    each other (riskassess.products.towing_plots.plot_control_plants), from this bench's ``.npz`` files.
+
+    Parameters
+    ----------
+    folder : Path
+        The ``--plots`` folder holding ``control_lower-order_<tag>.npz`` and ``control_full-net_<tag>.npz``.
+    tag : str
+        ``<rate>deg_s[_zd<z_d>]``.
+    title : str
+        Figure title.
+    target : float
+        MRAC target elongation (m).
+    """
+    plants = {}
+    for plant in ("lower-order", "full-net"):
+        with np.load(folder / f"control_{plant}_{tag}.npz") as data:
+            laws = dict.fromkeys(key.split("/")[0] for key in data.files)
+            plants[plant] = {law: {key.split("/")[1]: data[key] for key in data.files if key.startswith(law + "/")}
+                             for law in laws}
+    path = folder / f"control_plants_{tag}.png"
+    plot_control_plants(plants, path, title, target)
+    print(f"figure: {path}")
 
 
 if __name__ == "__main__":

@@ -6,7 +6,8 @@ import pytest
 
 from multibody.net_towing import run_exudyn
 from multibody.towing import run_exudyn as run_lower_order
-from multibody.tow_switch import SwitchCriterion, net_internal_kinetic_energy, switch_time
+from multibody.tow_switch import (SwitchCriterion, net_internal_kinetic_energy, net_kinetic_energy_relative_to_body,
+                                  switch_time)
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing_fullnet import full_net_model, lower_order_after_switch, switch_criterion
@@ -36,6 +37,22 @@ def test_internal_kinetic_energy_ignores_a_common_drift():
     m = np.array([1.0, 3.0])
     v = np.array([[7000.0, 3.0, 0.0], [7000.0, -1.0, 0.0]])
     assert net_internal_kinetic_energy(m, v) == pytest.approx(6.0, rel=1e-9)
+
+
+def test_a_net_turning_with_the_debris_carries_no_relative_kinetic_energy():
+    # nodes on a ring of radius 2 m about a body spinning at 0.3 rad/s about z (axis through its CoM), the body
+    # drifting at 7 km/s: riding on the body, each node moves at v_B + omega x r. About the net's own CoM (the
+    # ring's centre) that is rigid rotation, sum m (omega r)^2 / 2 = 4 x 0.01 x 0.36 / 2 = 7.2e-3 J; relative to the
+    # body's velocity field it is 0 (round-off of 7 km/s). A ring at rest in the drifting frame instead: 7.2e-3 J.
+    com, v_body, omega = np.array([1.0, -2.0, 0.5]), np.array([7000.0, 100.0, -3.0]), np.array([0.0, 0.0, 0.3])
+    angles = np.arange(4) * np.pi / 2
+    arm = 2.0 * np.c_[np.cos(angles), np.sin(angles), np.zeros(4)]
+    m = np.full(4, 0.01)
+    riding = v_body + np.cross(omega, arm)
+    assert net_internal_kinetic_energy(m, riding) == pytest.approx(7.2e-3, rel=1e-6)
+    assert net_kinetic_energy_relative_to_body(m, com + arm, riding, com, v_body, omega) == pytest.approx(0.0, abs=1e-12)
+    at_rest = np.tile(v_body, (4, 1))
+    assert net_kinetic_energy_relative_to_body(m, com + arm, at_rest, com, v_body, omega) == pytest.approx(7.2e-3, rel=1e-9)
 
 
 def small_tow(**full_net) -> TowingCase:
