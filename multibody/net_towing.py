@@ -428,7 +428,8 @@ class _Sampler:
             self.sample += 1
             if self.state_at is None and m.state_at is not None and m.start_time + t >= m.state_at - 1e-9:
                 self.state_at = self.full_state(t, q, v)
-            if self.watch is not None and self.watch.update(m.start_time + t, self.kinetic[k], s.diag[D_TENSION]):
+            if self.watch is not None and self.watch.update(m.start_time + t, self.kinetic_relative[k],
+                                                            s.diag[D_TENSION]):
                 self.switch = self.full_state(t, q, v)
                 self.count += 1
                 return False  # quasi-steady: the lower-order model takes over (multibody.tow_switch)
