@@ -233,7 +233,8 @@ class FullNet(Strict):
                            "from the net's state there (multibody/tow_switch.py, docs/towing.md).")
     switch_window: Positive | None = Field(
         None, description="Quasi-steady criterion: the conditions must hold over this time (s); at least two "
-                          "averaging blocks; default two blocks (two debris spin periods), 5 s with switch_averaging = 0.")
+                          "averaging blocks; default three blocks (three debris spin periods: two would not see a slow trend), 5 s "
+                          "with switch_averaging = 0.")
     switch_averaging: NonNegative | None = Field(
         None, description="Quasi-steady criterion: tension and net energy are judged on their means over consecutive "
                           "blocks of this length (s); default one debris spin period, 360 / debris.spin_rate_deg_s "

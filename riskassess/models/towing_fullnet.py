@@ -254,7 +254,7 @@ def switch_criterion(case: TowingCase):
     Returns
     -------
     multibody.tow_switch.SwitchCriterion or None
-        Earliest switch (s; default ``thrust.t_on``), window (s; default two averaging blocks, 5 s when
+        Earliest switch (s; default ``thrust.t_on``), window (s; default three averaging blocks, 5 s when
         sample-wise), calm-net energy bound (J), variation bound (-), averaging block (s; default one debris
         spin period, 360 / ``debris.spin_rate_deg_s``).
     """
@@ -263,7 +263,7 @@ def switch_criterion(case: TowingCase):
         return None
     earliest = case.thrust.t_on if fn.switch_earliest is None else fn.switch_earliest
     averaging = fn.switch_averaging if fn.switch_averaging is not None else 360.0 / case.debris.spin_rate_deg_s
-    window = fn.switch_window if fn.switch_window is not None else (2.0 * averaging if averaging > 0 else 5.0)
+    window = fn.switch_window if fn.switch_window is not None else (3.0 * averaging if averaging > 0 else 5.0)
     return SwitchCriterion(earliest=float(earliest), window=float(window), kinetic_energy_max=fn.switch_kinetic_energy,
                            tension_rel_tol=fn.switch_tension_variation, averaging=float(averaging))
 
