@@ -9,6 +9,7 @@ from multibody.towing import run_exudyn as run_lower_order
 from multibody.tow_switch import (SwitchCriterion, net_internal_kinetic_energy, net_kinetic_energy_relative_to_body,
                                   switch_time)
 from riskassess.cases.impact import load_model
+from riskassess.cases.inputs import CaseError
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing_fullnet import full_net_model, lower_order_after_switch, switch_criterion
 from riskassess.stages.tow_fullnet import joined_series
@@ -56,6 +57,21 @@ def test_block_means_accept_a_tension_that_repeats_every_revolution():
     # the window must hold two blocks
     with pytest.raises(ValueError, match="at least two averaging blocks"):
         SwitchCriterion(earliest=25.0, window=6.0, kinetic_energy_max=0.5, tension_rel_tol=0.2, averaging=4.0)
+
+
+def test_shipped_case_judges_the_tow_per_revolution(tmp_path):
+    # cases/zenit2_towing_from_capture.toml leaves the averaging and window at their defaults: one debris spin period,
+    # 360 / 17.52 deg/s = 20.548 s, and three of them; a window shorter than two blocks is a case error naming the key
+    case = load_model("cases/zenit2_towing_from_capture.toml", TowingCase)
+    criterion = switch_criterion(case)
+    assert criterion.averaging == pytest.approx(360.0 / 17.52, rel=1e-12)
+    assert criterion.window == pytest.approx(3.0 * 360.0 / 17.52, rel=1e-12)
+    assert criterion.earliest == case.thrust.t_on and criterion.tension_rel_tol == 0.2
+    text = open("cases/zenit2_towing_from_capture.toml", encoding="utf-8").read()
+    short = tmp_path / "short_window.toml"
+    short.write_text(text.replace("switch_tension_variation = 0.2", "switch_tension_variation = 0.2\nswitch_window = 30.0"))
+    with pytest.raises(CaseError, match="full_net.switch_window must hold at least two averaging blocks"):
+        load_model(short, TowingCase)
 
 
 def test_internal_kinetic_energy_ignores_a_common_drift():
