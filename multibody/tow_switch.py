@@ -18,8 +18,9 @@ the next: the net wrapped on a spinning stage pulls on the tether with the revol
 17.5 deg/s: 10 s means of 100-250 N, in phase with the spin), which no sample-wise bound accepts, while the
 towing force averaged over a revolution, the one the lower-order model has to reproduce, is steady
 (docs/towing.md, "Switch to the lower-order model"). The energy is measured relative to the debris
-because a net turning with the stage carries kinetic energy about its own CoM (~2 J there) that is no
-flapping: the lower-order model lumps that net into the debris.
+because a net turning with the stage carries kinetic energy about its own CoM that is no flapping (the
+closed bag before the pull, there: 2.5-3.9 J about its CoM, 0.9-1.4 J relative to the debris): the
+lower-order model lumps that net into the debris.
 
 **Start state of the lower-order model** (:func:`lower_order_state`): chaser and debris attitude and
 angular velocities, chaser CoM position and velocity and debris CoM position are copied; the connection
