@@ -184,6 +184,8 @@ def print_tables(rows):
           "| max rel. error s1-s3 |")
     print("|---|---|---|---|---|---|---|")
     for label, cost, run in rows:
+        if run.get("truth") not in (None, [2.0, 7.0, 2.0, 1.0]):
+            label = f"{label} (truth {run['truth']})"
         print(f"| {label} {cost} | " + " | ".join(f"{v:.7f}" for v in run["s"]) + f" | {max(run['relative_error']):.1e} | "
               f"{max(run['relative_error'][:3]):.1e} |")
 
