@@ -2,7 +2,7 @@
 # The session's benchmark queue (issue 27): MADS from Table 6 starts 2-5, then the pattern search from starts 1-5,
 # cost f1, one worker; every finished run is appended to bench/results/identify_benchmark.jsonl (resumable).
 # This stop ran its first command only (stopped after MADS 2 to give the core to the MRAC and switch runs; MADS 3 and 4
-# and 5 then ran one start at a time with --only-start K); the pattern search from the Table 6 starts was not run.
+# and 5 then ran one start at a time with --only-start K); the pattern search ran from Table 6 start 1 only (--only-start 1).
 cd "$(dirname "$0")/../.." || exit 1
 PY=/work/main/.venv/bin/python
 export PYTHONPATH=$PWD
