@@ -7,11 +7,17 @@ processes.
     python bench/bench_identify.py [--optimizers pso pattern mads] [--cost f1 f2] [--starts s0|table6]
                                    [--swarm N] [--generations N] [--polish N] [--pattern N] [--restart N]
                                    [--tolerance X] [--mads N] [--truth S1 S2 S3 S4]
+                                   [--results FILE.jsonl] [--only-start K ...] [--table-only]
 
 ``--cost f1 f2`` runs every optimizer on each cost; ``--starts table6`` starts MADS and the pattern search
 from each of the paper's Table 6 initial guesses (MADS 1-5) instead of the case's s0 (Sec. 4.3 uses s0 for
 the benchmark). At the end the paper's Tables 4 (converged cost per optimizer and cost) and 5 (converged s)
-are printed as markdown rows, with the evaluations and wall time of each run.
+are printed as markdown rows, with the evaluations, wall and CPU time of each run.
+
+``--results FILE.jsonl`` makes the bench resumable: every finished (optimizer, cost, start) run is appended to
+the file as one JSON line (s, cost, relative error, evaluations, wall and CPU time, load average before and after)
+the moment it ends, and a run already in the file is not run again; ``--table-only`` prints the tables from the
+file without running anything. ``--only-start K ...`` runs only those Table 6 starts (1-5).
 
 (defaults: the case's ``[identification.optimizers]``). Prints the CPU time of one evaluation (its
 10 runs, one after the other, in this process), then per optimizer: s, cost, largest relative error
@@ -22,7 +28,9 @@ within 1e-3 relative, < 10 min on 2 cores. Timings are upper bounds when other j
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import resource
 import time
 
 import numpy as np
@@ -52,7 +60,16 @@ def main():
     parser.add_argument("--workers", type=int, default=None, help="worker processes (default identification.workers)")
     parser.add_argument("--truth", type=float, nargs=4, default=None,
                         help="s of the data instead of the case's benchmark_truth (a robustness check off the paper's s)")
+    parser.add_argument("--results", default=None,
+                        help="JSON-lines file: finished runs are appended and not run again (resumable)")
+    parser.add_argument("--only-start", type=int, nargs="+", default=None,
+                        help="with --starts table6: only these Table 6 starts (1-5)")
+    parser.add_argument("--table-only", action="store_true", help="print the tables from --results, run nothing")
     args = parser.parse_args()
+    done = read_results(args.results)
+    if args.table_only:
+        print_tables([(r["label"], r["cost_name"], r) for r in done.values()])
+        return
     case = load_model(args.case, TowingCase)
     ident = case.identification
     update = {key: value for key, value in vars(args).items() if key in Optimizers.model_fields and value is not None}
@@ -64,7 +81,8 @@ def main():
     print(f"settings: {settings.model_dump()}; load average {os.getloadavg()[0]:.1f}")
     costs = args.cost or [ident.cost]
     starts = {"s0": [("", ident.initial_guess)],
-              "table6": [(f" {k + 1}", guess) for k, guess in enumerate(TABLE6_INITIAL_GUESSES)]}[args.starts]
+              "table6": [(f" {k + 1}", guess) for k, guess in enumerate(TABLE6_INITIAL_GUESSES)
+                         if args.only_start is None or k + 1 in args.only_start]}[args.starts]
     simulate(case, case.rates.training_deg_s[0], ident.benchmark_truth)  # compiled code loaded
     cpu = time.process_time()
     for rate in case.rates.training_deg_s:
@@ -75,9 +93,16 @@ def main():
     for cost in costs:
         for name in args.optimizers:
             for label, guess in (starts if name in ("mads", "pattern") else [("", ident.initial_guess)]):
+                key = f"{name}{label}|{cost}|{list(guess)}|{truth}"
+                if key in {r["key"] for r in done.values()}:
+                    print(f"  {name}{label} {cost}: in {args.results}, not run again", flush=True)
+                    rows += [(r["label"], r["cost_name"], r) for r in done.values() if r["key"] == key]
+                    continue
                 run_case = case.model_copy(update=dict(identification=case.identification.model_copy(
                     update=dict(cost=cost, initial_guess=list(guess)))))
+                load_before, cpu_before = os.getloadavg()[0], _cpu_s()
                 out = benchmark(run_case, optimizers=(name,))
+                cpu_s = _cpu_s() - cpu_before
                 print(f"data: {len(out['rates_deg_s'])} runs of {case.simulation.end_time - case.simulation.start_time:g} s "
                       f"(step {ident.step * 1e3:g} ms) in {out['data_wall_s']:.1f} s; s_true = {out['truth']}, cost "
                       f"{cost}, start {list(guess)}; load average {os.getloadavg()[0]:.1f}")
@@ -86,8 +111,57 @@ def main():
                           f"{max(run['relative_error']):.2e} ({np.array(run['relative_error']).round(5).tolist()}) "
                           f"{run['evaluations']} evaluations {run['wall_s']:.0f} s wall", flush=True)
                     rows.append((f"{found}{label}", cost, run))
+                    record = {"key": key, "label": f"{found}{label}", "cost_name": cost, "start": list(guess),
+                              "truth": list(truth), "cpu_s_whole": cpu_s, "load_before": load_before,
+                              "load_after": os.getloadavg()[0], "settings": settings.model_dump(),
+                              **{k: v for k, v in run.items() if k != "history"}}
+                    append_result(args.results, record)
     print_tables(rows)
     print(f"total {time.perf_counter() - start:.0f} s wall; load average now {os.getloadavg()[0]:.1f}")
+
+
+def _cpu_s() -> float:
+    """CPU seconds of this process and its reaped worker processes (the pool's workers end with each search)."""
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + children.ru_utime + children.ru_stime
+
+
+def read_results(path) -> dict:
+    """Finished runs of a ``--results`` file, keyed by label and key (empty without a file).
+
+    Parameters
+    ----------
+    path : str or None
+        JSON-lines file written by :func:`append_result`.
+
+    Returns
+    -------
+    dict
+        {(key, label): record}, in file order.
+    """
+    if path is None or not os.path.exists(path):
+        return {}
+    with open(path, encoding="utf-8") as handle:
+        records = [json.loads(line) for line in handle if line.strip()]
+    return {(r["key"], r["label"]): r for r in records}
+
+
+def append_result(path, record: dict) -> None:
+    """Append one finished run to the ``--results`` file as one JSON line, flushed to disk at once.
+
+    Parameters
+    ----------
+    path : str or None
+        JSON-lines file; nothing is written without one.
+    record : dict
+        The run's record (JSON-serialisable).
+    """
+    if path is None:
+        return
+    with open(path, "a", encoding="utf-8") as handle:
+        handle.write(json.dumps(record) + "\n")
+        handle.flush()
+        os.fsync(handle.fileno())
 
 
 def print_tables(rows):
@@ -98,14 +172,22 @@ def print_tables(rows):
     rows : list of (str, str, dict)
         (optimizer label, cost name, benchmark entry: ``s``, ``cost``, ``relative_error``, ``evaluations``, ``wall_s``).
     """
-    print("\nTable 4 (converged cost, benchmark):\n| optimizer | cost | converged value | evaluations | wall (s) |")
-    print("|---|---|---|---|---|")
+    print("\nTable 4 (converged cost, benchmark):\n| optimizer | cost | start | converged value | evaluations | wall (s) "
+          "| CPU (s) | load |")
+    print("|---|---|---|---|---|---|---|---|")
     for label, cost, run in rows:
-        print(f"| {label} | {cost} | {run['cost']:.4g} | {run['evaluations']} | {run['wall_s']:.0f} |")
-    print("\nTable 5 (converged s, benchmark; truth [2, 7, 2, 1]):\n| optimizer, cost | s1 | s2 | s3 | s4 | max rel. error |")
-    print("|---|---|---|---|---|---|")
+        cpu = f"{run['cpu_s_whole']:.0f}" if "cpu_s_whole" in run else ""
+        load = f"{run['load_before']:.1f}-{run['load_after']:.1f}" if "load_before" in run else ""
+        print(f"| {label} | {cost} | {run.get('start', '')} | {run['cost']:.4g} | {run['evaluations']} | "
+              f"{run['wall_s']:.0f} | {cpu} | {load} |")
+    print("\nTable 5 (converged s, benchmark; truth [2, 7, 2, 1]):\n| optimizer, cost | s1 | s2 | s3 | s4 | max rel. error "
+          "| max rel. error s1-s3 |")
+    print("|---|---|---|---|---|---|---|")
     for label, cost, run in rows:
-        print(f"| {label} {cost} | " + " | ".join(f"{v:.7f}" for v in run["s"]) + f" | {max(run['relative_error']):.1e} |")
+        if run.get("truth") not in (None, [2.0, 7.0, 2.0, 1.0]):
+            label = f"{label} (truth {run['truth']})"
+        print(f"| {label} {cost} | " + " | ".join(f"{v:.7f}" for v in run["s"]) + f" | {max(run['relative_error']):.1e} | "
+              f"{max(run['relative_error'][:3]):.1e} |")
 
 
 if __name__ == "__main__":

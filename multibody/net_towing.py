@@ -35,7 +35,8 @@ from multibody.towing import HEALTH_EVERY_STEPS, TowedBodies, tow_failure_cause
 from multibody.net_towing_kernel import D_SLIDING, D_THRUST, D_TORQUE
 from multibody.orbit import add_body_gravity
 from multibody.health import SimulationFailed
-from multibody.tow_switch import QuasiSteadyWatch, SwitchCriterion, net_internal_kinetic_energy
+from multibody.tow_switch import (QuasiSteadyWatch, SwitchCriterion, net_internal_kinetic_energy,
+                                  net_kinetic_energy_relative_to_body)
 
 #: Layout of the run state ``clock``: net time (s), external impulse (3, N s) since the start.
 CLOCK_TIME, CLOCK_IMPULSE, CLOCK_SIZE = 0, 1, 4
@@ -360,6 +361,7 @@ class NetTowResult:
     kinetic: np.ndarray = None
     switch: dict | None = None
     state_at: dict | None = None
+    kinetic_relative: np.ndarray = None
 
     def series(self) -> dict:
         """The lower-order model's series names (:meth:`multibody.towing.TowResult.series`; the
@@ -382,6 +384,7 @@ class NetTowResult:
             "closing_thread_peak_tension": self.diag[:, D_CLOSING],
             "total_momentum_inertial": self.momentum, "external_impulse_inertial": self.external_impulse,
             "net_internal_kinetic_energy": self.kinetic,
+            "net_kinetic_energy_relative_to_debris": self.kinetic_relative,
             "net_time": self.net_time, "net_nodes_inertial": self.net_positions,
         }
 
@@ -396,7 +399,7 @@ class _Sampler:
         self.time, self.q, self.v, self.node = np.zeros(k), np.zeros((k, 12)), np.zeros((k, 12)), np.zeros((k, 6))
         self.diag, self.momentum, self.impulse = np.zeros((k, D_SIZE)), np.zeros((k, 3)), np.zeros((k, 3))
         self.net_time, self.net = np.zeros(j), np.zeros((j, len(state.x), 3))
-        self.kinetic = np.zeros(k)
+        self.kinetic, self.kinetic_relative = np.zeros(k), np.zeros(k)
         self.sample = self.net_sample = 0
         self.watch = QuasiSteadyWatch(m.switch) if m.switch is not None else None
         self.switch = self.state_at = None
@@ -419,10 +422,14 @@ class _Sampler:
             self.node[k] = np.r_[s.reference + s.x[m.net.central], s.v[m.net.central]]
             self.momentum[k], self.impulse[k] = s.momentum(v), s.clock[CLOCK_IMPULSE:CLOCK_IMPULSE + 3]
             self.kinetic[k] = net_internal_kinetic_energy(m.net.topology.masses, s.v)
+            self.kinetic_relative[k] = net_kinetic_energy_relative_to_body(
+                m.net.topology.masses, s.reference + s.x, s.v, m.positions[1] + q[6:9], v[6:9],
+                rotation_matrix_from_rotation_vector(q[9:12]) @ v[9:12])
             self.sample += 1
             if self.state_at is None and m.state_at is not None and m.start_time + t >= m.state_at - 1e-9:
                 self.state_at = self.full_state(t, q, v)
-            if self.watch is not None and self.watch.update(m.start_time + t, self.kinetic[k], s.diag[D_TENSION]):
+            if self.watch is not None and self.watch.update(m.start_time + t, self.kinetic_relative[k],
+                                                            s.diag[D_TENSION]):
                 self.switch = self.full_state(t, q, v)
                 self.count += 1
                 return False  # quasi-steady: the lower-order model takes over (multibody.tow_switch)
@@ -502,4 +509,4 @@ def run_exudyn(model: FullNetModel) -> NetTowResult:
     return NetTowResult(model, sampler.time[:k], sampler.q[:k], sampler.v[:k], sampler.node[:k], sampler.diag[:k],
                         sampler.momentum[:k], sampler.impulse[:k], sampler.net_time[:sampler.net_sample],
                         sampler.net[:sampler.net_sample], wall, sampler.kinetic[:k], sampler.switch,
-                        sampler.state_at)
+                        sampler.state_at, sampler.kinetic_relative[:k])

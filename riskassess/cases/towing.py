@@ -231,13 +231,22 @@ class FullNet(Strict):
     switch_to_lower_order: bool = Field(
         False, description="Stop the full-net run at quasi-steady state and continue with the lower-order model "
                            "from the net's state there (multibody/tow_switch.py, docs/towing.md).")
-    switch_window: Positive = Field(
-        5.0, description="Quasi-steady criterion: both conditions must hold over this time (s).")
+    switch_window: Positive | None = Field(
+        None, description="Quasi-steady criterion: the conditions must hold over this time (s); at least two "
+                          "averaging blocks; default three blocks (three debris spin periods: two would not see a slow trend), 5 s "
+                          "with switch_averaging = 0.")
+    switch_averaging: NonNegative | None = Field(
+        None, description="Quasi-steady criterion: tension and net energy are judged on their means over consecutive "
+                          "blocks of this length (s); default one debris spin period, 360 / debris.spin_rate_deg_s "
+                          "(the tow repeats itself from one revolution to the next); 0: every sample is a block.")
     switch_kinetic_energy: Positive = Field(
-        0.5, description="Quasi-steady criterion: largest kinetic energy of the net relative to its CoM (J).")
+        0.5, description="Quasi-steady criterion: the net counts as calm when its kinetic energy relative to the "
+                         "debris' rigid motion stays at or below this (block means, J); otherwise it must be "
+                         "stationary (block means within switch_tension_variation).")
     switch_tension_variation: Positive = Field(
-        0.2, description="Quasi-steady criterion: largest peak-to-peak main-tether tension over its window mean (-); "
-                         "the tether must also stay taut over the window.")
+        0.2, description="Quasi-steady criterion: largest peak-to-peak of the block means of the main-tether tension "
+                         "(and of a net energy above switch_kinetic_energy) over their mean (-); the tether must also "
+                         "stay taut over the window.")
     switch_earliest: NonNegative | None = Field(
         None, description="No switch before this time (s); default thrust.t_on.")
     launch_speed: Positive = Field(2.0, description="Capture start: speed of every net node relative to the chaser at "
@@ -307,6 +316,16 @@ class TowingCase(Strict):
                 raise ValueError(f"thrust.kind = '{self.thrust.kind}' needs an [{section}] section")
         if self.simulation.model == "full-net" and self.full_net is None:
             raise ValueError("simulation.model = 'full-net' needs a [full_net] section")
+        fn = self.full_net
+        if fn is not None and fn.switch_to_lower_order and fn.switch_averaging is None and self.debris.spin_rate_deg_s == 0:
+            raise ValueError("full_net.switch_averaging has no default for a debris that does not spin "
+                             "(debris.spin_rate_deg_s = 0): give a block length in s, or 0 to judge every sample")
+        if fn is not None and fn.switch_to_lower_order and fn.switch_window is not None:
+            averaging = fn.switch_averaging if fn.switch_averaging is not None else 360.0 / self.debris.spin_rate_deg_s
+            if averaging > 0 and fn.switch_window < 2.0 * averaging - 1e-9:
+                raise ValueError(f"full_net.switch_window must hold at least two averaging blocks: >= 2 x "
+                                 f"switch_averaging = {2.0 * averaging:g} s (switch_averaging defaults to one spin "
+                                 f"period, 360 / debris.spin_rate_deg_s). Got {fn.switch_window:g} s")
         if self.full_net is not None and 4 * self.full_net.corner_mass >= self.net_mass:
             raise ValueError(f"full_net.corner_mass must be < net_mass / 4 ({self.net_mass / 4:g} kg). "
                              f"Got {self.full_net.corner_mass:g} instead")

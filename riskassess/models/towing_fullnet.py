@@ -254,15 +254,18 @@ def switch_criterion(case: TowingCase):
     Returns
     -------
     multibody.tow_switch.SwitchCriterion or None
-        Earliest switch (s; default ``thrust.t_on``), window (s), net internal kinetic energy bound (J),
-        main-tether tension variation bound (-).
+        Earliest switch (s; default ``thrust.t_on``), window (s; default three averaging blocks, 5 s when
+        sample-wise), calm-net energy bound (J), variation bound (-), averaging block (s; default one debris
+        spin period, 360 / ``debris.spin_rate_deg_s``).
     """
     fn = case.full_net
     if not fn.switch_to_lower_order:
         return None
     earliest = case.thrust.t_on if fn.switch_earliest is None else fn.switch_earliest
-    return SwitchCriterion(earliest=float(earliest), window=fn.switch_window, kinetic_energy_max=fn.switch_kinetic_energy,
-                           tension_rel_tol=fn.switch_tension_variation)
+    averaging = fn.switch_averaging if fn.switch_averaging is not None else 360.0 / case.debris.spin_rate_deg_s
+    window = fn.switch_window if fn.switch_window is not None else (3.0 * averaging if averaging > 0 else 5.0)
+    return SwitchCriterion(earliest=float(earliest), window=float(window), kinetic_energy_max=fn.switch_kinetic_energy,
+                           tension_rel_tol=fn.switch_tension_variation, averaging=float(averaging))
 
 
 def net_start_state(full_model, state: dict) -> dict:

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 import matplotlib
+from matplotlib.figure import Figure
 
 from riskassess.products.plotting import STYLE, legend, panels, plain, write_png
 
@@ -142,18 +143,51 @@ def plot_control(runs: dict, path: Path, title: str, target_elongation: float | 
     """
     with matplotlib.rc_context(STYLE):
         fig, axes = panels(3, 1.8)
-        for law, s in runs.items():
-            t = s["time"]
-            axes[0].plot(t, s["main_tether_tension"], lw=0.8, label=plain(law))
-            axes[1].plot(t, s["main_tether_elongation"], lw=0.8, label=plain(law))
-            axes[2].plot(t, np.rad2deg(np.linalg.norm(s["debris_omega_body"], axis=1)), lw=0.8, label=plain(law))
-        if target_elongation is not None:
-            axes[1].axhline(target_elongation, color="k", ls=":", lw=1.0, label="MRAC target")
+        _control_panels(axes, runs, target_elongation)
         axes[0].set_title(plain(title))
-        axes[0].set_ylabel("T_MT (N)")
-        axes[1].set_ylabel("z (m)")
-        axes[2].set_ylabel("|omega_D| (deg/s)")
-        axes[2].set_xlabel("t (s)")
         for ax in axes:
             legend(ax)
+        _save(fig, path)
+
+
+def _control_panels(axes, runs: dict, target_elongation: float | None) -> None:
+    """Tension, elongation (target dotted) and debris rate of each law into three stacked axes."""
+    for law, s in runs.items():
+        t = s["time"]
+        axes[0].plot(t, s["main_tether_tension"], lw=0.8, label=plain(law))
+        axes[1].plot(t, s["main_tether_elongation"], lw=0.8, label=plain(law))
+        axes[2].plot(t, np.rad2deg(np.linalg.norm(s["debris_omega_body"], axis=1)), lw=0.8, label=plain(law))
+    if target_elongation is not None:
+        axes[1].axhline(target_elongation, color="k", ls=":", lw=1.0, label="MRAC target")
+    axes[0].set_ylabel("T_MT (N)")
+    axes[1].set_ylabel("z (m)")
+    axes[2].set_ylabel("|omega_D| (deg/s)")
+    axes[2].set_xlabel("t (s)")
+
+
+def plot_control_plants(plants: dict, path: Path, title: str, target_elongation: float | None) -> None:
+    """Thrust laws on two (or more) plants side by side: one column per plant (main-tether tension,
+    elongation with the MRAC target dotted, debris angular rate against time), rows on common y axes,
+    so the lower-order and full-net results of one spin rate are read next to each other; PNG.
+
+    Parameters
+    ----------
+    plants : dict of str to dict
+        Plant name -> {law name -> a tow's series as in :func:`plot_control`}.
+    path : Path
+        Output PNG.
+    title : str
+        Figure title (spin rate, desired elongation).
+    target_elongation : float or None
+        The MRAC laws' target elongation (m), drawn dotted; None: not drawn.
+    """
+    with matplotlib.rc_context(STYLE):
+        fig = Figure(figsize=(4.2 * len(plants), 6.2), layout="constrained")
+        grid = fig.subplots(3, len(plants), sharex=True, sharey="row", squeeze=False)
+        for column, (plant, runs) in enumerate(plants.items()):
+            axes = list(grid[:, column])
+            _control_panels(axes, runs, target_elongation)
+            axes[0].set_title(plain(plant))
+        grid[0, -1].legend(fontsize="small")
+        fig.suptitle(plain(title))
         _save(fig, path)
