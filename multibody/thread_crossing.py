@@ -22,6 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from multibody.geometry import contact_shapes_body_frame
+from multibody.net import thread_tension_strain
+
 #: Cosine of the angle between the entry and exit face normals below which a crossing thread went
 #: through the part from one side to the other (120 degrees: a box's opposite faces are at 180,
 #: adjacent ones at 90; a cylinder's sides seen by a chord of a quarter turn are at 90).
@@ -125,26 +128,6 @@ def pass_throughs_shape(positions_lvlh, threads, com_lvlh, body_to_lvlh, triangl
                         com_lvlh + middle_body[through] @ body_to_lvlh.T)
 
 
-def thread_tension(positions_lvlh, threads, rest_lengths, stiffness):
-    """Elastic tension of every thread (N), zero when slack (threads carry no compression).
-
-    Parameters
-    ----------
-    positions_lvlh : (n, 3) float
-        Net node positions, LVLH (m).
-    threads : (m, 2) int
-        Node pairs.
-    rest_lengths, stiffness : (m,) float
-        Unstretched lengths (m) and axial stiffness EA/l0 (N/m).
-
-    Returns
-    -------
-    tension : (m,) float
-    """
-    length = np.linalg.norm(positions_lvlh[threads[:, 1]] - positions_lvlh[threads[:, 0]], axis=1)
-    return np.asarray(stiffness) * np.maximum(length - np.asarray(rest_lengths), 0.0)
-
-
 def missed_load_bounds(crossings: PassThroughs, tension, point_lvlh) -> tuple[float, float]:
     """Upper bounds of the force and of the moment about ``point_lvlh`` that the passing threads would
     have put on the part: twice each thread's tension, at its crossing point.
@@ -211,22 +194,42 @@ def pass_through_history(net_time, net_positions_lvlh, series_time, body_com_lvl
     -------
     list of PassThroughSnapshot
     """
-    shapes = [(b, np.asarray(m.triangles, float), np.asarray(m.face_normals, float), np.asarray(m.bounds, float))
-              for b, meshes in enumerate(meshes_per_body) for m in meshes]
+    shapes = contact_shapes_body_frame(meshes_per_body, np.zeros((len(meshes_per_body), 3)))
     series_time = np.asarray(series_time, float)
     history = []
     for t, positions in zip(net_time, net_positions_lvlh):
         k = int(np.argmin(np.abs(series_time - t)))
         by_body = {}
-        for b, triangles, normals, bounds in shapes:
+        for s, b in enumerate(shapes.shape_body):
+            first, last = shapes.triangle_range[s]
             found = pass_throughs_shape(positions, net.threads, body_com_lvlh[k, b], body_to_lvlh[k, b],
-                                        triangles, normals, bounds[0], bounds[1])
+                                        shapes.triangles_body[first:last], shapes.normals_body[first:last],
+                                        shapes.box_min_body[s], shapes.box_max_body[s])
             if found.threads.size:
                 by_body[b] = found if b not in by_body else _merged(by_body[b], found)
         if by_body:
-            history.append(PassThroughSnapshot(float(t), by_body,
-                                               thread_tension(positions, net.threads, net.rest_lengths, net.stiffness)))
+            history.append(PassThroughSnapshot(float(t), by_body, elastic_tension(positions, net)))
     return history
+
+
+def elastic_tension(positions_lvlh, net):
+    """Every thread's tension (N) from its stretch alone: the net's own law
+    (:func:`multibody.net.thread_tension_strain`) with the damper left out, as the bound states.
+
+    Parameters
+    ----------
+    positions_lvlh : (n, 3) float
+        Node positions, LVLH (m).
+    net : multibody.net.NetTopology
+        Threads, rest lengths, stiffness and damping.
+
+    Returns
+    -------
+    tension : (m,) float
+    """
+    at_rest = np.zeros_like(positions_lvlh)
+    return thread_tension_strain(positions_lvlh, at_rest, net.threads, net.rest_lengths, net.stiffness,
+                                 net.damping)[0]
 
 
 def _merged(first: PassThroughs, second: PassThroughs) -> PassThroughs:

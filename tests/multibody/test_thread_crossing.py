@@ -4,13 +4,12 @@ import pytest
 import trimesh
 
 from multibody.maths.rotations import rotation_matrix_from_rotation_vector
-from multibody.net import NetTopology
+from multibody.net import NetTopology, thread_tension_strain
 from multibody.thread_crossing import (
     clip_segments_convex,
     missed_load_bounds,
     pass_through_history,
     pass_throughs_shape,
-    thread_tension,
 )
 
 
@@ -70,7 +69,8 @@ def test_the_body_pose_carries_the_shape():
 def test_tension_and_the_missed_load_bounds():
     positions = np.array([[0.0, 0.0, 0.0], [1.1, 0.0, 0.0], [1.1, 0.95, 0.0]])
     threads = np.array([[0, 1], [1, 2]])
-    tension = thread_tension(positions, threads, np.array([1.0, 1.0]), np.array([200.0, 200.0]))
+    tension, _ = thread_tension_strain(positions, np.zeros_like(positions), threads, np.array([1.0, 1.0]),
+                                       np.array([200.0, 200.0]), np.zeros(2))
     assert tension == pytest.approx([20.0, 0.0])     # 200 N/m x 0.1 m stretch; the second is slack
     crossings = _through(PLATE, [0.0, 0.0, -0.5], [0.0, 0.0, 0.5])
     force, moment = missed_load_bounds(crossings, np.array([20.0]), np.array([3.0, 4.0, 0.0]))
