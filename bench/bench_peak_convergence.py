@@ -25,6 +25,9 @@ so a single run's peak is one sample of a spread. The raw joint reactions of eve
 ``--cache`` (default: a folder under the system's temporary directory named for the case), so
 readings can be compared without running again.
 
+``--against CACHE`` adds the baseline runs of another cache (the same case with one physical input
+changed, e.g. ``--member-damping 0.05``) as one more column.
+
 Readings: "as recorded" (the stiff joint's reaction, as the verdict judges a location without
 ``structural_mode_hz``) and, for each ``--mode``, the reaction read through the structure's first mode
 (:mod:`structures.modal_load`, damping ``--mode-damping``; a range LOW,HIGH is judged by the envelope
@@ -271,6 +274,7 @@ def parse_mode(text: str) -> tuple[str, np.ndarray]:
 
 
 def main() -> None:
+    global VARIANTS     # --against adds a column
     parser = argparse.ArgumentParser()
     parser.add_argument("case", nargs="?", default=str(ROOT / "cases" / "envisat_small.toml"))
     parser.add_argument("--end-time", type=float, default=None)
@@ -290,6 +294,9 @@ def main() -> None:
     parser.add_argument("--member-damping", type=float, default=0.02, help="damping ratio of --member (-)")
     parser.add_argument("--output-rate", type=float, default=None, help="baseline output rate (Hz)")
     parser.add_argument("--report-only", action="store_true", help="report the runs the cache holds, run nothing")
+    parser.add_argument("--against", default=None, metavar="CACHE",
+                        help="also report the baseline runs of another cache (a physical change, e.g. "
+                             "--member-damping) as one more column, judged in this cache's windows")
     parser.add_argument("--variants", default=",".join(VARIANTS),
                         help="comma list of the configurations to run (default: all); the others are reported missing")
     args = parser.parse_args()
@@ -330,6 +337,12 @@ def main() -> None:
                 results[futures[future]] = future.result()
                 print(f"{len(results)}/{len(jobs)} {futures[future]} done, {time.perf_counter() - start:.0f} s wall, "
                       f"load {os.getloadavg()[0]:.1f}", flush=True)
+    if args.against:        # another cache's baselines as one more column (its runs must exist)
+        column = f"against {Path(args.against).name}"
+        VARIANTS = VARIANTS + (column,)
+        for r in range(args.replicas):
+            path = Path(args.against) / f"baseline-{r}.npz"
+            results[(column, r)] = str(path) if path.exists() else "missing: not in the other cache"
     results = {k: (v if v.startswith(("failed", "missing")) else dict(np.load(v))) for k, v in results.items()}
     cpu = [float(v["cpu"]) for v in results.values() if not isinstance(v, str)]
     print(f"{args.case}, release off, joints: "

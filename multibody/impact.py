@@ -36,6 +36,7 @@ from multibody.kernel_net import KernelNet, kernel_net_start, kernel_net_step
 from multibody.recorded_loads import add_recorded_loads
 from multibody.net import thread_runs
 from multibody.recorder import Recorder
+from multibody.rotation_update import ExactRotations
 from multibody.solver_output import solver_chatter_captured
 
 #: Exudyn explicit integrators a case may choose, with their force evaluations per step.
@@ -62,6 +63,7 @@ class BuiltSystem:
     joint_point_parent_body: list   # (3,) joint point, parent body frame (m)
     joint_point_child_body: list    # (3,) joint point, child body frame (m)
     kernel_net: KernelNet | None = None  # the net's state when the kernel integrates it
+    rotations: ExactRotations | None = None  # VelocityVerlet: the attitudes restored after each step
 
     def net_state(self, q, qt):
         """(n, 3) node positions (m) and velocities (m/s), LVLH, at the end of the last step, from
@@ -265,16 +267,19 @@ def build_impact_system(assembly: ImpactAssembly, rest_body_to_lvlh=None, rest_c
     mbs.Assemble()
     state_index = _object_state_index(mbs, generic_nodes, [3 * n_exudyn] * bool(n_exudyn) + [6] * len(body_nodes))
     kernel_net = None
+    # Exudyn's explicit Lie-group update loses turns below ~2e-8 rad a step (multibody.rotation_update)
+    rotations = ExactRotations(3 * n_exudyn, len(body_nodes), state_index) if verlet else None
     if in_kernel:
-        kernel_net = KernelNet(mbs, coupled, kernel, assembly.net_velocity, state_index)
+        kernel_net = KernelNet(mbs, coupled, kernel, assembly.net_velocity, state_index, rotations)
         mbs.SetPreStepUserFunction(kernel_net)
     elif verlet:
         mbs.SetPreStepUserFunction(VerletForces(mbs, coupled, kernel, assembly.solver.step, 3 * n,
-                                                len(body_nodes), state_index))
+                                                len(body_nodes), state_index, rotations))
     else:
         layout["index"] = state_index
     return BuiltSystem(sc, mbs, kernel, net_node, body_nodes, body_objects, joint_objects,
-                       joints_to_parent, joints_to_child, points_parent_body, points_child_body, kernel_net)
+                       joints_to_parent, joints_to_child, points_parent_body, points_child_body, kernel_net,
+                       rotations)
 
 
 def uses_kernel_net(assembly: ImpactAssembly) -> bool:
@@ -320,8 +325,9 @@ class VerletForces:
     Exudyn's own, evaluated inside the step.
     """
 
-    def __init__(self, mbs, coupled_object, kernel, step, n_net_coordinates, n_bodies, state_index):
+    def __init__(self, mbs, coupled_object, kernel, step, n_net_coordinates, n_bodies, state_index, rotations=None):
         self.mbs = mbs
+        self.rotations = rotations      # ExactRotations: keeps the step's exact end attitudes
         self.coupled_object = coupled_object
         self.kernel = kernel
         self.step = step
@@ -340,6 +346,8 @@ class VerletForces:
         q, v, a = _object_state(self.state_index, data.GetODE2Coordinates(), data.GetODE2Coordinates_t(),
                                 data.GetODE2Coordinates_tt())
         q_next, v_half = verlet_evaluation_state(q, v, a, self.step, self.n_net_coordinates, self.n_bodies)
+        if self.rotations is not None:
+            self.rotations.keep(q_next)
         # Exudyn calls the pre-step function with the step's end time already set: t is the time
         # of the evaluation state (checked in tests/multibody/test_towing.py).
         self._set_force(self.kernel.evaluate(q_next, v_half, t))
@@ -545,7 +553,10 @@ class ImpactSimulation:
         recorder = Recorder(self.assembly, self.system, progress=progress, monitor=monitor, health=self.health)
         self.recorder = recorder
         mbs = self.system.mbs
-        mbs.SetPostStepUserFunction(recorder.post_step)
+        post_step = recorder.post_step
+        if self.system.rotations is not None:
+            post_step = self.system.rotations.restoring(post_step)
+        mbs.SetPostStepUserFunction(post_step)
         settings = simulation_settings(self.assembly)
         recorder.sample(0.0)
         start = time.perf_counter()

@@ -195,10 +195,13 @@ class KernelNet:
         Initial node velocities (m/s), LVLH.
     state_index : (6 nb,) int or None
         Where the bodies' coordinates sit in Exudyn's system vectors (None: the whole vector).
+    rotations : multibody.rotation_update.ExactRotations or None
+        Keeps each step's exact end attitudes, for the post-step function to restore.
     """
 
-    def __init__(self, mbs, coupled_object, kernel: KernelData, net_velocity, state_index):
+    def __init__(self, mbs, coupled_object, kernel: KernelData, net_velocity, state_index, rotations=None):
         self.mbs = mbs
+        self.rotations = rotations
         self.coupled_object = coupled_object
         self.kernel = kernel
         self.state_index = state_index
@@ -227,8 +230,12 @@ class KernelNet:
 
     def __call__(self, mbs, t):
         q, qt, qtt = self._state_views(mbs, t)
+        q_bodies, qt_bodies, qtt_bodies = self._bodies(q), self._bodies(qt), self._bodies(qtt)
+        if self.rotations is not None:
+            self.rotations.keep(verlet_evaluation_state(q_bodies, qt_bodies, qtt_bodies, self.kernel.step, 0,
+                                                        q_bodies.shape[0] // 6)[0])
         # t is the time of the evaluation state (see multibody.impact.VerletForces)
-        force = kernel_net_step(self.model, self._bodies(q), self._bodies(qt), self._bodies(qtt), t)
+        force = kernel_net_step(self.model, q_bodies, qt_bodies, qtt_bodies, t)
         mbs.SetObjectParameter(self.coupled_object, "forceVector", force)
         return True
 
