@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import open3d as o3d
 
-from multibody.maths.rotations import rotation_matrix_from_rotation_vector, rotation_vector_from_matrix
+from multibody.maths.rotations import rotation_vector_from_matrix
 from perception.nearest_grid import CellList
 from perception.normals import surface_normals
 from perception.point_to_plane import point_to_plane_information, tukey_normal_equations
@@ -59,13 +59,14 @@ BODY_SIZE = 1.0
 SETTLED = 1e-4
 #: Tukey cut-off of the ICP's point-to-plane residuals, as a share of the level's correspondence
 #: distance. Half of it (1.7 cm at the fine level, 1.9 times the measured 0.8-1.0 cm scatter of the
-#: residuals) made the iteration walk: with the nearest map points re-associated every iteration the
-#: steepest weights kept moving, steps of 0.002-0.005 deg were still taken after 100 iterations and one
-#: frame moved 1.4 deg in 300 (featured body, frames 30-60 of seed 0); with the full distance (3.7
-#: scatters, near the 4.685 of Tukey's 95 %-efficiency constant) the same frames stop moving within
-#: 30 iterations. Frozen correspondences settle in ~10 with either: the walk is the re-weighting
-#: chasing the re-association.
-TUKEY_CUTOFF = 1.0
+#: residuals) is what makes the iteration walk: with the nearest map points re-associated every
+#: iteration the steepest weights keep moving, steps of 0.002-0.005 deg were still taken after 100
+#: iterations and one frame moved 1.4 deg in 300 (featured body, frames 30-60 of seed 0); with the full
+#: distance (3.7 scatters) the same frames stop moving within ~30 iterations, and frozen correspondences
+#: settle in ~10 with either. Kept at 0.5: the full distance did not make a frame cheaper at the 0.1 mm
+#: stop and moved the inertia ratios from -0.23/-0.26 and -0.22/-0.28 % to -1.04/-1.26 and +0.54/+0.65 %
+#: (seeds 0, 1, 10 s), though the attitudes improved (docs/perception.md, "ICP creep").
+TUKEY_CUTOFF = 0.5
 #: Scan points below which a frame is not registered (too few to fix 6 degrees of freedom reliably).
 MIN_POINTS = 50
 
@@ -223,7 +224,7 @@ def register_with_motion_prior(scan_world, map_points, map_normals, predicted_wo
     """
     index = map_index(map_points, max_correspondence) if index is None else index
     pose = np.asarray(predicted_world_to_body, float)
-    reference, reference_inverse = pose, _rigid_inverse(pose)
+    reference_inverse = _rigid_inverse(pose)
     prior_information = np.zeros(6) if prior_sigma is None else 1.0 / np.asarray(prior_sigma, float) ** 2
     coarse = scan_world[::max(1, len(scan_world) // COARSE_POINTS)]
     fine = scan_world[::max(1, len(scan_world) // FINE_POINTS)]
@@ -231,92 +232,22 @@ def register_with_motion_prior(scan_world, map_points, map_normals, predicted_wo
                                          (fine, max_correspondence / 3, FINE_ITERATIONS)):
         cutoff = TUKEY_CUTOFF * distance
         scatter2 = (cutoff / 3) ** 2      # the Tukey cut-off at 3 scatters
-        history = AndersonHistory(ANDERSON_DEPTH)
         for _ in range(iterations):
             body = _transform(points, pose)
             _, nearest = index.query(body, distance_upper_bound=distance)
             hessian, gradient, _, count = tukey_normal_equations(body, nearest, map_points, map_normals, cutoff)
             if count < 6:
                 break
-            difference = _pose_difference(pose, reference_inverse)
+            difference = _pose_difference(pose, reference_inverse) if prior_sigma is not None else np.zeros(6)
             try:
                 step = np.linalg.solve(hessian / scatter2 + np.diag(prior_information),
                                        -(gradient / scatter2 + prior_information * difference))
             except np.linalg.LinAlgError:   # degenerate matches (all on one plane) and no prior
                 break
+            pose = _twist(step) @ pose
             if np.linalg.norm(step[:3]) * BODY_SIZE + np.linalg.norm(step[3:]) < SETTLED:
-                pose = _twist(step) @ pose
                 break
-            # the Gauss-Newton map x -> G(x), in coordinates of the pose relative to the prediction
-            mapped = _pose_difference(_twist(step) @ pose, reference_inverse)
-            pose = _pose_from_difference(history.next(difference, mapped), reference)
     return pose
-
-
-#: Depth of the Anderson acceleration of the ICP's iterations (0: plain Gauss-Newton steps).
-ANDERSON_DEPTH = 0
-
-
-class AndersonHistory:
-    """Anderson acceleration (type II) of a fixed-point iteration x -> G(x) on 6-vectors (Walker & Ni
-    2011; for ICP: Pavlov et al. 2018, AA-ICP; Zhang et al. 2022, Fast and Robust ICP).
-
-    Why: with the correspondences held fixed, the scan-to-map Gauss-Newton steps settle in ~10
-    iterations (median step 0.0004 deg at the 10th, featured body); re-associating the nearest map
-    points each iteration turns that into a slow linear convergence, each step 0.96 times the last
-    and in a steady direction (0.02 deg at the 1st, 0.007 at the 20th, 0.003 at the 40th), so 60 % of
-    the frames ran into the iteration cap 0.15 deg short of the limit. The fixed point is sound (the
-    converged pose is the better one); a steady geometric sequence is what Anderson's extrapolation
-    jumps to the end of, from the last few iterates.
-
-    Parameters
-    ----------
-    depth : int
-        Past iterates mixed (0: the plain iteration x_{k+1} = G(x_k)).
-    """
-
-    def __init__(self, depth):
-        self.depth = depth
-        self.x, self.g = [], []
-
-    def next(self, x, g) -> np.ndarray:
-        """The next iterate from the current one ``x`` (6,) and its image ``g`` = G(x) (6,).
-
-        Parameters
-        ----------
-        x, g : (6,) float
-            Iterate and its image under the fixed-point map (rad, m).
-
-        Returns
-        -------
-        (6,) float
-            The accelerated iterate; ``g`` itself while fewer than two iterates are known, or when
-            the mixing is degenerate or would step more than 10 times the plain step.
-        """
-        if self.depth <= 0:
-            return g
-        self.x.append(np.asarray(x, float))
-        self.g.append(np.asarray(g, float))
-        del self.x[:-(self.depth + 1)], self.g[:-(self.depth + 1)]
-        if len(self.x) < 2:
-            return g
-        residuals = np.array(self.g) - np.array(self.x)          # f_i = G(x_i) - x_i
-        delta_f = np.diff(residuals, axis=0).T                    # (6, m)
-        delta_g = np.diff(np.array(self.g), axis=0).T
-        gamma, *_ = np.linalg.lstsq(delta_f, residuals[-1], rcond=1e-10)
-        accelerated = g - delta_g @ gamma
-        if not np.all(np.isfinite(accelerated)) or (np.linalg.norm(accelerated - x) > 10 * np.linalg.norm(g - x)):
-            self.x, self.g = [], []   # start the history again from the plain step
-            return g
-        return accelerated
-
-
-def _pose_from_difference(difference, reference) -> np.ndarray:
-    """world -> B pose (4, 4) whose :func:`_pose_difference` from ``reference`` (4, 4) is ``difference`` (6,)."""
-    delta = np.eye(4)
-    delta[:3, :3] = rotation_matrix_from_rotation_vector(np.ascontiguousarray(difference[:3]))
-    delta[:3, 3] = difference[3:]
-    return delta @ reference
 
 
 def map_fit(scan_world, world_to_body, map_tree, distance) -> tuple[float, float]:

@@ -482,6 +482,11 @@ def _register(tracker, frames, t, phase, points, sensor_world, true_rot, true_co
     _record(frames, t, phase, points, true_rot, true_com)
     frames.rotation_error.append(rotation_error(alignment.body_to_world[:3, :3], true_rot @ target_to_body.T, symmetries)
                                  if alignment.ok else np.nan)
+    for index in tracker.revised:   # frames of a re-acquisition the following frames' motion confirmed
+        revised = tracker.alignments[index]
+        frames.rotation_error[index] = (rotation_error(revised.body_to_world[:3, :3],
+                                                       frames.true_target_to_world[index] @ target_to_body.T, symmetries)
+                                        if revised.ok else np.nan)
 
 
 # ------------------------------------------------------------------------------ estimation
@@ -640,6 +645,11 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         track.true_positions.append(true_net)
         track.separation.append(float(nearest_segments(debris_world, estimate, net.threads)[2].min())
                                 if alignment.ok else np.nan)   # unknown without a debris pose
+        for index in tracker.revised:   # frames a re-acquisition confirmed after the fact: their debris pose
+            revised = tracker.alignments[index].body_to_world
+            before = index - (len(tracker.alignments) - len(track.separation))
+            track.separation[before] = float(nearest_segments(model_sample @ revised[:3, :3].T + revised[:3, 3],
+                                                              track.positions[before], net.threads)[2].min())
         if progress:
             progress("collision", k, len(times) - 1)
     return track

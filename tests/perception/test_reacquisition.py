@@ -82,22 +82,35 @@ def _lost(tracker, pose):
                           Alignment(0.1, pose, np.eye(6), 0.0, 1.0, 0.0, False, False, 0.0, 0)]
 
 
-def test_a_search_passing_two_different_poses_fails_the_frame(paper_ellipsoid, c_fans_lidar, monkeypatch):
-    # The paper's ellipsoid after a lost track: its half turns fit the scan exactly as well as the
-    # truth. Told the symmetries, the tracker takes the variant nearest its last pose (a right answer
-    # up to them: within 3 deg, one searched frame of the mesh at 6 m). Not told (as for a map, whose
-    # symmetries are unknown), the search passes poses 180 deg apart and the frame fails: it does not
-    # pick one of them.
+def _turning_frames(mesh, lidar, position, times):
+    """Scans of a body turning at a constant 1.2 rad/s about a fixed axis (a rigid motion the
+    constant-rate prediction follows exactly) and its true body -> world rotations."""
+    rotations = [Rotation.from_rotvec(np.array([0.7, 0.2, -0.6]) * t).as_matrix()
+                 @ Rotation.from_rotvec([0.4, 1.1, -0.3]).as_matrix() for t in times]
+    return [(_scene(mesh, lidar, rotation, position, seed=k), rotation) for k, rotation in enumerate(rotations)]
+
+
+@pytest.mark.parametrize("told", [True, False])
+def test_the_motion_decides_between_the_poses_a_search_passes(paper_ellipsoid, c_fans_lidar, monkeypatch, told):
+    # The paper's ellipsoid after a lost track. Its searched frame passes the truth and, beside it,
+    # a pose 61 deg off (a turn about the near-symmetry axis; measured) and, not told the symmetries,
+    # its half turns. No frame is accepted until the motion decides: the chains are followed through
+    # two more frames (small-turn search, then the constant-rate prediction), and only the chain of
+    # one rigid motion is kept. Told the symmetries (the mesh's half turns), one chain survives and
+    # its three frames are accepted, each within 3 deg of the truth up to the symmetries (one
+    # searched frame of the mesh at 6 m is good to ~1 deg). Not told them (as for a map), the half
+    # turns are rigid motions as good as the truth: no frame is accepted rather than one of them.
     monkeypatch.setattr(registration, "LOST_SEEDS", 240)   # the ellipsoid's basin is found with 240 (test time)
-    rotation = Rotation.from_rotvec([0.4, 1.1, -0.3]).as_matrix()
-    points, sensor_to_world, truth = _scene(paper_ellipsoid, c_fans_lidar, rotation, np.array([6.0, 0.0, 0.0]))
     symmetries = half_turn_symmetry_transforms(paper_ellipsoid, 0.015)
-    told = _tracker(paper_ellipsoid, c_fans_lidar, symmetries_body=symmetries)
-    _lost(told, np.eye(4))
-    found = told.update(0.2, points, SENSOR, all_returns_world=points, sensor_to_world=sensor_to_world)
-    assert found.ok
-    assert np.degrees(rotation_error(found.body_to_world[:3, :3], rotation, [s[:3, :3] for s in symmetries])) < 3.0
-    blind = _tracker(paper_ellipsoid, c_fans_lidar)
-    _lost(blind, np.eye(4))
-    ambiguous = blind.update(0.2, points, SENSOR, all_returns_world=points, sensor_to_world=sensor_to_world)
-    assert not ambiguous.ok
+    tracker = _tracker(paper_ellipsoid, c_fans_lidar, **({"symmetries_body": symmetries} if told else {}))
+    _lost(tracker, np.eye(4))
+    frames = _turning_frames(paper_ellipsoid, c_fans_lidar, np.array([6.0, 0.0, 0.0]), [0.2, 0.3, 0.4])
+    for t, ((points, sensor_to_world, _), _) in zip([0.2, 0.3, 0.4], frames):
+        tracker.update(t, points, SENSOR, all_returns_world=points, sensor_to_world=sensor_to_world)
+    found = tracker.alignments[2:]
+    if not told:
+        assert not any(a.ok for a in found)
+        return
+    assert all(a.ok for a in found) and tracker.revised == [2, 3]
+    for alignment, (_, rotation) in zip(found, frames):
+        assert np.degrees(rotation_error(alignment.body_to_world[:3, :3], rotation, [t[:3, :3] for t in symmetries])) < 3.0
