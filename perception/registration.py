@@ -26,7 +26,7 @@ the predicted model: returns of other objects (net threads in front of the debri
 Why a check of its own: Open3D's ``fitness`` and ``inlier_rmse`` are computed inside the
 correspondence distance that ICP itself used, so an ICP that slid into a wrong pose (users
 report it beyond ~45 degrees of initial error) still reports a high fitness. The check uses
-three figures that a wrong pose cannot all pass:
+figures that a wrong pose cannot all pass:
 
 * **tight fitness**: share of scan points within 3 sigma of the model surface (sigma: the
   measured point-to-plane scatter), not within the loose ICP distance;
@@ -34,7 +34,16 @@ three figures that a wrong pose cannot all pass:
   model lies in front of what the LiDAR measured: the ray would have stopped on the model,
   so the pose contradicts the measurement;
 * **innovation**: rotation between the registered and the predicted pose; a jump larger than
-  the motion allows (a symmetric flip of a near-symmetric body) fails even when the surface fits.
+  the motion allows (a symmetric flip of a near-symmetric body) fails even when the surface fits;
+* **unseen model** (given the sensor's attitude and field of view): share of the posed model's
+  directions in the field where no ray returned; the free-space violation only judges directions
+  with returns, so a box-like body's half turn with its far parts sticking into empty space passed.
+
+After a lost track a pose found by the search over all attitudes is not accepted alone: each passing
+pose starts a chain, the next two frames must continue it as one rigid motion (small-turn search,
+then the constant-rate prediction within the innovation limit), and only a single surviving chain
+is accepted, its frames revised after the fact (``revised``). Two surviving chains leave every frame
+failed: a wrong pose that passes is worse than a failed frame.
 
 The surface figures (tight fitness, sigma, information) are taken on about ``CHECKED_POINTS``
 evenly spread scan points: shares to ~1 %, the information scaled to the whole scan.
@@ -81,7 +90,7 @@ DEPTH_BUFFER_POINTS = 3000  # model points placing the visible-side seeds (a few
 CONFIRMING_FRAMES = 3   # a re-acquired pose and the two frames continuing it (the last one predicted from the motion)
 MAX_CHAINS = 3          # candidate poses of a re-acquisition followed through the next frames
 SEARCH_SCREENED = 40    # best-fitting distinct seeds of a search over all attitudes screened by the check before refining
-AMBIGUOUS_TURN = np.radians(15.0)  # rad; a search passing two poses this far apart (beyond the known symmetries) fails
+AMBIGUOUS_TURN = np.radians(15.0)  # rad; passing poses this far apart (beyond the known symmetries) start chains of their own
 
 
 def _turn_candidates(largest) -> list[np.ndarray]:
@@ -592,6 +601,7 @@ class DebrisTracker:
         # one spacing per frame for every check of it (a search checks up to SEARCH_REFINED poses)
         self._frame_spacing = _sample_spacing(points) if len(points) >= MIN_POINTS else None
         if len(points) < MIN_POINTS:   # e.g. everything gated away: record the frame as failed, do not guess
+            self._chains = []          # a chain continues frame by frame only
             pose = predicted if predicted is not None else np.eye(4)
             return Alignment(time_s, pose, np.zeros((6, 6)), 0.0, 1.0, np.inf, False, False, 0.0, len(points))
         if self._chains:
@@ -623,8 +633,7 @@ class DebrisTracker:
                         for symmetry in self.symmetries_body) > AMBIGUOUS_TURN for kept in starts):
                 starts.append(other)
         self._chains = [[start] for start in starts]
-        pending = Alignment(**{**alignment.__dict__, "ok": False})
-        return pending
+        return Alignment(**{**alignment.__dict__, "ok": False})
 
     def _continue_chains(self, time_s, scan, sensor_world) -> Alignment:
         """One more frame for each candidate chain after a lost track: the second frame by the
