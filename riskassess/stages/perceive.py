@@ -648,6 +648,8 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         for index in tracker.revised:   # frames a re-acquisition confirmed after the fact: their debris pose
             revised = tracker.alignments[index].body_to_world
             before = index - (len(tracker.alignments) - len(track.separation))
+            if before < 0:   # an observation frame (a chain begun before the run in): no net gap
+                continue
             track.separation[before] = float(nearest_segments(model_sample @ revised[:3, :3].T + revised[:3, 3],
                                                               track.positions[before], net.threads)[2].min())
         if progress:
