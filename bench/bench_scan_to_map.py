@@ -13,7 +13,7 @@ frames apart), frames registered, attitude error
 the world at t = 0, and the inertia-ratio errors of the torque-free fit.
 
     python bench/bench_scan_to_map.py [--seeds 0 1 2 3 4] [--duration 20] [--body featured|ellipsoid]
-                                      [--models none known] [--settled 1e-4 1e-3]
+                                      [--models none known] [--settled 1e-4 1e-3] [--tukey 0.5 1]
 """
 from __future__ import annotations
 
@@ -81,6 +81,9 @@ def main():
                         help="scan-to-map ICP stop tolerances to compare (m: a step's rotation times "
                              "scan_to_map.BODY_SIZE plus its translation); each seed is tracked once per value, "
                              "back to back (A/B in one process); default the module's SETTLED")
+    parser.add_argument("--tukey", type=float, nargs="+", default=None,
+                        help="scan-to-map Tukey cut-offs to compare (share of the correspondence distance, "
+                             "scan_to_map.TUKEY_CUTOFF); each seed is tracked once per value, back to back")
     args = parser.parse_args()
     times = np.arange(int(round(args.duration * LIDAR.rate)) + 1) / LIDAR.rate
     quaternions, _ = propagate_torque_free(np.array([1.0, 0, 0, 0]), OMEGA0, MOMENTS / MOMENTS[2], times, 0.005)
@@ -92,12 +95,14 @@ def main():
         rng = np.random.default_rng(seed)
         scans = [cast(LIDAR, [(mesh.vertices @ r.T + COM0 + VELOCITY * t, mesh.faces)], t, rng).points_sensor
                  for t, r in zip(times, body_to_world)]
-        for settled in (args.settled or [scan_to_map.SETTLED]) if "none" in args.models else []:
-            scan_to_map.SETTLED = settled
+        variants = [(settled, tukey) for settled in (args.settled or [scan_to_map.SETTLED])
+                    for tukey in (args.tukey or [scan_to_map.TUKEY_CUTOFF])]
+        for settled, tukey in variants if "none" in args.models else []:
+            scan_to_map.SETTLED, scan_to_map.TUKEY_CUTOFF = settled, tukey
             free = track_scans(scans, VOXEL, CORRESPONDENCE)
             records = alignments(free, times)
             # B of the model-free track is the first scan's frame; the truth in it: R_k R_0^T (R_0 = I here)
-            print(f"seed {seed} none, settled {1e3 * settled:g} mm: "
+            print(f"seed {seed} none, settled {1e3 * settled:g} mm, Tukey {tukey:g} x distance: "
                   + _figures(times, body_to_world, free.world_to_body, free.ok,
                              np.array([a.information for a in records]), free.cpu_seconds), flush=True)
         if "known" not in args.models:

@@ -26,7 +26,7 @@ the predicted model: returns of other objects (net threads in front of the debri
 Why a check of its own: Open3D's ``fitness`` and ``inlier_rmse`` are computed inside the
 correspondence distance that ICP itself used, so an ICP that slid into a wrong pose (users
 report it beyond ~45 degrees of initial error) still reports a high fitness. The check uses
-three figures that a wrong pose cannot all pass:
+figures that a wrong pose cannot all pass:
 
 * **tight fitness**: share of scan points within 3 sigma of the model surface (sigma: the
   measured point-to-plane scatter), not within the loose ICP distance;
@@ -34,7 +34,16 @@ three figures that a wrong pose cannot all pass:
   model lies in front of what the LiDAR measured: the ray would have stopped on the model,
   so the pose contradicts the measurement;
 * **innovation**: rotation between the registered and the predicted pose; a jump larger than
-  the motion allows (a symmetric flip of a near-symmetric body) fails even when the surface fits.
+  the motion allows (a symmetric flip of a near-symmetric body) fails even when the surface fits;
+* **unseen model** (given the sensor's attitude and field of view): share of the posed model's
+  directions in the field where no ray returned; the free-space violation only judges directions
+  with returns, so a box-like body's half turn with its far parts sticking into empty space passed.
+
+After a lost track a pose found by the search over all attitudes is not accepted alone: each passing
+pose starts a chain, the next two frames must continue it as one rigid motion (small-turn search,
+then the constant-rate prediction within the innovation limit), and only a single surviving chain
+is accepted, its frames revised after the fact (``revised``). Two surviving chains leave every frame
+failed: a wrong pose that passes is worse than a failed frame.
 
 The surface figures (tight fitness, sigma, information) are taken on about ``CHECKED_POINTS``
 evenly spread scan points: shares to ~1 %, the information scaled to the whole scan.
@@ -61,6 +70,7 @@ MAX_FREE_SPACE_VIOLATION = 0.05  # share of viewing directions where the model b
 MAX_INNOVATION = np.radians(10.0)  # rad; the constant-rate prediction is good to ~0.2 deg for 2.3 rad/s tumbles at 10 Hz
 SEARCH_TURN = np.radians(30.0)     # rad; largest turn between frames searched without a prediction (3 rad/s at 10 Hz, paper Sec. 2)
 MIN_POINTS = 50                    # thinned scan points below which a frame is not registered (too few for the check)
+MAX_UNSEEN = 0.02  # share of the posed model's viewing directions inside the field of view with no return near them
 
 #: Effort of the ICP and of the search.
 ICP_ITERATIONS = 15     # per level, at most; from a good prediction a level settles in 1-4
@@ -73,6 +83,14 @@ CHECKED_POINTS = 1000   # scan points in the coarse ICP level and in the check (
 SEARCH_VOXELS = 4       # the search ranks its seeds on the scan thinned to this many voxels (~300 points)
 SEARCH_REFINED = 6      # best-ranked distinct seeds refined and checked (an ellipsoid's 4 symmetric poses, spares)
 DISTINCT_TURN = np.radians(5.0)  # rad; ranked poses closer than this in attitude are one result
+# Attitudes seeding the search after a lost track: with 240 the nearest was 15-23 deg from the truth and
+# no seed reached it (featured debris after the net contact, 1.5-3.3 s); with 1000 it was found.
+LOST_SEEDS = 1000
+DEPTH_BUFFER_POINTS = 3000  # model points placing the visible-side seeds (a few per 12 cm cell of a 2 m body)
+CONFIRMING_FRAMES = 3   # a re-acquired pose and the two frames continuing it (the last one predicted from the motion)
+MAX_CHAINS = 3          # candidate poses of a re-acquisition followed through the next frames
+SEARCH_SCREENED = 40    # best-fitting distinct seeds of a search over all attitudes screened by the check before refining
+AMBIGUOUS_TURN = np.radians(15.0)  # rad; passing poses this far apart (beyond the known symmetries) start chains of their own
 
 
 def _turn_candidates(largest) -> list[np.ndarray]:
@@ -124,8 +142,9 @@ def _distinct(poses, count) -> list[np.ndarray]:
 
 
 def _score(alignment) -> float:
-    """Ranks candidate alignments: checks passed first, then tight fitness less violation."""
-    return float(alignment.ok) + alignment.tight_fitness - alignment.free_space_violation
+    """Ranks candidate alignments: checks passed first, then tight fitness less the shares of
+    directions where the model blocks a return or lies where no ray returned."""
+    return float(alignment.ok) + alignment.tight_fitness - alignment.free_space_violation - alignment.unseen
 
 
 @dataclass
@@ -149,6 +168,7 @@ class Alignment:
     seconds: float
     n_points: int
     cpu_seconds: float = 0.0   # process time of the registration (s; all threads, at least the one-core time)
+    unseen: float = 0.0        # share of the posed model's directions in the field of view with no return near them
 
     @property
     def body_to_world(self) -> np.ndarray:
@@ -226,6 +246,96 @@ def free_space_violation(points_world, model_world, sensor_world, bin_angle, mar
     seen = np.where(seen_bin[slot] == model_bin, nearest[slot], np.inf)
     blocked = np.unique(model_bin[np.isfinite(seen) & (model_range < seen - margins)])
     return len(blocked) / max(len(seen_bin), 1)
+
+
+def unseen_model_share(model_world, returns_world, sensor_world, sensor_to_world, field_of_view, bin_angle) -> float:
+    """Share of the viewing directions the posed model covers, inside the sensor's field of view,
+    that hold no return in their bin or the 8 bins around it: the LiDAR looked there and its rays
+    met nothing, so a model surface there contradicts the scan (the free space beside the body, which
+    :func:`free_space_violation`, judging only bins with returns, cannot see).
+
+    A half turn of a box-like body fits the seen side as well as the truth but puts its far parts
+    (an array, the bus' other end) where the rays passed: on the featured debris after the net
+    contact (dumped frames 0.1-6.1 s, 2-16 m) the truth scored at most 0.002, the map's half turns
+    about its principal axes refined by ICP 0.003-0.56 (mostly above 0.03), one of which passed the
+    other checks (tight fitness 0.83, violation 0.033) with 0.149. The one-bin dilation keeps the
+    limb bins, partly covered by the body, from counting.
+
+    Parameters
+    ----------
+    model_world : (k, 3) float
+        Model points at the pose under test (m, world frame).
+    returns_world : (n, 3) float
+        Every return of the frame (m, world frame): debris, net, anything.
+    sensor_world : (3,) float
+        Sensor origin (m, world frame).
+    sensor_to_world : (3, 3) float
+        Sensor -> world rotation (sensor frame of :mod:`perception.lidar`: boresight +x, up +z).
+    field_of_view : (2,) float
+        Full field of view (rad): azimuth, elevation.
+    bin_angle : float
+        Angular size of a viewing-direction bin (rad), several ray spacings.
+
+    Returns
+    -------
+    float
+        Share (0 to 1) of the model's bins inside the field of view (shrunk by two bins) with no
+        return in the 3 x 3 bins about them; 0 when the model covers none.
+    """
+    def bins(points):
+        d = (np.asarray(points, float) - sensor_world) @ sensor_to_world
+        r = np.sqrt(np.einsum("ij,ij->i", d, d))
+        return np.arcsin(np.clip(d[:, 2] / r, -1, 1)), np.arctan2(d[:, 1], d[:, 0])
+
+    elevation, azimuth = bins(model_world)
+    inside = ((np.abs(elevation) < 0.5 * field_of_view[1] - 2 * bin_angle)
+              & (np.abs(azimuth) < 0.5 * field_of_view[0] - 2 * bin_angle))
+    row = 1_000_003   # key = elevation bin * row + azimuth bin
+    model_keys = np.unique(np.floor(elevation[inside] / bin_angle).astype(np.int64) * row
+                           + np.floor(azimuth[inside] / bin_angle).astype(np.int64))
+    if not len(model_keys):
+        return 0.0
+    elevation, azimuth = bins(returns_world)
+    return_keys = np.unique(np.floor(elevation / bin_angle).astype(np.int64) * row
+                            + np.floor(azimuth / bin_angle).astype(np.int64))
+    seen = np.zeros(len(model_keys), bool)
+    for up in (-1, 0, 1):
+        for side in (-1, 0, 1):
+            seen |= np.isin(model_keys + up * row + side, return_keys)
+    return float(1.0 - seen.mean())
+
+
+def visible_side_centroid(points_body, view_body, cell) -> np.ndarray:
+    """Centroid of the points (n, 3) (m, frame B) a distant viewer looking along ``view_body``
+    sees: per ``cell`` (m) square across the view, the points within one cell of the front-most (a
+    depth buffer; parallel projection, a few cm off at 2-6 m). Needs no normals (a map's estimated
+    normals have no consistent sign).
+
+    Parameters
+    ----------
+    points_body : (n, 3) float
+        Model points (m, frame B).
+    view_body : (3,) float
+        Unit viewing direction, from the viewer towards the body (frame B).
+    cell : float
+        Size of the depth buffer's squares (m).
+
+    Returns
+    -------
+    (3,) float
+        Centroid of the seen points (m, frame B).
+    """
+    helper = np.eye(3)[int(np.argmin(np.abs(view_body)))]
+    across = np.cross(view_body, helper)
+    across /= np.linalg.norm(across)
+    up = np.cross(view_body, across)
+    depth = points_body @ view_body
+    key = (np.floor(points_body @ across / cell).astype(np.int64) * 1_000_003
+           + np.floor(points_body @ up / cell).astype(np.int64))
+    order = np.lexsort((depth, key))
+    first = np.r_[True, np.diff(key[order]) != 0]
+    front = np.repeat(depth[order][first], np.diff(np.r_[np.flatnonzero(first), len(order)]))
+    return points_body[order[depth[order] <= front + cell]].mean(axis=0)
 
 
 def _sample_spacing(points) -> float:
@@ -322,6 +432,13 @@ class DebrisTracker:
                                 pose: the surface cannot tell them apart, and a jump between them
                                 breaks the torque-free fit of the free flight (seen once after a
                                 failed frame at 18 m: a 176 deg flip made the collision "not observable").
+    field_of_view : (2,) float, optional
+                                The LiDAR's full field of view (rad): azimuth, elevation. With it, and
+                                the sensor attitude given to :meth:`update`, the check also counts the
+                                model's directions in the field where the rays met nothing
+                                (:func:`unseen_model_share`).
+    ray_spacing : float         The LiDAR's larger angular step between rays (rad); the unseen-model
+                                check's bins span at least 3 of them.
     seed : int                  Seed of the global (RANSAC) alignments: Open3D's generator is
                                 re-seeded with ``seed`` + the frame number before each, so a run
                                 repeats exactly (unseeded, two runs of one case tracked 189 and
@@ -329,8 +446,14 @@ class DebrisTracker:
     """
 
     def __init__(self, voxel=0.03, max_correspondence=0.1, model_frames=30, model_points_body=None,
-                 model_normals_body=None, symmetries_body=None, seed=0):
+                 model_normals_body=None, symmetries_body=None, seed=0, field_of_view=None, ray_spacing=0.0):
         self.voxel = voxel
+        self.field_of_view = None if field_of_view is None else np.asarray(field_of_view, float)
+        self.ray_spacing = float(ray_spacing)
+        self._frame_sensor_to_world = None   # sensor attitude of the frame being registered, for the unseen-model check
+        self._passing_alignments = []        # passing alignments of the last search other than the kept one
+        self._chains = []                    # candidate pose sequences after a lost track (see _continue_chains)
+        self.revised = []                    # indices of earlier frames whose alignment the last update replaced
         self.symmetries_body = [np.eye(4)] if symmetries_body is None else [np.asarray(s, float) for s in symmetries_body]
         self.seed = seed
         self._frame_spacing = None   # scan sample spacing (m) of the frame being registered
@@ -412,7 +535,8 @@ class DebrisTracker:
         self._nearest = NearestPointGrid(self._model_points, self.voxel / 3, self.max_correspondence)
 
     # -- one frame -------------------------------------------------------------------
-    def update(self, time_s, points_world, sensor_world, gate=None, all_returns_world=None) -> Alignment:
+    def update(self, time_s, points_world, sensor_world, gate=None, all_returns_world=None,
+               sensor_to_world=None) -> Alignment:
         """Register one scan (n, 3) (m, world frame) taken from ``sensor_world`` (3,) (m).
 
         Parameters
@@ -435,6 +559,11 @@ class DebrisTracker:
             in front of them counts as a contradiction. Measured on the featured debris at the first
             collision frame (net 7 cm off the bus): correct pose (0.2 deg from the prediction,
             tight fitness 0.99) rejected with 7.4 % of the bins violated (limit 5 %).
+        sensor_to_world : (3, 3) float, optional
+            Sensor -> world rotation at the scan. With the tracker's ``field_of_view``, a pose whose
+            model covers more than MAX_UNSEEN of its directions in the field where no ray returned
+            fails the check (:func:`unseen_model_share`); needs ``all_returns_world`` when
+            ``points_world`` is a selection.
 
         Returns
         -------
@@ -443,7 +572,9 @@ class DebrisTracker:
             ``alignments``.
         """
         start, cpu_start = time.perf_counter(), time.process_time()
+        self.revised = []
         self._frame_returns = None if all_returns_world is None else np.asarray(all_returns_world, float)
+        self._frame_sensor_to_world = None if sensor_to_world is None else np.asarray(sensor_to_world, float)
         scan = _cloud(points_world).voxel_down_sample(self.voxel)
         if self._model is None:   # the first scan starts the model and defines the frame B
             alignment = self._start_model(time_s, np.asarray(scan.points))
@@ -453,7 +584,7 @@ class DebrisTracker:
                 scan = self._gated(scan, predicted, gate)
             alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
             self._frame_spacing = None
-        self._frame_returns = None
+        self._frame_returns = self._frame_sensor_to_world = None
         alignment.seconds = time.perf_counter() - start
         alignment.cpu_seconds = time.process_time() - cpu_start
         self.alignments.append(alignment)
@@ -470,8 +601,11 @@ class DebrisTracker:
         # one spacing per frame for every check of it (a search checks up to SEARCH_REFINED poses)
         self._frame_spacing = _sample_spacing(points) if len(points) >= MIN_POINTS else None
         if len(points) < MIN_POINTS:   # e.g. everything gated away: record the frame as failed, do not guess
+            self._chains = []          # a chain continues frame by frame only
             pose = predicted if predicted is not None else np.eye(4)
             return Alignment(time_s, pose, np.zeros((6, 6)), 0.0, 1.0, np.inf, False, False, 0.0, len(points))
+        if self._chains:
+            return self._continue_chains(time_s, scan, sensor_world)
         if has_motion:
             alignment = self._judge(time_s, points, self._icp(scan, predicted), predicted, sensor_world, True)
         elif self.alignments and self.alignments[-1].ok:
@@ -480,10 +614,72 @@ class DebrisTracker:
         else:
             # No pose yet, or the track was lost for frames (a collision may have changed the spin a lot).
             alignment = self._search(time_s, scan, self._acquisition_start(points, predicted),
-                                     _orientation_candidates(), sensor_world)
+                                     _orientation_candidates(LOST_SEEDS if self.alignments else 240), sensor_world,
+                                     visible_side=True)
+            if alignment.ok and any(a.ok for a in self.alignments):
+                return self._start_chains(alignment)   # a lost track: the motion decides (_continue_chains)
         if not alignment.ok:
             alignment = self._retry_from_global(time_s, scan, alignment, predicted, has_motion, sensor_world)
         return alignment
+
+    def _start_chains(self, alignment) -> Alignment:
+        """The passing poses of a search after a lost track (the kept one and the others, one per
+        attitude beyond the model's known symmetries, at most MAX_CHAINS), each the start of a chain
+        the next frames must continue (:meth:`_continue_chains`); the frame counts as failed until then."""
+        starts = [alignment]
+        for other in self._passing_alignments:
+            if len(starts) < MAX_CHAINS and all(
+                    min(_turn_angle((symmetry @ other.world_to_body)[:3, :3], kept.world_to_body[:3, :3])
+                        for symmetry in self.symmetries_body) > AMBIGUOUS_TURN for kept in starts):
+                starts.append(other)
+        self._chains = [[start] for start in starts]
+        return Alignment(**{**alignment.__dict__, "ok": False})
+
+    def _continue_chains(self, time_s, scan, sensor_world) -> Alignment:
+        """One more frame for each candidate chain after a lost track: the second frame by the
+        small-turn search from the chain's pose, the third by ICP from the constant-rate prediction
+        of the two (the check with the innovation limit: one angular velocity). Chains failing the
+        check are dropped. After CONFIRMING_FRAMES frames a single surviving chain is the track: its
+        frames replace the pending ones (their indices in ``revised``). Several surviving chains are
+        poses the scans cannot tell apart: every frame of them stays failed.
+
+        Why: a box-like body's near half turn can pass every check of one frame (featured debris,
+        2.2 s after the start of the run in: tight fitness 0.99, free-space violation 0.046, 177 deg
+        from the truth), and the paper's ellipsoid after a lost track passed a pose 61 deg from the
+        truth beside the truth (a turn about its near-symmetry axis); a wrong pose the next frames
+        continue as one rigid motion is much rarer than one that fits one frame.
+        """
+        points = np.asarray(scan.points)
+        survivors, tried = [], []
+        for chain in self._chains:
+            if len(chain) == 1:
+                # seeds on the visible side: the debris may have moved beyond the coarse ICP's reach in
+                # one frame (0.3 m at the featured debris' 3.15 m/s after the contact; seeds at the
+                # last pose's place ended 30 deg off the truth there)
+                candidate = self._search(time_s, scan, chain[-1].world_to_body, _turn_candidates(SEARCH_TURN),
+                                         sensor_world, visible_side=True)
+            else:
+                predicted = predict_pose(chain[-1].world_to_body, chain[-2].world_to_body)
+                candidate = self._judge(time_s, points, self._icp(scan, predicted), predicted, sensor_world, True)
+            tried.append(candidate)
+            if candidate.ok:
+                survivors.append(chain + [candidate])
+        self._chains = survivors
+        if not survivors:
+            best = max(tried, key=_score)
+            return Alignment(**{**best.__dict__, "ok": False})
+        if len(survivors[0]) < CONFIRMING_FRAMES:
+            return Alignment(**{**survivors[0][-1].__dict__, "ok": False})
+        self._chains = []
+        if len(survivors) > 1:   # two rigid motions explain the scans: no answer rather than a guess
+            return Alignment(**{**survivors[0][-1].__dict__, "ok": False})
+        first = len(self.alignments) - (CONFIRMING_FRAMES - 1)
+        for index, confirmed in zip(range(first, len(self.alignments)), survivors[0]):
+            previous = self.alignments[index]
+            self.alignments[index] = Alignment(**{**confirmed.__dict__, "time": previous.time,
+                                                  "seconds": previous.seconds, "cpu_seconds": previous.cpu_seconds})
+            self.revised.append(index)
+        return survivors[0][-1]
 
     def _retry_from_global(self, time_s, scan, failed, predicted, has_motion, sensor_world) -> Alignment:
         """The frame again from FPFH + RANSAC; kept when it passes or fits tighter than ``failed``."""
@@ -514,23 +710,56 @@ class DebrisTracker:
         start[:3, 3] = self._model_points.mean(axis=0) - start[:3, :3] @ points.mean(axis=0)
         return start
 
-    def _search(self, time_s, scan, start, turns, sensor_world) -> Alignment:
+    def _search(self, time_s, scan, start, turns, sensor_world, visible_side=False) -> Alignment:
         """Without a motion prediction: ``start`` turned by each of ``turns`` about the scan
         centroid (a smooth body, the paper's ellipsoid, gives ICP a basin of only a few degrees),
         each seed ranked by one coarse ICP level on a heavily thinned scan; the best SEARCH_REFINED
-        distinct results are refined and checked, the best-checked kept."""
+        distinct results are refined and checked, the best-checked kept (the other passing ones in
+        ``self._passing_alignments``). With ``visible_side`` each seed's scan centroid is put on the centroid of
+        the model's side the sensor sees at that attitude (:meth:`_visible_side_seeds`)."""
         points = np.asarray(scan.points)
         thin = np.asarray(scan.voxel_down_sample(SEARCH_VOXELS * self.voxel).points)
-        fits = [self._icp_level(thin, seed, self.max_correspondence, SEARCH_SETTLED)
-                for seed in _seeds(start, points.mean(axis=0), turns)]
+        seeds = (self._visible_side_seeds(start, points, sensor_world, turns) if visible_side
+                 else _seeds(start, points.mean(axis=0), turns))
+        fits = [self._icp_level(thin, seed, self.max_correspondence, SEARCH_SETTLED) for seed in seeds]
         fits.sort(key=lambda fit: -fit[1])
-        best = None
-        for pose in _distinct([pose for pose, _ in fits], SEARCH_REFINED):
+        ranked = [pose for pose, _ in fits]
+        if visible_side:
+            # A half turn of a box-like body fits the seen side about as well as the truth and outranks
+            # it on the fit alone; the free space (both checks) tells them apart before the refinement.
+            ranked = _distinct(ranked, SEARCH_SCREENED)
+            screened = [self._judge(time_s, points, pose, start, sensor_world, False) for pose in ranked]
+            ranked = [ranked[i] for i in np.argsort([-_score(a) for a in screened], kind="stable")]
+        best, passing = None, []
+        for pose in _distinct(ranked, SEARCH_REFINED):
             candidate = self._judge(time_s, points, self._nearest_variant(self._icp(scan, pose), start), start,
                                     sensor_world, False)
+            if candidate.ok:
+                passing.append(candidate)
             if best is None or _score(candidate) > _score(best):
                 best = candidate
+        self._passing_alignments = [candidate for candidate in passing if candidate is not best]
         return best
+
+    def _visible_side_seeds(self, start, points, sensor_world, turns) -> list[np.ndarray]:
+        """world_to_body seeds: ``start``'s attitude turned by each of ``turns``, placed so that the
+        scan centroid lands on the centroid of the model's side seen from the sensor at that attitude
+        (:func:`visible_side_centroid`). A scan shows one side: its centroid lies about half the
+        body's depth in front of the model centroid, beyond the coarse ICP's reach
+        (``max_correspondence``) on a 1-2 m body seen from 2-6 m (the featured debris after the net
+        contact: with the centroids matched, every seed ended 0.8-1.2 m off)."""
+        centroid = points.mean(axis=0)
+        view_world = (centroid - sensor_world) / max(np.linalg.norm(centroid - sensor_world), 1e-9)
+        # a few model points per depth-buffer cell are enough for a centroid (1000 seeds: seconds saved)
+        model = _thinned(self._coarse_points, DEPTH_BUFFER_POINTS)
+        seeds = []
+        for turn in turns:
+            seed = np.eye(4)
+            seed[:3, :3] = turn @ start[:3, :3]
+            side = visible_side_centroid(model, seed[:3, :3] @ view_world, SEARCH_VOXELS * self.voxel)
+            seed[:3, 3] = side - seed[:3, :3] @ centroid
+            seeds.append(seed)
+        return seeds
 
     def _nearest_variant(self, pose, reference) -> np.ndarray:
         """Of the poses S @ ``pose`` (world -> B) the surface cannot tell apart, the one whose
@@ -592,10 +821,14 @@ class DebrisTracker:
                                          3 * sigma + self.voxel, self._coarse_normals @ body_to_world[:3, :3].T,
                                          self._frame_spacing or _sample_spacing(points_world))
         innovation = _turn_angle(pose[:3, :3], predicted[:3, :3])
-        ok = (tight >= MIN_TIGHT_FITNESS and violation <= MAX_FREE_SPACE_VIOLATION
+        unseen = 0.0
+        if self.field_of_view is not None and self._frame_sensor_to_world is not None:
+            unseen = unseen_model_share(model_world, returns, sensor_world, self._frame_sensor_to_world,
+                                        self.field_of_view, max(2 * self.voxel / range_scale, 3 * self.ray_spacing))
+        ok = (tight >= MIN_TIGHT_FITNESS and violation <= MAX_FREE_SPACE_VIOLATION and unseen <= MAX_UNSEEN
               and (innovation <= MAX_INNOVATION or not has_motion))
         return Alignment(time_s, pose, information, tight, violation, innovation, bool(ok), global_init, 0.0,
-                         len(points_world))
+                         len(points_world), unseen=unseen)
 
     def _surface_fit(self, points_world, pose) -> tuple[float, float, np.ndarray]:
         """Tight fitness, point-to-plane scatter sigma (m) and information of the posed scan, from

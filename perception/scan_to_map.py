@@ -57,6 +57,16 @@ MAP_INTERVAL = 10
 #: SETTLED (m): <1 % of the 2 cm range noise of the paper's LiDAR.
 BODY_SIZE = 1.0
 SETTLED = 1e-4
+#: Tukey cut-off of the ICP's point-to-plane residuals, as a share of the level's correspondence
+#: distance. Half of it (1.7 cm at the fine level, 1.9 times the measured 0.8-1.0 cm scatter of the
+#: residuals) is what makes the iteration walk: with the nearest map points re-associated every
+#: iteration the steepest weights keep moving, steps of 0.002-0.005 deg were still taken after 100
+#: iterations and one frame moved 1.4 deg in 300 (featured body, frames 30-60 of seed 0); with the full
+#: distance (3.7 scatters) the same frames stop moving within ~30 iterations, and frozen correspondences
+#: settle in ~10 with either. Kept at 0.5: the full distance did not make a frame cheaper at the 0.1 mm
+#: stop and moved the inertia ratios from -0.23/-0.26 and -0.22/-0.28 % to -1.04/-1.26 and +0.54/+0.65 %
+#: (seeds 0, 1, 10 s), though the attitudes improved (docs/perception.md, "ICP creep").
+TUKEY_CUTOFF = 0.5
 #: Scan points below which a frame is not registered (too few to fix 6 degrees of freedom reliably).
 MIN_POINTS = 50
 
@@ -188,7 +198,7 @@ def register_with_motion_prior(scan_world, map_points, map_normals, predicted_wo
     """Point-to-plane ICP (Tukey kernel) of a thinned scan to the map, regularized towards the
     pose predicted from the motion: the Gauss-Newton steps minimize
     ``sum w r^2 / s^2 + d^T P d`` with r the point-to-plane residuals (Tukey weights w, cut-off
-    half the level's correspondence distance, scatter s a third of that cut-off), d the pose's
+    TUKEY_CUTOFF times the level's correspondence distance, scatter s a third of that cut-off), d the pose's
     difference from the prediction and P = diag(1 / prior_sigma^2).
 
     Why: on a smooth near-spheroid the turn about the near-symmetry axis barely changes the fit
@@ -220,11 +230,12 @@ def register_with_motion_prior(scan_world, map_points, map_normals, predicted_wo
     fine = scan_world[::max(1, len(scan_world) // FINE_POINTS)]
     for points, distance, iterations in ((coarse, max_correspondence, COARSE_ITERATIONS),
                                          (fine, max_correspondence / 3, FINE_ITERATIONS)):
-        scatter2 = (distance / 6) ** 2    # Tukey cut-off distance/2 at 3 scatters
+        cutoff = TUKEY_CUTOFF * distance
+        scatter2 = (cutoff / 3) ** 2      # the Tukey cut-off at 3 scatters
         for _ in range(iterations):
             body = _transform(points, pose)
             _, nearest = index.query(body, distance_upper_bound=distance)
-            hessian, gradient, _, count = tukey_normal_equations(body, nearest, map_points, map_normals, distance / 2)
+            hessian, gradient, _, count = tukey_normal_equations(body, nearest, map_points, map_normals, cutoff)
             if count < 6:
                 break
             difference = _pose_difference(pose, reference_inverse) if prior_sigma is not None else np.zeros(6)

@@ -472,15 +472,21 @@ def _record(frames, t, phase, points, true_rot, true_com):
 
 
 def _register(tracker, frames, t, phase, points, sensor_world, true_rot, true_com, symmetries, target_to_body=np.eye(3),
-              all_returns=None):
+              all_returns=None, sensor_to_world=None):
     """Register a scan (a tiny one is recorded as failed by the tracker) and score it against the
     true attitude (target -> world ``true_rot``; ``target_to_body`` (3, 3) the truth's rotation into
     the tracker's frame B: identity when B is the target frame). ``all_returns`` (m, 3) (m, world):
-    every return of the frame when ``points`` is the debris' share of them, for the free-space check."""
-    alignment = tracker.update(t, points, sensor_world, all_returns_world=all_returns)
+    every return of the frame when ``points`` is the debris' share of them, for the free-space check;
+    ``sensor_to_world`` (3, 3): the sensor's attitude, for the unseen-model check."""
+    alignment = tracker.update(t, points, sensor_world, all_returns_world=all_returns, sensor_to_world=sensor_to_world)
     _record(frames, t, phase, points, true_rot, true_com)
     frames.rotation_error.append(rotation_error(alignment.body_to_world[:3, :3], true_rot @ target_to_body.T, symmetries)
                                  if alignment.ok else np.nan)
+    for index in tracker.revised:   # frames of a re-acquisition the following frames' motion confirmed
+        revised = tracker.alignments[index]
+        frames.rotation_error[index] = (rotation_error(revised.body_to_world[:3, :3],
+                                                       frames.true_target_to_world[index] @ target_to_body.T, symmetries)
+                                        if revised.ok else np.nan)
 
 
 # ------------------------------------------------------------------------------ estimation
@@ -585,6 +591,11 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
     estimate = net.positions.copy()
     times = net_snapshots["time"]
     pointing = _pointing(tracker, frames, com_body)
+    # The mount turns through the run: a lost track is searched over all attitudes, and a box-like
+    # debris' half turns pass the surface checks; the directions where the rays met nothing tell them
+    # apart (perception.registration.unseen_model_share).
+    tracker.field_of_view = np.array([scene.spec.fov_azimuth, scene.spec.fov_elevation])
+    tracker.ray_spacing = max(scene.spec.resolution_azimuth, scene.spec.resolution_elevation)
     # the debris' reach about its CoM (m), plus a margin for the map's and the scan's errors
     radius_body = float(np.max(np.linalg.norm(tracker.model_points_body - pointing.com_body, axis=1))) + BLOB_MARGIN
     for k, t in enumerate(times):
@@ -610,7 +621,7 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         on_net = nearest_segments(points, predicted, net.threads)[2] < NET_GATE if len(points) else np.zeros(0, bool)
         debris_points, blob = _debris_returns(tracker, pointing, t, points[~on_net], radius_body)
         _register(tracker, frames, t, 1, debris_points, sensor_world, rot, com,
-                  symmetries, target_to_body[:3, :3], all_returns=points)
+                  symmetries, target_to_body[:3, :3], all_returns=points, sensor_to_world=sensor_to_world)
         alignment = tracker.alignments[-1]
         pointing.record(t, alignment.body_to_world if alignment.ok else None, len(debris_points) >= MIN_POINTS, blob)
         # The net's nodes are fitted to the returns the debris does not explain, the rim held at
@@ -634,6 +645,13 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         track.true_positions.append(true_net)
         track.separation.append(float(nearest_segments(debris_world, estimate, net.threads)[2].min())
                                 if alignment.ok else np.nan)   # unknown without a debris pose
+        for index in tracker.revised:   # frames a re-acquisition confirmed after the fact: their debris pose
+            revised = tracker.alignments[index].body_to_world
+            before = index - (len(tracker.alignments) - len(track.separation))
+            if before < 0:   # an observation frame (a chain begun before the run in): no net gap
+                continue
+            track.separation[before] = float(nearest_segments(model_sample @ revised[:3, :3].T + revised[:3, 3],
+                                                              track.positions[before], net.threads)[2].min())
         if progress:
             progress("collision", k, len(times) - 1)
     return track

@@ -93,8 +93,9 @@ def test_debris_leaving_during_a_lost_track_is_found_again(paper_ellipsoid, c_fa
     # turns; bound 3 deg: one frame of the known mesh at 6-8 m is good to ~1 deg, the search's first
     # frame after the loss admits more). Aimed at the last good pose instead (the stage before this
     # change), the debris leaves the field for good: no returns at all from 1.1 s on.
-    # (A box-like body is not found again this way: the search over all attitudes takes its near
-    # half turns, docs/perception.md, "Pointing after a lost track".)
+    # (The re-acquired pose is accepted once the next two frames continue it as one rigid motion,
+    # perception/registration.py, _continue_chains. A box-like body's near half turns are rejected
+    # by the unseen-model check and the chains: tests/perception/test_reacquisition.py.)
     symmetries = half_turn_symmetry_transforms(paper_ellipsoid, 0.015)
     com_body = np.zeros(3)   # the ellipsoid's centre
     alignments, truths, returns = _fly_off(paper_ellipsoid, com_body, c_fans_lidar,

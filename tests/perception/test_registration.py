@@ -6,6 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from perception.lidar import cast
 from perception.registration import Alignment, DebrisTracker, _cloud, known_shape_model
+from perception.shape import half_turn_symmetry_transforms
 
 SENSOR = np.zeros(3)
 RANGE = 10.0   # m, the case's hold distance
@@ -101,17 +102,28 @@ def _seen(time_s, pose, ok=True):
 
 def test_lost_track_is_found_again_over_all_attitudes(paper_ellipsoid, c_fans_lidar):
     # Frames failed since the last good one (say a collision): the body may have turned far. Here
-    # 90 deg about its x axis, beyond the small-turn search (30 deg) and no symmetry of the body;
-    # the search over all attitudes finds it, not the RANSAC fallback. Seen this way the turn about
-    # the long axis is weak: ICP from the true pose itself ends 3-4 deg off.
+    # 90 deg about its x axis, beyond the small-turn search (30 deg) and no symmetry of the body,
+    # then turning on at 0.05 rad per frame; the search over all attitudes finds it, not the RANSAC
+    # fallback. A re-acquired pose counts only once the next two frames continue it as one rigid
+    # motion (perception/registration.py, _continue_chains): the searched frame is pending until
+    # then, and the three are accepted together. Seen this way the turn about the long axis is weak:
+    # ICP from the true pose itself ends 3-4 deg off.
+    # The tracker knows the ellipsoid's half turns (as the stage does for a mesh): without them they
+    # are rigid motions as good as the truth and nothing is accepted (tests/perception/test_reacquisition.py).
     truth = Rotation.from_rotvec([0.3, 0.2, 0.1]).as_matrix()
     position = np.array([RANGE, 0.0, 0.0])
-    tracker = _tracker(paper_ellipsoid)
+    tracker = DebrisTracker(0.03, 0.1, 30, *known_shape_model(paper_ellipsoid, 0.03, seed=0),
+                            symmetries_body=half_turn_symmetry_transforms(paper_ellipsoid, 0.015))
     tracker.alignments = [_seen(0.0, _pose(truth, position)), _seen(0.1, np.eye(4), ok=False)]
-    turned = truth @ Rotation.from_rotvec([np.pi / 2, 0.0, 0.0]).as_matrix()
-    alignment = tracker.update(0.2, _scan(paper_ellipsoid, c_fans_lidar, turned, position, 0), SENSOR)
-    assert alignment.ok and not alignment.global_init
-    assert _attitude_error(alignment, turned) < np.radians(6.0)
+    turned = [Rotation.from_rotvec([0.0, 0.0, 0.05 * k]).as_matrix() @ truth
+              @ Rotation.from_rotvec([np.pi / 2, 0.0, 0.0]).as_matrix() for k in range(3)]
+    first = tracker.update(0.2, _scan(paper_ellipsoid, c_fans_lidar, turned[0], position, 0), SENSOR)
+    assert not first.ok and not first.global_init
+    for k in (1, 2):
+        tracker.update(0.2 + 0.1 * k, _scan(paper_ellipsoid, c_fans_lidar, turned[k], position, k), SENSOR)
+    assert tracker.revised == [2, 3]
+    for alignment, rotation in zip(tracker.alignments[2:], turned):
+        assert alignment.ok and _attitude_error(alignment, rotation) < np.radians(6.0)
 
 
 def test_gate_drops_returns_in_front_of_the_debris(paper_ellipsoid, c_fans_lidar):

@@ -1,0 +1,116 @@
+"""Re-acquiring a lost track without taking a wrong pose: the unseen-model check rejects a box-like
+body's half turns, and a search that passes two different poses fails the frame."""
+import numpy as np
+import pytest
+import trimesh
+from scipy.spatial.transform import Rotation
+
+import perception.registration as registration
+from multibody.geometry import shape_mesh
+from perception.lidar import cast, sensor_to_platform
+from perception.registration import MAX_UNSEEN, Alignment, DebrisTracker, _cloud, known_shape_model
+from perception.shape import half_turn_symmetry_transforms, rotation_error
+
+SENSOR = np.zeros(3)
+UP = np.array([0.0, 0.0, 1.0])
+BUS_CENTRE = np.zeros(3)
+
+
+@pytest.fixture(scope="module")
+def featured_body():
+    """The featured debris' shape (cases/featured_debris_perception_model_free.toml): a 1.2 x 1.0 x
+    1.6 m bus and a 2 x 0.8 m array on its +y side."""
+    return trimesh.util.concatenate([shape_mesh("box", size=[1.2, 1.0, 1.6]),
+                                     shape_mesh("box", size=[0.05, 2.0, 0.8], center=(0.0, 1.5, 0.2))])
+
+
+def _scene(mesh, lidar, rotation, position, seed=0):
+    """Scan of the body (body -> world ``rotation``, origin at ``position``, m) from the sensor at the
+    origin, boresight on the body: returns (m, world), the sensor attitude and the true world -> B."""
+    sensor_to_world = sensor_to_platform(position - SENSOR, UP)
+    vertices = np.asarray(mesh.vertices) @ rotation.T + position
+    scan = cast(lidar, [((vertices - SENSOR) @ sensor_to_world, mesh.faces)], 0.0, np.random.default_rng(seed))
+    truth = np.eye(4)
+    truth[:3, :3], truth[:3, 3] = rotation.T, -rotation.T @ position
+    return scan.points_sensor @ sensor_to_world.T + SENSOR, sensor_to_world, truth
+
+
+def _tracker(mesh, lidar, **options):
+    return DebrisTracker(0.03, 0.1, 30, *known_shape_model(mesh, 0.03, seed=0), seed=0,
+                         field_of_view=(lidar.fov_azimuth, lidar.fov_elevation),
+                         ray_spacing=max(lidar.resolution_azimuth, lidar.resolution_elevation), **options)
+
+
+def _judged(tracker, points, sensor_to_world, pose):
+    """The check of one pose, as the tracker judges a searched frame (no motion prediction)."""
+    scan = np.asarray(_cloud(points).voxel_down_sample(tracker.voxel).points)
+    tracker._frame_returns, tracker._frame_sensor_to_world = points, sensor_to_world
+    tracker._frame_spacing = registration._sample_spacing(scan)
+    return tracker._judge(0.0, scan, pose, pose, SENSOR, has_motion=False)
+
+
+@pytest.mark.parametrize("axis", range(3))
+def test_half_turns_of_the_bus_are_rejected_by_the_unseen_model(featured_body, c_fans_lidar, axis):
+    # The featured debris at 4 m, its array in view. A half turn about one of the bus' axes (through
+    # its centre) maps the bus onto itself and puts the array where the rays passed by; refined by
+    # ICP it fits the seen side. The true pose leaves no model direction without a return (0.000
+    # measured, bound MAX_UNSEEN / 4: the dilated bins cover the limb). Measured for the half turns
+    # about x, y, z: unseen 0.040, 0.162, 0.040 (bound: above MAX_UNSEEN). The one about y keeps the
+    # array on its side, shifted 0.4 m: it passes the surface checks (tight fitness 0.89, free-space
+    # violation 0.042) and only the unseen model rejects it; the other two also fail on the fit (0.65).
+    rotation = Rotation.from_rotvec([0.3, -0.2, 0.9]).as_matrix()
+    points, sensor_to_world, truth = _scene(featured_body, c_fans_lidar, rotation, np.array([4.0, 0.0, 0.3]))
+    tracker = _tracker(featured_body, c_fans_lidar)
+    right = _judged(tracker, points, sensor_to_world, truth)
+    assert right.ok and right.unseen < MAX_UNSEEN / 4
+    half = np.eye(4)
+    half[:3, :3] = Rotation.from_rotvec(np.pi * np.eye(3)[axis]).as_matrix()
+    half[:3, 3] = BUS_CENTRE - half[:3, :3] @ BUS_CENTRE
+    scan = _cloud(points).voxel_down_sample(tracker.voxel)
+    turned = tracker._icp(scan, half @ truth)
+    wrong = _judged(tracker, points, sensor_to_world, turned)
+    assert np.degrees(rotation_error(np.linalg.inv(turned)[:3, :3], rotation, [np.eye(3)])) > 150
+    assert wrong.unseen > MAX_UNSEEN and not wrong.ok
+    if axis == 1:   # without the sensor's field the check has no free space beside the body: passed
+        tracker.field_of_view = None
+        assert _judged(tracker, points, sensor_to_world, turned).ok
+
+
+def _lost(tracker, pose):
+    """The tracker as after a lost track: a good frame long ago, then a failed one."""
+    tracker.alignments = [Alignment(0.0, pose, np.eye(6), 1.0, 0.0, 0.0, True, False, 0.0, 0),
+                          Alignment(0.1, pose, np.eye(6), 0.0, 1.0, 0.0, False, False, 0.0, 0)]
+
+
+def _turning_frames(mesh, lidar, position, times):
+    """Scans of a body turning at a constant 1.2 rad/s about a fixed axis (a rigid motion the
+    constant-rate prediction follows exactly) and its true body -> world rotations."""
+    rotations = [Rotation.from_rotvec(np.array([0.7, 0.2, -0.6]) * t).as_matrix()
+                 @ Rotation.from_rotvec([0.4, 1.1, -0.3]).as_matrix() for t in times]
+    return [(_scene(mesh, lidar, rotation, position, seed=k), rotation) for k, rotation in enumerate(rotations)]
+
+
+@pytest.mark.parametrize("told", [True, False])
+def test_the_motion_decides_between_the_poses_a_search_passes(paper_ellipsoid, c_fans_lidar, monkeypatch, told):
+    # The paper's ellipsoid after a lost track. Its searched frame passes the truth and, beside it,
+    # a pose 61 deg off (a turn about the near-symmetry axis; measured) and, not told the symmetries,
+    # its half turns. No frame is accepted until the motion decides: the chains are followed through
+    # two more frames (small-turn search, then the constant-rate prediction), and only the chain of
+    # one rigid motion is kept. Told the symmetries (the mesh's half turns), one chain survives and
+    # its three frames are accepted, each within 3 deg of the truth up to the symmetries (one
+    # searched frame of the mesh at 6 m is good to ~1 deg). Not told them (as for a map), the half
+    # turns are rigid motions as good as the truth: no frame is accepted rather than one of them.
+    monkeypatch.setattr(registration, "LOST_SEEDS", 240)   # the ellipsoid's basin is found with 240 (test time)
+    symmetries = half_turn_symmetry_transforms(paper_ellipsoid, 0.015)
+    tracker = _tracker(paper_ellipsoid, c_fans_lidar, **({"symmetries_body": symmetries} if told else {}))
+    _lost(tracker, np.eye(4))
+    frames = _turning_frames(paper_ellipsoid, c_fans_lidar, np.array([6.0, 0.0, 0.0]), [0.2, 0.3, 0.4])
+    for t, ((points, sensor_to_world, _), _) in zip([0.2, 0.3, 0.4], frames):
+        tracker.update(t, points, SENSOR, all_returns_world=points, sensor_to_world=sensor_to_world)
+    found = tracker.alignments[2:]
+    if not told:
+        assert not any(a.ok for a in found)
+        return
+    assert all(a.ok for a in found) and tracker.revised == [2, 3]
+    for alignment, (_, rotation) in zip(found, frames):
+        assert np.degrees(rotation_error(alignment.body_to_world[:3, :3], rotation, [t[:3, :3] for t in symmetries])) < 3.0
