@@ -38,7 +38,7 @@ import math
 
 from numba import njit
 
-from multibody.contact import _power
+from multibody.contact import _power, hollar_friction_coefficient_inverse
 
 #: Off by default (``SolverSpec.implicit_contact_speed = 0``, every contact sub-cycled): with this value
 #: the reference case's results held (docs/model.md, Speed), but in the perception scenario
@@ -209,23 +209,14 @@ MAX_FRICTION_ITERATIONS = 60
 
 
 @njit(cache=True, inline="always")
-def _hollar(slip_speed, mu_static, mu_kinetic, inverse_transition_speed):
-    """:func:`multibody.contact.hollar_friction_coefficient` with 1 / transition speed (s/m) given."""
-    ratio = slip_speed * inverse_transition_speed
-    mu = mu_kinetic + 2.0 * (mu_static - mu_kinetic) / (1.0 + ratio * ratio)
-    if ratio < 1.0:
-        return ratio * mu
-    return mu
-
-
-@njit(cache=True, inline="always")
 def _friction_residual(j, free_mid_slip, normal_impulse, half_inverse_mass, mu_static, mu_kinetic,
                        inverse_transition_speed):
     """j - mu(mean slip) N (N s) at friction impulse j, and its derivative with respect to j (-); the Hollar
     law and its slope (:func:`multibody.contact.hollar_friction_coefficient_and_slope`) with one division."""
     mean_slip = free_mid_slip - j * half_inverse_mass
     if mean_slip <= 0.0:
-        return j - _hollar(0.0, mu_static, mu_kinetic, inverse_transition_speed) * normal_impulse, 1.0
+        mu_zero = hollar_friction_coefficient_inverse(0.0, mu_static, mu_kinetic, inverse_transition_speed)
+        return j - mu_zero * normal_impulse, 1.0
     ratio = mean_slip * inverse_transition_speed
     inverse_denominator = 1.0 / (1.0 + ratio * ratio)
     drop = mu_static - mu_kinetic
@@ -272,11 +263,13 @@ def friction_impulse(free_mid_slip, free_end_slip, normal_impulse, reduced_mass,
     inverse_transition_speed = 1.0 / transition_speed
     half_inverse_mass = 0.5 / reduced_mass
     mean_slip = max(free_mid_slip - stop * half_inverse_mass, 0.0)
-    if stop <= _hollar(mean_slip, mu_static, mu_kinetic, inverse_transition_speed) * normal_impulse:
+    if stop <= hollar_friction_coefficient_inverse(mean_slip, mu_static, mu_kinetic,
+                                                   inverse_transition_speed) * normal_impulse:
         return stop            # friction enough to stop the slip within the step
     lo, hi = 0.0, stop
     # start from the friction at the free slip, clipped into the bracket
-    j = min(_hollar(free_mid_slip, mu_static, mu_kinetic, inverse_transition_speed) * normal_impulse, 0.5 * stop)
+    j = min(hollar_friction_coefficient_inverse(free_mid_slip, mu_static, mu_kinetic, inverse_transition_speed)
+            * normal_impulse, 0.5 * stop)
     tolerance = 4e-16 * stop
     for _ in range(MAX_FRICTION_ITERATIONS):
         residual, derivative = _friction_residual(j, free_mid_slip, normal_impulse, half_inverse_mass, mu_static,
