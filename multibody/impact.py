@@ -87,6 +87,28 @@ class BuiltSystem:
         return (self.kernel.net.reference_lvlh + np.asarray(q[i:i + 3 * n]).reshape(n, 3),
                 np.asarray(qt[i:i + 3 * n]).reshape(n, 3))
 
+    def net_state_layout(self, q, qt):
+        """The net's state where it lives, without copies: coordinates and velocities (flat, m and m/s, LVLH,
+        displacements from ``self.kernel.net.reference_lvlh``) and where node ``i``'s coordinate ``d`` sits in them,
+        ``offset + i * node_stride + d * coordinate_stride`` (the kernel's coordinate-major state, or the net
+        node's block of Exudyn's vectors ``q``, ``qt``).
+
+        Parameters
+        ----------
+        q, qt : (N,) float
+            Exudyn's ODE2 coordinates and velocities (unused when the kernel holds the net).
+
+        Returns
+        -------
+        q_net, qt_net : (M,) float
+        offset, node_stride, coordinate_stride : int
+        """
+        n = self.kernel.n_nodes
+        if self.kernel_net is not None:
+            return self.kernel_net.q, self.kernel_net.qt, 0, 1, n
+        i = self.mbs.GetNodeODE2Index(self.net_node) if self.net_node is not None else 0
+        return np.asarray(q), np.asarray(qt), i, 3, 1
+
     def state_arrays(self) -> tuple:
         """Every state array of the run, for the finite-state check: Exudyn's coordinates and
         velocities, and the net's when the kernel holds it (Exudyn does not see it then)."""
