@@ -571,7 +571,13 @@ class ImpactSimulation:
         recorder = Recorder(self.assembly, self.system, progress=progress, monitor=monitor, health=self.health)
         self.recorder = recorder
         mbs = self.system.mbs
-        mbs.SetPostStepUserFunction(recorder.post_step)
+        kernel_net = self.system.kernel_net
+        if kernel_net is not None:
+            # the recorder's post-step work runs from the kernel's pre-step, for the step before (one Python
+            # call from Exudyn a step instead of two; the same work in the same order)
+            kernel_net.set_after_step(recorder.post_step, mbs.systemData.GetTime())
+        else:
+            mbs.SetPostStepUserFunction(recorder.post_step)
         settings = simulation_settings(self.assembly)
         recorder.sample(0.0)
         start = time.perf_counter()
@@ -579,6 +585,8 @@ class ImpactSimulation:
             if not self.health.ok:
                 raise self.health.failure
             solve_checked(mbs, settings, INTEGRATORS[self.assembly.solver.integrator][0], self.health)
+            if kernel_net is not None and not kernel_net.finish_steps(mbs):
+                raise self.health.failure
             if not self.health.finish():
                 raise self.health.failure
         finally:
