@@ -65,7 +65,8 @@ HEALTH_INTERVAL_S = 1e-3
 
 
 class Recorder:
-    """Samples the running system from Exudyn's post-step hook."""
+    """Samples the running system from Exudyn's post-step hook (when the kernel integrates the net, from its
+    pre-step hook for the step before: :meth:`multibody.kernel_net.KernelNet.set_after_step`)."""
 
     def __init__(self, assembly, system, progress=None, monitor=None, health=None):
         self.assembly = assembly
