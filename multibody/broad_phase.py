@@ -45,26 +45,31 @@ def box_shape_flags(triangles, triangle_range, box_min, box_max) -> np.ndarray:
 
 
 @njit(cache=True, inline="always")
-def box_signed_distance(px, py, pz, lo, hi):
-    """Signed distance (m) of body-frame point p to the box [lo, hi] (negative inside), and the unit
-    normal from the surface to the point (the face normal inside), body frame; as
+def box_signed_distance(px, py, pz, box_min, box_max, s):
+    """Signed distance (m) of body-frame point p to the box [lo, hi] = [box_min[s], box_max[s]] (negative
+    inside), and the unit normal from the surface to the point (the face normal inside), body frame; as
     :func:`multibody.contact.signed_distance_to_mesh` on the box's mesh.
 
     Parameters
     ----------
     px, py, pz : float
         The point, body frame (origin at the body's CoM) (m).
-    lo, hi : (3,) float
-        The box's lower and upper corners, body frame (m).
+    box_min, box_max : (ns, 3) float
+        The shapes' lower and upper corners, body frame (m); read at row ``s`` (whole arrays and an index,
+        not row views: a view is a reference count taken and dropped per node and shape).
+    s : int
+        The shape.
 
     Returns
     -------
     tuple of 4 float
         Distance (m) and the unit normal's x, y, z components, body frame.
     """
-    cx, cy, cz = 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])
+    lo0, lo1, lo2 = box_min[s, 0], box_min[s, 1], box_min[s, 2]
+    hi0, hi1, hi2 = box_max[s, 0], box_max[s, 1], box_max[s, 2]
+    cx, cy, cz = 0.5 * (lo0 + hi0), 0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2)
     dx, dy, dz = px - cx, py - cy, pz - cz
-    qx, qy, qz = abs(dx) - 0.5 * (hi[0] - lo[0]), abs(dy) - 0.5 * (hi[1] - lo[1]), abs(dz) - 0.5 * (hi[2] - lo[2])
+    qx, qy, qz = abs(dx) - 0.5 * (hi0 - lo0), abs(dy) - 0.5 * (hi1 - lo1), abs(dz) - 0.5 * (hi2 - lo2)
     # nearest face: the largest q
     if qx >= qy and qx >= qz:
         face, fx, fy, fz = qx, math.copysign(1.0, dx), 0.0, 0.0

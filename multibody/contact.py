@@ -81,6 +81,28 @@ def hollar_friction_coefficient(slip_speed, mu_static, mu_kinetic, transition_sp
 
 
 @njit(cache=True, inline="always")
+def hollar_friction_coefficient_inverse(slip_speed, mu_static, mu_kinetic, inverse_transition_speed):
+    """:func:`hollar_friction_coefficient` with 1 / transition speed (s/m) given: a product instead of a
+    division, for the loops that evaluate the law many times per contact (the sub-cycle, the implicit
+    friction solve); equal to it to round-off.
+
+    Parameters
+    ----------
+    slip_speed : float
+        Tangential slip speed (m/s), >= 0.
+    mu_static, mu_kinetic : float
+        Static and kinetic coefficients (-).
+    inverse_transition_speed : float
+        :math:`1 / V_{t,0}` (s/m).
+    """
+    ratio = slip_speed * inverse_transition_speed
+    mu = mu_kinetic + 2.0 * (mu_static - mu_kinetic) / (1.0 + ratio * ratio)
+    if ratio < 1.0:
+        return ratio * mu
+    return mu
+
+
+@njit(cache=True, inline="always")
 def hollar_friction_coefficient_and_slope(slip_speed, mu_static, mu_kinetic, transition_speed):
     """:func:`hollar_friction_coefficient` (-) and its derivative with respect to the slip speed (s/m),
     for Newton iterations on friction laws; the slope is one-sided (from above) at the transition.
@@ -290,14 +312,23 @@ def contact_over_step(penetrations, relative_velocities, normals, external_force
     """
     n_contacts = penetrations.shape[0]
     dt = step / n_substeps
+    # divisions by the masses, the sub-step and the transition speed as products with reciprocals formed
+    # once per call (the sub-step's chain is long; a division is 4-5 times a product's latency)
+    inverse_dt = 1.0 / dt
+    inverse_node_mass = 1.0 / node_mass
+    inverse_transition_speed = 1.0 / transition_speed
+    inverse_body_mass = np.empty(n_contacts)
+    reduced_mass = np.empty(n_contacts)
     for c in range(n_contacts):
         delta[c] = penetrations[c]
+        inverse_body_mass[c] = 1.0 / body_masses[c]
+        reduced_mass[c] = node_mass * body_masses[c] / (node_mass + body_masses[c])
         for k in range(3):
             recoil[c, k] = 0.0  # body surface velocity change at the contact
             impulses[c, k] = 0.0
-    ax = external_force[0] / node_mass
-    ay = external_force[1] / node_mass
-    az = external_force[2] / node_mass
+    ax = external_force[0] * inverse_node_mass
+    ay = external_force[1] * inverse_node_mass
+    az = external_force[2] * inverse_node_mass
     ux = uy = uz = 0.0  # node velocity change by contact
     sx = sy = sz = 0.0  # its time integral (displacement change)
     dissipated = 0.0
@@ -327,32 +358,38 @@ def contact_over_step(penetrations, relative_velocities, normals, external_force
             wy = relative_velocities[c, 1] + uy + ay * t - recoil[c, 1]
             wz = relative_velocities[c, 2] + uz + az * t - recoil[c, 2]
             rate = -_dot(wx, wy, wz, nx, ny, nz)
-            fn = hertz_hunt_crossley_normal_force(delta[c], rate, stiffness, exponent, damping)
+            # hertz_hunt_crossley_normal_force, with the power kept for the dissipation below
+            fn = 0.0
+            elastic = 0.0
+            if delta[c] > 0.0:
+                dn = _power(delta[c], exponent)
+                elastic = stiffness * dn
+                fn = max(elastic + damping * dn * rate, 0.0)
             gx, gy, gz = wx + rate * nx, wy + rate * ny, wz + rate * nz  # slip velocity
             speed = math.sqrt(gx * gx + gy * gy + gz * gz)
             fx, fy, fz = fn * nx, fn * ny, fn * nz
             if fn > 0.0 and speed > 0.0:
-                mu = hollar_friction_coefficient(speed, mu_static, mu_kinetic, transition_speed)
-                reduced_mass = node_mass * body_masses[c] / (node_mass + body_masses[c])
+                mu = hollar_friction_coefficient_inverse(speed, mu_static, mu_kinetic, inverse_transition_speed)
                 # Friction may stop the slip within a sub-step but never reverse it.
-                magnitude = min(mu * fn, reduced_mass * speed / dt)
-                fx -= magnitude * gx / speed
-                fy -= magnitude * gy / speed
-                fz -= magnitude * gz / speed
+                magnitude = min(mu * fn, reduced_mass[c] * speed * inverse_dt)
+                along = magnitude / speed
+                fx -= along * gx
+                fy -= along * gy
+                fz -= along * gz
                 dissipated += magnitude * speed * dt
             if delta[c] > 0.0:
                 # Work of the non-elastic part: damping, or the stored energy lost when a
                 # fast separation clips the force to zero (no adhesion).
-                dissipated += (fn - stiffness * _power(delta[c], exponent)) * rate * dt
+                dissipated += (fn - elastic) * rate * dt
             forces[c, 0] = fx
             forces[c, 1] = fy
             forces[c, 2] = fz
         for c in range(n_contacts):
-            ux += dt * forces[c, 0] / node_mass
-            uy += dt * forces[c, 1] / node_mass
-            uz += dt * forces[c, 2] / node_mass
+            ux += dt * forces[c, 0] * inverse_node_mass
+            uy += dt * forces[c, 1] * inverse_node_mass
+            uz += dt * forces[c, 2] * inverse_node_mass
             for k in range(3):
-                recoil[c, k] -= dt * forces[c, k] / body_masses[c]
+                recoil[c, k] -= dt * forces[c, k] * inverse_body_mass[c]
                 impulses[c, k] += dt * forces[c, k]
         # The constant external force moves the node by a (t1^2 - t0^2) / 2 over the sub-step.
         tm = t + 0.5 * dt

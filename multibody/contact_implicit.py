@@ -38,11 +38,7 @@ import math
 
 from numba import njit
 
-from multibody.contact import (
-    _power,
-    hollar_friction_coefficient,
-    hollar_friction_coefficient_and_slope,
-)
+from multibody.contact import _power, hollar_friction_coefficient_inverse
 
 #: Off by default (``SolverSpec.implicit_contact_speed = 0``, every contact sub-cycled): with this value
 #: the reference case's results held (docs/model.md, Speed), but in the perception scenario
@@ -67,45 +63,60 @@ def _hertz_energy(penetration, stiffness, exponent):
     return stiffness * _power(penetration, exponent) * penetration / (exponent + 1.0)
 
 
-# the Newton residuals are inlined (numba IR): called 3-8 times per contact and step, the call
-# overhead was a visible share of the implicit contact (results bit-identical)
 @njit(cache=True, inline="always")
-def _secant_force(d0, d1, stiffness, exponent):
-    """Discrete gradient (E(d1) - E(d0)) / (d1 - d0) of the Hertz energy (N), and an estimate of its
-    derivative with respect to d1 (N/m), for Newton."""
-    p0 = d0 if d0 > 0.0 else 0.0
+def _power_and_ratio(base, exponent):
+    """``base ** exponent`` and ``base ** (exponent - 1)`` for ``base`` > 0; for the Hertz exponent 1.5 one
+    square root and no division (the Newton residuals below need both, several times per contact and step)."""
+    if exponent == 1.5:
+        root = math.sqrt(base)
+        return base * root, root
+    power = base ** exponent
+    return power, power / base
+
+
+# the Newton residuals are inlined (numba IR): called 3-8 times per contact and step, the call
+# overhead was a visible share of the implicit contact. Divisions by the step and the reduced mass are
+# products with reciprocals formed once per contact (a division is 4-5 times the latency of a product,
+# and the residual's chain is long): 276 -> 183 ns per normal solve on contacts recorded from the
+# reference run (the results move at round-off, 1e-9 of the velocity change at most).
+@njit(cache=True, inline="always")
+def _normal_residual(d1, d0, p0, e0, rate0, accel_n, inv_step, step, step_over_mass, stiffness, exponent, damping):
+    """Residual of the implicit normal step at end penetration d1 (m/s), its derivative (1/s), the
+    mean contact force (N) and its non-conservative part (N).
+
+    The elastic part is the discrete gradient (E(d1) - E(d0)) / (d1 - d0) of the Hertz energy (``p0``,
+    ``e0``: the start penetration clipped at 0 and its energy), the midpoint force when d1 and d0 nearly
+    agree (to O((d1 - d0)^2)); its derivative is estimated at the midpoint, for Newton. ``inv_step`` is
+    1 / step, ``step_over_mass`` step / reduced mass.
+    """
     p1 = d1 if d1 > 0.0 else 0.0
     scale = max(p0, p1)
-    if scale <= 0.0:
-        return 0.0, 0.0
-    pm = 0.5 * (p0 + p1)
-    slope = 0.5 * exponent * stiffness * _power(pm, exponent) / pm if pm > 0.0 else 0.0
-    if abs(d1 - d0) <= 1e-7 * scale:
-        # both in contact and nearly equal: the secant is the midpoint force to O((d1-d0)^2)
-        return stiffness * _power(pm, exponent) * ((p1 - p0) / (d1 - d0) if d1 != d0 else 1.0), slope
-    return (_hertz_energy(p1, stiffness, exponent) - _hertz_energy(p0, stiffness, exponent)) / (d1 - d0), slope
-
-
-@njit(cache=True, inline="always")
-def _normal_residual(d1, d0, rate0, accel_n, step, reduced_mass, stiffness, exponent, damping):
-    """Residual of the implicit normal step at end penetration d1 (m/s), its derivative (1/s), the
-    mean contact force (N) and its non-conservative part (N)."""
-    secant, slope = _secant_force(d0, d1, stiffness, exponent)
+    change = d1 - d0
+    secant = 0.0
+    slope = 0.0
+    if scale > 0.0:
+        pm = 0.5 * (p0 + p1)
+        force_mid, ratio_mid = _power_and_ratio(pm, exponent)
+        slope = 0.5 * exponent * stiffness * ratio_mid
+        if abs(change) <= 1e-7 * scale:
+            secant = stiffness * force_mid * ((p1 - p0) / change if change != 0.0 else 1.0)
+        else:
+            secant = (_hertz_energy(p1, stiffness, exponent) - e0) / change
     mean = 0.5 * (d0 + d1)
-    rate_mean = (d1 - d0) / step
     viscous = 0.0
     viscous_slope = 0.0
     if mean > 0.0:
-        dn = _power(mean, exponent)
+        dn, ratio = _power_and_ratio(mean, exponent)
+        rate_mean = change * inv_step
         viscous = damping * dn * rate_mean
-        viscous_slope = damping * (0.5 * exponent * dn / mean * rate_mean + dn / step)
+        viscous_slope = damping * (0.5 * exponent * ratio * rate_mean + dn * inv_step)
     force = secant + viscous
-    derivative = 2.0 / step
+    derivative = 2.0 * inv_step
     if force > 0.0:
-        derivative += step / reduced_mass * (slope + viscous_slope)
+        derivative += step_over_mass * (slope + viscous_slope)
     else:
         force = 0.0
-    residual = 2.0 * (d1 - d0) / step - 2.0 * rate0 + step * accel_n + step * force / reduced_mass
+    residual = 2.0 * change * inv_step - 2.0 * rate0 + step * accel_n + step_over_mass * force
     return residual, derivative, force, force - secant
 
 
@@ -133,15 +144,29 @@ def implicit_normal_step(d0, rate0, accel_n, step, reduced_mass, stiffness, expo
     free = d0 + step * rate0 - 0.5 * step * step * accel_n  # no contact force: the upper bracket
     if d0 <= 0.0 and free <= 0.0:
         return free, 0.0, 0.0  # a gap at both ends: free flight (the end penetration is at most ``free``)
-    # Newton from the free-flight end, where the residual is >= 0: the residual is increasing and convex
-    # in d1 (the secant of a convex energy), so the iterates fall monotonically onto the root; a
-    # bisection against a lower bracket guards the damping term's departures from convexity.
+    inv_step = 1.0 / step
+    step_over_mass = step / reduced_mass
+    p0 = d0 if d0 > 0.0 else 0.0
+    e0 = _hertz_energy(p0, stiffness, exponent)
+    # The residual is increasing and convex in d1 (the secant of a convex energy): Newton from above the
+    # root falls monotonically onto it; a bisection against a lower bracket guards the damping term's
+    # departures from convexity. Start: the step linearized about the start penetration (tangent
+    # stiffness and damping there), when it lies below the free-flight end (the upper bracket); else the
+    # free-flight end. On the reference run's resting contacts this saves about one evaluation in six.
     hi = free
     lo = -math.inf
     d1 = free
-    r, dr, force, extra = _normal_residual(d1, d0, rate0, accel_n, step, reduced_mass, stiffness, exponent, damping)
+    if p0 > 0.0:
+        force0, ratio0 = _power_and_ratio(p0, exponent)
+        tangent = 0.5 * exponent * stiffness * ratio0 + damping * force0 * inv_step
+        guess = d0 + (2.0 * rate0 - step * accel_n - step_over_mass * stiffness * force0) / (
+            2.0 * inv_step + step_over_mass * tangent)
+        if guess < free:
+            d1 = guess
+    r, dr, force, extra = _normal_residual(d1, d0, p0, e0, rate0, accel_n, inv_step, step, step_over_mass, stiffness,
+                                           exponent, damping)
     # residual in m/s: converged when the rate 2 (d1 - d0) / h - rate0 is good to 1e-12 of the step's speeds
-    tolerance = 1e-12 * (abs(rate0) + abs(accel_n) * step + abs(d0) / step) + 1e-300
+    tolerance = 1e-12 * (abs(rate0) + abs(accel_n) * step + abs(d0) * inv_step) + 1e-300
     for _ in range(MAX_NEWTON_ITERATIONS):
         if r <= 0.0:
             lo = d1
@@ -159,8 +184,8 @@ def implicit_normal_step(d0, rate0, accel_n, step, reduced_mass, stiffness, expo
         if trial == d1:
             break
         d1 = trial
-        r, dr, force, extra = _normal_residual(d1, d0, rate0, accel_n, step, reduced_mass, stiffness, exponent,
-                                               damping)
+        r, dr, force, extra = _normal_residual(d1, d0, p0, e0, rate0, accel_n, inv_step, step, step_over_mass,
+                                               stiffness, exponent, damping)
     return d1, force, extra
 
 
@@ -168,27 +193,40 @@ def implicit_normal_step(d0, rate0, accel_n, step, reduced_mass, stiffness, expo
 def _lower_bracket(d0, free, rate0, accel_n, step, reduced_mass, stiffness, exponent, damping):
     """An end penetration whose residual is negative: a rebound cannot leave faster than the stored
     energy and the approach allow."""
-    e0 = _hertz_energy(d0, stiffness, exponent)
+    p0 = d0 if d0 > 0.0 else 0.0
+    e0 = _hertz_energy(p0, stiffness, exponent)
     reach = step * (2.0 * abs(rate0) + math.sqrt(2.0 * e0 / reduced_mass) + 2.0 * abs(accel_n) * step) + 1e-12
     lo = min(d0, free) - reach
-    while _normal_residual(lo, d0, rate0, accel_n, step, reduced_mass, stiffness, exponent, damping)[0] > 0.0:
+    while _normal_residual(lo, d0, p0, e0, rate0, accel_n, 1.0 / step, step, step / reduced_mass, stiffness,
+                           exponent, damping)[0] > 0.0:
         reach *= 2.0
         lo = min(d0, free) - reach
     return lo
 
 
-#: Iteration cap of the friction impulse's safeguarded Newton solve; it converges to round-off in 3-8.
+#: Iteration cap of the friction impulse's safeguarded Newton solve; it converges within 2-6 evaluations.
 MAX_FRICTION_ITERATIONS = 60
 
 
 @njit(cache=True, inline="always")
-def _friction_residual(j, free_mid_slip, normal_impulse, reduced_mass, mu_static, mu_kinetic, transition_speed):
-    """j - mu(mean slip) N (N s) at friction impulse j, and its derivative with respect to j (-)."""
-    mean_slip = free_mid_slip - 0.5 * j / reduced_mass
+def _friction_residual(j, free_mid_slip, normal_impulse, half_inverse_mass, mu_static, mu_kinetic,
+                       inverse_transition_speed):
+    """j - mu(mean slip) N (N s) at friction impulse j, and its derivative with respect to j (-); the Hollar
+    law and its slope (:func:`multibody.contact.hollar_friction_coefficient_and_slope`) with one division."""
+    mean_slip = free_mid_slip - j * half_inverse_mass
     if mean_slip <= 0.0:
-        return j - hollar_friction_coefficient(0.0, mu_static, mu_kinetic, transition_speed) * normal_impulse, 1.0
-    mu, slope = hollar_friction_coefficient_and_slope(mean_slip, mu_static, mu_kinetic, transition_speed)
-    return j - mu * normal_impulse, 1.0 + 0.5 * slope * normal_impulse / reduced_mass
+        mu_zero = hollar_friction_coefficient_inverse(0.0, mu_static, mu_kinetic, inverse_transition_speed)
+        return j - mu_zero * normal_impulse, 1.0
+    ratio = mean_slip * inverse_transition_speed
+    inverse_denominator = 1.0 / (1.0 + ratio * ratio)
+    drop = mu_static - mu_kinetic
+    mu = mu_kinetic + 2.0 * drop * inverse_denominator
+    mu_slope = -4.0 * drop * ratio * inverse_denominator * inverse_denominator  # d mu / d ratio
+    if ratio < 1.0:
+        mu, slope = ratio * mu, (mu + ratio * mu_slope) * inverse_transition_speed
+    else:
+        slope = mu_slope * inverse_transition_speed
+    return j - mu * normal_impulse, 1.0 + slope * normal_impulse * half_inverse_mass
 
 
 @njit(cache=True)
@@ -222,17 +260,23 @@ def friction_impulse(free_mid_slip, free_end_slip, normal_impulse, reduced_mass,
     stop = reduced_mass * max(free_end_slip, 0.0)
     if stop <= 0.0:
         return 0.0
-    mean_slip = max(free_mid_slip - 0.5 * stop / reduced_mass, 0.0)
-    if stop <= hollar_friction_coefficient(mean_slip, mu_static, mu_kinetic, transition_speed) * normal_impulse:
+    inverse_transition_speed = 1.0 / transition_speed
+    half_inverse_mass = 0.5 / reduced_mass
+    mean_slip = max(free_mid_slip - stop * half_inverse_mass, 0.0)
+    if stop <= hollar_friction_coefficient_inverse(mean_slip, mu_static, mu_kinetic,
+                                                   inverse_transition_speed) * normal_impulse:
         return stop            # friction enough to stop the slip within the step
     lo, hi = 0.0, stop
     # start from the friction at the free slip, clipped into the bracket
-    j = min(hollar_friction_coefficient(free_mid_slip, mu_static, mu_kinetic, transition_speed) * normal_impulse,
-            0.5 * stop)
-    tolerance = 4e-16 * stop
+    j = min(hollar_friction_coefficient_inverse(free_mid_slip, mu_static, mu_kinetic, inverse_transition_speed)
+            * normal_impulse, 0.5 * stop)
+    # 1e-13 of the impulse that stops the slip (4e-16, round-off, took one evaluation in four more:
+    # 205-221 -> 171-177 ns a contact on the reference run's recorded contacts; the residual left is at
+    # most 2.3e-13 of the stopping impulse on tests/multibody/test_contact_implicit.py's inputs)
+    tolerance = 1e-13 * stop
     for _ in range(MAX_FRICTION_ITERATIONS):
-        residual, derivative = _friction_residual(j, free_mid_slip, normal_impulse, reduced_mass, mu_static,
-                                                  mu_kinetic, transition_speed)
+        residual, derivative = _friction_residual(j, free_mid_slip, normal_impulse, half_inverse_mass, mu_static,
+                                                  mu_kinetic, inverse_transition_speed)
         if residual == 0.0:
             return j
         if residual < 0.0:
@@ -276,10 +320,24 @@ def contact_implicit_step(penetration, relative_velocity, normal, external_force
         As :func:`multibody.contact.contact_over_step`: the node's velocity change by contact,
         averaged over the step and at its end (m/s), and the energy dissipated (J).
     """
-    nx, ny, nz = normal[0], normal[1], normal[2]
+    mx, my, mz, ex, ey, ez, dissipated, jx, jy, jz = contact_implicit_step_xyz(
+        penetration, relative_velocity[0], relative_velocity[1], relative_velocity[2], normal[0], normal[1], normal[2],
+        external_force[0], external_force[1], external_force[2], node_mass, body_mass, step, stiffness, exponent,
+        damping, mu_static, mu_kinetic, transition_speed)
+    impulse[0], impulse[1], impulse[2] = jx, jy, jz
+    return mx, my, mz, ex, ey, ez, dissipated
+
+
+# in scalars, so the compiled contact pass hands over no array views: each view is a reference count taken
+# and dropped per contact and step (numba's NRT_incref/decref were 6 % of the reference case's run)
+@njit(cache=True, inline="always")
+def contact_implicit_step_xyz(penetration, wx, wy, wz, nx, ny, nz, fx, fy, fz, node_mass, body_mass, step,
+                              stiffness, exponent, damping, mu_static, mu_kinetic, transition_speed):
+    """:func:`contact_implicit_step` with its vectors as components (relative velocity ``w`` (m/s), unit
+    normal ``n``, non-contact force ``f`` (N), global frame); returns its seven values and then the
+    impulse on the node over the step (3 components, N s, global frame)."""
     reduced_mass = node_mass * body_mass / (node_mass + body_mass)
-    ax, ay, az = external_force[0] / node_mass, external_force[1] / node_mass, external_force[2] / node_mass
-    wx, wy, wz = relative_velocity[0], relative_velocity[1], relative_velocity[2]
+    ax, ay, az = fx / node_mass, fy / node_mass, fz / node_mass
     w_n = wx * nx + wy * ny + wz * nz
     a_n = ax * nx + ay * ny + az * nz
     d1, force, extra = implicit_normal_step(penetration, -w_n, a_n, step, reduced_mass, stiffness, exponent, damping)
@@ -302,6 +360,5 @@ def contact_implicit_step(penetration, relative_velocity, normal, external_force
             jz -= j_t * uz
             # its work on the step's mean slip (trapezoid, as the drift): booked as dissipated
             dissipated += j_t * max(0.5 * (start + end_free - j_t / reduced_mass), 0.0)
-    impulse[0], impulse[1], impulse[2] = jx, jy, jz
     ex, ey, ez = jx / node_mass, jy / node_mass, jz / node_mass
-    return 0.5 * ex, 0.5 * ey, 0.5 * ez, ex, ey, ez, dissipated
+    return 0.5 * ex, 0.5 * ey, 0.5 * ez, ex, ey, ez, dissipated, jx, jy, jz

@@ -19,7 +19,7 @@ from multibody.contact import (
     hertz_elastic_energy,
     signed_distance_to_mesh,
 )
-from multibody.contact_implicit import contact_implicit_step
+from multibody.contact_implicit import contact_implicit_step_xyz
 
 
 @njit(cache=True, inline="always")
@@ -239,7 +239,7 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
                     or pz < shape_box_min[s, 2] - margin or pz > shape_box_max[s, 2] + margin):
                 continue
             if shape_is_box[s]:
-                distance, nbx, nby, nbz = box_signed_distance(px, py, pz, shape_box_min[s], shape_box_max[s])
+                distance, nbx, nby, nbz = box_signed_distance(px, py, pz, shape_box_min, shape_box_max, s)
             else:
                 distance, nbx, nby, nbz = signed_distance_to_mesh(
                     px, py, pz, triangles, triangle_normals, shape_triangle_range[s, 0], shape_triangle_range[s, 1])
@@ -280,9 +280,12 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
                                + c_rel[0, 2] * c_normal[0, 2])
             if n_substeps > 1 and k == 1 and normal_speed < implicit_speed:
                 # a resting or slow single contact: one implicit step (multibody.contact_implicit)
-                mx, my, mz, ex, ey, ez, dissipated = contact_implicit_step(
-                    c_pen[0], c_rel[0], c_normal[0], non_contact_force_lvlh[i], net_mass[i], c_mass[0], step,
-                    k_contact, exponent, d_contact, mu_s, mu_k, v_transition, impulses[0])
+                # in scalars: array views would cost a reference count each per contact and step
+                mx, my, mz, ex, ey, ez, dissipated, jx, jy, jz = contact_implicit_step_xyz(
+                    c_pen[0], c_rel[0, 0], c_rel[0, 1], c_rel[0, 2], c_normal[0, 0], c_normal[0, 1], c_normal[0, 2],
+                    non_contact_force_lvlh[i, 0], non_contact_force_lvlh[i, 1], non_contact_force_lvlh[i, 2],
+                    net_mass[i], c_mass[0], step, k_contact, exponent, d_contact, mu_s, mu_k, v_transition)
+                impulses[0, 0], impulses[0, 1], impulses[0, 2] = jx, jy, jz
             else:
                 n_node = n_substeps
                 if n_substeps > 1:

@@ -89,6 +89,28 @@ class BuiltSystem:
         return (self.kernel.net.reference_lvlh + np.asarray(q[i:i + 3 * n]).reshape(n, 3),
                 np.asarray(qt[i:i + 3 * n]).reshape(n, 3))
 
+    def net_state_layout(self, q, qt):
+        """The net's state where it lives, without copies: coordinates and velocities (flat, m and m/s, LVLH,
+        displacements from ``self.kernel.net.reference_lvlh``) and where node ``i``'s coordinate ``d`` sits in them,
+        ``offset + i * node_stride + d * coordinate_stride`` (the kernel's coordinate-major state, or the net
+        node's block of Exudyn's vectors ``q``, ``qt``).
+
+        Parameters
+        ----------
+        q, qt : (N,) float
+            Exudyn's ODE2 coordinates and velocities (unused when the kernel holds the net).
+
+        Returns
+        -------
+        q_net, qt_net : (M,) float
+        offset, node_stride, coordinate_stride : int
+        """
+        n = self.kernel.n_nodes
+        if self.kernel_net is not None:
+            return self.kernel_net.q, self.kernel_net.qt, 0, 1, n
+        i = self.mbs.GetNodeODE2Index(self.net_node) if self.net_node is not None else 0
+        return np.asarray(q), np.asarray(qt), i, 3, 1
+
     def state_arrays(self) -> tuple:
         """Every state array of the run, for the finite-state check: Exudyn's coordinates and
         velocities, and the net's when the kernel holds it (Exudyn does not see it then)."""
@@ -116,11 +138,15 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
     net, law = assembly.net, assembly.contact
     shapes = contact_shapes_body_frame([b.meshes_body for b in assembly.bodies],
                                        np.zeros((len(assembly.bodies), 3)))
+    # Only the bending springs that act: a triple of zero stiffness adds nothing (bending off, the default,
+    # is all zeros), and scanning them was 1.5 % of the reference case's run (perf, cpu-clock samples).
+    bending = np.asarray(net.bending_stiffness, float) != 0.0
     net_arrays = NetArrays(
         reference_lvlh=np.ascontiguousarray(net.positions, float), mass=np.asarray(net.masses, float),
         radius=np.asarray(net.radii, float), threads=net.threads, rest_lengths=net.rest_lengths,
         thread_stiffness=net.stiffness, thread_damping=net.damping,
-        bending_triples=net.bending_triples, bending_stiffness=net.bending_stiffness,
+        bending_triples=np.ascontiguousarray(np.asarray(net.bending_triples, np.int64).reshape(-1, 3)[bending]),
+        bending_stiffness=np.ascontiguousarray(np.asarray(net.bending_stiffness, float)[bending]),
         thread_runs=thread_runs(net.threads, net.rest_lengths, net.stiffness, net.damping))
     bodies = BodyArrays(
         reference_com_lvlh=np.array([b.com_lvlh for b in assembly.bodies], float).reshape(-1, 3),
@@ -555,8 +581,15 @@ class ImpactSimulation:
         mbs = self.system.mbs
         post_step = recorder.post_step
         if self.system.rotations is not None:
+            # Exudyn's attitudes made exact before anything reads them (multibody.rotation_update)
             post_step = self.system.rotations.restoring(post_step)
-        mbs.SetPostStepUserFunction(post_step)
+        kernel_net = self.system.kernel_net
+        if kernel_net is not None:
+            # the post-step work runs from the kernel's pre-step, for the step before (one Python
+            # call from Exudyn a step instead of two; the same work in the same order)
+            kernel_net.set_after_step(post_step, mbs.systemData.GetTime())
+        else:
+            mbs.SetPostStepUserFunction(post_step)
         settings = simulation_settings(self.assembly)
         recorder.sample(0.0)
         start = time.perf_counter()
@@ -564,6 +597,8 @@ class ImpactSimulation:
             if not self.health.ok:
                 raise self.health.failure
             solve_checked(mbs, settings, INTEGRATORS[self.assembly.solver.integrator][0], self.health)
+            if kernel_net is not None and not kernel_net.finish_steps(mbs):
+                raise self.health.failure
             if not self.health.finish():
                 raise self.health.failure
         finally:

@@ -208,6 +208,11 @@ class KernelNet:
         self.model, self.q, self.qt = net_step_model(kernel, net_velocity)
         self._views = None
         self._last_time = -np.inf
+        #: optional ``after_step(mbs, t) -> bool``, the work of a post-step function for the step that ended at
+        #: ``t`` (s), run at the start of the next step's pre-step instead (one Python call a step from Exudyn
+        #: instead of two); False stops the solver. The last step's is left to :meth:`finish_steps`.
+        self.after_step = None
+        self._previous_end = 0.0    # Exudyn calls the post-step function once at t = 0 too
         # The solver's initial acceleration uses the force at the initial state.
         data = mbs.systemData
         q, qt = self._bodies(data.GetODE2Coordinates()), self._bodies(data.GetODE2Coordinates_t())
@@ -229,6 +234,11 @@ class KernelNet:
         return self._views
 
     def __call__(self, mbs, t):
+        if self.after_step is not None:
+            keep = self.after_step(mbs, self._previous_end)
+            self._previous_end = t
+            if not keep:
+                return False
         q, qt, qtt = self._state_views(mbs, t)
         q_bodies, qt_bodies, qtt_bodies = self._bodies(q), self._bodies(qt), self._bodies(qtt)
         if self.rotations is not None:
@@ -238,6 +248,29 @@ class KernelNet:
         force = kernel_net_step(self.model, q_bodies, qt_bodies, qtt_bodies, t)
         mbs.SetObjectParameter(self.coupled_object, "forceVector", force)
         return True
+
+    def set_after_step(self, after_step, start_time: float = 0.0):
+        """Run ``after_step(mbs, t) -> bool`` for every step of the next solve (:attr:`after_step`).
+
+        Parameters
+        ----------
+        after_step : callable or None
+        start_time : float
+            The solve's start time (s): Exudyn calls a post-step function once there too.
+        """
+        self.after_step = after_step
+        self._previous_end = start_time
+
+    def finish_steps(self, mbs) -> bool:
+        """Run :attr:`after_step` for the last step taken (after the solve); returns its answer (True without one).
+
+        Parameters
+        ----------
+        mbs : exudyn.MainSystem
+        """
+        if self.after_step is None:
+            return True
+        return bool(self.after_step(mbs, self._previous_end))
 
     def positions(self) -> np.ndarray:
         """(n, 3) node positions (m), LVLH, at the end of the last step."""

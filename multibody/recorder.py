@@ -37,6 +37,8 @@ to ~5 um, a thread stretch worth ~0.3 N of tension.
 """
 from __future__ import annotations
 
+import math
+
 import exudyn as exu
 import numpy as np
 
@@ -63,7 +65,8 @@ HEALTH_INTERVAL_S = 1e-3
 
 
 class Recorder:
-    """Samples the running system from Exudyn's post-step hook."""
+    """Samples the running system from Exudyn's post-step hook (when the kernel integrates the net, from its
+    pre-step hook for the step before: :meth:`multibody.kernel_net.KernelNet.set_after_step`)."""
 
     def __init__(self, assembly, system, progress=None, monitor=None, health=None):
         self.assembly = assembly
@@ -169,18 +172,22 @@ class Recorder:
         t : float
             Current simulated time (s).
         """
-        arrays = self.system.state_arrays()
-        q, qt = arrays[:2]
-        if not self.health.state(t, *arrays):
-            return  # nothing recorded from a lost state; the run stops at this step
-        x_lvlh, v_lvlh = self.system.net_state(q, qt)
-        row = self._compute_row(t, q, qt, x_lvlh, v_lvlh)
+        data = self.system.mbs.systemData
+        q, qt = data.GetODE2Coordinates(), data.GetODE2Coordinates_t()
+        # the net's sums first: their pass over the net's state also tells whether it is finite (the full
+        # check, with its message, runs only when it is not); nothing is recorded from a lost state
+        net_finite = math.isfinite(net_sums(*self.system.net_state_layout(q, qt), self.system.kernel.net.reference_lvlh,
+                                            self._net_masses, self.assembly.mean_motion, self._net_totals))
+        if not (self.health.state(t, q, qt) if net_finite else self.health.state(t, *self.system.state_arrays())):
+            return  # the run stops at this step
+        row = self._compute_row(t, q, qt)
         if not self.health.energy(t, row["energy_total"]):
             return
         self._store(row)
         if self.monitor is not None:
             self._check_monitor(t, row)
         if t == 0.0 or t >= self._next_net - 0.5 * self.step:
+            x_lvlh, v_lvlh = self.system.net_state(q, qt)
             k = self._n_net
             self._net_time[k] = t
             self._net_positions[k] = x_lvlh
@@ -210,15 +217,15 @@ class Recorder:
             self.joint_active[event.joint] = False
             self._released_energy += event.stored_energy
 
-    def _compute_row(self, t, q, qt, x_lvlh, v_lvlh) -> dict:
-        """One sample's values (see the module doc), from the compiled sums of multibody.recorder_kernel."""
+    def _compute_row(self, t, q, qt) -> dict:
+        """One sample's values (see the module doc), from the compiled sums of multibody.recorder_kernel (the
+        net's, ``self._net_totals``, computed by the caller)."""
         w = self._body_out
         interval = t - self._last_output_time
         self._last_output_time = t
         body_sample(q, qt, self._bodies, self._joints, self.joint_active.astype(float),
                     self.system.kernel.buffers.body_impulse_lvlh, interval, self.assembly.mean_motion, w)
         net = self._net_totals
-        net_sums(x_lvlh, v_lvlh, self._net_masses, self.assembly.mean_motion, net)
         mbs = self.system.mbs
         nj = len(self.system.joint_objects)
         forces_joint, moments_joint = np.zeros((nj, 3)), np.zeros((nj, 3))

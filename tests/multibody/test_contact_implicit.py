@@ -95,7 +95,7 @@ def test_friction_impulse_solves_its_consistency_equation_to_round_off(seed):
     mean slip) or stops the slip, and equals the unique root a bracketing solver finds where the
     residual is monotonic. Inputs span slips of 0.1 to 100 times the transition speed and normal
     impulses from feather touches to ones that stop the slip. Tolerance 1e-12 of the stopping
-    impulse: the solver stops at 4e-16 of it, Brent's method here at 1e-15."""
+    impulse: the solver stops when its Newton step is below 1e-13 of it, Brent's method here at 1e-15."""
     from scipy.optimize import brentq
 
     from multibody.contact import hollar_friction_coefficient as mu
