@@ -73,7 +73,21 @@ def hollar_friction_coefficient(slip_speed, mu_static, mu_kinetic, transition_sp
     transition_speed : float
         :math:`V_{t,0}` (m/s), > 0.
     """
-    ratio = slip_speed / transition_speed
+    return hollar_friction_of_ratio(slip_speed / transition_speed, mu_static, mu_kinetic)
+
+
+@njit(cache=True, inline="always")
+def hollar_friction_of_ratio(ratio, mu_static, mu_kinetic):
+    """Friction coefficient (-) of :func:`hollar_friction_coefficient` at the slip speed's ratio to the
+    transition speed (-), the one place the law's shape is written.
+
+    Parameters
+    ----------
+    ratio : float
+        Slip speed / :math:`V_{t,0}` (-), >= 0.
+    mu_static, mu_kinetic : float
+        Static and kinetic coefficients (-).
+    """
     mu = mu_kinetic + 2.0 * (mu_static - mu_kinetic) / (1.0 + ratio * ratio)
     if ratio < 1.0:
         return ratio * mu
@@ -95,11 +109,7 @@ def hollar_friction_coefficient_inverse(slip_speed, mu_static, mu_kinetic, inver
     inverse_transition_speed : float
         :math:`1 / V_{t,0}` (s/m).
     """
-    ratio = slip_speed * inverse_transition_speed
-    mu = mu_kinetic + 2.0 * (mu_static - mu_kinetic) / (1.0 + ratio * ratio)
-    if ratio < 1.0:
-        return ratio * mu
-    return mu
+    return hollar_friction_of_ratio(slip_speed * inverse_transition_speed, mu_static, mu_kinetic)
 
 
 @njit(cache=True, inline="always")
