@@ -32,8 +32,8 @@ from __future__ import annotations
 from numba import njit
 
 # params indices common to both laws; each law appends its gains (thrust_laws/mrac1.py, mrac2.py)
-T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU = range(9)
-N_COMMON = 9
+T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN = range(10)
+N_COMMON = 10
 # state: reference model z_m, z_m rate, the rate estimate's last elongation and last rate, then adaptive parameters
 ZM, ZM_RATE, Z_LAST, RATE_LAST, A0 = 0, 1, 2, 3, 4
 
@@ -100,10 +100,11 @@ def abstracted_tether(case, tether) -> tuple[float, float]:
 
 
 def common_params(case, tether) -> list:
-    """The parameters both laws share (indices ``T_ON`` ... ``RATE_TAU``) from a towing case (``thrust``,
+    """The parameters both laws share (indices ``T_ON`` ... ``U_MIN``) from a towing case (``thrust``,
     ``mrac``, ``chaser.mass``, ``main_tether.stiffness``) and its main tether ``tether`` = [k_MT (N/m),
     c_MT (N s/m), ...]: thrust-on time (s), saturation u_max (N), b = 1/m_C (1/kg), k_MT, c_MT,
-    z_d (m), K_P (N/m), K_D (N s/m), the rate estimate's time constant (s, 0: the measured rate).
+    z_d (m), K_P (N/m), K_D (N s/m), the rate estimate's time constant (s, 0: the measured rate), the
+    saturation's lower bound u_min (N; ``mrac.min_thrust``, default -u_max: the paper's symmetric sat).
 
     Parameters
     ----------
@@ -115,8 +116,9 @@ def common_params(case, tether) -> list:
     th, m = case.thrust, case.mrac
     k_mt, c_mt = abstracted_tether(case, tether)
     z_d = command_elongation(m.desired_elongation, k_mt, m.k_p, m.settle_at_desired)
+    u_min = -th.max_force if m.min_thrust is None else m.min_thrust
     return [th.t_on, th.max_force, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
-            m.rate_filter_time]
+            m.rate_filter_time, u_min]
 
 
 def initial_state(z0, z_rate0) -> list:
@@ -177,8 +179,39 @@ def reference_acceleration(params, zm, zm_rate):
     """
     b, k, c = params[B], params[K_MT], params[C_MT]
     pd = params[K_P] * (params[Z_D] - zm) - params[K_D] * zm_rate
-    pd = min(max(pd, -params[U_MAX]), params[U_MAX])
+    pd = saturated(pd, params)
     return -b * (k * zm + c * zm_rate) * pulling(zm, zm_rate, k, c) + b * pd
+
+
+@njit(cache=True)
+def saturated(u, params):
+    """The actuator's saturation, :math:`\\mathrm{sat}(u)` of eq. (16) (N): u clipped to [u_min, u_max]
+    (the paper: u_min = -u_max; ``mrac.min_thrust`` sets a floor, e.g. 0 for a main engine that cannot
+    push the chaser back towards the debris).
+
+    Parameters
+    ----------
+    u : float
+        Pre-saturation command (N).
+    params : (k,) float
+        The law's parameters (``U_MIN``, ``U_MAX`` used).
+    """
+    return min(max(u, params[U_MIN]), params[U_MAX])
+
+
+@njit(cache=True)
+def adapting(u, params):
+    """:math:`H(u_{max} - |u|)` of eqs. (15) and (20) for the actuator's range [u_min, u_max]: True while the
+    command is inside it (the adaptation is frozen while the command saturates).
+
+    Parameters
+    ----------
+    u : float
+        Pre-saturation command (N).
+    params : (k,) float
+        The law's parameters (``U_MIN``, ``U_MAX`` used).
+    """
+    return params[U_MIN] < u < params[U_MAX]
 
 
 @njit(cache=True)

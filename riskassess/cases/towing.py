@@ -101,6 +101,12 @@ class Mrac(Strict):
                          "difference quotient of the sampled elongation, corner 1/tau; 0: the plant's "
                          "instantaneous elongation rate (on the full-net plant that is the net node's vibration, "
                          "docs/towing.md). One decade above the reference model: 0.1 / sqrt((k_MT + K_P) / m_C).")
+    min_thrust: float | None = Field(
+        None, description="Lower bound u_min of the actuator's saturation, sat(u) of eq. (16) (N): the command is "
+                          "clipped to [min_thrust, thrust.max_force] and the adaptation frozen outside it; must lie in "
+                          "[-max_force, max_force). Default: -max_force (the paper's symmetric saturation). 0: a main "
+                          "engine along the chaser's body z, which never pushes the chaser back towards the debris "
+                          "(docs/towing.md, MRAC on the full net).")
     free_debris: bool = Field(
         False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
                            "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "
@@ -326,6 +332,10 @@ class TowingCase(Strict):
                 raise ValueError(f"full_net.switch_window must hold at least two averaging blocks: >= 2 x "
                                  f"switch_averaging = {2.0 * averaging:g} s (switch_averaging defaults to one spin "
                                  f"period, 360 / debris.spin_rate_deg_s). Got {fn.switch_window:g} s")
+        m = self.mrac
+        if m is not None and m.min_thrust is not None and not -self.thrust.max_force <= m.min_thrust < self.thrust.max_force:
+            raise ValueError(f"mrac.min_thrust must lie in [-thrust.max_force, thrust.max_force) = "
+                             f"[{-self.thrust.max_force:g}, {self.thrust.max_force:g}) N. Got {m.min_thrust:g} instead")
         if self.full_net is not None and 4 * self.full_net.corner_mass >= self.net_mass:
             raise ValueError(f"full_net.corner_mass must be < net_mass / 4 ({self.net_mass / 4:g} kg). "
                              f"Got {self.full_net.corner_mass:g} instead")
