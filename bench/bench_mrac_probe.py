@@ -6,6 +6,7 @@ debris CoM and the debris' angular momentum (issue 27: why MRAC fails on the ful
 
     python bench/bench_mrac_probe.py --law mrac2 --rate 20.44 --out bench/results/probe/mrac2_20.44.npz
                                      [--end 300] [--set mrac.KEY=VALUE ...] [--set thrust.KEY=VALUE ...]
+    python bench/bench_mrac_probe.py --analyse bench/results/probe/*.npz      # the mechanism line of each run
 
 Writes one ``.npz`` (series below; SI, frames in the names) and prints a per-25-s table. ``--set``
 overrides case keys of ``[mrac]`` or ``[thrust]`` (numbers, booleans or lists as JSON).
@@ -127,6 +128,31 @@ def table(series, t_on):
               flush=True)
 
 
+def mechanism(series, label):
+    """One line of the slack-and-snap mechanism (printed): the debris' angular-momentum change about its spin axis
+    against the integral of the main tether's moment about its CoM (the spin is lost through the tether if they
+    agree), the mean thrust while the tether is slack (T < 1 N) and while it snaps (T > 300 N), from 50 s on, the
+    slack share, the elongation's mean and its standard deviation from 150 s on with the share of its variance at
+    0.5-1 rad/s (twice the spin rate, 0.71 rad/s at 20.44 deg/s: the net's breathing on the tumbling stage)."""
+    t, tension, thrust, z = series["time"], series["tension"], series["thrust"], series["elongation"]
+    momentum = series["debris_angular_momentum_inertial"]
+    axis = momentum[0] / np.linalg.norm(momentum[0])
+    moment = series["tether_moment_inertial"] @ axis
+    integral = float(np.sum(0.5 * (moment[1:] + moment[:-1]) * np.diff(t)))
+    late, tail = t >= 50.0, t >= 150.0
+    slack, snap = late & (tension < 1.0), late & (tension > 300.0)
+    x = z[tail] - z[tail].mean()
+    power = np.abs(np.fft.rfft(x * np.hanning(len(x)))) ** 2
+    w = 2 * np.pi * np.fft.rfftfreq(len(x), t[1] - t[0])
+    breathing = power[(w >= 0.5) & (w < 1.0)].sum() / power[1:].sum()
+    spin = np.degrees(np.linalg.norm(series["debris_omega_body"], axis=1))
+    print(f"{label:34s} dL_spin {momentum[-1] @ axis - momentum[0] @ axis:9.0f} N m s, tether moment integral "
+          f"{integral:9.0f} N m s; thrust slack {thrust[slack].mean() if slack.any() else np.nan:6.1f} N, snap "
+          f"{thrust[snap].mean() if snap.any() else np.nan:6.1f} N; slack share {slack.sum() / late.sum():.2f}; "
+          f"z 150-300 s mean {z[tail].mean():.4f} std {x.std():.4f} m (0.5-1 rad/s: {breathing:.2f}); "
+          f"spin {spin[0]:.2f} -> {spin[-1]:.2f} deg/s", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--case", default="cases/zenit2_towing.toml")
@@ -134,8 +160,17 @@ def main():
     parser.add_argument("--rate", type=float, default=20.44)
     parser.add_argument("--end", type=float, default=None)
     parser.add_argument("--set", nargs="*", default=[])
-    parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument("--analyse", type=Path, nargs="+", default=None,
+                        help="print the mechanism line of probe files already written, run nothing")
     args = parser.parse_args()
+    if args.analyse:
+        for path in args.analyse:
+            with np.load(path) as data:
+                mechanism(dict(data), path.stem)
+        return
+    if args.out is None:
+        parser.error("--out is required unless --analyse")
     if args.out.exists():
         parser.error(f"--out {args.out} exists")
     case = load_model(args.case, TowingCase)
@@ -167,6 +202,7 @@ def main():
     print(f"law {args.law}, {args.rate} deg/s, set {args.set}: {cpu:.1f} s CPU, load {load0:.1f} -> "
           f"{os.getloadavg()[0]:.1f}; {args.out}")
     table(series, case.thrust.t_on)
+    mechanism(series, args.out.stem)
 
 
 if __name__ == "__main__":

@@ -102,7 +102,8 @@ def abstracted_tether(case, tether) -> tuple[float, float]:
 def common_params(case, tether) -> list:
     """The parameters both laws share (indices ``T_ON`` ... ``U_MIN``) from a towing case (``thrust``,
     ``mrac``, ``chaser.mass``, ``main_tether.stiffness``) and its main tether ``tether`` = [k_MT (N/m),
-    c_MT (N s/m), ...]: thrust-on time (s), saturation u_max (N), b = 1/m_C (1/kg), k_MT, c_MT,
+    c_MT (N s/m), ...]: thrust-on time (s), saturation u_max (N; ``mrac.max_thrust``, default
+    ``thrust.max_force``), b = 1/m_C (1/kg), k_MT, c_MT,
     z_d (m), K_P (N/m), K_D (N s/m), the rate estimate's time constant (s, 0: the measured rate), the
     saturation's lower bound u_min (N; ``mrac.min_thrust``, default -u_max: the paper's symmetric sat).
 
@@ -117,7 +118,8 @@ def common_params(case, tether) -> list:
     k_mt, c_mt = abstracted_tether(case, tether)
     z_d = command_elongation(m.desired_elongation, k_mt, m.k_p, m.settle_at_desired)
     u_min = -th.max_force if m.min_thrust is None else m.min_thrust
-    return [th.t_on, th.max_force, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
+    u_max = th.max_force if m.max_thrust is None else m.max_thrust
+    return [th.t_on, u_max, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
             m.rate_filter_time, u_min]
 
 

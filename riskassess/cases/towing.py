@@ -107,6 +107,10 @@ class Mrac(Strict):
                           "[-max_force, max_force). Default: -max_force (the paper's symmetric saturation). 0: a main "
                           "engine along the chaser's body z, which never pushes the chaser back towards the debris "
                           "(docs/towing.md, MRAC on the full net).")
+    max_thrust: float | None = Field(
+        None, description="Upper bound u_max of the actuator's saturation for the MRAC laws (N), at most "
+                          "thrust.max_force (the default). With min_thrust it confines the command to a band around "
+                          "the steady thrust (docs/towing.md, MRAC on the full net).")
     free_debris: bool = Field(
         False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
                            "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "
@@ -336,6 +340,11 @@ class TowingCase(Strict):
         if m is not None and m.min_thrust is not None and not -self.thrust.max_force <= m.min_thrust < self.thrust.max_force:
             raise ValueError(f"mrac.min_thrust must lie in [-thrust.max_force, thrust.max_force) = "
                              f"[{-self.thrust.max_force:g}, {self.thrust.max_force:g}) N. Got {m.min_thrust:g} instead")
+        if m is not None and m.max_thrust is not None:
+            low = -self.thrust.max_force if m.min_thrust is None else m.min_thrust
+            if not low < m.max_thrust <= self.thrust.max_force:
+                raise ValueError(f"mrac.max_thrust must lie in (mrac.min_thrust, thrust.max_force] = ({low:g}, "
+                                 f"{self.thrust.max_force:g}] N. Got {m.max_thrust:g} instead")
         if self.full_net is not None and 4 * self.full_net.corner_mass >= self.net_mass:
             raise ValueError(f"full_net.corner_mass must be < net_mass / 4 ({self.net_mass / 4:g} kg). "
                              f"Got {self.full_net.corner_mass:g} instead")

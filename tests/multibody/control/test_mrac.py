@@ -84,3 +84,22 @@ def test_a_thrust_floor_outside_the_actuator_range_is_refused():
             TowingCase.model_validate(data)
     data["mrac"]["min_thrust"] = -200.0
     assert TowingCase.model_validate(data).mrac.min_thrust == -200.0
+
+
+def test_a_thrust_band_confines_the_command_and_is_checked():
+    """mrac.min_thrust and mrac.max_thrust confine sat(u) to a band around the steady thrust (here 110-170 N about
+    the free-debris balance (1 + m_C/m_D) k_MT z_d = 141.4 N): MRAC-1 and MRAC-2 commands from far below and far
+    above their target land exactly on the band's edges; a ceiling above thrust.max_force or not above the floor is
+    refused, naming the key."""
+    band = _case(min_thrust=110.0, max_thrust=170.0)
+    for kind in ("mrac1", "mrac2"):
+        params, state = _arrays(kind, band, z0=0.5)
+        assert (params[U_MIN], params[U_MAX]) == (110.0, 170.0)
+        assert LAWS[kind].command(30.0, 0.5, 0.0, params, state, 2e-3, True) == 110.0
+        params, state = _arrays(kind, band, z0=-0.5)
+        assert LAWS[kind].command(30.0, -0.5, 0.0, params, state, 2e-3, True) == 170.0
+    data = load_model(CASE, TowingCase).model_dump()
+    for low, high in ((None, 250.0), (110.0, 110.0), (None, -200.0)):
+        data["mrac"]["min_thrust"], data["mrac"]["max_thrust"] = low, high
+        with pytest.raises(ValueError, match=r"mrac.max_thrust must lie in \(mrac.min_thrust, thrust.max_force\]"):
+            TowingCase.model_validate(data)
