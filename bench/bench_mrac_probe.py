@@ -148,7 +148,8 @@ def mechanism(series, label):
     spin = np.degrees(np.linalg.norm(series["debris_omega_body"], axis=1))
     print(f"{label:34s} dL_spin {momentum[-1] @ axis - momentum[0] @ axis:9.0f} N m s, tether moment integral "
           f"{integral:9.0f} N m s; thrust slack {thrust[slack].mean() if slack.any() else np.nan:6.1f} N, snap "
-          f"{thrust[snap].mean() if snap.any() else np.nan:6.1f} N; slack share {slack.sum() / late.sum():.2f}; "
+          f"{thrust[snap].mean() if snap.any() else np.nan:6.1f} N; slack share {slack.sum() / late.sum():.2f}, peak "
+          f"{tension[late].max():5.0f} N; "
           f"z 150-300 s mean {z[tail].mean():.4f} std {x.std():.4f} m (0.5-1 rad/s: {breathing:.2f}); "
           f"spin {spin[0]:.2f} -> {spin[-1]:.2f} deg/s", flush=True)
 

@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from multibody.control.mrac import abstracted_tether, actuator_range, steady_thrust
 from multibody.net_towing import run_exudyn as run_full_net
 from multibody.towing import run_exudyn
 from riskassess.cases.impact import load_model
@@ -111,7 +112,7 @@ def main():
             t, z = series["time"], series["main_tether_elongation"]
             z_100 = float(z[t > t[-1] - 100.0].mean())
             on = t >= case.thrust.t_on
-            saturated = float(np.mean(np.abs(series["thrust"][on]) >= case.thrust.max_force * (1 - 1e-9)))
+            saturated = saturated_share(law, series["thrust"][on])
             if args.results is not None:
                 record = {"key": key, "plant": args.plant, "law": kind, "rate_deg_s": rate, "desired_m": z_d,
                           "target_m": desired, "tautness": f, "mean_last_100_s_m": z_100, "saturated": saturated,
@@ -144,6 +145,28 @@ def main():
         plot_control(shown, args.plots / f"control_{tag}.png",
                      f"{args.plant} plant, {rates[0]} deg/s, z_d = {z_d:g} m: " + ", ".join(shown), desired)
         print(f"figure: {args.plots / f'control_{tag}.png'}")
+
+
+def saturated_share(case, thrust) -> float:
+    """Share of the samples at which the command sits at its saturation: for the ramp its plateau
+    (``thrust.max_force``), for the MRAC laws either edge of their actuator range [u_min, u_max]
+    (``multibody.control.mrac.actuator_range``: ``mrac.thrust_band`` or ``mrac.min_thrust`` / ``mrac.max_thrust``,
+    default -+``thrust.max_force``: the paper's symmetric sat).
+
+    Parameters
+    ----------
+    case : TowingCase
+        The case the run was made with (``thrust.kind`` picks the rule).
+    thrust : (k,) float
+        Thrust samples after t_on (N).
+    """
+    f_max = case.thrust.max_force
+    if case.thrust.kind == "ramp":
+        return float(np.mean(thrust >= f_max * (1 - 1e-9)))
+    mt = case.main_tether
+    k_abstracted, _ = abstracted_tether(case, [mt.stiffness, mt.damping])
+    low, high = actuator_range(case, steady_thrust(k_abstracted, case.mrac.desired_elongation))
+    return float(np.mean((thrust >= high - 1e-9 * f_max) | (thrust <= low + 1e-9 * f_max)))
 
 
 def side_by_side(folder: Path, tag: str, title: str, target: float) -> None:

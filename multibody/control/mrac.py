@@ -102,10 +102,10 @@ def abstracted_tether(case, tether) -> tuple[float, float]:
 def common_params(case, tether) -> list:
     """The parameters both laws share (indices ``T_ON`` ... ``U_MIN``) from a towing case (``thrust``,
     ``mrac``, ``chaser.mass``, ``main_tether.stiffness``) and its main tether ``tether`` = [k_MT (N/m),
-    c_MT (N s/m), ...]: thrust-on time (s), saturation u_max (N; ``mrac.max_thrust``, default
-    ``thrust.max_force``), b = 1/m_C (1/kg), k_MT, c_MT,
+    c_MT (N s/m), ...]: thrust-on time (s), saturation u_max (N; :func:`actuator_range`), b = 1/m_C (1/kg),
+    k_MT, c_MT,
     z_d (m), K_P (N/m), K_D (N s/m), the rate estimate's time constant (s, 0: the measured rate), the
-    saturation's lower bound u_min (N; ``mrac.min_thrust``, default -u_max: the paper's symmetric sat).
+    saturation's lower bound u_min (N; :func:`actuator_range`, default -u_max: the paper's symmetric sat).
 
     Parameters
     ----------
@@ -117,10 +117,43 @@ def common_params(case, tether) -> list:
     th, m = case.thrust, case.mrac
     k_mt, c_mt = abstracted_tether(case, tether)
     z_d = command_elongation(m.desired_elongation, k_mt, m.k_p, m.settle_at_desired)
-    u_min = -th.max_force if m.min_thrust is None else m.min_thrust
-    u_max = th.max_force if m.max_thrust is None else m.max_thrust
+    u_min, u_max = actuator_range(case, steady_thrust(k_mt, m.desired_elongation))
     return [th.t_on, u_max, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
             m.rate_filter_time, u_min]
+
+
+def steady_thrust(k_abstracted, desired) -> float:
+    """Thrust (N) that holds the abstracted model at the desired elongation in steady towing: the tether force
+    :math:`k z_d` with the abstracted stiffness (with ``mrac.free_debris``, :math:`(1 + m_C/m_D) k_{MT} z_d`: the
+    chaser pulls its own share of the common acceleration too).
+
+    Parameters
+    ----------
+    k_abstracted : float
+        The abstracted model's tether stiffness (N/m), :func:`abstracted_tether`.
+    desired : float
+        Desired elongation (m).
+    """
+    return k_abstracted * desired
+
+
+def actuator_range(case, f_steady) -> tuple[float, float]:
+    """[u_min, u_max] (N) of sat(u), eq. (16): with ``mrac.thrust_band`` = beta the band
+    :math:`[(1-\\beta) F_{ss}, (1+\\beta) F_{ss}]` about the steady thrust ``f_steady`` (clipped to
+    +-``thrust.max_force``); otherwise ``mrac.min_thrust`` / ``mrac.max_thrust``, each defaulting to the paper's
+    symmetric saturation -+``thrust.max_force``.
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        Read: ``thrust.max_force``, ``mrac.thrust_band``, ``mrac.min_thrust``, ``mrac.max_thrust``.
+    f_steady : float
+        Steady thrust (N), :func:`steady_thrust`.
+    """
+    f_max, m = case.thrust.max_force, case.mrac
+    if m.thrust_band is not None:
+        return max(-f_max, (1.0 - m.thrust_band) * f_steady), min(f_max, (1.0 + m.thrust_band) * f_steady)
+    return (-f_max if m.min_thrust is None else m.min_thrust), (f_max if m.max_thrust is None else m.max_thrust)
 
 
 def initial_state(z0, z_rate0) -> list:

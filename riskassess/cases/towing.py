@@ -111,6 +111,12 @@ class Mrac(Strict):
         None, description="Upper bound u_max of the actuator's saturation for the MRAC laws (N), at most "
                           "thrust.max_force (the default). With min_thrust it confines the command to a band around "
                           "the steady thrust (docs/towing.md, MRAC on the full net).")
+    thrust_band: Annotated[float, Field(gt=0, le=1)] | None = Field(
+        None, description="Actuator band of both laws as a fraction beta of the steady thrust F_ss = k z_d (k the "
+                          "abstracted tether stiffness; with free_debris (1 + m_C/m_D) k_MT z_d): sat(u) of eq. (16) "
+                          "clips to [(1 - beta) F_ss, (1 + beta) F_ss] (within +-thrust.max_force) and the adaptation "
+                          "is frozen outside it. Not together with min_thrust / max_thrust. Default: none (the "
+                          "paper's symmetric saturation). docs/towing.md, MRAC on the full net.")
     free_debris: bool = Field(
         False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
                            "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "
@@ -340,6 +346,9 @@ class TowingCase(Strict):
         if m is not None and m.min_thrust is not None and not -self.thrust.max_force <= m.min_thrust < self.thrust.max_force:
             raise ValueError(f"mrac.min_thrust must lie in [-thrust.max_force, thrust.max_force) = "
                              f"[{-self.thrust.max_force:g}, {self.thrust.max_force:g}) N. Got {m.min_thrust:g} instead")
+        if m is not None and m.thrust_band is not None and (m.min_thrust is not None or m.max_thrust is not None):
+            raise ValueError("mrac.thrust_band sets the actuator range itself: give it or mrac.min_thrust / "
+                             "mrac.max_thrust, not both")
         if m is not None and m.max_thrust is not None:
             low = -self.thrust.max_force if m.min_thrust is None else m.min_thrust
             if not low < m.max_thrust <= self.thrust.max_force:

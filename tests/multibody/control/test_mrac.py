@@ -17,8 +17,9 @@ CASE = Path(__file__).parents[3] / "cases" / "zenit2_towing.toml"
 
 
 def _case(**mrac):
+    """The shipped case with the paper's symmetric saturation (no thrust band) unless ``mrac`` says otherwise."""
     case = load_model(CASE, TowingCase)
-    return case.model_copy(update=dict(mrac=case.mrac.model_copy(update=mrac)))
+    return case.model_copy(update=dict(mrac=case.mrac.model_copy(update=dict(thrust_band=None) | mrac)))
 
 
 def _arrays(kind, case, z0=0.0, rate0=0.0):
@@ -76,8 +77,8 @@ def test_the_thrust_floor_clips_the_command_and_freezes_the_adaptation():
 
 def test_a_thrust_floor_outside_the_actuator_range_is_refused():
     """mrac.min_thrust must lie in [-max_force, max_force): the case check names the key and the range."""
-    case = load_model(CASE, TowingCase)
-    data = case.model_dump()
+    data = load_model(CASE, TowingCase).model_dump()
+    data["mrac"]["thrust_band"] = None
     for bad in (200.0, -250.0):
         data["mrac"]["min_thrust"] = bad
         with pytest.raises(ValueError, match=r"mrac.min_thrust must lie in \[-thrust.max_force"):
@@ -99,7 +100,24 @@ def test_a_thrust_band_confines_the_command_and_is_checked():
         params, state = _arrays(kind, band, z0=-0.5)
         assert LAWS[kind].command(30.0, -0.5, 0.0, params, state, 2e-3, True) == 170.0
     data = load_model(CASE, TowingCase).model_dump()
+    data["mrac"]["thrust_band"] = None
     for low, high in ((None, 250.0), (110.0, 110.0), (None, -200.0)):
         data["mrac"]["min_thrust"], data["mrac"]["max_thrust"] = low, high
         with pytest.raises(ValueError, match=r"mrac.max_thrust must lie in \(mrac.min_thrust, thrust.max_force\]"):
             TowingCase.model_validate(data)
+
+
+def test_the_shipped_thrust_band_is_ten_percent_about_the_steady_thrust():
+    """mrac.thrust_band = 0.1 of the shipped case: sat(u) to [0.9, 1.1] x (1 + m_C/m_D) k_MT z_d
+    = [0.9, 1.1] x (1 + 1600/9000) 3000 N/m 0.04 m = [127.2, 155.47] N (hand arithmetic), for both laws; with
+    min_thrust or max_thrust as well the case is refused."""
+    case = load_model(CASE, TowingCase)
+    steady = (1.0 + 1600.0 / 9000.0) * 3000.0 * 0.04
+    for kind in ("mrac1", "mrac2"):
+        params, _ = _arrays(kind, case)
+        assert params[U_MIN] == pytest.approx(0.9 * steady, rel=1e-12)
+        assert params[U_MAX] == pytest.approx(1.1 * steady, rel=1e-12)
+    data = case.model_dump()
+    data["mrac"]["min_thrust"] = 100.0
+    with pytest.raises(ValueError, match="mrac.thrust_band sets the actuator range itself"):
+        TowingCase.model_validate(data)
