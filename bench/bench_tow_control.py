@@ -58,10 +58,18 @@ def main():
     parser.add_argument("--desired", type=float, default=None, help="MRAC desired elongation z_d (m)")
     parser.add_argument("--laws", nargs="+", choices=("ramp", "mrac1", "mrac2"), default=("ramp", "mrac1", "mrac2"))
     parser.add_argument("--results", default=None, help="JSON-lines file of finished runs (resumable)")
+    parser.add_argument("--near-slack", type=Path, nargs="+", default=None,
+                        help="print, per law of these control_*.npz files, the share of samples after engagement with "
+                             "T_MT < 1 N, the debris spin at the end and the elongation's mean over the last 100 s; "
+                             "run nothing")
     parser.add_argument("--side-by-side", action="store_true",
                         help="only draw DIR/control_plants_<rate>.png from the lower-order and full-net series in "
                              "--plots DIR (written by earlier runs of this bench with the same --rate/--desired)")
     args = parser.parse_args()
+    if args.near_slack:
+        for path in args.near_slack:
+            near_slack(path)
+        return
     case = load_model(args.case, TowingCase)
     if args.desired is not None:
         case = case.model_copy(update=dict(mrac=case.mrac.model_copy(update=dict(desired_elongation=args.desired))))
@@ -145,6 +153,27 @@ def main():
         plot_control(shown, args.plots / f"control_{tag}.png",
                      f"{args.plant} plant, {rates[0]} deg/s, z_d = {z_d:g} m: " + ", ".join(shown), desired)
         print(f"figure: {args.plots / f'control_{tag}.png'}")
+
+
+def near_slack(path: Path) -> None:
+    """Print per law of a ``control_*.npz`` file (this bench's series) the share of the samples after engagement
+    (first T_MT > 1 N) with T_MT < 1 N: on the full net a slack tether still carries the central node's pull (a few
+    tenths of a newton), which the tautness figures' T <= 0 does not count; the debris spin at the end (deg/s), the
+    elongation's mean and its RMS error to 0.04 m... over the last 100 s (m).
+
+    Parameters
+    ----------
+    path : Path
+        A ``control_<plant>_....npz`` written by this bench.
+    """
+    with np.load(path) as data:
+        for law in dict.fromkeys(key.split("/")[0] for key in data.files):
+            t, tension = data[f"{law}/time"], data[f"{law}/main_tether_tension"]
+            z, spin = data[f"{law}/main_tether_elongation"], np.linalg.norm(data[f"{law}/debris_omega_body"][-1])
+            after = t >= t[np.argmax(tension > 1.0)]
+            last = t > t[-1] - 100.0
+            print(f"{path.name:40s} {law:6s} T < 1 N after engagement {np.mean(tension[after] < 1.0):.3f}; spin at "
+                  f"{t[-1]:.0f} s {np.degrees(spin):.2f} deg/s; z last 100 s mean {z[last].mean():.4f} m")
 
 
 def saturated_share(case, thrust) -> float:

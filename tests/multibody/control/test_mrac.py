@@ -17,7 +17,7 @@ CASE = Path(__file__).parents[3] / "cases" / "zenit2_towing.toml"
 
 
 def _case(**mrac):
-    """The shipped case with the paper's symmetric saturation (no thrust band) unless ``mrac`` says otherwise."""
+    """The shipped case (the paper's symmetric saturation, no thrust band) with ``mrac`` keys changed."""
     case = load_model(CASE, TowingCase)
     return case.model_copy(update=dict(mrac=case.mrac.model_copy(update=dict(thrust_band=None) | mrac)))
 
@@ -107,17 +107,18 @@ def test_a_thrust_band_confines_the_command_and_is_checked():
             TowingCase.model_validate(data)
 
 
-def test_the_shipped_thrust_band_is_ten_percent_about_the_steady_thrust():
-    """mrac.thrust_band = 0.1 of the shipped case: sat(u) to [0.9, 1.1] x (1 + m_C/m_D) k_MT z_d
+def test_a_thrust_band_of_ten_percent_is_about_the_steady_thrust():
+    """mrac.thrust_band = 0.1 on the shipped case: sat(u) to [0.9, 1.1] x (1 + m_C/m_D) k_MT z_d
     = [0.9, 1.1] x (1 + 1600/9000) 3000 N/m 0.04 m = [127.2, 155.47] N (hand arithmetic), for both laws; with
-    min_thrust or max_thrust as well the case is refused."""
-    case = load_model(CASE, TowingCase)
+    min_thrust or max_thrust as well the case is refused. The shipped case has no band (the paper's saturation)."""
+    assert load_model(CASE, TowingCase).mrac.thrust_band is None
+    case = _case(thrust_band=0.1)
     steady = (1.0 + 1600.0 / 9000.0) * 3000.0 * 0.04
     for kind in ("mrac1", "mrac2"):
         params, _ = _arrays(kind, case)
         assert params[U_MIN] == pytest.approx(0.9 * steady, rel=1e-12)
         assert params[U_MAX] == pytest.approx(1.1 * steady, rel=1e-12)
     data = case.model_dump()
-    data["mrac"]["min_thrust"] = 100.0
+    data["mrac"]["thrust_band"], data["mrac"]["min_thrust"] = 0.1, 100.0
     with pytest.raises(ValueError, match="mrac.thrust_band sets the actuator range itself"):
         TowingCase.model_validate(data)

@@ -199,9 +199,8 @@ def test_mrac1_with_the_wall_model_falls_short_as_its_static_balance_says():
 @pytest.mark.parametrize("kind", ["mrac1", "mrac2"])
 def test_mrac_drives_the_full_net_plant(kind):
     """The laws as thrust laws of the full-net tow (7 x 7 net, 2 s from the wrapped start, thrust on at
-    once): the run completes, the command stays inside the shipped actuator band (mrac.thrust_band: 0.9-1.1 x the
-    steady thrust (1 + m_C/m_D) k_MT z_d = 127.2-155.5 N) and acts (the reference model starts on the measured,
-    near-zero elongation and pulls towards z_d, so the thrust is positive)."""
+    once): the run completes, the command stays inside the saturation and acts (the reference model
+    starts on the measured, near-zero elongation and pulls towards z_d, so the thrust is positive)."""
     from multibody.net_towing import run_exudyn as run_full_net
     from riskassess.models.towing_fullnet import full_net_model
 
@@ -212,6 +211,4 @@ def test_mrac_drives_the_full_net_plant(kind):
     thrust = series["thrust"]
     assert series["time"][-1] == pytest.approx(27.0)
     assert np.all(np.isfinite(thrust)) and np.all(np.abs(thrust) <= case.thrust.max_force)
-    steady = (1.0 + case.chaser.mass / case.debris.nominal_mass) * case.main_tether.stiffness * 0.04
-    assert np.all((thrust[1:] >= 0.9 * steady * (1 - 1e-12)) & (thrust[1:] <= 1.1 * steady * (1 + 1e-12)))
     assert thrust[1:].mean() > 0.0
