@@ -32,8 +32,8 @@ from __future__ import annotations
 from numba import njit
 
 # params indices common to both laws; each law appends its gains (thrust_laws/mrac1.py, mrac2.py)
-T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN = range(10)
-N_COMMON = 10
+T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN, Z_SLACK, F_STEADY = range(12)
+N_COMMON = 12
 # state: reference model z_m, z_m rate, the rate estimate's last elongation and last rate, then adaptive parameters
 ZM, ZM_RATE, Z_LAST, RATE_LAST, A0 = 0, 1, 2, 3, 4
 
@@ -105,7 +105,9 @@ def common_params(case, tether) -> list:
     c_MT (N s/m), ...]: thrust-on time (s), saturation u_max (N; :func:`actuator_range`), b = 1/m_C (1/kg),
     k_MT, c_MT,
     z_d (m), K_P (N/m), K_D (N s/m), the rate estimate's time constant (s, 0: the measured rate), the
-    saturation's lower bound u_min (N; :func:`actuator_range`, default -u_max: the paper's symmetric sat).
+    saturation's lower bound u_min (N; :func:`actuator_range`, default -u_max: the paper's symmetric sat), the
+    slack threshold (m; ``mrac.slack_elongation``, -1: off) and the steady thrust (N; :func:`steady_thrust`), which
+    :func:`slack_hold` commands below that threshold.
 
     Parameters
     ----------
@@ -117,9 +119,11 @@ def common_params(case, tether) -> list:
     th, m = case.thrust, case.mrac
     k_mt, c_mt = abstracted_tether(case, tether)
     z_d = command_elongation(m.desired_elongation, k_mt, m.k_p, m.settle_at_desired)
-    u_min, u_max = actuator_range(case, steady_thrust(k_mt, m.desired_elongation))
+    f_steady = steady_thrust(k_mt, m.desired_elongation)
+    u_min, u_max = actuator_range(case, f_steady)
+    z_slack = -1.0 if m.slack_elongation is None else m.slack_elongation
     return [th.t_on, u_max, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
-            m.rate_filter_time, u_min]
+            m.rate_filter_time, u_min, z_slack, f_steady]
 
 
 def steady_thrust(k_abstracted, desired) -> float:
@@ -247,6 +251,25 @@ def adapting(u, params):
         The law's parameters (``U_MIN``, ``U_MAX`` used).
     """
     return params[U_MIN] < u < params[U_MAX]
+
+
+@njit(cache=True)
+def slack_hold(z, params):
+    """True while the measured elongation ``z`` (m) is below the slack threshold ``params[Z_SLACK]``: the laws then
+    command the steady thrust ``params[F_STEADY]`` and do not adapt. On the full net a slack main tether reads
+    z ~ 0 whatever the distance to the debris (the central node hangs at the tether's natural length), so the
+    elongation says nothing about the distance and the law's own reaction to it (MRAC-2: K_P z_cmd, 181 N; MRAC-1:
+    k_s lambda_0 (z_m - z), 84 N) either drives the chaser into the next snap or lets the tow fall short
+    (docs/towing.md, MRAC on the full net). The threshold -1 (the default) never holds.
+
+    Parameters
+    ----------
+    z : float
+        Measured elongation (m).
+    params : (k,) float
+        The law's parameters (``Z_SLACK`` used).
+    """
+    return z < params[Z_SLACK]
 
 
 @njit(cache=True)

@@ -117,6 +117,11 @@ class Mrac(Strict):
                           "clips to [(1 - beta) F_ss, (1 + beta) F_ss] (within +-thrust.max_force) and the adaptation "
                           "is frozen outside it. Not together with min_thrust / max_thrust. Default: none (the "
                           "paper's symmetric saturation). docs/towing.md, MRAC on the full net.")
+    slack_elongation: NonNegative | None = Field(
+        None, description="Slack hold (m): while the measured main-tether elongation is below it both laws command the "
+                          "steady thrust k z_d (k the abstracted stiffness) and do not adapt; on the full net a slack "
+                          "tether reads z ~ 0 whatever the distance (docs/towing.md, MRAC on the full net). Default: "
+                          "none (the paper's laws throughout).")
     free_debris: bool = Field(
         False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
                            "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "

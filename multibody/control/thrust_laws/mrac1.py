@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from multibody.control.mrac import (A0, B, C_MT, K_MT, N_COMMON, T_ON, ZM, ZM_RATE, adapting, advance_reference,
+from multibody.control.mrac import (A0, B, F_STEADY, C_MT, K_MT, N_COMMON, T_ON, ZM, ZM_RATE, adapting, advance_reference,
                                     common_params, elongation_rate_estimate, initial_state, pulling,
-                                    reference_acceleration, saturated, store_rate)
+                                    reference_acceleration, saturated, slack_hold, store_rate)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac1"
@@ -32,7 +32,7 @@ def command(t, z, z_rate, params, state, step, advance):
     t, z, z_rate, step, advance
         As in the thrust-law interface (:mod:`multibody.control.thrust`): time (s), main-tether
         elongation (m) and rate (m/s), sampling step (s), whether to advance the states.
-    params : (16,) float
+    params : (18,) float
         The common head (:mod:`multibody.control.mrac`), then lambda_0 (1/s), k_s (N s/m), gamma, xi_h, xi_a (2) (-).
     state : (7,) float
         z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), h (kg), a1 (N/m), a2 (N s/m);
@@ -50,8 +50,11 @@ def command(t, z, z_rate, params, state, step, advance):
     g = pulling(z, z_rate, params[K_MT], params[C_MT])
     u = state[A0] * eta + g * (state[A0 + 1] * z + state[A0 + 2] * z_rate) - params[K_S] * s   # eq. (11)
     force = saturated(u, params)                                            # eq. (16)
+    hold = slack_hold(z, params)
+    if hold:
+        force = params[F_STEADY]
     if advance:
-        if adapting(u, params):                                             # H(u_max - |u|)
+        if adapting(u, params) and not hold:                                # H(u_max - |u|)
             gamma = params[GAMMA]
             state[A0] += step * (-s * gamma * eta - s * s * params[XI_H] * state[A0])            # eq. (15a)
             state[A0 + 1] += step * (-s * gamma * z - s * s * params[XI_A1] * state[A0 + 1])     # eq. (15b)

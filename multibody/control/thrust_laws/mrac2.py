@@ -13,9 +13,9 @@ import numpy as np
 from numba import njit
 from scipy.linalg import solve_continuous_lyapunov
 
-from multibody.control.mrac import (A0, B, C_MT, K_D, K_MT, K_P, N_COMMON, T_ON, Z_D, ZM, ZM_RATE, adapting,
+from multibody.control.mrac import (A0, B, F_STEADY, C_MT, K_D, K_MT, K_P, N_COMMON, T_ON, Z_D, ZM, ZM_RATE, adapting,
                                     advance_reference, common_params, elongation_rate_estimate, initial_state, pulling,
-                                    reference_acceleration, saturated, store_rate)
+                                    reference_acceleration, saturated, slack_hold, store_rate)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac2"
@@ -39,7 +39,7 @@ def command(t, z, z_rate, params, state, step, advance):
     ----------
     t, z, z_rate, step, advance
         As :func:`multibody.control.thrust_laws.mrac1.command` takes them (s, m, m/s, s, bool).
-    params : (20,) float
+    params : (22,) float
         The common head (:mod:`multibody.control.mrac`), then Gamma_z (2), gamma_r, Gamma_theta (2), xi_2, P (2x2).
     state : (9,) float
         z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), Kz (2), kr, Theta (2); advanced
@@ -57,8 +57,11 @@ def command(t, z, z_rate, params, state, step, advance):
     u = (state[KZ1] * z + state[KZ2] * z_rate + state[KR] * z_d
          - (state[TH1] * phi1 + state[TH2] * phi2))                             # eq. (19)
     force = saturated(u, params)                                               # eq. (16)
+    hold = slack_hold(z, params)
+    if hold:
+        force = params[F_STEADY]
     if advance:
-        if adapting(u, params):                                                 # H(u_max - |u|)
+        if adapting(u, params) and not hold:                                    # H(u_max - |u|)
             e1, e2 = z - state[ZM], z_rate - state[ZM_RATE]
             epb = (e1 * params[P12] + e2 * params[P22]) * params[B]        # e^T P B, B = [0, b]
             damp = params[XI_2] * abs(epb)

@@ -122,3 +122,24 @@ def test_a_thrust_band_of_ten_percent_is_about_the_steady_thrust():
     data["mrac"]["thrust_band"], data["mrac"]["min_thrust"] = 0.1, 100.0
     with pytest.raises(ValueError, match="mrac.thrust_band sets the actuator range itself"):
         TowingCase.model_validate(data)
+
+
+def test_the_slack_hold_commands_the_steady_thrust_below_its_elongation():
+    """mrac.slack_elongation = 4 mm: below it both laws command exactly the steady thrust
+    (1 + m_C/m_D) k_MT z_d = 141.33 N (hand arithmetic) and leave their adaptive parameters unchanged; above it the
+    command is the law's own (MRAC-2 at z = 0.03 m, z' = 0 with its ideal gains: K_P (z_cmd - z) = 1000 (0.1813 - 0.03)
+    = 151.3 N); without the setting (the shipped case) the law acts at any elongation."""
+    steady = (1.0 + 1600.0 / 9000.0) * 3000.0 * 0.04
+    held = _case(slack_elongation=0.004)
+    for kind in ("mrac1", "mrac2"):
+        params, state = _arrays(kind, held, z0=0.001)
+        adaptive = state[4:].copy()
+        assert LAWS[kind].command(30.0, 0.001, 0.0, params, state, 2e-3, True) == pytest.approx(steady, rel=1e-12)
+        assert np.array_equal(state[4:], adaptive)
+    params, state = _arrays("mrac2", held, z0=0.03)
+    command_z = 0.04 * (1.0 + 1600.0 / 9000.0) * 3000.0 / 1000.0 + 0.04
+    assert LAWS["mrac2"].command(30.0, 0.03, 0.0, params, state, 2e-3, False) == pytest.approx(
+        1000.0 * (command_z - 0.03), rel=1e-9)
+    params, state = _arrays("mrac2", _case(), z0=0.001)
+    assert LAWS["mrac2"].command(30.0, 0.001, 0.0, params, state, 2e-3, False) == pytest.approx(
+        1000.0 * (command_z - 0.001), rel=1e-9)
