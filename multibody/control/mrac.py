@@ -273,6 +273,33 @@ def slack_hold(z, params):
 
 
 @njit(cache=True)
+def actuate(u, z, params):
+    """The thrust a law delivers for its command ``u`` (N) at the measured elongation ``z`` (m), and whether it adapts:
+    sat(u) of eq. (16) and the :math:`H(\\cdot)` of eqs. (15) and (20), or, under the slack hold
+    (:func:`slack_hold`), the steady thrust without adaptation.
+
+    Parameters
+    ----------
+    u : float
+        Pre-saturation command (N).
+    z : float
+        Measured elongation (m).
+    params : (k,) float
+        The law's parameters (``U_MIN``, ``U_MAX``, ``Z_SLACK``, ``F_STEADY`` used).
+
+    Returns
+    -------
+    force : float
+        Thrust (N).
+    adapt : bool
+        Advance the adaptive parameters.
+    """
+    if slack_hold(z, params):
+        return params[F_STEADY], False
+    return saturated(u, params), adapting(u, params)
+
+
+@njit(cache=True)
 def advance_reference(params, state, zm_acc, step):
     """Reference model's state (z_m (m), its rate (m/s)) advanced over ``step`` (s) by forward Euler
     (digital controller) with the acceleration ``zm_acc`` (m/s^2).

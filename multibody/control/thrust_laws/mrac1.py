@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from multibody.control.mrac import (A0, B, F_STEADY, C_MT, K_MT, N_COMMON, T_ON, ZM, ZM_RATE, adapting, advance_reference,
+from multibody.control.mrac import (A0, B, C_MT, K_MT, N_COMMON, T_ON, ZM, ZM_RATE, actuate, advance_reference,
                                     common_params, elongation_rate_estimate, initial_state, pulling,
-                                    reference_acceleration, saturated, slack_hold, store_rate)
+                                    reference_acceleration, store_rate)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac1"
@@ -49,12 +49,9 @@ def command(t, z, z_rate, params, state, step, advance):
     s = (z_rate - state[ZM_RATE]) + lam * (z - state[ZM])                   # eq. (14)
     g = pulling(z, z_rate, params[K_MT], params[C_MT])
     u = state[A0] * eta + g * (state[A0 + 1] * z + state[A0 + 2] * z_rate) - params[K_S] * s   # eq. (11)
-    force = saturated(u, params)                                            # eq. (16)
-    hold = slack_hold(z, params)
-    if hold:
-        force = params[F_STEADY]
+    force, adapt = actuate(u, z, params)                                    # eq. (16), H(u_max - |u|)
     if advance:
-        if adapting(u, params) and not hold:                                # H(u_max - |u|)
+        if adapt:
             gamma = params[GAMMA]
             state[A0] += step * (-s * gamma * eta - s * s * params[XI_H] * state[A0])            # eq. (15a)
             state[A0 + 1] += step * (-s * gamma * z - s * s * params[XI_A1] * state[A0 + 1])     # eq. (15b)

@@ -13,9 +13,9 @@ import numpy as np
 from numba import njit
 from scipy.linalg import solve_continuous_lyapunov
 
-from multibody.control.mrac import (A0, B, F_STEADY, C_MT, K_D, K_MT, K_P, N_COMMON, T_ON, Z_D, ZM, ZM_RATE, adapting,
+from multibody.control.mrac import (A0, B, C_MT, K_D, K_MT, K_P, N_COMMON, T_ON, Z_D, ZM, ZM_RATE, actuate,
                                     advance_reference, common_params, elongation_rate_estimate, initial_state, pulling,
-                                    reference_acceleration, saturated, slack_hold, store_rate)
+                                    reference_acceleration, store_rate)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac2"
@@ -56,12 +56,9 @@ def command(t, z, z_rate, params, state, step, advance):
     z_d = params[Z_D]
     u = (state[KZ1] * z + state[KZ2] * z_rate + state[KR] * z_d
          - (state[TH1] * phi1 + state[TH2] * phi2))                             # eq. (19)
-    force = saturated(u, params)                                               # eq. (16)
-    hold = slack_hold(z, params)
-    if hold:
-        force = params[F_STEADY]
+    force, adapt = actuate(u, z, params)                                       # eq. (16), H(u_max - |u|)
     if advance:
-        if adapting(u, params) and not hold:                                    # H(u_max - |u|)
+        if adapt:
             e1, e2 = z - state[ZM], z_rate - state[ZM_RATE]
             epb = (e1 * params[P12] + e2 * params[P22]) * params[B]        # e^T P B, B = [0, b]
             damp = params[XI_2] * abs(epb)
