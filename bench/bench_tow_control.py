@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from multibody.control.mrac import abstracted_tether, actuator_range, steady_thrust
 from multibody.net_towing import run_exudyn as run_full_net
 from multibody.towing import run_exudyn
 from riskassess.cases.impact import load_model
@@ -57,10 +58,18 @@ def main():
     parser.add_argument("--desired", type=float, default=None, help="MRAC desired elongation z_d (m)")
     parser.add_argument("--laws", nargs="+", choices=("ramp", "mrac1", "mrac2"), default=("ramp", "mrac1", "mrac2"))
     parser.add_argument("--results", default=None, help="JSON-lines file of finished runs (resumable)")
+    parser.add_argument("--near-slack", type=Path, nargs="+", default=None,
+                        help="print, per law of these control_*.npz files, the share of samples after engagement with "
+                             "T_MT < 1 N, the debris spin at the end and the elongation's mean over the last 100 s; "
+                             "run nothing")
     parser.add_argument("--side-by-side", action="store_true",
                         help="only draw DIR/control_plants_<rate>.png from the lower-order and full-net series in "
                              "--plots DIR (written by earlier runs of this bench with the same --rate/--desired)")
     args = parser.parse_args()
+    if args.near_slack:
+        for path in args.near_slack:
+            near_slack(path)
+        return
     case = load_model(args.case, TowingCase)
     if args.desired is not None:
         case = case.model_copy(update=dict(mrac=case.mrac.model_copy(update=dict(desired_elongation=args.desired))))
@@ -111,7 +120,7 @@ def main():
             t, z = series["time"], series["main_tether_elongation"]
             z_100 = float(z[t > t[-1] - 100.0].mean())
             on = t >= case.thrust.t_on
-            saturated = float(np.mean(np.abs(series["thrust"][on]) >= case.thrust.max_force * (1 - 1e-9)))
+            saturated = saturated_share(law, series["thrust"][on])
             if args.results is not None:
                 record = {"key": key, "plant": args.plant, "law": kind, "rate_deg_s": rate, "desired_m": z_d,
                           "target_m": desired, "tautness": f, "mean_last_100_s_m": z_100, "saturated": saturated,
@@ -144,6 +153,49 @@ def main():
         plot_control(shown, args.plots / f"control_{tag}.png",
                      f"{args.plant} plant, {rates[0]} deg/s, z_d = {z_d:g} m: " + ", ".join(shown), desired)
         print(f"figure: {args.plots / f'control_{tag}.png'}")
+
+
+def near_slack(path: Path) -> None:
+    """Print per law of a ``control_*.npz`` file (this bench's series) the share of the samples after engagement
+    (first T_MT > 1 N) with T_MT < 1 N: on the full net a slack tether still carries the central node's pull (a few
+    tenths of a newton), which the tautness figures' T <= 0 does not count; the debris spin at the end (deg/s), the
+    elongation's mean and its RMS error to 0.04 m... over the last 100 s (m).
+
+    Parameters
+    ----------
+    path : Path
+        A ``control_<plant>_....npz`` written by this bench.
+    """
+    with np.load(path) as data:
+        for law in dict.fromkeys(key.split("/")[0] for key in data.files):
+            t, tension = data[f"{law}/time"], data[f"{law}/main_tether_tension"]
+            z, spin = data[f"{law}/main_tether_elongation"], np.linalg.norm(data[f"{law}/debris_omega_body"][-1])
+            after = t >= t[np.argmax(tension > 1.0)]
+            last = t > t[-1] - 100.0
+            print(f"{path.name:40s} {law:6s} T < 1 N after engagement {np.mean(tension[after] < 1.0):.3f}; spin at "
+                  f"{t[-1]:.0f} s {np.degrees(spin):.2f} deg/s; z last 100 s mean {z[last].mean():.4f} m")
+
+
+def saturated_share(case, thrust) -> float:
+    """Share of the samples at which the command sits at its saturation: for the ramp its plateau
+    (``thrust.max_force``), for the MRAC laws either edge of their actuator range [u_min, u_max]
+    (``multibody.control.mrac.actuator_range``: ``mrac.thrust_band`` or ``mrac.min_thrust`` / ``mrac.max_thrust``,
+    default -+``thrust.max_force``: the paper's symmetric sat).
+
+    Parameters
+    ----------
+    case : TowingCase
+        The case the run was made with (``thrust.kind`` picks the rule).
+    thrust : (k,) float
+        Thrust samples after t_on (N).
+    """
+    f_max = case.thrust.max_force
+    if case.thrust.kind == "ramp":
+        return float(np.mean(thrust >= f_max * (1 - 1e-9)))
+    mt = case.main_tether
+    k_abstracted, _ = abstracted_tether(case, [mt.stiffness, mt.damping])
+    low, high = actuator_range(case, steady_thrust(k_abstracted, case.mrac.desired_elongation))
+    return float(np.mean((thrust >= high - 1e-9 * f_max) | (thrust <= low + 1e-9 * f_max)))
 
 
 def side_by_side(folder: Path, tag: str, title: str, target: float) -> None:

@@ -32,8 +32,8 @@ from __future__ import annotations
 from numba import njit
 
 # params indices common to both laws; each law appends its gains (thrust_laws/mrac1.py, mrac2.py)
-T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU = range(9)
-N_COMMON = 9
+T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN, Z_SLACK, F_STEADY = range(12)
+N_COMMON = 12
 # state: reference model z_m, z_m rate, the rate estimate's last elongation and last rate, then adaptive parameters
 ZM, ZM_RATE, Z_LAST, RATE_LAST, A0 = 0, 1, 2, 3, 4
 
@@ -100,10 +100,14 @@ def abstracted_tether(case, tether) -> tuple[float, float]:
 
 
 def common_params(case, tether) -> list:
-    """The parameters both laws share (indices ``T_ON`` ... ``RATE_TAU``) from a towing case (``thrust``,
+    """The parameters both laws share (indices ``T_ON`` ... ``U_MIN``) from a towing case (``thrust``,
     ``mrac``, ``chaser.mass``, ``main_tether.stiffness``) and its main tether ``tether`` = [k_MT (N/m),
-    c_MT (N s/m), ...]: thrust-on time (s), saturation u_max (N), b = 1/m_C (1/kg), k_MT, c_MT,
-    z_d (m), K_P (N/m), K_D (N s/m), the rate estimate's time constant (s, 0: the measured rate).
+    c_MT (N s/m), ...]: thrust-on time (s), saturation u_max (N; :func:`actuator_range`), b = 1/m_C (1/kg),
+    k_MT, c_MT,
+    z_d (m), K_P (N/m), K_D (N s/m), the rate estimate's time constant (s, 0: the measured rate), the
+    saturation's lower bound u_min (N; :func:`actuator_range`, default -u_max: the paper's symmetric sat), the
+    slack threshold (m; ``mrac.slack_elongation``, -1: off) and the steady thrust (N; :func:`steady_thrust`), which
+    :func:`slack_hold` commands below that threshold.
 
     Parameters
     ----------
@@ -115,8 +119,45 @@ def common_params(case, tether) -> list:
     th, m = case.thrust, case.mrac
     k_mt, c_mt = abstracted_tether(case, tether)
     z_d = command_elongation(m.desired_elongation, k_mt, m.k_p, m.settle_at_desired)
-    return [th.t_on, th.max_force, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
-            m.rate_filter_time]
+    f_steady = steady_thrust(k_mt, m.desired_elongation)
+    u_min, u_max = actuator_range(case, f_steady)
+    z_slack = -1.0 if m.slack_elongation is None else m.slack_elongation
+    return [th.t_on, u_max, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
+            m.rate_filter_time, u_min, z_slack, f_steady]
+
+
+def steady_thrust(k_abstracted, desired) -> float:
+    """Thrust (N) that holds the abstracted model at the desired elongation in steady towing: the tether force
+    :math:`k z_d` with the abstracted stiffness (with ``mrac.free_debris``, :math:`(1 + m_C/m_D) k_{MT} z_d`: the
+    chaser pulls its own share of the common acceleration too).
+
+    Parameters
+    ----------
+    k_abstracted : float
+        The abstracted model's tether stiffness (N/m), :func:`abstracted_tether`.
+    desired : float
+        Desired elongation (m).
+    """
+    return k_abstracted * desired
+
+
+def actuator_range(case, f_steady) -> tuple[float, float]:
+    """[u_min, u_max] (N) of sat(u), eq. (16): with ``mrac.thrust_band`` = beta the band
+    :math:`[(1-\\beta) F_{ss}, (1+\\beta) F_{ss}]` about the steady thrust ``f_steady`` (clipped to
+    +-``thrust.max_force``); otherwise ``mrac.min_thrust`` / ``mrac.max_thrust``, each defaulting to the paper's
+    symmetric saturation -+``thrust.max_force``.
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        Read: ``thrust.max_force``, ``mrac.thrust_band``, ``mrac.min_thrust``, ``mrac.max_thrust``.
+    f_steady : float
+        Steady thrust (N), :func:`steady_thrust`.
+    """
+    f_max, m = case.thrust.max_force, case.mrac
+    if m.thrust_band is not None:
+        return max(-f_max, (1.0 - m.thrust_band) * f_steady), min(f_max, (1.0 + m.thrust_band) * f_steady)
+    return (-f_max if m.min_thrust is None else m.min_thrust), (f_max if m.max_thrust is None else m.max_thrust)
 
 
 def initial_state(z0, z_rate0) -> list:
@@ -177,8 +218,85 @@ def reference_acceleration(params, zm, zm_rate):
     """
     b, k, c = params[B], params[K_MT], params[C_MT]
     pd = params[K_P] * (params[Z_D] - zm) - params[K_D] * zm_rate
-    pd = min(max(pd, -params[U_MAX]), params[U_MAX])
+    pd = saturated(pd, params)
     return -b * (k * zm + c * zm_rate) * pulling(zm, zm_rate, k, c) + b * pd
+
+
+@njit(cache=True)
+def saturated(u, params):
+    """The actuator's saturation, :math:`\\mathrm{sat}(u)` of eq. (16) (N): u clipped to [u_min, u_max]
+    (the paper: u_min = -u_max; ``mrac.min_thrust`` sets a floor, e.g. 0 for a main engine that cannot
+    push the chaser back towards the debris).
+
+    Parameters
+    ----------
+    u : float
+        Pre-saturation command (N).
+    params : (k,) float
+        The law's parameters (``U_MIN``, ``U_MAX`` used).
+    """
+    return min(max(u, params[U_MIN]), params[U_MAX])
+
+
+@njit(cache=True)
+def adapting(u, params):
+    """:math:`H(u_{max} - |u|)` of eqs. (15) and (20) for the actuator's range [u_min, u_max]: True while the
+    command is inside it (the adaptation is frozen while the command saturates).
+
+    Parameters
+    ----------
+    u : float
+        Pre-saturation command (N).
+    params : (k,) float
+        The law's parameters (``U_MIN``, ``U_MAX`` used).
+    """
+    return params[U_MIN] < u < params[U_MAX]
+
+
+@njit(cache=True)
+def slack_hold(z, params):
+    """True while the measured elongation ``z`` (m) is below the slack threshold ``params[Z_SLACK]``: the laws then
+    command the steady thrust ``params[F_STEADY]`` and do not adapt. On the full net a slack main tether reads
+    z ~ 0 whatever the distance to the debris (the central node hangs at the tether's natural length), so the
+    elongation says nothing about the distance and the law's own reaction to it (MRAC-2: K_P z_cmd, 181 N; MRAC-1:
+    k_s lambda_0 (z_m - z), 84 N) either drives the chaser into the next snap or lets the tow fall short
+    (docs/towing.md, MRAC on the full net). The threshold -1 (the default) never holds.
+
+    Parameters
+    ----------
+    z : float
+        Measured elongation (m).
+    params : (k,) float
+        The law's parameters (``Z_SLACK`` used).
+    """
+    return z < params[Z_SLACK]
+
+
+@njit(cache=True)
+def actuate(u, z, params):
+    """The thrust a law delivers for its command ``u`` (N) at the measured elongation ``z`` (m), and whether it adapts:
+    sat(u) of eq. (16) and the :math:`H(\\cdot)` of eqs. (15) and (20), or, under the slack hold
+    (:func:`slack_hold`), the steady thrust without adaptation.
+
+    Parameters
+    ----------
+    u : float
+        Pre-saturation command (N).
+    z : float
+        Measured elongation (m).
+    params : (k,) float
+        The law's parameters (``U_MIN``, ``U_MAX``, ``Z_SLACK``, ``F_STEADY`` used).
+
+    Returns
+    -------
+    force : float
+        Thrust (N).
+    adapt : bool
+        Advance the adaptive parameters.
+    """
+    if slack_hold(z, params):
+        return params[F_STEADY], False
+    return saturated(u, params), adapting(u, params)
 
 
 @njit(cache=True)

@@ -101,6 +101,27 @@ class Mrac(Strict):
                          "difference quotient of the sampled elongation, corner 1/tau; 0: the plant's "
                          "instantaneous elongation rate (on the full-net plant that is the net node's vibration, "
                          "docs/towing.md). One decade above the reference model: 0.1 / sqrt((k_MT + K_P) / m_C).")
+    min_thrust: float | None = Field(
+        None, description="Lower bound u_min of the actuator's saturation, sat(u) of eq. (16) (N): the command is "
+                          "clipped to [min_thrust, thrust.max_force] and the adaptation frozen outside it; must lie in "
+                          "[-max_force, max_force). Default: -max_force (the paper's symmetric saturation). 0: a main "
+                          "engine along the chaser's body z, which never pushes the chaser back towards the debris "
+                          "(docs/towing.md, MRAC on the full net).")
+    max_thrust: float | None = Field(
+        None, description="Upper bound u_max of the actuator's saturation for the MRAC laws (N), at most "
+                          "thrust.max_force (the default). With min_thrust it confines the command to a band around "
+                          "the steady thrust (docs/towing.md, MRAC on the full net).")
+    thrust_band: Annotated[float, Field(gt=0, le=1)] | None = Field(
+        None, description="Actuator band of both laws as a fraction beta of the steady thrust F_ss = k z_d (k the "
+                          "abstracted tether stiffness; with free_debris (1 + m_C/m_D) k_MT z_d): sat(u) of eq. (16) "
+                          "clips to [(1 - beta) F_ss, (1 + beta) F_ss] (within +-thrust.max_force) and the adaptation "
+                          "is frozen outside it. Not together with min_thrust / max_thrust. Default: none (the "
+                          "paper's symmetric saturation). docs/towing.md, MRAC on the full net.")
+    slack_elongation: NonNegative | None = Field(
+        None, description="Slack hold (m): while the measured main-tether elongation is below it both laws command the "
+                          "steady thrust k z_d (k the abstracted stiffness) and do not adapt; on the full net a slack "
+                          "tether reads z ~ 0 whatever the distance (docs/towing.md, MRAC on the full net). Default: "
+                          "none (the paper's laws throughout).")
     free_debris: bool = Field(
         False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
                            "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "
@@ -326,6 +347,18 @@ class TowingCase(Strict):
                 raise ValueError(f"full_net.switch_window must hold at least two averaging blocks: >= 2 x "
                                  f"switch_averaging = {2.0 * averaging:g} s (switch_averaging defaults to one spin "
                                  f"period, 360 / debris.spin_rate_deg_s). Got {fn.switch_window:g} s")
+        m = self.mrac
+        if m is not None and m.min_thrust is not None and not -self.thrust.max_force <= m.min_thrust < self.thrust.max_force:
+            raise ValueError(f"mrac.min_thrust must lie in [-thrust.max_force, thrust.max_force) = "
+                             f"[{-self.thrust.max_force:g}, {self.thrust.max_force:g}) N. Got {m.min_thrust:g} instead")
+        if m is not None and m.thrust_band is not None and (m.min_thrust is not None or m.max_thrust is not None):
+            raise ValueError("mrac.thrust_band sets the actuator range itself: give it or mrac.min_thrust / "
+                             "mrac.max_thrust, not both")
+        if m is not None and m.max_thrust is not None:
+            low = -self.thrust.max_force if m.min_thrust is None else m.min_thrust
+            if not low < m.max_thrust <= self.thrust.max_force:
+                raise ValueError(f"mrac.max_thrust must lie in (mrac.min_thrust, thrust.max_force] = ({low:g}, "
+                                 f"{self.thrust.max_force:g}] N. Got {m.max_thrust:g} instead")
         if self.full_net is not None and 4 * self.full_net.corner_mass >= self.net_mass:
             raise ValueError(f"full_net.corner_mass must be < net_mass / 4 ({self.net_mass / 4:g} kg). "
                              f"Got {self.full_net.corner_mass:g} instead")

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from multibody.control.mrac import (A0, B, C_MT, K_MT, N_COMMON, T_ON, U_MAX, ZM, ZM_RATE, advance_reference,
+from multibody.control.mrac import (A0, B, C_MT, K_MT, N_COMMON, T_ON, ZM, ZM_RATE, actuate, advance_reference,
                                     common_params, elongation_rate_estimate, initial_state, pulling,
                                     reference_acceleration, store_rate)
 from multibody.control.thrust import THRUST_SIGNATURE
@@ -25,14 +25,14 @@ LAMBDA0, K_S, GAMMA, XI_H, XI_A1, XI_A2 = range(N_COMMON, N_COMMON + 6)
 
 @njit(THRUST_SIGNATURE, cache=True)
 def command(t, z, z_rate, params, state, step, advance):
-    """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16), saturated at u_max; 0 before t_on.
+    """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16), saturated to [u_min, u_max]; 0 before t_on.
 
     Parameters
     ----------
     t, z, z_rate, step, advance
         As in the thrust-law interface (:mod:`multibody.control.thrust`): time (s), main-tether
         elongation (m) and rate (m/s), sampling step (s), whether to advance the states.
-    params : (15,) float
+    params : (18,) float
         The common head (:mod:`multibody.control.mrac`), then lambda_0 (1/s), k_s (N s/m), gamma, xi_h, xi_a (2) (-).
     state : (7,) float
         z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), h (kg), a1 (N/m), a2 (N s/m);
@@ -49,9 +49,9 @@ def command(t, z, z_rate, params, state, step, advance):
     s = (z_rate - state[ZM_RATE]) + lam * (z - state[ZM])                   # eq. (14)
     g = pulling(z, z_rate, params[K_MT], params[C_MT])
     u = state[A0] * eta + g * (state[A0 + 1] * z + state[A0 + 2] * z_rate) - params[K_S] * s   # eq. (11)
-    force = min(max(u, -params[U_MAX]), params[U_MAX])                      # eq. (16)
+    force, adapt = actuate(u, z, params)                                    # eq. (16), H(u_max - |u|)
     if advance:
-        if abs(u) < params[U_MAX]:                                          # H(u_max - |u|)
+        if adapt:
             gamma = params[GAMMA]
             state[A0] += step * (-s * gamma * eta - s * s * params[XI_H] * state[A0])            # eq. (15a)
             state[A0 + 1] += step * (-s * gamma * z - s * s * params[XI_A1] * state[A0 + 1])     # eq. (15b)

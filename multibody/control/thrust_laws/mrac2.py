@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 from scipy.linalg import solve_continuous_lyapunov
 
-from multibody.control.mrac import (A0, B, C_MT, K_D, K_MT, K_P, N_COMMON, T_ON, U_MAX, Z_D, ZM, ZM_RATE,
+from multibody.control.mrac import (A0, B, C_MT, K_D, K_MT, K_P, N_COMMON, T_ON, Z_D, ZM, ZM_RATE, actuate,
                                     advance_reference, common_params, elongation_rate_estimate, initial_state, pulling,
                                     reference_acceleration, store_rate)
 from multibody.control.thrust import THRUST_SIGNATURE
@@ -28,7 +28,7 @@ KZ1, KZ2, KR, TH1, TH2 = range(A0, A0 + 5)
 
 @njit(THRUST_SIGNATURE, cache=True)
 def command(t, z, z_rate, params, state, step, advance):
-    """MRAC-2 thrust (N), eqs. (19)-(21), saturated at u_max; 0 before t_on.
+    """MRAC-2 thrust (N), eqs. (19)-(21), saturated to [u_min, u_max]; 0 before t_on.
 
     The :math:`\\hat\\Theta` law is taken with the sign that makes the Lyapunov derivative of
     the e-modification vanish for :math:`u = \\dots - \\hat\\Theta^T\\phi` (Lavretsky & Wise 2013,
@@ -39,7 +39,7 @@ def command(t, z, z_rate, params, state, step, advance):
     ----------
     t, z, z_rate, step, advance
         As :func:`multibody.control.thrust_laws.mrac1.command` takes them (s, m, m/s, s, bool).
-    params : (19,) float
+    params : (22,) float
         The common head (:mod:`multibody.control.mrac`), then Gamma_z (2), gamma_r, Gamma_theta (2), xi_2, P (2x2).
     state : (9,) float
         z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), Kz (2), kr, Theta (2); advanced
@@ -56,9 +56,9 @@ def command(t, z, z_rate, params, state, step, advance):
     z_d = params[Z_D]
     u = (state[KZ1] * z + state[KZ2] * z_rate + state[KR] * z_d
          - (state[TH1] * phi1 + state[TH2] * phi2))                             # eq. (19)
-    force = min(max(u, -params[U_MAX]), params[U_MAX])
+    force, adapt = actuate(u, z, params)                                       # eq. (16), H(u_max - |u|)
     if advance:
-        if abs(u) < params[U_MAX]:
+        if adapt:
             e1, e2 = z - state[ZM], z_rate - state[ZM_RATE]
             epb = (e1 * params[P12] + e2 * params[P22]) * params[B]        # e^T P B, B = [0, b]
             damp = params[XI_2] * abs(epb)
