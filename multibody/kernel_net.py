@@ -144,7 +144,7 @@ def kernel_net_start(m, q_bodies, qt_bodies):
 
 
 @njit(cache=True)
-def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
+def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies):
     """One VelocityVerlet step of the net inside the bodies' step (module doc); returns the bodies'
     generalized forces (6 nb,) at the evaluation state, for Exudyn's coupled object.
 
@@ -156,6 +156,9 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
         layout, :mod:`multibody.kernel`).
     time : float
         Time of the evaluation state, the step's end (s); 0 evaluates without sub-cycling.
+    q_next_bodies : (6 nb,) float
+        Filled with the bodies' evaluation state, the step's end coordinates (m, rad; the rotation vectors
+        exact, :func:`multibody.kernel.verlet_evaluation_state`), for :class:`multibody.rotation_update.ExactRotations`.
     """
     # the structref's arrays as locals: a field read inside a loop is not hoisted (stores through the
     # other arrays may alias it), which cost about 5 ns per coordinate, 18 us a step for the reference net
@@ -169,6 +172,7 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time):
     for k in range(n3):
         q_eval[k] = q[k] + step * qt_eval[k]
     q_next, v_half_bodies = verlet_evaluation_state(q_bodies, qt_bodies, qtt_bodies, step, 0, nb)
+    q_next_bodies[:] = q_next
     force, body_force = _forces(m, q_next, v_half_bodies, m.n_substeps if time > 0.0 else 1)
     # flat loops over the coordinates with few arrays each: the compiler vectorizes them (with more
     # arrays in one loop its run-time overlap checks give up and the loop stays scalar)
@@ -206,6 +210,7 @@ class KernelNet:
         self.kernel = kernel
         self.state_index = state_index
         self.model, self.q, self.qt = net_step_model(kernel, net_velocity)
+        self._q_next_bodies = np.zeros(6 * kernel.n_bodies)  # the step's end coordinates of the bodies (m, rad)
         self._views = None
         self._last_time = -np.inf
         #: optional ``after_step(mbs, t) -> bool``, the work of a post-step function for the step that ended at
@@ -241,11 +246,10 @@ class KernelNet:
                 return False
         q, qt, qtt = self._state_views(mbs, t)
         q_bodies, qt_bodies, qtt_bodies = self._bodies(q), self._bodies(qt), self._bodies(qtt)
-        if self.rotations is not None:
-            self.rotations.keep(verlet_evaluation_state(q_bodies, qt_bodies, qtt_bodies, self.kernel.step, 0,
-                                                        q_bodies.shape[0] // 6)[0])
         # t is the time of the evaluation state (see multibody.impact.VerletForces)
-        force = kernel_net_step(self.model, q_bodies, qt_bodies, qtt_bodies, t)
+        force = kernel_net_step(self.model, q_bodies, qt_bodies, qtt_bodies, t, self._q_next_bodies)
+        if self.rotations is not None:
+            self.rotations.keep(self._q_next_bodies)
         mbs.SetObjectParameter(self.coupled_object, "forceVector", force)
         return True
 
