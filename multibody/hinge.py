@@ -56,6 +56,8 @@ PENALTY_ROTATIONAL_CAP = 1e8
 #: A structural mode (``first_mode_hz``) must be resolved in time: Verlet's phase error is
 #: (omega h)^2 / 24, 0.4 % of the frequency at 20 steps per period.
 STRUCTURAL_STEPS_PER_PERIOD = 20
+#: names of a joint's six spring axes in messages: translations along, rotations about the hinge frame's axes
+JOINT_AXIS_NAMES = ("x", "y", "z", "rot h1", "rot h2", "rot h3")
 
 
 def effective_mass_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec) -> np.ndarray:
@@ -194,7 +196,7 @@ def joint_stiffness_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: 
         k[4] = joint.torsional_stiffness
     omega_step = np.sqrt(k / inertia) * step
     if omega_step.max() > 1.0:
-        axis = ["x", "y", "z", "rot h1", "rot h2", "rot h3"][int(omega_step.argmax())]
+        axis = JOINT_AXIS_NAMES[int(omega_step.argmax())]
         raise ValueError(
             f"joint '{joint.name}': stiffness {k[omega_step.argmax()]:.3g} on {axis} gives a mode at "
             f"{omega_step.max() / step:.3g} rad/s, too fast for the step {step:g} s (limit 1/step); "
@@ -209,7 +211,7 @@ def _resolved_structural_stiffness(joint: JointSpec, parent: RigidBodySpec, chil
     k = np.asarray(joint.structural_stiffness, float).copy()
     frequency_hz = np.sqrt(k / coupled_mode_inertia_joint_frame(joint, parent, child)) / (2.0 * np.pi)
     if frequency_hz.max() * step * STRUCTURAL_STEPS_PER_PERIOD > 1.0:
-        axis = ["x", "y", "z", "rot h1", "rot h2", "rot h3"][int(frequency_hz.argmax())]
+        axis = JOINT_AXIS_NAMES[int(frequency_hz.argmax())]
         raise ValueError(
             f"joint '{joint.name}': its structural stiffness {k[frequency_hz.argmax()]:.3g} on {axis} rings at "
             f"{frequency_hz.max():.3g} Hz, fewer than {STRUCTURAL_STEPS_PER_PERIOD} steps of {step:g} s per period; "
