@@ -45,6 +45,16 @@ then the constant-rate prediction within the innovation limit), and only a singl
 is accepted, its frames revised after the fact (``revised``). Two surviving chains leave every frame
 failed: a wrong pose that passes is worse than a failed frame.
 
+**Search budget.** A search over all attitudes costs seconds of CPU (1000 seeds), and a lost track
+searches every frame: on the featured debris after the net contact 2-12 s CPU a frame, one stage 35
+min wall. ``search_cpu_per_frame`` and ``search_cpu_per_run`` (s of ``time.process_time``) bound the
+work of the frames that are not a plain ICP from the motion prediction (searches, chain
+continuations, the global retry): a frame whose work passes its own limit, or the run's remaining
+search time, is abandoned and recorded as not registered (``Alignment.over_budget``), never as the
+best pose found so far; once the run's search time is spent, a lost track is not searched again
+(tracked frames go on as before). CPU time depends on the machine: which frames a budget cuts may
+differ between machines, and the answer names them.
+
 The surface figures (tight fitness, sigma, information) are taken on about ``CHECKED_POINTS``
 evenly spread scan points: shares to ~1 %, the information scaled to the whole scan.
 """
@@ -91,6 +101,10 @@ CONFIRMING_FRAMES = 3   # a re-acquired pose and the two frames continuing it (t
 MAX_CHAINS = 3          # candidate poses of a re-acquisition followed through the next frames
 SEARCH_SCREENED = 40    # best-fitting distinct seeds of a search over all attitudes screened by the check before refining
 AMBIGUOUS_TURN = np.radians(15.0)  # rad; passing poses this far apart (beyond the known symmetries) start chains of their own
+
+
+class SearchBudgetSpent(Exception):
+    """A frame's search passed its CPU limit or the run's remaining search time (module docstring)."""
 
 
 def _turn_candidates(largest) -> list[np.ndarray]:
@@ -169,6 +183,8 @@ class Alignment:
     n_points: int
     cpu_seconds: float = 0.0   # process time of the registration (s; all threads, at least the one-core time)
     unseen: float = 0.0        # share of the posed model's directions in the field of view with no return near them
+    over_budget: bool = False  # the frame's search was abandoned: its CPU limit or the run's search time spent
+    searched: bool = False     # the frame needed more than an ICP from the motion prediction (counts against the budget)
 
     @property
     def body_to_world(self) -> np.ndarray:
@@ -443,15 +459,27 @@ class DebrisTracker:
                                 re-seeded with ``seed`` + the frame number before each, so a run
                                 repeats exactly (unseeded, two runs of one case tracked 189 and
                                 194 of 201 frames once a re-acquisition was needed).
+    search_cpu_per_frame : float
+                                Largest CPU time (s) of one frame's search work (searches, chain
+                                continuations, global retry); beyond it the frame is not registered.
+                                Default: no limit.
+    search_cpu_per_run : float  Largest CPU time (s) of all frames' search work together; once spent,
+                                a lost track is not searched again. Default: no limit.
     """
 
     def __init__(self, voxel=0.03, max_correspondence=0.1, model_frames=30, model_points_body=None,
-                 model_normals_body=None, symmetries_body=None, seed=0, field_of_view=None, ray_spacing=0.0):
+                 model_normals_body=None, symmetries_body=None, seed=0, field_of_view=None, ray_spacing=0.0,
+                 search_cpu_per_frame=np.inf, search_cpu_per_run=np.inf):
         self.voxel = voxel
+        self.search_cpu_per_frame = float(search_cpu_per_frame)
+        self.search_cpu_per_run = float(search_cpu_per_run)
+        self.search_cpu_spent = 0.0          # CPU time (s) of the frames' search work so far (the run's budget)
+        self._frame_deadline = np.inf        # process time (s) at which the frame's search work is abandoned
         self.field_of_view = None if field_of_view is None else np.asarray(field_of_view, float)
         self.ray_spacing = float(ray_spacing)
         self._frame_sensor_to_world = None   # sensor attitude of the frame being registered, for the unseen-model check
         self._passing_alignments = []        # passing alignments of the last search other than the kept one
+        self._searched = False               # the frame being registered has done search work
         self._chains = []                    # candidate pose sequences after a lost track (see _continue_chains)
         self.revised = []                    # indices of earlier frames whose alignment the last update replaced
         self.symmetries_body = [np.eye(4)] if symmetries_body is None else [np.asarray(s, float) for s in symmetries_body]
@@ -572,6 +600,7 @@ class DebrisTracker:
             ``alignments``.
         """
         start, cpu_start = time.perf_counter(), time.process_time()
+        self._frame_deadline = cpu_start + min(self.search_cpu_per_frame, self.search_cpu_per_run - self.search_cpu_spent)
         self.revised = []
         self._frame_returns = None if all_returns_world is None else np.asarray(all_returns_world, float)
         self._frame_sensor_to_world = None if sensor_to_world is None else np.asarray(sensor_to_world, float)
@@ -582,11 +611,13 @@ class DebrisTracker:
             predicted, has_motion = self.prediction()
             if gate is not None and has_motion:
                 scan = self._gated(scan, predicted, gate)
-            alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
+            alignment = self._track_within_budget(time_s, scan, predicted, has_motion, sensor_world)
             self._frame_spacing = None
         self._frame_returns = self._frame_sensor_to_world = None
         alignment.seconds = time.perf_counter() - start
         alignment.cpu_seconds = time.process_time() - cpu_start
+        if alignment.searched:
+            self.search_cpu_spent += alignment.cpu_seconds
         self.alignments.append(alignment)
         self._grow_model(alignment, np.asarray(scan.points))
         return alignment
@@ -595,6 +626,27 @@ class DebrisTracker:
         """The scan points within ``gate`` (m) of a model point at the ``predicted`` pose."""
         gap, _ = self._tree.query(_transform(np.asarray(scan.points), predicted), distance_upper_bound=gate)
         return scan.select_by_index(np.flatnonzero(np.isfinite(gap)))
+
+    def _track_within_budget(self, time_s, scan, predicted, has_motion, sensor_world) -> Alignment:
+        """:meth:`_track`, its search work abandoned at the frame's deadline (module docstring, "Search
+        budget"): the frame is then not registered, its pose the prediction (or the last good pose), and
+        candidate chains are dropped (a chain continues frame by frame only)."""
+        self._searched = False
+        try:
+            alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
+        except SearchBudgetSpent:
+            self._chains, self._passing_alignments = [], []
+            pose = predicted if predicted is not None else np.eye(4)
+            alignment = Alignment(time_s, pose, np.zeros((6, 6)), 0.0, 1.0, np.inf, False, False, 0.0,
+                                  len(scan.points), over_budget=True)
+        alignment.searched = self._searched
+        return alignment
+
+    def _spend(self) -> None:
+        """Marks the frame as doing search work; raises :class:`SearchBudgetSpent` past its deadline."""
+        self._searched = True
+        if time.process_time() > self._frame_deadline:
+            raise SearchBudgetSpent
 
     def _track(self, time_s, scan, predicted, has_motion, sensor_world) -> Alignment:
         points = np.asarray(scan.points)
@@ -652,6 +704,7 @@ class DebrisTracker:
         points = np.asarray(scan.points)
         survivors, tried = [], []
         for chain in self._chains:
+            self._spend()
             if len(chain) == 1:
                 # seeds on the visible side: the debris may have moved beyond the coarse ICP's reach in
                 # one frame (0.3 m at the featured debris' 3.15 m/s after the contact; seeds at the
@@ -683,6 +736,7 @@ class DebrisTracker:
 
     def _retry_from_global(self, time_s, scan, failed, predicted, has_motion, sensor_world) -> Alignment:
         """The frame again from FPFH + RANSAC; kept when it passes or fits tighter than ``failed``."""
+        self._spend()
         reference = failed.world_to_body if predicted is None else predicted
         pose = self._nearest_variant(self._icp(scan, self._global(scan, reference)), reference)
         points = np.asarray(scan.points)
@@ -721,17 +775,24 @@ class DebrisTracker:
         thin = np.asarray(scan.voxel_down_sample(SEARCH_VOXELS * self.voxel).points)
         seeds = (self._visible_side_seeds(start, points, sensor_world, turns) if visible_side
                  else _seeds(start, points.mean(axis=0), turns))
-        fits = [self._icp_level(thin, seed, self.max_correspondence, SEARCH_SETTLED) for seed in seeds]
+        fits = []
+        for seed in seeds:
+            self._spend()
+            fits.append(self._icp_level(thin, seed, self.max_correspondence, SEARCH_SETTLED))
         fits.sort(key=lambda fit: -fit[1])
         ranked = [pose for pose, _ in fits]
         if visible_side:
             # A half turn of a box-like body fits the seen side about as well as the truth and outranks
             # it on the fit alone; the free space (both checks) tells them apart before the refinement.
             ranked = _distinct(ranked, SEARCH_SCREENED)
-            screened = [self._judge(time_s, points, pose, start, sensor_world, False) for pose in ranked]
+            screened = []
+            for pose in ranked:
+                self._spend()
+                screened.append(self._judge(time_s, points, pose, start, sensor_world, False))
             ranked = [ranked[i] for i in np.argsort([-_score(a) for a in screened], kind="stable")]
         best, passing = None, []
         for pose in _distinct(ranked, SEARCH_REFINED):
+            self._spend()
             candidate = self._judge(time_s, points, self._nearest_variant(self._icp(scan, pose), start), start,
                                     sensor_world, False)
             if candidate.ok:
@@ -754,6 +815,7 @@ class DebrisTracker:
         model = _thinned(self._coarse_points, DEPTH_BUFFER_POINTS)
         seeds = []
         for turn in turns:
+            self._spend()
             seed = np.eye(4)
             seed[:3, :3] = turn @ start[:3, :3]
             side = visible_side_centroid(model, seed[:3, :3] @ view_world, SEARCH_VOXELS * self.voxel)
