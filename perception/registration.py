@@ -98,7 +98,16 @@ DISTINCT_TURN = np.radians(5.0)  # rad; ranked poses closer than this in attitud
 LOST_SEEDS = 1000
 DEPTH_BUFFER_POINTS = 3000  # model points placing the visible-side seeds (a few per 12 cm cell of a 2 m body)
 CONFIRMING_FRAMES = 3   # a re-acquired pose and the two frames continuing it (the last one predicted from the motion)
+# ... and the chain must have seen the body from directions this far apart (in the body frame): a box-like
+# body's half turn moves rigidly too, and is told from the truth only once the view shows the side that
+# differs. Featured debris after the net contact (seed 0): a chain of the bus' half turn (176 deg off)
+# passed 3 frames and was accepted at 3.7 s; it broke at 4.1 s, the view then turned 23 deg from its
+# first frame. 45 deg [assumed]: about twice that.
+CONFIRMING_VIEW_TURN = np.radians(45.0)
 MAX_CHAINS = 3          # candidate poses of a re-acquisition followed through the next frames
+# Best refined candidates of a search after a lost track searched again over small turns about themselves
+# (_polished); 0: off. Tried offline, not adopted (docs/perception.md, "Free-space refinement, tried offline").
+POLISHED = 0
 SEARCH_SCREENED = 40    # best-fitting distinct seeds of a search over all attitudes screened by the check before refining
 AMBIGUOUS_TURN = np.radians(15.0)  # rad; passing poses this far apart (beyond the known symmetries) start chains of their own
 
@@ -155,6 +164,17 @@ def _distinct(poses, count) -> list[np.ndarray]:
     return kept
 
 
+def _view_turn(chain) -> float:
+    """Largest angle (rad) between a chain's viewing direction at its second frame and at a later one,
+    in the body frame: how far round the body the chain has looked as one motion. From the second
+    frame: the jump from the searched pose to the small-turn search after it is not a view of the
+    body from elsewhere (a wrong start's jump measured 48 deg at once)."""
+    if len(chain) < 3:
+        return 0.0
+    first = chain[1].view_body
+    return max(float(np.arccos(np.clip(first @ later.view_body, -1.0, 1.0))) for later in chain[2:])
+
+
 def _score(alignment) -> float:
     """Ranks candidate alignments: checks passed first, then tight fitness less the shares of
     directions where the model blocks a return or lies where no ray returned."""
@@ -184,6 +204,7 @@ class Alignment:
     cpu_seconds: float = 0.0   # process time of the registration (s; all threads, at least the one-core time)
     unseen: float = 0.0        # share of the posed model's directions in the field of view with no return near them
     over_budget: bool = False  # the frame's search was abandoned: its CPU limit or the run's search time spent
+    view_body: np.ndarray | None = None  # unit direction sensor -> scan centroid in frame B at this pose
     searched: bool = False     # the frame needed more than an ICP from the motion prediction (counts against the budget)
 
     @property
@@ -667,7 +688,7 @@ class DebrisTracker:
             # No pose yet, or the track was lost for frames (a collision may have changed the spin a lot).
             alignment = self._search(time_s, scan, self._acquisition_start(points, predicted),
                                      _orientation_candidates(LOST_SEEDS if self.alignments else 240), sensor_world,
-                                     visible_side=True)
+                                     visible_side=True, polish=bool(self.alignments))
             if alignment.ok and any(a.ok for a in self.alignments):
                 return self._start_chains(alignment)   # a lost track: the motion decides (_continue_chains)
         if not alignment.ok:
@@ -691,7 +712,9 @@ class DebrisTracker:
         """One more frame for each candidate chain after a lost track: the second frame by the
         small-turn search from the chain's pose, the third by ICP from the constant-rate prediction
         of the two (the check with the innovation limit: one angular velocity). Chains failing the
-        check are dropped. After CONFIRMING_FRAMES frames a single surviving chain is the track: its
+        check are dropped. After CONFIRMING_FRAMES frames, and once the chain's view of the body has
+        turned by CONFIRMING_VIEW_TURN (a half turn of a box-like body moves rigidly too and is told apart
+        only when the differing side comes into view), a single surviving chain is the track: its
         frames replace the pending ones (their indices in ``revised``). Several surviving chains are
         poses the scans cannot tell apart: every frame of them stays failed.
 
@@ -721,12 +744,12 @@ class DebrisTracker:
         if not survivors:
             best = max(tried, key=_score)
             return Alignment(**{**best.__dict__, "ok": False})
-        if len(survivors[0]) < CONFIRMING_FRAMES:
+        if len(survivors[0]) < CONFIRMING_FRAMES or _view_turn(survivors[0]) < CONFIRMING_VIEW_TURN:
             return Alignment(**{**survivors[0][-1].__dict__, "ok": False})
         self._chains = []
         if len(survivors) > 1:   # two rigid motions explain the scans: no answer rather than a guess
             return Alignment(**{**survivors[0][-1].__dict__, "ok": False})
-        first = len(self.alignments) - (CONFIRMING_FRAMES - 1)
+        first = len(self.alignments) - (len(survivors[0]) - 1)
         for index, confirmed in zip(range(first, len(self.alignments)), survivors[0]):
             previous = self.alignments[index]
             self.alignments[index] = Alignment(**{**confirmed.__dict__, "time": previous.time,
@@ -764,13 +787,14 @@ class DebrisTracker:
         start[:3, 3] = self._model_points.mean(axis=0) - start[:3, :3] @ points.mean(axis=0)
         return start
 
-    def _search(self, time_s, scan, start, turns, sensor_world, visible_side=False) -> Alignment:
+    def _search(self, time_s, scan, start, turns, sensor_world, visible_side=False, polish=False) -> Alignment:
         """Without a motion prediction: ``start`` turned by each of ``turns`` about the scan
         centroid (a smooth body, the paper's ellipsoid, gives ICP a basin of only a few degrees),
         each seed ranked by one coarse ICP level on a heavily thinned scan; the best SEARCH_REFINED
         distinct results are refined and checked, the best-checked kept (the other passing ones in
         ``self._passing_alignments``). With ``visible_side`` each seed's scan centroid is put on the centroid of
-        the model's side the sensor sees at that attitude (:meth:`_visible_side_seeds`)."""
+        the model's side the sensor sees at that attitude (:meth:`_visible_side_seeds`). With ``polish``
+        the best refined results are searched again about themselves (:meth:`_polished`)."""
         points = np.asarray(scan.points)
         thin = np.asarray(scan.voxel_down_sample(SEARCH_VOXELS * self.voxel).points)
         seeds = (self._visible_side_seeds(start, points, sensor_world, turns) if visible_side
@@ -790,17 +814,29 @@ class DebrisTracker:
                 self._spend()
                 screened.append(self._judge(time_s, points, pose, start, sensor_world, False))
             ranked = [ranked[i] for i in np.argsort([-_score(a) for a in screened], kind="stable")]
-        best, passing = None, []
+        refined = []
         for pose in _distinct(ranked, SEARCH_REFINED):
             self._spend()
-            candidate = self._judge(time_s, points, self._nearest_variant(self._icp(scan, pose), start), start,
-                                    sensor_world, False)
-            if candidate.ok:
-                passing.append(candidate)
-            if best is None or _score(candidate) > _score(best):
-                best = candidate
-        self._passing_alignments = [candidate for candidate in passing if candidate is not best]
+            refined.append(self._judge(time_s, points, self._nearest_variant(self._icp(scan, pose), start), start,
+                                       sensor_world, False))
+        if polish:
+            refined += self._polished(time_s, scan, refined, sensor_world)
+        best = max(refined, key=_score)
+        self._passing_alignments = [candidate for candidate in refined if candidate.ok and candidate is not best]
         return best
+
+    def _polished(self, time_s, scan, refined, sensor_world) -> list[Alignment]:
+        """The POLISHED best-scored of a search's ``refined`` candidates searched again over small
+        turns on the visible side (as a chain's second frame), with the passing results of each.
+        Why (offline, featured debris after the net contact): the all-attitude search's nearest seed
+        lies 17-19 deg from the truth, and its refined pose stops 7-9 deg and 10-13 cm off in a local
+        minimum that more ICP does not leave; searched again about it, 1.5-4 deg."""
+        polished = []
+        for candidate in sorted(refined, key=_score, reverse=True)[:POLISHED]:
+            polished.append(self._search(time_s, scan, candidate.world_to_body, _turn_candidates(SEARCH_TURN),
+                                         sensor_world, visible_side=True))
+            polished += self._passing_alignments
+        return polished
 
     def _visible_side_seeds(self, start, points, sensor_world, turns) -> list[np.ndarray]:
         """world_to_body seeds: ``start``'s attitude turned by each of ``turns``, placed so that the
@@ -889,8 +925,9 @@ class DebrisTracker:
                                         self.field_of_view, max(2 * self.voxel / range_scale, 3 * self.ray_spacing))
         ok = (tight >= MIN_TIGHT_FITNESS and violation <= MAX_FREE_SPACE_VIOLATION and unseen <= MAX_UNSEEN
               and (innovation <= MAX_INNOVATION or not has_motion))
+        view = points_world.mean(axis=0) - sensor_world
         return Alignment(time_s, pose, information, tight, violation, innovation, bool(ok), global_init, 0.0,
-                         len(points_world), unseen=unseen)
+                         len(points_world), unseen=unseen, view_body=pose[:3, :3] @ view / max(np.linalg.norm(view), 1e-12))
 
     def _surface_fit(self, points_world, pose) -> tuple[float, float, np.ndarray]:
         """Tight fitness, point-to-plane scatter sigma (m) and information of the posed scan, from
