@@ -40,9 +40,11 @@ figures that a wrong pose cannot all pass:
   with returns, so a box-like body's half turn with its far parts sticking into empty space passed.
 
 After a lost track a pose found by the search over all attitudes is not accepted alone: each passing
-pose starts a chain, the next two frames must continue it as one rigid motion (small-turn search,
-then the constant-rate prediction within the innovation limit), and only a single surviving chain
-is accepted, its frames revised after the fact (``revised``). Two surviving chains leave every frame
+pose starts a chain, the next frames must continue it as one rigid motion (small-turn search, then
+the constant-rate prediction within the innovation limit) until the chain's view of the body has
+turned by CONFIRMING_VIEW_TURN (a box-like body's half turn is a rigid motion too, told apart only
+when the side that differs comes into view), and only a single surviving chain is accepted, its
+frames revised after the fact (``revised``). Two surviving chains leave every frame
 failed: a wrong pose that passes is worse than a failed frame.
 
 **Search budget.** A search over all attitudes costs seconds of CPU (1000 seeds), and a lost track
