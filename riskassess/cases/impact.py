@@ -417,7 +417,7 @@ class Registration(Strict):
     search_cpu_per_frame: Positive = Field(
         15.0, description="Largest CPU time of one frame's search for a lost debris track (s): a frame whose "
                           "search (over all attitudes, chain continuation, global retry) takes longer is not "
-                          "registered. The default keeps every search measured on the featured debris (2-12 s).")
+                          "registered. The default keeps every search measured on the featured debris (1-14 s at load 4-8).")
     search_cpu_per_run: Annotated[float, Field(ge=0)] = Field(
         300.0, description="Largest CPU time of all searches of a perceive run together (s); once spent, frames "
                            "of a lost track are not registered (their estimates then say 'not observable'). "
