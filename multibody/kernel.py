@@ -48,7 +48,7 @@ def verlet_evaluation_state(q, qt, qtt, step, n_net_coordinates, n_bodies):
     """The state at which Exudyn's VelocityVerlet evaluates the forces of the step that starts
     at (q, qt, qtt): mid-step velocity qt + step/2 qtt and end position q + step * that;
     rigid-body rotation vectors are advanced by the Lie-group composition with the
-    mid-step angular velocity (body frame), as Exudyn does.
+    mid-step angular velocity (node frame), as Exudyn does.
 
     Parameters
     ----------
@@ -290,7 +290,7 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
 def coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, net, bodies, shapes, law, mounts, n_orbit, step,
                        n_substeps, stage_weight, buffers, force_soa, body_force):
     """The coupled forces with the net coordinate-major: ``force_soa`` (3, n) on the nodes (N, LVLH),
-    ``body_force`` (6 nb,) on the bodies (module doc's layout: force, LVLH; torque, body frame).
+    ``body_force`` (6 nb,) on the bodies (module doc's layout: force, LVLH; torque, node frame).
 
     Coordinate-major (3, n) arrays let the passes over all nodes vectorize (threads, orbit terms, the
     contact's reach and box tests) without copies in and out of the node-major layout, about 10 us a
