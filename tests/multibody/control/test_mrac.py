@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from multibody.control.mrac import (B, C_MT, K_D, K_MT, K_P, U_MAX, U_MIN, Z_D, ZM, ZM_RATE, adapting,
+from multibody.control.mrac import (A0, B, C_MT, K_D, K_MT, K_P, U_MAX, U_MIN, Z_D, ZM, ZM_RATE, adapting,
                                     advance_reference, reference_acceleration, saturated)
 from multibody.control.thrust_laws import LAWS
 from riskassess.cases.impact import load_model
@@ -67,9 +67,9 @@ def test_the_thrust_floor_clips_the_command_and_freezes_the_adaptation():
     assert not adapting(0.0, params) and adapting(1e-9, params) and not adapting(params[U_MAX], params)
     b, k, c = params[B], params[K_MT], params[C_MT]
     assert reference_acceleration(params, 0.3, 0.01) == -b * (k * 0.3 + c * 0.01)
-    adaptive = state[4:].copy()
+    adaptive = state[A0:].copy()
     thrust = LAWS["mrac2"].command(30.0, 0.5, 0.0, params, state, 2e-3, True)
-    assert thrust == 0.0 and np.array_equal(state[4:], adaptive)
+    assert thrust == 0.0 and np.array_equal(state[A0:], adaptive)
     paper, paper_state = _arrays("mrac2", _case(), z0=0.5)
     assert paper[U_MIN] == -paper[U_MAX]
     assert LAWS["mrac2"].command(30.0, 0.5, 0.0, paper, paper_state, 2e-3, True) == -paper[U_MAX]
@@ -133,9 +133,9 @@ def test_the_slack_hold_commands_the_steady_thrust_below_its_elongation():
     held = _case(slack_elongation=0.004)
     for kind in ("mrac1", "mrac2"):
         params, state = _arrays(kind, held, z0=0.001)
-        adaptive = state[4:].copy()
+        adaptive = state[A0:].copy()
         assert LAWS[kind].command(30.0, 0.001, 0.0, params, state, 2e-3, True) == pytest.approx(steady, rel=1e-12)
-        assert np.array_equal(state[4:], adaptive)
+        assert np.array_equal(state[A0:], adaptive)
     params, state = _arrays("mrac2", held, z0=0.03)
     command_z = 0.04 * (1.0 + 1600.0 / 9000.0) * 3000.0 / 1000.0 + 0.04
     assert LAWS["mrac2"].command(30.0, 0.03, 0.0, params, state, 2e-3, False) == pytest.approx(
