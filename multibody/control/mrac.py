@@ -42,11 +42,13 @@ import math
 from numba import njit
 
 # params indices common to both laws; each law appends its gains (thrust_laws/mrac1.py, mrac2.py)
-T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN, Z_SLACK, F_STEADY, NOTCH_W, NOTCH_SIGMA = range(14)
-N_COMMON = 14
+(T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN, Z_SLACK, F_STEADY, NOTCH_W, NOTCH_SIGMA,
+ HOLD_TIME) = range(15)
+N_COMMON = 15
 # state: reference model z_m, z_m rate, the rate estimate's last elongation and last rate, the breathing notch's last
-# two inputs and outputs, then adaptive parameters
-ZM, ZM_RATE, Z_LAST, RATE_LAST, NOTCH_X1, NOTCH_X2, NOTCH_Y1, NOTCH_Y2, A0 = range(9)
+# two inputs and outputs, the time of the last slack sample, then adaptive parameters
+ZM, ZM_RATE, Z_LAST, RATE_LAST, NOTCH_X1, NOTCH_X2, NOTCH_Y1, NOTCH_Y2, SLACK_AT, A0 = range(10)
+NEVER = -1e30   # SLACK_AT before any slack sample (s)
 
 
 def command_elongation(desired, k_mt, k_p, settle_at_desired) -> float:
@@ -135,7 +137,33 @@ def common_params(case, tether) -> list:
     z_slack = -1.0 if m.slack_elongation is None else m.slack_elongation
     omega_notch = notch_frequency(case)
     return [th.t_on, u_max, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
-            m.rate_filter_time, u_min, z_slack, f_steady, omega_notch, omega_notch / (2.0 * m.notch_quality)]
+            m.rate_filter_time, u_min, z_slack, f_steady, omega_notch, omega_notch / (2.0 * m.notch_quality),
+            hold_time(case)]
+
+
+def hold_time(case) -> float:
+    """How long the slack hold lasts after the last slack sample (s): ``mrac.slack_hold_periods`` breathing periods,
+    a breathing period being half a spin period, :math:`\\pi / \\omega_{spin}` (the net breathes at twice the spin;
+    ``debris.spin_rate_deg_s``, which the model builders set to the rate the run is made at); 0 without it (the hold
+    lasts only while the elongation reads slack).
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        Read: ``mrac.slack_hold_periods``, ``debris.spin_rate_deg_s``.
+
+    Raises
+    ------
+    ValueError
+        Periods are asked for and the debris does not spin.
+    """
+    periods = case.mrac.slack_hold_periods
+    if periods == 0.0:
+        return 0.0
+    if case.debris.spin_rate_deg_s <= 0.0:
+        raise ValueError("mrac.slack_hold_periods counts breathing periods (half a spin period), but the debris does "
+                         "not spin (debris.spin_rate_deg_s = 0); set mrac.slack_hold_periods = 0")
+    return periods * 180.0 / case.debris.spin_rate_deg_s
 
 
 def notch_frequency(case) -> float:
@@ -201,14 +229,15 @@ def actuator_range(case, f_steady) -> tuple[float, float]:
 
 def initial_state(z0, z_rate0) -> list:
     """The shared head of a law's state: reference model on the measured state (z0 (m), z_rate0 (m/s)),
-    the rate estimate and the breathing notch started on it (the notch at rest on z0: its output is z0).
+    the rate estimate and the breathing notch started on it (the notch at rest on z0: its output is z0), no slack
+    sample yet.
 
     Parameters
     ----------
     z0, z_rate0 : float
         Elongation (m) and its rate (m/s) at the start.
     """
-    return [z0, z_rate0, z0, z_rate0, z0, z0, z0, z0]
+    return [z0, z_rate0, z0, z_rate0, z0, z0, z0, z0, NEVER]
 
 
 def reference_steady_elongation(k_mt, k_p, z_d) -> float:
@@ -293,38 +322,51 @@ def adapting(u, params):
 
 
 @njit(cache=True)
-def slack_hold(z, params):
-    """True while the measured elongation ``z`` (m) is below the slack threshold ``params[Z_SLACK]``: the laws then
-    command the steady thrust ``params[F_STEADY]`` and do not adapt. On the full net a slack main tether reads
-    z ~ 0 whatever the distance to the debris (the central node hangs at the tether's natural length), so the
-    elongation says nothing about the distance and the law's own reaction to it (MRAC-2: K_P z_cmd, 181 N; MRAC-1:
-    k_s lambda_0 (z_m - z), 84 N) either drives the chaser into the next snap or lets the tow fall short
-    (docs/towing.md, MRAC on the full net). The threshold -1 (the default) never holds.
+def slack_hold(t, z, params, state, advance):
+    """True while the law holds the steady thrust ``params[F_STEADY]`` without adapting: the measured elongation ``z``
+    (m) is below the slack threshold ``params[Z_SLACK]``, or was within the last ``params[HOLD_TIME]`` seconds.
+
+    On the full net a slack main tether reads z ~ 0 whatever the distance to the debris (the central node hangs at
+    the tether's natural length), and the re-engagement that follows is a snap through the net, not the abstracted
+    model's spring: while slack and until the tether has pulled again for HOLD_TIME (``mrac.slack_hold_periods``
+    breathing periods), the elongation says nothing the laws' model can use, and their own reactions to it (MRAC-2:
+    K_P z_cmd, 181 N while slack, then -30 N during the snap; MRAC-1: k_s lambda_0 (z_m - z), 84 N) drive the
+    slack-and-snap cycle (docs/towing.md, MRAC on the full net). The threshold -1 (the default) never holds.
 
     Parameters
     ----------
+    t : float
+        Time (s).
     z : float
-        Measured elongation (m).
+        Measured elongation (m), before any filter.
     params : (k,) float
-        The law's parameters (``Z_SLACK`` used).
+        The law's parameters (``Z_SLACK``, ``HOLD_TIME`` used).
+    state : (j,) float
+        The law's state (``SLACK_AT``: time of the last slack sample (s), written when ``advance``).
+    advance : bool
+        A new sample (record it).
     """
-    return z < params[Z_SLACK]
+    if z < params[Z_SLACK]:
+        if advance:
+            state[SLACK_AT] = t
+        return True
+    return t - state[SLACK_AT] < params[HOLD_TIME]
 
 
 @njit(cache=True)
-def actuate(u, z, params):
-    """The thrust a law delivers for its command ``u`` (N) at the measured elongation ``z`` (m), and whether it adapts:
-    sat(u) of eq. (16) and the :math:`H(\\cdot)` of eqs. (15) and (20), or, under the slack hold
-    (:func:`slack_hold`), the steady thrust without adaptation.
+def actuate(u, hold, params):
+    """The thrust a law delivers for its command ``u`` (N), and whether it adapts: sat(u) of eq. (16) and the
+    :math:`H(\\cdot)` of eqs. (15) and (20), or, under the slack hold (``hold``, :func:`slack_hold`), the steady
+    thrust without adaptation.
 
     Parameters
     ----------
     u : float
         Pre-saturation command (N).
-    z : float
-        Measured elongation (m).
+    hold : bool
+        The slack hold is on (:func:`slack_hold`).
     params : (k,) float
-        The law's parameters (``U_MIN``, ``U_MAX``, ``Z_SLACK``, ``F_STEADY`` used).
+        The law's parameters (``U_MIN``, ``U_MAX``, ``F_STEADY`` used).
 
     Returns
     -------
@@ -333,7 +375,7 @@ def actuate(u, z, params):
     adapt : bool
         Advance the adaptive parameters.
     """
-    if slack_hold(z, params):
+    if hold:
         return params[F_STEADY], False
     return saturated(u, params), adapting(u, params)
 

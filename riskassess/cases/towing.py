@@ -124,6 +124,11 @@ class Mrac(Strict):
                           "steady thrust k z_d (k the abstracted stiffness) and do not adapt; on the full net a slack "
                           "tether reads z ~ 0 whatever the distance (docs/towing.md, MRAC on the full net). Default: "
                           "none (the paper's laws throughout).")
+    slack_hold_periods: NonNegative = Field(
+        0.0, description="With slack_elongation: the slack hold lasts this many breathing periods (half a debris spin "
+                         "period each: the net breathes at twice the spin) after the last sample below "
+                         "slack_elongation, so the re-engagement snap is also met with the steady thrust; 0: only "
+                         "while slack. docs/towing.md, MRAC on the full net.")
     breathing_notch: bool = Field(
         False, description="Both laws see the main-tether elongation through a notch at twice the debris spin rate "
                            "(the netted stage presents its outline twice a revolution, so the net breathes at 2 "
@@ -394,6 +399,12 @@ class TowingCase(Strict):
                                  f"{self.thrust.max_force:g}] N. Got {m.max_thrust:g} instead")
         if m is not None and m.breathing_notch:
             self._check_notch(m)
+        if m is not None and m.slack_hold_periods > 0 and m.slack_elongation is None:
+            raise ValueError("mrac.slack_hold_periods needs mrac.slack_elongation (the elongation below which the "
+                             "tether counts as slack and the hold starts)")
+        if m is not None and m.slack_hold_periods > 0 and self.debris.spin_rate_deg_s <= 0.0:
+            raise ValueError("mrac.slack_hold_periods counts breathing periods (half a spin period), but "
+                             "debris.spin_rate_deg_s = 0; set mrac.slack_hold_periods = 0")
         if self.full_net is not None and 4 * self.full_net.corner_mass >= self.net_mass:
             raise ValueError(f"full_net.corner_mass must be < net_mass / 4 ({self.net_mass / 4:g} kg). "
                              f"Got {self.full_net.corner_mass:g} instead")
