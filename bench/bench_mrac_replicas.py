@@ -23,12 +23,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from bench_mrac_probe import overridden
 from multibody.net_towing import run_exudyn as run_full_net
 from multibody.towing import run_exudyn
 from riskassess.cases.impact import load_model
@@ -37,6 +37,8 @@ from riskassess.models.towing import towing_model
 from riskassess.models.towing_fullnet import full_net_model, wrapped_net
 from riskassess.products import results
 from riskassess.products.towing_figures import reference_elongation, tautness
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+from bench_mrac_probe import overridden  # noqa: E402
 
 COLUMNS = (("mean_last_100_s_m", "mean z (m)", ".4f"), ("rms_error_m", "RMS z - z_d (m)", ".4f"),
            ("slack_s", "slack (s)", ".1f"), ("near_slack_share", "T < 1 N", ".2f"),
