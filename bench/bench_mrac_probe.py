@@ -37,6 +37,7 @@ from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing_fullnet import full_net_model
 from riskassess.products import results
+from multibody.control.mrac import A0
 
 
 class _ProbeForces(net_towing._Forces):
@@ -124,7 +125,7 @@ def table(series, t_on):
               f"{series['elongation'][w].mean():7.4f} {state[w, 0].mean():8.4f} {thrust[w].mean():7.1f} "
               f"{np.mean(thrust[w] < 0):5.2f} {np.mean(thrust[w] >= u_max * (1 - 1e-9)):5.2f} "
               f"{np.mean(thrust[w] <= -u_max * (1 - 1e-9)):5.2f} {np.degrees(series['pointing_error'][w]).mean():9.1f} "
-              f"{spin[w][0]:6.2f}->{spin[w][-1]:6.2f} {np.array2string(state[w, 4:].mean(axis=0), precision=1):>30}",
+              f"{spin[w][0]:6.2f}->{spin[w][-1]:6.2f} {np.array2string(state[w, A0:].mean(axis=0), precision=1):>30}",
               flush=True)
 
 

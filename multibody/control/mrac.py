@@ -11,6 +11,14 @@ mass with saturated force. The adaptive states are integrated with the controlle
 step (forward Euler, the controller is digital with zero-order hold) and frozen while the
 command saturates (the :math:`H(u_{max}-|u|)` factor of eqs. 15 and 20).
 
+**Breathing notch** (``mrac.breathing_notch``). On the full net the netted stage, tumbling in the bag, presents its
+outline twice per revolution: the main-tether elongation breathes at twice the spin rate (79-82 % of its variance
+under constant thrust, docs/towing.md). With the notch on, both laws see the elongation through
+:func:`breathing_notch` (a second-order digital notch whose zeros sit exactly on :math:`2\\omega_{spin}`; unit gain at
+zero frequency), so they neither chase that periodic swing nor adapt on it; the rate estimate below is then the
+difference quotient of the notched elongation. The spin rate is the tow's (the GNC's estimate from perception,
+``debris.spin_rate_deg_s`` or the rate the run is made at) unless ``mrac.notch_frequency`` states the frequency.
+
 **Measured elongation rate.** Both laws take :math:`\\dot z` from :func:`elongation_rate_estimate`: with
 ``RATE_TAU`` > 0 the band-limited difference quotient of the sampled elongation (a first-order
 "dirty derivative", time constant tau), with 0 the plant's instantaneous rate. On the full-net plant
@@ -29,13 +37,18 @@ interface is described in :mod:`multibody.control.thrust`.
 """
 from __future__ import annotations
 
+import math
+
 from numba import njit
 
 # params indices common to both laws; each law appends its gains (thrust_laws/mrac1.py, mrac2.py)
-T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN, Z_SLACK, F_STEADY = range(12)
-N_COMMON = 12
-# state: reference model z_m, z_m rate, the rate estimate's last elongation and last rate, then adaptive parameters
-ZM, ZM_RATE, Z_LAST, RATE_LAST, A0 = 0, 1, 2, 3, 4
+(T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN, Z_SLACK, F_STEADY, NOTCH_W, NOTCH_SIGMA,
+ HOLD_TIME) = range(15)
+N_COMMON = 15
+# state: reference model z_m, z_m rate, the rate estimate's last elongation and last rate, the breathing notch's last
+# two inputs and outputs, the time of the last slack sample, then adaptive parameters
+ZM, ZM_RATE, Z_LAST, RATE_LAST, NOTCH_X1, NOTCH_X2, NOTCH_Y1, NOTCH_Y2, SLACK_AT, A0 = range(10)
+NEVER = -1e30   # SLACK_AT before any slack sample (s)
 
 
 def command_elongation(desired, k_mt, k_p, settle_at_desired) -> float:
@@ -122,8 +135,62 @@ def common_params(case, tether) -> list:
     f_steady = steady_thrust(k_mt, m.desired_elongation)
     u_min, u_max = actuator_range(case, f_steady)
     z_slack = -1.0 if m.slack_elongation is None else m.slack_elongation
+    omega_notch = notch_frequency(case)
     return [th.t_on, u_max, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
-            m.rate_filter_time, u_min, z_slack, f_steady]
+            m.rate_filter_time, u_min, z_slack, f_steady, omega_notch, omega_notch / (2.0 * m.notch_quality),
+            hold_time(case)]
+
+
+def hold_time(case) -> float:
+    """How long the slack hold lasts after the last slack sample (s): ``mrac.slack_hold_periods`` breathing periods,
+    a breathing period being half a spin period, :math:`\\pi / \\omega_{spin}` (the net breathes at twice the spin;
+    ``debris.spin_rate_deg_s``, which the model builders set to the rate the run is made at); 0 without it (the hold
+    lasts only while the elongation reads slack).
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        Read: ``mrac.slack_hold_periods``, ``debris.spin_rate_deg_s``.
+
+    Raises
+    ------
+    ValueError
+        Periods are asked for and the debris does not spin.
+    """
+    periods = case.mrac.slack_hold_periods
+    if periods == 0.0:
+        return 0.0
+    if case.debris.spin_rate_deg_s <= 0.0:
+        raise ValueError("mrac.slack_hold_periods counts breathing periods (half a spin period), but the debris does "
+                         "not spin (debris.spin_rate_deg_s = 0); set mrac.slack_hold_periods = 0")
+    return periods * 180.0 / case.debris.spin_rate_deg_s
+
+
+def notch_frequency(case) -> float:
+    """Centre of the breathing notch (rad/s): ``mrac.notch_frequency`` if given, else twice the tow's spin rate
+    (``debris.spin_rate_deg_s``, which the model builders set to the rate the run is made at); 0 with
+    ``mrac.breathing_notch`` off (the laws see the measured elongation).
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        Read: ``mrac.breathing_notch``, ``mrac.notch_frequency``, ``debris.spin_rate_deg_s``.
+
+    Raises
+    ------
+    ValueError
+        The notch is on, no frequency is stated and the debris does not spin.
+    """
+    m = case.mrac
+    if not m.breathing_notch:
+        return 0.0
+    if m.notch_frequency is not None:
+        return float(m.notch_frequency)
+    if case.debris.spin_rate_deg_s <= 0.0:
+        raise ValueError("mrac.breathing_notch: the debris does not spin (debris.spin_rate_deg_s = 0), so there is no "
+                         "breathing at twice the spin rate; give mrac.notch_frequency (rad/s) or set "
+                         "mrac.breathing_notch = false")
+    return 2.0 * math.radians(case.debris.spin_rate_deg_s)
 
 
 def steady_thrust(k_abstracted, desired) -> float:
@@ -162,14 +229,15 @@ def actuator_range(case, f_steady) -> tuple[float, float]:
 
 def initial_state(z0, z_rate0) -> list:
     """The shared head of a law's state: reference model on the measured state (z0 (m), z_rate0 (m/s)),
-    the rate estimate started on it.
+    the rate estimate and the breathing notch started on it (the notch at rest on z0: its output is z0), no slack
+    sample yet.
 
     Parameters
     ----------
     z0, z_rate0 : float
         Elongation (m) and its rate (m/s) at the start.
     """
-    return [z0, z_rate0, z0, z_rate0]
+    return [z0, z_rate0, z0, z_rate0, z0, z0, z0, z0, NEVER]
 
 
 def reference_steady_elongation(k_mt, k_p, z_d) -> float:
@@ -254,38 +322,51 @@ def adapting(u, params):
 
 
 @njit(cache=True)
-def slack_hold(z, params):
-    """True while the measured elongation ``z`` (m) is below the slack threshold ``params[Z_SLACK]``: the laws then
-    command the steady thrust ``params[F_STEADY]`` and do not adapt. On the full net a slack main tether reads
-    z ~ 0 whatever the distance to the debris (the central node hangs at the tether's natural length), so the
-    elongation says nothing about the distance and the law's own reaction to it (MRAC-2: K_P z_cmd, 181 N; MRAC-1:
-    k_s lambda_0 (z_m - z), 84 N) either drives the chaser into the next snap or lets the tow fall short
-    (docs/towing.md, MRAC on the full net). The threshold -1 (the default) never holds.
+def slack_hold(t, z, params, state, advance):
+    """True while the law holds the steady thrust ``params[F_STEADY]`` without adapting: the measured elongation ``z``
+    (m) is below the slack threshold ``params[Z_SLACK]``, or was within the last ``params[HOLD_TIME]`` seconds.
+
+    On the full net a slack main tether reads z ~ 0 whatever the distance to the debris (the central node hangs at
+    the tether's natural length), and the re-engagement that follows is a snap through the net, not the abstracted
+    model's spring: while slack and until the tether has pulled again for HOLD_TIME (``mrac.slack_hold_periods``
+    breathing periods), the elongation says nothing the laws' model can use, and their own reactions to it (MRAC-2:
+    K_P z_cmd, 181 N while slack, then -30 N during the snap; MRAC-1: k_s lambda_0 (z_m - z), 84 N) drive the
+    slack-and-snap cycle (docs/towing.md, MRAC on the full net). The threshold -1 (the default) never holds.
 
     Parameters
     ----------
+    t : float
+        Time (s).
     z : float
-        Measured elongation (m).
+        Measured elongation (m), before any filter.
     params : (k,) float
-        The law's parameters (``Z_SLACK`` used).
+        The law's parameters (``Z_SLACK``, ``HOLD_TIME`` used).
+    state : (j,) float
+        The law's state (``SLACK_AT``: time of the last slack sample (s), written when ``advance``).
+    advance : bool
+        A new sample (record it).
     """
-    return z < params[Z_SLACK]
+    if z < params[Z_SLACK]:
+        if advance:
+            state[SLACK_AT] = t
+        return True
+    return t - state[SLACK_AT] < params[HOLD_TIME]
 
 
 @njit(cache=True)
-def actuate(u, z, params):
-    """The thrust a law delivers for its command ``u`` (N) at the measured elongation ``z`` (m), and whether it adapts:
-    sat(u) of eq. (16) and the :math:`H(\\cdot)` of eqs. (15) and (20), or, under the slack hold
-    (:func:`slack_hold`), the steady thrust without adaptation.
+def actuate(u, hold, params):
+    """The thrust a law delivers for its command ``u`` (N), and whether it adapts: sat(u) of eq. (16) and the
+    :math:`H(\\cdot)` of eqs. (15) and (20), or, under the slack hold (``hold``, :func:`slack_hold`), the steady
+    thrust without adaptation.
 
     Parameters
     ----------
     u : float
         Pre-saturation command (N).
-    z : float
-        Measured elongation (m).
+    hold : bool
+        The slack hold is on (:func:`slack_hold`).
     params : (k,) float
-        The law's parameters (``U_MIN``, ``U_MAX``, ``Z_SLACK``, ``F_STEADY`` used).
+        The law's parameters (``U_MIN``, ``U_MAX``, ``F_STEADY`` used).
 
     Returns
     -------
@@ -294,7 +375,7 @@ def actuate(u, z, params):
     adapt : bool
         Advance the adaptive parameters.
     """
-    if slack_hold(z, params):
+    if hold:
         return params[F_STEADY], False
     return saturated(u, params), adapting(u, params)
 
@@ -356,3 +437,109 @@ def store_rate(state, z, rate):
     """
     state[Z_LAST] = z
     state[RATE_LAST] = rate
+
+
+@njit(cache=True)
+def notch_coefficients(omega, sigma, step):
+    """Second-order digital notch at ``omega`` (rad/s) for the sampling step ``step`` (s), by pole-zero placement:
+    zeros on the unit circle at :math:`e^{\\pm j\\omega h}` (a sampled sinusoid of that frequency is removed
+    exactly in steady state), poles at :math:`r e^{\\pm j\\omega h}` with :math:`r = e^{-\\sigma h}` (the -3 dB
+    width is about :math:`2\\sigma`, and the filter forgets its past with :math:`e^{-\\sigma t}`), gain g that
+    makes the zero-frequency gain exactly 1:
+
+    .. math:: H(z) = g \\frac{1 - 2\\cos\\theta\\,z^{-1} + z^{-2}}{1 - 2r\\cos\\theta\\,z^{-1} + r^2 z^{-2}},
+              \\quad g = \\frac{(1 - r)^2 + 4r\\sin^2(\\theta/2)}{4\\sin^2(\\theta/2)},\\quad \\theta = \\omega h
+
+    (both sums written without the cancellation of 1 - cos theta at small theta h).
+
+    Parameters
+    ----------
+    omega : float
+        Notch frequency (rad/s), 0 < omega h < pi.
+    sigma : float
+        Pole decay rate (1/s): omega / (2 Q).
+    step : float
+        Sampling step h (s).
+
+    Returns
+    -------
+    g, b1, a1, a2 : float
+        y_k = g (x_k + b1 x_{k-1} + x_{k-2}) - a1 y_{k-1} - a2 y_{k-2}.
+    """
+    theta = omega * step
+    r = math.exp(-sigma * step)
+    half = math.sin(0.5 * theta) ** 2
+    g = ((1.0 - r) ** 2 + 4.0 * r * half) / (4.0 * half)
+    return g, -2.0 * math.cos(theta), -2.0 * r * math.cos(theta), r * r
+
+
+@njit(cache=True)
+def breathing_notch(params, state, z, step):
+    """The elongation the laws see (m): ``z`` through the notch at ``params[NOTCH_W]`` (:func:`notch_coefficients`),
+    or ``z`` itself with the notch off (``NOTCH_W`` = 0). The notch's past samples are read from ``state``;
+    :func:`store_notch` writes this sample's.
+
+    Parameters
+    ----------
+    params : (k,) float
+        The law's parameters (``NOTCH_W``, ``NOTCH_SIGMA`` used).
+    state : (j,) float
+        The law's state (``NOTCH_X1`` ... ``NOTCH_Y2`` read).
+    z : float
+        Measured elongation (m).
+    step : float
+        Sampling step (s).
+    """
+    if params[NOTCH_W] <= 0.0:
+        return z
+    g, b1, a1, a2 = notch_coefficients(params[NOTCH_W], params[NOTCH_SIGMA], step)
+    return g * (z + b1 * state[NOTCH_X1] + state[NOTCH_X2]) - a1 * state[NOTCH_Y1] - a2 * state[NOTCH_Y2]
+
+
+@njit(cache=True)
+def store_notch(state, z, z_seen):
+    """Shift the notch's memory by one sample: input ``z`` and output ``z_seen`` (m) become the last ones.
+
+    Parameters
+    ----------
+    state : (j,) float
+        The law's state, ``NOTCH_X1`` ... ``NOTCH_Y2`` written.
+    z, z_seen : float
+        This sample's measured and notched elongation (m).
+    """
+    state[NOTCH_X2], state[NOTCH_X1] = state[NOTCH_X1], z
+    state[NOTCH_Y2], state[NOTCH_Y1] = state[NOTCH_Y1], z_seen
+
+
+@njit(cache=True)
+def law_measurement(params, state, z, z_rate, step, advance):
+    """The elongation (m) and elongation rate (m/s) both laws act on: the measured ones, or with the breathing notch
+    on (``params[NOTCH_W]`` > 0) the notched elongation (:func:`breathing_notch`) and the band-limited difference
+    quotient of it (:func:`elongation_rate_estimate`; the plant's instantaneous rate is not notched, so the case
+    check asks for ``mrac.rate_filter_time`` > 0 with the notch). The filters' memories advance when ``advance``.
+
+    Parameters
+    ----------
+    params : (k,) float
+        The law's parameters (``NOTCH_W``, ``NOTCH_SIGMA``, ``RATE_TAU`` used).
+    state : (j,) float
+        The law's state (notch and rate-estimate memories).
+    z, z_rate : float
+        Measured elongation (m) and instantaneous rate (m/s).
+    step : float
+        Sampling step (s).
+    advance : bool
+        Advance the memories (a new sample).
+
+    Returns
+    -------
+    z_seen, rate : float
+        Elongation (m) and rate (m/s) for the law.
+    """
+    z_seen = breathing_notch(params, state, z, step)
+    rate = elongation_rate_estimate(params, state, z_seen, z_rate, step)
+    if advance:
+        if params[NOTCH_W] > 0.0:
+            store_notch(state, z, z_seen)
+        store_rate(state, z_seen, rate)
+    return z_seen, rate

@@ -8,6 +8,8 @@ Load with ``riskassess.cases.impact.load_model(path, TowingCase)``.
 """
 from __future__ import annotations
 
+import math
+
 from typing import Annotated, Literal, get_args
 
 import numpy as np
@@ -122,6 +124,25 @@ class Mrac(Strict):
                           "steady thrust k z_d (k the abstracted stiffness) and do not adapt; on the full net a slack "
                           "tether reads z ~ 0 whatever the distance (docs/towing.md, MRAC on the full net). Default: "
                           "none (the paper's laws throughout).")
+    slack_hold_periods: NonNegative = Field(
+        0.0, description="With slack_elongation: the slack hold lasts this many breathing periods (half a debris spin "
+                         "period each: the net breathes at twice the spin) after the last sample below "
+                         "slack_elongation, so the re-engagement snap is also met with the steady thrust; 0: only "
+                         "while slack. docs/towing.md, MRAC on the full net.")
+    breathing_notch: bool = Field(
+        False, description="Both laws see the main-tether elongation through a notch at twice the debris spin rate "
+                           "(the netted stage presents its outline twice a revolution, so the net breathes at 2 "
+                           "omega_spin; the laws then neither chase nor adapt on that swing); the rate estimate is "
+                           "then the difference quotient of the notched elongation (needs rate_filter_time > 0). The "
+                           "spin rate is the tow's (debris.spin_rate_deg_s or the rate the run is made at, the GNC's "
+                           "estimate) unless notch_frequency is given. docs/towing.md, MRAC on the full net.")
+    notch_frequency: Positive | None = Field(
+        None, description="Centre of the breathing notch (rad/s), a stated input instead of twice the tow's spin rate.")
+    notch_quality: Positive = Field(
+        4.0, description="Quality Q of the breathing notch (-): -3 dB width about omega_notch / Q, memory time "
+                         "2 Q / omega_notch. 4: +-12.5 % about twice the spin rate, wide against the spin estimate's "
+                         "error and the spin's change over a steady tow (< 1 %), narrow enough to leave the tow's "
+                         "own bounce (~0.3 rad/s) mostly alone (docs/towing.md).")
     free_debris: bool = Field(
         False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
                            "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "
@@ -330,6 +351,23 @@ class TowingCase(Strict):
     identification: Identification
     full_net: FullNet | None = None
 
+    def _check_notch(self, m):
+        """The breathing notch's settings: a rate estimate to take the notched rate from, a frequency (stated or
+        from a spinning debris) below the Nyquist frequency of the coarser of the two plants' steps."""
+        if m.rate_filter_time <= 0.0:
+            raise ValueError("mrac.breathing_notch needs mrac.rate_filter_time > 0: the laws' rate is then the "
+                             "difference quotient of the notched elongation (0 would hand the plant's instantaneous "
+                             f"rate through, breathing and all). Got rate_filter_time = {m.rate_filter_time:g}")
+        if m.notch_frequency is None and self.debris.spin_rate_deg_s <= 0.0:
+            raise ValueError("mrac.breathing_notch: debris.spin_rate_deg_s = 0, so there is no breathing at twice the "
+                             "spin rate; give mrac.notch_frequency (rad/s) or set mrac.breathing_notch = false")
+        omega = m.notch_frequency if m.notch_frequency is not None else 2.0 * math.radians(self.debris.spin_rate_deg_s)
+        step = max(self.simulation.step, self.full_net.step if self.full_net is not None else 0.0)
+        if omega * step >= math.pi:
+            raise ValueError(f"mrac.notch_frequency (or twice debris.spin_rate_deg_s) = {omega:g} rad/s is above the "
+                             f"Nyquist frequency pi / step = {math.pi / step:g} rad/s of the controller's step "
+                             f"{step:g} s")
+
     @model_validator(mode="after")
     def _mrac_given(self):
         for section in THRUST_LAWS[self.thrust.kind].CASE_SECTIONS:
@@ -359,6 +397,14 @@ class TowingCase(Strict):
             if not low < m.max_thrust <= self.thrust.max_force:
                 raise ValueError(f"mrac.max_thrust must lie in (mrac.min_thrust, thrust.max_force] = ({low:g}, "
                                  f"{self.thrust.max_force:g}] N. Got {m.max_thrust:g} instead")
+        if m is not None and m.breathing_notch:
+            self._check_notch(m)
+        if m is not None and m.slack_hold_periods > 0 and m.slack_elongation is None:
+            raise ValueError("mrac.slack_hold_periods needs mrac.slack_elongation (the elongation below which the "
+                             "tether counts as slack and the hold starts)")
+        if m is not None and m.slack_hold_periods > 0 and self.debris.spin_rate_deg_s <= 0.0:
+            raise ValueError("mrac.slack_hold_periods counts breathing periods (half a spin period), but "
+                             "debris.spin_rate_deg_s = 0; set mrac.slack_hold_periods = 0")
         if self.full_net is not None and 4 * self.full_net.corner_mass >= self.net_mass:
             raise ValueError(f"full_net.corner_mass must be < net_mass / 4 ({self.net_mass / 4:g} kg). "
                              f"Got {self.full_net.corner_mass:g} instead")

@@ -74,9 +74,10 @@ def connection_point_start(debris_com, debris_to_inertial, attach_body, toward, 
     return debris_com + brentq(reach, nearest, span, xtol=1e-12) * axis
 
 
-def case_thrust_law(case: TowingCase, tether, z0, z_rate0):
+def case_thrust_law(case: TowingCase, tether, z0, z_rate0, spin_rate_deg_s=None):
     """The case's thrust law (a plug-in of :mod:`multibody.control.thrust_laws`), its parameters and
-    initial state.
+    initial state, for a tow at ``spin_rate_deg_s`` (the laws' breathing notch, ``mrac.breathing_notch``, sits at
+    twice it).
 
     Parameters
     ----------
@@ -88,6 +89,8 @@ def case_thrust_law(case: TowingCase, tether, z0, z_rate0):
         Initial main-tether elongation (m).
     z_rate0 : float
         Initial elongation rate (m/s).
+    spin_rate_deg_s : float or None
+        The tow's debris spin rate (deg/s), the GNC's estimate; default ``debris.spin_rate_deg_s``.
 
     Returns
     -------
@@ -99,6 +102,8 @@ def case_thrust_law(case: TowingCase, tether, z0, z_rate0):
         Its initial state.
     """
     law = LAWS[case.thrust.kind]
+    if spin_rate_deg_s is not None:
+        case = case.model_copy(update=dict(debris=case.debris.model_copy(update=dict(spin_rate_deg_s=spin_rate_deg_s))))
     params, state = law.arrays(case, tether, z0, z_rate0)
     return law, params, state
 
@@ -163,7 +168,7 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
         p0 = np.asarray(case.sub_tethers.connection_point_start_inertial, float)
     v_p0 = np.asarray(de.velocity_inertial) + rot[1] @ np.cross(omega[1], rot[1].T @ (p0 - com[1]))
     z0 = np.linalg.norm(p0 - a_point) - mt.natural_length
-    law, params, state = case_thrust_law(case, tether, z0, 0.0)
+    law, params, state = case_thrust_law(case, tether, z0, 0.0, np.rad2deg(rate))
     model = TowingModel(
         masses=masses, inertia_body=np.array([np.diag(ch.principal_inertia), np.diag(de.principal_inertia)], float),
         attach_chaser_body=np.asarray(ch.tether_attachment_body, float), attach_debris_body=attach_debris,

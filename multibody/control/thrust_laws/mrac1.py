@@ -2,10 +2,11 @@
 ``towing-mrac-tether-control``): thrust along the chaser's body z; shared parts (abstracted model,
 reference model, parameter head) in :mod:`multibody.control.mrac`.
 
-``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``RATE_TAU``), then lambda_0 (1/s),
+``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``HOLD_TIME``), then lambda_0 (1/s),
 k_s (N s/m), gamma, xi_h, xi_a (2) (-); ``state`` = [z_m (m), z_m rate (m/s), last elongation (m), last
-rate estimate (m/s), h (kg), a1 (N/m), a2 (N s/m)]. The elongation rate is
-:func:`multibody.control.mrac.elongation_rate_estimate`'s.
+rate estimate (m/s), the breathing notch's last two inputs and outputs (m), the last slack
+sample's time (s), h (kg), a1 (N/m),
+a2 (N s/m)]. The elongation and its rate are :func:`multibody.control.mrac.law_measurement`'s.
 """
 from __future__ import annotations
 
@@ -13,8 +14,8 @@ import numpy as np
 from numba import njit
 
 from multibody.control.mrac import (A0, B, C_MT, K_MT, N_COMMON, T_ON, ZM, ZM_RATE, actuate, advance_reference,
-                                    common_params, elongation_rate_estimate, initial_state, pulling,
-                                    reference_acceleration, store_rate)
+                                    common_params, initial_state, law_measurement, pulling,
+                                    reference_acceleration, slack_hold)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac1"
@@ -32,15 +33,15 @@ def command(t, z, z_rate, params, state, step, advance):
     t, z, z_rate, step, advance
         As in the thrust-law interface (:mod:`multibody.control.thrust`): time (s), main-tether
         elongation (m) and rate (m/s), sampling step (s), whether to advance the states.
-    params : (18,) float
+    params : (21,) float
         The common head (:mod:`multibody.control.mrac`), then lambda_0 (1/s), k_s (N s/m), gamma, xi_h, xi_a (2) (-).
-    state : (7,) float
-        z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), h (kg), a1 (N/m), a2 (N s/m);
+    state : (12,) float
+        z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), notch memory (4, m), last slack
+        sample (s), h (kg), a1 (N/m), a2 (N s/m);
         advanced in place when ``advance``.
     """
-    z_rate = elongation_rate_estimate(params, state, z, z_rate, step)
-    if advance:
-        store_rate(state, z, z_rate)
+    hold = slack_hold(t, z, params, state, advance)                        # on the measured elongation
+    z, z_rate = law_measurement(params, state, z, z_rate, step, advance)   # notched (mrac.breathing_notch) or not
     if t < params[T_ON]:
         return 0.0
     zm_acc = reference_acceleration(params, state[ZM], state[ZM_RATE])
@@ -49,7 +50,7 @@ def command(t, z, z_rate, params, state, step, advance):
     s = (z_rate - state[ZM_RATE]) + lam * (z - state[ZM])                   # eq. (14)
     g = pulling(z, z_rate, params[K_MT], params[C_MT])
     u = state[A0] * eta + g * (state[A0 + 1] * z + state[A0 + 2] * z_rate) - params[K_S] * s   # eq. (11)
-    force, adapt = actuate(u, z, params)                                    # eq. (16), H(u_max - |u|)
+    force, adapt = actuate(u, hold, params)                                    # eq. (16), H(u_max - |u|)
     if advance:
         if adapt:
             gamma = params[GAMMA]

@@ -2,10 +2,12 @@
 ``towing-mrac-tether-control``): thrust along the chaser's body z; shared parts (abstracted model,
 reference model, parameter head) in :mod:`multibody.control.mrac`.
 
-``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``RATE_TAU``), then Gamma_z (2),
+``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``HOLD_TIME``), then Gamma_z (2),
 gamma_r, Gamma_theta (2), xi_2 (-) and P (2x2 row-major, eq. 21a); ``state`` = [z_m (m), z_m rate
-(m/s), last elongation (m), last rate estimate (m/s), Kz1 (N/m), Kz2 (N s/m), kr (N/m), theta1 (N/m),
-theta2 (N s/m)]. The elongation rate is :func:`multibody.control.mrac.elongation_rate_estimate`'s.
+(m/s), last elongation (m), last rate estimate (m/s), the breathing notch's last two inputs and
+outputs (m), the last slack sample's time (s), Kz1 (N/m), Kz2 (N s/m), kr (N/m), theta1 (N/m),
+theta2 (N s/m)]. The elongation and its rate are
+:func:`multibody.control.mrac.law_measurement`'s.
 """
 from __future__ import annotations
 
@@ -14,8 +16,8 @@ from numba import njit
 from scipy.linalg import solve_continuous_lyapunov
 
 from multibody.control.mrac import (A0, B, C_MT, K_D, K_MT, K_P, N_COMMON, T_ON, Z_D, ZM, ZM_RATE, actuate,
-                                    advance_reference, common_params, elongation_rate_estimate, initial_state, pulling,
-                                    reference_acceleration, store_rate)
+                                    advance_reference, common_params, initial_state, law_measurement, pulling,
+                                    reference_acceleration, slack_hold)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac2"
@@ -39,15 +41,15 @@ def command(t, z, z_rate, params, state, step, advance):
     ----------
     t, z, z_rate, step, advance
         As :func:`multibody.control.thrust_laws.mrac1.command` takes them (s, m, m/s, s, bool).
-    params : (22,) float
+    params : (25,) float
         The common head (:mod:`multibody.control.mrac`), then Gamma_z (2), gamma_r, Gamma_theta (2), xi_2, P (2x2).
-    state : (9,) float
-        z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), Kz (2), kr, Theta (2); advanced
+    state : (14,) float
+        z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), notch memory (4, m), last slack
+        sample (s), Kz (2), kr, Theta (2); advanced
         in place when ``advance``.
     """
-    z_rate = elongation_rate_estimate(params, state, z, z_rate, step)
-    if advance:
-        store_rate(state, z, z_rate)
+    hold = slack_hold(t, z, params, state, advance)                        # on the measured elongation
+    z, z_rate = law_measurement(params, state, z, z_rate, step, advance)   # notched (mrac.breathing_notch) or not
     if t < params[T_ON]:
         return 0.0
     zm_acc = reference_acceleration(params, state[ZM], state[ZM_RATE])
@@ -56,7 +58,7 @@ def command(t, z, z_rate, params, state, step, advance):
     z_d = params[Z_D]
     u = (state[KZ1] * z + state[KZ2] * z_rate + state[KR] * z_d
          - (state[TH1] * phi1 + state[TH2] * phi2))                             # eq. (19)
-    force, adapt = actuate(u, z, params)                                       # eq. (16), H(u_max - |u|)
+    force, adapt = actuate(u, hold, params)                                       # eq. (16), H(u_max - |u|)
     if advance:
         if adapt:
             e1, e2 = z - state[ZM], z_rate - state[ZM_RATE]

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from multibody.control.mrac import (B, C_MT, K_D, K_MT, K_P, U_MAX, U_MIN, Z_D, ZM, ZM_RATE, adapting,
-                                    advance_reference, reference_acceleration, saturated)
+from multibody.control.mrac import (A0, B, C_MT, K_D, K_MT, K_P, RATE_LAST, U_MAX, U_MIN, Z_D, Z_LAST, ZM, ZM_RATE,
+                                    adapting, advance_reference, reference_acceleration, saturated)
 from multibody.control.thrust_laws import LAWS
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
@@ -67,9 +67,9 @@ def test_the_thrust_floor_clips_the_command_and_freezes_the_adaptation():
     assert not adapting(0.0, params) and adapting(1e-9, params) and not adapting(params[U_MAX], params)
     b, k, c = params[B], params[K_MT], params[C_MT]
     assert reference_acceleration(params, 0.3, 0.01) == -b * (k * 0.3 + c * 0.01)
-    adaptive = state[4:].copy()
+    adaptive = state[A0:].copy()
     thrust = LAWS["mrac2"].command(30.0, 0.5, 0.0, params, state, 2e-3, True)
-    assert thrust == 0.0 and np.array_equal(state[4:], adaptive)
+    assert thrust == 0.0 and np.array_equal(state[A0:], adaptive)
     paper, paper_state = _arrays("mrac2", _case(), z0=0.5)
     assert paper[U_MIN] == -paper[U_MAX]
     assert LAWS["mrac2"].command(30.0, 0.5, 0.0, paper, paper_state, 2e-3, True) == -paper[U_MAX]
@@ -133,9 +133,9 @@ def test_the_slack_hold_commands_the_steady_thrust_below_its_elongation():
     held = _case(slack_elongation=0.004)
     for kind in ("mrac1", "mrac2"):
         params, state = _arrays(kind, held, z0=0.001)
-        adaptive = state[4:].copy()
+        adaptive = state[A0:].copy()
         assert LAWS[kind].command(30.0, 0.001, 0.0, params, state, 2e-3, True) == pytest.approx(steady, rel=1e-12)
-        assert np.array_equal(state[4:], adaptive)
+        assert np.array_equal(state[A0:], adaptive)
     params, state = _arrays("mrac2", held, z0=0.03)
     command_z = 0.04 * (1.0 + 1600.0 / 9000.0) * 3000.0 / 1000.0 + 0.04
     assert LAWS["mrac2"].command(30.0, 0.03, 0.0, params, state, 2e-3, False) == pytest.approx(
@@ -143,3 +143,36 @@ def test_the_slack_hold_commands_the_steady_thrust_below_its_elongation():
     params, state = _arrays("mrac2", _case(), z0=0.001)
     assert LAWS["mrac2"].command(30.0, 0.001, 0.0, params, state, 2e-3, False) == pytest.approx(
         1000.0 * (command_z - 0.001), rel=1e-9)
+
+
+def test_the_slack_hold_lasts_its_breathing_periods_after_the_last_slack_sample():
+    """mrac.slack_hold_periods = 1 at 20.44 deg/s: the hold lasts one breathing period, half a spin period,
+    180 / 20.44 = 8.806 s (hand arithmetic), after the last sample below slack_elongation. A slack sample at t = 30 s,
+    then taut samples (z = 0.03 m): the command is the steady thrust 141.33 N until 38.806 s and the law's own after
+    (MRAC-2 with its ideal gains at z' = 0: K_P (z_cmd - z) = 151.3 N, as above), the adaptive parameters unchanged
+    while held. Without slack_elongation, or on a debris that does not spin, the setting is refused naming the key."""
+    steady = (1.0 + 1600.0 / 9000.0) * 3000.0 * 0.04
+    command_z = 0.04 * (1.0 + 1600.0 / 9000.0) * 3000.0 / 1000.0 + 0.04
+    case = _case(slack_elongation=0.001, slack_hold_periods=1.0)
+    case = case.model_copy(update=dict(debris=case.debris.model_copy(update=dict(spin_rate_deg_s=20.44))))
+    params, state = _arrays("mrac2", case, z0=0.03)
+    law = LAWS["mrac2"].command
+    assert law(30.0, 0.0005, 0.0, params, state, 2e-3, True) == pytest.approx(steady, rel=1e-12)
+    adaptive = state[A0:].copy()
+    hold = 180.0 / 20.44
+    assert law(30.0 + hold - 1e-3, 0.03, 0.0, params, state.copy(), 2e-3, False) == pytest.approx(steady, rel=1e-12)
+    law(30.0 + hold - 1e-3, 0.03, 0.0, params, state, 2e-3, True)
+    assert np.array_equal(state[A0:], adaptive)
+    state[Z_LAST], state[RATE_LAST] = 0.03, 0.0      # the rate estimate at rest on z = 0.03 m
+    assert law(30.0 + hold + 1e-3, 0.03, 0.0, params, state, 2e-3, False) == pytest.approx(
+        1000.0 * (command_z - 0.03), rel=1e-9)
+    data = case.model_dump()
+    data["mrac"]["slack_elongation"] = None
+    with pytest.raises(ValueError, match="mrac.slack_hold_periods needs mrac.slack_elongation"):
+        TowingCase.model_validate(data)
+    data = case.model_dump()
+    data["debris"]["spin_rate_deg_s"] = 0.0
+    if data.get("full_net") is not None:
+        data["full_net"]["switch_to_lower_order"] = False
+    with pytest.raises(ValueError, match="mrac.slack_hold_periods"):
+        TowingCase.model_validate(data)
