@@ -152,6 +152,11 @@ class KernelBuffers(NamedTuple):
     candidates: np.ndarray         # (ns + 1, n) uint8 node near shape; last row: near any
     work_soa: np.ndarray           # (3, 3, n) positions, velocities, node forces, coordinate-major
     work_thread: np.ndarray        # (5, P) per padded thread: force on its node a, energy, power
+    work_shape: np.ndarray         # (5, ns, 3) one node's contacts: normals, relative velocities, impulses;
+                                   # sub-cycle recoils and forces (multibody.contact_kernel)
+    work_shape_scalar: np.ndarray  # (5, ns) penetrations, effective masses, impulse norms, sub-cycle
+                                   # penetrations; each shape's surface speed bound
+    contact_body: np.ndarray       # (ns,) int64 the body of each of one node's contacts
 
 
 def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffers:
@@ -170,7 +175,9 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffer
                          lag_body=np.full(n, -1, dtype=np.int64), scalars=np.zeros(N_SCALARS),
                          work=np.zeros((4, n, 3)), work_node=work_node,
                          candidates=np.zeros((n_shapes + 1, n), np.uint8), work_soa=np.zeros((3, 3, n)),
-                         work_thread=np.zeros((5, len(net.thread_runs.rest_lengths))))
+                         work_thread=np.zeros((5, len(net.thread_runs.rest_lengths))),
+                         work_shape=np.zeros((5, n_shapes, 3)), work_shape_scalar=np.zeros((5, n_shapes)),
+                         contact_body=np.zeros(n_shapes, np.int64))
 
 
 class BodyStates(NamedTuple):
