@@ -209,7 +209,10 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
         shape_speed[s] = (math.sqrt(velocity_lvlh[b, 0] ** 2 + velocity_lvlh[b, 1] ** 2 + velocity_lvlh[b, 2] ** 2)
                           + math.sqrt(omega_lvlh[b, 0] ** 2 + omega_lvlh[b, 1] ** 2 + omega_lvlh[b, 2] ** 2) * extent)
     # bounding-sphere pass (multibody.broad_phase); the box test below stays the exact filter
-    flag_candidates(x, reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max, step * shape_speed,
+    shape_reach = work_shape_scalar[5]
+    for s in range(n_shapes):
+        shape_reach[s] = step * shape_speed[s]
+    flag_candidates(x, reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max, shape_reach,
                     candidates)
     # per-node contact lists and sub-cycle work space, reused
     c_body = buffers.contact_body
