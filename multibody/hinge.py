@@ -14,6 +14,7 @@ from exudyn.itemInterface import MarkerBodyRigid, ObjectConnectorRigidBodySpring
 
 from multibody.assembly import JointSpec, RigidBodySpec
 from multibody.maths.rotations import rotation_vector_from_matrix
+from multibody.node_frame import frame_node, vector_node
 
 
 def hinge_frame_lvlh(axis_lvlh, point_lvlh, child_com_lvlh) -> np.ndarray:
@@ -267,7 +268,8 @@ def joint_damping_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: Ri
 
 
 def add_penalty_joint(mbs, joint: JointSpec, bodies: list[RigidBodySpec], body_objects,
-                      child_body_to_lvlh_unrotated: np.ndarray, child_com_lvlh_unrotated: np.ndarray, step: float):
+                      child_body_to_lvlh_unrotated: np.ndarray, child_com_lvlh_unrotated: np.ndarray, step: float,
+                      node_to_body=None):
     """Add the joint's connector to ``mbs``; return its object index.
 
     The joint frame is attached to the child as it was before any initial hinge angle, so
@@ -289,6 +291,9 @@ def add_penalty_joint(mbs, joint: JointSpec, bodies: list[RigidBodySpec], body_o
         The child's CoM at zero hinge angle (m), LVLH.
     step : float
         Step the automatic penalty springs are tuned to (s).
+    node_to_body : (nb, 3, 3) float, optional
+        Each body's Exudyn node frame in its body frame (:mod:`multibody.node_frame`): the markers are
+        placed in it. None: the node frames are the body frames.
 
     Returns
     -------
@@ -301,10 +306,12 @@ def add_penalty_joint(mbs, joint: JointSpec, bodies: list[RigidBodySpec], body_o
     point_parent_body = parent.body_to_lvlh.T @ (joint.point_lvlh - parent.com_lvlh)
     point_child_body = child_body_to_lvlh_unrotated.T @ (joint.point_lvlh - child_com_lvlh_unrotated)
     stiffness = joint_stiffness_joint_frame(joint, parent, child, step)
-    m0 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body_objects[joint.parent],
-                                       localHT=exu.HT(rotation=joint_to_parent, translation=point_parent_body)))
-    m1 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body_objects[joint.child],
-                                       localHT=exu.HT(rotation=joint_to_child, translation=point_child_body)))
+    c_parent, c_child = (np.eye(3), np.eye(3)) if node_to_body is None else (node_to_body[joint.parent],
+                                                                               node_to_body[joint.child])
+    m0 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body_objects[joint.parent], localHT=exu.HT(
+        rotation=frame_node(joint_to_parent, c_parent), translation=vector_node(point_parent_body, c_parent))))
+    m1 = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body_objects[joint.child], localHT=exu.HT(
+        rotation=frame_node(joint_to_child, c_child), translation=vector_node(point_child_body, c_child))))
     return mbs.AddObject(ObjectConnectorRigidBodySpringDamper(
         name=joint.name, markerNumbers=[m0, m1],
         stiffness=np.diag(stiffness), damping=np.diag(joint_damping_joint_frame(joint, parent, child, stiffness)),

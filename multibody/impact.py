@@ -35,6 +35,7 @@ from multibody.kernel import (
 from multibody.kernel_net import KernelNet, kernel_net_start, kernel_net_step
 from multibody.recorded_loads import add_recorded_loads
 from multibody.net import thread_runs
+from multibody.node_frame import inertia_node, node_to_body_rotations, vector_node
 from multibody.recorder import Recorder
 from multibody.rotation_update import ExactRotations
 from multibody.solver_output import solver_chatter_captured
@@ -151,7 +152,8 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
     bodies = BodyArrays(
         reference_com_lvlh=np.array([b.com_lvlh for b in assembly.bodies], float).reshape(-1, 3),
         mass=np.array([b.mass for b in assembly.bodies], float),
-        inverse_inertia_body=np.array([np.linalg.inv(b.inertia_body) for b in assembly.bodies]).reshape(-1, 3, 3))
+        inverse_inertia_body=np.array([np.linalg.inv(b.inertia_body) for b in assembly.bodies]).reshape(-1, 3, 3),
+        node_to_body=node_to_body_rotations(assembly.bodies))
     shape_arrays = ShapeArrays(
         triangles_body=shapes.triangles_body, normals_body=shapes.normals_body, body=shapes.shape_body,
         triangle_range=shapes.triangle_range, box_min_body=shapes.box_min_body, box_max_body=shapes.box_max_body,
@@ -186,7 +188,7 @@ def _inertia6(inertia):
     return [j[0, 0], j[1, 1], j[2, 2], j[1, 2], j[0, 2], j[0, 1]]
 
 
-def add_rigid_bodies(mbs, bodies) -> tuple[list, list]:
+def add_rigid_bodies(mbs, bodies, node_to_body=None) -> tuple[list, list]:
     """Add each body as a rotation-vector node (Lie-group integration) and a rigid body;
     returns the node and object numbers.
 
@@ -197,6 +199,9 @@ def add_rigid_bodies(mbs, bodies) -> tuple[list, list]:
     bodies : list of RigidBodySpec
         Mass, body-frame inertia, LVLH CoM, body->LVLH attitude, LVLH velocity and body-frame
         angular velocity of each body at t = 0.
+    node_to_body : (nb, 3, 3) float, optional
+        Each node's frame in its body frame (:mod:`multibody.node_frame`); the node's attitude,
+        angular velocity and inertia are given in it. None: the node frame is the body frame.
 
     Returns
     -------
@@ -204,14 +209,16 @@ def add_rigid_bodies(mbs, bodies) -> tuple[list, list]:
         Exudyn node and object numbers, one per body.
     """
     nodes, objects = [], []
-    for body in bodies:
+    for k, body in enumerate(bodies):
+        c = np.eye(3) if node_to_body is None else node_to_body[k]
         node = mbs.AddNode(NodeRigidBodyRotVecLG(
             referenceCoordinates=list(body.com_lvlh) + [0.0, 0.0, 0.0],
-            initialCoordinates=[0.0, 0.0, 0.0] + list(Rotation.from_matrix(body.body_to_lvlh).as_rotvec()),
-            initialVelocities=list(body.velocity_lvlh) + list(body.omega_body)))
+            initialCoordinates=[0.0, 0.0, 0.0] + list(Rotation.from_matrix(body.body_to_lvlh @ c).as_rotvec()),
+            initialVelocities=list(body.velocity_lvlh) + list(vector_node(body.omega_body, c))))
         nodes.append(node)
         objects.append(mbs.AddObject(ObjectRigidBody(
-            name=body.name, nodeNumber=node, physicsMass=body.mass, physicsInertia=_inertia6(body.inertia_body))))
+            name=body.name, nodeNumber=node, physicsMass=body.mass,
+            physicsInertia=_inertia6(inertia_node(body.inertia_body, c)))))
     return nodes, objects
 
 
@@ -249,10 +256,12 @@ def build_impact_system(assembly: ImpactAssembly, rest_body_to_lvlh=None, rest_c
             numberOfODE2Coordinates=3 * n))
         generic_nodes.append(net_node)
 
-    body_nodes, body_objects = add_rigid_bodies(mbs, assembly.bodies)
+    kernel = kernel_data(assembly)
+    # every node's frame turned from its body's, away from Exudyn's imprecise identity (multibody.node_frame)
+    node_to_body = kernel.bodies.node_to_body
+    body_nodes, body_objects = add_rigid_bodies(mbs, assembly.bodies, node_to_body)
     generic_nodes += body_nodes
 
-    kernel = kernel_data(assembly)
     size = 3 * n_exudyn + 6 * len(assembly.bodies)
     mass = exu.MatrixContainer()
     diagonal = np.arange(3 * n_exudyn)
@@ -282,14 +291,15 @@ def build_impact_system(assembly: ImpactAssembly, rest_body_to_lvlh=None, rest_c
     for joint in assembly.joints:
         joint_objects.append(add_penalty_joint(mbs, joint, assembly.bodies, body_objects,
                                                rest_body_to_lvlh[joint.child], rest_com_lvlh[joint.child],
-                                               assembly.solver.joint_tuning_step or assembly.solver.step))
+                                               assembly.solver.joint_tuning_step or assembly.solver.step,
+                                               node_to_body))
         parent = assembly.bodies[joint.parent]
         joints_to_parent.append(parent.body_to_lvlh.T @ joint.hinge_to_lvlh)
         joints_to_child.append(rest_body_to_lvlh[joint.child].T @ joint.hinge_to_lvlh)
         points_parent_body.append(parent.body_to_lvlh.T @ (joint.point_lvlh - parent.com_lvlh))
         points_child_body.append(rest_body_to_lvlh[joint.child].T @ (joint.point_lvlh - rest_com_lvlh[joint.child]))
     if assembly.body_loads is not None:
-        add_recorded_loads(mbs, body_objects, assembly.body_loads, assembly.solver.step)
+        add_recorded_loads(mbs, body_objects, assembly.body_loads, assembly.solver.step, node_to_body)
     mbs.Assemble()
     state_index = _object_state_index(mbs, generic_nodes, [3 * n_exudyn] * bool(n_exudyn) + [6] * len(body_nodes))
     kernel_net = None

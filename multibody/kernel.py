@@ -13,10 +13,13 @@ Coordinate layout of the generic object (Exudyn ``q`` / ``q_t``):
 
 * ``3 n`` net coordinates: node displacement from its reference position (m), LVLH;
   velocities (m/s), LVLH.
-* 6 per rigid body: CoM displacement (m) and rotation vector body->LVLH (rad);
-  velocities: CoM velocity (m/s), LVLH, and angular velocity (rad/s), body frame.
-  The generalized force on the rotational part is the torque in the body frame
+* 6 per rigid body: CoM displacement (m) and rotation vector node->LVLH (rad);
+  velocities: CoM velocity (m/s), LVLH, and angular velocity (rad/s), node frame.
+  The generalized force on the rotational part is the torque in the node frame
   (angular momentum conservation in ``tests/multibody/test_conservation.py`` depends on it).
+  The node frame is the body frame turned by the fixed ``BodyArrays.node_to_body``
+  (:mod:`multibody.node_frame`: it keeps Exudyn's rotation vectors away from zero);
+  :func:`body_states` turns it back, so contact shapes and inertias stay in the body frame.
 """
 from __future__ import annotations
 
@@ -42,7 +45,7 @@ def verlet_evaluation_state(q, qt, qtt, step, n_net_coordinates, n_bodies):
     """The state at which Exudyn's VelocityVerlet evaluates the forces of the step that starts
     at (q, qt, qtt): mid-step velocity qt + step/2 qtt and end position q + step * that;
     rigid-body rotation vectors are advanced by the Lie-group composition with the
-    mid-step angular velocity (body frame), as Exudyn does.
+    mid-step angular velocity (node frame), as Exudyn does.
 
     Parameters
     ----------
@@ -89,6 +92,7 @@ class BodyArrays(NamedTuple):
     reference_com_lvlh: np.ndarray     # (nb, 3) reference CoM positions, LVLH (m)
     mass: np.ndarray                   # (nb,) (kg)
     inverse_inertia_body: np.ndarray   # (nb, 3, 3) inverse inertia about the CoM, body frame (1/(kg m^2))
+    node_to_body: np.ndarray           # (nb, 3, 3) each body's Exudyn node frame in its body frame (multibody.node_frame)
 
 
 class ShapeArrays(NamedTuple):
@@ -178,7 +182,8 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffer
                          work_shape=np.zeros((5, n_shapes, 3)), work_shape_scalar=np.zeros((6, n_shapes)),
                          contact_body=np.zeros(n_shapes, np.int64), work_body=np.zeros((2, n_bodies, 3)),
                          states=BodyStates(np.zeros((n_bodies, 3, 3)), np.zeros((n_bodies, 3)),
-                                           np.zeros((n_bodies, 3)), np.zeros((n_bodies, 3))))
+                                           np.zeros((n_bodies, 3)), np.zeros((n_bodies, 3)),
+                                           np.zeros((n_bodies, 3, 3))))
 
 
 class BodyStates(NamedTuple):
@@ -188,6 +193,7 @@ class BodyStates(NamedTuple):
     com_lvlh: np.ndarray       # (nb, 3) CoM (m)
     velocity_lvlh: np.ndarray  # (nb, 3) CoM velocity (m/s)
     omega_lvlh: np.ndarray     # (nb, 3) angular velocity (rad/s)
+    node_to_lvlh: np.ndarray   # (nb, 3, 3) the Exudyn node's attitude (its frame carries the generalized torque)
 
 
 @dataclass
@@ -293,7 +299,7 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
 def coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, net, bodies, shapes, law, mounts, n_orbit, step,
                        n_substeps, stage_weight, buffers, force_soa, body_force):
     """The coupled forces with the net coordinate-major: ``force_soa`` (3, n) on the nodes (N, LVLH),
-    ``body_force`` (6 nb,) on the bodies (module doc's layout: force, LVLH; torque, body frame).
+    ``body_force`` (6 nb,) on the bodies (module doc's layout: force, LVLH; torque, node frame).
 
     Coordinate-major (3, n) arrays let the passes over all nodes vectorize (threads, orbit terms, the
     contact's reach and box tests) without copies in and out of the node-major layout, about 10 us a
@@ -333,8 +339,8 @@ def coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, net, bodies, shapes, l
             f2[i] += net_mass[i] * az
 
     states = buffers.states
-    body_states_into(q_bodies, qt_bodies, 0, bodies.reference_com_lvlh, states)
-    body_to_lvlh, com_lvlh, velocity_lvlh = states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh
+    body_states_into(q_bodies, qt_bodies, 0, bodies.reference_com_lvlh, bodies.node_to_body, states)
+    node_to_lvlh, com_lvlh, velocity_lvlh = states.node_to_lvlh, states.com_lvlh, states.velocity_lvlh
     # accumulators from the buffers, and the orbit terms in scalars: allocations here were about 12 a step
     body_force_lvlh, torque_lvlh = buffers.work_body[0], buffers.work_body[1]
     body_force_lvlh[:] = 0.0
@@ -357,10 +363,10 @@ def coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, net, bodies, shapes, l
     for b in range(nb):
         base = 6 * b
         body_force[base:base + 3] = body_force_lvlh[b]
-        for r in range(3):  # body-frame torque R^T t, in scalars (no BLAS call)
-            body_force[base + 3 + r] = (body_to_lvlh[b, 0, r] * torque_lvlh[b, 0]
-                                        + body_to_lvlh[b, 1, r] * torque_lvlh[b, 1]
-                                        + body_to_lvlh[b, 2, r] * torque_lvlh[b, 2])
+        for r in range(3):  # node-frame torque R^T t, in scalars (no BLAS call)
+            body_force[base + 3 + r] = (node_to_lvlh[b, 0, r] * torque_lvlh[b, 0]
+                                        + node_to_lvlh[b, 1, r] * torque_lvlh[b, 1]
+                                        + node_to_lvlh[b, 2, r] * torque_lvlh[b, 2])
     out_scalars[CONTACT_ELASTIC] = contact_energy
     out_scalars[N_CONTACTS] = n_contacts
     out_scalars[CONTACT_DISSIPATED] += contact_dissipated
@@ -439,9 +445,9 @@ def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torq
 
 
 @njit(cache=True)
-def body_states(q, qt, n_nodes, reference_com_lvlh):
+def body_states(q, qt, n_nodes, reference_com_lvlh, node_to_body):
     """:class:`BodyStates` (attitude body->LVLH, CoM (m), CoM velocity (m/s), angular velocity (rad/s),
-    LVLH) from the coordinates in the module doc's layout.
+    LVLH; the node's attitude) from the coordinates in the module doc's layout.
 
     Parameters
     ----------
@@ -451,34 +457,41 @@ def body_states(q, qt, n_nodes, reference_com_lvlh):
         Net nodes ahead of the bodies (0 when the kernel holds the net).
     reference_com_lvlh : (nb, 3) float
         Reference CoM positions (m), LVLH.
+    node_to_body : (nb, 3, 3) float
+        Each body's node frame in its body frame (:mod:`multibody.node_frame`).
     """
     nb = reference_com_lvlh.shape[0]
-    states = BodyStates(np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3)), np.empty((nb, 3)))
-    body_states_into(q, qt, n_nodes, reference_com_lvlh, states)
+    states = BodyStates(np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3)), np.empty((nb, 3)),
+                        np.empty((nb, 3, 3)))
+    body_states_into(q, qt, n_nodes, reference_com_lvlh, node_to_body, states)
     return states
 
 
 @njit(cache=True)
-def body_states_into(q, qt, n_nodes, reference_com_lvlh, states):
+def body_states_into(q, qt, n_nodes, reference_com_lvlh, node_to_body, states):
     """:func:`body_states` into ``states`` (:class:`BodyStates`, preallocated: the kernel's buffers).
 
     Parameters
     ----------
-    q, qt, n_nodes, reference_com_lvlh
+    q, qt, n_nodes, reference_com_lvlh, node_to_body
         As :func:`body_states`.
     states : BodyStates
         Output.
     """
     nb = reference_com_lvlh.shape[0]
-    body_to_lvlh, com_lvlh, velocity_lvlh, omega_lvlh = (states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh,
-                                                         states.omega_lvlh)
+    body_to_lvlh, com_lvlh, velocity_lvlh, omega_lvlh, node_to_lvlh = (
+        states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh, states.omega_lvlh, states.node_to_lvlh)
     for b in range(nb):
         base = 3 * n_nodes + 6 * b
         for d in range(3):
             com_lvlh[b, d] = reference_com_lvlh[b, d] + q[base + d]
             velocity_lvlh[b, d] = qt[base + d]
-        rotation_matrix_from_rotation_vector_into(q[base + 3], q[base + 4], q[base + 5], body_to_lvlh, b)
+        rotation_matrix_from_rotation_vector_into(q[base + 3], q[base + 4], q[base + 5], node_to_lvlh, b)
         # in scalars: numba sends small matrix products to BLAS, microseconds a call
         for r in range(3):
-            omega_lvlh[b, r] = (body_to_lvlh[b, r, 0] * qt[base + 3] + body_to_lvlh[b, r, 1] * qt[base + 4]
-                                + body_to_lvlh[b, r, 2] * qt[base + 5])
+            omega_lvlh[b, r] = (node_to_lvlh[b, r, 0] * qt[base + 3] + node_to_lvlh[b, r, 1] * qt[base + 4]
+                                + node_to_lvlh[b, r, 2] * qt[base + 5])
+            for k in range(3):      # body->LVLH = node->LVLH (node->body)^T
+                body_to_lvlh[b, r, k] = (node_to_lvlh[b, r, 0] * node_to_body[b, k, 0]
+                                         + node_to_lvlh[b, r, 1] * node_to_body[b, k, 1]
+                                         + node_to_lvlh[b, r, 2] * node_to_body[b, k, 2])

@@ -120,14 +120,17 @@ class _HeldLoad:
     at t gave one half step too many at each switch-on, 1e-3 of a 500-step hold).
     """
 
-    def __init__(self, loads: RecordedBodyLoads, body: int, moment: bool, step: float):
+    def __init__(self, loads: RecordedBodyLoads, body: int, moment: bool, step: float, body_to_node=None):
         self.loads, self.body, self.part, self.lag = loads, body, int(moment), 0.5 * step
+        # a moment is recorded in the body frame and applied in the node's (multibody.node_frame)
+        self.body_to_node = body_to_node if moment and body_to_node is not None else None
 
     def __call__(self, mbs, t, load_vector):
-        return self.loads.at(t - self.lag, self.body)[self.part].tolist()
+        value = self.loads.at(t - self.lag, self.body)[self.part]
+        return (value if self.body_to_node is None else self.body_to_node @ value).tolist()
 
 
-def add_recorded_loads(mbs, body_objects, loads: RecordedBodyLoads, step: float) -> None:
+def add_recorded_loads(mbs, body_objects, loads: RecordedBodyLoads, step: float, node_to_body=None) -> None:
     """Add, for every body, the recorded force (LVLH) and moment (body frame) at its CoM, read for
     a VelocityVerlet step of ``step``.
 
@@ -141,10 +144,13 @@ def add_recorded_loads(mbs, body_objects, loads: RecordedBodyLoads, step: float)
         The record (forces LVLH, moments body frame).
     step : float
         The solver's (VelocityVerlet) step (s).
+    node_to_body : (nb, 3, 3) float, optional
+        Each body's Exudyn node frame in its body frame (:mod:`multibody.node_frame`); None: the same.
     """
     for k, body in enumerate(body_objects):
+        body_to_node = None if node_to_body is None else np.asarray(node_to_body[k], float).T
         marker = mbs.AddMarker(MarkerBodyRigid(bodyNumber=body, localPosition=[0.0, 0.0, 0.0]))
         mbs.AddLoad(LoadForceVector(markerNumber=marker, loadVector=[0.0] * 3, bodyFixed=False,
                                     loadVectorUserFunction=_HeldLoad(loads, k, False, step)))
         mbs.AddLoad(LoadTorqueVector(markerNumber=marker, loadVector=[0.0] * 3, bodyFixed=True,
-                                     loadVectorUserFunction=_HeldLoad(loads, k, True, step)))
+                                     loadVectorUserFunction=_HeldLoad(loads, k, True, step, body_to_node)))

@@ -173,7 +173,8 @@ class Recorder:
             mass=np.array([b.mass for b in bodies], float),
             inertia_body=np.array([b.inertia_body for b in bodies], float).reshape(nb, 3, 3),
             debris_mask=np.isin(np.arange(nb), np.array(assembly.debris_indices, np.int64)).astype(np.int64),
-            chaser=-1 if assembly.chaser is None else int(assembly.chaser))
+            chaser=-1 if assembly.chaser is None else int(assembly.chaser),
+            node_to_body=system.kernel.bodies.node_to_body)
         self._net_masses = np.asarray(assembly.net.masses, float)
         self._joints = SampledJoints(
             parent=np.array([j.parent for j in joints], np.int64), child=np.array([j.child for j in joints], np.int64),

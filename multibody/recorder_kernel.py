@@ -78,6 +78,7 @@ class SampledBodies(NamedTuple):
     inertia_body: np.ndarray          # (nb, 3, 3) about the CoM, body frame (kg m^2)
     debris_mask: np.ndarray           # (nb,) int64, 1 for debris bodies
     chaser: int                       # the chaser's index, -1 for none
+    node_to_body: np.ndarray          # (nb, 3, 3) each body's Exudyn node frame in its body frame (multibody.node_frame)
 
 
 class SampledJoints(NamedTuple):
@@ -135,7 +136,8 @@ def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
     ----------
     q, qt : (N,) float
         Exudyn's coordinates and velocities; body ``b`` starts at ``bodies.index[b]`` (CoM displacement
-        (m), rotation vector (rad); CoM velocity (m/s), omega (rad/s, body frame)).
+        (m), rotation vector node->LVLH (rad); CoM velocity (m/s), omega (rad/s, node frame)); the
+        sample turns the node's attitude and rate into the body's (``bodies.node_to_body``).
     bodies : SampledBodies
     joints : SampledJoints
     active : (nj,) float
@@ -160,11 +162,12 @@ def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
     nb = body_mass.shape[0]
     for b in range(nb):
         i = body_index[b]
+        c = bodies.node_to_body[b]
         for d in range(3):
             com[b, d] = body_reference[b, d] + q[i + d]
             vel[b, d] = qt[i + d]
-            omega[b, d] = qt[i + 3 + d]
-        rot[b] = rotation_matrix_from_rotation_vector(q[i + 3:i + 6])
+        omega[b] = matvec3(c, qt[i + 3:i + 6])
+        rot[b] = matmat3(rotation_matrix_from_rotation_vector(q[i + 3:i + 6]), c.T)
         for d in range(3):
             force_lvlh[b, d] = impulse[b, d] / interval if interval > 0.0 else 0.0
             moment_lvlh[b, d] = impulse[b, 3 + d] / interval if interval > 0.0 else 0.0

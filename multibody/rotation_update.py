@@ -16,10 +16,12 @@ VelocityVerlet's end-of-step attitude is known before the step
 (:func:`multibody.kernel.verlet_evaluation_state`: the rotation vector composed with the mid-step angular
 velocity through quaternions, accurate at every angle). :class:`ExactRotations` keeps it from the
 pre-step function and writes it over Exudyn's after the step, so every attitude the run carries, records
-and starts its next step from is exact to round-off. Left: inside a step Exudyn evaluates its joint
-springs at its own end attitude, which misses that one step's increment when the increment is below the
-floor (at most about 2e-8 rad, not accumulated). The Runge-Kutta integrators are not corrected (their
-stages' attitudes are not known outside Exudyn); a case using them keeps the floor.
+and starts its next step from is exact to round-off. Inside a step Exudyn evaluates its joint springs at
+its own end attitude; near the identity that attitude has a dead zone (a total rotation vector below about
+2e-8 rad comes out as zero), which the restore cannot reach: :mod:`multibody.node_frame` keeps every
+node's rotation vector about 2 rad from zero, where Exudyn's update is exact to round-off, so the restore
+is now a second guard (a body that turned back near its node's identity). The Runge-Kutta integrators are
+not restored (their stages' attitudes are not known outside Exudyn); the node frames serve them too.
 """
 from __future__ import annotations
 

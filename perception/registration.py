@@ -40,10 +40,22 @@ figures that a wrong pose cannot all pass:
   with returns, so a box-like body's half turn with its far parts sticking into empty space passed.
 
 After a lost track a pose found by the search over all attitudes is not accepted alone: each passing
-pose starts a chain, the next two frames must continue it as one rigid motion (small-turn search,
-then the constant-rate prediction within the innovation limit), and only a single surviving chain
-is accepted, its frames revised after the fact (``revised``). Two surviving chains leave every frame
+pose starts a chain, the next frames must continue it as one rigid motion (small-turn search, then
+the constant-rate prediction within the innovation limit) until the chain's view of the body has
+turned by CONFIRMING_VIEW_TURN (a box-like body's half turn is a rigid motion too, told apart only
+when the side that differs comes into view), and only a single surviving chain is accepted, its
+frames revised after the fact (``revised``). Two surviving chains leave every frame
 failed: a wrong pose that passes is worse than a failed frame.
+
+**Search budget.** A search over all attitudes costs seconds of CPU (1000 seeds), and a lost track
+searches every frame: on the featured debris after the net contact 2-12 s CPU a frame, one stage 35
+min wall. ``search_cpu_per_frame`` and ``search_cpu_per_run`` (s of ``time.process_time``) bound the
+work of the frames that are not a plain ICP from the motion prediction (searches, chain
+continuations, the global retry): a frame whose work passes its own limit, or the run's remaining
+search time, is abandoned and recorded as not registered (``Alignment.over_budget``), never as the
+best pose found so far; once the run's search time is spent, a lost track is not searched again
+(tracked frames go on as before). CPU time depends on the machine: which frames a budget cuts may
+differ between machines, and the answer names them.
 
 The surface figures (tight fitness, sigma, information) are taken on about ``CHECKED_POINTS``
 evenly spread scan points: shares to ~1 %, the information scaled to the whole scan.
@@ -88,9 +100,22 @@ DISTINCT_TURN = np.radians(5.0)  # rad; ranked poses closer than this in attitud
 LOST_SEEDS = 1000
 DEPTH_BUFFER_POINTS = 3000  # model points placing the visible-side seeds (a few per 12 cm cell of a 2 m body)
 CONFIRMING_FRAMES = 3   # a re-acquired pose and the two frames continuing it (the last one predicted from the motion)
+# ... and the chain must have seen the body from directions this far apart (in the body frame): a box-like
+# body's half turn moves rigidly too, and is told from the truth only once the view shows the side that
+# differs. Featured debris after the net contact (seed 0): a chain of the bus' half turn (176 deg off)
+# passed 3 frames and was accepted at 3.7 s; it broke at 4.1 s, the view then turned 23 deg from its
+# first frame. 45 deg [assumed]: about twice that.
+CONFIRMING_VIEW_TURN = np.radians(45.0)
 MAX_CHAINS = 3          # candidate poses of a re-acquisition followed through the next frames
+# Best refined candidates of a search after a lost track searched again over small turns about themselves
+# (_polished); 0: off. Tried offline, not adopted (docs/perception.md, "Free-space refinement, tried offline").
+POLISHED = 0
 SEARCH_SCREENED = 40    # best-fitting distinct seeds of a search over all attitudes screened by the check before refining
 AMBIGUOUS_TURN = np.radians(15.0)  # rad; passing poses this far apart (beyond the known symmetries) start chains of their own
+
+
+class SearchBudgetSpent(Exception):
+    """A frame's search passed its CPU limit or the run's remaining search time (module docstring)."""
 
 
 def _turn_candidates(largest) -> list[np.ndarray]:
@@ -141,6 +166,17 @@ def _distinct(poses, count) -> list[np.ndarray]:
     return kept
 
 
+def _view_turn(chain) -> float:
+    """Largest angle (rad) between a chain's viewing direction at its second frame and at a later one,
+    in the body frame: how far round the body the chain has looked as one motion. From the second
+    frame: the jump from the searched pose to the small-turn search after it is not a view of the
+    body from elsewhere (a wrong start's jump measured 48 deg at once)."""
+    if len(chain) < 3:
+        return 0.0
+    first = chain[1].view_body
+    return max(float(np.arccos(np.clip(first @ later.view_body, -1.0, 1.0))) for later in chain[2:])
+
+
 def _score(alignment) -> float:
     """Ranks candidate alignments: checks passed first, then tight fitness less the shares of
     directions where the model blocks a return or lies where no ray returned."""
@@ -169,6 +205,9 @@ class Alignment:
     n_points: int
     cpu_seconds: float = 0.0   # process time of the registration (s; all threads, at least the one-core time)
     unseen: float = 0.0        # share of the posed model's directions in the field of view with no return near them
+    over_budget: bool = False  # the frame's search was abandoned: its CPU limit or the run's search time spent
+    view_body: np.ndarray | None = None  # unit direction sensor -> scan centroid in frame B at this pose
+    searched: bool = False     # the frame needed more than an ICP from the motion prediction (counts against the budget)
 
     @property
     def body_to_world(self) -> np.ndarray:
@@ -443,15 +482,27 @@ class DebrisTracker:
                                 re-seeded with ``seed`` + the frame number before each, so a run
                                 repeats exactly (unseeded, two runs of one case tracked 189 and
                                 194 of 201 frames once a re-acquisition was needed).
+    search_cpu_per_frame : float
+                                Largest CPU time (s) of one frame's search work (searches, chain
+                                continuations, global retry); beyond it the frame is not registered.
+                                Default: no limit.
+    search_cpu_per_run : float  Largest CPU time (s) of all frames' search work together; once spent,
+                                a lost track is not searched again. Default: no limit.
     """
 
     def __init__(self, voxel=0.03, max_correspondence=0.1, model_frames=30, model_points_body=None,
-                 model_normals_body=None, symmetries_body=None, seed=0, field_of_view=None, ray_spacing=0.0):
+                 model_normals_body=None, symmetries_body=None, seed=0, field_of_view=None, ray_spacing=0.0,
+                 search_cpu_per_frame=np.inf, search_cpu_per_run=np.inf):
         self.voxel = voxel
+        self.search_cpu_per_frame = float(search_cpu_per_frame)
+        self.search_cpu_per_run = float(search_cpu_per_run)
+        self.search_cpu_spent = 0.0          # CPU time (s) of the frames' search work so far (the run's budget)
+        self._frame_deadline = np.inf        # process time (s) at which the frame's search work is abandoned
         self.field_of_view = None if field_of_view is None else np.asarray(field_of_view, float)
         self.ray_spacing = float(ray_spacing)
         self._frame_sensor_to_world = None   # sensor attitude of the frame being registered, for the unseen-model check
         self._passing_alignments = []        # passing alignments of the last search other than the kept one
+        self._searched = False               # the frame being registered has done search work
         self._chains = []                    # candidate pose sequences after a lost track (see _continue_chains)
         self.revised = []                    # indices of earlier frames whose alignment the last update replaced
         self.symmetries_body = [np.eye(4)] if symmetries_body is None else [np.asarray(s, float) for s in symmetries_body]
@@ -572,6 +623,7 @@ class DebrisTracker:
             ``alignments``.
         """
         start, cpu_start = time.perf_counter(), time.process_time()
+        self._frame_deadline = cpu_start + min(self.search_cpu_per_frame, self.search_cpu_per_run - self.search_cpu_spent)
         self.revised = []
         self._frame_returns = None if all_returns_world is None else np.asarray(all_returns_world, float)
         self._frame_sensor_to_world = None if sensor_to_world is None else np.asarray(sensor_to_world, float)
@@ -582,11 +634,13 @@ class DebrisTracker:
             predicted, has_motion = self.prediction()
             if gate is not None and has_motion:
                 scan = self._gated(scan, predicted, gate)
-            alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
+            alignment = self._track_within_budget(time_s, scan, predicted, has_motion, sensor_world)
             self._frame_spacing = None
         self._frame_returns = self._frame_sensor_to_world = None
         alignment.seconds = time.perf_counter() - start
         alignment.cpu_seconds = time.process_time() - cpu_start
+        if alignment.searched:
+            self.search_cpu_spent += alignment.cpu_seconds
         self.alignments.append(alignment)
         self._grow_model(alignment, np.asarray(scan.points))
         return alignment
@@ -595,6 +649,27 @@ class DebrisTracker:
         """The scan points within ``gate`` (m) of a model point at the ``predicted`` pose."""
         gap, _ = self._tree.query(_transform(np.asarray(scan.points), predicted), distance_upper_bound=gate)
         return scan.select_by_index(np.flatnonzero(np.isfinite(gap)))
+
+    def _track_within_budget(self, time_s, scan, predicted, has_motion, sensor_world) -> Alignment:
+        """:meth:`_track`, its search work abandoned at the frame's deadline (module docstring, "Search
+        budget"): the frame is then not registered, its pose the prediction (or the last good pose), and
+        candidate chains are dropped (a chain continues frame by frame only)."""
+        self._searched = False
+        try:
+            alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
+        except SearchBudgetSpent:
+            self._chains, self._passing_alignments = [], []
+            pose = predicted if predicted is not None else np.eye(4)
+            alignment = Alignment(time_s, pose, np.zeros((6, 6)), 0.0, 1.0, np.inf, False, False, 0.0,
+                                  len(scan.points), over_budget=True)
+        alignment.searched = self._searched
+        return alignment
+
+    def _spend(self) -> None:
+        """Marks the frame as doing search work; raises :class:`SearchBudgetSpent` past its deadline."""
+        self._searched = True
+        if time.process_time() > self._frame_deadline:
+            raise SearchBudgetSpent
 
     def _track(self, time_s, scan, predicted, has_motion, sensor_world) -> Alignment:
         points = np.asarray(scan.points)
@@ -615,7 +690,7 @@ class DebrisTracker:
             # No pose yet, or the track was lost for frames (a collision may have changed the spin a lot).
             alignment = self._search(time_s, scan, self._acquisition_start(points, predicted),
                                      _orientation_candidates(LOST_SEEDS if self.alignments else 240), sensor_world,
-                                     visible_side=True)
+                                     visible_side=True, polish=bool(self.alignments))
             if alignment.ok and any(a.ok for a in self.alignments):
                 return self._start_chains(alignment)   # a lost track: the motion decides (_continue_chains)
         if not alignment.ok:
@@ -639,7 +714,9 @@ class DebrisTracker:
         """One more frame for each candidate chain after a lost track: the second frame by the
         small-turn search from the chain's pose, the third by ICP from the constant-rate prediction
         of the two (the check with the innovation limit: one angular velocity). Chains failing the
-        check are dropped. After CONFIRMING_FRAMES frames a single surviving chain is the track: its
+        check are dropped. After CONFIRMING_FRAMES frames, and once the chain's view of the body has
+        turned by CONFIRMING_VIEW_TURN (a half turn of a box-like body moves rigidly too and is told apart
+        only when the differing side comes into view), a single surviving chain is the track: its
         frames replace the pending ones (their indices in ``revised``). Several surviving chains are
         poses the scans cannot tell apart: every frame of them stays failed.
 
@@ -652,6 +729,7 @@ class DebrisTracker:
         points = np.asarray(scan.points)
         survivors, tried = [], []
         for chain in self._chains:
+            self._spend()
             if len(chain) == 1:
                 # seeds on the visible side: the debris may have moved beyond the coarse ICP's reach in
                 # one frame (0.3 m at the featured debris' 3.15 m/s after the contact; seeds at the
@@ -668,12 +746,12 @@ class DebrisTracker:
         if not survivors:
             best = max(tried, key=_score)
             return Alignment(**{**best.__dict__, "ok": False})
-        if len(survivors[0]) < CONFIRMING_FRAMES:
+        if len(survivors[0]) < CONFIRMING_FRAMES or _view_turn(survivors[0]) < CONFIRMING_VIEW_TURN:
             return Alignment(**{**survivors[0][-1].__dict__, "ok": False})
         self._chains = []
         if len(survivors) > 1:   # two rigid motions explain the scans: no answer rather than a guess
             return Alignment(**{**survivors[0][-1].__dict__, "ok": False})
-        first = len(self.alignments) - (CONFIRMING_FRAMES - 1)
+        first = len(self.alignments) - (len(survivors[0]) - 1)
         for index, confirmed in zip(range(first, len(self.alignments)), survivors[0]):
             previous = self.alignments[index]
             self.alignments[index] = Alignment(**{**confirmed.__dict__, "time": previous.time,
@@ -683,6 +761,7 @@ class DebrisTracker:
 
     def _retry_from_global(self, time_s, scan, failed, predicted, has_motion, sensor_world) -> Alignment:
         """The frame again from FPFH + RANSAC; kept when it passes or fits tighter than ``failed``."""
+        self._spend()
         reference = failed.world_to_body if predicted is None else predicted
         pose = self._nearest_variant(self._icp(scan, self._global(scan, reference)), reference)
         points = np.asarray(scan.points)
@@ -710,36 +789,56 @@ class DebrisTracker:
         start[:3, 3] = self._model_points.mean(axis=0) - start[:3, :3] @ points.mean(axis=0)
         return start
 
-    def _search(self, time_s, scan, start, turns, sensor_world, visible_side=False) -> Alignment:
+    def _search(self, time_s, scan, start, turns, sensor_world, visible_side=False, polish=False) -> Alignment:
         """Without a motion prediction: ``start`` turned by each of ``turns`` about the scan
         centroid (a smooth body, the paper's ellipsoid, gives ICP a basin of only a few degrees),
         each seed ranked by one coarse ICP level on a heavily thinned scan; the best SEARCH_REFINED
         distinct results are refined and checked, the best-checked kept (the other passing ones in
         ``self._passing_alignments``). With ``visible_side`` each seed's scan centroid is put on the centroid of
-        the model's side the sensor sees at that attitude (:meth:`_visible_side_seeds`)."""
+        the model's side the sensor sees at that attitude (:meth:`_visible_side_seeds`). With ``polish``
+        the best refined results are searched again about themselves (:meth:`_polished`)."""
         points = np.asarray(scan.points)
         thin = np.asarray(scan.voxel_down_sample(SEARCH_VOXELS * self.voxel).points)
         seeds = (self._visible_side_seeds(start, points, sensor_world, turns) if visible_side
                  else _seeds(start, points.mean(axis=0), turns))
-        fits = [self._icp_level(thin, seed, self.max_correspondence, SEARCH_SETTLED) for seed in seeds]
+        fits = []
+        for seed in seeds:
+            self._spend()
+            fits.append(self._icp_level(thin, seed, self.max_correspondence, SEARCH_SETTLED))
         fits.sort(key=lambda fit: -fit[1])
         ranked = [pose for pose, _ in fits]
         if visible_side:
             # A half turn of a box-like body fits the seen side about as well as the truth and outranks
             # it on the fit alone; the free space (both checks) tells them apart before the refinement.
             ranked = _distinct(ranked, SEARCH_SCREENED)
-            screened = [self._judge(time_s, points, pose, start, sensor_world, False) for pose in ranked]
+            screened = []
+            for pose in ranked:
+                self._spend()
+                screened.append(self._judge(time_s, points, pose, start, sensor_world, False))
             ranked = [ranked[i] for i in np.argsort([-_score(a) for a in screened], kind="stable")]
-        best, passing = None, []
+        refined = []
         for pose in _distinct(ranked, SEARCH_REFINED):
-            candidate = self._judge(time_s, points, self._nearest_variant(self._icp(scan, pose), start), start,
-                                    sensor_world, False)
-            if candidate.ok:
-                passing.append(candidate)
-            if best is None or _score(candidate) > _score(best):
-                best = candidate
-        self._passing_alignments = [candidate for candidate in passing if candidate is not best]
+            self._spend()
+            refined.append(self._judge(time_s, points, self._nearest_variant(self._icp(scan, pose), start), start,
+                                       sensor_world, False))
+        if polish:
+            refined += self._polished(time_s, scan, refined, sensor_world)
+        best = max(refined, key=_score)
+        self._passing_alignments = [candidate for candidate in refined if candidate.ok and candidate is not best]
         return best
+
+    def _polished(self, time_s, scan, refined, sensor_world) -> list[Alignment]:
+        """The POLISHED best-scored of a search's ``refined`` candidates searched again over small
+        turns on the visible side (as a chain's second frame), with the passing results of each.
+        Why (offline, featured debris after the net contact): the all-attitude search's nearest seed
+        lies 17-19 deg from the truth, and its refined pose stops 7-9 deg and 10-13 cm off in a local
+        minimum that more ICP does not leave; searched again about it, 1.5-4 deg."""
+        polished = []
+        for candidate in sorted(refined, key=_score, reverse=True)[:POLISHED]:
+            polished.append(self._search(time_s, scan, candidate.world_to_body, _turn_candidates(SEARCH_TURN),
+                                         sensor_world, visible_side=True))
+            polished += self._passing_alignments
+        return polished
 
     def _visible_side_seeds(self, start, points, sensor_world, turns) -> list[np.ndarray]:
         """world_to_body seeds: ``start``'s attitude turned by each of ``turns``, placed so that the
@@ -754,6 +853,7 @@ class DebrisTracker:
         model = _thinned(self._coarse_points, DEPTH_BUFFER_POINTS)
         seeds = []
         for turn in turns:
+            self._spend()
             seed = np.eye(4)
             seed[:3, :3] = turn @ start[:3, :3]
             side = visible_side_centroid(model, seed[:3, :3] @ view_world, SEARCH_VOXELS * self.voxel)
@@ -827,8 +927,9 @@ class DebrisTracker:
                                         self.field_of_view, max(2 * self.voxel / range_scale, 3 * self.ray_spacing))
         ok = (tight >= MIN_TIGHT_FITNESS and violation <= MAX_FREE_SPACE_VIOLATION and unseen <= MAX_UNSEEN
               and (innovation <= MAX_INNOVATION or not has_motion))
+        view = points_world.mean(axis=0) - sensor_world
         return Alignment(time_s, pose, information, tight, violation, innovation, bool(ok), global_init, 0.0,
-                         len(points_world), unseen=unseen)
+                         len(points_world), unseen=unseen, view_body=pose[:3, :3] @ view / max(np.linalg.norm(view), 1e-12))
 
     def _surface_fit(self, points_world, pose) -> tuple[float, float, np.ndarray]:
         """Tight fitness, point-to-plane scatter sigma (m) and information of the posed scan, from

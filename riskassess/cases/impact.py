@@ -414,6 +414,21 @@ class Registration(Strict):
     voxel: Positive = Field(0.03, description="Voxel size the scans are thinned to before ICP (m).")
     model_frames: Annotated[int, Field(ge=1)] = Field(30, description="Frames merged into the debris model before it is frozen (-).")
     max_correspondence: Positive = Field(0.1, description="ICP correspondence distance (m).")
+    search_cpu_per_frame: Positive = Field(
+        15.0, description="Largest CPU time of one frame's search for a lost debris track (s): a frame whose "
+                          "search (over all attitudes, chain continuation, global retry) takes longer is not "
+                          "registered. The default keeps every search measured on the featured debris (1-14 s at load 4-8).")
+    search_cpu_per_run: Annotated[float, Field(ge=0)] = Field(
+        300.0, description="Largest CPU time of all searches of a perceive run together (s); once spent, frames "
+                           "of a lost track are not registered (their estimates then say 'not observable'). "
+                           "0: no search at all.")
+
+    @model_validator(mode="after")
+    def _budget(self):
+        if self.search_cpu_per_frame > self.search_cpu_per_run > 0:
+            raise ValueError(f"search_cpu_per_frame ({self.search_cpu_per_frame} s) must not exceed "
+                             f"search_cpu_per_run ({self.search_cpu_per_run} s)")
+        return self
 
 
 class Bend(Strict):

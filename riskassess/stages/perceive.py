@@ -407,7 +407,8 @@ def track_model_free(scene: Scene, frames: Frames):
     track = track_scans(frames.scans, reg.voxel, reg.max_correspondence)
     # No registered frame (e.g. empty scans): no map; the fits below answer "not observable".
     tracker = DebrisTracker(reg.voxel, reg.max_correspondence, reg.model_frames,
-                            *((track.map_points, track.map_normals) if track.ok.any() else ()), seed=p.seed)
+                            *((track.map_points, track.map_normals) if track.ok.any() else ()), seed=p.seed,
+                            **_search_budget(reg))
     tracker.alignments = map_alignments(track, frames.time)
     target_to_body = np.eye(4)
     if track.ok.any():
@@ -417,6 +418,26 @@ def track_model_free(scene: Scene, frames: Frames):
                                             [np.eye(3)]) if alignment.ok else np.nan
                              for alignment, true_rot in zip(tracker.alignments, frames.true_target_to_world)]
     return tracker, target_to_body
+
+
+def _search_budget(registration) -> dict:
+    """The tracker's CPU limits of the search for a lost track (``perception.registration``'s
+    ``search_cpu_per_frame`` and ``search_cpu_per_run``, s), as keyword arguments of
+    :class:`perception.registration.DebrisTracker`."""
+    return {"search_cpu_per_frame": registration.search_cpu_per_frame,
+            "search_cpu_per_run": registration.search_cpu_per_run}
+
+
+def _search_budget_figures(tracker: DebrisTracker, frames: Frames) -> dict:
+    """The search budget, what was spent of it (CPU s) and the frames it left not registered (their
+    times, s; phase 0 observation, 1 collision)."""
+    cut = [i for i, alignment in enumerate(tracker.alignments) if alignment.over_budget]
+    return {"cpu_per_frame_s": tracker.search_cpu_per_frame, "cpu_per_run_s": tracker.search_cpu_per_run,
+            "cpu_spent_s": tracker.search_cpu_spent,
+            "frames_searched": int(sum(alignment.searched for alignment in tracker.alignments)),
+            "frames_not_registered": len(cut),
+            "frames_not_registered_times_s": [round(float(frames.time[i]), 3) for i in cut],
+            "frames_not_registered_phases": [int(frames.phase[i]) for i in cut]}
 
 
 def check_model(scene: Scene, tracker: DebrisTracker, frames: Frames) -> ModelCheck:
@@ -1015,7 +1036,7 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
             symmetry_transforms = half_turn_symmetry_transforms(scene.model_mesh_target, 0.5 * p.registration.voxel)
             tracker = DebrisTracker(p.registration.voxel, p.registration.max_correspondence, p.registration.model_frames,
                                     *known_shape_model(scene.model_mesh_target, p.registration.voxel, p.seed),
-                                    symmetries_body=symmetry_transforms, seed=p.seed)
+                                    symmetries_body=symmetry_transforms, seed=p.seed, **_search_budget(p.registration))
             symmetries = [transform[:3, :3] for transform in symmetry_transforms]
             state_at_zero, check = observe_tumble(scene, tracker, frames, symmetries, rng, progress, EARLY_CHECK_FRAMES)
         else:
@@ -1075,6 +1096,10 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
         answer["observation_time_s"] = float(p.observation_time + after.times[-1])
     except NotObservable as exc:
         answer["not_observable"] = f"after the collision: {exc}"
+        cut = sum(alignment.over_budget for alignment, phase in zip(tracker.alignments, frames.phase) if phase == 1)
+        if cut:   # say that more search time might have found the debris again
+            answer["not_observable"] += (f" ({cut} collision frames not registered: the search budget of "
+                                         f"perception.registration was spent)")
     answer.update(estimates(scene, before, after, step, state_at_zero, target_to_body, answer["body_frame"]))
     return _conclude(folder, answer, tracker, frames, track, assembly, wall, pending)
 
@@ -1085,6 +1110,7 @@ def _conclude(folder, answer, tracker, frames, track: NetTrack, assembly, wall, 
     quantity not observable after it is named in the answer), ``not_observable`` before it."""
     answer.update(_timing(tracker, frames))
     answer["tracking"] = _tracking_figures(tracker, frames)
+    answer["search_budget"] = _search_budget_figures(tracker, frames)
     if assembly is not None:
         answer["net"] = _net_figures(track, assembly)
     answer["wall_s"] = time.perf_counter() - wall
@@ -1108,6 +1134,7 @@ def _write_perception(folder, answer, tracker, frames, track: NetTrack) -> None:
         "true_com_world": np.array(frames.true_com_world), "rotation_error_rad": np.array(frames.rotation_error, float),
         "n_points": np.array(frames.n_points), "registration_s": np.array([a.seconds for a in tracker.alignments]),
         "tight_fitness": np.array([a.tight_fitness for a in tracker.alignments]),
+        "over_budget": np.array([a.over_budget for a in tracker.alignments], bool),
         "net_time": np.array(track.times), "net_positions_world": np.array(track.positions),
         "net_true_positions_world": np.array(track.true_positions), "net_separation_m": np.array(track.separation)})
     results.atomic_write_json(out / "perception.json", answer)

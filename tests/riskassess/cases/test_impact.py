@@ -161,3 +161,21 @@ def test_perception_model_is_known_by_default_and_checked(tmp_path):
     path.write_text(perception.read_text().replace("seed = 0", 'seed = 0\nmodel = "mesh"', 1))
     with pytest.raises(CaseError, match=r"case.toml: perception.model: Input should be 'known' or 'none'"):
         load_case(path)
+
+
+@pytest.mark.parametrize("budget, expected", [
+    ("search_cpu_per_frame = 0.0", r"case.toml: perception.registration.search_cpu_per_frame: Input should be greater than 0"),
+    ("search_cpu_per_run = -1.0", r"case.toml: perception.registration.search_cpu_per_run: Input should be greater than or equal to 0"),
+    ("search_cpu_per_frame = 20.0\nsearch_cpu_per_run = 10.0",
+     r"case.toml: perception.registration: search_cpu_per_frame \(20.0 s\) must not exceed search_cpu_per_run \(10.0 s\)"),
+])
+def test_search_budget_has_defaults_and_is_checked(tmp_path, budget, expected):
+    # The lost-track search budget (docs/perception.md, "Search budget"): stated defaults, and a bad
+    # value named with its key before any scan is made.
+    perception = CASES / "tang2023_debris_perception.toml"
+    registration = load_case(perception).perception.registration
+    assert (registration.search_cpu_per_frame, registration.search_cpu_per_run) == (15.0, 300.0)
+    path = tmp_path / "case.toml"
+    path.write_text(perception.read_text().replace("[perception.registration]", "[perception.registration]\n" + budget, 1))
+    with pytest.raises(CaseError, match=expected):
+        load_case(path)

@@ -63,6 +63,11 @@ def test_perceive_estimates_mass_and_inertia(perceived, capsys):
     assert 15.0 < answer["observation_time_s"] <= 20.0 + 1e-9   # tumble plus collision run
     manifest = json.loads((tmp / "run" / "manifest.json").read_text())
     assert manifest["status"] == "complete" and "perception.json" in manifest["files"]
+    # the lost-track search budget (case defaults, docs/perception.md "Search budget") is stated and,
+    # on this case, cut no frame: its estimates are those of the unbudgeted tracker
+    budget = answer["search_budget"]
+    assert (budget["cpu_per_frame_s"], budget["cpu_per_run_s"]) == (15.0, 300.0)
+    assert budget["frames_not_registered"] == 0 and budget["cpu_spent_s"] <= 300.0
 
 
 def test_case_takes_mass_properties_from_a_perception_result(perceived):

@@ -1,0 +1,119 @@
+"""Each rigid body's Exudyn node carries a frame turned from the body frame, so its rotation vector never
+sits near zero, where Exudyn's explicit Lie-group update loses small turns inside a step.
+
+Measured (Exudyn 1.13.6, ``bench/bench_instep_attitude.py``; ``tests/multibody/test_node_frame.py``):
+the Lie-group composition Exudyn applies to rotation-vector nodes reads the composed angle through
+``cos`` of half of it, so a total rotation vector below about 2e-8 rad comes out as exactly zero and,
+near it, an increment carries an absolute error of about 4e-16 rad over the angle. The end-of-step
+restore of :mod:`multibody.rotation_update` corrects what the run keeps, but inside the step Exudyn's
+joint springs still see its own attitude: a body on a 2 Hz rotational spring started at rest with
+1e-7 rad of amplitude gains 3 % amplitude in three periods (27 % at 50 Hz), and one of 1e-9 rad is
+never pulled back: its spring sees a dead zone of +-2e-8 rad, a spurious moment of up to 2e-8 k
+(2 N m on a 1e8 N m/rad penalty spring) on bodies near their start attitude -- the size of the small
+loads whose convergence was in doubt (docs/structures.md, "Are the judged peaks converged?").
+
+The composition is exact to round-off away from the identity, so each body's node is given the fixed
+attitude :data:`NODE_TO_LVLH_AT_START` (2 rad about a generic axis) at t = 0: the node frame is the
+body frame turned by ``node_to_body = body_to_lvlh(0)^T NODE_TO_LVLH_AT_START``, fixed for the run.
+Everything Exudyn sees of a body (its initial rotation vector and angular velocity, its inertia, the
+joint markers' positions and frames, recorded moments) is written in the node frame once at build
+time by the functions here; the compiled kernels and the recorder turn the node's attitude and rate
+back to the body's (``body_to_lvlh = node_to_lvlh node_to_body^T``), so contact shapes, outputs and
+every caller keep the body frame. The node would return near the identity only if its body turned by
+that very rotation (2 rad about that axis); the end-of-step restore still keeps the attitude exact then.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+#: The nodes' attitude (node->LVLH) at t = 0: 2 rad about (1, 2, 3)/sqrt(14), far from the identity
+#: (where the Lie-group update loses small turns) and from a half turn (where rotation vectors flip).
+NODE_TO_LVLH_AT_START = Rotation.from_rotvec(2.0 * np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)).as_matrix()
+
+
+def node_to_body_rotation(body_to_lvlh_start) -> np.ndarray:
+    """The fixed rotation from a body's Exudyn node frame to its body frame.
+
+    Parameters
+    ----------
+    body_to_lvlh_start : (3, 3) float
+        The body's attitude (body->LVLH) at t = 0.
+
+    Returns
+    -------
+    (3, 3) float
+        node->body rotation: ``body_to_lvlh_start @ node_to_body = NODE_TO_LVLH_AT_START``.
+    """
+    return np.asarray(body_to_lvlh_start, float).T @ NODE_TO_LVLH_AT_START
+
+
+def node_to_body_rotations(bodies) -> np.ndarray:
+    """:func:`node_to_body_rotation` of every body (from its ``body_to_lvlh`` at t = 0).
+
+    Parameters
+    ----------
+    bodies : list of RigidBodySpec
+        The assembly's bodies.
+
+    Returns
+    -------
+    (nb, 3, 3) float
+    """
+    return np.array([node_to_body_rotation(b.body_to_lvlh) for b in bodies], float).reshape(-1, 3, 3)
+
+
+def vector_node(vector_body, node_to_body) -> np.ndarray:
+    """A body-frame vector (a position, rate or moment) in the node frame.
+
+    Parameters
+    ----------
+    vector_body : (3,) float
+        Body-frame components.
+    node_to_body : (3, 3) float
+        :func:`node_to_body_rotation`.
+
+    Returns
+    -------
+    (3,) float
+        Node-frame components.
+    """
+    return np.asarray(node_to_body, float).T @ np.asarray(vector_body, float)
+
+
+def frame_node(frame_to_body, node_to_body) -> np.ndarray:
+    """A frame given in the body frame (e.g. a joint frame, columns its axes) in the node frame.
+
+    Parameters
+    ----------
+    frame_to_body : (3, 3) float
+        frame->body rotation.
+    node_to_body : (3, 3) float
+        :func:`node_to_body_rotation`.
+
+    Returns
+    -------
+    (3, 3) float
+        frame->node rotation.
+    """
+    return np.asarray(node_to_body, float).T @ np.asarray(frame_to_body, float)
+
+
+def inertia_node(inertia_body, node_to_body) -> np.ndarray:
+    """An inertia tensor about the CoM in the node frame.
+
+    Parameters
+    ----------
+    inertia_body : (3, 3) float
+        Body-frame inertia (kg m^2).
+    node_to_body : (3, 3) float
+        :func:`node_to_body_rotation`.
+
+    Returns
+    -------
+    (3, 3) float
+        Node-frame inertia (kg m^2), symmetrized (round-off of the two products).
+    """
+    c = np.asarray(node_to_body, float)
+    j = c.T @ np.asarray(inertia_body, float) @ c
+    return 0.5 * (j + j.T)
