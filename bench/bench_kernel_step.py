@@ -59,9 +59,10 @@ def time_frozen_steps(t0: float, steps: int, repeat: int) -> tuple[float, str]:
     saved = [a.copy() for a in state]
     step = inputs.assembly.solver.step
     best = np.inf
-    # the bodies' end-state output argument (absent in older trees, for "before" figures)
-    extra = ((np.zeros_like(q_bodies),)
-             if len(inspect.signature(kernel_net_module.kernel_net_step.py_func).parameters) > 5 else ())
+    # the output arguments after the time: the bodies' end state, their forces (absent in older trees, for
+    # "before" figures)
+    n_outputs = len(inspect.signature(kernel_net_module.kernel_net_step.py_func).parameters) - 5
+    extra = tuple(np.zeros_like(q_bodies) for _ in range(n_outputs))
     for _ in range(repeat):
         for array, snapshot in zip(state, saved):
             array[...] = snapshot

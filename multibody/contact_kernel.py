@@ -23,19 +23,30 @@ from multibody.contact_implicit import contact_implicit_step_xyz
 
 
 @njit(cache=True, inline="always")
-def _effective_mass_along_normal(rot, inverse_inertia_body, mass, ax, ay, az, nx, ny, nz):
-    """Mass (kg) a body shows to a push along n at arm a from its CoM: 1 / (1/m + (a x n)^T J^-1 (a x n))."""
+def _effective_mass_of_body(body_to_lvlh, inverse_inertia_body, b, mass, ax, ay, az, nx, ny, nz):
+    """Mass (kg) body ``b`` shows to a push along n at arm a from its CoM: 1 / (1/m + (a x n)^T J^-1 (a x n)).
+
+    ``body_to_lvlh``, ``inverse_inertia_body`` (nb, 3, 3) are read at ``b`` (whole arrays and an index: row
+    views cost a reference count taken and dropped per contact and step)."""
     lx = ay * nz - az * ny
     ly = az * nx - ax * nz
     lz = ax * ny - ay * nx
     # lever in the body frame
-    bx = rot[0, 0] * lx + rot[1, 0] * ly + rot[2, 0] * lz
-    by = rot[0, 1] * lx + rot[1, 1] * ly + rot[2, 1] * lz
-    bz = rot[0, 2] * lx + rot[1, 2] * ly + rot[2, 2] * lz
+    rot = body_to_lvlh
+    bx = rot[b, 0, 0] * lx + rot[b, 1, 0] * ly + rot[b, 2, 0] * lz
+    by = rot[b, 0, 1] * lx + rot[b, 1, 1] * ly + rot[b, 2, 1] * lz
+    bz = rot[b, 0, 2] * lx + rot[b, 1, 2] * ly + rot[b, 2, 2] * lz
     j = inverse_inertia_body
-    quad = (bx * (j[0, 0] * bx + j[0, 1] * by + j[0, 2] * bz) + by * (j[1, 0] * bx + j[1, 1] * by + j[1, 2] * bz)
-            + bz * (j[2, 0] * bx + j[2, 1] * by + j[2, 2] * bz))
+    quad = (bx * (j[b, 0, 0] * bx + j[b, 0, 1] * by + j[b, 0, 2] * bz)
+            + by * (j[b, 1, 0] * bx + j[b, 1, 1] * by + j[b, 1, 2] * bz)
+            + bz * (j[b, 2, 0] * bx + j[b, 2, 1] * by + j[b, 2, 2] * bz))
     return 1.0 / (1.0 / mass + quad)
+
+
+@njit(cache=True, inline="always")
+def _effective_mass_along_normal(rot, inverse_inertia_body, mass, ax, ay, az, nx, ny, nz):
+    """:func:`_effective_mass_of_body` of one body given by its (3, 3) attitude ``rot`` and inverse inertia."""
+    return _effective_mass_of_body(rot[np.newaxis], inverse_inertia_body[np.newaxis], 0, mass, ax, ay, az, nx, ny, nz)
 
 
 # inlined (numba IR): as a call, each of its seven array arguments was reference-counted per contact
@@ -187,7 +198,9 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
             push_bound += abs(net_force_lvlh[d, i])
         reach[i] = 1.001 * (net_radius[i] + step * speed_bound + 0.5 * step * step * push_bound * inverse_mass)
     n_shapes = shape_body.shape[0]
-    shape_speed = np.empty(n_shapes)
+    # per-shape work space from the buffers (allocating it was 11 arrays a step)
+    work_shape, work_shape_scalar = buffers.work_shape, buffers.work_shape_scalar
+    shape_speed = work_shape_scalar[4]
     for s in range(n_shapes):
         b = shape_body[s]
         lo, hi = shape_box_min[s], shape_box_max[s]
@@ -196,19 +209,17 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
         shape_speed[s] = (math.sqrt(velocity_lvlh[b, 0] ** 2 + velocity_lvlh[b, 1] ** 2 + velocity_lvlh[b, 2] ** 2)
                           + math.sqrt(omega_lvlh[b, 0] ** 2 + omega_lvlh[b, 1] ** 2 + omega_lvlh[b, 2] ** 2) * extent)
     # bounding-sphere pass (multibody.broad_phase); the box test below stays the exact filter
-    flag_candidates(x, reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max, step * shape_speed,
+    shape_reach = work_shape_scalar[5]
+    for s in range(n_shapes):
+        shape_reach[s] = step * shape_speed[s]
+    flag_candidates(x, reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max, shape_reach,
                     candidates)
     # per-node contact lists and sub-cycle work space, reused
-    c_body = np.empty(n_shapes, np.int64)
-    c_pen = np.empty(n_shapes)
-    c_normal = np.empty((n_shapes, 3))
-    c_rel = np.empty((n_shapes, 3))
-    c_mass = np.empty(n_shapes)
-    impulses = np.empty((n_shapes, 3))
-    impulse_norm = np.empty(n_shapes)
-    work_delta = np.empty(n_shapes)
-    work_recoil = np.empty((n_shapes, 3))
-    work_forces = np.empty((n_shapes, 3))
+    c_body = buffers.contact_body
+    c_pen, c_mass, impulse_norm, work_delta = (work_shape_scalar[0], work_shape_scalar[1], work_shape_scalar[2],
+                                               work_shape_scalar[3])
+    c_normal, c_rel, impulses, work_recoil, work_forces = (work_shape[0], work_shape[1], work_shape[2], work_shape[3],
+                                                           work_shape[4])
     for i in range(n):
         if lag_body[i] < 0 and not candidates[n_shapes, i]:
             continue  # far from every shape and nothing carried: no contact work for this node
@@ -263,8 +274,8 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
             c_pen[k] = penetration
             c_normal[k, 0], c_normal[k, 1], c_normal[k, 2] = nx, ny, nz
             c_rel[k, 0], c_rel[k, 1], c_rel[k, 2] = rx, ry, rz
-            c_mass[k] = _effective_mass_along_normal(body_to_lvlh[b], inverse_inertia[b], body_mass_all[b],
-                                                     ax, ay, az, nx, ny, nz)
+            c_mass[k] = _effective_mass_of_body(body_to_lvlh, inverse_inertia, b, body_mass_all[b], ax, ay, az,
+                                                nx, ny, nz)
             k += 1
             if penetration > 0.0:
                 contact_energy += hertz_elastic_energy(penetration, k_contact, exponent)

@@ -590,15 +590,16 @@ class ImpactSimulation:
         self.recorder = recorder
         mbs = self.system.mbs
         post_step = recorder.post_step
-        if self.system.rotations is not None:
-            # Exudyn's attitudes made exact before anything reads them (multibody.rotation_update)
-            post_step = self.system.rotations.restoring(post_step)
         kernel_net = self.system.kernel_net
         if kernel_net is not None:
             # the post-step work runs from the kernel's pre-step, for the step before (one Python
-            # call from Exudyn a step instead of two; the same work in the same order)
+            # call from Exudyn a step instead of two; the same work in the same order), after the kernel
+            # has restored the step's exact attitudes (multibody.rotation_update)
             kernel_net.set_after_step(post_step, mbs.systemData.GetTime())
         else:
+            if self.system.rotations is not None:
+                # Exudyn's attitudes made exact before anything reads them (multibody.rotation_update)
+                post_step = self.system.rotations.restoring(post_step)
             mbs.SetPostStepUserFunction(post_step)
         settings = simulation_settings(self.assembly)
         recorder.sample(0.0)

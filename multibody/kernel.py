@@ -32,11 +32,8 @@ from numba import njit
 
 from multibody.contact_kernel import add_contact_forces
 from multibody.net import ThreadRuns, add_bending_forces, add_thread_forces_runs
-from multibody.orbit import (
-    clohessy_wiltshire_acceleration,
-    clohessy_wiltshire_acceleration_xyz,
-)
-from multibody.maths.rotations import compose_rotation_vectors, rotation_matrix_from_rotation_vector
+from multibody.orbit import clohessy_wiltshire_acceleration_xyz
+from multibody.maths.rotations import compose_rotation_vectors, rotation_matrix_from_rotation_vector_into
 
 #: Indices into the kernel's scalar output buffer.
 THREAD_ELASTIC, BENDING_ELASTIC, CONTACT_ELASTIC, THREAD_DISSIPATED, CONTACT_DISSIPATED, N_CONTACTS = range(6)
@@ -156,6 +153,13 @@ class KernelBuffers(NamedTuple):
     candidates: np.ndarray         # (ns + 1, n) uint8 node near shape; last row: near any
     work_soa: np.ndarray           # (3, 3, n) positions, velocities, node forces, coordinate-major
     work_thread: np.ndarray        # (5, P) per padded thread: force on its node a, energy, power
+    work_shape: np.ndarray         # (5, ns, 3) one node's contacts: normals, relative velocities, impulses;
+                                   # sub-cycle recoils and forces (multibody.contact_kernel)
+    work_shape_scalar: np.ndarray  # (6, ns) penetrations, effective masses, impulse norms, sub-cycle
+                                   # penetrations; each shape's surface speed bound and reach within the step
+    contact_body: np.ndarray       # (ns,) int64 the body of each of one node's contacts
+    work_body: np.ndarray          # (2, nb, 3) the bodies' force and torque accumulators (LVLH)
+    states: "BodyStates"           # the bodies' state at the evaluation (body_states_into)
 
 
 def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffers:
@@ -174,7 +178,12 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffer
                          lag_body=np.full(n, -1, dtype=np.int64), scalars=np.zeros(N_SCALARS),
                          work=np.zeros((4, n, 3)), work_node=work_node,
                          candidates=np.zeros((n_shapes + 1, n), np.uint8), work_soa=np.zeros((3, 3, n)),
-                         work_thread=np.zeros((5, len(net.thread_runs.rest_lengths))))
+                         work_thread=np.zeros((5, len(net.thread_runs.rest_lengths))),
+                         work_shape=np.zeros((5, n_shapes, 3)), work_shape_scalar=np.zeros((6, n_shapes)),
+                         contact_body=np.zeros(n_shapes, np.int64), work_body=np.zeros((2, n_bodies, 3)),
+                         states=BodyStates(np.zeros((n_bodies, 3, 3)), np.zeros((n_bodies, 3)),
+                                           np.zeros((n_bodies, 3)), np.zeros((n_bodies, 3)),
+                                           np.zeros((n_bodies, 3, 3))))
 
 
 class BodyStates(NamedTuple):
@@ -329,14 +338,20 @@ def coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, net, bodies, shapes, l
             f1[i] += net_mass[i] * ay
             f2[i] += net_mass[i] * az
 
-    states = body_states(q_bodies, qt_bodies, 0, bodies.reference_com_lvlh, bodies.node_to_body)
+    states = buffers.states
+    body_states_into(q_bodies, qt_bodies, 0, bodies.reference_com_lvlh, bodies.node_to_body, states)
     node_to_lvlh, com_lvlh, velocity_lvlh = states.node_to_lvlh, states.com_lvlh, states.velocity_lvlh
-    body_force_lvlh = np.zeros((nb, 3))
+    # accumulators from the buffers, and the orbit terms in scalars: allocations here were about 12 a step
+    body_force_lvlh, torque_lvlh = buffers.work_body[0], buffers.work_body[1]
+    body_force_lvlh[:] = 0.0
+    torque_lvlh[:] = 0.0
     if n_orbit != 0.0:
         for b in range(nb):
-            body_force_lvlh[b] += bodies.mass[b] * clohessy_wiltshire_acceleration(com_lvlh[b], velocity_lvlh[b],
-                                                                                   n_orbit)
-    torque_lvlh = np.zeros((nb, 3))
+            ax, ay, az = clohessy_wiltshire_acceleration_xyz(com_lvlh[b, 0], com_lvlh[b, 2], velocity_lvlh[b, 0],
+                                                             velocity_lvlh[b, 1], n_orbit)
+            body_force_lvlh[b, 0] += bodies.mass[b] * ax
+            body_force_lvlh[b, 1] += bodies.mass[b] * ay
+            body_force_lvlh[b, 2] += bodies.mass[b] * az
     mount_elastic, mount_power = add_mount_forces(x_soa, v_soa, states, mounts, force_soa, body_force_lvlh,
                                                   torque_lvlh)
     # Mounts are the rods that hold the net's rim on the chaser: booked with the threads.
@@ -406,6 +421,8 @@ def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torq
     velocity_lvlh, omega_lvlh = states.velocity_lvlh, states.omega_lvlh
     elastic = 0.0
     power = 0.0
+    if mounts.node.shape[0] == 0:
+        return 0.0, 0.0     # none (the impact's usual case): nothing to allocate
     node_x = np.empty(3)
     node_v = np.empty(3)
     for m in range(mounts.node.shape[0]):
@@ -444,21 +461,37 @@ def body_states(q, qt, n_nodes, reference_com_lvlh, node_to_body):
         Each body's node frame in its body frame (:mod:`multibody.node_frame`).
     """
     nb = reference_com_lvlh.shape[0]
-    body_to_lvlh = np.empty((nb, 3, 3))
-    node_to_lvlh = np.empty((nb, 3, 3))
-    com_lvlh = np.empty((nb, 3))
-    velocity_lvlh = np.empty((nb, 3))
-    omega_lvlh = np.empty((nb, 3))
+    states = BodyStates(np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3)), np.empty((nb, 3)),
+                        np.empty((nb, 3, 3)))
+    body_states_into(q, qt, n_nodes, reference_com_lvlh, node_to_body, states)
+    return states
+
+
+@njit(cache=True)
+def body_states_into(q, qt, n_nodes, reference_com_lvlh, node_to_body, states):
+    """:func:`body_states` into ``states`` (:class:`BodyStates`, preallocated: the kernel's buffers).
+
+    Parameters
+    ----------
+    q, qt, n_nodes, reference_com_lvlh, node_to_body
+        As :func:`body_states`.
+    states : BodyStates
+        Output.
+    """
+    nb = reference_com_lvlh.shape[0]
+    body_to_lvlh, com_lvlh, velocity_lvlh, omega_lvlh, node_to_lvlh = (
+        states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh, states.omega_lvlh, states.node_to_lvlh)
     for b in range(nb):
         base = 3 * n_nodes + 6 * b
-        com_lvlh[b] = reference_com_lvlh[b] + q[base:base + 3]
-        velocity_lvlh[b] = qt[base:base + 3]
-        node = rotation_matrix_from_rotation_vector(q[base + 3:base + 6])
-        node_to_lvlh[b] = node
-        c = node_to_body[b]
+        for d in range(3):
+            com_lvlh[b, d] = reference_com_lvlh[b, d] + q[base + d]
+            velocity_lvlh[b, d] = qt[base + d]
+        rotation_matrix_from_rotation_vector_into(q[base + 3], q[base + 4], q[base + 5], node_to_lvlh, b)
         # in scalars: numba sends small matrix products to BLAS, microseconds a call
         for r in range(3):
-            omega_lvlh[b, r] = node[r, 0] * qt[base + 3] + node[r, 1] * qt[base + 4] + node[r, 2] * qt[base + 5]
+            omega_lvlh[b, r] = (node_to_lvlh[b, r, 0] * qt[base + 3] + node_to_lvlh[b, r, 1] * qt[base + 4]
+                                + node_to_lvlh[b, r, 2] * qt[base + 5])
             for k in range(3):      # body->LVLH = node->LVLH (node->body)^T
-                body_to_lvlh[b, r, k] = node[r, 0] * c[k, 0] + node[r, 1] * c[k, 1] + node[r, 2] * c[k, 2]
-    return BodyStates(body_to_lvlh, com_lvlh, velocity_lvlh, omega_lvlh, node_to_lvlh)
+                body_to_lvlh[b, r, k] = (node_to_lvlh[b, r, 0] * node_to_body[b, k, 0]
+                                         + node_to_lvlh[b, r, 1] * node_to_body[b, k, 1]
+                                         + node_to_lvlh[b, r, 2] * node_to_body[b, k, 2])

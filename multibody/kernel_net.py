@@ -144,9 +144,9 @@ def kernel_net_start(m, q_bodies, qt_bodies):
 
 
 @njit(cache=True)
-def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies):
-    """One VelocityVerlet step of the net inside the bodies' step (module doc); returns the bodies'
-    generalized forces (6 nb,) at the evaluation state, for Exudyn's coupled object.
+def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies, force_bodies):
+    """One VelocityVerlet step of the net inside the bodies' step (module doc); writes the bodies'
+    generalized forces (6 nb,) at the evaluation state, for Exudyn's coupled object, into ``force_bodies``.
 
     Parameters
     ----------
@@ -159,6 +159,9 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies):
     q_next_bodies : (6 nb,) float
         Filled with the bodies' evaluation state, the step's end coordinates (m, rad; the rotation vectors
         exact, :func:`multibody.kernel.verlet_evaluation_state`), for :class:`multibody.rotation_update.ExactRotations`.
+    force_bodies : (6 nb,) float
+        Output: the bodies' generalized forces (a preallocated array: returning a new one cost its
+        allocation and a Python object every step).
     """
     # the structref's arrays as locals: a field read inside a loop is not hoisted (stores through the
     # other arrays may alias it), which cost about 5 ns per coordinate, 18 us a step for the reference net
@@ -182,7 +185,7 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies):
     for k in range(n3):
         qt[k] = qt_eval[k] + half * qtt[k]
     q[:] = q_eval[:n3]
-    return body_force.copy()
+    force_bodies[:] = body_force
 
 
 class KernelNet:
@@ -200,7 +203,8 @@ class KernelNet:
     state_index : (6 nb,) int or None
         Where the bodies' coordinates sit in Exudyn's system vectors (None: the whole vector).
     rotations : multibody.rotation_update.ExactRotations or None
-        Keeps each step's exact end attitudes, for the post-step function to restore.
+        Keeps each step's exact end attitudes; they are written over Exudyn's at the start of the next
+        pre-step, before :attr:`after_step` reads the state (and by :meth:`finish_steps` after the last step).
     """
 
     def __init__(self, mbs, coupled_object, kernel: KernelData, net_velocity, state_index, rotations=None):
@@ -211,6 +215,7 @@ class KernelNet:
         self.state_index = state_index
         self.model, self.q, self.qt = net_step_model(kernel, net_velocity)
         self._q_next_bodies = np.zeros(6 * kernel.n_bodies)  # the step's end coordinates of the bodies (m, rad)
+        self._force_bodies = np.zeros(6 * kernel.n_bodies)   # the bodies' generalized forces of the step
         self._views = None
         self._last_time = -np.inf
         #: optional ``after_step(mbs, t) -> bool``, the work of a post-step function for the step that ended at
@@ -239,22 +244,29 @@ class KernelNet:
         return self._views
 
     def __call__(self, mbs, t):
+        q, qt, qtt = self._state_views(mbs, t)
+        rotations = self.rotations
+        if rotations is not None:
+            # the previous step's exact attitudes, before anything reads the state (multibody.rotation_update);
+            # through the view already at hand (fetching one was about 1 us of every step)
+            rotations.restore_into(q)
         if self.after_step is not None:
             keep = self.after_step(mbs, self._previous_end)
             self._previous_end = t
             if not keep:
                 return False
-        q, qt, qtt = self._state_views(mbs, t)
-        q_bodies, qt_bodies, qtt_bodies = self._bodies(q), self._bodies(qt), self._bodies(qtt)
+        if self.state_index is not None:
+            q, qt, qtt = self._bodies(q), self._bodies(qt), self._bodies(qtt)
         # t is the time of the evaluation state (see multibody.impact.VerletForces)
-        force = kernel_net_step(self.model, q_bodies, qt_bodies, qtt_bodies, t, self._q_next_bodies)
-        if self.rotations is not None:
-            self.rotations.keep(self._q_next_bodies)
-        mbs.SetObjectParameter(self.coupled_object, "forceVector", force)
+        kernel_net_step(self.model, q, qt, qtt, t, self._q_next_bodies, self._force_bodies)
+        if rotations is not None:
+            rotations.keep(self._q_next_bodies)
+        mbs.SetObjectParameter(self.coupled_object, "forceVector", self._force_bodies)
         return True
 
     def set_after_step(self, after_step, start_time: float = 0.0):
-        """Run ``after_step(mbs, t) -> bool`` for every step of the next solve (:attr:`after_step`).
+        """Run ``after_step(mbs, t) -> bool`` for every step of the next solve (:attr:`after_step`), after
+        the step's attitudes are restored.
 
         Parameters
         ----------
@@ -266,12 +278,15 @@ class KernelNet:
         self._previous_end = start_time
 
     def finish_steps(self, mbs) -> bool:
-        """Run :attr:`after_step` for the last step taken (after the solve); returns its answer (True without one).
+        """Restore the last step's attitudes and run :attr:`after_step` for it (after the solve); returns its
+        answer (True without one).
 
         Parameters
         ----------
         mbs : exudyn.MainSystem
         """
+        if self.rotations is not None:
+            self.rotations.restore(mbs)
         if self.after_step is None:
             return True
         return bool(self.after_step(mbs, self._previous_end))

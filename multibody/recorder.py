@@ -54,14 +54,49 @@ from multibody.recorded_loads import applied_work
 from multibody.recorder_kernel import (
     SampledBodies,
     SampledJoints,
-    body_sample,
+    SampleModel,
     body_sample_buffers,
+    body_sample_model,
     net_sums,
 )
 
 #: Longest simulated time between two finite-state checks when the output rate is lower (s):
 #: a NaN spreads through the coupled state within a few steps and stays, so 1 ms loses nothing.
 HEALTH_INTERVAL_S = 1e-3
+
+#: The energy terms of every run, in the order the total adds them (then ``chaser_kinetic`` with a chaser,
+#: ``applied_loads_work`` with recorded loads, and ``total``).
+ENERGY_TERMS = ("net_kinetic", "net_elastic", "net_bending", "contact_elastic", "debris_translational",
+                "debris_rotational", "joint_elastic", "released_joints", "orbital_potential", "dissipated_threads",
+                "dissipated_contact")
+
+
+def series_layout(n_bodies: int, n_joints: int, chaser: bool, applied_loads: bool) -> list:
+    """The time series' keys and the shape of one sample of each, in the order of :attr:`Recorder.series`.
+
+    Parameters
+    ----------
+    n_bodies, n_joints : int
+    chaser : bool
+        The run has a chaser (``energy_chaser_kinetic``).
+    applied_loads : bool
+        The run has recorded loads (``energy_applied_loads_work``).
+
+    Returns
+    -------
+    list of (str, tuple)
+    """
+    nb, nj = n_bodies, n_joints
+    energies = list(ENERGY_TERMS) + ["chaser_kinetic"] * chaser + ["applied_loads_work"] * applied_loads + ["total"]
+    return ([("time", ())]
+            + [(key, (nb, 3)) for key in ("contact_force_lvlh", "contact_moment_lvlh", "contact_force_body",
+                                          "contact_moment_body", "body_com_lvlh", "body_velocity_lvlh",
+                                          "body_omega_body")]
+            + [("body_to_lvlh", (nb, 3, 3)), ("debris_com_lvlh", (3,)), ("debris_velocity_lvlh", (3,))]
+            + [(key, (nj, 3)) for key in ("joint_rotation_joint", "joint_rate_joint", "joint_force_joint",
+                                          "joint_moment_joint")]
+            + [("energy_" + key, ()) for key in energies]
+            + [("momentum_linear_lvlh", (3,)), ("momentum_angular_lvlh", (3,))])
 
 
 class Recorder:
@@ -89,7 +124,7 @@ class Recorder:
         self._next_output = self.output_interval
         self._end_time = solver.n_steps * solver.step
         self._health_every = max(1, int(HEALTH_INTERVAL_S / solver.step))
-        self._steps = 0
+        self._steps_unchecked = 0   # steps since the state was last checked (by a sample or on its own)
         self._next_net = self.net_interval
         self._last_output_time = 0.0
         mbs = system.mbs
@@ -102,10 +137,27 @@ class Recorder:
         self.stopped_early = False
 
     def _preallocate(self, assembly, system):
-        """Series and snapshot arrays for every sample the run can take, and the recorder kernel's inputs."""
+        """Series and snapshot arrays for every sample the run can take, and the recorder kernel's inputs.
+
+        A sample is written into one flat row (:attr:`_row`; the body kernel's outputs are views of it, so it
+        writes there directly) and stored with one copy into a (capacity, row) table; :meth:`finish` cuts the
+        table into the series (storing some 35 arrays one by one was about 20 us of every sample)."""
         self._capacity = int(np.ceil(self._end_time / self.output_interval)) + 3
-        self._series: dict[str, np.ndarray] = {}
+        nb, nj = len(assembly.bodies), len(assembly.joints)
+        self._layout = series_layout(nb, nj, assembly.chaser is not None, assembly.body_loads is not None)
+        self._columns = {}
+        width = 0
+        for key, shape in self._layout:
+            size = int(np.prod(shape, dtype=np.int64))
+            self._columns[key] = (width, width + size, shape)
+            width += size
+        self._row = np.zeros(width)
+        self._rows = np.zeros((self._capacity, width))
         self._n_rows = 0
+        self._row_view = {key: self._row[first:last].reshape(shape) for key, (first, last, shape) in self._columns.items()}
+        energy_keys = [key for key, _ in self._layout if key.startswith("energy_")]
+        self._energy_slice = slice(self._columns[energy_keys[0]][0], self._columns[energy_keys[-1]][1])
+        self._time_column = self._columns["time"][0]
         n_net = int(np.ceil(self._end_time / self.net_interval)) + 3
         n = assembly.net.n_nodes
         self._net_time = np.zeros(n_net)
@@ -115,7 +167,6 @@ class Recorder:
         self._last_net_time = 0.0
         self._n_net = 0
         bodies, joints = assembly.bodies, assembly.joints
-        nb, nj = len(bodies), len(joints)
         self._bodies = SampledBodies(
             index=np.array(self._body_index, np.int64),
             reference_com_lvlh=np.array([b.com_lvlh for b in bodies], float).reshape(nb, 3),
@@ -132,8 +183,19 @@ class Recorder:
             point_parent=np.array(system.joint_point_parent_body, float).reshape(nj, 3),
             point_child=np.array(system.joint_point_child_body, float).reshape(nj, 3),
             stiffness=np.array(self._joint_stiffness, float).reshape(nj, 6))
-        self._body_out = body_sample_buffers(nb, nj)
+        view = self._row_view
+        self._body_out = body_sample_buffers(nb, nj)._replace(
+            com_lvlh=view["body_com_lvlh"], velocity_lvlh=view["body_velocity_lvlh"],
+            body_to_lvlh=view["body_to_lvlh"], omega_body=view["body_omega_body"],
+            force_lvlh=view["contact_force_lvlh"], moment_lvlh=view["contact_moment_lvlh"],
+            force_body=view["contact_force_body"], moment_body=view["contact_moment_body"],
+            joint_rotation=view["joint_rotation_joint"], joint_rate=view["joint_rate_joint"])
+        self._joint_active_float = np.ones(nj)
+        self._sample_model = SampleModel(self._bodies, self._joints, self._joint_active_float,
+                                         system.kernel.buffers.body_impulse_lvlh, self._body_out)
         self._net_totals = np.zeros(8)
+        self._force_local = exu.OutputVariableType.ForceLocal
+        self._torque_local = exu.OutputVariableType.TorqueLocal
 
     # -- Exudyn hook -----------------------------------------------------------------
     def post_step(self, mbs, t):
@@ -152,13 +214,15 @@ class Recorder:
             False stops the solver (a failed health check).
         """
         half = 0.5 * self.step
-        self._steps += 1
+        self._steps_unchecked += 1
         if t >= self._next_output - half or t >= self._end_time - half:
             # the last step is always sampled, so a run's series ends at its end time whatever the rate
             self.sample(t)
+            self._steps_unchecked = 0   # a sample checks the state
             while self._next_output - half <= t:
                 self._next_output += self.output_interval
-        elif self._steps % self._health_every == 0:
+        elif self._steps_unchecked >= self._health_every:
+            self._steps_unchecked = 0
             self.health.state(t, *self.system.state_arrays())
         return self.health.ok
 
@@ -174,19 +238,20 @@ class Recorder:
             Current simulated time (s).
         """
         data = self.system.mbs.systemData
-        q, qt = data.GetODE2Coordinates(), data.GetODE2Coordinates_t()
+        # views (nothing here writes them; the row keeps what it needs)
+        q, qt = data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False)
         # the net's sums first: their pass over the net's state also tells whether it is finite (the full
         # check, with its message, runs only when it is not); nothing is recorded from a lost state
         net_finite = math.isfinite(net_sums(*self.system.net_state_layout(q, qt), self.system.kernel.net.reference_lvlh,
                                             self._net_masses, self.assembly.mean_motion, self._net_totals))
         if not (self.health.state(t, q, qt) if net_finite else self.health.state(t, *self.system.state_arrays())):
             return  # the run stops at this step
-        row = self._compute_row(t, q, qt)
-        if not self.health.energy(t, row["energy_total"]):
+        total_energy, forces_joint, moments_joint = self._compute_row(t, q, qt)
+        if not self.health.energy(t, total_energy):
             return
-        self._store(row)
+        self._store()
         if self.monitor is not None:
-            self._check_monitor(t, row)
+            self._check_monitor(t, forces_joint, moments_joint)
         if t == 0.0 or t >= self._next_net - 0.5 * self.step:
             x_lvlh, v_lvlh = self.system.net_state(q, qt)
             k = self._n_net
@@ -209,23 +274,25 @@ class Recorder:
         self._last_net_time = t
         return force_lvlh
 
-    def _check_monitor(self, t, row):
+    def _check_monitor(self, t, force_joint, moment_joint):
         before = len(self.monitor.events)
-        self.monitor.check(t, row["joint_force_joint"], row["joint_moment_joint"], self._joint_energies)
+        self.monitor.check(t, force_joint, moment_joint, self._joint_energies)
         for event in self.monitor.events[before:]:
             # The connector is off from the next step on: its loads read zero and the elastic
             # energy it held leaves the balance as "released" energy, so the total stays closed.
             self.joint_active[event.joint] = False
+            self._joint_active_float[event.joint] = 0.0
             self._released_energy += event.stored_energy
 
-    def _compute_row(self, t, q, qt) -> dict:
-        """One sample's values (see the module doc), from the compiled sums of multibody.recorder_kernel (the
-        net's, ``self._net_totals``, computed by the caller)."""
+    def _compute_row(self, t, q, qt) -> tuple:
+        """One sample's values (see the module doc) into :attr:`_row`, from the compiled sums of
+        multibody.recorder_kernel (the net's, ``self._net_totals``, computed by the caller). Returns the energy
+        balance's total (J) and the joints' reaction forces and moments (new (nj, 3) arrays, joint frame)."""
         w = self._body_out
+        view = self._row_view
         interval = t - self._last_output_time
         self._last_output_time = t
-        body_sample(q, qt, self._bodies, self._joints, self.joint_active.astype(float),
-                    self.system.kernel.buffers.body_impulse_lvlh, interval, self.assembly.mean_motion, w)
+        body_sample_model(self._sample_model, q, qt, interval, self.assembly.mean_motion)
         net = self._net_totals
         mbs = self.system.mbs
         nj = len(self.system.joint_objects)
@@ -234,41 +301,32 @@ class Recorder:
             if self.joint_active[j]:
                 # Exudyn's connector force is the spring force acting on marker 1 (child) with
                 # reversed sign; the parent's load on the child is its negative.
-                forces_joint[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.ForceLocal)
-                moments_joint[j] = mbs.GetObjectOutput(obj, exu.OutputVariableType.TorqueLocal)
+                forces_joint[j] = mbs.GetObjectOutput(obj, self._force_local)
+                moments_joint[j] = mbs.GetObjectOutput(obj, self._torque_local)
+        forces_joint, moments_joint = -forces_joint, -moments_joint
         self._joint_energies = w.joint_energy
         summary = w.summary.tolist()
         scalars = self.system.kernel.buffers.scalars.tolist()
-        row = {"time": t,
-               "contact_force_lvlh": w.force_lvlh, "contact_moment_lvlh": w.moment_lvlh,
-               "contact_force_body": w.force_body, "contact_moment_body": w.moment_body,
-               "body_com_lvlh": w.com_lvlh, "body_velocity_lvlh": w.velocity_lvlh, "body_omega_body": w.omega_body,
-               "body_to_lvlh": w.body_to_lvlh, "debris_com_lvlh": summary[0:3], "debris_velocity_lvlh": summary[3:6],
-               "joint_rotation_joint": w.joint_rotation, "joint_rate_joint": w.joint_rate,
-               "joint_force_joint": -forces_joint, "joint_moment_joint": -moments_joint}
-        e = {
-            "net_kinetic": net[0],
-            "net_elastic": scalars[THREAD_ELASTIC],
-            "net_bending": scalars[BENDING_ELASTIC],
-            "contact_elastic": scalars[CONTACT_ELASTIC],
-            "debris_translational": summary[6],
-            "debris_rotational": summary[7],
-            "joint_elastic": summary[16],
-            "released_joints": self._released_energy,
-            "orbital_potential": net[1] + summary[8] if self.assembly.mean_motion else 0.0,
-            "dissipated_threads": scalars[THREAD_DISSIPATED],
-            "dissipated_contact": scalars[CONTACT_DISSIPATED],
-        }
+        self._row[self._time_column] = t
+        view["debris_com_lvlh"][:] = summary[0:3]
+        view["debris_velocity_lvlh"][:] = summary[3:6]
+        view["joint_force_joint"][:] = forces_joint
+        view["joint_moment_joint"][:] = moments_joint
+        # the same terms in the same order as ENERGY_TERMS (the total adds them so)
+        e = [net[0], scalars[THREAD_ELASTIC], scalars[BENDING_ELASTIC], scalars[CONTACT_ELASTIC], summary[6],
+             summary[7], summary[16], self._released_energy,
+             net[1] + summary[8] if self.assembly.mean_motion else 0.0,
+             scalars[THREAD_DISSIPATED], scalars[CONTACT_DISSIPATED]]
         if self.assembly.chaser is not None:
-            e["chaser_kinetic"] = summary[9]
+            e.append(summary[9])
         if self.assembly.body_loads is not None:
-            e["applied_loads_work"] = -self._work_of_applied_loads(t, w.com_lvlh, w.velocity_lvlh, w.omega_body)
-        e["total"] = sum(e.values())
-        for key, value in e.items():
-            row["energy_" + key] = value
-        row["momentum_linear_lvlh"] = net[2:5] + w.summary[10:13]
-        row["momentum_angular_lvlh"] = net[5:8] + w.summary[13:16]
-        return row
+            e.append(-self._work_of_applied_loads(t, w.com_lvlh, w.velocity_lvlh, w.omega_body))
+        total = sum(e)
+        e.append(total)
+        self._row[self._energy_slice] = e
+        view["momentum_linear_lvlh"][:] = net[2:5] + w.summary[10:13]
+        view["momentum_angular_lvlh"][:] = net[5:8] + w.summary[13:16]
+        return total, forces_joint, moments_joint
 
     def _work_of_applied_loads(self, t, com_lvlh, velocity_lvlh, omega_body) -> float:
         """Work (J) done by the recorded loads since t = 0: the energy they bring in, which the
@@ -280,13 +338,9 @@ class Recorder:
         self._previous_body_state = (t, com_lvlh.copy(), velocity_lvlh.copy(), omega_body.copy())
         return self._applied_work
 
-    def _store(self, row):
-        """Write a row into the preallocated series (allocated at the first sample, from its shapes)."""
-        k = self._n_rows
-        if not self._series:
-            self._series = {key: np.zeros((self._capacity,) + np.shape(value)) for key, value in row.items()}
-        for key, value in row.items():
-            self._series[key][k] = value
+    def _store(self):
+        """Copy the sample's row (:attr:`_row`) into the preallocated table."""
+        self._rows[self._n_rows] = self._row
         self._n_rows += 1
 
     def finish(self, wall_time):
@@ -298,7 +352,10 @@ class Recorder:
             Wall-clock duration of the run (s).
         """
         self.wall_time = wall_time
-        self.series = {key: value[:self._n_rows].copy() for key, value in self._series.items()}
+        k = self._n_rows
+        self.series = {key: self._rows[:k, first:last].reshape((k,) + shape) for key, (first, last, shape)
+                       in self._columns.items()} if k else {}
+        self.series = {key: value.copy() for key, value in self.series.items()}
         self.net = {"time": self._net_time[:self._n_net].copy(), "positions_lvlh": self._net_positions[:self._n_net].copy(),
                     "velocities_lvlh": self._net_velocities[:self._n_net].copy(),
                     "contact_force_lvlh": self._net_contact_force[:self._n_net].copy()}

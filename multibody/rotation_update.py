@@ -75,7 +75,7 @@ class ExactRotations:
         q_next : (N,) float
             The coupled object's end-of-step coordinates (m, rad) (:func:`multibody.kernel.verlet_evaluation_state`).
         """
-        self._next = np.asarray(q_next)[self._local].copy()
+        self._next = np.asarray(q_next)[self._local]  # a gather: a new array
 
     def restore(self, mbs) -> None:
         """Write the kept rotation vectors over Exudyn's current coordinates (after the step).
@@ -89,7 +89,18 @@ class ExactRotations:
             return
         # a view of Exudyn's current coordinates: written in place (checked: the next step starts from it),
         # about 1 us against 8 for a copy set back with SetODE2Coordinates
-        q = mbs.systemData.GetODE2Coordinates(copy=False)
+        self.restore_into(mbs.systemData.GetODE2Coordinates(copy=False))
+
+    def restore_into(self, q) -> None:
+        """:meth:`restore` through a view of Exudyn's current coordinates the caller holds.
+
+        Parameters
+        ----------
+        q : (N,) float
+            Exudyn's ODE2 coordinates, a view (``GetODE2Coordinates(copy=False)``), written in place.
+        """
+        if self._next is None:
+            return
         q[self.rotation_index] = self._next
         self._next = None
 

@@ -130,25 +130,40 @@ def rotation_matrix_from_rotation_vector(rotation_vector):
     (3, 3) float
         body->reference matrix (columns: body axes in reference components, e.g. LVLH).
     """
-    x, y, z = rotation_vector[0], rotation_vector[1], rotation_vector[2]
+    out = np.empty((1, 3, 3))
+    rotation_matrix_from_rotation_vector_into(rotation_vector[0], rotation_vector[1], rotation_vector[2], out, 0)
+    return out[0]
+
+
+@njit(cache=True, inline="always")
+def rotation_matrix_from_rotation_vector_into(x, y, z, out, k):
+    """:func:`rotation_matrix_from_rotation_vector` of the rotation vector (x, y, z) (rad) into ``out[k]`` (no
+    allocation, no row view: the compiled kernels call it for every body every step).
+
+    Parameters
+    ----------
+    x, y, z : float
+        Axis times angle (rad) of the rotation body->reference.
+    out : (K, 3, 3) float
+        Output: ``out[k]`` is set to the body->reference matrix.
+    k : int
+    """
     angle2 = x * x + y * y + z * z
     if angle2 < 1e-16:
         a, b = 1.0, 0.5
     else:
         angle = math.sqrt(angle2)
         a, b = math.sin(angle) / angle, (1.0 - math.cos(angle)) / angle2
-    out = np.empty((3, 3))
     # K^2 = r r^T - |r|^2 I
-    out[0, 0] = 1.0 + b * (x * x - angle2)
-    out[1, 1] = 1.0 + b * (y * y - angle2)
-    out[2, 2] = 1.0 + b * (z * z - angle2)
-    out[0, 1] = -a * z + b * x * y
-    out[1, 0] = a * z + b * x * y
-    out[0, 2] = a * y + b * x * z
-    out[2, 0] = -a * y + b * x * z
-    out[1, 2] = -a * x + b * y * z
-    out[2, 1] = a * x + b * y * z
-    return out
+    out[k, 0, 0] = 1.0 + b * (x * x - angle2)
+    out[k, 1, 1] = 1.0 + b * (y * y - angle2)
+    out[k, 2, 2] = 1.0 + b * (z * z - angle2)
+    out[k, 0, 1] = -a * z + b * x * y
+    out[k, 1, 0] = a * z + b * x * y
+    out[k, 0, 2] = a * y + b * x * z
+    out[k, 2, 0] = -a * y + b * x * z
+    out[k, 1, 2] = -a * x + b * y * z
+    out[k, 2, 1] = a * x + b * y * z
 
 
 @njit(cache=True, inline="always")

@@ -1,0 +1,52 @@
+"""Bit-identity check of a code change: hashes of everything a reference run records.
+
+Usage: python3 bench/run_hashes.py [END_TIME]
+
+Runs the reference case (``cases/envisat_net_impact.toml``, 35 x 35, kernel path) to END_TIME (s, default 0.3) and
+prints a hash of every time series (keys and values), of the net snapshots and of Exudyn's end state, with the CPU
+time of the run. Two versions of the code that print the same hashes computed the same run to the last bit
+(docs/model.md, Speed).
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script
+from bench_impact import sized_inputs  # noqa: E402
+
+from multibody.impact import ImpactSimulation  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def digest(arrays) -> str:
+    """First 12 hex digits of the sha256 of ``arrays`` (name, array) pairs, names and bytes in order."""
+    h = hashlib.sha256()
+    for name, array in arrays:
+        h.update(name.encode())
+        h.update(np.ascontiguousarray(array).tobytes())
+    return h.hexdigest()[:12]
+
+
+def main():
+    end_time = float(sys.argv[1]) if len(sys.argv) > 1 else 0.3
+    _, inputs = sized_inputs(ROOT / "cases" / "envisat_net_impact.toml", 35, end_time, "kernel")
+    sim = ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
+    start = time.process_time()
+    recorder = sim.run()
+    cpu = time.process_time() - start
+    data = sim.system.mbs.systemData
+    state = [("q", np.array(data.GetODE2Coordinates())), ("qt", np.array(data.GetODE2Coordinates_t()))]
+    print(f"end {end_time:g} s: series {digest(recorder.series.items())} ({len(recorder.series)} keys, "
+          f"{len(recorder.series['time'])} rows), net {digest(recorder.net.items())}, bodies {digest(state)}; "
+          f"CPU {cpu:.2f} s (with compilation if the sources changed), load {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main()
