@@ -22,6 +22,7 @@ import time
 from pathlib import Path
 
 import numba
+from numba import types
 
 #: The packages that define ``@njit(cache=True)`` kernels, relative to the folder holding ``multibody``.
 COMPILED_PACKAGES = ("multibody", "perception", "riskassess/diagnosis")
@@ -138,3 +139,23 @@ def all_compiled_on_disk(dispatchers) -> bool:
         Compiled functions.
     """
     return all(compiled_on_disk(d) for d in dispatchers)
+
+
+class UnliteralStructRef(types.StructRef):
+    """Base of the project's numba structref types: field types without literal values, so one
+    compilation serves every case and run (a structref built from a case's constants would otherwise
+    be typed with those values and compile afresh for each). Subclass and register with
+    ``numba.experimental.structref.register``."""
+
+    def preprocess_fields(self, fields):
+        """Field types without literal values (numba's structref hook).
+
+        Parameters
+        ----------
+        fields : tuple of (str, numba type)
+
+        Returns
+        -------
+        tuple of (str, numba type)
+        """
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)

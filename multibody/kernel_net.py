@@ -30,11 +30,11 @@ kernel's 40 arrays as arguments cost 5-10 us in numba's dispatcher alone, a stru
 """
 from __future__ import annotations
 
-
 import numpy as np
-from numba import njit, types
+from numba import njit
 from numba.experimental import structref
 
+from multibody.jit_cache import UnliteralStructRef
 from multibody.kernel import (
     KernelData,
     coupled_forces_soa,
@@ -43,17 +43,8 @@ from multibody.kernel import (
 
 
 @structref.register
-class NetStepModelType(types.StructRef):
+class NetStepModelType(UnliteralStructRef):
     """Numba type of :class:`NetStepModel`."""
-
-    def preprocess_fields(self, fields):
-        """Field types without literal values (numba's structref hook), so one compilation serves every case.
-
-        Parameters
-        ----------
-        fields : tuple of (str, numba type)
-        """
-        return tuple((name, types.unliteral(typ)) for name, typ in fields)
 
 
 #: Fields of :class:`NetStepModel`: the groups and constants of :class:`multibody.kernel.KernelData`

@@ -10,9 +10,10 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, types
+from numba import njit
 from numba.experimental import structref
 
+from multibody.jit_cache import UnliteralStructRef
 from multibody.maths.linalg3 import matmat3, mattmat3, mattvec3, matvec3
 from multibody.maths.rotations import rotation_matrix_from_rotation_vector, rotation_vector_from_matrix_into
 
@@ -223,17 +224,8 @@ def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
 
 
 @structref.register
-class SampleModelType(types.StructRef):
+class SampleModelType(UnliteralStructRef):
     """Numba type of :class:`SampleModel`."""
-
-    def preprocess_fields(self, fields):
-        """Field types without literal values (numba's structref hook), so one compilation serves every run.
-
-        Parameters
-        ----------
-        fields : tuple of (str, numba type)
-        """
-        return tuple((name, types.unliteral(typ)) for name, typ in fields)
 
 
 class SampleModel(structref.StructRefProxy):
