@@ -8,7 +8,14 @@ import pytest
 from riskassess.products import results
 from riskassess.cases.impact import CaseError, load_model
 from riskassess.stages.identify import claim_identify_folder, simulate
-from riskassess.stages.identify_fullnet import comparison_rows, full_net_runs, identify_full_net, lower_order_case
+from riskassess.stages.identify_fullnet import (
+    comparison_rows,
+    full_net_runs,
+    held_reach,
+    identify_full_net,
+    lower_order_case,
+    not_held,
+)
 from riskassess.models.towing import towing_model
 from riskassess.cases.towing import TowingCase
 
@@ -130,3 +137,34 @@ def test_capture_start_runs_each_start_from_their_own_state(tmp_path):
     run = answer["runs"]["pso+pattern"]
     # as for the wrapped stand-in (measured there for seeds 0-4: 2.7e-3): s1-s3 within 1 %
     np.testing.assert_allclose(run["s"][:3], truth[:3], rtol=1e-2)
+
+
+def test_held_reach_is_the_tether_chain_net_and_debris_end_to_end():
+    """cases/zenit2_towing.toml: main tether 15 m, sub-tether 7 m (Table 1), net side 22 m (Sec. 4.1),
+    debris length 11 m: 55 m end to end, exactly."""
+    assert held_reach(load_model(CASE, TowingCase)) == pytest.approx(55.0, abs=1e-12)
+
+
+def test_a_run_whose_debris_left_is_named_and_a_held_one_is_not():
+    """The separation is the norm of r_D/C: a 3-4-12 triangle scaled gives exactly 13 k m."""
+    direction = np.array([3.0, 4.0, 12.0])
+    held = {"rate_deg_s": 20.44, "relative_position": np.outer(np.linspace(1.0, 4.0, 50), direction)}   # to 52 m
+    left = {"rate_deg_s": 28.25, "relative_position": np.outer(np.linspace(1.0, 300.0, 50), direction)}  # to 3900 m
+    assert not_held(held, 55.0) is None
+    why = not_held(left, 55.0)
+    assert why["rate_deg_s"] == 28.25 and why["largest_separation_m"] == pytest.approx(3900.0, rel=1e-12)
+    assert why["reach_m"] == 55.0 and "not held" in why["reason"]
+
+
+def test_identification_refuses_when_no_training_debris_was_held(tmp_path):
+    """A training run whose debris left (its stand-in relative position scaled 1000x: kilometres, as the
+    failed captures at 28.25 and 29.01 deg/s in docs/towing.md) leaves nothing to identify on: a clear
+    error naming the rate, before any optimizer runs."""
+    case = _small_case("f2", swarm_size=4, pso_generations=1, polish_evaluations=0)
+    _stand_in_full_net_runs(case, tmp_path)
+    name = tmp_path / f"fullnet/rate_{case.rates.training_deg_s[0]:.2f}_end_{END:g}.npz"
+    run = dict(np.load(name))
+    run["relative_position"] = 1000.0 * run["relative_position"]
+    results.atomic_write_npz(name, run)
+    with pytest.raises(CaseError, match=r"20\.44 deg/s: debris not held"):
+        identify_full_net(CASE, tmp_path, case, optimizers=["pso"], overwrite=True)
