@@ -313,12 +313,15 @@ def _cmd_identify(args) -> int:
         print(json.dumps(answer, indent=2))
         return 0
     for name, run in answer["runs"].items():
+        valid = run.get("validation_totals")
         against = (f"max relative error {max(run['relative_error']):.2e}" if args.benchmark else
-                   f"validation f1 {run['validation_totals']['f1']:.4g}, f2 {run['validation_totals']['f2']:.4g}")
+                   f"validation f1 {valid['f1']:.4g}, f2 {valid['f2']:.4g}" if valid else "no validation run held")
         print(f"{name:12s} s = {', '.join(f'{x:.6f}' for x in run['s'])}  cost {answer['cost_function']} {run['cost']:.4g}  "
               f"{against}  {run['evaluations']} evaluations, {run['wall_s']:.0f} s")
     if args.benchmark:
         print(f"{'truth':12s} s = {', '.join(f'{x:.6f}' for x in answer['truth'])}")
+    for why in answer.get("excluded_runs", []):
+        print(f"left out: {why['rate_deg_s']:g} deg/s: {why['reason']}")
     print(f"results: {out}")
     return 0
 

@@ -225,8 +225,11 @@ def comparison_rows(case: TowingCase, s, data: list[dict], end) -> list[dict]:
     return rows
 
 
-def _totals(rows: list[dict]) -> dict:
-    """Sums of f1 and f2 over the runs (eqs. 18, 20) and the mean RMSE of each channel."""
+def _totals(rows: list[dict]) -> dict | None:
+    """Sums of f1 and f2 over the runs (eqs. 18, 20) and the mean RMSE of each channel; None without runs
+    (every validation run left out as not held: no score, rather than a sum of 0 that reads as perfect)."""
+    if not rows:
+        return None
     return {"f1": sum(r["f1"] for r in rows), "f2": sum(r["f2"] for r in rows),
             **{f"mean_rmse_{c}": float(np.mean([r[f"rmse_{c}"] for r in rows])) for c in CHANNELS}}
 
