@@ -19,16 +19,25 @@ depend on the LiDAR noise (``perception.seed``) nor on the tracker (``perception
 simulated once per case and observation time and replayed for the other seeds and models
 (``--simulate-each`` simulates every run; the figures are the same).
 
+``--save DIR`` writes each run's answer (perception.json, with the process CPU time of the run and
+the load average before and after) to ``DIR/<model>_obs<observation>_seed<seed>.json`` as it comes,
+and skips a run whose file is already there: a long bench resumes where it stopped. ``--table DIR``
+prints the per-run blocks and the side-by-side table from the saved answers, running nothing.
+
 The paper (D2D-NDT, 300 s of data): 110 ms/frame, mass error < 0.72 %, principal moments < 0.59 %.
 """
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import tempfile
+import time
 import tomllib
 from pathlib import Path
 
 from riskassess.cases.impact import validate_case
+from riskassess.products.results import atomic_write_json
 from riskassess.stages import perceive
 from riskassess.stages.perceive import perceive_case
 
@@ -70,7 +79,14 @@ def main():
                         help="perception.model values; default: the case's")
     parser.add_argument("--simulate-each", action="store_true",
                         help="simulate the collision in every run (default: once per observation time)")
+    parser.add_argument("--save", type=Path, default=None,
+                        help="folder: write each answer as it comes, skip runs already saved there")
+    parser.add_argument("--table", type=Path, default=None,
+                        help="folder of saved answers: print the blocks and the table, run nothing")
     args = parser.parse_args()
+    if args.table is not None:
+        print_saved(args.table)
+        return
     if not args.simulate_each:
         reuse_collision_runs()
     path = Path(args.case)
@@ -81,7 +97,14 @@ def main():
         for observation in args.observation or [raw["perception"]["observation_time"]]:
             for seed in args.seeds or [raw["perception"]["seed"]]:
                 raw["perception"].update(observation_time=observation, seed=seed, model=model)
-                a = _run(path, raw)
+                saved = args.save / f"{model}_obs{observation:g}_seed{seed}.json" if args.save else None
+                if saved is not None and saved.exists():
+                    a = json.loads(saved.read_text())
+                    print(f"\n(seed {seed}, model '{model}', {observation:g} s: saved in {saved})")
+                else:
+                    a = _run(path, raw)
+                    if saved is not None:
+                        _save(saved, a)
                 answers.append((model, observation, a))
                 _report(a, observation, seed)
                 errors = a.get("principal_moments_error_percent") or [float("inf")]   # not observable
@@ -177,14 +200,38 @@ def side_by_side(answers) -> str:
 
 
 def _run(path, raw) -> dict:
+    load_before, cpu = os.getloadavg()[0], time.process_time()
     with tempfile.TemporaryDirectory() as out:
-        return perceive_case(path, out, case=validate_case(raw, path))
+        answer = perceive_case(path, out, case=validate_case(raw, path))
+    answer["bench_cpu_s"] = time.process_time() - cpu
+    answer["bench_load"] = [load_before, os.getloadavg()[0]]
+    answer["bench_seed"] = raw["perception"]["seed"]
+    answer["bench_observation_s"] = raw["perception"]["observation_time"]
+    return answer
+
+
+def _save(path, answer):
+    """Write one run's answer atomically (the project's JSON writer: numpy values as numbers)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_json(path, answer)
+
+
+def print_saved(folder):
+    """Print the per-run blocks and the side-by-side table of the answers saved in ``folder``."""
+    answers = []
+    for path in sorted(folder.glob("*_seed*.json")):
+        a = json.loads(path.read_text())
+        _report(a, a["bench_observation_s"], a["bench_seed"])
+        answers.append((a["perception_model"], a["bench_observation_s"], a))
+    print()
+    print(side_by_side(answers))
 
 
 def _report(a, observation, seed):
     track = a["tracking"]
     print(f"\n== model '{a['perception_model']}', observation {observation:g} s before the collision, seed {seed} "
-          f"({a['wall_s']:.0f} s wall) ==")
+          f"({a['wall_s']:.0f} s wall, {a.get('bench_cpu_s', float('nan')):.0f} s CPU, load "
+          f"{'-'.join(f'{x:.1f}' for x in a.get('bench_load', []))}) ==")
     print(f"registration: {a['registration_ms_per_frame']:.1f} ms/frame mean, {a['registration_ms_p95']:.1f} ms p95 "
           f"(observation), first frame {a['first_frame_search_s']:.2f} s, collision frames "
           f"{a['collision_registration_ms_per_frame']:.0f} ms/frame mean; ray casting {a['ray_casting_ms_per_frame']:.1f} ms/frame")
