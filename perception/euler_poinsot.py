@@ -174,6 +174,7 @@ class TorqueFreeFit:
     moments_ : (3,) float           [A/C, B/C, 1], normalized principal moments (Tang et al. 2023, eq. 19).
     principal_to_body_ : (3, 3)     T->B.
     omega0_principal_ : (3,) float  Rate at ``times[0]`` (rad/s), principal frame.
+    time0_ : float                  ``times[0]`` (s), the time of the fitted initial state.
     principal_to_world0_ : (3, 3)   T->W at ``times[0]``.
     residual_rms_ : float           Weighted RMS of the attitude residuals (-; 1 when the weights are right).
     covariance_ : (p, p) float      Parameter covariance (J^T J)^-1 scaled by the residual variance
@@ -279,6 +280,7 @@ class TorqueFreeFit:
                 break
             span *= 2.0
         self._p = result.x
+        self.time0_ = float(times[0])
         t2w, omega, moments, t2b = self._unpack(result.x)
         self.moments_, self.principal_to_body_ = moments, t2b
         self.omega0_principal_, self.principal_to_world0_ = omega, t2w.as_matrix()
@@ -290,6 +292,25 @@ class TorqueFreeFit:
         self.correlation_time_ = integrated_autocorrelation_time(result.fun.reshape(-1, 3))
         self.covariance_ = np.linalg.pinv(jac.T @ jac) * self.residual_rms_**2 * self.correlation_time_
         return self
+
+    def rate_body_at(self, time) -> np.ndarray:
+        """Angular velocity (3,) (rad/s, body frame B) of the fitted motion at ``time`` (s, not before
+        the fit's first time).
+
+        Parameters
+        ----------
+        time : float
+            Time (s) on the clock of the ``times`` given to :meth:`fit`, at or after ``times[0]``.
+
+        Returns
+        -------
+        (3,) float
+            The rate (rad/s, body frame B).
+        """
+        t2w, omega, moments, t2b = self._unpack(self._p)
+        _, omegas = propagate_torque_free(t2w.as_quat()[[3, 0, 1, 2]], omega, moments,
+                                          np.array([self.time0_, max(float(time), self.time0_)]), self.max_step)
+        return t2b @ omegas[-1]
 
     def spin_momentum_per_c(self) -> tuple[np.ndarray, np.ndarray]:
         """The fitted motion's spin angular momentum per unit C, h = R_T->W diag(J1, J2, 1) omega_T

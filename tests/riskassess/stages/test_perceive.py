@@ -8,6 +8,7 @@ import pytest
 
 from riskassess.cases.impact import load_case
 from riskassess.cli import main
+from riskassess.stages.perceive import _name_budget_cuts
 
 CASE = Path(__file__).parents[3] / "cases" / "tang2023_debris_perception.toml"
 
@@ -137,3 +138,20 @@ def test_model_free_tracking_of_the_smooth_ellipsoid_is_refused(tmp_path, capsys
     assert answer["perception_model"] == "none" and answer["body_frame"] == "first_scan"
     assert "model-free track does not determine the tumble" in answer["not_observable"]
     assert "inertia_ratios" not in answer and "mass_estimate" not in answer
+
+
+def test_not_observable_names_the_collision_frames_the_search_budget_cut():
+    # The message reads the count from the answer's search_budget figures (one count): 2 of the 3
+    # frames cut are collision frames (phase 1); an answer with estimates, or with no collision frame
+    # cut, is left as it is.
+    budget = {"frames_not_registered_phases": [0, 1, 1]}
+    answer = {"not_observable": "after the collision: only 5 registered frames of free flight", "search_budget": budget}
+    _name_budget_cuts(answer)
+    assert answer["not_observable"].endswith("(2 collision frames not registered: the search budget of "
+                                             "perception.registration was spent)")
+    answered = {"not_observable": None, "search_budget": budget}
+    _name_budget_cuts(answered)
+    assert answered["not_observable"] is None
+    uncut = {"not_observable": "after the collision: x", "search_budget": {"frames_not_registered_phases": [0]}}
+    _name_budget_cuts(uncut)
+    assert uncut["not_observable"] == "after the collision: x"
