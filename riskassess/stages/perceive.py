@@ -49,7 +49,7 @@ from perception.model_mismatch import CHECK_EVERY, ModelCheck, SurfaceDistance, 
 from perception.motion import NotObservable
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
 from perception.pointing import Pointing, debris_blob
-from perception.registration import MIN_POINTS, DebrisTracker, known_shape_model
+from perception.registration import MAP_LATERAL_BINS, MIN_POINTS, DebrisTracker, known_shape_model
 from perception.scan_to_map import alignments as map_alignments, track_scans
 from perception.shape import half_turn_symmetry_transforms, rotation_error
 from riskassess.products import results
@@ -408,7 +408,7 @@ def track_model_free(scene: Scene, frames: Frames):
     # No registered frame (e.g. empty scans): no map; the fits below answer "not observable".
     tracker = DebrisTracker(reg.voxel, reg.max_correspondence, reg.model_frames,
                             *((track.map_points, track.map_normals) if track.ok.any() else ()), seed=p.seed,
-                            **_search_budget(reg))
+                            free_space_lateral_bins=MAP_LATERAL_BINS, **_search_budget(reg))
     tracker.alignments = map_alignments(track, frames.time)
     target_to_body = np.eye(4)
     if track.ok.any():
