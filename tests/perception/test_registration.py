@@ -5,7 +5,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from perception.lidar import cast
-from perception.registration import Alignment, DebrisTracker, _cloud, known_shape_model
+from perception.registration import Alignment, DebrisTracker, _cloud, free_space_violation, known_shape_model
 from perception.shape import half_turn_symmetry_transforms
 
 SENSOR = np.zeros(3)
@@ -229,3 +229,23 @@ def test_tracked_frames_go_on_when_the_search_budget_is_spent(paper_ellipsoid, c
     assert frame.ok and not frame.over_budget and not frame.searched
     assert _attitude_error(frame, truth[2]) < np.radians(4.0)
     assert tracker.search_cpu_spent == 0.0
+
+
+def _wall(x, y_from, y_to, spacing=0.01):
+    """Returns on a wall facing the sensor at the origin: x = const (m), y in [y_from, y_to), |z| < 0.2 m."""
+    y, z = np.meshgrid(np.arange(y_from, y_to, spacing), np.arange(-0.2, 0.2, spacing))
+    return np.column_stack([np.full(y.size, x), y.ravel(), z.ravel()])
+
+
+def test_lateral_bins_forgive_a_silhouette_off_by_one_bin_not_a_body_in_free_space():
+    # A foreground wall at 5 m (y < 0.5 m) and the background at 6 m beside it, seen from the origin;
+    # bins of 0.01 rad (5 cm at 5 m), margin 5 cm. A model point on the foreground's plane 2 cm beyond
+    # its edge lies in a background bin, 1 m in front of that bin's nearest return: with its own bin
+    # alone it blocks; its neighbour bin holds the foreground's edge at its own depth, so with one bin
+    # about it it does not. A model point 0.4 m beyond the edge (8 bins) blocks either way.
+    returns = np.vstack([_wall(5.0, -0.5, 0.5), _wall(6.0, 0.5, 1.5)])
+    edge, beyond = np.array([[5.0, 0.52, 0.0]]), np.array([[5.0, 0.9, 0.0]])
+    sensor = np.zeros(3)
+    share = lambda model, lateral: free_space_violation(returns, model, sensor, 0.01, 0.05, lateral_bins=lateral)
+    assert share(edge, 0) > 0 and share(edge, 1) == 0.0
+    assert share(beyond, 0) > 0 and share(beyond, 1) > 0
