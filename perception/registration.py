@@ -86,9 +86,9 @@ MIN_POINTS = 50                    # thinned scan points below which a frame is 
 #: space only if it lies in front of the nearest returns of its own viewing bin and of the 8 bins about
 #: it (free_space_violation's lateral_bins): a silhouette off by up to one bin (2 voxels, 6 cm at any
 #: range) is the map's own error, not free space. On the featured debris' collision frames (0.6-6.1 s,
-#: 1.5-16 m) the true pose violated 0.055-0.096 on 15 of 56 frames beyond 11 m (limit 0.05), all of it
-#: model points at grazing incidence on the silhouette, 10-32 cm in front of the background return of
-#: their bin; the map's points lie 1.7 cm (median), 4.4 cm (p90) off the true surface. With one bin the
+#: 1.5-16 m) the true pose violated 0.055-0.076 on 11 of 56 frames, all at 11-16 m (limit 0.05; ICP from
+#: it up to 0.096 on 14), the violating model points at grazing incidence on the silhouette, 10-32 cm in
+#: front of the background return of their bin; the map's points lie 1.7 cm (median), 4.4 cm (p90) off the true surface. With one bin the
 #: truth scores 0.000 on every frame (docs/perception.md, "Why the near-truth poses were rejected").
 MAP_LATERAL_BINS = 1
 MAX_UNSEEN = 0.02  # share of the posed model's viewing directions inside the field of view with no return near them
@@ -296,9 +296,11 @@ def free_space_violation(points_world, model_world, sensor_world, bin_angle, mar
     seen_bin, nearest = scan_bin[order][first], scan_range[order][first]
     slot = np.clip(np.searchsorted(seen_bin, model_bin), 0, len(seen_bin) - 1)
     seen = np.where(seen_bin[slot] == model_bin, nearest[slot], np.inf)
-    neighbours = np.full(len(model_bin), np.inf)
+    neighbours = seen.copy()   # the nearest return over the bin and the bins about it
     for up in range(-lateral_bins, lateral_bins + 1):
         for side in range(-lateral_bins, lateral_bins + 1):
+            if up == 0 and side == 0:
+                continue
             key = model_bin + up * 1_000_003 + side
             slot = np.clip(np.searchsorted(seen_bin, key), 0, len(seen_bin) - 1)
             neighbours = np.minimum(neighbours, np.where(seen_bin[slot] == key, nearest[slot], np.inf))
