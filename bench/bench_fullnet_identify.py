@@ -12,7 +12,9 @@ The full-net runs (the first N training and validation rates of Table 3, to T) a
 copy an identify folder's ``fullnet/*.npz`` there to reuse them. MADS runs from the case's s0 and/or from each
 Table 6 initial guess (MADS 1-5, as the paper's Sec. 4.4); the pattern search from s0; PSO with the case's seed,
 then the polish. Every answer is kept in ``DIR/results.json`` as soon as it is found (a re-run skips those
-done, for the same runs and settings); ``--table-only`` prints the tables from it. CPU time counts this
+done, for the same held runs and settings); ``--table-only`` prints the tables from it. As ``riskassess identify``
+does, a run whose debris was not held (a failed capture, :func:`riskassess.stages.identify_fullnet.not_held`) is
+left out of training and validation and named in each answer's ``excluded_runs``. CPU time counts this
 process and its worker processes (the machine may be shared; wall times are printed with the load average).
 """
 from __future__ import annotations
@@ -28,7 +30,7 @@ from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.products import results
 from riskassess.stages.identify import run_optimizers
-from riskassess.stages.identify_fullnet import _entry, full_net_runs, lower_order_case
+from riskassess.stages.identify_fullnet import _entry, full_net_runs, held_runs, lower_order_case
 sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
 from bench_identify import TABLE6_INITIAL_GUESSES  # noqa: E402
 
@@ -72,13 +74,12 @@ def searches(optimizers, mads_starts, s0):
     return out
 
 
-def run_one(case: TowingCase, data, label, name, guess, cost, workers, end) -> dict:
-    """One search on the training runs and the identified model's scores; returns the entries per reported
-    optimizer ('pso' gives 'pso' and 'pso+pattern'; ``wall_s`` is each one's own, ``cpu_s`` the whole search's)."""
+def run_one(case: TowingCase, train, valid, label, name, guess, cost, workers, end) -> dict:
+    """One search on the (held) training runs and the identified model's scores on the training and the
+    (held) validation runs; returns the entries per reported optimizer ('pso' gives 'pso' and 'pso+pattern';
+    ``wall_s`` is each one's own, ``cpu_s`` the whole search's)."""
     ident = case.identification.model_copy(update=dict(cost=cost, initial_guess=guess, workers=workers))
-    lower = lower_order_case(case.model_copy(update=dict(identification=ident)), data[0])
-    n_train = case.full_net.identification_training_runs
-    train, valid = data[:n_train], data[n_train:]
+    lower = lower_order_case(case.model_copy(update=dict(identification=ident)), train[0])
     cpu, wall, load = cpu_seconds(), time.perf_counter(), os.getloadavg()[0]
     found = run_optimizers(lower, train, (name,), end_time=end, workers=workers)
     cpu, wall = cpu_seconds() - cpu, time.perf_counter() - wall
@@ -103,9 +104,12 @@ def print_tables(done: dict) -> None:
         nt, nv = len(entry["training"]), len(entry["validation"])
         tr, va = entry["training_totals"], entry["validation_totals"]
         s = entry["s"]
-        print(f"| {start}, {nt}+{nv} to {entry['end_s']:g} s | {cost} | {label} | {s[0]:.4f} | {s[1]:.4f} | "
+        left = len(entry.get("excluded_runs", []))
+        runs = f"{nt}+{nv}" + (f" held ({left} left out)" if left else "")
+        valid = (f"{va['f1'] / nv:.3f} | {va['f2'] / nv:.1f}" if va else "no validation run held | -")
+        print(f"| {start}, {runs} to {entry['end_s']:g} s | {cost} | {label} | {s[0]:.4f} | {s[1]:.4f} | "
               f"{s[2]:.4f} | {s[3]:.4f} | {entry['evaluations']} | {entry['cpu_s']:.0f} | {tr['f1'] / nt:.3f} | "
-              f"{tr['f2'] / nt:.1f} | {va['f1'] / nv:.3f} | {va['f2'] / nv:.1f} |")
+              f"{tr['f2'] / nt:.1f} | {valid} |")
     for cost, rows in PAPER.items():
         for label, (train, valid) in rows.items():
             f1 = (f"{train / PAPER_RUNS:.3f}", f"{valid / PAPER_RUNS:.3f}") if cost == "f1" else ("-", "-")
@@ -144,17 +148,24 @@ def main():
         print(f"{start}: {len(rates)} full-net runs to {args.end:g} s ready in {time.perf_counter() - wall:.0f} s wall "
               f"(load average {load:.1f} -> {os.getloadavg()[0]:.1f}; cached runs took "
               f"{sum(d['wall_s'] for d in data):.0f} s of solver wall time)", flush=True)
+        # the same rule as 'riskassess identify': a run whose debris was not held is left out and named
+        train, valid, excluded = held_runs(run_case, data, min(args.training, len(case.rates.training_deg_s)))
+        for why in excluded:
+            print(f"  left out {why['rate_deg_s']:g} deg/s: {why['reason']}", flush=True)
+        held = [float(r["rate_deg_s"]) for r in train + valid]
         for cost in args.cost:
             for label, name, guess in searches(args.optimizers, args.mads_starts, case.identification.initial_guess):
                 key = f"{start}|{cost}|{label}"
-                if key in done and done[key]["rates"] == rates and done[key]["end_s"] == args.end:
+                if key in done and done[key]["rates"] == held and done[key]["end_s"] == args.end:
                     continue
-                for reported, entry in run_one(run_case, data, label, name, guess, cost, args.workers, args.end).items():
-                    entry.update(rates=rates, end_s=args.end)
+                for reported, entry in run_one(run_case, train, valid, label, name, guess, cost, args.workers,
+                                               args.end).items():
+                    entry.update(rates=held, end_s=args.end, excluded_runs=excluded)
                     done[f"{start}|{cost}|{reported}"] = entry
                     tr, va = entry["training_totals"], entry["validation_totals"]
+                    scored = f"validation f1 {va['f1']:.3f} f2 {va['f2']:.1f}" if va else "no validation run held"
                     print(f"  {start} {cost} {reported:12s} s = {[round(v, 4) for v in entry['s']]} training f1 "
-                          f"{tr['f1']:.3f} f2 {tr['f2']:.1f}, validation f1 {va['f1']:.3f} f2 {va['f2']:.1f}; "
+                          f"{tr['f1']:.3f} f2 {tr['f2']:.1f}, {scored}; "
                           f"{entry['evaluations']} evaluations, {entry['cpu_s']:.0f} s CPU, {entry['wall_s']:.0f} s wall "
                           f"(load {entry['load_before']:.1f} -> {entry['load_after']:.1f})", flush=True)
                 results.atomic_write_json(store, done)

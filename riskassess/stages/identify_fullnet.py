@@ -176,6 +176,40 @@ def not_held(run: dict, reach: float) -> dict | None:
                       f"the net and the debris can span (a failed capture)"}
 
 
+def held_runs(case: TowingCase, data: list[dict], n_training: int) -> tuple[list[dict], list[dict], list[dict]]:
+    """The training and validation runs whose debris was held (:func:`not_held`), and why each other run was
+    left out.
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with a ``[full_net]`` table.
+    data : list of dict
+        The full-net runs (:func:`full_net_runs`), the training runs first.
+    n_training : int
+        How many of ``data`` are training runs.
+
+    Returns
+    -------
+    training, validation, excluded : list of dict
+        The held training and validation runs, and :func:`not_held`'s answer for every run left out.
+
+    Raises
+    ------
+    CaseError
+        When no training run is left, naming every left-out rate and why.
+    """
+    reach = held_reach(case)
+    excluded = [why for why in (not_held(run, reach) for run in data) if why is not None]
+    left_out = {why["rate_deg_s"] for why in excluded}
+    train = [run for run in data[:n_training] if float(run["rate_deg_s"]) not in left_out]
+    valid = [run for run in data[n_training:] if float(run["rate_deg_s"]) not in left_out]
+    if not train:
+        raise CaseError(f"{case.name}: every training run's debris was not held, nothing to identify on: "
+                        + "; ".join(f"{w['rate_deg_s']:g} deg/s: {w['reason']}" for w in excluded))
+    return train, valid, excluded
+
+
 def lower_order_case(case: TowingCase, run: dict) -> TowingCase:
     """The case whose lower-order runs start from the full-net start state (module doc, item 2).
 
@@ -291,14 +325,7 @@ def _identify(case: TowingCase, folder: OutputFolder, optimizers) -> dict:
     data = full_net_runs(case, list(training) + list(validation), out, end, case.identification.workers,
                          record=folder.add_files)
     data_wall = time.perf_counter() - start
-    reach = held_reach(case)
-    excluded = [why for why in (not_held(run, reach) for run in data) if why is not None]
-    left_out = {why["rate_deg_s"] for why in excluded}
-    train = [run for run in data[:len(training)] if float(run["rate_deg_s"]) not in left_out]
-    valid = [run for run in data[len(training):] if float(run["rate_deg_s"]) not in left_out]
-    if not train:
-        raise CaseError(f"{case.name}: every training run's debris was not held, nothing to identify on: "
-                        + "; ".join(f"{w['rate_deg_s']:g} deg/s: {w['reason']}" for w in excluded))
+    train, valid, excluded = held_runs(case, data, len(training))
     lower = lower_order_case(case, train[0])
     runs = {name: _entry(lower, found, train, valid, end)
             for name, found in run_optimizers(lower, train, optimizers, end_time=end).items()}
