@@ -6,6 +6,7 @@ from the capture start, each identified model scored on the training and the uns
     python bench/bench_fullnet_identify.py --out DIR [--case cases/zenit2_towing.toml]
         [--starts wrapped capture] [--training N] [--validation N] [--end T]
         [--optimizers pso pattern mads] [--cost f1 f2] [--mads-starts s0 table6] [--workers N] [--table-only]
+        [--rescore]
 
 The full-net runs (the first N training and validation rates of Table 3, to T) are cached in
 ``DIR/<start>/fullnet/rate_<deg_s>_end_<T>[_capture].npz``, the same files ``riskassess identify`` writes:
@@ -30,7 +31,8 @@ from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.products import results
 from riskassess.stages.identify import run_optimizers
-from riskassess.stages.identify_fullnet import _entry, full_net_runs, held_runs, lower_order_case
+from riskassess.stages.identify_fullnet import (_entry, _totals, comparison_rows, full_net_runs, held_runs,
+                                                lower_order_case)
 sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
 from bench_identify import TABLE6_INITIAL_GUESSES  # noqa: E402
 
@@ -93,9 +95,31 @@ def run_one(case: TowingCase, train, valid, label, name, guess, cost, workers, e
     return out
 
 
+def rescore(case: TowingCase, done: dict, start: str, train, valid, held, end) -> None:
+    """Every answer in ``done`` of ``start`` on these held runs (same rates and end) compared again with
+    today's :func:`comparison_rows` (its training and validation rows and totals replaced; s, evaluations and
+    CPU kept)."""
+    for key, entry in done.items():
+        if key.split("|")[0] != start or entry["rates"] != held or entry["end_s"] != end:
+            continue
+        lower = lower_order_case(case, train[0])
+        rows = {role: comparison_rows(lower, entry["s"], runs, end) for role, runs in (("training", train),
+                                                                                        ("validation", valid))}
+        entry.update(training=rows["training"], validation=rows["validation"],
+                     training_totals=_totals(rows["training"]), validation_totals=_totals(rows["validation"]))
+        print(f"  rescored {key}", flush=True)
+
+
+def free_roll(totals: dict, n: int) -> str:
+    """' (x.xxx)': f1 per run with omega_D compared blind to a roll about the debris' symmetry axis (the
+    diagnostic of identify_fullnet.comparison_rows), or '' when not computed."""
+    return f" ({totals['f1_free_roll'] / n:.3f})" if "f1_free_roll" in totals else ""
+
+
 def print_tables(done: dict) -> None:
-    """Markdown rows: per start and cost, every search's s, evaluations, training and validation f1, f2 per run,
-    then the paper's per-run values of the same cost."""
+    """Markdown rows: per start and cost, every search's s, evaluations, training and validation f1, f2 per run
+    (f1 in brackets: omega_D compared blind to a roll about the debris' symmetry axis, when computed), then the
+    paper's per-run values of the same cost."""
     print("\n| start, runs | cost | optimizer | s1 | s2 (m) | s3 | s4 | evaluations | CPU (s) | training f1 / run "
           "| training f2 / run (N) | validation f1 / run | validation f2 / run (N) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -106,10 +130,10 @@ def print_tables(done: dict) -> None:
         s = entry["s"]
         left = len(entry.get("excluded_runs", []))
         runs = f"{nt}+{nv}" + (f" held ({left} left out)" if left else "")
-        valid = (f"{va['f1'] / nv:.3f} | {va['f2'] / nv:.1f}" if va else "no validation run held | -")
+        valid = (f"{va['f1'] / nv:.3f}{free_roll(va, nv)} | {va['f2'] / nv:.1f}" if va else "no validation run held | -")
         print(f"| {start}, {runs} to {entry['end_s']:g} s | {cost} | {label} | {s[0]:.4f} | {s[1]:.4f} | "
-              f"{s[2]:.4f} | {s[3]:.4f} | {entry['evaluations']} | {entry['cpu_s']:.0f} | {tr['f1'] / nt:.3f} | "
-              f"{tr['f2'] / nt:.1f} | {valid} |")
+              f"{s[2]:.4f} | {s[3]:.4f} | {entry['evaluations']} | {entry['cpu_s']:.0f} | {tr['f1'] / nt:.3f}"
+              f"{free_roll(tr, nt)} | {tr['f2'] / nt:.1f} | {valid} |")
     for cost, rows in PAPER.items():
         for label, (train, valid) in rows.items():
             f1 = (f"{train / PAPER_RUNS:.3f}", f"{valid / PAPER_RUNS:.3f}") if cost == "f1" else ("-", "-")
@@ -130,6 +154,9 @@ def main():
     parser.add_argument("--mads-starts", nargs="+", default=["s0", "table6"], choices=["s0", "table6"])
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--table-only", action="store_true", help="print the tables of DIR/results.json")
+    parser.add_argument("--rescore", action="store_true",
+                        help="score every answer of DIR/results.json for these runs again with today's comparison "
+                             "(no search; e.g. to add a diagnostic column)")
     args = parser.parse_args()
     out = Path(args.out)
     store = out / "results.json"
@@ -153,6 +180,10 @@ def main():
         for why in excluded:
             print(f"  left out {why['rate_deg_s']:g} deg/s: {why['reason']}", flush=True)
         held = [float(r["rate_deg_s"]) for r in train + valid]
+        if args.rescore:
+            rescore(run_case, done, start, train, valid, held, args.end)
+            results.atomic_write_json(store, done)
+            continue
         for cost in args.cost:
             for label, name, guess in searches(args.optimizers, args.mads_starts, case.identification.initial_guess):
                 key = f"{start}|{cost}|{label}"

@@ -185,3 +185,24 @@ def test_held_runs_keep_the_order_and_leave_out_each_failed_capture_by_its_role(
     assert [r["rate_deg_s"] for r in train] == [9.60] and [r["rate_deg_s"] for r in valid] == [26.29]
     assert [w["rate_deg_s"] for w in excluded] == [28.25, 29.01]
     assert excluded[0]["largest_separation_m"] == pytest.approx(3903.7, rel=1e-12)
+
+
+def test_roll_about_the_symmetry_axis_is_seen_by_the_body_frame_rmse_and_not_by_the_roll_free_one():
+    """omega_D of 0.3 rad/s turned within the body x-y plane by phi(t) = 0..pi (a roll about z, the Zenit-2's
+    symmetry axis) against one fixed along -y: the body-frame RMSE is the RMS of the chord 2 |w| sin(phi / 2),
+    sqrt(2) |w| for phi uniform in [0, pi] (the mean of 4 sin^2(phi / 2) there is 2); the roll-free RMSE is 0
+    to round-off; an axial difference of 0.01 rad/s is seen in full."""
+    from riskassess.stages.identify import rmse, rmse_free_roll, symmetry_axis_body
+
+    axis = symmetry_axis_body(load_model(CASE, TowingCase).debris.principal_inertia)
+    np.testing.assert_array_equal(axis, [0.0, 0.0, 1.0])   # Table 1: J_D = diag(94880, 94880, 46295.5)
+    phi = np.linspace(0.0, np.pi, 1001)
+    data = 0.3 * np.column_stack([np.sin(phi), -np.cos(phi), np.zeros_like(phi)])
+    model = np.tile([0.0, -0.3, 0.0], (len(phi), 1))
+    chord = 2 * 0.3 * np.sin(phi / 2)
+    assert rmse(model, data) == pytest.approx(np.sqrt(np.mean(chord**2)), rel=1e-12)
+    assert rmse(model, data) == pytest.approx(0.3 * np.sqrt(2.0), rel=1e-9)   # the samples are symmetric about pi/2
+    assert rmse_free_roll(model, data, axis) < 1e-15
+    model_axial = model + [0.0, 0.0, 0.01]
+    assert rmse_free_roll(model_axial, data, axis) == pytest.approx(0.01, rel=1e-9)
+    assert symmetry_axis_body([1.0, 2.0, 3.0]) is None and symmetry_axis_body([2.0, 2.0, 2.0]) is None
