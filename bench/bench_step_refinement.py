@@ -3,7 +3,7 @@ And which part of a joint's reaction carries the peak: its springs (the elastic 
 
     python3 bench/bench_step_refinement.py [CASE] [--replicas R] [--end-time T] [--steps 1e-4,5e-5,2.5e-5]
         [--first-mode HZ] [--member JOINT:LENGTH ...] [--output-rate HZ] [--edge-margin S] [--cache DIR]
-        [--report-only] [--history LOCATION] [--window-end T]
+        [--report-only] [--history LOCATION] [--window-end T] [--judged]
 
 The case (default ``cases/envisat_small.toml``, release off) is built as ``bench_peak_convergence.py`` builds
 it (``--first-mode`` on every numerical joint, ``--member`` on the Ka-band joints, ``--output-rate``), and each
@@ -143,6 +143,20 @@ def report(runs: dict, steps: list, replicas: int, locations, in_dynamics: set, 
                           + " ".join(f"{x:.3g}" for x in d[around]))
 
 
+def judged_comparison(runs: dict, steps: list, replicas: int, locations, in_dynamics: set, skip: float) -> None:
+    """Per location and step: the judged peak (t >= ``skip``) as recorded and from the springs alone, median
+    over the replicas, and their ratio: how much of a judged peak the joints' dashpots carry."""
+    print(f"\n=== judged window (t >= {skip:g} s): median peak as recorded, springs alone, ratio (median over replicas)")
+    for h in steps:
+        rec = [demands(locations, runs[(h, r)], False, in_dynamics) for r in range(replicas)]
+        ela = [demands(locations, runs[(h, r)], True, in_dynamics) for r in range(replicas)]
+        for key in rec[0]:
+            pr, pe = ([float(d[key][runs[(h, r)]["time"] >= skip].max()) for r, d in enumerate(x)] for x in (rec, ela))
+            ratio = np.median(np.array(pe) / np.array(pr))
+            print(f"  step {h:g}  {key:36s} recorded {np.median(pr):.4g}  springs alone {np.median(pe):.4g}  "
+                  f"ratio {ratio:.3f} [{min(np.array(pe) / np.array(pr)):.3f}, {max(np.array(pe) / np.array(pr)):.3f}]")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("case", nargs="?", default=str(ROOT / "cases" / "envisat_small.toml"))
@@ -158,6 +172,8 @@ def main() -> None:
     parser.add_argument("--cache", required=True)
     parser.add_argument("--report-only", action="store_true")
     parser.add_argument("--history", default=None, metavar="LOCATION")
+    parser.add_argument("--judged", action="store_true",
+                        help="also compare the judged peaks (t >= skip_initial) as recorded and from the springs alone")
     parser.add_argument("--window-end", type=float, default=None, metavar="T",
                         help="end every first window at T (s) instead of --edge-margin before the coarsest step's "
                              "parting (the same window for runs whose replicas part at other times)")
@@ -203,6 +219,8 @@ def main() -> None:
     locations = weak_locations(case, model_inputs(case, case_path.parent).assembly)
     in_dynamics = {i for i, j in enumerate(case.target.joints) if j.member is not None}
     report(runs, steps, len(done), locations, in_dynamics, args.edge_margin, args.history, args.window_end)
+    if args.judged:
+        judged_comparison(runs, steps, len(done), locations, in_dynamics, case.structures.skip_initial)
 
 
 if __name__ == "__main__":
