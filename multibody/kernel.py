@@ -33,7 +33,8 @@ from numba import njit
 from multibody.contact_kernel import add_contact_forces
 from multibody.net import ThreadRuns, add_bending_forces, add_thread_forces_runs
 from multibody.orbit import clohessy_wiltshire_acceleration_xyz
-from multibody.maths.rotations import compose_rotation_vectors, rotation_matrix_from_rotation_vector_into
+from multibody.maths.rotations import compose_rotation_vectors
+from multibody.node_frame import body_state_into
 
 #: Indices into the kernel's scalar output buffer.
 THREAD_ELASTIC, BENDING_ELASTIC, CONTACT_ELASTIC, THREAD_DISSIPATED, CONTACT_DISSIPATED, N_CONTACTS = range(6)
@@ -183,7 +184,7 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffer
                          contact_body=np.zeros(n_shapes, np.int64), work_body=np.zeros((2, n_bodies, 3)),
                          states=BodyStates(np.zeros((n_bodies, 3, 3)), np.zeros((n_bodies, 3)),
                                            np.zeros((n_bodies, 3)), np.zeros((n_bodies, 3)),
-                                           np.zeros((n_bodies, 3, 3))))
+                                           np.zeros((n_bodies, 3, 3)), np.zeros((n_bodies, 3))))
 
 
 class BodyStates(NamedTuple):
@@ -194,6 +195,7 @@ class BodyStates(NamedTuple):
     velocity_lvlh: np.ndarray  # (nb, 3) CoM velocity (m/s)
     omega_lvlh: np.ndarray     # (nb, 3) angular velocity (rad/s)
     node_to_lvlh: np.ndarray   # (nb, 3, 3) the Exudyn node's attitude (its frame carries the generalized torque)
+    omega_body: np.ndarray     # (nb, 3) angular velocity (rad/s), body frame
 
 
 @dataclass
@@ -447,7 +449,7 @@ def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torq
 @njit(cache=True)
 def body_states(q, qt, n_nodes, reference_com_lvlh, node_to_body):
     """:class:`BodyStates` (attitude body->LVLH, CoM (m), CoM velocity (m/s), angular velocity (rad/s),
-    LVLH; the node's attitude) from the coordinates in the module doc's layout.
+    LVLH; the node's attitude; the angular velocity in the body frame) from the coordinates in the module doc's layout.
 
     Parameters
     ----------
@@ -462,7 +464,7 @@ def body_states(q, qt, n_nodes, reference_com_lvlh, node_to_body):
     """
     nb = reference_com_lvlh.shape[0]
     states = BodyStates(np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3)), np.empty((nb, 3)),
-                        np.empty((nb, 3, 3)))
+                        np.empty((nb, 3, 3)), np.empty((nb, 3)))
     body_states_into(q, qt, n_nodes, reference_com_lvlh, node_to_body, states)
     return states
 
@@ -478,20 +480,8 @@ def body_states_into(q, qt, n_nodes, reference_com_lvlh, node_to_body, states):
     states : BodyStates
         Output.
     """
-    nb = reference_com_lvlh.shape[0]
-    body_to_lvlh, com_lvlh, velocity_lvlh, omega_lvlh, node_to_lvlh = (
-        states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh, states.omega_lvlh, states.node_to_lvlh)
-    for b in range(nb):
-        base = 3 * n_nodes + 6 * b
-        for d in range(3):
-            com_lvlh[b, d] = reference_com_lvlh[b, d] + q[base + d]
-            velocity_lvlh[b, d] = qt[base + d]
-        rotation_matrix_from_rotation_vector_into(q[base + 3], q[base + 4], q[base + 5], node_to_lvlh, b)
-        # in scalars: numba sends small matrix products to BLAS, microseconds a call
-        for r in range(3):
-            omega_lvlh[b, r] = (node_to_lvlh[b, r, 0] * qt[base + 3] + node_to_lvlh[b, r, 1] * qt[base + 4]
-                                + node_to_lvlh[b, r, 2] * qt[base + 5])
-            for k in range(3):      # body->LVLH = node->LVLH (node->body)^T
-                body_to_lvlh[b, r, k] = (node_to_lvlh[b, r, 0] * node_to_body[b, k, 0]
-                                         + node_to_lvlh[b, r, 1] * node_to_body[b, k, 1]
-                                         + node_to_lvlh[b, r, 2] * node_to_body[b, k, 2])
+    com_lvlh, velocity_lvlh, node_to_lvlh = states.com_lvlh, states.velocity_lvlh, states.node_to_lvlh
+    body_to_lvlh, omega_lvlh, omega_body = states.body_to_lvlh, states.omega_lvlh, states.omega_body
+    for b in range(reference_com_lvlh.shape[0]):
+        body_state_into(q, qt, 3 * n_nodes + 6 * b, b, reference_com_lvlh, node_to_body, com_lvlh, velocity_lvlh,
+                        node_to_lvlh, body_to_lvlh, omega_lvlh, omega_body)
