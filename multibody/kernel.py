@@ -145,7 +145,8 @@ class KernelBuffers(NamedTuple):
     force: np.ndarray              # (3 n + 6 nb,) generalized forces (module doc)
     body_impulse_lvlh: np.ndarray  # (nb, 6) accumulated contact impulse (N s), angular impulse about CoM (N m s), LVLH
     node_impulse_lvlh: np.ndarray  # (n, 3) accumulated contact impulse on each net node (N s), LVLH
-    velocity_lag: np.ndarray       # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s), LVLH
+    velocity_lag: np.ndarray       # (3, n) true minus integrator velocity of sub-cycled nodes (m/s), LVLH,
+                                   # coordinate-major
     lag_body: np.ndarray           # (n,) int64 body of the node's last contact, -1 for none
     scalars: np.ndarray            # (N_SCALARS,) energies (J) and contact count, indices above
     work: np.ndarray               # (4, n, 3) positions, forces (bending's node-major copies), non-contact
@@ -175,7 +176,7 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffer
     work_node = np.zeros((4, n))
     work_node[3] = 1.0 / np.asarray(net.mass, float)  # constant: a product is cheaper than a division
     return KernelBuffers(force=np.zeros(3 * n + 6 * n_bodies), body_impulse_lvlh=np.zeros((n_bodies, 6)),
-                         node_impulse_lvlh=np.zeros((n, 3)), velocity_lag=np.zeros((n, 3)),
+                         node_impulse_lvlh=np.zeros((n, 3)), velocity_lag=np.zeros((3, n)),
                          lag_body=np.full(n, -1, dtype=np.int64), scalars=np.zeros(N_SCALARS),
                          work=np.zeros((4, n, 3)), work_node=work_node,
                          candidates=np.zeros((n_shapes + 1, n), np.uint8), work_soa=np.zeros((3, 3, n)),
