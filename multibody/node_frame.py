@@ -19,8 +19,9 @@ Everything Exudyn sees of a body (its initial rotation vector and angular veloci
 joint markers' positions and frames, recorded moments) is written in the node frame once at build
 time by the functions here; the compiled kernels and the recorder turn the node's attitude and rate
 back to the body's (``body_to_lvlh = node_to_lvlh node_to_body^T``), so contact shapes, outputs and
-every caller keep the body frame (:func:`body_state_into`, the one turn both use). The node would return near the identity only if its body turned by
-that very rotation (2 rad about that axis); the end-of-step restore still keeps the attitude exact then.
+every caller keep the body frame (:func:`body_state_into`, the one turn both use). The node would return
+near the identity only if its body turned by that very rotation (2 rad about that axis); the end-of-step
+restore still keeps the attitude exact then.
 """
 from __future__ import annotations
 
