@@ -6,13 +6,16 @@ from the capture start, each identified model scored on the training and the uns
     python bench/bench_fullnet_identify.py --out DIR [--case cases/zenit2_towing.toml]
         [--starts wrapped capture] [--training N] [--validation N] [--end T]
         [--optimizers pso pattern mads] [--cost f1 f2] [--mads-starts s0 table6] [--workers N] [--table-only]
+        [--rescore]
 
 The full-net runs (the first N training and validation rates of Table 3, to T) are cached in
 ``DIR/<start>/fullnet/rate_<deg_s>_end_<T>[_capture].npz``, the same files ``riskassess identify`` writes:
 copy an identify folder's ``fullnet/*.npz`` there to reuse them. MADS runs from the case's s0 and/or from each
 Table 6 initial guess (MADS 1-5, as the paper's Sec. 4.4); the pattern search from s0; PSO with the case's seed,
 then the polish. Every answer is kept in ``DIR/results.json`` as soon as it is found (a re-run skips those
-done, for the same runs and settings); ``--table-only`` prints the tables from it. CPU time counts this
+done, for the same held runs and settings); ``--table-only`` prints the tables from it. As ``riskassess identify``
+does, a run whose debris was not held (a failed capture, :func:`riskassess.stages.identify_fullnet.not_held`) is
+left out of training and validation and named in each answer's ``excluded_runs``. CPU time counts this
 process and its worker processes (the machine may be shared; wall times are printed with the load average).
 """
 from __future__ import annotations
@@ -28,7 +31,8 @@ from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.products import results
 from riskassess.stages.identify import run_optimizers
-from riskassess.stages.identify_fullnet import _entry, full_net_runs, lower_order_case
+from riskassess.stages.identify_fullnet import (_entry, _totals, comparison_rows, full_net_runs, held_runs,
+                                                lower_order_case)
 sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
 from bench_identify import TABLE6_INITIAL_GUESSES  # noqa: E402
 
@@ -72,13 +76,12 @@ def searches(optimizers, mads_starts, s0):
     return out
 
 
-def run_one(case: TowingCase, data, label, name, guess, cost, workers, end) -> dict:
-    """One search on the training runs and the identified model's scores; returns the entries per reported
-    optimizer ('pso' gives 'pso' and 'pso+pattern'; ``wall_s`` is each one's own, ``cpu_s`` the whole search's)."""
+def run_one(case: TowingCase, train, valid, label, name, guess, cost, workers, end) -> dict:
+    """One search on the (held) training runs and the identified model's scores on the training and the
+    (held) validation runs; returns the entries per reported optimizer ('pso' gives 'pso' and 'pso+pattern';
+    ``wall_s`` is each one's own, ``cpu_s`` the whole search's)."""
     ident = case.identification.model_copy(update=dict(cost=cost, initial_guess=guess, workers=workers))
-    lower = lower_order_case(case.model_copy(update=dict(identification=ident)), data[0])
-    n_train = case.full_net.identification_training_runs
-    train, valid = data[:n_train], data[n_train:]
+    lower = lower_order_case(case.model_copy(update=dict(identification=ident)), train[0])
     cpu, wall, load = cpu_seconds(), time.perf_counter(), os.getloadavg()[0]
     found = run_optimizers(lower, train, (name,), end_time=end, workers=workers)
     cpu, wall = cpu_seconds() - cpu, time.perf_counter() - wall
@@ -92,9 +95,31 @@ def run_one(case: TowingCase, data, label, name, guess, cost, workers, end) -> d
     return out
 
 
+def rescore(case: TowingCase, done: dict, start: str, train, valid, held, end) -> None:
+    """Every answer in ``done`` of ``start`` on these held runs (same rates and end) compared again with
+    today's :func:`comparison_rows` (its training and validation rows and totals replaced; s, evaluations and
+    CPU kept)."""
+    for key, entry in done.items():
+        if key.split("|")[0] != start or entry["rates"] != held or entry["end_s"] != end:
+            continue
+        lower = lower_order_case(case, train[0])
+        rows = {role: comparison_rows(lower, entry["s"], runs, end) for role, runs in (("training", train),
+                                                                                        ("validation", valid))}
+        entry.update(training=rows["training"], validation=rows["validation"],
+                     training_totals=_totals(rows["training"]), validation_totals=_totals(rows["validation"]))
+        print(f"  rescored {key}", flush=True)
+
+
+def free_roll(totals: dict, n: int) -> str:
+    """' (x.xxx)': f1 per run with omega_D compared blind to a roll about the debris' symmetry axis (the
+    diagnostic of identify_fullnet.comparison_rows), or '' when not computed."""
+    return f" ({totals['f1_free_roll'] / n:.3f})" if "f1_free_roll" in totals else ""
+
+
 def print_tables(done: dict) -> None:
-    """Markdown rows: per start and cost, every search's s, evaluations, training and validation f1, f2 per run,
-    then the paper's per-run values of the same cost."""
+    """Markdown rows: per start and cost, every search's s, evaluations, training and validation f1, f2 per run
+    (f1 in brackets: omega_D compared blind to a roll about the debris' symmetry axis, when computed), then the
+    paper's per-run values of the same cost."""
     print("\n| start, runs | cost | optimizer | s1 | s2 (m) | s3 | s4 | evaluations | CPU (s) | training f1 / run "
           "| training f2 / run (N) | validation f1 / run | validation f2 / run (N) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -103,9 +128,12 @@ def print_tables(done: dict) -> None:
         nt, nv = len(entry["training"]), len(entry["validation"])
         tr, va = entry["training_totals"], entry["validation_totals"]
         s = entry["s"]
-        print(f"| {start}, {nt}+{nv} to {entry['end_s']:g} s | {cost} | {label} | {s[0]:.4f} | {s[1]:.4f} | "
-              f"{s[2]:.4f} | {s[3]:.4f} | {entry['evaluations']} | {entry['cpu_s']:.0f} | {tr['f1'] / nt:.3f} | "
-              f"{tr['f2'] / nt:.1f} | {va['f1'] / nv:.3f} | {va['f2'] / nv:.1f} |")
+        left = len(entry.get("excluded_runs", []))
+        runs = f"{nt}+{nv}" + (f" held ({left} left out)" if left else "")
+        valid = (f"{va['f1'] / nv:.3f}{free_roll(va, nv)} | {va['f2'] / nv:.1f}" if va else "no validation run held | -")
+        print(f"| {start}, {runs} to {entry['end_s']:g} s | {cost} | {label} | {s[0]:.4f} | {s[1]:.4f} | "
+              f"{s[2]:.4f} | {s[3]:.4f} | {entry['evaluations']} | {entry['cpu_s']:.0f} | {tr['f1'] / nt:.3f}"
+              f"{free_roll(tr, nt)} | {tr['f2'] / nt:.1f} | {valid} |")
     for cost, rows in PAPER.items():
         for label, (train, valid) in rows.items():
             f1 = (f"{train / PAPER_RUNS:.3f}", f"{valid / PAPER_RUNS:.3f}") if cost == "f1" else ("-", "-")
@@ -126,6 +154,9 @@ def main():
     parser.add_argument("--mads-starts", nargs="+", default=["s0", "table6"], choices=["s0", "table6"])
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--table-only", action="store_true", help="print the tables of DIR/results.json")
+    parser.add_argument("--rescore", action="store_true",
+                        help="score every answer of DIR/results.json for these runs again with today's comparison "
+                             "(no search; e.g. to add a diagnostic column)")
     args = parser.parse_args()
     out = Path(args.out)
     store = out / "results.json"
@@ -144,17 +175,28 @@ def main():
         print(f"{start}: {len(rates)} full-net runs to {args.end:g} s ready in {time.perf_counter() - wall:.0f} s wall "
               f"(load average {load:.1f} -> {os.getloadavg()[0]:.1f}; cached runs took "
               f"{sum(d['wall_s'] for d in data):.0f} s of solver wall time)", flush=True)
+        # the same rule as 'riskassess identify': a run whose debris was not held is left out and named
+        train, valid, excluded = held_runs(run_case, data, min(args.training, len(case.rates.training_deg_s)))
+        for why in excluded:
+            print(f"  left out {why['rate_deg_s']:g} deg/s: {why['reason']}", flush=True)
+        held = [float(r["rate_deg_s"]) for r in train + valid]
+        if args.rescore:
+            rescore(run_case, done, start, train, valid, held, args.end)
+            results.atomic_write_json(store, done)
+            continue
         for cost in args.cost:
             for label, name, guess in searches(args.optimizers, args.mads_starts, case.identification.initial_guess):
                 key = f"{start}|{cost}|{label}"
-                if key in done and done[key]["rates"] == rates and done[key]["end_s"] == args.end:
+                if key in done and done[key]["rates"] == held and done[key]["end_s"] == args.end:
                     continue
-                for reported, entry in run_one(run_case, data, label, name, guess, cost, args.workers, args.end).items():
-                    entry.update(rates=rates, end_s=args.end)
+                for reported, entry in run_one(run_case, train, valid, label, name, guess, cost, args.workers,
+                                               args.end).items():
+                    entry.update(rates=held, end_s=args.end, excluded_runs=excluded)
                     done[f"{start}|{cost}|{reported}"] = entry
                     tr, va = entry["training_totals"], entry["validation_totals"]
+                    scored = f"validation f1 {va['f1']:.3f} f2 {va['f2']:.1f}" if va else "no validation run held"
                     print(f"  {start} {cost} {reported:12s} s = {[round(v, 4) for v in entry['s']]} training f1 "
-                          f"{tr['f1']:.3f} f2 {tr['f2']:.1f}, validation f1 {va['f1']:.3f} f2 {va['f2']:.1f}; "
+                          f"{tr['f1']:.3f} f2 {tr['f2']:.1f}, {scored}; "
                           f"{entry['evaluations']} evaluations, {entry['cpu_s']:.0f} s CPU, {entry['wall_s']:.0f} s wall "
                           f"(load {entry['load_before']:.1f} -> {entry['load_after']:.1f})", flush=True)
                 results.atomic_write_json(store, done)

@@ -83,6 +83,60 @@ def rmse(model, data) -> float:
     return float(np.sqrt(np.mean(np.sum(diff**2, axis=1))))
 
 
+def rmse_free_roll(model_omega_body, data_omega_body, axis_body) -> float:
+    r"""RMSE of a body-frame angular velocity, blind to a turn of the body about ``axis_body``: the axial
+    component and the norm of the transverse part are compared, not the transverse direction.
+
+    For a debris symmetric about ``axis_body`` (two equal principal moments) a slow roll about that axis turns
+    its body-frame angular velocity within the transverse plane without changing its spin about inertial space;
+    eq. (19b) read in the body frame counts it in full. This is the smallest eq. (19b) over every such turn at
+    each sample: a diagnostic beside f1, not a cost.
+
+    Parameters
+    ----------
+    model_omega_body, data_omega_body : (k, 3) float
+        Angular velocities in each one's own body frame (rad/s).
+    axis_body : (3,) float
+        The symmetry axis, body frame (any length).
+
+    Returns
+    -------
+    float
+        RMSE (rad/s).
+    """
+    axis = np.asarray(axis_body, float) / np.linalg.norm(axis_body)
+
+    def axial_and_transverse(omega_body):
+        omega_body = np.asarray(omega_body, float)
+        axial = omega_body @ axis
+        return np.column_stack([axial, np.linalg.norm(omega_body - np.outer(axial, axis), axis=1)])
+
+    return rmse(axial_and_transverse(model_omega_body), axial_and_transverse(data_omega_body))
+
+
+def symmetry_axis_body(principal_inertia, rtol: float = 1e-9):
+    """The body axis a body with two equal principal moments is symmetric about, or None.
+
+    Parameters
+    ----------
+    principal_inertia : (3,) float
+        Principal moments about the body axes (kg m^2).
+    rtol : float
+        Relative tolerance for "equal".
+
+    Returns
+    -------
+    (3,) float or None
+        The unit body axis of the distinct moment (None when no two moments, or all three, are equal).
+    """
+    j = np.asarray(principal_inertia, float)
+    for k in range(3):
+        a, b = (j[m] for m in range(3) if m != k)
+        if abs(a - b) <= rtol * max(a, b) and abs(j[k] - a) > rtol * max(a, j[k]):
+            return np.eye(3)[k]
+    return None
+
+
 def cost_f1(model: dict, data: dict, weights) -> float:
     r"""One run's term of eq. (18): :math:`w_1 RMSE_r + w_2 (RMSE_{\omega_D} + RMSE_{\omega_C})`.
 

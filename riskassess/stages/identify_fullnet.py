@@ -35,7 +35,8 @@ import numpy as np
 
 from riskassess.products import results
 from riskassess.cases.impact import CaseError
-from riskassess.stages.identify import COSTS, claim_identify_folder, rmse, simulate
+from riskassess.stages.identify import (COSTS, claim_identify_folder, rmse, rmse_free_roll, simulate,
+                                        symmetry_axis_body)
 from riskassess.products.outfolder import OutputFolder
 from riskassess.cases.towing import TowingCase
 from multibody.net_towing import run_exudyn
@@ -176,6 +177,40 @@ def not_held(run: dict, reach: float) -> dict | None:
                       f"the net and the debris can span (a failed capture)"}
 
 
+def held_runs(case: TowingCase, data: list[dict], n_training: int) -> tuple[list[dict], list[dict], list[dict]]:
+    """The training and validation runs whose debris was held (:func:`not_held`), and why each other run was
+    left out.
+
+    Parameters
+    ----------
+    case : TowingCase
+        A towing case with a ``[full_net]`` table.
+    data : list of dict
+        The full-net runs (:func:`full_net_runs`), the training runs first.
+    n_training : int
+        How many of ``data`` are training runs.
+
+    Returns
+    -------
+    training, validation, excluded : list of dict
+        The held training and validation runs, and :func:`not_held`'s answer for every run left out.
+
+    Raises
+    ------
+    CaseError
+        When no training run is left, naming every left-out rate and why.
+    """
+    reach = held_reach(case)
+    excluded = [why for why in (not_held(run, reach) for run in data) if why is not None]
+    left_out = {why["rate_deg_s"] for why in excluded}
+    train = [run for run in data[:n_training] if float(run["rate_deg_s"]) not in left_out]
+    valid = [run for run in data[n_training:] if float(run["rate_deg_s"]) not in left_out]
+    if not train:
+        raise CaseError(f"{case.name}: every training run's debris was not held, nothing to identify on: "
+                        + "; ".join(f"{w['rate_deg_s']:g} deg/s: {w['reason']}" for w in excluded))
+    return train, valid, excluded
+
+
 def lower_order_case(case: TowingCase, run: dict) -> TowingCase:
     """The case whose lower-order runs start from the full-net start state (module doc, item 2).
 
@@ -215,13 +250,24 @@ def comparison_rows(case: TowingCase, s, data: list[dict], end) -> list[dict]:
     Returns
     -------
     list of dict
-        Per run: ``rate_deg_s``, ``rmse_<channel>`` (m, rad/s or N) and the costs ``f1``, ``f2``.
+        Per run: ``rate_deg_s``, ``rmse_<channel>`` (m, rad/s or N) and the costs ``f1``, ``f2``; for a debris
+        symmetric about a body axis also ``rmse_debris_omega_free_roll`` and ``f1_free_roll``, eq. (18) with
+        omega_D compared blind to a roll about that axis (:func:`riskassess.stages.identify.rmse_free_roll`;
+        the paper's omega_D is the rate relative to the inertial frame, the frame it is compared in is not
+        stated; docs/towing.md: our full-net debris rolls slowly about its axis and the body-frame f1 counts it).
     """
+    axis = symmetry_axis_body(case.debris.principal_inertia)
+    w1, w2 = case.identification.weights
     rows = []
     for run in data:
         model = simulate(case, run["rate_deg_s"], s, end, run.get("start"))
-        rows.append({"rate_deg_s": run["rate_deg_s"], **{f"rmse_{c}": rmse(model[c], run[c]) for c in CHANNELS},
-                     "f1": COSTS["f1"](model, run, case.identification.weights), "f2": COSTS["f2"](model, run)})
+        row = {"rate_deg_s": run["rate_deg_s"], **{f"rmse_{c}": rmse(model[c], run[c]) for c in CHANNELS},
+               "f1": COSTS["f1"](model, run, case.identification.weights), "f2": COSTS["f2"](model, run)}
+        if axis is not None:
+            free = rmse_free_roll(model["debris_omega_body"], run["debris_omega_body"], axis)
+            row.update(rmse_debris_omega_free_roll=free, f1_free_roll=w1 * row["rmse_relative_position"]
+                       + w2 * (free + row["rmse_chaser_omega_body"]))
+        rows.append(row)
     return rows
 
 
@@ -230,8 +276,11 @@ def _totals(rows: list[dict]) -> dict | None:
     (every validation run left out as not held: no score, rather than a sum of 0 that reads as perfect)."""
     if not rows:
         return None
-    return {"f1": sum(r["f1"] for r in rows), "f2": sum(r["f2"] for r in rows),
-            **{f"mean_rmse_{c}": float(np.mean([r[f"rmse_{c}"] for r in rows])) for c in CHANNELS}}
+    totals = {"f1": sum(r["f1"] for r in rows), "f2": sum(r["f2"] for r in rows),
+              **{f"mean_rmse_{c}": float(np.mean([r[f"rmse_{c}"] for r in rows])) for c in CHANNELS}}
+    if all("f1_free_roll" in r for r in rows):
+        totals["f1_free_roll"] = sum(r["f1_free_roll"] for r in rows)
+    return totals
 
 
 def _entry(case: TowingCase, found, training: list[dict], validation: list[dict], end) -> dict:
@@ -291,14 +340,7 @@ def _identify(case: TowingCase, folder: OutputFolder, optimizers) -> dict:
     data = full_net_runs(case, list(training) + list(validation), out, end, case.identification.workers,
                          record=folder.add_files)
     data_wall = time.perf_counter() - start
-    reach = held_reach(case)
-    excluded = [why for why in (not_held(run, reach) for run in data) if why is not None]
-    left_out = {why["rate_deg_s"] for why in excluded}
-    train = [run for run in data[:len(training)] if float(run["rate_deg_s"]) not in left_out]
-    valid = [run for run in data[len(training):] if float(run["rate_deg_s"]) not in left_out]
-    if not train:
-        raise CaseError(f"{case.name}: every training run's debris was not held, nothing to identify on: "
-                        + "; ".join(f"{w['rate_deg_s']:g} deg/s: {w['reason']}" for w in excluded))
+    train, valid, excluded = held_runs(case, data, len(training))
     lower = lower_order_case(case, train[0])
     runs = {name: _entry(lower, found, train, valid, end)
             for name, found in run_optimizers(lower, train, optimizers, end_time=end).items()}
