@@ -97,6 +97,10 @@ def probe(case, rate, end, snap):
     return {"rate_deg_s": rate, "end_s": end, "cpu_s": cpu, "first_contact_s": first, "closed_s": closed,
             "turned_contact_to_closed_deg": turned, "turned_per_s_deg": float(np.degrees(w[0])),
             "separation_end_m": float(np.linalg.norm(s["debris_com_inertial"][-1] - s["chaser_com_inertial"][-1])),
+            "separation_max_m": float(np.linalg.norm(s["debris_com_inertial"] - s["chaser_com_inertial"], axis=1).max()),
+            "spin_end_deg_s": float(np.degrees(w[-1])),
+            "peak_tension_after_25_s_N": float(s["main_tether_tension"][t >= 25.0].max(initial=0.0)),
+            "slack_share_after_25_s": float(np.mean(s["main_tether_tension"][t >= 25.0] <= 0.0)) if end > 25.0 else None,
             "snapshots": snaps, "samples": samples}
 
 

@@ -36,7 +36,8 @@ def test_the_range_rate_is_the_relative_velocity_along_the_line_of_centres():
 def test_the_range_damping_adds_exactly_minus_c_times_the_range_rate(kind):
     """At the desired elongation both laws command about the steady thrust (141 N, inside the +-200 N saturation);
     with c_R = 800 N s/m a range rate of +0.02 m/s (separating) lowers the command by 16 N and -0.02 m/s raises it
-    by 16 N, to round-off (1e-9 N); with the default c_R = 0 the range rate changes nothing (bit-identical)."""
+    by 16 N, to round-off (1e-9 N); with c_R = 0 (the schema's default, the paper's laws) the range rate changes nothing
+    (bit-identical)."""
     case = load_model(CASE, TowingCase)
     damped = case.model_copy(update=dict(mrac=case.mrac.model_copy(update=dict(range_damping=800.0))))
     params, state = _arrays(kind, damped)
@@ -46,7 +47,8 @@ def test_the_range_damping_adds_exactly_minus_c_times_the_range_rate(kind):
     for rate in (0.02, -0.02):
         got = LAWS[kind].command(30.0, 0.04, 0.0, rate, params, state.copy(), 2e-3, False)
         assert got - base == pytest.approx(-800.0 * rate, abs=1e-9)
-    params0, state0 = _arrays(kind, case)
+    paper = case.model_copy(update=dict(mrac=case.mrac.model_copy(update=dict(range_damping=0.0))))
+    params0, state0 = _arrays(kind, paper)
     assert params0[C_RANGE] == 0.0
     assert (LAWS[kind].command(30.0, 0.04, 0.0, 0.3, params0, state0.copy(), 2e-3, False)
             == LAWS[kind].command(30.0, 0.04, 0.0, 0.0, params0, state0.copy(), 2e-3, False))
