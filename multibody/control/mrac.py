@@ -30,6 +30,13 @@ chattering. tau is set one decade above the reference model's natural frequency
 :math:`\\omega_m = \\sqrt{b (k_{MT} + K_P)}` (:func:`rate_filter_time`), so the reference dynamics
 pass with < 6 deg of phase lag.
 
+**Range-rate damping** (``mrac.range_damping``, :func:`range_damping_force`). On the full net the chaser hangs on the
+main tether in series with the net bag; the laws' rate gain acts on the tether's elongation rate, which the bag's
+compliance and the central node's vibration dominate, so the chaser-bag mode, which the breathing drives near
+resonance at 20.44 deg/s, is damped weakly and through a saturating channel. Both laws may add :math:`-c_R \dot r`,
+:math:`\dot r` the chaser-debris range rate (zero in steady towing); with it the rate estimate's corner can sit at
+:math:`\omega_m` (docs/towing.md, MRAC: "Why the taut-phase swing grows at 20.44 deg/s").
+
 This module holds what both laws share (parameter head, reference model); each law is a plug-in of
 :mod:`multibody.control.thrust_laws` (``mrac1.py``, ``mrac2.py``: its gains, ``command``, initial
 state); ``params`` and ``state`` are flat float arrays for the compiled towing kernels, the common
