@@ -1,7 +1,7 @@
 """The largest safe impact velocity at 95 % confidence and 90 % reliability, by Monte Carlo.
 
     python3 bench/bench_safe_velocity.py [CASE] [--velocities 2:5:4] [--runs 29] [--workers 2]
-                                         [--uncertain KEY=DIST(...) ...] [--seed 0]
+                                         [--uncertain KEY=DIST(...) ...] [--seed 0] [--store PATH]
 
 At each velocity, ``--runs`` Monte Carlo samples (29 by default: 0.9^29 = 0.047, the fewest debris-free
 runs that show P(no debris) >= 90 % at 95 % confidence) of the uncertain inputs (default: the paper's
@@ -10,11 +10,13 @@ array), on the project's sweep runner into a fresh store. Prints per velocity th
 debris and the unknown ones (failed or indeterminate: counted as debris, never safe), the one-sided
 Clopper-Pearson lower bound of P(no debris), the largest utilization, and the envelope's statement, with
 the wall time and the load. Default case: cases/envisat_small.toml (the reference case needs ~1 h for
-116 runs on 2 cores).
+116 runs on 2 cores). ``--store PATH`` keeps the runs in that store (a re-run resumes it: the finished runs
+are found, not run again); by default a temporary one.
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import tempfile
 import time
@@ -41,11 +43,13 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--uncertain", action="append", default=None)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--store", default=None, help="results store to keep and resume (default: a temporary one)")
     args = parser.parse_args()
     uncertain = [parse_uncertain(u) for u in (args.uncertain or DEFAULT_UNCERTAIN)]
     specs = run_specs([parse_vary(f"launch.velocity={args.velocities}")], uncertain, args.runs, args.seed)
     start, load = time.perf_counter(), os.getloadavg()[0]
-    with tempfile.TemporaryDirectory() as tmp, ResultStore(Path(tmp) / "safe.sqlite") as store:
+    where = contextlib.nullcontext(None) if args.store else tempfile.TemporaryDirectory()
+    with where as tmp, ResultStore(Path(args.store) if args.store else Path(tmp) / "safe.sqlite") as store:
         outcome = run_sweep(args.case, specs, store, {"arguments": []}, n_workers=args.workers)
         rows = store.rows()
     wall = time.perf_counter() - start
