@@ -33,7 +33,7 @@ from numba import njit
 from multibody.contact_kernel import add_contact_forces
 from multibody.net import ThreadRuns, add_bending_forces, add_thread_forces_runs
 from multibody.orbit import clohessy_wiltshire_acceleration_xyz
-from multibody.maths.rotations import compose_rotation_vectors, compose_rotation_vectors_into
+from multibody.maths.rotations import compose_rotation_vectors_into
 from multibody.node_frame import body_state_into
 
 #: Indices into the kernel's scalar output buffer.
