@@ -10,7 +10,7 @@ Replica j (0, 1, ...) starts the debris at the spin rate x (1 + j x ``--perturba
 (``cases/zenit2_towing.toml``, full net from the wrapped start, 25-300 s) with ``--set section.key=value`` overrides
 of ``[mrac]`` / ``[thrust]`` (as in bench/bench_mrac_probe.py), named ``--label``. Each finished run appends one JSON
 line to ``--results`` (resumable: a run already there is not repeated) and its series (time, tension, elongation,
-thrust, debris spin; every output sample) to ``<results stem>/<label>_<plant>_<law>_<rate>_<j>.npz``.
+thrust, debris spin, chaser-debris CoM distance; every output sample) to ``<results stem>/<label>_<plant>_<law>_<rate>_<j>.npz``.
 
 Per run: mean elongation over the last 100 s and its RMS error to the desired elongation (``mrac.desired_elongation``,
 the reference model's steady elongation with ``settle_at_desired``), slack time after engagement (T_MT <= 0, s), the
@@ -143,8 +143,9 @@ def main():
                           "rate_deg_s": rate, "replica": j, "spin_start_deg_s": spin, "target_m": target,
                           **figures(series, target), "cpu_s": cpu, "load": [load0, os.getloadavg()[0]]}
                 keys = ("time", "main_tether_tension", "main_tether_elongation", "thrust", "debris_omega_body")
+                separation = np.linalg.norm(series["debris_com_inertial"] - series["chaser_com_inertial"], axis=1)
                 results.atomic_write_npz(folder / f"{args.label}_{args.plant}_{law}_{rate:g}_{j}.npz",
-                                         {k: series[k] for k in keys})
+                                         {**{k: series[k] for k in keys}, "separation": separation})
                 with open(args.results, "a", encoding="utf-8") as handle:
                     handle.write(json.dumps(record) + "\n")
                 print(f"{key}: " + ", ".join(f"{name} {record[k]:{fmt}}" for k, name, fmt in COLUMNS) +

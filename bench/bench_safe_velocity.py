@@ -9,7 +9,10 @@ static friction and Hunt-Crossley damping with an assumed spread, and the aim po
 array), on the project's sweep runner into a fresh store. Prints per velocity the runs, those with
 debris and the unknown ones (failed or indeterminate: counted as debris, never safe), the one-sided
 Clopper-Pearson lower bound of P(no debris), the largest utilization, and the envelope's statement, with
-the wall time and the load. Default case: cases/envisat_small.toml (the reference case needs ~1 h for
+the wall time and the load; then why the indeterminate runs are indeterminate: per velocity, the number of
+runs each (location, rule) made so (the rules of structures.verdict.INDETERMINATE_RULES; the store keeps
+each run's reasons), and one reason in full per rule. A store written before the reasons were kept counts
+its runs under "not_recorded". Default case: cases/envisat_small.toml (the reference case needs ~1 h for
 116 runs on 2 cores). ``--store PATH`` keeps the runs in that store (a re-run resumes it: the finished runs
 are found, not run again); by default a temporary one.
 """
@@ -24,6 +27,7 @@ from pathlib import Path
 
 from riskassess.cases.uncertain import parse_uncertain
 from riskassess.products.envelope import envelope, envelope_statement
+from riskassess.products.sweep_records import indeterminate_reasons_of, indeterminate_rule_counts
 from riskassess.sweep.runner import run_sweep
 from riskassess.sweep.spec import parse_vary, run_specs
 from riskassess.sweep.store import ResultStore
@@ -62,6 +66,25 @@ def main() -> None:
         print(f"{p['value']:12.2f}  {p['total_runs']:4d}  {p['with_debris']:11d}  {p['unknown_runs']:7d}  "
               f"{p['no_debris_lower_bound']:22.3f}  {utilization:>15s}  {'yes' if p['safe'] else 'NO'}")
     print(envelope_statement(env))
+    print_indeterminate_reasons(rows)
+
+
+def print_indeterminate_reasons(rows: list[dict]) -> None:
+    """Per velocity, the indeterminate runs per (location, rule), then one full reason per rule."""
+    by_velocity: dict = {}
+    for row in rows:
+        by_velocity.setdefault(row["overrides"].get("launch.velocity"), []).append(row)
+    print("why indeterminate (runs per location and rule; a run can count under several)")
+    examples = {}
+    for velocity in sorted(by_velocity, key=lambda v: (v is None, v)):
+        counts = indeterminate_rule_counts(by_velocity[velocity])
+        shown = ", ".join(f"{loc or 'run'}: {rule} {n}" for (loc, rule), n in counts.items()) or "none"
+        print(f"{velocity:12.2f}  {shown}" if velocity is not None else f"{'-':>12s}  {shown}")
+        for row in by_velocity[velocity]:
+            for r in indeterminate_reasons_of(row["result"]) if row["state"] == "done" and row["result"] else []:
+                examples.setdefault(r["rule"], f"{r['location'] or 'run'} at {velocity} m/s: {r['reason']}")
+    for rule, text in examples.items():
+        print(f"  {rule}, e.g. {text}")
 
 
 if __name__ == "__main__":

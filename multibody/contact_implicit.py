@@ -86,7 +86,12 @@ def _normal_residual(d1, d0, p0, e0, rate0, accel_n, inv_step, step, step_over_m
 
     The elastic part is the discrete gradient (E(d1) - E(d0)) / (d1 - d0) of the Hertz energy (``p0``,
     ``e0``: the start penetration clipped at 0 and its energy), the midpoint force when d1 and d0 nearly
-    agree (to O((d1 - d0)^2)); its derivative is estimated at the midpoint, for Newton. ``inv_step`` is
+    agree (to O((d1 - d0)^2)). Its derivative for Newton is the secant's own, (E'(d1) - secant) / (d1 - d0),
+    so Newton converges quadratically; the midpoint estimate (the derivative of the midpoint force) is kept
+    where the midpoint force is. The midpoint estimate everywhere, used before, made Newton converge only
+    linearly (by 1/10 to 1/50 an iteration) wherever d1 and d0 differ much: rebounds, a gap closing within
+    the step. On 383 175 implicit contacts recorded from the reference run: 4.34 -> 2.82 residual
+    evaluations a contact, the end state the same to the tolerance (docs/model.md, Speed). ``inv_step`` is
     1 / step, ``step_over_mass`` step / reduced mass.
     """
     p1 = d1 if d1 > 0.0 else 0.0
@@ -95,13 +100,17 @@ def _normal_residual(d1, d0, p0, e0, rate0, accel_n, inv_step, step, step_over_m
     secant = 0.0
     slope = 0.0
     if scale > 0.0:
-        pm = 0.5 * (p0 + p1)
-        force_mid, ratio_mid = _power_and_ratio(pm, exponent)
-        slope = 0.5 * exponent * stiffness * ratio_mid
         if abs(change) <= 1e-7 * scale:
+            pm = 0.5 * (p0 + p1)
+            force_mid, ratio_mid = _power_and_ratio(pm, exponent)
+            slope = 0.5 * exponent * stiffness * ratio_mid
             secant = stiffness * force_mid * ((p1 - p0) / change if change != 0.0 else 1.0)
         else:
-            secant = (_hertz_energy(p1, stiffness, exponent) - e0) / change
+            # E(p1) as _hertz_energy, with its power E'(p1) / k kept for the slope
+            power1 = _power(p1, exponent) if p1 > 0.0 else 0.0
+            energy1 = stiffness * power1 * p1 / (exponent + 1.0) if p1 > 0.0 else 0.0
+            secant = (energy1 - e0) / change
+            slope = (stiffness * power1 - secant) / change
     mean = 0.5 * (d0 + d1)
     viscous = 0.0
     viscous_slope = 0.0
@@ -284,6 +293,11 @@ def friction_impulse(free_mid_slip, free_end_slip, normal_impulse, reduced_mass,
         else:
             hi = j
         trial = j - residual / derivative if derivative > 0.0 else -1.0
+        if derivative > 0.0 and abs(trial - j) <= tolerance:
+            # Newton has converged. Its last step can round onto the bracket's end that j just became, which
+            # the test below took for a step outside the bracket: it bisected from the far end instead, about
+            # 40 more evaluations, on 4.5 % of the reference run's sliding contacts.
+            return min(max(trial, lo), hi)
         if not (lo < trial < hi):
             trial = 0.5 * (lo + hi)  # Newton left the bracket (or mu falls too steeply): bisect
         if abs(trial - j) <= tolerance or hi - lo <= tolerance:

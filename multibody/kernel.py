@@ -33,7 +33,8 @@ from numba import njit
 from multibody.contact_kernel import add_contact_forces
 from multibody.net import ThreadRuns, add_bending_forces, add_thread_forces_runs
 from multibody.orbit import clohessy_wiltshire_acceleration_xyz
-from multibody.maths.rotations import compose_rotation_vectors, rotation_matrix_from_rotation_vector_into
+from multibody.maths.rotations import compose_rotation_vectors_into
+from multibody.node_frame import body_state_into
 
 #: Indices into the kernel's scalar output buffer.
 THREAD_ELASTIC, BENDING_ELASTIC, CONTACT_ELASTIC, THREAD_DISSIPATED, CONTACT_DISSIPATED, N_CONTACTS = range(6)
@@ -63,12 +64,32 @@ def verlet_evaluation_state(q, qt, qtt, step, n_net_coordinates, n_bodies):
     q_next, v_half : (N,) float
         The evaluation state: end positions (rotation vectors composed) and mid-step velocities.
     """
-    v_half = qt + (0.5 * step) * qtt
-    q_next = q + step * v_half
+    q_next, v_half = np.empty_like(q), np.empty_like(qt)
+    verlet_evaluation_state_into(q, qt, qtt, step, n_net_coordinates, n_bodies, q_next, v_half)
+    return q_next, v_half
+
+
+@njit(cache=True)
+def verlet_evaluation_state_into(q, qt, qtt, step, n_net_coordinates, n_bodies, q_next, v_half):
+    """:func:`verlet_evaluation_state` into ``q_next`` and ``v_half`` ((N,) float, preallocated): the net step
+    calls it every step (its arrays and the per-body compositions were about 12 allocations a step).
+
+    Parameters
+    ----------
+    q, qt, qtt, step, n_net_coordinates, n_bodies
+        As :func:`verlet_evaluation_state`.
+    q_next, v_half : (N,) float
+        Output: end positions (rotation vectors composed) and mid-step velocities.
+    """
+    half = 0.5 * step
+    for k in range(q.shape[0]):
+        v_half[k] = qt[k] + half * qtt[k]
+    for k in range(q.shape[0]):
+        q_next[k] = q[k] + step * v_half[k]
     for b in range(n_bodies):
         base = n_net_coordinates + 6 * b + 3
-        q_next[base:base + 3] = compose_rotation_vectors(q[base:base + 3], step * v_half[base:base + 3])
-    return q_next, v_half
+        compose_rotation_vectors_into(q[base], q[base + 1], q[base + 2], step * v_half[base],
+                                      step * v_half[base + 1], step * v_half[base + 2], q_next, base)
 
 
 class NetArrays(NamedTuple):
@@ -144,7 +165,8 @@ class KernelBuffers(NamedTuple):
     force: np.ndarray              # (3 n + 6 nb,) generalized forces (module doc)
     body_impulse_lvlh: np.ndarray  # (nb, 6) accumulated contact impulse (N s), angular impulse about CoM (N m s), LVLH
     node_impulse_lvlh: np.ndarray  # (n, 3) accumulated contact impulse on each net node (N s), LVLH
-    velocity_lag: np.ndarray       # (n, 3) true minus integrator velocity of sub-cycled nodes (m/s), LVLH
+    velocity_lag: np.ndarray       # (3, n) true minus integrator velocity of sub-cycled nodes (m/s), LVLH,
+                                   # coordinate-major
     lag_body: np.ndarray           # (n,) int64 body of the node's last contact, -1 for none
     scalars: np.ndarray            # (N_SCALARS,) energies (J) and contact count, indices above
     work: np.ndarray               # (4, n, 3) positions, forces (bending's node-major copies), non-contact
@@ -174,7 +196,7 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffer
     work_node = np.zeros((4, n))
     work_node[3] = 1.0 / np.asarray(net.mass, float)  # constant: a product is cheaper than a division
     return KernelBuffers(force=np.zeros(3 * n + 6 * n_bodies), body_impulse_lvlh=np.zeros((n_bodies, 6)),
-                         node_impulse_lvlh=np.zeros((n, 3)), velocity_lag=np.zeros((n, 3)),
+                         node_impulse_lvlh=np.zeros((n, 3)), velocity_lag=np.zeros((3, n)),
                          lag_body=np.full(n, -1, dtype=np.int64), scalars=np.zeros(N_SCALARS),
                          work=np.zeros((4, n, 3)), work_node=work_node,
                          candidates=np.zeros((n_shapes + 1, n), np.uint8), work_soa=np.zeros((3, 3, n)),
@@ -183,7 +205,7 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int) -> KernelBuffer
                          contact_body=np.zeros(n_shapes, np.int64), work_body=np.zeros((2, n_bodies, 3)),
                          states=BodyStates(np.zeros((n_bodies, 3, 3)), np.zeros((n_bodies, 3)),
                                            np.zeros((n_bodies, 3)), np.zeros((n_bodies, 3)),
-                                           np.zeros((n_bodies, 3, 3))))
+                                           np.zeros((n_bodies, 3, 3)), np.zeros((n_bodies, 3))))
 
 
 class BodyStates(NamedTuple):
@@ -194,6 +216,7 @@ class BodyStates(NamedTuple):
     velocity_lvlh: np.ndarray  # (nb, 3) CoM velocity (m/s)
     omega_lvlh: np.ndarray     # (nb, 3) angular velocity (rad/s)
     node_to_lvlh: np.ndarray   # (nb, 3, 3) the Exudyn node's attitude (its frame carries the generalized torque)
+    omega_body: np.ndarray     # (nb, 3) angular velocity (rad/s), body frame
 
 
 @dataclass
@@ -447,7 +470,7 @@ def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torq
 @njit(cache=True)
 def body_states(q, qt, n_nodes, reference_com_lvlh, node_to_body):
     """:class:`BodyStates` (attitude body->LVLH, CoM (m), CoM velocity (m/s), angular velocity (rad/s),
-    LVLH; the node's attitude) from the coordinates in the module doc's layout.
+    LVLH; the node's attitude; the angular velocity in the body frame) from the coordinates in the module doc's layout.
 
     Parameters
     ----------
@@ -462,7 +485,7 @@ def body_states(q, qt, n_nodes, reference_com_lvlh, node_to_body):
     """
     nb = reference_com_lvlh.shape[0]
     states = BodyStates(np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3)), np.empty((nb, 3)),
-                        np.empty((nb, 3, 3)))
+                        np.empty((nb, 3, 3)), np.empty((nb, 3)))
     body_states_into(q, qt, n_nodes, reference_com_lvlh, node_to_body, states)
     return states
 
@@ -478,20 +501,8 @@ def body_states_into(q, qt, n_nodes, reference_com_lvlh, node_to_body, states):
     states : BodyStates
         Output.
     """
-    nb = reference_com_lvlh.shape[0]
-    body_to_lvlh, com_lvlh, velocity_lvlh, omega_lvlh, node_to_lvlh = (
-        states.body_to_lvlh, states.com_lvlh, states.velocity_lvlh, states.omega_lvlh, states.node_to_lvlh)
-    for b in range(nb):
-        base = 3 * n_nodes + 6 * b
-        for d in range(3):
-            com_lvlh[b, d] = reference_com_lvlh[b, d] + q[base + d]
-            velocity_lvlh[b, d] = qt[base + d]
-        rotation_matrix_from_rotation_vector_into(q[base + 3], q[base + 4], q[base + 5], node_to_lvlh, b)
-        # in scalars: numba sends small matrix products to BLAS, microseconds a call
-        for r in range(3):
-            omega_lvlh[b, r] = (node_to_lvlh[b, r, 0] * qt[base + 3] + node_to_lvlh[b, r, 1] * qt[base + 4]
-                                + node_to_lvlh[b, r, 2] * qt[base + 5])
-            for k in range(3):      # body->LVLH = node->LVLH (node->body)^T
-                body_to_lvlh[b, r, k] = (node_to_lvlh[b, r, 0] * node_to_body[b, k, 0]
-                                         + node_to_lvlh[b, r, 1] * node_to_body[b, k, 1]
-                                         + node_to_lvlh[b, r, 2] * node_to_body[b, k, 2])
+    com_lvlh, velocity_lvlh, node_to_lvlh = states.com_lvlh, states.velocity_lvlh, states.node_to_lvlh
+    body_to_lvlh, omega_lvlh, omega_body = states.body_to_lvlh, states.omega_lvlh, states.omega_body
+    for b in range(reference_com_lvlh.shape[0]):
+        body_state_into(q, qt, 3 * n_nodes + 6 * b, b, reference_com_lvlh, node_to_body, com_lvlh, velocity_lvlh,
+                        node_to_lvlh, body_to_lvlh, omega_lvlh, omega_body)

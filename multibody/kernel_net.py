@@ -38,7 +38,7 @@ from multibody.jit_cache import UnliteralStructRef
 from multibody.kernel import (
     KernelData,
     coupled_forces_soa,
-    verlet_evaluation_state,
+    verlet_evaluation_state_into,
 )
 
 
@@ -60,9 +60,9 @@ class NetStepModel(structref.StructRefProxy):
     Fields: those of :class:`multibody.kernel.KernelData` (:data:`KERNEL_FIELDS`, the same arrays)
     and ``n_substeps`` (int, contact sub-steps per step), ``q``, ``qt``, ``qtt`` ((3 n,) the net's
     state, coordinate-major, module doc), ``q_eval``, ``qt_eval`` ((3 n + 6 nb,) work space: the net's
-    coordinates at the evaluation state (first 3 n)), ``inverse_mass`` ((3 n,) 1 / node mass per
-    coordinate (1/kg)), ``reference_soa`` ((3 n,) the nodes' reference positions (m), LVLH), both
-    coordinate-major.
+    coordinates at the evaluation state (first 3 n); the last 6 nb of ``qt_eval`` the bodies' mid-step
+    velocities), ``inverse_mass`` ((3 n,) 1 / node mass per coordinate (1/kg)), ``reference_soa`` ((3 n,)
+    the nodes' reference positions (m), LVLH), both coordinate-major.
     """
 
 
@@ -165,9 +165,10 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies, for
         qt_eval[k] = qt[k] + half * qtt[k]
     for k in range(n3):
         q_eval[k] = q[k] + step * qt_eval[k]
-    q_next, v_half_bodies = verlet_evaluation_state(q_bodies, qt_bodies, qtt_bodies, step, 0, nb)
-    q_next_bodies[:] = q_next
-    force, body_force = _forces(m, q_next, v_half_bodies, m.n_substeps if time > 0.0 else 1)
+    # the bodies' evaluation state straight into the output and the tail of qt_eval (work space)
+    v_half_bodies = qt_eval[n3:]
+    verlet_evaluation_state_into(q_bodies, qt_bodies, qtt_bodies, step, 0, nb, q_next_bodies, v_half_bodies)
+    force, body_force = _forces(m, q_next_bodies, v_half_bodies, m.n_substeps if time > 0.0 else 1)
     # flat loops over the coordinates with few arrays each: the compiler vectorizes them (with more
     # arrays in one loop its run-time overlap checks give up and the loop stays scalar)
     inverse_mass = m.inverse_mass

@@ -24,6 +24,7 @@ from scipy.spatial.transform import Rotation
 
 from multibody.health import HealthWatch
 from multibody.impact import checked_post_step, explicit_settings, solve_checked
+from multibody.control.thrust import range_rate
 from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING, ACC_CONTACT_F, ACC_CONTACTS,
                                          ACC_DEBRIS_F, ACC_DEBRIS_T, ACC_EXTERNAL, ACC_SIZE, ACC_TENSION, D_CLOSING,
@@ -220,8 +221,11 @@ def step_forces(q, v, t, advance, main_tether, tow):
     u /= np.sqrt(u @ u)
     chaser = force[0:6]
     before = chaser[0:3].copy()
-    chaser_actuation(t, z, rate, u, rot_c, bodies[0, 0:3], bodies[0, 6:9], bodies[0, 9:12], inertia[0], control, step,
-                     advance, chaser, diag)
+    separation, relative = bodies[1, 0:3] - bodies[0, 0:3], bodies[1, 6:9] - bodies[0, 6:9]
+    chaser_actuation(t, z, rate, range_rate(separation[0], separation[1], separation[2], relative[0], relative[1],
+                                            relative[2]),
+                     u, rot_c, bodies[0, 0:3], bodies[0, 6:9], bodies[0, 9:12], inertia[0], control, step, advance,
+                     chaser, diag)
     debris = force[6:12]
     add_body_gravity(chaser, 0, bodies[0, 0], bodies[0, 1], bodies[0, 2], body_masses[0], mu)
     add_body_gravity(debris, 0, bodies[1, 0], bodies[1, 1], bodies[1, 2], body_masses[1], mu)

@@ -453,8 +453,8 @@ def chaser_control(attitude, thrust, along_body_z, thrust_params, thrust_state):
 
 
 @njit(cache=True)
-def chaser_actuation(t, elongation, rate, u_inertial, rot_c, com_c, vel_c, omega_c, inertia_c, control, step, advance,
-                     force, diag):
+def chaser_actuation(t, elongation, rate, range_rate, u_inertial, rot_c, com_c, vel_c, omega_c, inertia_c, control, step,
+                     advance, force, diag):
     """Thrust (the case's law ``control.thrust``, along the chaser's body z or against its velocity as in the
     lower-order model) and the sliding-mode torque (eqs. 7-10, :mod:`multibody.control.attitude`) from the main
     tether's elongation (m), its rate (m/s) and direction ``u_inertial`` (A -> net node); ``control`` a
@@ -466,6 +466,8 @@ def chaser_actuation(t, elongation, rate, u_inertial, rot_c, com_c, vel_c, omega
         Time (s).
     elongation, rate : float
         Main-tether elongation (m) and rate (m/s).
+    range_rate : float
+        Chaser-debris range rate (m/s, > 0 separating), :func:`multibody.control.thrust.range_rate`.
     u_inertial : (3,) float
         Unit vector A -> net node (inertial).
     rot_c : (3, 3) float
@@ -488,7 +490,8 @@ def chaser_actuation(t, elongation, rate, u_inertial, rot_c, com_c, vel_c, omega
         ``D_THRUST``, ``D_TORQUE``, ``D_SLIDING`` written.
     """
     attitude = control.attitude
-    magnitude = control.thrust(t, elongation, rate, control.thrust_params, control.thrust_state, step, advance)
+    magnitude = control.thrust(t, elongation, rate, range_rate, control.thrust_params, control.thrust_state, step,
+                               advance)
     diag[D_THRUST] = magnitude
     if magnitude != 0.0:
         if control.along_body_z:

@@ -19,13 +19,17 @@ Everything Exudyn sees of a body (its initial rotation vector and angular veloci
 joint markers' positions and frames, recorded moments) is written in the node frame once at build
 time by the functions here; the compiled kernels and the recorder turn the node's attitude and rate
 back to the body's (``body_to_lvlh = node_to_lvlh node_to_body^T``), so contact shapes, outputs and
-every caller keep the body frame. The node would return near the identity only if its body turned by
-that very rotation (2 rad about that axis); the end-of-step restore still keeps the attitude exact then.
+every caller keep the body frame (:func:`body_state_into`, the one turn both use). The node would return
+near the identity only if its body turned by that very rotation (2 rad about that axis); the end-of-step
+restore still keeps the attitude exact then.
 """
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from scipy.spatial.transform import Rotation
+
+from multibody.maths.rotations import rotation_matrix_from_rotation_vector_into
 
 #: The nodes' attitude (node->LVLH) at t = 0: 2 rad about (1, 2, 3)/sqrt(14), far from the identity
 #: (where the Lie-group update loses small turns) and from a half turn (where rotation vectors flip).
@@ -117,3 +121,42 @@ def inertia_node(inertia_body, node_to_body) -> np.ndarray:
     c = np.asarray(node_to_body, float)
     j = c.T @ np.asarray(inertia_body, float) @ c
     return 0.5 * (j + j.T)
+
+
+@njit(cache=True, inline="always")
+def body_state_into(q, qt, i, b, reference_com_lvlh, node_to_body, com_lvlh, velocity_lvlh, node_to_lvlh,
+                    body_to_lvlh, omega_lvlh, omega_body):
+    """Body ``b``'s state from its Exudyn node's coordinates, into row ``b`` of the outputs (no allocation, no
+    row views: the force kernel calls it for every body at every evaluation, the recorder at every sample).
+
+    Parameters
+    ----------
+    q, qt : (N,) float
+        Exudyn's coordinates and velocities; the body's six start at ``i``: CoM displacement (m), LVLH, and
+        rotation vector node->LVLH (rad); CoM velocity (m/s), LVLH, and angular velocity (rad/s), node frame.
+    i, b : int
+        Where the body's coordinates start; its row in the other arrays.
+    reference_com_lvlh : (nb, 3) float
+        Reference CoM positions (m), LVLH.
+    node_to_body : (nb, 3, 3) float
+        :func:`node_to_body_rotations`.
+    com_lvlh, velocity_lvlh : (nb, 3) float
+        Output: CoM (m) and CoM velocity (m/s), LVLH.
+    node_to_lvlh, body_to_lvlh : (nb, 3, 3) float
+        Output: the node's attitude and the body's (``node_to_lvlh node_to_body^T``).
+    omega_lvlh, omega_body : (nb, 3) float
+        Output: the angular velocity (rad/s) in LVLH and in the body frame.
+    """
+    for d in range(3):
+        com_lvlh[b, d] = reference_com_lvlh[b, d] + q[i + d]
+        velocity_lvlh[b, d] = qt[i + d]
+    rotation_matrix_from_rotation_vector_into(q[i + 3], q[i + 4], q[i + 5], node_to_lvlh, b)
+    wx, wy, wz = qt[i + 3], qt[i + 4], qt[i + 5]
+    # in scalars: numba sends small matrix products to BLAS, microseconds a call
+    for r in range(3):
+        omega_lvlh[b, r] = node_to_lvlh[b, r, 0] * wx + node_to_lvlh[b, r, 1] * wy + node_to_lvlh[b, r, 2] * wz
+        omega_body[b, r] = node_to_body[b, r, 0] * wx + node_to_body[b, r, 1] * wy + node_to_body[b, r, 2] * wz
+        for k in range(3):
+            body_to_lvlh[b, r, k] = (node_to_lvlh[b, r, 0] * node_to_body[b, k, 0]
+                                     + node_to_lvlh[b, r, 1] * node_to_body[b, k, 1]
+                                     + node_to_lvlh[b, r, 2] * node_to_body[b, k, 2])

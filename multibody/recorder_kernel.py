@@ -15,7 +15,8 @@ from numba.experimental import structref
 
 from multibody.jit_cache import UnliteralStructRef
 from multibody.maths.linalg3 import matmat3, mattmat3, mattvec3, matvec3
-from multibody.maths.rotations import rotation_matrix_from_rotation_vector, rotation_vector_from_matrix_into
+from multibody.maths.rotations import rotation_vector_from_matrix_into
+from multibody.node_frame import body_state_into
 
 
 @njit(cache=True)
@@ -114,6 +115,8 @@ class BodySample(NamedTuple):
     #                                   and rotational kinetic energy (J); CW potential of all bodies (J); the chaser's
     #                                   kinetic energy (J); linear (3) and angular (3) momentum of all bodies (as
     #                                   body_totals); joint elastic energy (J)
+    node_to_lvlh: np.ndarray          # (nb, 3, 3) work space: each body's Exudyn node attitude (not recorded)
+    omega_lvlh: np.ndarray            # (nb, 3) work space: angular velocity (rad/s), LVLH (not recorded)
 
 
 def body_sample_buffers(n_bodies: int, n_joints: int) -> BodySample:
@@ -126,7 +129,8 @@ def body_sample_buffers(n_bodies: int, n_joints: int) -> BodySample:
     nb, nj = n_bodies, n_joints
     return BodySample(np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3, 3)), np.zeros((nb, 3)),
                       np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 9)),
-                      np.zeros((nj, 3)), np.zeros((nj, 3)), np.zeros(nj), np.zeros(17))
+                      np.zeros((nj, 3)), np.zeros((nj, 3)), np.zeros(nj), np.zeros(17), np.zeros((nb, 3, 3)),
+                      np.zeros((nb, 3)))
 
 
 @njit(cache=True)
@@ -138,7 +142,7 @@ def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
     q, qt : (N,) float
         Exudyn's coordinates and velocities; body ``b`` starts at ``bodies.index[b]`` (CoM displacement
         (m), rotation vector node->LVLH (rad); CoM velocity (m/s), omega (rad/s, node frame)); the
-        sample turns the node's attitude and rate into the body's (``bodies.node_to_body``).
+        sample turns the node's attitude and rate into the body's (:func:`multibody.node_frame.body_state_into`).
     bodies : SampledBodies
     joints : SampledJoints
     active : (nj,) float
@@ -160,15 +164,11 @@ def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
     force_lvlh, moment_lvlh, force_body, moment_body = out.force_lvlh, out.moment_lvlh, out.force_body, out.moment_body
     body_totals, joint_rotation, joint_rate = out.body_totals, out.joint_rotation, out.joint_rate
     joint_energy, summary = out.joint_energy, out.summary
+    node_to_body, node_to_lvlh, omega_lvlh = bodies.node_to_body, out.node_to_lvlh, out.omega_lvlh
     nb = body_mass.shape[0]
     for b in range(nb):
-        i = body_index[b]
-        c = bodies.node_to_body[b]
-        for d in range(3):
-            com[b, d] = body_reference[b, d] + q[i + d]
-            vel[b, d] = qt[i + d]
-        omega[b] = matvec3(c, qt[i + 3:i + 6])
-        rot[b] = matmat3(rotation_matrix_from_rotation_vector(q[i + 3:i + 6]), c.T)
+        body_state_into(q, qt, body_index[b], b, body_reference, node_to_body, com, vel, node_to_lvlh, rot,
+                        omega_lvlh, omega)
         for d in range(3):
             force_lvlh[b, d] = impulse[b, d] / interval if interval > 0.0 else 0.0
             moment_lvlh[b, d] = impulse[b, 3 + d] / interval if interval > 0.0 else 0.0

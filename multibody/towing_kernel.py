@@ -28,7 +28,7 @@ from numba import njit, types
 from numba.experimental import structref
 
 from multibody.control.attitude import desired_attitude, sliding_mode_torque
-from multibody.control.thrust import THRUST_LAW
+from multibody.control.thrust import THRUST_LAW, range_rate
 from multibody.connection_point import STATE_SIZE, TIME, V_N, X_N, advance_point, initial_point_state
 from multibody.kernel import verlet_evaluation_state
 from multibody.maths.rotations import rotation_matrix_from_rotation_vector
@@ -166,7 +166,9 @@ def towing_forces(q, v, t, parts, thrust, step, advance, out_force, out_diag):
     add_body_gravity(out_force, CHASER, com_c[0], com_c[1], com_c[2], masses[1], mu)
     add_body_gravity(out_force, DEBRIS, com_d[0], com_d[1], com_d[2], masses[2], mu)
 
-    magnitude = command(t, z, z_rate, thrust_params, thrust_state, step, advance)
+    r_rate = range_rate(com_d[0] - com_c[0], com_d[1] - com_c[1], com_d[2] - com_c[2], v[DEBRIS] - v[CHASER],
+                        v[DEBRIS + 1] - v[CHASER + 1], v[DEBRIS + 2] - v[CHASER + 2])
+    magnitude = command(t, z, z_rate, r_rate, thrust_params, thrust_state, step, advance)
     out_diag[THRUST] = magnitude
     if magnitude != 0.0:
         if thrust_along_body_z:

@@ -43,7 +43,13 @@ def _cmd_run(args) -> int:
         result = api.run(case, out, progress=lambda t: bar.update(task, completed=t, t=t),
                          overwrite=args.overwrite, pending=steps, command=args.command)
     if args.json:
-        extra = {"structures": result.verdict} if result.verdict is not None else {}
+        extra = {}
+        if result.verdict is not None:
+            from riskassess.products.envelope import single_run_probability
+
+            # the key scripts read from assess --json, in both modes: here it holds no number (one run is one draw)
+            p = single_run_probability(result.verdict)
+            extra = {"structures": result.verdict, "p_secondary_debris": p, "condition": p["condition"]}
         print(json.dumps({**result.summary, **extra}, indent=2))
     else:
         print_summary(result.summary, result.path)

@@ -55,6 +55,39 @@ def evidence_gaps(time, contact_force_debris_lvlh, skip_until: float) -> list[st
     return gaps
 
 
+#: The rules that make a location indeterminate, keyed by a phrase of the reason their producer writes
+#: (:func:`evidence_gaps`, :func:`location_state`, :func:`structures.thread_gaps.pass_through_reason`,
+#: :func:`apply_twin`), so a sweep can count runs per rule without parsing the numbers in the reasons.
+INDETERMINATE_RULES = (
+    ("samples after skip_initial", "too_few_judged_samples"),
+    ("s apart; a verdict needs at least", "coarse_sampling"),
+    ("no contact between the net and the debris", "no_capture_load"),
+    ("load samples that are not finite", "non_finite_loads"),
+    ("net threads passed through", "thread_pass_through"),
+    ("its twin run exceeds", "twin_exceeds"),
+    ("is one draw of a chaotic capture", "chaotic_peak"),
+    ("could not be checked against a twin run", "twin_not_run"),
+)
+
+
+def indeterminate_rules(reason: str | None) -> list[str]:
+    """The rules (:data:`INDETERMINATE_RULES`) a location's ``indeterminate_reason`` names, in their order there;
+    ``["other"]`` for a reason no rule's phrase matches, ``[]`` for None.
+
+    Parameters
+    ----------
+    reason : str or None
+        The location's ``indeterminate_reason`` (several reasons are joined by "; ").
+
+    Returns
+    -------
+    list of str
+    """
+    if not reason:
+        return []
+    return [rule for phrase, rule in INDETERMINATE_RULES if phrase in reason] or ["other"]
+
+
 def location_state(result: dict, gaps: list[str]) -> tuple[str, str | None]:
     """('fails' | 'holds' | 'indeterminate', reason) of one judged location. An exceedance seen
     is a failure whatever else is missing; a pass needs judged, finite loads and no evidence gap.

@@ -30,6 +30,13 @@ chattering. tau is set one decade above the reference model's natural frequency
 :math:`\\omega_m = \\sqrt{b (k_{MT} + K_P)}` (:func:`rate_filter_time`), so the reference dynamics
 pass with < 6 deg of phase lag.
 
+**Range-rate damping** (``mrac.range_damping``, :func:`range_damping_force`). On the full net the chaser hangs on the
+main tether in series with the net bag; the laws' rate gain acts on the tether's elongation rate, which the bag's
+compliance and the central node's vibration dominate, so the chaser-bag mode, which the breathing drives near
+resonance at 20.44 deg/s, is damped weakly and through a saturating channel. Both laws may add :math:`-c_R \dot r`,
+:math:`\dot r` the chaser-debris range rate (zero in steady towing); with it the rate estimate's corner can sit at
+:math:`\omega_m` (docs/towing.md, MRAC: "Why the taut-phase swing grows at 20.44 deg/s").
+
 This module holds what both laws share (parameter head, reference model); each law is a plug-in of
 :mod:`multibody.control.thrust_laws` (``mrac1.py``, ``mrac2.py``: its gains, ``command``, initial
 state); ``params`` and ``state`` are flat float arrays for the compiled towing kernels, the common
@@ -43,8 +50,8 @@ from numba import njit
 
 # params indices common to both laws; each law appends its gains (thrust_laws/mrac1.py, mrac2.py)
 (T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN, Z_SLACK, F_STEADY, NOTCH_W, NOTCH_SIGMA,
- HOLD_TIME) = range(15)
-N_COMMON = 15
+ HOLD_TIME, C_RANGE) = range(16)
+N_COMMON = 16
 # state: reference model z_m, z_m rate, the rate estimate's last elongation and last rate, the breathing notch's last
 # two inputs and outputs, the time of the last slack sample, then adaptive parameters
 ZM, ZM_RATE, Z_LAST, RATE_LAST, NOTCH_X1, NOTCH_X2, NOTCH_Y1, NOTCH_Y2, SLACK_AT, A0 = range(10)
@@ -120,7 +127,8 @@ def common_params(case, tether) -> list:
     z_d (m), K_P (N/m), K_D (N s/m), the rate estimate's time constant (s, 0: the measured rate), the
     saturation's lower bound u_min (N; :func:`actuator_range`, default -u_max: the paper's symmetric sat), the
     slack threshold (m; ``mrac.slack_elongation``, -1: off) and the steady thrust (N; :func:`steady_thrust`), which
-    :func:`slack_hold` commands below that threshold.
+    :func:`slack_hold` commands below that threshold, and the range damping c_R (N s/m; ``mrac.range_damping``,
+    :func:`range_damping_force`).
 
     Parameters
     ----------
@@ -138,7 +146,7 @@ def common_params(case, tether) -> list:
     omega_notch = notch_frequency(case)
     return [th.t_on, u_max, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
             m.rate_filter_time, u_min, z_slack, f_steady, omega_notch, omega_notch / (2.0 * m.notch_quality),
-            hold_time(case)]
+            hold_time(case), m.range_damping]
 
 
 def hold_time(case) -> float:
@@ -255,6 +263,30 @@ def reference_steady_elongation(k_mt, k_p, z_d) -> float:
         Desired elongation (m).
     """
     return k_p * z_d / (k_mt + k_p)
+
+
+@njit(cache=True)
+def range_damping_force(params, range_rate):
+    """The range-rate damping both laws add to their command (N): :math:`-c_R \dot r`, with :math:`\dot r` the rate
+    of the chaser-debris CoM distance (m/s, > 0 separating) and c_R = ``params[C_RANGE]`` (``mrac.range_damping``;
+    0: the paper's laws).
+
+    On the netted plant the chaser hangs on the main tether in series with the net bag, whose dynamic stiffness is
+    some 300-1100 N/m against the tether's 3000 N/m (docs/towing.md): the laws' rate gain acts on the main tether's
+    elongation rate, i.e. on the tension rate, which the bag's compliance and the central node's vibration dominate,
+    so it damps the chaser-bag mode only weakly and through a channel that chatters at the saturation. The mode
+    itself is the chaser moving against the debris; a force against the range rate damps it directly and vanishes
+    in steady towing (both bodies then share the acceleration, :math:`\dot r = 0`), so the laws' static balance and
+    their reference model are unchanged.
+
+    Parameters
+    ----------
+    params : (k,) float
+        The law's parameters (``C_RANGE`` used).
+    range_rate : float
+        Chaser-debris range rate (m/s), :func:`multibody.control.thrust.range_rate`.
+    """
+    return -params[C_RANGE] * range_rate
 
 
 @njit(cache=True)

@@ -4,10 +4,11 @@ main-tether elongation controllers (one module each in :mod:`multibody.control.t
 Every law is a compiled function of the same signature (:data:`THRUST_SIGNATURE`), called once per
 integration step (a digital controller with zero-order hold over the step):
 
-``command(t, z, z_rate, params, state, step, advance) -> F_t``
+``command(t, z, z_rate, range_rate, params, state, step, advance) -> F_t``
 
 * ``t`` time (s); ``z`` main-tether elongation :math:`l_{MT} - l_{MT,0}` (m) and ``z_rate`` its
-  rate (m/s), measured at the chaser;
+  rate (m/s), measured at the chaser; ``range_rate`` the rate of the chaser-debris CoM distance (m/s,
+  > 0 separating; :func:`range_rate`), what the chaser's relative navigation measures;
 * ``params`` (k,) float the law's constants, ``state`` (j,) float its internal states (reference
   model, adaptive parameters), updated in place over ``step`` (s) when ``advance``;
 * returns the thrust magnitude (N) along the chaser's thrust direction.
@@ -17,18 +18,34 @@ law is adding one module to :mod:`multibody.control.thrust_laws` implementing :c
 """
 from __future__ import annotations
 
+import math
 from typing import Protocol
 
 import numpy as np
-from numba import types
+from numba import njit, types
 
 _VECTOR = types.float64[::1]
 #: numba signature of a thrust law's ``command`` (see the module doc); every law is compiled eagerly
 #: with it so that one compiled towing kernel takes any of them.
-THRUST_SIGNATURE = types.float64(types.float64, types.float64, types.float64, _VECTOR, _VECTOR, types.float64,
-                                 types.boolean)
+THRUST_SIGNATURE = types.float64(types.float64, types.float64, types.float64, types.float64, _VECTOR, _VECTOR,
+                                 types.float64, types.boolean)
 #: numba type of a thrust law passed to a compiled kernel (first-class function).
 THRUST_LAW = types.FunctionType(THRUST_SIGNATURE)
+
+
+@njit(cache=True)
+def range_rate(dx, dy, dz, dvx, dvy, dvz):
+    """Rate of the chaser-debris CoM distance (m/s, > 0 while they separate): the relative velocity
+    projected on the line of centres.
+
+    Parameters
+    ----------
+    dx, dy, dz : float
+        Debris CoM minus chaser CoM (m), any frame.
+    dvx, dvy, dvz : float
+        Debris CoM velocity minus chaser CoM velocity (m/s), the same frame.
+    """
+    return (dx * dvx + dy * dvy + dz * dvz) / math.sqrt(dx * dx + dy * dy + dz * dz)
 
 
 class ThrustLaw(Protocol):

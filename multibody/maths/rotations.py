@@ -106,7 +106,23 @@ def quaternion_from_rotation_vector_tuple(rotation_vector):
     tuple of 4 float
         (q0, q1, q2, q3), scalar first.
     """
-    x, y, z = rotation_vector[0], rotation_vector[1], rotation_vector[2]
+    return quaternion_from_rotation_vector_xyz(rotation_vector[0], rotation_vector[1], rotation_vector[2])
+
+
+@njit(cache=True, inline="always")
+def quaternion_from_rotation_vector_xyz(x, y, z):
+    """:func:`quaternion_from_rotation_vector_tuple` of the rotation vector (x, y, z) (rad).
+
+    Parameters
+    ----------
+    x, y, z : float
+        Axis times angle (rad).
+
+    Returns
+    -------
+    tuple of 4 float
+        (q0, q1, q2, q3), scalar first.
+    """
     angle = math.sqrt(x * x + y * y + z * z)
     if angle < 1e-8:
         return 1.0 - angle * angle / 8.0, 0.5 * x, 0.5 * y, 0.5 * z
@@ -240,11 +256,30 @@ def compose_rotation_vectors(rotation_vector, increment_body):
     (3,) float
         The composed rotation body->reference (rad).
     """
-    w0, x0, y0, z0 = quaternion_from_rotation_vector_tuple(rotation_vector)
-    w1, x1, y1, z1 = quaternion_from_rotation_vector_tuple(increment_body)
     out = np.empty(3)
+    compose_rotation_vectors_into(rotation_vector[0], rotation_vector[1], rotation_vector[2], increment_body[0],
+                                  increment_body[1], increment_body[2], out, 0)
+    return out
+
+
+@njit(cache=True, inline="always")
+def compose_rotation_vectors_into(rx, ry, rz, ix, iy, iz, out, k):
+    """:func:`compose_rotation_vectors` of the rotation vector (rx, ry, rz) and the body-frame increment
+    (ix, iy, iz) (rad) into ``out[k:k + 3]`` (no allocation: the net step composes every body's every step).
+
+    Parameters
+    ----------
+    rx, ry, rz : float
+        Current rotation body->reference (rad).
+    ix, iy, iz : float
+        Rotation increment (rad), body frame.
+    out : (N,) float
+        Output: ``out[k:k + 3]`` is set to the composed rotation body->reference (rad).
+    k : int
+    """
+    w0, x0, y0, z0 = quaternion_from_rotation_vector_xyz(rx, ry, rz)
+    w1, x1, y1, z1 = quaternion_from_rotation_vector_xyz(ix, iy, iz)
     rotation_vector_from_quaternion_into(w0 * w1 - x0 * x1 - y0 * y1 - z0 * z1,
                                          w0 * x1 + x0 * w1 + y0 * z1 - z0 * y1,
                                          w0 * y1 - x0 * z1 + y0 * w1 + z0 * x1,
-                                         w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1, out)
-    return out
+                                         w0 * z1 + x0 * y1 - y0 * x1 + z0 * w1, out[k:k + 3])

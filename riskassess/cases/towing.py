@@ -98,6 +98,10 @@ class Mrac(Strict):
     gamma_theta: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = Field(description="MRAC-2 diagonal of Gamma_theta (-).")
     xi_2: NonNegative = Field(description="MRAC-2 e-modification gain xi_2 (-).")
     q: Annotated[list[Positive], Field(min_length=2, max_length=2)] = Field(description="MRAC-2 diagonal of Q in eq. (21a) (-).")
+    range_damping: NonNegative = Field(
+        0.0, description="Range-rate damping c_R (N s/m) both laws add to their command: -c_R dr/dt, r the chaser-debris "
+                         "CoM distance from relative navigation; it damps the chaser moving against the netted debris "
+                         "and is zero in steady towing. 0: the paper's laws (docs/towing.md, MRAC on the full net).")
     rate_filter_time: NonNegative = Field(
         0.0, description="Time constant tau of the elongation-rate estimate both laws use (s): the band-limited "
                          "difference quotient of the sampled elongation, corner 1/tau; 0: the plant's "

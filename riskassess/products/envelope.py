@@ -118,6 +118,64 @@ def debris_probability(rows: list[dict], confidence: float = 0.95) -> dict:
             "runs": n, "debris_runs": k, "no_debris_runs": m, "unknown_runs": unknown}
 
 
+#: What a single run's ``p_secondary_debris`` says it needs: one run is one draw, not a probability.
+MONTE_CARLO_NEEDED = "--monte-carlo N"
+
+
+def single_run_probability(verdict: dict) -> dict:
+    """``p_secondary_debris`` of a single run (``assess --json`` without ``--monte-carlo``): no number.
+
+    One deterministic run answers "debris / no debris / indeterminate" for one draw of the inputs; any
+    number put here (0, 1, a location's likelihood) could be read as P(secondary debris), so the
+    estimate and its interval are None, the Monte Carlo counts are 0, and ``needs`` says how to get one.
+    The run's answer and what it rests on go to ``deterministic`` and ``condition``.
+
+    Parameters
+    ----------
+    verdict : dict
+        The run's structural verdict (``structures.json``): ``debris_state`` and per location
+        ``state`` and ``condition``.
+
+    Returns
+    -------
+    dict
+        The keys of :func:`debris_probability` (``estimate``, ``interval``, ``confidence`` None;
+        ``runs``, ``debris_runs``, ``no_debris_runs``, ``unknown_runs`` 0: no Monte Carlo run), plus
+        ``needs`` (:data:`MONTE_CARLO_NEEDED`), ``deterministic`` (the run's ``debris_state``) and
+        ``condition`` (:func:`deterministic_condition`).
+    """
+    return {"estimate": None, "interval": None, "confidence": None, "runs": 0, "debris_runs": 0,
+            "no_debris_runs": 0, "unknown_runs": 0, "needs": MONTE_CARLO_NEEDED,
+            "deterministic": verdict.get("debris_state"), "condition": deterministic_condition(verdict)}
+
+
+def deterministic_condition(verdict: dict) -> str:
+    """The single run's result and the condition it rests on: the answer, then the condition sentence of
+    each location that decides it (the failing ones for debris, the indeterminate ones for no verdict, all
+    for no debris), then that a probability needs a Monte Carlo.
+
+    Parameters
+    ----------
+    verdict : dict
+        The structural verdict (``structures.json``).
+
+    Returns
+    -------
+    str
+    """
+    state = verdict.get("debris_state") or ("debris" if verdict.get("secondary_debris") else "no_debris")
+    deciding = {"debris": "fails", "indeterminate": "indeterminate"}.get(state)
+    locations = verdict.get("locations") or []
+    conditions = [loc["condition"] for loc in locations
+                  if loc.get("condition") and (deciding is None or loc.get("state") == deciding)]
+    answer = {"debris": "secondary debris", "no_debris": "no secondary debris",
+              "indeterminate": "indeterminate (no verdict; never read as no debris)"}[state]
+    if state == "debris" and verdict.get("released_pieces") and not conditions:
+        conditions = [f"{len(verdict['released_pieces'])} piece(s) released."]
+    return (f"One deterministic run: {answer}. " + " ".join(conditions)
+            + f" P(secondary debris) is not given by one run: it needs assess {MONTE_CARLO_NEEDED}.").replace("  ", " ")
+
+
 def utilization_sensitivity(rows: list[dict]) -> dict:
     """Sensitivity of each weak location's utilization (peak over decisive allowable) to each
     varied or uncertain input: Spearman's rank correlation over the finished runs with a finite

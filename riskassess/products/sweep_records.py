@@ -65,3 +65,58 @@ def debris_state_of(record: dict) -> str | None:
     if state == NO_DEBRIS and not evidence_is_finite(record):
         return INDETERMINATE
     return state
+
+
+def indeterminate_reasons_of(record: dict) -> list[dict]:
+    """Why a done run's record is indeterminate: one entry per (location, rule), ``location``, ``rule``
+    (:data:`structures.verdict.INDETERMINATE_RULES`) and the verdict's ``reason``; empty when it is not
+    indeterminate. A run made indeterminate by non-finite evidence alone (:func:`debris_state_of`) gets
+    ``location`` None and rule ``non_finite_evidence``.
+
+    Parameters
+    ----------
+    record : dict
+        A run's record (:func:`riskassess.sweep.runner.run_record`), with per location ``indeterminate_reason`` and
+        ``indeterminate_rules`` (records stored before them give ``rule`` "not_recorded").
+
+    Returns
+    -------
+    list of dict
+    """
+    if debris_state_of(record) != INDETERMINATE:
+        return []
+    reasons = []
+    for name, loc in (record.get("locations") or {}).items():
+        if "indeterminate_rules" not in loc:
+            continue
+        reasons += [{"location": name, "rule": rule, "reason": loc["indeterminate_reason"]}
+                    for rule in loc["indeterminate_rules"]]
+    if reasons:
+        return reasons
+    if any("indeterminate_rules" not in loc for loc in (record.get("locations") or {}).values()):
+        return [{"location": None, "rule": "not_recorded", "reason": "stored before the store kept reasons"}]
+    return [{"location": None, "rule": "non_finite_evidence",
+             "reason": "a location's peak, utilization or likelihood is not finite"}]
+
+
+def indeterminate_rule_counts(rows: list[dict]) -> dict:
+    """How many indeterminate runs each (location, rule) made so (a run with several counts under each).
+
+    Parameters
+    ----------
+    rows : list of dict
+        Run rows of the sweep store (:meth:`riskassess.sweep.store.ResultStore.rows`); done runs' ``result``
+        records (:func:`riskassess.sweep.runner.run_record`).
+
+    Returns
+    -------
+    dict
+        ``(location, rule) -> runs``, most runs first; ``location`` None for a run-wide rule.
+    """
+    counts: dict = {}
+    for row in rows:
+        if row.get("state") != "done" or not row.get("result"):
+            continue
+        for key in {(r["location"], r["rule"]) for r in indeterminate_reasons_of(row["result"])}:
+            counts[key] = counts.get(key, 0) + 1
+    return dict(sorted(counts.items(), key=lambda kv: (-kv[1], str(kv[0]))))

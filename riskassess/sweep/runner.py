@@ -24,10 +24,10 @@ from riskassess.cases.impact import CaseError, validate_case
 from riskassess.products.outfolder import open_existing
 from riskassess.products.results import atomic_write_json
 from riskassess.sweep.cluster_log import StderrToFile, distributed_logging_to
-from riskassess.products.sweep_records import debris_state_of
+from riskassess.products.sweep_records import debris_state_of, indeterminate_reasons_of
 from riskassess.sweep.spec import RunSpec, SweepSpecError, case_with
 from riskassess.sweep.store import ResultStore
-from structures.verdict import INDETERMINATE
+from structures.verdict import INDETERMINATE, indeterminate_rules
 
 #: Error types that come from the cluster, not from the run: a resume retries these runs.
 INFRASTRUCTURE_ERRORS = ("KilledWorker", "CommClosedError", "CancelledError", "TimeoutError", "FutureCancelledError")
@@ -80,7 +80,10 @@ def _location_record(loc: dict) -> dict:
             "min_margin_of_safety": min((c["margin_of_safety"] for c in criteria.values()
                                          if c["margin_of_safety"] is not None), default=None),
             "peaks": {name: c["peak"] for name, c in criteria.items()},
-            "units": {name: c["unit"] for name, c in criteria.items()}}
+            "units": {name: c["unit"] for name, c in criteria.items()},
+            # why a location has no verdict, kept so a sweep can say which rule made its runs indeterminate
+            "state": loc.get("state"), "indeterminate_reason": loc.get("indeterminate_reason"),
+            "indeterminate_rules": indeterminate_rules(loc.get("indeterminate_reason"))}
 
 
 def run_record(summary: dict, verdict: dict | None, overrides: dict) -> dict:
@@ -138,6 +141,7 @@ def run_record(summary: dict, verdict: dict | None, overrides: dict) -> dict:
     record["debris_state"] = debris_state_of(record)
     if record["debris_state"] == INDETERMINATE:
         record["secondary_debris"] = None
+    record["indeterminate_reasons"] = indeterminate_reasons_of(record)
     return record
 
 

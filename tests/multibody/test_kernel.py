@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from multibody.kernel import compose_rotation_vectors, verlet_evaluation_state
+from multibody.kernel import verlet_evaluation_state
+from multibody.maths.rotations import compose_rotation_vectors
 
 
 @pytest.mark.parametrize("seed", range(5))

@@ -8,7 +8,13 @@ from scipy.spatial.transform import Rotation
 
 from bench.bench_instep_attitude import ring
 from multibody.impact import ImpactSimulation
-from multibody.node_frame import NODE_TO_LVLH_AT_START, inertia_node, node_to_body_rotation, vector_node
+from multibody.node_frame import (
+    NODE_TO_LVLH_AT_START,
+    body_state_into,
+    inertia_node,
+    node_to_body_rotation,
+    vector_node,
+)
 from tests.multibody.test_hinge import analytic_frequency, ring_down_assembly
 
 
@@ -47,6 +53,31 @@ def test_node_frame_quantities_turn_back_to_the_body_frame():
     assert omega_node @ j_node @ omega_node == pytest.approx(omega_body @ inertia_body @ omega_body, rel=1e-14)
     np.testing.assert_allclose(NODE_TO_LVLH_AT_START @ j_node @ omega_node, body_to_lvlh @ inertia_body @ omega_body,
                                rtol=1e-14, atol=1e-15)
+
+
+def test_body_state_from_the_node_coordinates_matches_the_rotations():
+    # the one turn the kernel and the recorder share: body->LVLH = node->LVLH (node->body)^T, the node-frame
+    # rate turned into LVLH and into the body frame; against scipy's rotations (round-off, 1e-15)
+    body_to_lvlh_start = Rotation.from_rotvec([0.3, -0.2, 0.1]).as_matrix()
+    node_to_body = node_to_body_rotation(body_to_lvlh_start)[np.newaxis]
+    rotation_vector, omega_node = np.array([0.7, -1.1, 0.4]), np.array([0.02, -0.05, 0.3])
+    com, velocity = np.array([1.0, -2.0, 3.0]), np.array([0.1, 0.2, -0.3])
+    q = np.concatenate([np.zeros(4), com, rotation_vector])     # the body's six coordinates start at 4
+    qt = np.concatenate([np.zeros(4), velocity, omega_node])
+    reference = np.array([[10.0, 20.0, 30.0]])
+    out = [np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3, 3)), np.zeros((2, 3, 3)), np.zeros((2, 3)),
+           np.zeros((2, 3))]
+    body_state_into(q, qt, 4, 0, reference, node_to_body, *out)
+    com_lvlh, velocity_lvlh, node_to_lvlh, body_to_lvlh, omega_lvlh, omega_body = (a[0] for a in out)
+    node_expected = Rotation.from_rotvec(rotation_vector).as_matrix()
+    np.testing.assert_array_equal(com_lvlh, reference[0] + com)
+    np.testing.assert_array_equal(velocity_lvlh, velocity)
+    np.testing.assert_allclose(node_to_lvlh, node_expected, atol=1e-15)
+    np.testing.assert_allclose(body_to_lvlh, node_expected @ node_to_body[0].T, atol=1e-15)
+    np.testing.assert_allclose(omega_lvlh, node_expected @ omega_node, atol=1e-15)
+    np.testing.assert_allclose(omega_body, node_to_body[0] @ omega_node, atol=1e-15)
+    # the same rate, seen from either frame
+    np.testing.assert_allclose(body_to_lvlh @ omega_body, omega_lvlh, atol=1e-15)
 
 
 def hinge_angle_per_amplitude(angle0):

@@ -1,4 +1,6 @@
 """Run folders shared by the riskassess tests (simulated once per session)."""
+import contextlib
+import io
 from pathlib import Path
 
 import pytest
@@ -22,7 +24,11 @@ def assessed(tmp_path_factory):
     case = tmp / "small_assess.toml"
     case.write_text(shortened_case(2.0))
     out = tmp / "run"
-    assert main(["assess", str(case), "--out", str(out), "--json"]) == 0
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        assert main(["assess", str(case), "--out", str(out), "--json"]) == 0
+    # what `assess --json` printed, kept beside the folder (not in it: the folder is the tool's)
+    (tmp / "assess_stdout.json").write_text(printed.getvalue())
     return out
 
 

@@ -37,3 +37,26 @@ def test_stress_series_written(assessed):
     stresses = np.load(assessed / "structures.npz")
     assert "asar_mount/von_mises_stress" in stresses.files
     assert len(stresses["time"]) == len(stresses["asar_mount/normal_stress"])
+
+
+def test_single_run_json_carries_p_secondary_debris_without_a_number(assessed):
+    """`assess --json` without --monte-carlo: the key scripts read is there, with no number that could read as a
+    probability (one run is one draw), the run's answer, and its condition sentence (issue 23, "Done when")."""
+    printed = json.loads((assessed.parent / "assess_stdout.json").read_text())
+    verdict = json.loads((assessed / "structures.json").read_text())
+    p = printed["p_secondary_debris"]
+    # the Monte Carlo keys of riskassess.products.envelope.debris_probability, all without a value
+    assert p["estimate"] is None and p["interval"] is None and p["confidence"] is None
+    assert (p["runs"], p["debris_runs"], p["no_debris_runs"], p["unknown_runs"]) == (0, 0, 0, 0)
+    assert p["needs"] == "--monte-carlo N"
+    assert p["deterministic"] == verdict["debris_state"] == printed["structures"]["debris_state"]
+    assert printed["condition"] == p["condition"]
+    # the sentence states the answer and every location that decides it, word for word from structures.json
+    deciding = {"debris": "fails", "indeterminate": "indeterminate"}.get(verdict["debris_state"])
+    answer = {"debris": "secondary debris.", "no_debris": "no secondary debris.",
+              "indeterminate": "indeterminate"}[verdict["debris_state"]]
+    assert p["condition"].startswith("One deterministic run: " + answer)
+    for loc in verdict["locations"]:
+        if deciding is None or loc["state"] == deciding:
+            assert loc["condition"] in p["condition"]
+    assert p["condition"].endswith("it needs assess --monte-carlo N.")

@@ -262,3 +262,28 @@ def test_utilization_sensitivity_is_the_rank_correlation_with_each_input():
     s = utilization_sensitivity(rows)
     assert s["hinge"]["launch.velocity"] == pytest.approx(1.0) and s["dish"]["contact.mu_kinetic"] == pytest.approx(-1.0)
     assert abs(s["hinge"]["contact.mu_kinetic"]) < 0.7 and s["hinge"]["c"] is None
+
+
+def test_single_run_probability_holds_no_number_whatever_the_run_said():
+    """A single run's p_secondary_debris (assess --json without --monte-carlo): no estimate, no interval, for each of
+    the three answers; an indeterminate run is never worded as no debris, and only the deciding locations' conditions
+    are quoted."""
+    from riskassess.products.envelope import single_run_probability
+
+    holds = {"name": "a", "state": "holds", "condition": "a holds: margin +0.50."}
+    fails = {"name": "b", "state": "fails", "condition": "b breaks if its moment allowable is below 223 N m."}
+    unknown = {"name": "c", "state": "indeterminate", "condition": "c: indeterminate (twin unchecked)."}
+    cases = {"debris": ([holds, fails], "secondary debris.", [fails], [holds]),
+             "no_debris": ([holds], "no secondary debris.", [holds], []),
+             "indeterminate": ([holds, unknown], "indeterminate (no verdict; never read as no debris).", [unknown],
+                               [holds])}
+    for state, (locations, answer, quoted, left_out) in cases.items():
+        p = single_run_probability({"debris_state": state, "locations": locations, "released_pieces": []})
+        assert p["estimate"] is None and p["interval"] is None and p["confidence"] is None and p["runs"] == 0
+        assert p["deterministic"] == state and p["needs"] == "--monte-carlo N"
+        assert p["condition"].startswith(f"One deterministic run: {answer} ")
+        assert all(loc["condition"] in p["condition"] for loc in quoted)
+        assert not any(loc["condition"] in p["condition"] for loc in left_out)
+    # a release without a failing row (older folders) still says what made the debris
+    p = single_run_probability({"debris_state": "debris", "locations": [holds], "released_pieces": [{}]})
+    assert "1 piece(s) released." in p["condition"]

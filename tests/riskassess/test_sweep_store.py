@@ -187,3 +187,42 @@ def test_lock_file_that_is_not_ours_is_left_alone(tmp_path):
     with pytest.raises(StoreError, match="not a lock file"):
         ResultStore(path)
     assert (tmp_path / "results.sqlite.lock").read_text() == "my notes\n"
+
+
+def test_the_store_keeps_why_a_run_is_indeterminate():
+    """run_record keeps each location's state, reason and rule; an indeterminate run's record lists them per
+    (location, rule), and a set of rows counts runs per (location, rule) (bench/bench_safe_velocity.py prints it)."""
+    from riskassess.products.sweep_records import indeterminate_rule_counts
+    from riskassess.sweep.runner import run_record
+
+    summary = {"peak_contact_force_N": {"value": 10.0}, "peak_contact_moment_about_debris_com_Nm": {"value": 1.0},
+               "joints": {}, "checks": {"energy_balance_relative_drift": 1e-6}, "wall_time_s": 1.0,
+               "steps_per_second": 1e3}
+    threads = ("net threads passed through solar_array (node-only contact; ...): the load they would have put on it, "
+               "at most 80 N and 355 N m about the joint, could take moment past the allowable (1.20 of it)")
+
+    def location(name, state, reason=None, peak=88.0):
+        return {"name": name, "fails": state == "fails", "likelihood": 0.0, "released_at_s": None, "state": state,
+                "indeterminate_reason": reason,
+                "criteria": {"moment": {"peak": peak, "decisive_allowable": 200.0, "margin_of_safety": 200 / peak - 1,
+                                        "unit": "N m"}}}
+
+    def verdict(state, *locations):
+        return {"locations": list(locations), "released_pieces": [], "debris_state": state,
+                "secondary_debris": {"debris": True, "no_debris": False}.get(state)}
+
+    unknown = run_record(summary, verdict("indeterminate", location("array", "indeterminate", threads),
+                                          location("asar", "holds")), {"launch.velocity": 2.0})
+    assert unknown["locations"]["array"]["indeterminate_rules"] == ["thread_pass_through"]
+    assert unknown["locations"]["asar"]["state"] == "holds" and unknown["locations"]["asar"]["indeterminate_rules"] == []
+    assert unknown["indeterminate_reasons"] == [{"location": "array", "rule": "thread_pass_through", "reason": threads}]
+    safe = run_record(summary, verdict("no_debris", location("array", "holds")), {"launch.velocity": 2.0})
+    assert safe["indeterminate_reasons"] == []
+    # "no debris" on a NaN peak is indeterminate run-wide (debris_state_of), with its own rule
+    nan = run_record(summary, verdict("no_debris", location("array", "holds", peak=float("nan"))), {})
+    assert nan["indeterminate_reasons"][0]["rule"] == "non_finite_evidence"
+    old = {"secondary_debris": None, "locations": {"array": {"utilization": 0.4}}}      # stored before the reasons
+    rows = [{"state": "done", "result": r} for r in (unknown, unknown, safe, nan, old)] + [{"state": "failed",
+                                                                                            "result": None}]
+    assert indeterminate_rule_counts(rows) == {("array", "thread_pass_through"): 2, (None, "non_finite_evidence"): 1,
+                                               (None, "not_recorded"): 1}

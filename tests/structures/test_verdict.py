@@ -50,3 +50,36 @@ def test_a_hold_unchecked_for_chaos_says_so():
         "assess --monte-carlo gives P).")
     result["state"] = "fails"
     assert "Unchecked" not in condition_sentence(result, "low")
+
+
+def test_each_indeterminate_reason_names_its_rule():
+    """The rule of each reason the verdict's producers write (the reasons keep their numbers; the rule is what a
+    sweep counts), on hand-made series and checks; a reason joined from several rules names each."""
+    import numpy as np
+
+    from structures.thread_gaps import pass_through_reason
+    from structures.verdict import MIN_JUDGED_SAMPLES, apply_twin, evidence_gaps, indeterminate_rules, location_state
+
+    time = np.arange(0.0, 1.0, 1e-3)
+    touching = np.zeros((time.size, 1, 3))
+    touching[:, 0, 1] = 100.0
+    early = touching.copy()
+    early[time >= 0.25] = 0.0
+    short = time[:250 + MIN_JUDGED_SAMPLES - 1]
+    sparse = np.arange(0.0, 1.0, 0.0101)
+    assert [indeterminate_rules(g) for g in evidence_gaps(time, early, 0.25)] == [["no_capture_load"]]
+    assert indeterminate_rules(evidence_gaps(short, touching[:short.size], 0.25)[0]) == ["too_few_judged_samples"]
+    assert indeterminate_rules(evidence_gaps(sparse, touching[:sparse.size], 0.25)[0]) == ["coarse_sampling"]
+    both = evidence_gaps(sparse[:30], touching[:30], 0.25)        # 5 judged samples, 10.1 ms apart
+    assert indeterminate_rules("; ".join(both)) == ["too_few_judged_samples", "coarse_sampling"]
+    _, reason = location_state({"fails": False, "released_at_s": None, "judged": False}, [])
+    assert indeterminate_rules(reason) == ["non_finite_loads"]
+    check = {"bodies": ["solar_array"], "most_threads": 17, "snapshots": 50, "first_s": 1.74, "last_s": 7.5,
+             "force_bound_N": 80.0, "moment_bound_Nm": 355.0, "could_exceed": ["moment"], "worst_ratio": 1.2}
+    assert indeterminate_rules(pass_through_reason(check)) == ["thread_pass_through"]
+    row = {"name": "a", "state": "holds", "indeterminate_reason": None, "criteria": {"moment": {"peak": 100.0}}}
+    verdict = apply_twin({"debris_state": "no_debris", "secondary_debris": False, "locations": [row]}, [None],
+                         {}, None, 0.25, "low", note="no time left")
+    assert verdict["debris_state"] == "indeterminate"
+    assert indeterminate_rules(row["indeterminate_reason"]) == ["twin_not_run"]
+    assert indeterminate_rules(None) == [] and indeterminate_rules("a reason nobody wrote") == ["other"]

@@ -15,7 +15,7 @@ from numba import njit
 
 from multibody.control.mrac import (A0, B, C_MT, K_MT, N_COMMON, T_ON, ZM, ZM_RATE, actuate, advance_reference,
                                     common_params, initial_state, law_measurement, pulling,
-                                    reference_acceleration, slack_hold)
+                                    range_damping_force, reference_acceleration, slack_hold)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac1"
@@ -25,15 +25,16 @@ LAMBDA0, K_S, GAMMA, XI_H, XI_A1, XI_A2 = range(N_COMMON, N_COMMON + 6)
 
 
 @njit(THRUST_SIGNATURE, cache=True)
-def command(t, z, z_rate, params, state, step, advance):
+def command(t, z, z_rate, range_rate, params, state, step, advance):
     """MRAC-1 thrust (N), eqs. (11), (12), (14)-(16), saturated to [u_min, u_max]; 0 before t_on.
 
     Parameters
     ----------
-    t, z, z_rate, step, advance
+    t, z, z_rate, range_rate, step, advance
         As in the thrust-law interface (:mod:`multibody.control.thrust`): time (s), main-tether
-        elongation (m) and rate (m/s), sampling step (s), whether to advance the states.
-    params : (21,) float
+        elongation (m) and rate (m/s), chaser-debris range rate (m/s), sampling step (s), whether to advance the
+        states.
+    params : (22,) float
         The common head (:mod:`multibody.control.mrac`), then lambda_0 (1/s), k_s (N s/m), gamma, xi_h, xi_a (2) (-).
     state : (12,) float
         z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), notch memory (4, m), last slack
@@ -50,6 +51,7 @@ def command(t, z, z_rate, params, state, step, advance):
     s = (z_rate - state[ZM_RATE]) + lam * (z - state[ZM])                   # eq. (14)
     g = pulling(z, z_rate, params[K_MT], params[C_MT])
     u = state[A0] * eta + g * (state[A0 + 1] * z + state[A0 + 2] * z_rate) - params[K_S] * s   # eq. (11)
+    u += range_damping_force(params, range_rate)                              # mrac.range_damping (0: the paper's)
     force, adapt = actuate(u, hold, params)                                    # eq. (16), H(u_max - |u|)
     if advance:
         if adapt:

@@ -17,7 +17,7 @@ from scipy.linalg import solve_continuous_lyapunov
 
 from multibody.control.mrac import (A0, B, C_MT, K_D, K_MT, K_P, N_COMMON, T_ON, Z_D, ZM, ZM_RATE, actuate,
                                     advance_reference, common_params, initial_state, law_measurement, pulling,
-                                    reference_acceleration, slack_hold)
+                                    range_damping_force, reference_acceleration, slack_hold)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac2"
@@ -29,7 +29,7 @@ KZ1, KZ2, KR, TH1, TH2 = range(A0, A0 + 5)
 
 
 @njit(THRUST_SIGNATURE, cache=True)
-def command(t, z, z_rate, params, state, step, advance):
+def command(t, z, z_rate, range_rate, params, state, step, advance):
     """MRAC-2 thrust (N), eqs. (19)-(21), saturated to [u_min, u_max]; 0 before t_on.
 
     The :math:`\\hat\\Theta` law is taken with the sign that makes the Lyapunov derivative of
@@ -39,9 +39,9 @@ def command(t, z, z_rate, params, state, step, advance):
 
     Parameters
     ----------
-    t, z, z_rate, step, advance
-        As :func:`multibody.control.thrust_laws.mrac1.command` takes them (s, m, m/s, s, bool).
-    params : (25,) float
+    t, z, z_rate, range_rate, step, advance
+        As :func:`multibody.control.thrust_laws.mrac1.command` takes them (s, m, m/s, m/s, s, bool).
+    params : (26,) float
         The common head (:mod:`multibody.control.mrac`), then Gamma_z (2), gamma_r, Gamma_theta (2), xi_2, P (2x2).
     state : (14,) float
         z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), notch memory (4, m), last slack
@@ -58,6 +58,7 @@ def command(t, z, z_rate, params, state, step, advance):
     z_d = params[Z_D]
     u = (state[KZ1] * z + state[KZ2] * z_rate + state[KR] * z_d
          - (state[TH1] * phi1 + state[TH2] * phi2))                             # eq. (19)
+    u += range_damping_force(params, range_rate)                              # mrac.range_damping (0: the paper's)
     force, adapt = actuate(u, hold, params)                                       # eq. (16), H(u_max - |u|)
     if advance:
         if adapt:

@@ -34,7 +34,7 @@ def ramp_thrust(t, t_on, t_slope, f_max):
 
 
 @njit(THRUST_SIGNATURE, cache=True)
-def command(t, z, z_rate, params, state, step, advance):
+def command(t, z, z_rate, range_rate, params, state, step, advance):
     """:func:`ramp_thrust` behind the common interface (:mod:`multibody.control.thrust`).
 
     Parameters
@@ -43,7 +43,7 @@ def command(t, z, z_rate, params, state, step, advance):
         Time (s).
     params : (3,) float
         t_on (s), t_slope (s), f_max (N).
-    z, z_rate, state, step, advance
+    z, z_rate, range_rate, state, step, advance
         Not used (open loop, no state).
     """
     return ramp_thrust(t, params[0], params[1], params[2])

@@ -68,11 +68,11 @@ def test_the_thrust_floor_clips_the_command_and_freezes_the_adaptation():
     b, k, c = params[B], params[K_MT], params[C_MT]
     assert reference_acceleration(params, 0.3, 0.01) == -b * (k * 0.3 + c * 0.01)
     adaptive = state[A0:].copy()
-    thrust = LAWS["mrac2"].command(30.0, 0.5, 0.0, params, state, 2e-3, True)
+    thrust = LAWS["mrac2"].command(30.0, 0.5, 0.0, 0.0, params, state, 2e-3, True)
     assert thrust == 0.0 and np.array_equal(state[A0:], adaptive)
     paper, paper_state = _arrays("mrac2", _case(), z0=0.5)
     assert paper[U_MIN] == -paper[U_MAX]
-    assert LAWS["mrac2"].command(30.0, 0.5, 0.0, paper, paper_state, 2e-3, True) == -paper[U_MAX]
+    assert LAWS["mrac2"].command(30.0, 0.5, 0.0, 0.0, paper, paper_state, 2e-3, True) == -paper[U_MAX]
 
 
 def test_a_thrust_floor_outside_the_actuator_range_is_refused():
@@ -96,9 +96,9 @@ def test_a_thrust_band_confines_the_command_and_is_checked():
     for kind in ("mrac1", "mrac2"):
         params, state = _arrays(kind, band, z0=0.5)
         assert (params[U_MIN], params[U_MAX]) == (110.0, 170.0)
-        assert LAWS[kind].command(30.0, 0.5, 0.0, params, state, 2e-3, True) == 110.0
+        assert LAWS[kind].command(30.0, 0.5, 0.0, 0.0, params, state, 2e-3, True) == 110.0
         params, state = _arrays(kind, band, z0=-0.5)
-        assert LAWS[kind].command(30.0, -0.5, 0.0, params, state, 2e-3, True) == 170.0
+        assert LAWS[kind].command(30.0, -0.5, 0.0, 0.0, params, state, 2e-3, True) == 170.0
     data = load_model(CASE, TowingCase).model_dump()
     data["mrac"]["thrust_band"] = None
     for low, high in ((None, 250.0), (110.0, 110.0), (None, -200.0)):
@@ -134,14 +134,14 @@ def test_the_slack_hold_commands_the_steady_thrust_below_its_elongation():
     for kind in ("mrac1", "mrac2"):
         params, state = _arrays(kind, held, z0=0.001)
         adaptive = state[A0:].copy()
-        assert LAWS[kind].command(30.0, 0.001, 0.0, params, state, 2e-3, True) == pytest.approx(steady, rel=1e-12)
+        assert LAWS[kind].command(30.0, 0.001, 0.0, 0.0, params, state, 2e-3, True) == pytest.approx(steady, rel=1e-12)
         assert np.array_equal(state[A0:], adaptive)
     params, state = _arrays("mrac2", held, z0=0.03)
     command_z = 0.04 * (1.0 + 1600.0 / 9000.0) * 3000.0 / 1000.0 + 0.04
-    assert LAWS["mrac2"].command(30.0, 0.03, 0.0, params, state, 2e-3, False) == pytest.approx(
+    assert LAWS["mrac2"].command(30.0, 0.03, 0.0, 0.0, params, state, 2e-3, False) == pytest.approx(
         1000.0 * (command_z - 0.03), rel=1e-9)
     params, state = _arrays("mrac2", _case(), z0=0.001)
-    assert LAWS["mrac2"].command(30.0, 0.001, 0.0, params, state, 2e-3, False) == pytest.approx(
+    assert LAWS["mrac2"].command(30.0, 0.001, 0.0, 0.0, params, state, 2e-3, False) == pytest.approx(
         1000.0 * (command_z - 0.001), rel=1e-9)
 
 
@@ -157,14 +157,14 @@ def test_the_slack_hold_lasts_its_breathing_periods_after_the_last_slack_sample(
     case = case.model_copy(update=dict(debris=case.debris.model_copy(update=dict(spin_rate_deg_s=20.44))))
     params, state = _arrays("mrac2", case, z0=0.03)
     law = LAWS["mrac2"].command
-    assert law(30.0, 0.0005, 0.0, params, state, 2e-3, True) == pytest.approx(steady, rel=1e-12)
+    assert law(30.0, 0.0005, 0.0, 0.0, params, state, 2e-3, True) == pytest.approx(steady, rel=1e-12)
     adaptive = state[A0:].copy()
     hold = 180.0 / 20.44
-    assert law(30.0 + hold - 1e-3, 0.03, 0.0, params, state.copy(), 2e-3, False) == pytest.approx(steady, rel=1e-12)
-    law(30.0 + hold - 1e-3, 0.03, 0.0, params, state, 2e-3, True)
+    assert law(30.0 + hold - 1e-3, 0.03, 0.0, 0.0, params, state.copy(), 2e-3, False) == pytest.approx(steady, rel=1e-12)
+    law(30.0 + hold - 1e-3, 0.03, 0.0, 0.0, params, state, 2e-3, True)
     assert np.array_equal(state[A0:], adaptive)
     state[Z_LAST], state[RATE_LAST] = 0.03, 0.0      # the rate estimate at rest on z = 0.03 m
-    assert law(30.0 + hold + 1e-3, 0.03, 0.0, params, state, 2e-3, False) == pytest.approx(
+    assert law(30.0 + hold + 1e-3, 0.03, 0.0, 0.0, params, state, 2e-3, False) == pytest.approx(
         1000.0 * (command_z - 0.03), rel=1e-9)
     data = case.model_dump()
     data["mrac"]["slack_elongation"] = None

@@ -30,7 +30,7 @@ CASE_SECTIONS = ()
 
 
 @njit(THRUST_SIGNATURE)
-def command(t, z, z_rate, params, state, step, advance):
+def command(t, z, z_rate, range_rate, params, state, step, advance):
     return params[0]
 
 
