@@ -8,7 +8,10 @@ held-out part it was not fitted on. A cause is named only when all of these hold
 1. decisive against the nominal: BIC_nominal - BIC_best > ``decisive_delta_bic`` (10: "very
    strong" evidence, Kass & Raftery 1995, J. Am. Stat. Assoc. 90, 773, Sec. 3.2);
 2. decisive against the runner-up effect (same threshold), otherwise the data cannot tell them
-   apart and the answer is "unexplained" (ambiguous);
+   apart and the answer is "unexplained" (ambiguous); a runner-up counts only if it meets the
+   held-out condition of item 4 itself (it does not predict the held-out part worse than the
+   nominal model): an effect that makes the unseen data worse explains nothing there, however
+   close its training BIC (named in the reason as "not rivals");
 3. adequate: the extended model's training residual RMS is within ``adequate_rms`` sigma in every
    channel (what is left is noise), otherwise the effect only absorbs part of something else; a
    model's own discretization error e (noise sigmas, when given) widens that to
@@ -295,6 +298,13 @@ def material_gain(scores: dict[str, dict], key: str) -> float:
     return max(gains)
 
 
+def _no_rival_note(ranked: list[str], rivals: list[str]) -> str:
+    """' (not rivals: ...)' naming the candidates left out of the margin because their held-out prediction was
+    worse than the nominal model's, or ''."""
+    left = [k for k in ranked[1:] if k not in rivals]
+    return f" (not rivals, held-out prediction worse than the nominal model's: {', '.join(left)})" if left else ""
+
+
 def _step_note(scores: dict) -> str:
     """What the statement adds when the model's own step error widened the adequacy bound."""
     error = max(v.get("step_error_sigma", 0.0) for v in scores["train"].values())
@@ -344,8 +354,13 @@ def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float,
     if ranked:
         best = ranked[0]
         delta = nominal.bic - fits[best].bic
-        margin = fits[ranked[1]].bic - fits[best].bic if len(ranked) > 1 else np.inf
         gain = gain_percent(scores["nominal"]["holdout_rms_sigma"], scores[best]["holdout_rms_sigma"])
+        # a rival explanation must meet the held-out condition the best one must meet: a candidate that
+        # predicts the held-out data worse than the nominal model explains nothing there, however close its BIC
+        rivals = [k for k in ranked[1:]
+                  if gain_percent(scores["nominal"]["holdout_rms_sigma"], scores[k]["holdout_rms_sigma"]) >= 0]
+        runner_up = rivals[0] if rivals else "-"
+        margin = fits[runner_up].bic - fits[best].bic if rivals else np.inf
         gain_train = gain_percent(scores["nominal"]["train_rms_sigma"], scores[best]["train_rms_sigma"])
         decisive_and_material = (delta > decisive and material_gain(scores, best) >= MIN_GAIN_PERCENT
                                  and gain >= 0 and _rms_adequate(scores[best], adequate_rms))
@@ -362,10 +377,10 @@ def decide(fits: dict[str, FitResult], scores: dict[str, dict], decisive: float,
             if margin > decisive:
                 return {**answer, "cause": best, "model": best, "confidence": weights[best],
                         "reason": f"{best}: BIC lower by {delta:.1f} than the nominal model and by {margin:.1f} than "
-                                  f"the runner-up {ranked[1] if len(ranked) > 1 else '-'}; residual within "
+                                  f"the runner-up {runner_up}{_no_rival_note(ranked, rivals)}; residual within "
                                   f"{adequate_rms:g} sigma{_step_note(scores[best])} and white, training and "
                                   f"held-out; fit {gain_train:.0f} % and held-out prediction {gain:.0f} % better"}
-            close = [k for k in ranked if fits[k].bic - fits[best].bic <= decisive]
+            close = [best] + [k for k in rivals if fits[k].bic - fits[best].bic <= decisive]
             return {**answer, "cause": "unexplained", "model": best, "confidence": None,
                     "reason": f"ambiguous: {', '.join(close)} explain the data about equally (BIC within "
                               f"{decisive:g}); no single cause is decisive"}

@@ -55,6 +55,18 @@ def test_decisive_adequate_effect_is_named():
     assert answer["cause"] == "a" and answer["confidence"] > 0.999
 
 
+def test_a_close_runner_up_that_predicts_the_held_out_part_worse_than_nominal_is_no_rival():
+    # b's training BIC is within the threshold of a's (5 < 10), but it predicts the held-out part worse than
+    # the nominal model (1.9 > 1.8 sigma): it fails the held-out condition the best must meet (item 4), so it
+    # is no rival and a is named, the margin taken against no rival (inf); with b's held-out at 1.8 (no worse
+    # than nominal) the same BICs are ambiguous
+    fits = {"nominal": _fit("nominal", 9000.0, 2), "a": _fit("a", 3000.0, 3), "b": _fit("b", 3005.0, 3)}
+    worse = decide(fits, {"nominal": _score(1.7, 1.8), "a": _score(1.0, 1.0), "b": _score(1.0, 1.9)}, 10.0, 1.25)
+    assert worse["cause"] == "a" and "not rivals" in worse["reason"] and "b" in worse["reason"]
+    equal = decide(fits, {"nominal": _score(1.7, 1.8), "a": _score(1.0, 1.0), "b": _score(1.0, 1.8)}, 10.0, 1.25)
+    assert equal["cause"] == "unexplained" and "ambiguous: a, b" in equal["reason"]
+
+
 def test_two_effects_explaining_alike_are_ambiguous():
     fits = {"nominal": _fit("nominal", 9000.0, 2), "a": _fit("a", 3000.0, 3), "b": _fit("b", 3005.0, 3)}
     scores = {"nominal": _score(1.7, 1.8), "a": _score(1.0, 1.0), "b": _score(1.0, 1.0)}
