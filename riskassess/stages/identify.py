@@ -104,14 +104,29 @@ def rmse_free_roll(model_omega_body, data_omega_body, axis_body) -> float:
     float
         RMSE (rad/s).
     """
+    return rmse(axial_and_transverse(model_omega_body, axis_body), axial_and_transverse(data_omega_body, axis_body))
+
+
+def axial_and_transverse(omega_body, axis_body) -> np.ndarray:
+    """A body-frame angular velocity's component along ``axis_body`` and the norm of the rest: what a turn of
+    the body about that axis leaves unchanged (:func:`rmse_free_roll`).
+
+    Parameters
+    ----------
+    omega_body : (k, 3) float
+        Angular velocity (rad/s), body frame.
+    axis_body : (3,) float
+        The axis, body frame (any length).
+
+    Returns
+    -------
+    (k, 2) float
+        Axial component and transverse norm (rad/s).
+    """
     axis = np.asarray(axis_body, float) / np.linalg.norm(axis_body)
-
-    def axial_and_transverse(omega_body):
-        omega_body = np.asarray(omega_body, float)
-        axial = omega_body @ axis
-        return np.column_stack([axial, np.linalg.norm(omega_body - np.outer(axial, axis), axis=1)])
-
-    return rmse(axial_and_transverse(model_omega_body), axial_and_transverse(data_omega_body))
+    omega_body = np.asarray(omega_body, float)
+    axial = omega_body @ axis
+    return np.column_stack([axial, np.linalg.norm(omega_body - np.outer(axial, axis), axis=1)])
 
 
 def symmetry_axis_body(principal_inertia, rtol: float = 1e-9):

@@ -35,7 +35,7 @@ import numpy as np
 
 from riskassess.products import results
 from riskassess.cases.impact import CaseError
-from riskassess.stages.identify import (COSTS, claim_identify_folder, rmse, rmse_free_roll, simulate,
+from riskassess.stages.identify import (COSTS, axial_and_transverse, claim_identify_folder, rmse, simulate,
                                         symmetry_axis_body)
 from riskassess.products.outfolder import OutputFolder
 from riskassess.cases.towing import TowingCase
@@ -257,16 +257,17 @@ def comparison_rows(case: TowingCase, s, data: list[dict], end) -> list[dict]:
         stated; docs/towing.md: our full-net debris rolls slowly about its axis and the body-frame f1 counts it).
     """
     axis = symmetry_axis_body(case.debris.principal_inertia)
-    w1, w2 = case.identification.weights
     rows = []
     for run in data:
         model = simulate(case, run["rate_deg_s"], s, end, run.get("start"))
         row = {"rate_deg_s": run["rate_deg_s"], **{f"rmse_{c}": rmse(model[c], run[c]) for c in CHANNELS},
                "f1": COSTS["f1"](model, run, case.identification.weights), "f2": COSTS["f2"](model, run)}
         if axis is not None:
-            free = rmse_free_roll(model["debris_omega_body"], run["debris_omega_body"], axis)
-            row.update(rmse_debris_omega_free_roll=free, f1_free_roll=w1 * row["rmse_relative_position"]
-                       + w2 * (free + row["rmse_chaser_omega_body"]))
+            # eq. (18) itself on omega_D's roll-blind components (their RMSE is rmse_free_roll's)
+            blind_model = {**model, "debris_omega_body": axial_and_transverse(model["debris_omega_body"], axis)}
+            blind_run = {**run, "debris_omega_body": axial_and_transverse(run["debris_omega_body"], axis)}
+            row.update(rmse_debris_omega_free_roll=rmse(blind_model["debris_omega_body"], blind_run["debris_omega_body"]),
+                       f1_free_roll=COSTS["f1"](blind_model, blind_run, case.identification.weights))
         rows.append(row)
     return rows
 
