@@ -353,9 +353,8 @@ class Recorder:
         """
         self.wall_time = wall_time
         k = self._n_rows
-        self.series = {key: self._rows[:k, first:last].reshape((k,) + shape) for key, (first, last, shape)
+        self.series = {key: self._rows[:k, first:last].reshape((k,) + shape).copy() for key, (first, last, shape)
                        in self._columns.items()} if k else {}
-        self.series = {key: value.copy() for key, value in self.series.items()}
         self.net = {"time": self._net_time[:self._n_net].copy(), "positions_lvlh": self._net_positions[:self._n_net].copy(),
                     "velocities_lvlh": self._net_velocities[:self._n_net].copy(),
                     "contact_force_lvlh": self._net_contact_force[:self._n_net].copy()}
