@@ -18,7 +18,7 @@ MIN_FRAMES_AFTER = 10
 #: A torque-free fit that leaves the registered attitudes more than this RMS turn (deg) from the fitted
 #: ones has stopped in a wrong optimum (a right one leaves the frames' own error: 0.4-2.2 deg measured,
 #: docs/perception.md); it is redone from other starting rates and the best fit kept. The stage refuses
-#: a fit still beyond this (riskassess/stages/perceive.py, MAX_MODEL_FREE_RESIDUAL_DEG, the same 5 deg).
+#: a fit still beyond this (riskassess/stages/perceive.py, MAX_MODEL_FREE_RESIDUAL_DEG is this constant).
 RESTART_RESIDUAL_DEG = 5.0
 #: Frames whose rates give the other starting rates (the local-fit window of rates_from_attitudes).
 START_WINDOW = 11

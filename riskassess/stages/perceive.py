@@ -41,7 +41,7 @@ from scipy.spatial.transform import Rotation
 
 from multibody.free_motion import free_motion
 from multibody.impact import ImpactSimulation
-from perception.free_flight import FreeMotion, fit_free_motion, normalized_energy_and_momentum
+from perception.free_flight import RESTART_RESIDUAL_DEG, FreeMotion, fit_free_motion, normalized_energy_and_momentum
 from perception.lidar import LidarSpec, cast, sensor_to_platform
 from perception.momentum import point_masses_momentum, rigid_body_momentum
 from perception.momentum_balance import momentum_step
@@ -67,7 +67,9 @@ DEBRIS_GATE = 0.3
 #: ~1 deg, mostly a constant turn of the map); on the paper's smooth ellipsoid the map slides about
 #: the near-symmetry axis and the fit leaves 12 deg (10 s) (tests/perception/test_scan_to_map.py,
 #: docs/perception.md).
-MAX_MODEL_FREE_RESIDUAL_DEG = 5.0
+#: The same bound the torque-free fit restarts beyond (perception/free_flight.py): one rule, "a fit this far
+#: from its frames stopped in a wrong optimum", so the restart and the refusal cannot drift apart.
+MAX_MODEL_FREE_RESIDUAL_DEG = RESTART_RESIDUAL_DEG
 #: ... and when the fit determines the inertia ratios to this relative 1-sigma (-). A track that slid
 #: smoothly (the paper's ellipsoid over 5 s: 2.6 deg from the fit, 19 deg from the truth) passes the
 #: residual test but leaves the ratios undetermined (1-sigma 120 %, the fit at its bound of 2);
