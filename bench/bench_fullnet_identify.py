@@ -5,8 +5,8 @@ from the capture start, each identified model scored on the training and the uns
 
     python bench/bench_fullnet_identify.py --out DIR [--case cases/zenit2_towing.toml]
         [--starts wrapped capture] [--training N] [--validation N] [--end T]
-        [--optimizers pso pattern mads] [--cost f1 f2] [--mads-starts s0 table6] [--workers N] [--table-only]
-        [--rescore]
+        [--optimizers pso pattern mads] [--cost f1 f1_inertial f2] [--mads-starts s0 table6] [--workers N]
+        [--table-only] [--rescore]
 
 The full-net runs (the first N training and validation rates of Table 3, to T) are cached in
 ``DIR/<start>/fullnet/rate_<deg_s>_end_<T>[_capture].npz``, the same files ``riskassess identify`` writes:
@@ -15,7 +15,9 @@ Table 6 initial guess (MADS 1-5, as the paper's Sec. 4.4); the pattern search fr
 then the polish. Every answer is kept in ``DIR/results.json`` as soon as it is found (a re-run skips those
 done, for the same held runs and settings); ``--table-only`` prints the tables from it. As ``riskassess identify``
 does, a run whose debris was not held (a failed capture, :func:`riskassess.stages.identify_fullnet.not_held`) is
-left out of training and validation and named in each answer's ``excluded_runs``. CPU time counts this
+left out of training and validation and named in each answer's ``excluded_runs``. The second table gives f1
+per run with the angular velocities compared in body components (the cost ``f1``), in inertial components
+(``f1_inertial``: runs cached since 2026-11-27 store the attitudes; '-' for older runs) and roll-blind. CPU time counts this
 process and its worker processes (the machine may be shared; wall times are printed with the load average).
 """
 from __future__ import annotations
@@ -30,11 +32,12 @@ from pathlib import Path
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.products import results
-from riskassess.stages.identify import run_optimizers
+from riskassess.stages.identify import has_attitudes, run_optimizers
 from riskassess.stages.identify_fullnet import (_entry, _totals, comparison_rows, full_net_runs, held_runs,
                                                 lower_order_case)
 sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
 from bench_identify import TABLE6_INITIAL_GUESSES  # noqa: E402
+from bench_omega_frames import attitude_from_rates  # noqa: E402
 
 #: Boonrath et al. 2024 Sec. 4.4 (10 training + 10 validation runs, 275 s of towing): per cost, per optimizer
 #: run, (training cost, validation cost): Tables 7 and 10 (f1), 8 and 10 (f2).
@@ -45,6 +48,19 @@ PAPER = {"f1": {"MADS 1": (55.6119, 50.2055), "MADS 2": (55.5872, 50.2248), "MAD
                 "MADS 4": (1226.35, 1301.70), "MADS 5": (1227.10, 1299.75), "PSO 1": (1226.18, 1299.46),
                 "PSO 2": (1226.42, 1302.19), "PSO 3": (1226.17, 1299.21)}}
 PAPER_RUNS = 10
+
+
+def reconstruct_attitudes(data: list[dict], dt: float) -> list[float]:
+    """Give every run cached without attitudes (before 2026-11-27) attitudes integrated from its start attitude and
+    sampled body rates (:func:`bench_omega_frames.attitude_from_rates`); returns their rates (deg/s)."""
+    rebuilt = []
+    for run in data:
+        if has_attitudes(run) or run.get("start") is None:
+            continue
+        for b, key in enumerate(("chaser", "debris")):
+            run[f"{key}_to_inertial"] = attitude_from_rates(run["start"]["body_to_inertial"][b], run[f"{key}_omega_body"], dt)
+        rebuilt.append(float(run["rate_deg_s"]))
+    return rebuilt
 
 
 def cpu_seconds() -> float:
@@ -95,17 +111,21 @@ def run_one(case: TowingCase, train, valid, label, name, guess, cost, workers, e
     return out
 
 
-def rescore(case: TowingCase, done: dict, start: str, train, valid, held, end) -> None:
-    """Every answer in ``done`` of ``start`` on these held runs (same rates and end) compared again with
-    today's :func:`comparison_rows` (its training and validation rows and totals replaced; s, evaluations and
-    CPU kept)."""
+def rescore(case: TowingCase, done: dict, start: str, train, valid, held, end, rebuilt=()) -> None:
+    """Every answer in ``done`` of ``start`` identified on these held training runs (same rates and end) compared
+    again with today's :func:`comparison_rows` on today's held training and validation runs (its rows, totals and
+    ``rates`` replaced, ``reconstructed_attitudes``: the runs whose attitudes were integrated from their rates;
+    s, evaluations and CPU kept)."""
+    trained = [float(r["rate_deg_s"]) for r in train]
     for key, entry in done.items():
-        if key.split("|")[0] != start or entry["rates"] != held or entry["end_s"] != end:
+        if (key.split("|")[0] != start or [r["rate_deg_s"] for r in entry["training"]] != trained
+                or entry["end_s"] != end):
             continue
         lower = lower_order_case(case, train[0])
         rows = {role: comparison_rows(lower, entry["s"], runs, end) for role, runs in (("training", train),
                                                                                         ("validation", valid))}
-        entry.update(training=rows["training"], validation=rows["validation"],
+        entry.update(training=rows["training"], validation=rows["validation"], rates=held,
+                     reconstructed_attitudes=list(rebuilt),
                      training_totals=_totals(rows["training"]), validation_totals=_totals(rows["validation"]))
         print(f"  rescored {key}", flush=True)
 
@@ -141,6 +161,31 @@ def print_tables(done: dict) -> None:
             print(f"| paper, 10+10 to 300 s | {cost} | {label} | | | | | | | {f1[0]} | {f2[0]} | {f1[1]} | {f2[1]} |")
 
 
+def frame_cell(totals: dict | None, n: int) -> str:
+    """'body / inertial / roll-blind' f1 per run of one set of runs (a '-' where not computed: runs cached
+    without attitudes give no inertial figure)."""
+    if not totals:
+        return "no run held | | "
+    return " | ".join(f"{totals[key] / n:.3f}" if key in totals else "-" for key in ("f1", "f1_inertial", "f1_free_roll"))
+
+
+def print_frame_table(done: dict) -> None:
+    """Markdown rows: per answer, f1 per run with the angular velocities compared in body components (eq. 18 as
+    the cost ``f1``), in inertial components (``f1_inertial``) and with omega_D blind to a roll about the debris'
+    axis, on training and validation runs; then the paper's f1 per run (Tables 7, 10)."""
+    print("\n| start, runs | identified on | s1 | s2 (m) | s3 | s4 | training f1 / run: body | inertial | roll-blind "
+          "| validation f1 / run: body | inertial | roll-blind |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for key, entry in done.items():
+        start, cost, label = key.split("|")
+        nt, nv = len(entry["training"]), len(entry["validation"])
+        s = entry["s"]
+        print(f"| {start}, {nt}+{nv} to {entry['end_s']:g} s | {cost}, {label} | {s[0]:.4f} | {s[1]:.4f} | {s[2]:.4f} "
+              f"| {s[3]:.4f} | {frame_cell(entry['training_totals'], nt)} | {frame_cell(entry['validation_totals'], nv)} |")
+    for label, (train, valid) in PAPER["f1"].items():
+        print(f"| paper, 10+10 to 300 s | f1, {label} | | | | | {train / PAPER_RUNS:.3f} | | | {valid / PAPER_RUNS:.3f} | | |")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--case", default="cases/zenit2_towing.toml")
@@ -150,10 +195,15 @@ def main():
     parser.add_argument("--validation", type=int, default=10, help="first N validation rates of Table 3")
     parser.add_argument("--end", type=float, default=300.0, help="end of every run (s)")
     parser.add_argument("--optimizers", nargs="+", default=["pso", "pattern", "mads"], choices=["pso", "pattern", "mads"])
-    parser.add_argument("--cost", nargs="+", default=["f1", "f2"], choices=["f1", "f2"])
+    parser.add_argument("--cost", nargs="+", default=["f1", "f2"], choices=["f1", "f1_inertial", "f2"])
     parser.add_argument("--mads-starts", nargs="+", default=["s0", "table6"], choices=["s0", "table6"])
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--table-only", action="store_true", help="print the tables of DIR/results.json")
+    parser.add_argument("--runs-only", type=float, nargs="+", metavar="RATE",
+                        help="only run (or find cached) the full-net runs at these rates, in this order, and stop")
+    parser.add_argument("--reconstruct-attitudes", action="store_true",
+                        help="runs cached without attitudes get them integrated from their sampled body rates "
+                             "(bench_omega_frames.attitude_from_rates; each answer lists which runs had them so)")
     parser.add_argument("--rescore", action="store_true",
                         help="score every answer of DIR/results.json for these runs again with today's comparison "
                              "(no search; e.g. to add a diagnostic column)")
@@ -163,6 +213,7 @@ def main():
     done = json.loads(store.read_text()) if store.exists() else {}
     if args.table_only:
         print_tables(done)
+        print_frame_table(done)
         return
     case = load_model(args.case, TowingCase)
     if case.full_net is None:
@@ -171,7 +222,14 @@ def main():
         run_case = start_case(case, start, args.training, args.validation, args.end)
         rates = list(case.rates.training_deg_s[:args.training]) + list(case.rates.validation_deg_s[:args.validation])
         wall, load = time.perf_counter(), os.getloadavg()[0]
+        if args.runs_only:
+            for rate in args.runs_only:   # one at a time: each is cached as it ends
+                full_net_runs(run_case, [rate], out / start, args.end, args.workers)
+                print(f"{start}: {rate:g} deg/s cached ({time.perf_counter() - wall:.0f} s wall so far, load "
+                      f"{load:.1f} -> {os.getloadavg()[0]:.1f})", flush=True)
+            continue
         data = full_net_runs(run_case, rates, out / start, args.end, args.workers)
+        rebuilt = reconstruct_attitudes(data, case.simulation.output_interval) if args.reconstruct_attitudes else []
         print(f"{start}: {len(rates)} full-net runs to {args.end:g} s ready in {time.perf_counter() - wall:.0f} s wall "
               f"(load average {load:.1f} -> {os.getloadavg()[0]:.1f}; cached runs took "
               f"{sum(d['wall_s'] for d in data):.0f} s of solver wall time)", flush=True)
@@ -181,17 +239,18 @@ def main():
             print(f"  left out {why['rate_deg_s']:g} deg/s: {why['reason']}", flush=True)
         held = [float(r["rate_deg_s"]) for r in train + valid]
         if args.rescore:
-            rescore(run_case, done, start, train, valid, held, args.end)
+            rescore(run_case, done, start, train, valid, held, args.end, rebuilt)
             results.atomic_write_json(store, done)
             continue
         for cost in args.cost:
             for label, name, guess in searches(args.optimizers, args.mads_starts, case.identification.initial_guess):
                 key = f"{start}|{cost}|{label}"
-                if key in done and done[key]["rates"] == held and done[key]["end_s"] == args.end:
+                if (key in done and done[key]["rates"] == held and done[key]["end_s"] == args.end
+                        and done[key].get("reconstructed_attitudes", []) == rebuilt):
                     continue
                 for reported, entry in run_one(run_case, train, valid, label, name, guess, cost, args.workers,
                                                args.end).items():
-                    entry.update(rates=held, end_s=args.end, excluded_runs=excluded)
+                    entry.update(rates=held, end_s=args.end, excluded_runs=excluded, reconstructed_attitudes=rebuilt)
                     done[f"{start}|{cost}|{reported}"] = entry
                     tr, va = entry["training_totals"], entry["validation_totals"]
                     scored = f"validation f1 {va['f1']:.3f} f2 {va['f2']:.1f}" if va else "no validation run held"
@@ -201,6 +260,7 @@ def main():
                           f"(load {entry['load_before']:.1f} -> {entry['load_after']:.1f})", flush=True)
                 results.atomic_write_json(store, done)
     print_tables(done)
+    print_frame_table(done)
 
 
 if __name__ == "__main__":

@@ -700,8 +700,10 @@ def build_parser() -> argparse.ArgumentParser:
                        "with identification.benchmark_truth at the training rates")
     ident.add_argument("--optimizers", nargs="+", choices=SEARCHES, help="optimizers to run, in order "
                        "(default identification.searches); 'pso' is followed by the pattern-search polish")
-    ident.add_argument("--cost", choices=["f1", "f2"], help="cost function (default identification.cost): f1 weighted "
-                       "RMSE of r_D/C and both angular velocities (eq. 18), f2 main-tether tension RMSE (eq. 20)")
+    ident.add_argument("--cost", choices=["f1", "f1_inertial", "f2"], help="cost function (default "
+                       "identification.cost): f1 weighted RMSE of r_D/C and both angular velocities (eq. 18; rates in "
+                       "body components), f1_inertial the same with the rates in inertial components, f2 main-tether "
+                       "tension RMSE (eq. 20)")
     approach = _case_command(sub, "approach", _cmd_approach,
                              "optimal approach of the net carried by two maneuverable units (direct collocation, "
                              "IPOPT); exit code 4 when not solved or a constraint fails",

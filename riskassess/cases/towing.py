@@ -221,8 +221,11 @@ class Optimizers(Strict):
 
 
 class Identification(Strict):
-    cost: Literal["f1", "f2"] = Field("f1", description="f1: weighted RMSE of r_D/C and both angular velocities, "
-                                                        "eq. (18); f2: main-tether tension RMSE, eq. (20).")
+    cost: Literal["f1", "f1_inertial", "f2"] = Field(
+        "f1", description="f1: weighted RMSE of r_D/C and both angular velocities, eq. (18), the rates compared in "
+                          "body components; f1_inertial: the same, the rates compared in inertial components (each "
+                          "turned by its own body's attitude; needs full-net runs that store the attitudes); f2: "
+                          "main-tether tension RMSE, eq. (20).")
     weights: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = Field(
         description="w1 (1/m) and w2 (s/rad) of eq. (18), Sec. 4.2.")
     lower_bounds: DecisionVector = Field(description="Lower bounds of s = [log10 k_ST, l_ST0, log10 c_ST, m_P/m_net], eq. (24).")

@@ -7,6 +7,8 @@ the bounds of eq. (24). For each candidate, one lower-order run per spin rate of
 data by
 
 * :func:`cost_f1`: :math:`\\sum_j w_1 RMSE_{r,j} + w_2 (RMSE_{\\omega_D,j} + RMSE_{\\omega_C,j})`, eqs. (17)-(19);
+* :func:`cost_f1_inertial`: the same with both angular velocities compared in inertial components (eq. 17e
+  does not say in which frame's components its difference is taken; docs/towing.md);
 * :func:`cost_f2`: :math:`\\sum_j RMSE_{T,j}` of the main-tether tension, eqs. (20)-(21).
 
 Two maintained optimizers of pymoo minimize it: particle swarm (:class:`pymoo.algorithms.soo.nonconvex.pso.PSO`,
@@ -26,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 from pymoo.core.problem import Problem
+from scipy.spatial.transform import Rotation
 
 from multibody.towing import run_twin
 from multibody.towing_kernel import MT_TENSION
@@ -40,6 +43,18 @@ from riskassess.stages.optimizers import OPTIMIZERS
 
 #: The quantities the costs compare, from :meth:`multibody.towing.TowResult.series`.
 COMPARED = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
+
+#: Per body, its body-frame angular velocity and its attitude (rotation matrices body -> Earth-centred inertial,
+#: (k, 3, 3)) in a compared series: ``omega_inertial = attitude @ omega_body`` (:func:`angular_velocity`).
+ATTITUDE_OF = {"chaser_omega_body": "chaser_to_inertial", "debris_omega_body": "debris_to_inertial"}
+
+#: The frames eq. (19b, 19c) can compare the angular velocities in (:func:`angular_velocity`).
+FRAMES = ("body", "inertial")
+
+
+class MissingAttitude(KeyError):
+    """A compared series lacks the attitude an inertial-frame comparison needs (a full-net run cached before
+    the attitudes were stored with every run)."""
 
 
 def compared_series(result) -> dict:
@@ -56,12 +71,73 @@ def compared_series(result) -> dict:
     -------
     dict
         ``relative_position`` (k, 3) m, inertial; ``chaser_omega_body`` and ``debris_omega_body``
-        (k, 3) rad/s, each body's frame; ``main_tether_tension`` (k,) N.
+        (k, 3) rad/s, each body's frame; ``main_tether_tension`` (k,) N; ``chaser_to_inertial`` and
+        ``debris_to_inertial`` (k, 3, 3), the attitudes (body -> inertial) from the rotation vectors
+        (``series``' matrices to round-off: one vectorized Rodrigues here instead of a compiled call per sample).
     """
     m, q, v = result.model, result.q, result.v
     return {"relative_position": (m.positions[2] + q[:, 9:12]) - (m.positions[1] + q[:, 3:6]),
             "chaser_omega_body": v[:, 6:9], "debris_omega_body": v[:, 12:15],
-            "main_tether_tension": result.diag[:, MT_TENSION]}
+            "main_tether_tension": result.diag[:, MT_TENSION],
+            "chaser_to_inertial": Rotation.from_rotvec(q[:, 6:9]).as_matrix(),
+            "debris_to_inertial": Rotation.from_rotvec(q[:, 12:15]).as_matrix()}
+
+
+def angular_velocity(series: dict, channel: str, frame: str = "body") -> np.ndarray:
+    """A compared angular velocity in body or in Earth-centred inertial components.
+
+    Both are the body's rate relative to the inertial frame (the paper's :math:`{}^{O}\\omega^D`, eq. 17e);
+    ``frame`` picks the components: ``"body"`` as integrated, ``"inertial"`` turned by the body's own attitude.
+    (The RMSE of eq. 19 compares norms of differences, so any frame both models share at each sample, LVLH
+    included, gives the inertial figure: a common rotation leaves the norm unchanged.)
+
+    Parameters
+    ----------
+    series : dict
+        A compared series (:func:`compared_series`, or a cached full-net run).
+    channel : str
+        ``"chaser_omega_body"`` or ``"debris_omega_body"``.
+    frame : str
+        ``"body"`` or ``"inertial"``.
+
+    Returns
+    -------
+    (k, 3) float
+        Angular velocity (rad/s) in the frame asked for.
+
+    Raises
+    ------
+    MissingAttitude
+        ``frame="inertial"`` on a series without the body's attitude, naming what is missing.
+    """
+    if frame not in FRAMES:
+        raise ValueError(f"unknown frame {frame!r}; the known frames are: {', '.join(FRAMES)}")
+    omega_body = np.asarray(series[channel], float)
+    if frame == "body":
+        return omega_body
+    key = ATTITUDE_OF[channel]
+    if key not in series:
+        rate = series.get("rate_deg_s")
+        raise MissingAttitude(f"{channel} in inertial components needs '{key}' (rotation body -> inertial per "
+                              f"sample), which this run{'' if rate is None else f' ({float(rate):g} deg/s)'} does "
+                              f"not store (full-net runs cached before 2026-11-27 keep only body-frame rates and "
+                              f"the start state: run them again)")
+    return np.einsum("kij,kj->ki", np.asarray(series[key], float), omega_body)
+
+
+def has_attitudes(series: dict) -> bool:
+    """Whether ``series`` stores both bodies' attitudes (:data:`ATTITUDE_OF`).
+
+    Parameters
+    ----------
+    series : dict
+        A compared series.
+
+    Returns
+    -------
+    bool
+    """
+    return all(key in series for key in ATTITUDE_OF.values())
 
 
 def rmse(model, data) -> float:
@@ -152,23 +228,47 @@ def symmetry_axis_body(principal_inertia, rtol: float = 1e-9):
     return None
 
 
-def cost_f1(model: dict, data: dict, weights) -> float:
+def cost_f1(model: dict, data: dict, weights, frame: str = "body") -> float:
     r"""One run's term of eq. (18): :math:`w_1 RMSE_r + w_2 (RMSE_{\omega_D} + RMSE_{\omega_C})`.
 
     Parameters
     ----------
     model, data : dict
-        Compared series (:func:`compared_series`): r_D/C (m, inertial), angular velocities (rad/s, body).
+        Compared series (:func:`compared_series`): r_D/C (m, inertial), angular velocities (rad/s, body) and,
+        for ``frame="inertial"``, the attitudes.
     weights : (2,) float
         w_1 (1/m) and w_2 (s/rad), ``identification.weights``; the cost is dimensionless.
+    frame : str
+        Components the angular velocities are compared in (:func:`angular_velocity`).
 
     Returns
     -------
     float
     """
+    def omega_rmse(channel):
+        return rmse(angular_velocity(model, channel, frame), angular_velocity(data, channel, frame))
+
     return weights[0] * rmse(model["relative_position"], data["relative_position"]) + weights[1] * (
-        rmse(model["debris_omega_body"], data["debris_omega_body"])
-        + rmse(model["chaser_omega_body"], data["chaser_omega_body"]))
+        omega_rmse("debris_omega_body") + omega_rmse("chaser_omega_body"))
+
+
+def cost_f1_inertial(model: dict, data: dict, weights) -> float:
+    """Eq. (18) with both angular velocities compared in inertial components (:func:`cost_f1`,
+    ``frame="inertial"``): the reading of eq. (17d, 17e) in which a turn of a body about its own spin axis
+    that leaves its rate in inertial space unchanged costs nothing (docs/towing.md).
+
+    Parameters
+    ----------
+    model, data : dict
+        Compared series with the attitudes (:func:`compared_series`).
+    weights : (2,) float
+        w_1 (1/m) and w_2 (s/rad).
+
+    Returns
+    -------
+    float
+    """
+    return cost_f1(model, data, weights, frame="inertial")
 
 
 def cost_f2(model: dict, data: dict, weights=None) -> float:
@@ -189,7 +289,7 @@ def cost_f2(model: dict, data: dict, weights=None) -> float:
     return rmse(model["main_tether_tension"], data["main_tether_tension"])
 
 
-COSTS = {"f1": cost_f1, "f2": cost_f2}
+COSTS = {"f1": cost_f1, "f1_inertial": cost_f1_inertial, "f2": cost_f2}
 
 
 def simulate(case: TowingCase, rate_deg_s: float, s, end_time=None, start=None) -> dict:
@@ -304,6 +404,12 @@ def identify(case: TowingCase, data: list[dict], optimizer: str, end_time=None, 
     """
     search = OPTIMIZERS[optimizer].search        # an unknown name fails here, before any run
     ident = case.identification
+    if ident.cost == "f1_inertial":
+        lacking = [f"{float(run['rate_deg_s']):g}" for run in data if not has_attitudes(run)]
+        if lacking:   # before any run, not as an infinite cost in every worker
+            raise MissingAttitude(f"cost f1_inertial compares angular velocities in inertial components; the runs at "
+                                  f"{', '.join(lacking)} deg/s store no attitudes (cached before 2026-11-27: run them "
+                                  f"again, or use cost f1)")
     settings = ident.optimizers
     x0 = ident.initial_guess if initial_guess is None else initial_guess
     start = time.perf_counter()

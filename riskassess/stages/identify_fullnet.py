@@ -35,8 +35,8 @@ import numpy as np
 
 from riskassess.products import results
 from riskassess.cases.impact import CaseError
-from riskassess.stages.identify import (COSTS, axial_and_transverse, claim_identify_folder, rmse, simulate,
-                                        symmetry_axis_body)
+from riskassess.stages.identify import (COSTS, angular_velocity, axial_and_transverse, claim_identify_folder,
+                                        has_attitudes, rmse, simulate, symmetry_axis_body)
 from riskassess.products.outfolder import OutputFolder
 from riskassess.cases.towing import TowingCase
 from multibody.net_towing import run_exudyn
@@ -47,6 +47,11 @@ from riskassess.products.towing_plots import plot_convergence
 
 CHANNELS = ("relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension")
 
+
+#: Attitude series stored with every full-net run since 2026-11-27: rotation matrices body -> Earth-centred
+#: inertial, (k, 3, 3), the samples of the compared series (runs cached before then lack them:
+#: :func:`riskassess.stages.identify.omega_inertial` names what is missing).
+ATTITUDES = ("chaser_to_inertial", "debris_to_inertial")
 
 #: Prefix of the start-state entries of a cached capture-start run (:func:`start_state`).
 START = "start_"
@@ -61,15 +66,37 @@ def _run_full_net(task):
     if capture:
         model.state_at = case.simulation.start_time   # the lower-order runs start there (Sec. 4.1)
     result = run_exudyn(model)
-    s = result.series()
-    keep = s["time"] >= case.simulation.start_time - 1e-9
-    series = {"relative_position": s["debris_com_inertial"] - s["chaser_com_inertial"],
-              "chaser_omega_body": s["chaser_omega_body"], "debris_omega_body": s["debris_omega_body"],
-              "main_tether_tension": s["main_tether_tension"]}   # the channels of identify.compared_series
-    series = {k: v[keep] for k, v in series.items()}
+    series = full_net_compared(result.series(), case.simulation.start_time)
     start = {START + k: v for k, v in net_start_state(model, result.state_at).items()} if capture else {}
     return {**series, **start, "rate_deg_s": rate, "chaser_start_inertial": model.positions[0],
             "node_start_inertial": model.node_positions[model.net.central], "wall_s": result.wall_time}
+
+
+def full_net_compared(series: dict, start_time: float) -> dict:
+    """What a cached full-net run keeps of its series (:meth:`multibody.net_towing.NetTowResult.series`): the
+    channels of :func:`riskassess.stages.identify.compared_series` and the attitudes (:data:`ATTITUDES`), from
+    ``start_time`` on.
+
+    Parameters
+    ----------
+    series : dict
+        The full-net run's series.
+    start_time : float
+        First compared time (s; ``simulation.start_time``, Sec. 4.1).
+
+    Returns
+    -------
+    dict
+        ``relative_position`` (k, 3) m, inertial; ``chaser_omega_body``, ``debris_omega_body`` (k, 3) rad/s, body
+        frames; ``main_tether_tension`` (k,) N; ``chaser_to_inertial``, ``debris_to_inertial`` (k, 3, 3).
+    """
+    keep = series["time"] >= start_time - 1e-9
+    compared = {"relative_position": series["debris_com_inertial"] - series["chaser_com_inertial"],
+                "chaser_omega_body": series["chaser_omega_body"], "debris_omega_body": series["debris_omega_body"],
+                "main_tether_tension": series["main_tether_tension"],
+                # omega in inertial components needs each body's attitude (eq. 17d, 17e; identify.angular_velocity)
+                **{key: series[key] for key in ATTITUDES}}
+    return {key: value[keep] for key, value in compared.items()}
 
 
 def start_state(run: dict) -> dict | None:
@@ -112,7 +139,8 @@ def full_net_runs(case: TowingCase, rates, out: Path, end, workers, record=None)
     -------
     list of dict
         Per rate: compared series (r_D/C (k, 3) m inertial, angular velocities (k, 3) rad/s body
-        frames, main-tether tension (k,) N), ``rate_deg_s``, ``chaser_start_inertial`` and
+        frames, main-tether tension (k,) N; the attitudes body -> inertial (k, 3, 3), :data:`ATTITUDES`, in runs
+        cached since 2026-11-27, absent from older ones), ``rate_deg_s``, ``chaser_start_inertial`` and
         ``node_start_inertial`` (3,) m, ``wall_s`` (s).
     """
     cache = out / "fullnet"
@@ -254,7 +282,9 @@ def comparison_rows(case: TowingCase, s, data: list[dict], end) -> list[dict]:
         symmetric about a body axis also ``rmse_debris_omega_free_roll`` and ``f1_free_roll``, eq. (18) with
         omega_D compared blind to a roll about that axis (:func:`riskassess.stages.identify.rmse_free_roll`;
         the paper's omega_D is the rate relative to the inertial frame, the frame it is compared in is not
-        stated; docs/towing.md: our full-net debris rolls slowly about its axis and the body-frame f1 counts it).
+        stated; docs/towing.md: our full-net debris rolls slowly about its axis and the body-frame f1 counts it);
+        and the rates compared in inertial components (:func:`inertial_rows`: ``rmse_chaser_omega_inertial``,
+        ``rmse_debris_omega_inertial``, ``f1_inertial``, or ``inertial_missing`` for a run cached without attitudes).
     """
     axis = symmetry_axis_body(case.debris.principal_inertia)
     rows = []
@@ -262,6 +292,7 @@ def comparison_rows(case: TowingCase, s, data: list[dict], end) -> list[dict]:
         model = simulate(case, run["rate_deg_s"], s, end, run.get("start"))
         row = {"rate_deg_s": run["rate_deg_s"], **{f"rmse_{c}": rmse(model[c], run[c]) for c in CHANNELS},
                "f1": COSTS["f1"](model, run, case.identification.weights), "f2": COSTS["f2"](model, run)}
+        row.update(inertial_rows(model, run, case.identification.weights))
         if axis is not None:
             # eq. (18) itself on omega_D's roll-blind components (their RMSE is rmse_free_roll's)
             blind_model = {**model, "debris_omega_body": axial_and_transverse(model["debris_omega_body"], axis)}
@@ -272,6 +303,34 @@ def comparison_rows(case: TowingCase, s, data: list[dict], end) -> list[dict]:
     return rows
 
 
+def inertial_rows(model: dict, run: dict, weights) -> dict:
+    """The angular-velocity RMSEs and f1 with the rates compared in inertial components (eq. 18 read in the
+    inertial frame, :func:`riskassess.stages.identify.cost_f1_inertial`), or what is missing for them.
+
+    Parameters
+    ----------
+    model : dict
+        The lower-order run's compared series (with its attitudes).
+    run : dict
+        A cached full-net run.
+    weights : (2,) float
+        w_1 (1/m), w_2 (s/rad).
+
+    Returns
+    -------
+    dict
+        ``rmse_chaser_omega_inertial``, ``rmse_debris_omega_inertial`` (rad/s) and ``f1_inertial``; or, for a run
+        cached without attitudes, ``inertial_missing``: why they are not given.
+    """
+    if not has_attitudes(run):
+        return {"inertial_missing": f"the full-net run stores no attitudes ({', '.join(ATTITUDES)}): "
+                                    f"cached before 2026-11-27"}
+    return {**{f"rmse_{c.replace('_body', '_inertial')}": rmse(angular_velocity(model, c, "inertial"),
+                                                               angular_velocity(run, c, "inertial"))
+               for c in ("chaser_omega_body", "debris_omega_body")},
+            "f1_inertial": COSTS["f1_inertial"](model, run, weights)}
+
+
 def _totals(rows: list[dict]) -> dict | None:
     """Sums of f1 and f2 over the runs (eqs. 18, 20) and the mean RMSE of each channel; None without runs
     (every validation run left out as not held: no score, rather than a sum of 0 that reads as perfect)."""
@@ -279,8 +338,9 @@ def _totals(rows: list[dict]) -> dict | None:
         return None
     totals = {"f1": sum(r["f1"] for r in rows), "f2": sum(r["f2"] for r in rows),
               **{f"mean_rmse_{c}": float(np.mean([r[f"rmse_{c}"] for r in rows])) for c in CHANNELS}}
-    if all("f1_free_roll" in r for r in rows):
-        totals["f1_free_roll"] = sum(r["f1_free_roll"] for r in rows)
+    for key in ("f1_free_roll", "f1_inertial"):
+        if all(key in r for r in rows):
+            totals[key] = sum(r[key] for r in rows)
     return totals
 
 

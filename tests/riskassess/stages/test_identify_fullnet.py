@@ -4,12 +4,14 @@ import json
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from riskassess.products import results
 from riskassess.cases.impact import CaseError, load_model
-from riskassess.stages.identify import claim_identify_folder, simulate
+from riskassess.stages.identify import MissingAttitude, claim_identify_folder, cost_f1, cost_f1_inertial, identify, simulate
 from riskassess.stages.identify_fullnet import (
     comparison_rows,
+    full_net_compared,
     full_net_runs,
     held_reach,
     held_runs,
@@ -206,3 +208,79 @@ def test_roll_about_the_symmetry_axis_is_seen_by_the_body_frame_rmse_and_not_by_
     model_axial = model + [0.0, 0.0, 0.01]
     assert rmse_free_roll(model_axial, data, axis) == pytest.approx(0.01, rel=1e-9)
     assert symmetry_axis_body([1.0, 2.0, 3.0]) is None and symmetry_axis_body([2.0, 2.0, 2.0]) is None
+
+
+def _spin_series(omega_body, to_inertial, rate=15.57):
+    """A compared series (identify.compared_series' keys) of a debris turning at ``omega_body`` (k, 3) rad/s with
+    attitude ``to_inertial`` (k, 3, 3); chaser at rest, same position and tension for every series."""
+    k = len(omega_body)
+    return {"rate_deg_s": rate, "relative_position": np.tile([0.0, 20.0, 0.0], (k, 1)), "main_tether_tension": np.zeros(k),
+            "debris_omega_body": np.asarray(omega_body, float), "chaser_omega_body": np.zeros((k, 3)),
+            "debris_to_inertial": np.asarray(to_inertial, float), "chaser_to_inertial": np.tile(np.eye(3), (k, 1, 1))}
+
+
+def _about_z(phi):
+    """Rotations (k, 3, 3) about z by the angles ``phi`` (k,) (rad)."""
+    c, s = np.cos(phi), np.sin(phi)
+    return np.array([[[ci, -si, 0.0], [si, ci, 0.0], [0.0, 0.0, 1.0]] for ci, si in zip(c, s)])
+
+
+def test_inertial_f1_is_the_body_f1_when_the_debris_does_not_turn():
+    """Both models hold the same attitude (Table 2's q^D, fixed: the debris does not turn) and differ in omega_D by
+    0.01-0.05 rad/s: omega_inertial = R omega_body with one R for both, so the RMSE of eq. (19b) is the same in
+    either frame (a rotation keeps the norm) and f1_inertial = f1 to round-off (1e-12 relative)."""
+    q = [0.38344, 0.4526, 0.7958, 0.1218]                      # Table 2, scalar first
+    fixed = np.tile(Rotation.from_quat(q[1:] + q[:1]).as_matrix(), (200, 1, 1))
+    t = np.linspace(0.0, 10.0, 200)
+    model = _spin_series(np.column_stack([0.01 * np.sin(t), -0.3 + 0.05 * np.cos(t), 0.02 * t / 10]), fixed)
+    data = _spin_series(np.tile([0.0, -0.3, 0.0], (200, 1)), fixed)
+    weights = load_model(CASE, TowingCase).identification.weights
+    assert cost_f1(model, data, weights) > 1.0
+    assert cost_f1_inertial(model, data, weights) == pytest.approx(cost_f1(model, data, weights), rel=1e-12)
+
+
+def test_a_roll_that_keeps_the_inertial_rate_costs_nothing_in_inertial_components():
+    """The data's debris is rolled about its symmetry axis (body z) by phi(t) = 0..pi relative to the model's, its
+    body-frame rate turned back by the same angle, so omega_D in inertial components is the model's, 0.3 rad/s
+    along -y: f1 in body components counts w2 sqrt(2) |w| (the chord, as in the roll test above), f1 in inertial
+    components 0 (round-off)."""
+    phi = np.linspace(0.0, np.pi, 1001)
+    fixed = np.tile(np.eye(3), (len(phi), 1, 1))
+    omega_inertial = np.tile([0.0, -0.3, 0.0], (len(phi), 1))
+    rolled = _about_z(phi)
+    model = _spin_series(omega_inertial, fixed)
+    data = _spin_series(np.einsum("kji,kj->ki", rolled, omega_inertial), rolled)   # body = R^T omega_inertial
+    weights = load_model(CASE, TowingCase).identification.weights
+    assert cost_f1(model, data, weights) == pytest.approx(weights[1] * 0.3 * np.sqrt(2.0), rel=1e-9)
+    assert cost_f1_inertial(model, data, weights) < 1e-12
+
+
+def test_runs_cached_without_attitudes_say_so_and_the_inertial_identification_refuses_them(tmp_path):
+    """A full-net run cached before the attitudes were stored: its comparison row names what is missing instead
+    of an inertial f1, and identification on f1_inertial stops before any run, naming the rate."""
+    case = _small_case("f1_inertial", swarm_size=4, pso_generations=1, polish_evaluations=0)
+    _stand_in_full_net_runs(case, tmp_path)
+    data = full_net_runs(case, case.rates.training_deg_s, tmp_path, END, 1)
+    truth = case.identification.benchmark_truth
+    row = comparison_rows(lower_order_case(case, data[0]), truth, data, END)[0]
+    assert row["f1_inertial"] == 0.0 and row["f1"] == 0.0   # the stand-in data are the model at s_true
+    old = [{k: v for k, v in run.items() if not k.endswith("_to_inertial")} for run in data]
+    row = comparison_rows(lower_order_case(case, old[0]), truth, old, END)[0]
+    assert "f1_inertial" not in row and "stores no attitudes" in row["inertial_missing"]
+    with pytest.raises(MissingAttitude, match=r"20\.44 deg/s store no attitudes"):
+        identify(lower_order_case(case, old[0]), old, "pso", END, workers=1)
+
+
+def test_a_cached_full_net_run_keeps_the_attitudes_from_the_start_time_on():
+    """full_net_compared keeps every compared channel and both attitudes at the samples from start_time (25 s) on,
+    unchanged: here 10 samples at 0.1 s from 24.5 s, the last 5 (25.0-25.4 s) kept."""
+    time = 24.5 + 0.1 * np.arange(10)
+    turn = _about_z(0.2 * time)
+    series = {"time": time, "debris_com_inertial": np.outer(time, [1.0, 2.0, 3.0]), "chaser_com_inertial": np.zeros((10, 3)),
+              "chaser_omega_body": np.zeros((10, 3)), "debris_omega_body": np.tile([0.0, 0.0, 0.2], (10, 1)),
+              "main_tether_tension": time, "chaser_to_inertial": np.tile(np.eye(3), (10, 1, 1)), "debris_to_inertial": turn}
+    kept = full_net_compared(series, 25.0)
+    np.testing.assert_array_equal(kept["debris_to_inertial"], turn[5:])
+    np.testing.assert_array_equal(kept["main_tether_tension"], time[5:])
+    assert set(kept) == {"relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension",
+                         "chaser_to_inertial", "debris_to_inertial"}
