@@ -52,9 +52,10 @@ ATTITUDE_OF = {"chaser_omega_body": "chaser_to_inertial", "debris_omega_body": "
 FRAMES = ("body", "inertial")
 
 
-class MissingAttitude(KeyError):
+class MissingAttitude(ValueError):
     """A compared series lacks the attitude an inertial-frame comparison needs (a full-net run cached before
-    the attitudes were stored with every run)."""
+    the attitudes were stored with every run); a ValueError, so the CLI reports it as bad input (exit 2).
+    :func:`identify` checks the data before any run, so a worker never turns it into an infinite cost."""
 
 
 def compared_series(result) -> dict:
