@@ -68,7 +68,7 @@ def explaining(run: Path) -> dict:
     loads = np.load(wall) if wall.exists() else s
     t = loads["time"]
     dt = np.diff(t, prepend=t[0])               # the series hold interval means: F dt is the interval's impulse
-    force, _ = contact_totals_debris(loads)
+    force, moment = contact_totals_debris(loads)
     first = t <= FIRST_S
     impulse_y = force[:, 1] * dt
     net_momentum0 = float(loads["momentum_linear_lvlh"][0, 1])          # the debris is at rest at t = 0
@@ -80,7 +80,17 @@ def explaining(run: Path) -> dict:
         loads["body_to_lvlh"][-1, main] @ loads["body_to_lvlh"][0, main].T)))
     hinge = list(s["joint_names"]).index("solar_array_hinge")
     judged = s["time"] >= SKIP_S
+    ka = [list(s["body_names"]).index(name) for name in ("ka_band_boom", "ka_band_dish")]
+    ka_force = np.linalg.norm(loads["contact_force_lvlh"][:, ka].sum(axis=1), axis=1)
+    rate = np.degrees(np.linalg.norm(s["body_omega_body"][:, main], axis=1))
     return {
+        "angular impulse about the debris CoM, first 0.5 s (N m s, LVLH x y z)": (
+            moment[first] * dt[first, None]).sum(axis=0).tolist(),
+        "angular impulse about the debris CoM, after 0.5 s (N m s, LVLH x y z)": (
+            moment[~first] * dt[~first, None]).sum(axis=0).tolist(),
+        "contact on the Ka-band, first second: impulse sum |F| dt (N s)": float((ka_force * dt)[t <= 1.0].sum()),
+        "contact on the Ka-band, first second: largest (N)": float(ka_force[t <= 1.0].max()),
+        "debris main body rate, largest (deg/s)": float(rate.max()),
         "contact impulse along-track, first 0.5 s (N s)": float(impulse_y[first].sum()),
         "contact impulse along-track, after 0.5 s (N s)": float(impulse_y[~first].sum()),
         "net along-track velocity at the end, mass mean (m/s)": float(net_v_end),
@@ -112,17 +122,16 @@ def run_one(mode: str, k: int, eps: float, end_time: float | None) -> dict:
 
 
 def scalar_rows(rows: list[dict]) -> list[str]:
-    """The figures of a run that are one number (the tuples of the side-by-side bench are split)."""
+    """The figures the runs hold, in their order (runs stored before a figure was added lack it)."""
     keys = []
-    for key, value in rows[0].items():
-        if key in ("cpu (s)", "wall (s)", "load"):
-            continue
-        keys.append(key)
+    for row in rows:
+        keys += [key for key in row if key not in keys and key not in ("cpu (s)", "wall (s)", "load")]
     return keys
 
 
 def values_of(rows: list[dict], key: str) -> dict[str, np.ndarray]:
-    """``key`` over the replicas, one array per number (a tuple figure gives one array per element)."""
+    """``key`` over the replicas that have it, one array per number (a tuple figure gives one array per element)."""
+    rows = [r for r in rows if key in r]
     first = rows[0][key]
     if isinstance(first, (list, tuple)):
         return {f"{key} [{i}]": np.array([r[key][i] for r in rows]) for i in range(len(first))}
@@ -145,6 +154,8 @@ def table(store: dict) -> None:
     print(f"\n{'figure':62s} {'paper':>8s} | {'sequential mean +- sd [min, max]':>36s} | "
           f"{'coupled mean +- sd [min, max]':>36s} | {'coupled - seq':>13s} {'Welch t':>8s}")
     for key in scalar_rows(runs["sequential"]):
+        if min(sum(key in r for r in runs[m]) for m in MODES) < 2:
+            continue
         for name, seq in values_of(runs["sequential"], key).items():
             cou = values_of(runs["coupled"], key)[name]
             diff = cou.mean() - seq.mean()
@@ -155,7 +166,8 @@ def table(store: dict) -> None:
             def cell(v):
                 return f"{v.mean():9.4g} +- {v.std(ddof=1):8.3g} [{v.min():.3g}, {v.max():.3g}]"
             rel = f"{diff / abs(seq.mean()):+.0%}" if seq.mean() else ""
-            print(f"{name[:62]:62s} {ref} | {cell(seq):>36s} | {cell(cou):>36s} | {diff:+8.3g} {rel:>5s} {tval:+8.1f}")
+            print(f"{name[:62]:62s} {ref} | {cell(seq):>36s} | {cell(cou):>36s} | {diff:+8.3g} {rel:>5s} {tval:+8.1f}"
+                  + (f"  (n = {seq.size}, {cou.size})" if (seq.size, cou.size) != (n["sequential"], n["coupled"]) else ""))
 
 
 def main() -> None:
