@@ -49,9 +49,10 @@ def evidence_gaps(time, contact_force_debris_lvlh, skip_until: float) -> list[In
     judged = time >= skip_until
     gaps = []
     if judged.sum() < MIN_JUDGED_SAMPLES:
+        end = time[-1] if time.size else 0.0
         gaps.append(Indeterminacy("too_few_judged_samples",
                                   f"{int(judged.sum())} samples after skip_initial = {skip_until:g} s (the run ends at "
-                                  f"{time[-1] if time.size else 0.0:g} s); a verdict needs at least {MIN_JUDGED_SAMPLES}"))
+                                  f"{end:g} s); a verdict needs at least {MIN_JUDGED_SAMPLES}"))
     if time.size > 1 and np.max(np.diff(time)) > MAX_SAMPLE_INTERVAL_S * (1 + 1e-9):
         gaps.append(Indeterminacy("coarse_sampling",
                                   f"samples up to {np.max(np.diff(time)):.3g} s apart; a verdict needs at least "
@@ -130,7 +131,8 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
     dict
         ``skip_initial_s``, ``release_policy``, ``locations`` (one verdict each), ``released_pieces``,
         ``debris_state``, ``secondary_debris`` (True / False / None) and ``indeterminate_reasons``; each
-        location's ``indeterminate_reason`` comes with its ``indeterminate_rules`` (:mod:`structures.indeterminacy`).
+        location's ``indeterminate_reason`` comes with its ``indeterminate_rules``
+        (:mod:`structures.indeterminacy`).
     """
     time = series["time"]
     released_at = {e.location: e for e in events}
