@@ -139,13 +139,19 @@ CONTACT_READINGS = {"V_t0 = 0.1 m/s": {"transition_speed": 0.1}, "V_t0 = 0.001 m
                     "d_n = alpha k_n": {"hunt_crossley_alpha": 0.05 / 1.5}}
 
 
-def contact_readings() -> dict:
+#: The aim point the case assumes (target frame, m; the paper gives none): the middle of the body + array span.
+AIM_READINGS = {"aim at the main body's centre [0, 0, 0]": {"aim_point": [0.0, 0.0, 0.0]},
+                "aim at [0, 0, 3.5]": {"aim_point": [0.0, 0.0, 3.5]}}
+
+
+def contact_readings(readings=None, section="contact") -> dict:
     """The wrapping contact level (0.5-6 s, per LVLH component, 95th / 99th percentile of |F| (N) and |M| (N m), 1 kHz)
-    of the sequential wall run under each of :data:`CONTACT_READINGS`, one run each (6 s)."""
+    of the sequential wall run under each of ``readings`` (default :data:`CONTACT_READINGS`, changes of the case's
+    ``section``), one run each (6 s)."""
     rows = {}
-    for reading, update in CONTACT_READINGS.items():
+    for reading, update in (readings or CONTACT_READINGS).items():
         case = _case(end_time=6.0)
-        case = case.model_copy(update={"contact": case.contact.model_copy(update=update)})
+        case = case.model_copy(update={section: getattr(case, section).model_copy(update=update)})
         with tempfile.TemporaryDirectory() as tmp:
             row = _timed(case, Path(tmp) / "run")
             s = np.load(Path(tmp) / "run" / "wall_timeseries.npz")
@@ -250,7 +256,8 @@ def kept_run(**changes) -> dict:
 
 
 ITEMS = {"first_impact": first_impact, "sampling_windows": sampling_windows, "wrapping_windows": wrapping_windows,
-         "contact_readings": contact_readings, "nominal": lambda: kept_run(),
+         "contact_readings": contact_readings,
+         "aim_readings": lambda: contact_readings(AIM_READINGS, "launch"), "nominal": lambda: kept_run(),
          "soft_hinge": lambda: kept_run(hinge_scale=0.25), "softer_hinge": lambda: kept_run(hinge_scale=1 / 16)}
 
 
