@@ -14,25 +14,24 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-from riskassess.cases.impact import load_case
-from riskassess.stages.run import run_case
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+from bench_coupling_replicas import CASE, ROOT, replica_case  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
-CASE = ROOT / "cases" / "envisat_paper_sequential.toml"
+from riskassess.stages.run import run_case  # noqa: E402
+
 STORE = ROOT / "bench" / "results" / "array_deflection_modes.json"
 
 
 def one(mode: str, k: int, end_time: float) -> dict:
-    case = load_case(CASE)
-    launch = case.launch.model_copy(update={"velocity": case.launch.velocity * (1.0 + k * 1e-7)})
-    case = case.model_copy(update={"launch": launch, "simulation": case.simulation.model_copy(
-        update={"coupling": mode, "end_time": end_time})})
+    """One run in ``mode`` to ``end_time`` (s), launch speed x (1 + k 1e-7): the array's swing and its load."""
+    case = replica_case(mode, k, end_time=end_time)
     array = next(b for b in case.target.bodies if b.name == "solar_array")
     hinge = next(j for j in case.target.joints if j.name == "solar_array_hinge")
     com_to_hinge_body = np.asarray(hinge.position, float) - np.asarray(array.center_of_mass, float)

@@ -105,12 +105,18 @@ def explaining(run: Path) -> dict:
     }
 
 
-def run_one(mode: str, k: int, eps: float, end_time: float | None) -> dict:
-    """One run of the paper case in ``mode`` with the launch speed x (1 + k eps): its figures."""
+def replica_case(mode: str, k: int, eps: float = 1e-7, **simulation):
+    """The paper case (:data:`CASE`) in ``mode`` ("sequential" or "coupled") with the launch speed x (1 + k eps) and
+    the ``simulation`` keys changed (e.g. ``end_time``, ``output_rate``)."""
     case = load_case(CASE)
     launch = case.launch.model_copy(update={"velocity": case.launch.velocity * (1.0 + k * eps)})
-    update = {"coupling": mode} | ({"end_time": end_time} if end_time else {})
-    case = case.model_copy(update={"launch": launch, "simulation": case.simulation.model_copy(update=update)})
+    update = {"coupling": mode} | simulation
+    return case.model_copy(update={"launch": launch, "simulation": case.simulation.model_copy(update=update)})
+
+
+def run_one(mode: str, k: int, eps: float, end_time: float | None) -> dict:
+    """One run of the paper case in ``mode`` with the launch speed x (1 + k eps): its figures."""
+    case = replica_case(mode, k, eps, **({"end_time": end_time} if end_time else {}))
     load = os.getloadavg()[0]
     cpu, wall = time.process_time(), time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:

@@ -14,25 +14,24 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-from riskassess.cases.impact import load_case
-from riskassess.stages.run import run_case
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+from bench_coupling_replicas import CASE, ROOT, replica_case  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
-CASE = ROOT / "cases" / "envisat_paper_sequential.toml"
+from riskassess.stages.run import run_case  # noqa: E402
+
 STORE = ROOT / "bench" / "results" / "held_loads_kaband.json"
 
 
 def one(mode: str, rate: float, k: int) -> dict:
-    case = load_case(CASE)
-    launch = case.launch.model_copy(update={"velocity": case.launch.velocity * (1.0 + k * 1e-7)})
-    sim = case.simulation.model_copy(update={"coupling": mode, "output_rate": rate, "end_time": 1.0})
-    case = case.model_copy(update={"launch": launch, "simulation": sim})
+    """The first second in ``mode`` at ``rate`` (Hz) output, launch speed x (1 + k 1e-7): the dish root's peaks."""
+    case = replica_case(mode, k, output_rate=rate, end_time=1.0)
     cpu, load = time.process_time(), os.getloadavg()[0]
     with tempfile.TemporaryDirectory() as tmp:
         run_case(CASE, Path(tmp) / "run", case=case)

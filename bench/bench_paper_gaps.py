@@ -27,15 +27,19 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-from riskassess.cases.impact import load_case
-from riskassess.products.summary import contact_totals_debris
-from riskassess.stages.run import run_case
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+from bench_paper_side_by_side import composite_inertia  # noqa: E402
+
+from riskassess.cases.impact import load_case  # noqa: E402
+from riskassess.products.summary import contact_totals_debris  # noqa: E402
+from riskassess.stages.run import run_case  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "cases" / "envisat_paper_sequential.toml"
@@ -165,18 +169,6 @@ def contact_readings(readings=None, section="contact") -> dict:
     return rows
 
 
-def composite_inertia(case) -> tuple[np.ndarray, float]:
-    """Inertia (kg m^2) of the debris as one rigid body about its CoM, target frame (= LVLH at rest), and its mass."""
-    bodies = case.target.bodies
-    mass = sum(b.mass for b in bodies)
-    com = sum(b.mass * np.asarray(b.center_of_mass) for b in bodies) / mass
-    inertia = np.zeros((3, 3))
-    for b in bodies:
-        r = np.asarray(b.center_of_mass) - com
-        inertia += np.asarray(b.inertia) + b.mass * (r @ r * np.eye(3) - np.outer(r, r))
-    return inertia, mass
-
-
 def read_run(run: Path, case) -> dict:
     """The measurements of one kept sequential run (module docstring)."""
     s = np.load(run / "timeseries.npz")
@@ -185,7 +177,7 @@ def read_run(run: Path, case) -> dict:
     t = wall["time"]
     dt = np.diff(t, prepend=0.0)
     force, moment = contact_totals_debris(wall)
-    inertia, _ = composite_inertia(case)
+    inertia = composite_inertia(case.model_dump(mode="json"))
     first = t <= 0.5
     spin_first = np.degrees(np.linalg.solve(inertia, (moment[first] * dt[first, None]).sum(axis=0)))
     spin_end = np.degrees(np.linalg.solve(inertia, (moment * dt[:, None]).sum(axis=0)))
