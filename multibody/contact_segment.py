@@ -75,6 +75,8 @@ class SegmentBuffers(NamedTuple):
     lag_body: np.ndarray            # (m,) int64 body of that impulse, -1 for none
     lag_split: np.ndarray           # (m,) its point's position along the thread, s (-)
     lag_point_body: np.ndarray      # (m, 3) its point, body frame of lag_body (m)
+    lag_end_node: np.ndarray        # (m,) int64 the node that handed its load to the point (-1: none)
+    lag_end_impulse_lvlh: np.ndarray  # (m, 3) the impulse still to apply on that node (N s), LVLH
     node_force_lvlh: np.ndarray     # (3, n) this pass's forces on the nodes (N), LVLH, coordinate-major
     lag_velocity_lvlh: np.ndarray   # (3, n) the carried impulses' velocity change of each node (m/s), LVLH
     centre_distance: np.ndarray     # (ns, n) each node's distance to each shape's bounding-sphere centre (m)
@@ -98,6 +100,7 @@ def segment_buffers(n_threads: int, n_nodes: int, n_shapes: int, enabled: bool) 
     m, n, ns = (n_threads, n_nodes, n_shapes) if enabled else (0, 0, 0)
     return SegmentBuffers(enabled=int(bool(enabled)), lag_impulse_lvlh=np.zeros((m, 3)),
                           lag_body=np.full(m, -1, np.int64), lag_split=np.zeros(m), lag_point_body=np.zeros((m, 3)),
+                          lag_end_node=np.full(m, -1, np.int64), lag_end_impulse_lvlh=np.zeros((m, 3)),
                           node_force_lvlh=np.zeros((3, n)), lag_velocity_lvlh=np.zeros((3, n)),
                           centre_distance=np.zeros((ns, n)), node_speed=np.zeros(n), shape_work=np.zeros((2, ns)),
                           breakpoints=np.zeros(MAX_BREAKPOINTS), contact_scalar=np.zeros((5, 1)),
@@ -287,16 +290,23 @@ def segment_box_sublevel(a, d, lo, hi, level, work):
 
 
 @njit(cache=True)
-def box_normal_at(px, py, pz, lo, hi, wx, wy, wz):
-    """Unit normal (body frame) from the box to the body-frame point p: from the nearest surface point
-    outside; inside, the nearest face's, and on a mid-plane (a thread already through the middle of a thin
-    plate) the face against the point's relative velocity w (body frame, m/s), so it is pushed back the
-    way it came.
+def segment_box_normal(px, py, pz, dx, dy, dz, lo, hi, wx, wy, wz):
+    """Unit contact normal (body frame) from the box to a segment's deepest point p (direction d).
+
+    Outside the box, from the nearest surface point (the segment's depth peaks there, so this is
+    perpendicular to the segment). Inside, the faces nearest to p within :data:`TIE_DISTANCE` (an interior
+    deepest point lies where two faces' depths cross): their combination perpendicular to the segment, which
+    is the direction in which moving the segment sideways relieves it (a face's own normal, were it not
+    perpendicular, would push the thread along itself, which relieves nothing). On a mid-plane of the box
+    (a thread already through the middle of a thin plate) the geometry cannot tell the side: the face
+    against the point's relative velocity w, so it is pushed back the way it came.
 
     Parameters
     ----------
     px, py, pz : float
-        The point, body frame (m).
+        The deepest point, body frame (m).
+    dx, dy, dz : float
+        The segment's direction (end minus start), body frame (m).
     lo, hi : tuple of 3 float
         The box's corners, body frame (m).
     wx, wy, wz : float
@@ -306,30 +316,48 @@ def box_normal_at(px, py, pz, lo, hi, wx, wy, wz):
     -------
     tuple of 3 float
     """
-    p = (px, py, pz)
-    w = (wx, wy, wz)
+    p, d, w = (px, py, pz), (dx, dy, dz), (wx, wy, wz)
     ox = px - min(max(px, lo[0]), hi[0])
     oy = py - min(max(py, lo[1]), hi[1])
     oz = pz - min(max(pz, lo[2]), hi[2])
     norm = math.sqrt(ox * ox + oy * oy + oz * oz)
     if norm > 0.0:
         return ox / norm, oy / norm, oz / norm
-    axis, deepest = 0, -math.inf
+    deepest = -math.inf
     for i in range(3):
-        excess = max(lo[i] - p[i], p[i] - hi[i])
-        if excess > deepest:
-            axis, deepest = i, excess
-    offset = p[axis] - 0.5 * (lo[axis] + hi[axis])
-    # the mid-plane to round-off of the plate's thickness: the geometry cannot tell the side
-    if abs(offset) <= 1e-9 * (hi[axis] - lo[axis]):
-        sign = -1.0 if w[axis] > 0.0 else 1.0
-    else:
-        sign = 1.0 if offset > 0.0 else -1.0
-    if axis == 0:
-        return sign, 0.0, 0.0
-    if axis == 1:
-        return 0.0, sign, 0.0
-    return 0.0, 0.0, sign
+        deepest = max(deepest, lo[i] - p[i], p[i] - hi[i])
+    n = [0.0, 0.0, 0.0]
+    rate = [0.0, 0.0, 0.0]   # each active face's depth change along the segment, sigma_i d_i
+    active = [False, False, False]
+    for i in range(3):
+        offset = p[i] - 0.5 * (lo[i] + hi[i])
+        if max(lo[i] - p[i], p[i] - hi[i]) < deepest - TIE_DISTANCE:
+            continue
+        if abs(offset) <= 1e-9 * (hi[i] - lo[i]):
+            sign = -1.0 if w[i] > 0.0 else 1.0
+            out = [0.0, 0.0, 0.0]
+            out[i] = sign
+            return out[0], out[1], out[2]
+        active[i] = True
+        n[i] = 1.0 if offset > 0.0 else -1.0
+        rate[i] = n[i] * d[i]
+    # a convex combination with no component along the segment: two faces whose depths change oppositely along it
+    for i in range(3):
+        for k in range(i + 1, 3):
+            if active[i] and active[k] and rate[i] * rate[k] < 0.0:
+                share = rate[k] / (rate[k] - rate[i])
+                out = [0.0, 0.0, 0.0]
+                out[i], out[k] = share * n[i], (1.0 - share) * n[k]
+                size = math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
+                return out[0] / size, out[1] / size, out[2] / size
+    # one face (or faces whose depths do not cross): the one the segment runs along most nearly
+    best, axis = math.inf, 0
+    for i in range(3):
+        if active[i] and abs(rate[i]) < best:
+            best, axis = abs(rate[i]), i
+    out = [0.0, 0.0, 0.0]
+    out[axis] = n[axis]
+    return out[0], out[1], out[2]
 
 
 @njit(cache=True, inline="always")
@@ -385,7 +413,7 @@ def _apply_at_point(a, b, split, body, fx, fy, fz, arm_x, arm_y, arm_z, weight, 
 
 
 @njit(cache=True)
-def _release_carried(seg, threads, net_mass, states, step, stage_weight, body_force_lvlh, torque_lvlh,
+def _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body_force_lvlh, torque_lvlh,
                      out_body_impulse, out_node_impulse):
     """Apply every thread's impulse carried from the previous step (its contact's end minus mean velocity
     change) as a force over this step at its stored point, and note the velocity change it gives each node
@@ -414,7 +442,17 @@ def _release_carried(seg, threads, net_mass, states, step, stage_weight, body_fo
         _apply_at_point(a, c, s, b, jx * inverse_step, jy * inverse_step, jz * inverse_step, arm_x, arm_y, arm_z,
                         step * stage_weight, seg.node_force_lvlh, body_force_lvlh, torque_lvlh, out_body_impulse,
                         out_node_impulse)
+        e = seg.lag_end_node[j]
+        if e >= 0:
+            for d in range(3):
+                lag_velocity[d, e] += seg.lag_end_impulse_lvlh[j, d] / net_mass[e]
+            _apply_at_point(e, e, 0.0, b, seg.lag_end_impulse_lvlh[j, 0] * inverse_step,
+                            seg.lag_end_impulse_lvlh[j, 1] * inverse_step, seg.lag_end_impulse_lvlh[j, 2] * inverse_step,
+                            x[0, e] - com_lvlh[b, 0], x[1, e] - com_lvlh[b, 1], x[2, e] - com_lvlh[b, 2],
+                            step * stage_weight, seg.node_force_lvlh, body_force_lvlh, torque_lvlh, out_body_impulse,
+                            out_node_impulse)
         seg.lag_body[j] = -1
+        seg.lag_end_node[j] = -1
     return any_carried
 
 
@@ -502,7 +540,7 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
     out_body_impulse, out_node_impulse = buffers.body_impulse_lvlh, buffers.node_impulse_lvlh
     node_force = seg.node_force_lvlh
     node_force[:] = 0.0
-    carried = _release_carried(seg, threads, net_mass, states, step, stage_weight, body_force_lvlh, torque_lvlh,
+    carried = _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body_force_lvlh, torque_lvlh,
                                out_body_impulse, out_node_impulse)
     _near_shapes(x, v, net_force_lvlh, net_mass, buffers.velocity_lag, seg, states, shapes, step)
     energy, count, dissipated = 0.0, 0, 0.0
@@ -553,20 +591,29 @@ def _thread_on_box(j, a, c, s, b, pa, pc, reach, x, v, net_force_lvlh, net, stat
                    n_substeps, stage_weight, buffers, body_force_lvlh, torque_lvlh):
     """Thread ``j`` (nodes a, c; body-frame ends ``pa``, ``pc``) against box shape ``s`` of body ``b`` over the
     step (module doc); returns the contact's elastic energy (J), 1 if it penetrates (else 0), and the energy
-    it dissipated (J, weighted)."""
+    it dissipated (J, weighted).
+
+    The contact's coordinate is the excess q = delta(t*) - delta_e of the deepest point over the deeper node
+    e when that node's own sphere penetrates (else q = delta(t*)), and the forces are its energy's gradient:
+    F (1 - s) n and F s n on the nodes at the point, and -F n_e on node e, which hands the load its own
+    contact carried up to q to the point (module doc); the body takes every reaction on the same lines."""
     seg = buffers.segments
     net_mass, radius = net.mass, net.radius
     lo = (shapes.box_min_body[s, 0], shapes.box_min_body[s, 1], shapes.box_min_body[s, 2])
     hi = (shapes.box_max_body[s, 0], shapes.box_max_body[s, 1], shapes.box_max_body[s, 2])
     d = (pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2])
     t_deepest, distance = segment_box_deepest(pa, d, lo, hi, seg.breakpoints)
-    depth_a = radius[a] - box_signed_distance(pa[0], pa[1], pa[2], shapes.box_min_body, shapes.box_max_body, s)[0]
-    depth_c = radius[c] - box_signed_distance(pc[0], pc[1], pc[2], shapes.box_min_body, shapes.box_max_body, s)[0]
+    gap_a, eax, eay, eaz = box_signed_distance(pa[0], pa[1], pa[2], shapes.box_min_body, shapes.box_max_body, s)
+    gap_c, ecx, ecy, ecz = box_signed_distance(pc[0], pc[1], pc[2], shapes.box_min_body, shapes.box_max_body, s)
+    depth_a, depth_c = radius[a] - gap_a, radius[c] - gap_c
     thread_radius = min(radius[a], radius[c])
     depth = thread_radius - distance
-    # only an interior point deeper than both nodes' own spheres, and only by its excess (no double count)
+    # only an interior point deeper than both nodes' own spheres (no double count of a thread on a face)
     if depth <= max(depth_a, depth_c) + TIE_DISTANCE:
         return 0.0, 0, 0.0
+    end = -1
+    if max(depth_a, depth_c) > 0.0:
+        end = a if depth_a >= depth_c else c
     penetration = depth - max(0.0, depth_a, depth_c)
     if penetration + reach - thread_radius <= 0.0:
         return 0.0, 0, 0.0
@@ -574,66 +621,114 @@ def _thread_on_box(j, a, c, s, b, pa, pc, reach, x, v, net_force_lvlh, net, stat
     t_low, t_high = segment_box_sublevel(pa, d, lo, hi, distance + 0.5 * max(depth, 0.0) + TIE_DISTANCE,
                                          seg.breakpoints)
     split = 0.5 * (t_low + t_high) if t_low <= t_high else t_deepest
-    body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
+    rot, com_lvlh = states.body_to_lvlh, states.com_lvlh
     velocity_lvlh, omega_lvlh = states.velocity_lvlh, states.omega_lvlh
     half_kick = 0.5 * step if n_substeps > 1 else 0.0
     lag, node_lag = seg.lag_velocity_lvlh, buffers.velocity_lag
     wa, wc = 1.0 - split, split
-    # the point's start velocity (the nodes' as in the node contact) and its non-contact acceleration
-    point_velocity = np.empty(3)
-    point_accel = np.empty(3)
-    arm = np.empty(3)
+    # start velocities (as the node contact's) and non-contact accelerations: the point's and node e's
+    u = np.empty((3, 3))     # rows: point, node e (LVLH, m/s); then the point's arm from the CoM (m)
+    acc = np.zeros((2, 3))   # point, node e (m/s^2)
     for k in range(3):
         ua = v[k, a] + node_lag[k, a] + lag[k, a] + half_kick * net_force_lvlh[k, a] / net_mass[a]
         uc = v[k, c] + node_lag[k, c] + lag[k, c] + half_kick * net_force_lvlh[k, c] / net_mass[c]
-        point_velocity[k] = wa * ua + wc * uc
-        point_accel[k] = wa * net_force_lvlh[k, a] / net_mass[a] + wc * net_force_lvlh[k, c] / net_mass[c]
-        arm[k] = wa * x[k, a] + wc * x[k, c] - com_lvlh[b, k]
-    wx = point_velocity[0] - velocity_lvlh[b, 0] - (omega_lvlh[b, 1] * arm[2] - omega_lvlh[b, 2] * arm[1])
-    wy = point_velocity[1] - velocity_lvlh[b, 1] - (omega_lvlh[b, 2] * arm[0] - omega_lvlh[b, 0] * arm[2])
-    wz = point_velocity[2] - velocity_lvlh[b, 2] - (omega_lvlh[b, 0] * arm[1] - omega_lvlh[b, 1] * arm[0])
-    rot = body_to_lvlh
-    w_body = (rot[b, 0, 0] * wx + rot[b, 1, 0] * wy + rot[b, 2, 0] * wz,
-              rot[b, 0, 1] * wx + rot[b, 1, 1] * wy + rot[b, 2, 1] * wz,
-              rot[b, 0, 2] * wx + rot[b, 1, 2] * wy + rot[b, 2, 2] * wz)
-    nbx, nby, nbz = box_normal_at(pa[0] + t_deepest * d[0], pa[1] + t_deepest * d[1], pa[2] + t_deepest * d[2],
-                                  lo, hi, w_body[0], w_body[1], w_body[2])
+        u[0, k] = wa * ua + wc * uc
+        acc[0, k] = wa * net_force_lvlh[k, a] / net_mass[a] + wc * net_force_lvlh[k, c] / net_mass[c]
+        u[2, k] = wa * x[k, a] + wc * x[k, c] - com_lvlh[b, k]
+        if end >= 0:
+            u[1, k] = ua if end == a else uc
+            acc[1, k] = net_force_lvlh[k, end] / net_mass[end]
+    arm_x, arm_y, arm_z = u[2, 0], u[2, 1], u[2, 2]
+    wx = u[0, 0] - velocity_lvlh[b, 0] - (omega_lvlh[b, 1] * arm_z - omega_lvlh[b, 2] * arm_y)
+    wy = u[0, 1] - velocity_lvlh[b, 1] - (omega_lvlh[b, 2] * arm_x - omega_lvlh[b, 0] * arm_z)
+    wz = u[0, 2] - velocity_lvlh[b, 2] - (omega_lvlh[b, 0] * arm_y - omega_lvlh[b, 1] * arm_x)
+    nbx, nby, nbz = segment_box_normal(pa[0] + t_deepest * d[0], pa[1] + t_deepest * d[1], pa[2] + t_deepest * d[2],
+                                       d[0], d[1], d[2], lo, hi,
+                                       rot[b, 0, 0] * wx + rot[b, 1, 0] * wy + rot[b, 2, 0] * wz,
+                                       rot[b, 0, 1] * wx + rot[b, 1, 1] * wy + rot[b, 2, 1] * wz,
+                                       rot[b, 0, 2] * wx + rot[b, 1, 2] * wy + rot[b, 2, 2] * wz)
     nx = rot[b, 0, 0] * nbx + rot[b, 0, 1] * nby + rot[b, 0, 2] * nbz
     ny = rot[b, 1, 0] * nbx + rot[b, 1, 1] * nby + rot[b, 1, 2] * nbz
     nz = rot[b, 2, 0] * nbx + rot[b, 2, 1] * nby + rot[b, 2, 2] * nbz
+    # node e's normal (LVLH), its normal speed relative to the surface and its normal acceleration
+    mx_e = my_e = mz_e = 0.0
+    rate_e = accel_e = 0.0
+    ex_arm = ey_arm = ez_arm = 0.0
+    inverse_mass_a = (wa * wa) / net_mass[a]
+    inverse_mass_c = (wc * wc) / net_mass[c]
+    if end >= 0:
+        ebx, eby, ebz = (eax, eay, eaz) if end == a else (ecx, ecy, ecz)
+        mx_e = rot[b, 0, 0] * ebx + rot[b, 0, 1] * eby + rot[b, 0, 2] * ebz
+        my_e = rot[b, 1, 0] * ebx + rot[b, 1, 1] * eby + rot[b, 1, 2] * ebz
+        mz_e = rot[b, 2, 0] * ebx + rot[b, 2, 1] * eby + rot[b, 2, 2] * ebz
+        ex_arm, ey_arm, ez_arm = x[0, end] - com_lvlh[b, 0], x[1, end] - com_lvlh[b, 1], x[2, end] - com_lvlh[b, 2]
+        sx = u[1, 0] - velocity_lvlh[b, 0] - (omega_lvlh[b, 1] * ez_arm - omega_lvlh[b, 2] * ey_arm)
+        sy = u[1, 1] - velocity_lvlh[b, 1] - (omega_lvlh[b, 2] * ex_arm - omega_lvlh[b, 0] * ez_arm)
+        sz = u[1, 2] - velocity_lvlh[b, 2] - (omega_lvlh[b, 0] * ey_arm - omega_lvlh[b, 1] * ex_arm)
+        rate_e = sx * mx_e + sy * my_e + sz * mz_e
+        accel_e = acc[1, 0] * mx_e + acc[1, 1] * my_e + acc[1, 2] * mz_e
+        # the coordinate's inverse mass: node e moves along (its share of n) - n_e
+        share = wa if end == a else wc
+        along = share * (nx * mx_e + ny * my_e + nz * mz_e)
+        change = (share * share - 2.0 * along + 1.0) / net_mass[end]
+        if end == a:
+            inverse_mass_a = change
+        else:
+            inverse_mass_c = change
+    # the coordinate as a particle: its normal rate and acceleration less node e's; the slip is the point's
+    wx, wy, wz = wx - rate_e * nx, wy - rate_e * ny, wz - rate_e * nz
+    ax_p, ay_p, az_p = acc[0, 0] - accel_e * nx, acc[0, 1] - accel_e * ny, acc[0, 2] - accel_e * nz
     # touches within the step under its velocity and non-contact acceleration (as the node contact)
-    pull = point_accel[0] * nx + point_accel[1] * ny + point_accel[2] * nz
+    pull = ax_p * nx + ay_p * ny + az_p * nz
     closing = (wx * nx + wy * ny + wz * nz) * step
     if penetration - closing - 0.5 * pull * step * step <= 0.0 and penetration <= 0.0:
         return 0.0, 0, 0.0
-    point_mass = point_effective_mass(net_mass[a], net_mass[c], split)
-    fx, fy, fz = point_mass * point_accel[0], point_mass * point_accel[1], point_mass * point_accel[2]
-    body_mass = _effective_mass_of_body(body_to_lvlh, bodies.inverse_inertia_body, b, bodies.mass[b], arm[0], arm[1],
-                                        arm[2], nx, ny, nz)
-    mx, my, mz, ex, ey, ez, lost = _point_contact_over_step(penetration, wx, wy, wz, nx, ny, nz, fx, fy, fz,
-                                                             point_mass, body_mass, law, step, n_substeps, seg)
+    point_mass = 1.0 / (inverse_mass_a + inverse_mass_c)
+    body_mass = _effective_mass_of_body(rot, bodies.inverse_inertia_body, b, bodies.mass[b], arm_x, arm_y, arm_z,
+                                        nx, ny, nz)
+    mx, my, mz, ex, ey, ez, lost = _point_contact_over_step(penetration, wx, wy, wz, nx, ny, nz, point_mass * ax_p,
+                                                             point_mass * ay_p, point_mass * az_p, point_mass,
+                                                             body_mass, law, step, n_substeps, seg)
     scale = point_mass / step
-    _apply_at_point(a, c, split, b, scale * mx, scale * my, scale * mz, arm[0], arm[1], arm[2], step * stage_weight,
-                    seg.node_force_lvlh, body_force_lvlh, torque_lvlh, buffers.body_impulse_lvlh,
-                    buffers.node_impulse_lvlh)
-    # the rest of the step's velocity change, carried to the next evaluation at this point; a thread already
-    # carrying one from another shape this step takes this one now (momentum stays exact)
+    weight = step * stage_weight
+    _apply_pair(a, c, split, b, end, scale * mx, scale * my, scale * mz, nx, ny, nz, mx_e, my_e, mz_e, arm_x, arm_y,
+                arm_z, ex_arm, ey_arm, ez_arm, weight, seg, body_force_lvlh, torque_lvlh, buffers)
+    # the rest of the step's velocity change, carried to the next evaluation; a thread already carrying one
+    # from another shape this step takes this one now (momentum stays exact)
     if seg.lag_body[j] >= 0:
-        _apply_at_point(a, c, split, b, scale * (ex - mx), scale * (ey - my), scale * (ez - mz), arm[0], arm[1],
-                        arm[2], step * stage_weight, seg.node_force_lvlh, body_force_lvlh, torque_lvlh,
-                        buffers.body_impulse_lvlh, buffers.node_impulse_lvlh)
+        _apply_pair(a, c, split, b, end, scale * (ex - mx), scale * (ey - my), scale * (ez - mz), nx, ny, nz, mx_e,
+                    my_e, mz_e, arm_x, arm_y, arm_z, ex_arm, ey_arm, ez_arm, weight, seg, body_force_lvlh, torque_lvlh,
+                    buffers)
     elif ex != mx or ey != my or ez != mz:
+        jx, jy, jz = point_mass * (ex - mx), point_mass * (ey - my), point_mass * (ez - mz)
         seg.lag_body[j] = b
         seg.lag_split[j] = split
-        seg.lag_impulse_lvlh[j, 0] = point_mass * (ex - mx)
-        seg.lag_impulse_lvlh[j, 1] = point_mass * (ey - my)
-        seg.lag_impulse_lvlh[j, 2] = point_mass * (ez - mz)
-        seg.lag_point_body[j, 0] = rot[b, 0, 0] * arm[0] + rot[b, 1, 0] * arm[1] + rot[b, 2, 0] * arm[2]
-        seg.lag_point_body[j, 1] = rot[b, 0, 1] * arm[0] + rot[b, 1, 1] * arm[1] + rot[b, 2, 1] * arm[2]
-        seg.lag_point_body[j, 2] = rot[b, 0, 2] * arm[0] + rot[b, 1, 2] * arm[1] + rot[b, 2, 2] * arm[2]
+        seg.lag_impulse_lvlh[j, 0], seg.lag_impulse_lvlh[j, 1], seg.lag_impulse_lvlh[j, 2] = jx, jy, jz
+        seg.lag_point_body[j, 0] = rot[b, 0, 0] * arm_x + rot[b, 1, 0] * arm_y + rot[b, 2, 0] * arm_z
+        seg.lag_point_body[j, 1] = rot[b, 0, 1] * arm_x + rot[b, 1, 1] * arm_y + rot[b, 2, 1] * arm_z
+        seg.lag_point_body[j, 2] = rot[b, 0, 2] * arm_x + rot[b, 1, 2] * arm_y + rot[b, 2, 2] * arm_z
+        normal_impulse = jx * nx + jy * ny + jz * nz
+        seg.lag_end_node[j] = end
+        seg.lag_end_impulse_lvlh[j, 0] = -normal_impulse * mx_e
+        seg.lag_end_impulse_lvlh[j, 1] = -normal_impulse * my_e
+        seg.lag_end_impulse_lvlh[j, 2] = -normal_impulse * mz_e
     if penetration > 0.0:
         return hertz_elastic_energy(penetration, law.stiffness, law.exponent), 1, lost * stage_weight
     return 0.0, 0, lost * stage_weight
+
+
+@njit(cache=True, inline="always")
+def _apply_pair(a, c, split, b, end, fx, fy, fz, nx, ny, nz, ex, ey, ez, arm_x, arm_y, arm_z, end_arm_x, end_arm_y,
+                end_arm_z, weight, seg, body_force_lvlh, torque_lvlh, buffers):
+    """The contact force f at the thread's point (split over a and c, reaction on body b) and, with a node
+    ``end`` >= 0, -(f . n) n_e on that node with its reaction at the node (``e``: its unit normal, LVLH)."""
+    _apply_at_point(a, c, split, b, fx, fy, fz, arm_x, arm_y, arm_z, weight, seg.node_force_lvlh, body_force_lvlh,
+                    torque_lvlh, buffers.body_impulse_lvlh, buffers.node_impulse_lvlh)
+    if end >= 0:
+        normal = fx * nx + fy * ny + fz * nz
+        _apply_at_point(end, end, 0.0, b, -normal * ex, -normal * ey, -normal * ez, end_arm_x, end_arm_y, end_arm_z,
+                        weight, seg.node_force_lvlh, body_force_lvlh, torque_lvlh, buffers.body_impulse_lvlh,
+                        buffers.node_impulse_lvlh)
 
 
 @njit(cache=True)
