@@ -28,10 +28,17 @@ it touches a box shape under the same law as the nodes:
   + s f_b/m_b)`. The reaction -F acts on the body at p, on the same line, so linear and angular momentum are
   exchanged exactly.
 * **no double count**: the node contact already carries the nodes' own spheres, so a thread adds only
-  where its interior is deeper than both its ends (the deepest point is interior) and only by the excess,
-  :math:`\\delta_{seg} = \\delta(t^*) - \\max(0, \\delta_a, \\delta_b)`: a thread lying on a flat face (its
-  penetration linear along it, deepest at an end) adds nothing; one bent over an edge, or across a plate
-  narrower than the mesh, adds the whole contact.
+  where its interior is deeper than both its ends (the deepest point is interior), and only by its excess
+  over the deeper node e when that node's sphere penetrates, :math:`q = \delta(t^*) - \max(0, \delta_a,
+  \delta_b)`: a thread lying on a flat face (its penetration linear along it, deepest at an end) adds
+  nothing; one bent over an edge, or across a plate narrower than the mesh, adds the whole contact. The
+  forces are the gradient of the contact's energy :math:`k q^{n+1}/(n+1)`: besides F at the point, -F n_e on
+  node e (it hands its load up to q over to the point) with its reaction on the body at the node, so the
+  contact is conservative in q and momentum stays exact; the coordinate moves as a particle of mass
+  :math:`(|J_a|^2/m_a + |J_b|^2/m_b)^{-1}`, J the nodes' shares of n (less n_e for node e).
+* **the normal**: from the box to the deepest point, perpendicular to the thread (outside the box the
+  nearest-point direction is; inside, the combination of the two nearest faces that is), so the contact
+  never pushes a thread along itself.
 
 As in the node contact, the velocity change over the step is applied as the kick that makes the
 integrator's next drift follow the contact's path, and its remainder (the end minus the mean change) is
