@@ -424,18 +424,15 @@ def _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body
                      out_body_impulse, out_node_impulse):
     """Apply every thread's impulse carried from the previous step (its contact's end minus mean velocity
     change) as a force over this step at its stored point, and note the velocity change it gives each node
-    (``seg.lag_velocity_lvlh``) for this step's contact start velocities; clears the carried impulses.
-    Returns whether any was carried."""
+    (``seg.lag_velocity_lvlh``) for this step's contact start velocities; clears the carried impulses."""
     lag_velocity = seg.lag_velocity_lvlh
     lag_velocity[:] = 0.0
     body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
-    any_carried = False
     inverse_step = 1.0 / step
     for j in range(threads.shape[0]):
         b = seg.lag_body[j]
         if b < 0:
             continue
-        any_carried = True
         a, c = threads[j, 0], threads[j, 1]
         s = seg.lag_split[j]
         jx, jy, jz = seg.lag_impulse_lvlh[j, 0], seg.lag_impulse_lvlh[j, 1], seg.lag_impulse_lvlh[j, 2]
@@ -460,7 +457,6 @@ def _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body
                             out_node_impulse)
         seg.lag_body[j] = -1
         seg.lag_end_node[j] = -1
-    return any_carried
 
 
 @njit(cache=True)
@@ -547,7 +543,7 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
     out_body_impulse, out_node_impulse = buffers.body_impulse_lvlh, buffers.node_impulse_lvlh
     node_force = seg.node_force_lvlh
     node_force[:] = 0.0
-    carried = _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body_force_lvlh, torque_lvlh,
+    _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body_force_lvlh, torque_lvlh,
                                out_body_impulse, out_node_impulse)
     _near_shapes(x, v, net_force_lvlh, net_mass, buffers.velocity_lag, seg, states, shapes, step)
     energy, count, dissipated = 0.0, 0, 0.0
