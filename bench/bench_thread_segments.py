@@ -103,7 +103,8 @@ def run(case_path: Path, thread_segments: bool, args) -> dict:
 
 def print_run(r: dict) -> None:
     if "failed" in r:
-        print(f"\n{r['case']}  thread_segments = {str(r['thread_segments']).lower()}: FAILED after {r['cpu_s']:.1f} s CPU "
+        key = str(r['thread_segments']).lower()
+        print(f"\n{r['case']}  thread_segments = {key}: FAILED after {r['cpu_s']:.1f} s CPU "
               f"(load {r['load'][0]:.1f}): {r['failed']}")
         return
     peak = r["peak_contact_force_N"]
@@ -113,8 +114,8 @@ def print_run(r: dict) -> None:
           f"energy drift {100 * r['energy_drift']:.2f} %; peak contact force {peak:.4g} N; answer {r['debris_state']}")
     bodies = r["pass_throughs"]["bodies"]
     print(f"  threads through (of {r['pass_throughs']['snapshots']} snapshots): "
-          + ("; ".join(f"{n}: up to {b['most']} at once, {b['snapshots']} snapshots, {b['first_s']:.2f}-{b['last_s']:.2f} s"
-                       for n, b in bodies.items()) or "none"))
+          + ("; ".join(f"{n}: up to {b['most']} at once, {b['snapshots']} snapshots, "
+                       f"{b['first_s']:.2f}-{b['last_s']:.2f} s" for n, b in bodies.items()) or "none"))
     for name, loc in r["locations"].items():
         u = "-" if loc["utilization"] is None else f"{loc['utilization']:.3g}"
         print(f"  {name:26s} {loc['state']:13s} utilization {u}" + (f"  ({loc['reason']})" if loc["reason"] else ""))

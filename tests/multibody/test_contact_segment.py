@@ -1,4 +1,4 @@
-"""Thread-to-surface contact (multibody/contact_segment.py) against closed forms.
+"""Thread-to-surface contact (multibody/contact_segment.py, multibody/segment_box.py) against closed forms.
 
 - The deepest point of a segment against a box and the part of it below a level, exact, against a dense
   sampling of the signed distance along the segment.
@@ -18,7 +18,7 @@ import pytest
 import trimesh
 
 from multibody.assembly import ContactLaw, ImpactAssembly, RigidBodySpec, SolverSpec
-from multibody.contact_segment import MAX_BREAKPOINTS, segment_box_deepest, segment_box_sublevel
+from multibody.segment_box import MAX_BREAKPOINTS, segment_box_deepest, segment_box_sublevel
 from multibody.impact import ImpactSimulation
 from multibody.net import NetTopology
 from multibody.thread_crossing import pass_throughs_shape
