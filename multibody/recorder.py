@@ -198,8 +198,11 @@ class Recorder:
                                     np.array(net_layout, np.int64), self._net_totals, system.kernel.buffers.scalars,
                                     self._row, np.array(columns, np.int64), self._extras)
         self._net_in_kernel = system.kernel_net is not None
-        self._joint_force = view["joint_force_joint"]
-        self._joint_moment = view["joint_moment_joint"]
+        # the joints' forces and then their moments, next to each other in the row (series_layout): one (2 nj, 3) block
+        first, last = self._columns["joint_force_joint"][0], self._columns["joint_moment_joint"][1]
+        self._joint_loads_block = self._row[first:last].reshape(2 * nj, 3)
+        self._joint_force, self._joint_moment = self._joint_loads_block[:nj], self._joint_loads_block[nj:]
+        self._zero_load = np.zeros(3)
         self._force_local = exu.OutputVariableType.ForceLocal
         self._torque_local = exu.OutputVariableType.TorqueLocal
 
@@ -284,20 +287,17 @@ class Recorder:
     def _joint_loads(self):
         """The joints' reaction forces and moments (N, N m, joint frame; the load the parent exerts on the child)
         into the row; returns its (nj, 3) views. A released joint reads zero."""
-        mbs = self.system.mbs
-        forces_joint, moments_joint = self._joint_force, self._joint_moment
-        for j, obj in enumerate(self.system.joint_objects):
-            if self.joint_active[j]:
-                # Exudyn's connector force is the spring force acting on marker 1 (child) with
-                # reversed sign; the parent's load on the child is its negative.
-                forces_joint[j] = mbs.GetObjectOutput(obj, self._force_local)
-                moments_joint[j] = mbs.GetObjectOutput(obj, self._torque_local)
-            else:
-                forces_joint[j] = 0.0
-                moments_joint[j] = 0.0
-        np.negative(forces_joint, out=forces_joint)
-        np.negative(moments_joint, out=moments_joint)
-        return forces_joint, moments_joint
+        get, joints, active = self.system.mbs.GetObjectOutput, self.system.joint_objects, self.joint_active
+        force, torque, zero = self._force_local, self._torque_local, self._zero_load
+        # Exudyn's connector force is the spring force acting on marker 1 (child) with reversed sign; the
+        # parent's load on the child is its negative. One assignment of all of them (one a row was 1 us each).
+        loads = self._joint_loads_block
+        if not len(joints):
+            return self._joint_force, self._joint_moment
+        loads[:] = ([get(obj, force) if active[j] else zero for j, obj in enumerate(joints)]
+                    + [get(obj, torque) if active[j] else zero for j, obj in enumerate(joints)])
+        np.negative(loads, out=loads)
+        return self._joint_force, self._joint_moment
 
     def _node_contact_force(self, t):
         """Contact force on each net node (N, LVLH), averaged since the previous net snapshot."""
