@@ -215,6 +215,7 @@ class KernelNet:
         self._force_bodies = np.zeros(6 * kernel.n_bodies)   # the bodies' generalized forces of the step
         self._views = None
         self._last_time = -np.inf
+        self._view_window = 1.5 * kernel.step   # a time further on than this starts a new solve (_state_views)
         #: optional ``after_step(mbs, t) -> bool``, the work of a post-step function for the step that ended at
         #: ``t`` (s), run at the start of the next step's pre-step instead (one Python call a step from Exudyn
         #: instead of two); False stops the solver. The last step's is left to :meth:`finish_steps`.
@@ -233,7 +234,7 @@ class KernelNet:
         calls were about 2 us of every step). Exudyn keeps these vectors in place through a solve (checked
         against copies at every step of a run while this was built); they are taken again at the first step
         of a solve, recognised by a time that does not follow the previous step's."""
-        if self._views is None or not (self._last_time < t <= self._last_time + 1.5 * self.kernel.step):
+        if self._views is None or not (self._last_time < t <= self._last_time + self._view_window):
             data = mbs.systemData
             self._views = (data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False),
                            data.GetODE2Coordinates_tt(copy=False))
@@ -241,7 +242,11 @@ class KernelNet:
         return self._views
 
     def __call__(self, mbs, t):
-        q, qt, qtt = self._state_views(mbs, t)
+        # the views of _state_views, its test written out (a method call is a few tenths of a us of every step)
+        if self._views is None or not (self._last_time < t <= self._last_time + self._view_window):
+            self._state_views(mbs, t)
+        self._last_time = t
+        q, qt, qtt = self._views
         rotations = self.rotations
         if rotations is not None:
             # the previous step's exact attitudes, before anything reads the state (multibody.rotation_update);
