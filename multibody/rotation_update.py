@@ -65,8 +65,7 @@ class ExactRotations:
     def __init__(self, n_net_coordinates: int, n_bodies: int, state_index=None):
         self._local = body_rotation_index(n_net_coordinates, n_bodies)
         self.rotation_index = body_rotation_index(n_net_coordinates, n_bodies, state_index)
-        self._next = np.zeros(len(self._local))  # the kept rotation vectors (rad), written in place every step
-        self._pending = False                    # kept and not yet restored
+        self._next = None
 
     def keep(self, q_next: np.ndarray) -> None:
         """Keep the step's exact end rotation vectors.
@@ -76,8 +75,7 @@ class ExactRotations:
         q_next : (N,) float
             The coupled object's end-of-step coordinates (m, rad) (:func:`multibody.kernel.verlet_evaluation_state`).
         """
-        np.take(q_next, self._local, out=self._next)  # a gather into the kept array (no new array a step)
-        self._pending = True
+        self._next = np.asarray(q_next)[self._local]  # a gather: a new array
 
     def restore(self, mbs) -> None:
         """Write the kept rotation vectors over Exudyn's current coordinates (after the step).
@@ -87,7 +85,7 @@ class ExactRotations:
         mbs : exudyn.MainSystem
             The running system.
         """
-        if not self._pending:
+        if self._next is None:
             return
         # a view of Exudyn's current coordinates: written in place (checked: the next step starts from it),
         # about 1 us against 8 for a copy set back with SetODE2Coordinates
@@ -101,10 +99,10 @@ class ExactRotations:
         q : (N,) float
             Exudyn's ODE2 coordinates, a view (``GetODE2Coordinates(copy=False)``), written in place.
         """
-        if not self._pending:
+        if self._next is None:
             return
         q[self.rotation_index] = self._next
-        self._pending = False
+        self._next = None
 
     def restoring(self, post_step):
         """A post-step function that restores the rotations, then calls ``post_step``.
