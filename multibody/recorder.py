@@ -37,7 +37,6 @@ to ~5 um, a thread stretch worth ~0.3 N of tension.
 """
 from __future__ import annotations
 
-
 import exudyn as exu
 import numpy as np
 
