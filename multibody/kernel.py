@@ -396,9 +396,10 @@ def coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, net, bodies, shapes, l
     # the threads' own contact first (off unless the case asks): the nodes' contacts then see it as an outside force
     # (measured: after them, the thread's point saw the nodes' impact kicks as its own motion and the energy
     # balance of envisat_small's first 0.4 s drifted 12 % instead of 2.8 %)
-    thread_energy, thread_contacts, thread_dissipated = add_segment_contact_forces(
+    # called only when on: a call reference-counts every array it is handed (the default path pays nothing)
+    thread_energy, thread_contacts, thread_dissipated = (add_segment_contact_forces(
         x_soa, v_soa, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, force_soa,
-        body_force_lvlh, torque_lvlh)
+        body_force_lvlh, torque_lvlh) if buffers.segments.enabled != 0 else (0.0, 0, 0.0))
     contact_energy, n_contacts, contact_dissipated = add_contact_forces(
         x_soa, v_soa, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, force_soa,
         body_force_lvlh, torque_lvlh)
