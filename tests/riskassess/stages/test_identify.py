@@ -181,3 +181,19 @@ def test_mads_refuses_a_start_outside_the_bounds_before_any_run():
 
     with pytest.raises(ValueError, match="MADS: the start .* lies outside the bounds"):
         OPTIMIZERS["mads"].search(ValleyCone([2.0, 7.0, 2.0, 0.73]), [0.5, 6.0, 3.0, 0.25], Optimizers())
+
+
+def test_the_benchmark_table_sets_the_papers_runs_beside_ours_and_only_the_same_runs():
+    """bench/bench_identify.py prints Boonrath et al. 2024's Tables 4-5 beside our runs: its PSO beside our PSO (with or
+    without the polish), its MADS from s0 beside ours from s0; nothing beside the pattern search (the paper has none),
+    a MADS from a Table 6 start (the paper's benchmark starts at s0) or another truth. Values from the seed's tables."""
+    from bench.bench_identify import paper_row
+
+    benchmark = dict(truth=[2.0, 7.0, 2.0, 1.0], start=[1.0, 6.0, 3.0, 0.25])
+    assert paper_row("pso+pattern", "f2", benchmark) == (0.0217, [2.0000035, 7.0000049, 2.0000158, 0.9999974])
+    assert paper_row("pso", "f1", benchmark)[0] == 6.3958e-5
+    assert paper_row("mads", "f1", benchmark) == (0.4960, [1.9959287, 6.9976071, 1.9901418, 0.4832296])
+    assert paper_row("mads", "f2", benchmark)[1][3] == 0.8285154
+    assert paper_row("pattern", "f1", benchmark) is None
+    assert paper_row("mads 3", "f1", dict(benchmark, start=[3.0, 8.0, 1.0, 0.5])) is None
+    assert paper_row("mads", "f1", dict(benchmark, truth=[2.137, 7.419, 1.862, 0.731])) is None
