@@ -2,7 +2,7 @@
 captured perception run (bench/perception_capture.py): the momentum step is redone with one input at a
 time replaced by its truth, and C's error and stated 1-sigma printed for each.
 
-    python bench/perception_substitution.py bench/results/capture/none_seed1.pkl [...]
+    python bench/perception_substitution.py runs/captures/none_obs20_seed1.pkl [...] [--unweighted]
 
 Two kinds of substitution:
 
@@ -28,6 +28,7 @@ import sys
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from perception import momentum
 from perception.free_flight import fit_free_motion
 from perception.momentum import point_masses_momentum, rigid_body_momentum, smallest_moment_from_angular_momentum
 from perception.momentum_balance import _line_covariances, _mean_and_covariance_of_mean, _orbital_per_mass, momentum_step
@@ -68,6 +69,12 @@ def with_true_poses(cap, indices) -> Tracker:
         if not a.ok:
             a.information, a.ok = mean_information, True
     return Tracker(alignments)
+
+
+def true_body_to_world_com_error(cap, k) -> np.ndarray:
+    """Frame k's registered pose applied to the true CoM in B, minus the true CoM (m, world)."""
+    pose = cap["alignments"][k].body_to_world
+    return pose[:3, :3] @ true_com_body(cap) + pose[:3, 3] - np.asarray(cap["frames"]["true_com_world"][k])
 
 
 def true_com_body(cap) -> np.ndarray:
@@ -260,6 +267,12 @@ def report(path):
     print(f"\ntrue spin change per C |h1 - h0| = {np.linalg.norm(dh):.4f} rad/s (C dh = {c_true * np.linalg.norm(dh):.1f} N m s); "
           f"true h1 spread over the frames {_vec(truth['h1_spread'])} rad/s; "
           f"h0, h1 1-sigma (stated): {_vec(np.sqrt(np.diag(before.spin_per_c_cov)))}, {_vec(np.sqrt(np.diag(after.spin_per_c_cov)))}")
+    errors = np.array([true_body_to_world_com_error(cap, k) for k in after_idx])
+    unit = after.line.velocity_world / np.linalg.norm(after.line.velocity_world)
+    across = errors - np.outer(errors @ unit, unit)
+    print(f"per frame after the collision, the registered pose's CoM (true CoM in B) off the truth: across the "
+          f"flight direction {1e3 * np.sqrt(np.mean(np.sum(across**2, axis=1))):.1f} mm rms, mean "
+          f"{_vec(1e3 * across.mean(axis=0))} mm; along it {1e3 * np.sqrt(np.mean((errors @ unit) ** 2)):.1f} mm rms")
     print(f"after fit: {len(after.times)} frames {after.times[0]:.1f}-{after.times[-1]:.1f} s, "
           f"{after.attitude_residual_deg:.2f} deg rms, correlation time {after.fit.correlation_time_:.1f} frames; "
           f"true contact end {contact_end:.2f} s")
@@ -278,10 +291,25 @@ def _vec(v):
     return "[" + ", ".join(f"{x:+.4g}" for x in np.ravel(v)) + "]"
 
 
+def unweighted(direction, target, cov_direction, cov_target, name, unit):
+    """The balance's solution before 2026-11-27: ordinary least squares over the three components, its
+    variance propagated to first order (for the "before" column of the substitution table)."""
+    d, b = np.asarray(direction, float), np.asarray(target, float)
+    norm2 = float(d @ d)
+    x = float(d @ b) / norm2
+    g_b, g_d = d / norm2, (b - 2.0 * x * d) / norm2
+    variance = g_b @ np.asarray(cov_target) @ g_b + g_d @ np.asarray(cov_direction) @ g_d
+    return x, float(np.sqrt(max(variance, 0.0))), float(np.linalg.norm(b - x * d)), float("nan")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("captures", nargs="+")
+    parser.add_argument("--unweighted", action="store_true",
+                        help="solve the balances by ordinary least squares, as the stage did before 2026-11-27")
     args = parser.parse_args()
+    if args.unweighted:
+        momentum._scalar_least_squares = unweighted
     np.set_printoptions(precision=4, suppress=True)
     for path in args.captures:
         report(path)
