@@ -11,8 +11,9 @@ where ``v0, v1`` are the debris CoM velocities before and after, ``p`` its CoM, 
 ``h = R_T->W diag(A/C, B/C, 1) omega_T`` its spin angular momentum per unit C: the torque-free
 fits before and after give ``h`` (the normalized inertia is known from before the collision),
 so each balance is linear in its one unknown (``m_deb``, then ``C``) and is solved by least
-squares over its three components. Uncertainties are first-order propagations of the inputs'
-covariances.
+squares over its three components weighted by their covariance (the debris' orbital term after the
+collision is known along its flight direction, not across it). Uncertainties are first-order
+propagations of the inputs' covariances, widened when the balance's weighted misfit is beyond chance.
 
 Everything here is a pure function of SI arrays in the world frame W.
 """
