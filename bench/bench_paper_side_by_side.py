@@ -51,8 +51,22 @@ PAPER = [
      "8.55 kPa = 2000 N / (1.5 m x 0.156 m): axial only [Sec. 3.4]"),
     ("ASAR mount transverse shear stress (kPa)", 2.78, "kPa", "2.78 kPa from 750 N [Sec. 3.4]"),
     ("main body roll rate at the end (deg/s)", 1.75, "deg/s", "+1.75 deg/s for the single-body model; larger "
-                                                              "with the array, no number [Sec. 3.3.2]"),
+                                                              "with the array, no number [Sec. 3.3.2]; read here: "
+                                                              "the main body's x rate at the end (a phase of its "
+                                                              "exchange with the flapping array; x is the axis of "
+                                                              "the largest contact moment, the paper's yaw)"),
+    ("ASAR mount compression / (1.5 m x 0.156 m), the paper's reading (kPa)", 8.55, "kPa",
+     "8.55 kPa = 2000 N / (1.5 m x 0.156 m) [Sec. 3.4]; read here: the along-track push at the mount (joint h1), "
+     "largest over the whole run, first impact included"),
+    ("debris spin-up about its lowest-inertia axis, single body (deg/s)", 1.75, "deg/s",
+     "+1.75 deg/s in roll, 'where the inertia term is the lowest', single-body model [Sec. 3.3.2]; read here: the "
+     "contact's angular impulse about the debris CoM over the run / the debris' composite inertia, about body z"),
+    ("debris spin-up about the axis of the largest contact moment, single body (deg/s)", -0.25, "deg/s",
+     "yaw (Z, the largest contact moment) 'damped by 0.25 deg/s' from a tumble the paper does not give [Sec. "
+     "3.3.2]; read here as above, about body x"),
 ]
+
+ASAR_SECTION_M2 = 1.5 * 0.156     # the ASAR's width x thickness the paper divides its loads by [Sec. 3.4]
 
 
 def run_variant(text: str, case_dir: str) -> dict:
@@ -64,6 +78,18 @@ def run_variant(text: str, case_dir: str) -> dict:
         run_case(case, Path(tmp) / "run")
         wall = time.perf_counter() - start
         return figures(Path(tmp) / "run") | {"wall time (s)": wall}
+
+
+def composite_inertia(case: dict) -> np.ndarray:
+    """Inertia (kg m^2) of the debris as one rigid body about its CoM, target frame, from a run's ``case.json``."""
+    bodies = case["target"]["bodies"]
+    mass = sum(b["mass"] for b in bodies)
+    com = sum(b["mass"] * np.asarray(b["center_of_mass"], float) for b in bodies) / mass
+    inertia = np.zeros((3, 3))
+    for b in bodies:
+        r = np.asarray(b["center_of_mass"], float) - com
+        inertia += np.asarray(b["inertia"], float) + b["mass"] * (r @ r * np.eye(3) - np.outer(r, r))
+    return inertia
 
 
 def figures(run: Path) -> dict:
@@ -81,6 +107,11 @@ def figures(run: Path) -> dict:
     judged = ts >= SKIP_S
     locations = {loc["name"]: loc for loc in verdict["locations"]}
     stress = np.load(run / "structures.npz")
+    asar = joints.index("asar_mount")
+    # single-body spin-up: the contact's angular impulse about the debris CoM (LVLH = target frame at rest, the
+    # debris starts at rest) over the composite inertia; the series hold interval means, so M dt is exact
+    spin = np.degrees(np.linalg.solve(composite_inertia(json.loads((run / "case.json").read_text())),
+                                      (moment * np.diff(t, prepend=t[0])[:, None]).sum(axis=0)))
 
     def peak_within(name, criterion, until):
         values = stress[f"{name}/{criterion}"]
@@ -101,6 +132,9 @@ def figures(run: Path) -> dict:
         PAPER[11][0]: 1e-3 * peak_within("asar_mount", "axial_stress", ts[-1]),
         PAPER[12][0]: 1e-3 * peak_within("asar_mount", "transverse_shear_stress", ts[-1]),
         PAPER[13][0]: float(np.degrees(s["body_omega_body"][-1, 0, 0])),
+        PAPER[14][0]: 1e-3 * float(np.abs(s["joint_force_joint"][:, asar, 0]).max()) / ASAR_SECTION_M2,
+        PAPER[15][0]: float(spin[2]),
+        PAPER[16][0]: float(spin[0]),
         "hinge moment h1 / h3 RMS after 0.25 s (N m)": (
             float(np.sqrt(np.mean(s["joint_moment_joint"][judged, hinge, 0] ** 2))),
             float(np.sqrt(np.mean(s["joint_moment_joint"][judged, hinge, 2] ** 2)))),

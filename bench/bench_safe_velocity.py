@@ -10,7 +10,7 @@ array), on the project's sweep runner into a fresh store. Prints per velocity th
 debris and the unknown ones (failed or indeterminate: counted as debris, never safe), the one-sided
 Clopper-Pearson lower bound of P(no debris), the largest utilization, and the envelope's statement, with
 the wall time and the load; then why the indeterminate runs are indeterminate: per velocity, the number of
-runs each (location, rule) made so (the rules of structures.verdict.INDETERMINATE_RULES; the store keeps
+runs each (location, rule) made so (the rules of structures.indeterminacy.RULES; the store keeps
 each run's reasons), and one reason in full per rule. A store written before the reasons were kept counts
 its runs under "not_recorded". Default case: cases/envisat_small.toml (the reference case needs ~1 h for
 116 runs on 2 cores). ``--store PATH`` keeps the runs in that store (a re-run resumes it: the finished runs

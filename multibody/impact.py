@@ -37,6 +37,7 @@ from multibody.recorded_loads import add_recorded_loads
 from multibody.net import thread_runs
 from multibody.node_frame import inertia_node, node_to_body_rotations, vector_node
 from multibody.recorder import Recorder
+from multibody.recorder_kernel import sample_row
 from multibody.rotation_update import ExactRotations
 from multibody.solver_output import solver_chatter_captured
 
@@ -426,14 +427,26 @@ def simulation_settings(assembly: ImpactAssembly) -> exu.SimulationSettings:
     return s
 
 
-#: The compiled functions an impact run calls from Python; the others compile inside them.
-COMPILED_KERNELS = (coupled_generalized_forces, verlet_evaluation_state, kernel_net_start, kernel_net_step)
+#: The compiled functions an impact run calls from Python, per path (the others compile inside them; the
+#: recorder's sample, :func:`multibody.recorder_kernel.sample_row`, on both): the
+#: kernel integrating the net (the default, :func:`uses_kernel_net`), and Exudyn integrating every net node (the
+#: reference path, and every Runge-Kutta integrator). A run of one path compiles only its own: asking for both
+#: after a default run read "not compiled" and announced the compilation before every run.
+KERNEL_NET_KERNELS = (kernel_net_start, kernel_net_step, sample_row)
+EXUDYN_NET_KERNELS = (coupled_generalized_forces, verlet_evaluation_state, sample_row)
 
 
-def kernels_compiled() -> bool:
-    """The impact kernels are in numba's disk cache: a run starts at once (else it first compiles
-    them, about 30 s on one core; :mod:`multibody.jit_cache`)."""
-    return all_compiled_on_disk(COMPILED_KERNELS)
+def kernels_compiled(kernel_net: bool = True) -> bool:
+    """The impact kernels of one path are in numba's disk cache: a run starts at once (else it first
+    compiles them, about 30 s on one core; :mod:`multibody.jit_cache`).
+
+    Parameters
+    ----------
+    kernel_net : bool
+        The path of the run: the compiled kernel integrates the net (True, :data:`KERNEL_NET_KERNELS`) or
+        Exudyn integrates every net node (False, :data:`EXUDYN_NET_KERNELS`).
+    """
+    return all_compiled_on_disk(KERNEL_NET_KERNELS if kernel_net else EXUDYN_NET_KERNELS)
 
 
 def net_stable_step(net) -> float:

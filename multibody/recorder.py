@@ -37,27 +37,18 @@ to ~5 um, a thread stretch worth ~0.3 N of tension.
 """
 from __future__ import annotations
 
-import math
-
 import exudyn as exu
 import numpy as np
 
 from multibody.health import HealthWatch
-from multibody.kernel import (
-    BENDING_ELASTIC,
-    CONTACT_DISSIPATED,
-    CONTACT_ELASTIC,
-    THREAD_DISSIPATED,
-    THREAD_ELASTIC,
-)
 from multibody.recorded_loads import applied_work
 from multibody.recorder_kernel import (
+    EXTRA_RELEASED_ENERGY,
+    RecorderModel,
     SampledBodies,
     SampledJoints,
-    SampleModel,
     body_sample_buffers,
-    body_sample_model,
-    net_sums,
+    sample_row,
 )
 
 #: Longest simulated time between two finite-state checks when the output rate is lower (s):
@@ -191,9 +182,26 @@ class Recorder:
             force_body=view["contact_force_body"], moment_body=view["contact_moment_body"],
             joint_rotation=view["joint_rotation_joint"], joint_rate=view["joint_rate_joint"])
         self._joint_active_float = np.ones(nj)
-        self._sample_model = SampleModel(self._bodies, self._joints, self._joint_active_float,
-                                         system.kernel.buffers.body_impulse_lvlh, self._body_out)
         self._net_totals = np.zeros(8)
+        data = system.mbs.systemData
+        _, _, *net_layout = system.net_state_layout(data.GetODE2Coordinates(copy=False),
+                                                    data.GetODE2Coordinates_t(copy=False))
+        # the energy total's column follows the energy terms (the recorded loads' work, if any, is the last term)
+        columns = [self._columns[key][0] for key in ("time", "debris_com_lvlh", "debris_velocity_lvlh")]
+        columns += [self._energy_slice.start, self._energy_slice.stop - 1]
+        columns += [self._columns[key][0] for key in ("momentum_linear_lvlh", "momentum_angular_lvlh")]
+        self._extras = np.array([0.0, float(assembly.mean_motion)])  # recorder_kernel.EXTRA_*
+        self._model = RecorderModel(self._bodies, self._joints, self._joint_active_float,
+                                    system.kernel.buffers.body_impulse_lvlh, self._body_out, self._net_masses,
+                                    np.ascontiguousarray(system.kernel.net.reference_lvlh, float),
+                                    np.array(net_layout, np.int64), self._net_totals, system.kernel.buffers.scalars,
+                                    self._row, np.array(columns, np.int64), self._extras)
+        self._net_in_kernel = system.kernel_net is not None
+        # the joints' forces and then their moments, next to each other in the row (series_layout): one (2 nj, 3) block
+        first, last = self._columns["joint_force_joint"][0], self._columns["joint_moment_joint"][1]
+        self._joint_loads_block = self._row[first:last].reshape(2 * nj, 3)
+        self._joint_force, self._joint_moment = self._joint_loads_block[:nj], self._joint_loads_block[nj:]
+        self._zero_load = np.zeros(3)
         self._force_local = exu.OutputVariableType.ForceLocal
         self._torque_local = exu.OutputVariableType.TorqueLocal
 
@@ -237,21 +245,31 @@ class Recorder:
         t : float
             Current simulated time (s).
         """
+        if not self.health.ok:
+            return  # the run has stopped
         data = self.system.mbs.systemData
         # views (nothing here writes them; the row keeps what it needs)
         q, qt = data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False)
-        # the net's sums first: their pass over the net's state also tells whether it is finite (the full
-        # check, with its message, runs only when it is not); nothing is recorded from a lost state
-        net_finite = math.isfinite(net_sums(*self.system.net_state_layout(q, qt), self.system.kernel.net.reference_lvlh,
-                                            self._net_masses, self.assembly.mean_motion, self._net_totals))
-        if not (self.health.state(t, q, qt) if net_finite else self.health.state(t, *self.system.state_arrays())):
+        net_q, net_qt = (self.system.kernel_net.q, self.system.kernel_net.qt) if self._net_in_kernel else (q, qt)
+        # the whole row but the joint loads in one compiled call; nothing is recorded from a lost state
+        finite, total_energy = sample_row(self._model, q, qt, net_q, net_qt, t, t - self._last_output_time)
+        if not finite:
+            self.health.state(t, *self.system.state_arrays())  # the full check, with its message
             return  # the run stops at this step
-        total_energy, forces_joint, moments_joint = self._compute_row(t, q, qt)
+        self._last_output_time = t
+        forces_joint, moments_joint = self._joint_loads()
+        if self.assembly.body_loads is not None:
+            w = self._body_out
+            work_term = -self._work_of_applied_loads(t, w.com_lvlh, w.velocity_lvlh, w.omega_body)
+            total_column = self._energy_slice.stop - 1
+            self._row[total_column - 1] = work_term
+            total_energy = total_energy + work_term  # the sum's last term, in the order ENERGY_TERMS adds them
+            self._row[total_column] = total_energy
         if not self.health.energy(t, total_energy):
             return
         self._store()
         if self.monitor is not None:
-            self._check_monitor(t, forces_joint, moments_joint)
+            self._check_monitor(t, forces_joint.copy(), moments_joint.copy())
         if t == 0.0 or t >= self._next_net - 0.5 * self.step:
             x_lvlh, v_lvlh = self.system.net_state(q, qt)
             k = self._n_net
@@ -265,6 +283,21 @@ class Recorder:
         if self.progress is not None:
             self.progress(t)
 
+    def _joint_loads(self):
+        """The joints' reaction forces and moments (N, N m, joint frame; the load the parent exerts on the child)
+        into the row; returns its (nj, 3) views. A released joint reads zero."""
+        get, joints, active = self.system.mbs.GetObjectOutput, self.system.joint_objects, self.joint_active
+        force, torque, zero = self._force_local, self._torque_local, self._zero_load
+        # Exudyn's connector force is the spring force acting on marker 1 (child) with reversed sign; the
+        # parent's load on the child is its negative. One assignment of all of them (one a row was 1 us each).
+        loads = self._joint_loads_block
+        if not len(joints):
+            return self._joint_force, self._joint_moment
+        loads[:] = ([get(obj, force) if active[j] else zero for j, obj in enumerate(joints)]
+                    + [get(obj, torque) if active[j] else zero for j, obj in enumerate(joints)])
+        np.negative(loads, out=loads)
+        return self._joint_force, self._joint_moment
+
     def _node_contact_force(self, t):
         """Contact force on each net node (N, LVLH), averaged since the previous net snapshot."""
         impulse_lvlh = self.system.kernel.buffers.node_impulse_lvlh
@@ -276,57 +309,14 @@ class Recorder:
 
     def _check_monitor(self, t, force_joint, moment_joint):
         before = len(self.monitor.events)
-        self.monitor.check(t, force_joint, moment_joint, self._joint_energies)
+        self.monitor.check(t, force_joint, moment_joint, self._body_out.joint_energy)
         for event in self.monitor.events[before:]:
             # The connector is off from the next step on: its loads read zero and the elastic
             # energy it held leaves the balance as "released" energy, so the total stays closed.
             self.joint_active[event.joint] = False
             self._joint_active_float[event.joint] = 0.0
             self._released_energy += event.stored_energy
-
-    def _compute_row(self, t, q, qt) -> tuple:
-        """One sample's values (see the module doc) into :attr:`_row`, from the compiled sums of
-        multibody.recorder_kernel (the net's, ``self._net_totals``, computed by the caller). Returns the energy
-        balance's total (J) and the joints' reaction forces and moments (new (nj, 3) arrays, joint frame)."""
-        w = self._body_out
-        view = self._row_view
-        interval = t - self._last_output_time
-        self._last_output_time = t
-        body_sample_model(self._sample_model, q, qt, interval, self.assembly.mean_motion)
-        net = self._net_totals
-        mbs = self.system.mbs
-        nj = len(self.system.joint_objects)
-        forces_joint, moments_joint = np.zeros((nj, 3)), np.zeros((nj, 3))
-        for j, obj in enumerate(self.system.joint_objects):
-            if self.joint_active[j]:
-                # Exudyn's connector force is the spring force acting on marker 1 (child) with
-                # reversed sign; the parent's load on the child is its negative.
-                forces_joint[j] = mbs.GetObjectOutput(obj, self._force_local)
-                moments_joint[j] = mbs.GetObjectOutput(obj, self._torque_local)
-        forces_joint, moments_joint = -forces_joint, -moments_joint
-        self._joint_energies = w.joint_energy
-        summary = w.summary.tolist()
-        scalars = self.system.kernel.buffers.scalars.tolist()
-        self._row[self._time_column] = t
-        view["debris_com_lvlh"][:] = summary[0:3]
-        view["debris_velocity_lvlh"][:] = summary[3:6]
-        view["joint_force_joint"][:] = forces_joint
-        view["joint_moment_joint"][:] = moments_joint
-        # the same terms in the same order as ENERGY_TERMS (the total adds them so)
-        e = [net[0], scalars[THREAD_ELASTIC], scalars[BENDING_ELASTIC], scalars[CONTACT_ELASTIC], summary[6],
-             summary[7], summary[16], self._released_energy,
-             net[1] + summary[8] if self.assembly.mean_motion else 0.0,
-             scalars[THREAD_DISSIPATED], scalars[CONTACT_DISSIPATED]]
-        if self.assembly.chaser is not None:
-            e.append(summary[9])
-        if self.assembly.body_loads is not None:
-            e.append(-self._work_of_applied_loads(t, w.com_lvlh, w.velocity_lvlh, w.omega_body))
-        total = sum(e)
-        e.append(total)
-        self._row[self._energy_slice] = e
-        view["momentum_linear_lvlh"][:] = net[2:5] + w.summary[10:13]
-        view["momentum_angular_lvlh"][:] = net[5:8] + w.summary[13:16]
-        return total, forces_joint, moments_joint
+            self._extras[EXTRA_RELEASED_ENERGY] = self._released_energy
 
     def _work_of_applied_loads(self, t, com_lvlh, velocity_lvlh, omega_body) -> float:
         """Work (J) done by the recorded loads since t = 0: the energy they bring in, which the

@@ -124,10 +124,20 @@ def load_case(path: str | Path) -> ImpactCase:
     return ImpactCase(path, raw, validate_case(raw, path))
 
 
-def needs_compilation() -> bool:
+def needs_compilation(case: ImpactCase | None = None) -> bool:
     """The first run will compile the force kernels (about 30 s on one core): numba's disk cache
-    holds no compilation of their current source for this CPU (:mod:`multibody.jit_cache`)."""
-    return not kernels_compiled()
+    holds no compilation of their current source for this CPU (:mod:`multibody.jit_cache`).
+
+    Parameters
+    ----------
+    case : ImpactCase or riskassess.cases.impact.Case, optional
+        The case to be run: its ``simulation.net_integration`` and ``integrator`` choose the kernels
+        (Runge-Kutta integrators and ``"exudyn"`` use the reference path's); default the kernel path.
+    """
+    if case is None:
+        return not kernels_compiled()
+    simulation = case.simulation
+    return not kernels_compiled(simulation.net_integration == "kernel" and simulation.integrator == "VelocityVerlet")
 
 
 def run(case: ImpactCase | str | Path, out: str | Path, *, overwrite: bool = False,

@@ -34,7 +34,7 @@ def _cmd_run(args) -> int:
     _check_work(impact_estimate_of(case.model), args)
     out = Path(args.out) if args.out else default_out(case.name)
     end = case.simulation.end_time
-    _announce_compilation(api.needs_compilation())
+    _announce_compilation(api.needs_compilation(case))
     columns = [TextColumn("[bold]simulating[/bold] {task.fields[t]:.3f} / %.3g s" % end), BarColumn(),
                TimeElapsedColumn(), TimeRemainingColumn()]
     steps = _steps(args)
@@ -241,7 +241,7 @@ def _cmd_perceive(args) -> int:
     _check_work(impact_estimate_of(case), args)
     out = Path(args.out) if args.out else default_out(case.name)
     steps = _steps(args)
-    _announce_compilation(needs_compilation())
+    _announce_compilation(needs_compilation(case))
     with _progress_bar("perceive", args.json) as bar:
         task = bar.add_task("", total=None)
 

@@ -18,6 +18,7 @@ import numpy as np
 
 from multibody.assembly import subtree_bodies
 from multibody.thread_crossing import PassThroughSnapshot, missed_load_bounds
+from structures.indeterminacy import Indeterminacy
 from structures.weak_location import WeakLocation, demands, judged_demands
 
 
@@ -124,10 +125,22 @@ def pass_through_check(location: WeakLocation, result: dict, history: list[PassT
             "could_exceed": sorted(could_exceed), "worst_ratio": float(worst)}
 
 
-def pass_through_reason(check: dict) -> str:
-    """Why a location that held is indeterminate because of threads passing through what it carries."""
-    return (f"net threads passed through {', '.join(check['bodies'])} (node-only contact; up to "
+def pass_through_reason(check: dict) -> Indeterminacy:
+    """Why a location that held is indeterminate because of threads passing through what it carries
+    (rule ``thread_pass_through``).
+
+    Parameters
+    ----------
+    check : dict
+        The location's :func:`pass_through_check` (bodies, snapshots, times, bounds, criteria it could exceed).
+
+    Returns
+    -------
+    structures.indeterminacy.Indeterminacy
+    """
+    return Indeterminacy("thread_pass_through", (
+            f"net threads passed through {', '.join(check['bodies'])} (node-only contact; up to "
             f"{check['most_threads']} threads at once, {check['snapshots']} snapshots from {check['first_s']:.2f} to "
             f"{check['last_s']:.2f} s): the load they would have put on it, at most {check['force_bound_N']:.3g} N and "
             f"{check['moment_bound_Nm']:.3g} N m about the joint, could take {', '.join(check['could_exceed'])} "
-            f"past the allowable ({check['worst_ratio']:.2f} of it)")
+            f"past the allowable ({check['worst_ratio']:.2f} of it)"))

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from structures.indeterminacy import Indeterminacy, mark
 from structures.release import ReleaseEvent, released_pieces
 from structures.reproducibility import TWIN_OFFSET, twin_label
 from structures.thread_gaps import pass_through_check, pass_through_reason
@@ -27,8 +28,9 @@ MIN_JUDGED_SAMPLES = 10
 MAX_SAMPLE_INTERVAL_S = 1e-2
 
 
-def evidence_gaps(time, contact_force_debris_lvlh, skip_until: float) -> list[str]:
-    """Why the recorded samples cannot support a structural verdict (empty when they can).
+def evidence_gaps(time, contact_force_debris_lvlh, skip_until: float) -> list[Indeterminacy]:
+    """Why the recorded samples cannot support a structural verdict (empty when they can): (rule, reason) pairs,
+    rules ``too_few_judged_samples``, ``coarse_sampling``, ``no_capture_load``.
 
     Parameters
     ----------
@@ -38,58 +40,33 @@ def evidence_gaps(time, contact_force_debris_lvlh, skip_until: float) -> list[st
         Net contact force on each debris body (N, LVLH), averaged over each output interval.
     skip_until : float
         Loads before this time are not judged (s).
+
+    Returns
+    -------
+    list of structures.indeterminacy.Indeterminacy
     """
     time = np.asarray(time, float)
     judged = time >= skip_until
     gaps = []
     if judged.sum() < MIN_JUDGED_SAMPLES:
-        gaps.append(f"{int(judged.sum())} samples after skip_initial = {skip_until:g} s (the run ends at "
-                    f"{time[-1] if time.size else 0.0:g} s); a verdict needs at least {MIN_JUDGED_SAMPLES}")
+        end = time[-1] if time.size else 0.0
+        gaps.append(Indeterminacy("too_few_judged_samples",
+                                  f"{int(judged.sum())} samples after skip_initial = {skip_until:g} s (the run ends at "
+                                  f"{end:g} s); a verdict needs at least {MIN_JUDGED_SAMPLES}"))
     if time.size > 1 and np.max(np.diff(time)) > MAX_SAMPLE_INTERVAL_S * (1 + 1e-9):
-        gaps.append(f"samples up to {np.max(np.diff(time)):.3g} s apart; a verdict needs at least "
-                    f"{1 / MAX_SAMPLE_INTERVAL_S:g} Hz (simulation.output_rate) to see the load peaks")
+        gaps.append(Indeterminacy("coarse_sampling",
+                                  f"samples up to {np.max(np.diff(time)):.3g} s apart; a verdict needs at least "
+                                  f"{1 / MAX_SAMPLE_INTERVAL_S:g} Hz (simulation.output_rate) to see the load peaks"))
     force = np.asarray(contact_force_debris_lvlh, float)
     if judged.any() and not np.any(np.linalg.norm(force[judged], axis=-1) > 0.0):
-        gaps.append(f"no contact between the net and the debris after skip_initial = {skip_until:g} s: "
-                    f"the judged window holds no capture load")
+        gaps.append(Indeterminacy("no_capture_load",
+                                  f"no contact between the net and the debris after skip_initial = {skip_until:g} s: "
+                                  f"the judged window holds no capture load"))
     return gaps
 
 
-#: The rules that make a location indeterminate, keyed by a phrase of the reason their producer writes
-#: (:func:`evidence_gaps`, :func:`location_state`, :func:`structures.thread_gaps.pass_through_reason`,
-#: :func:`apply_twin`), so a sweep can count runs per rule without parsing the numbers in the reasons.
-INDETERMINATE_RULES = (
-    ("samples after skip_initial", "too_few_judged_samples"),
-    ("s apart; a verdict needs at least", "coarse_sampling"),
-    ("no contact between the net and the debris", "no_capture_load"),
-    ("load samples that are not finite", "non_finite_loads"),
-    ("net threads passed through", "thread_pass_through"),
-    ("its twin run exceeds", "twin_exceeds"),
-    ("is one draw of a chaotic capture", "chaotic_peak"),
-    ("could not be checked against a twin run", "twin_not_run"),
-)
-
-
-def indeterminate_rules(reason: str | None) -> list[str]:
-    """The rules (:data:`INDETERMINATE_RULES`) a location's ``indeterminate_reason`` names, in their order there;
-    ``["other"]`` for a reason no rule's phrase matches, ``[]`` for None.
-
-    Parameters
-    ----------
-    reason : str or None
-        The location's ``indeterminate_reason`` (several reasons are joined by "; ").
-
-    Returns
-    -------
-    list of str
-    """
-    if not reason:
-        return []
-    return [rule for phrase, rule in INDETERMINATE_RULES if phrase in reason] or ["other"]
-
-
-def location_state(result: dict, gaps: list[str]) -> tuple[str, str | None]:
-    """('fails' | 'holds' | 'indeterminate', reason) of one judged location. An exceedance seen
+def location_state(result: dict, gaps: list[Indeterminacy]) -> tuple[str, list[Indeterminacy]]:
+    """('fails' | 'holds' | 'indeterminate', why) of one judged location. An exceedance seen
     is a failure whatever else is missing; a pass needs judged, finite loads and no evidence gap.
 
     Parameters
@@ -97,23 +74,24 @@ def location_state(result: dict, gaps: list[str]) -> tuple[str, str | None]:
     result : dict
         The location's verdict (:func:`structures.weak_location.assess`) with ``released_at_s``
         (s, or None) added.
-    gaps : list of str
+    gaps : list of Indeterminacy
         Evidence gaps of the run (:func:`evidence_gaps`); empty when the samples can support a
         verdict.
 
     Returns
     -------
     state : {"fails", "holds", "indeterminate"}
-    reason : str or None
-        Why the state is indeterminate; None otherwise.
+    why : list of structures.indeterminacy.Indeterminacy
+        Why the state is indeterminate (rule ``non_finite_loads`` for loads that are not finite, or the
+        evidence gaps); empty otherwise.
     """
     if result["fails"] or result["released_at_s"] is not None:
-        return "fails", None
+        return "fails", []
     if not result["judged"]:
-        return "indeterminate", "; ".join(gaps) or "load samples that are not finite"
+        return "indeterminate", list(gaps) or [Indeterminacy("non_finite_loads", "load samples that are not finite")]
     if gaps:
-        return "indeterminate", "; ".join(gaps)
-    return "holds", None
+        return "indeterminate", list(gaps)
+    return "holds", []
 
 
 def structures_verdict(locations: list[WeakLocation], series: dict, assembly, events: list[ReleaseEvent],
@@ -152,7 +130,9 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
     -------
     dict
         ``skip_initial_s``, ``release_policy``, ``locations`` (one verdict each), ``released_pieces``,
-        ``debris_state``, ``secondary_debris`` (True / False / None) and ``indeterminate_reasons``.
+        ``debris_state``, ``secondary_debris`` (True / False / None) and ``indeterminate_reasons``; each
+        location's ``indeterminate_reason`` comes with its ``indeterminate_rules``
+        (:mod:`structures.indeterminacy`).
     """
     time = series["time"]
     released_at = {e.location: e for e in events}
@@ -168,12 +148,12 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
         # After a release the location carries nothing, so its peak (and likelihood) only
         # covers the loads up to the release: a lower bound of what the intact joint would see.
         result["likelihood_is_lower_bound"] = event is not None
-        result["state"], result["indeterminate_reason"] = location_state(result, gaps)
+        mark(result, *location_state(result, gaps))
         check = (pass_through_check(loc, result, pass_throughs, assembly, series, skip_until)
                  if pass_throughs and result["judged"] else None)
         result["thread_pass_through"] = check
         if judge_pass_throughs and result["state"] == "holds" and check and check["could_exceed"]:
-            result["state"], result["indeterminate_reason"] = "indeterminate", pass_through_reason(check)
+            mark(result, "indeterminate", [pass_through_reason(check)])
         result["peak_window"] = "unchecked"        # deterministic or chaotic once a twin run checks it (apply_twin)
         result["condition"] = condition_sentence(result, judged_at)
         rows.append(result)
@@ -241,22 +221,23 @@ def apply_twin(verdict: dict, locations: list[WeakLocation], series: dict, twin_
             criterion["twin"] = label
             windows.append(label["window"])
             if label["twin_peak"] >= criterion["decisive_allowable"]:
-                reasons.append(f"its twin run exceeds its {name.replace('_', ' ')} allowable")
+                reasons.append(Indeterminacy("twin_exceeds", f"its twin run exceeds its {name.replace('_', ' ')} "
+                                                             f"allowable"))
             elif not label["reproduced"]:
-                reasons.append(f"its {name.replace('_', ' ')} peak at {criterion['peak_time_s']:.3g} s is one draw of "
-                               f"a chaotic capture (a twin run {TWIN_OFFSET:g} apart in launch speed parts at "
-                               f"{label['parting_time_s']:.3g} s and peaks {label['twin_peak'] / criterion['peak'] - 1:+.0%}"
-                               f" from it)")
+                reasons.append(Indeterminacy(
+                    "chaotic_peak", f"its {name.replace('_', ' ')} peak at {criterion['peak_time_s']:.3g} s is one draw "
+                                    f"of a chaotic capture (a twin run {TWIN_OFFSET:g} apart in launch speed parts at "
+                                    f"{label['parting_time_s']:.3g} s and peaks "
+                                    f"{label['twin_peak'] / criterion['peak'] - 1:+.0%} from it)"))
         row["peak_window"] = ("unchecked" if "unchecked" in windows else "chaotic" if "chaotic" in windows
                               else "deterministic" if windows else None)
         if row["state"] != "holds":
             row["condition"] = condition_sentence(row, judged_at)
             continue
         if twin_series is None:
-            reasons.append(f"its peaks could not be checked against a twin run ({note})")
+            reasons.append(Indeterminacy("twin_not_run", f"its peaks could not be checked against a twin run ({note})"))
         if reasons:
-            row["state"] = "indeterminate"
-            row["indeterminate_reason"] = ("; ".join(reasons) + "; P(secondary debris) needs assess --monte-carlo")
+            mark(row, "indeterminate", reasons, suffix="; P(secondary debris) needs assess --monte-carlo")
         row["condition"] = condition_sentence(row, judged_at)
     states = [r["state"] for r in verdict["locations"]]
     if verdict["debris_state"] == NO_DEBRIS and "indeterminate" in states:

@@ -69,7 +69,7 @@ def debris_state_of(record: dict) -> str | None:
 
 def indeterminate_reasons_of(record: dict) -> list[dict]:
     """Why a done run's record is indeterminate: one entry per (location, rule), ``location``, ``rule``
-    (:data:`structures.verdict.INDETERMINATE_RULES`) and the verdict's ``reason``; empty when it is not
+    (:data:`structures.indeterminacy.RULES`) and the verdict's ``reason``; empty when it is not
     indeterminate. A run made indeterminate by non-finite evidence alone (:func:`debris_state_of`) gets
     ``location`` None and rule ``non_finite_evidence``.
 

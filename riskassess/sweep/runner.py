@@ -27,7 +27,7 @@ from riskassess.sweep.cluster_log import StderrToFile, distributed_logging_to
 from riskassess.products.sweep_records import debris_state_of, indeterminate_reasons_of
 from riskassess.sweep.spec import RunSpec, SweepSpecError, case_with
 from riskassess.sweep.store import ResultStore
-from structures.verdict import INDETERMINATE, indeterminate_rules
+from structures.verdict import INDETERMINATE
 
 #: Error types that come from the cluster, not from the run: a resume retries these runs.
 INFRASTRUCTURE_ERRORS = ("KilledWorker", "CommClosedError", "CancelledError", "TimeoutError", "FutureCancelledError")
@@ -81,9 +81,9 @@ def _location_record(loc: dict) -> dict:
                                          if c["margin_of_safety"] is not None), default=None),
             "peaks": {name: c["peak"] for name, c in criteria.items()},
             "units": {name: c["unit"] for name, c in criteria.items()},
-            # why a location has no verdict, kept so a sweep can say which rule made its runs indeterminate
+            # why a location has no verdict and the rules with it (structures.indeterminacy), so a sweep counts runs per rule
             "state": loc.get("state"), "indeterminate_reason": loc.get("indeterminate_reason"),
-            "indeterminate_rules": indeterminate_rules(loc.get("indeterminate_reason"))}
+            "indeterminate_rules": list(loc["indeterminate_rules"])}
 
 
 def run_record(summary: dict, verdict: dict | None, overrides: dict) -> dict:

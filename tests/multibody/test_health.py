@@ -7,6 +7,7 @@ import pytest
 from multibody.health import (ENERGY_DRIFT_HARD_LIMIT, ENERGY_DRIFT_LIMIT, ENERGY_PERSISTENCE_S, HealthWatch,
                               SimulationFailed, check_finite, energy_drift, stable_step_estimate)
 from multibody.impact import ImpactSimulation, net_stable_step
+from multibody.recorder import ENERGY_TERMS
 
 
 def test_stable_step_is_half_the_central_difference_limit():
@@ -102,5 +103,10 @@ def test_a_healthy_run_reports_its_drift(small_net_on_box):
     assert health["energy_max_drift"] == pytest.approx(np.abs(e - e[0]).max() / health["energy_reference_J"],
                                                        rel=1e-9)
     assert health["energy_max_drift"] < 0.01
+    # the total is the recorded terms added in ENERGY_TERMS order from 0.0, as Python's sum of them: to the bit
+    total = np.zeros_like(e)
+    for key in ENERGY_TERMS:
+        total = total + recorder.series["energy_" + key]
+    assert np.array_equal(total, e)
     # the last step is always sampled
     assert recorder.series["time"][-1] == pytest.approx(0.1, abs=1e-9)

@@ -90,3 +90,26 @@ def test_the_finite_state_check_sees_the_kernels_net(both_paths):
         assert "not finite" in str(watch.failure)
     finally:
         system.kernel_net.qt[7] = saved
+
+
+def test_a_sample_stores_nothing_from_a_lost_net_state(both_paths):
+    """The recorder's compiled sample (multibody.recorder_kernel.sample_row) tests the kernel's net state as it
+    sums it: a NaN there fails the health check, with the entry named by the full check, and no row is stored;
+    the same sample with the state restored stores one."""
+    from multibody.health import HealthWatch
+
+    simulation, recorder = both_paths["kernel"]
+    node_velocities, kept_watch, rows = simulation.system.kernel_net.qt, recorder.health, recorder._n_rows
+    saved = node_velocities[7]
+    recorder.health = watch = HealthWatch(cause="test")
+    node_velocities[7] = np.nan
+    try:
+        recorder.sample(0.3)
+        assert not watch.ok and "state is not finite" in str(watch.failure) and recorder._n_rows == rows
+        node_velocities[7] = saved
+        recorder.health = HealthWatch(cause="test")
+        recorder.sample(0.3)
+        assert recorder.health.ok and recorder._n_rows == rows + 1
+    finally:
+        node_velocities[7] = saved
+        recorder.health, recorder._n_rows = kept_watch, rows

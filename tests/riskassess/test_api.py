@@ -71,7 +71,7 @@ def test_report_of_an_api_run(api_run):
 def test_first_run_announces_compilation_and_keeps_solver_notices_off_the_terminal(tmp_path, capfd, monkeypatch):
     case = tmp_path / "tiny.toml"
     case.write_text((CASES / "envisat_small.toml").read_text().replace("end_time = 7.5", "end_time = 0.08", 1))
-    monkeypatch.setattr(ra, "needs_compilation", lambda: True)   # as on a fresh install
+    monkeypatch.setattr(ra, "needs_compilation", lambda case=None: True)   # as on a fresh install
     # 0.08 s ends before the verdict's skipped transient (0.25 s): no evidence, exit code 6
     assert main(["run", str(case), "--out", str(tmp_path / "run"), "--json"]) == 6
     out, err = capfd.readouterr()
@@ -81,13 +81,16 @@ def test_first_run_announces_compilation_and_keeps_solver_notices_off_the_termin
     # Exudyn prints its notice once per process: in the log of whichever run came first here
     assert (tmp_path / "run" / "solver.log").is_file()
     assert "solver.log" in ra.open_run(tmp_path / "run").manifest["files"]
-    monkeypatch.setattr(ra, "needs_compilation", lambda: False)
+    monkeypatch.setattr(ra, "needs_compilation", lambda case=None: False)
     assert main(["run", str(case), "--out", str(tmp_path / "run"), "--overwrite", "--json"]) == 6
     assert COMPILING not in capfd.readouterr().err
 
 
-def test_kernels_are_reported_compiled_after_a_run(api_run):
+def test_kernels_are_reported_compiled_after_a_run(envisat_small_first_0p3s, api_run):
+    # the run compiled the kernel path's kernels (the default); the reference path's are not asked for: a
+    # default run alone once left those uncompiled, and every later run announced a compilation
     assert not ra.needs_compilation()
+    assert not ra.needs_compilation(ra.load_case(envisat_small_first_0p3s[0]))
 
 
 def test_a_case_with_weak_locations_and_no_verdict_is_indeterminate(api_run, tmp_path):

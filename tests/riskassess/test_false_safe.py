@@ -89,14 +89,14 @@ def test_evidence_needs_samples_resolution_and_contact():
     # no contact after skip_initial (contact only before it): nothing judged was loaded by the net
     early = touching.copy()
     early[time >= 0.25] = 0.0
-    assert evidence_gaps(time, early, 0.25) == ["no contact between the net and the debris after skip_initial = "
-                                                "0.25 s: the judged window holds no capture load"]
+    assert evidence_gaps(time, early, 0.25) == [("no_capture_load", "no contact between the net and the debris after "
+                                                "skip_initial = 0.25 s: the judged window holds no capture load")]
     # MIN_JUDGED_SAMPLES - 1 judged samples
     short = time[:250 + MIN_JUDGED_SAMPLES - 1]
-    assert "a verdict needs at least 10" in evidence_gaps(short, touching[:short.size], 0.25)[0]
+    assert "a verdict needs at least 10" in evidence_gaps(short, touching[:short.size], 0.25)[0].reason
     # a gap just above MAX_SAMPLE_INTERVAL_S
     sparse = np.arange(0.0, 1.0, 1.01 * MAX_SAMPLE_INTERVAL_S)
-    assert "a verdict needs at least 100 Hz" in evidence_gaps(sparse, touching[:sparse.size], 0.25)[0]
+    assert "a verdict needs at least 100 Hz" in evidence_gaps(sparse, touching[:sparse.size], 0.25)[0].reason
 
 
 def test_huge_work_is_refused_before_any_folder_exists(tmp_path, capsys):

@@ -202,8 +202,9 @@ def test_the_store_keeps_why_a_run_is_indeterminate():
                "at most 80 N and 355 N m about the joint, could take moment past the allowable (1.20 of it)")
 
     def location(name, state, reason=None, peak=88.0):
+        # the verdict gives each reason with its rule (structures.indeterminacy)
         return {"name": name, "fails": state == "fails", "likelihood": 0.0, "released_at_s": None, "state": state,
-                "indeterminate_reason": reason,
+                "indeterminate_reason": reason, "indeterminate_rules": ["thread_pass_through"] if reason else [],
                 "criteria": {"moment": {"peak": peak, "decisive_allowable": 200.0, "margin_of_safety": 200 / peak - 1,
                                         "unit": "N m"}}}
 

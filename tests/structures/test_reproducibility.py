@@ -83,6 +83,39 @@ def test_a_twin_that_exceeds_or_did_not_run_leaves_nothing_safe():
     assert missing["twin"]["ran"] is False
 
 
+def test_a_chaotic_or_exceeded_twin_gives_its_rule_to_the_sweep_store():
+    """The rules chaotic_peak and twin_exceeds come from apply_twin itself (structures.indeterminacy) and travel
+    through the sweep's record (riskassess.sweep.runner.run_record) to its counts per (location, rule)."""
+    from riskassess.products.sweep_records import indeterminate_rule_counts
+    from riskassess.sweep.runner import run_record
+
+    chaotic = _verdict(_moment_history(300.0), _moment_history(250.0))       # twin peaks -17 %: not reproduced
+    exceeded = _verdict(_moment_history(300.0), _moment_history(1200.0))     # twin 1200 N m > 1000 N m allowable
+    assert chaotic["locations"][0]["indeterminate_rules"] == ["chaotic_peak"]
+    assert exceeded["locations"][0]["indeterminate_rules"] == ["twin_exceeds"]
+    # one location with a force and a moment criterion: the twin exceeds the force allowable (the run's 300 N
+    # holds 1000 N, the twin's 1200 N does not) while its moment peak is a chaotic draw: both rules, once each
+    location = WeakLocation(name="root", joint=0, section_to_joint=np.eye(3), offset_joint=np.zeros(3),
+                            allowable_moment=Allowable.of(1000.0), allowable_force=Allowable.of(1000.0))
+    force, twin_force = _moment_history(300.0), _moment_history(1200.0)
+    moment, twin_moment = _moment_history(300.0), _moment_history(250.0)
+    row = assess(location, T, force, moment, skip_until=0.25)
+    row.update(state="holds", indeterminate_reason=None, released_at_s=None)
+    series = {"time": T, "joint_force_joint": force[:, None], "joint_moment_joint": moment[:, None]}
+    twin = {"time": T, "joint_force_joint": twin_force[:, None], "joint_moment_joint": twin_moment[:, None]}
+    both = apply_twin({"locations": [row], "debris_state": "no_debris", "secondary_debris": False}, [location],
+                      series, twin, 0.25, "low")
+    assert both["locations"][0]["indeterminate_rules"] == ["twin_exceeds", "chaotic_peak"]
+    assert both["debris_state"] == "indeterminate"
+    summary = {"peak_contact_force_N": {"value": 1.0}, "peak_contact_moment_about_debris_com_Nm": {"value": 1.0},
+               "joints": {}, "checks": {"energy_balance_relative_drift": 0.0}, "wall_time_s": 1.0,
+               "steps_per_second": 1.0}
+    records = [run_record(summary, verdict | {"released_pieces": []}, {}) for verdict in (chaotic, exceeded, both)]
+    assert records[2]["locations"]["root"]["indeterminate_rules"] == ["twin_exceeds", "chaotic_peak"]
+    assert indeterminate_rule_counts([{"state": "done", "result": r} for r in records]) == {
+        ("root", "chaotic_peak"): 2, ("root", "twin_exceeds"): 2}
+
+
 def _short_case(tmp_path, extra=""):
     text = (CASES / "envisat_small.toml").read_text().replace("end_time = 7.5", "end_time = 0.6")
     text = text.replace('release = "low"', 'release = "never"\ntwin = true' + extra)

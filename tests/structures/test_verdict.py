@@ -52,13 +52,16 @@ def test_a_hold_unchecked_for_chaos_says_so():
     assert "Unchecked" not in condition_sentence(result, "low")
 
 
-def test_each_indeterminate_reason_names_its_rule():
-    """The rule of each reason the verdict's producers write (the reasons keep their numbers; the rule is what a
-    sweep counts), on hand-made series and checks; a reason joined from several rules names each."""
+def test_each_indeterminate_reason_comes_with_its_rule():
+    """Each producer of a reason returns its rule with it (the reasons keep their numbers; the rule is what a
+    sweep counts), on hand-made series and checks; a location with several reasons lists each rule once, in the
+    order of structures.indeterminacy.RULES."""
     import numpy as np
+    import pytest
 
+    from structures.indeterminacy import RULES, Indeterminacy, mark, rules_of
     from structures.thread_gaps import pass_through_reason
-    from structures.verdict import MIN_JUDGED_SAMPLES, apply_twin, evidence_gaps, indeterminate_rules, location_state
+    from structures.verdict import MIN_JUDGED_SAMPLES, apply_twin, evidence_gaps, location_state
 
     time = np.arange(0.0, 1.0, 1e-3)
     touching = np.zeros((time.size, 1, 3))
@@ -67,19 +70,29 @@ def test_each_indeterminate_reason_names_its_rule():
     early[time >= 0.25] = 0.0
     short = time[:250 + MIN_JUDGED_SAMPLES - 1]
     sparse = np.arange(0.0, 1.0, 0.0101)
-    assert [indeterminate_rules(g) for g in evidence_gaps(time, early, 0.25)] == [["no_capture_load"]]
-    assert indeterminate_rules(evidence_gaps(short, touching[:short.size], 0.25)[0]) == ["too_few_judged_samples"]
-    assert indeterminate_rules(evidence_gaps(sparse, touching[:sparse.size], 0.25)[0]) == ["coarse_sampling"]
+    assert [g.rule for g in evidence_gaps(time, early, 0.25)] == ["no_capture_load"]
+    assert [g.rule for g in evidence_gaps(short, touching[:short.size], 0.25)] == ["too_few_judged_samples"]
+    assert [g.rule for g in evidence_gaps(sparse, touching[:sparse.size], 0.25)] == ["coarse_sampling"]
     both = evidence_gaps(sparse[:30], touching[:30], 0.25)        # 5 judged samples, 10.1 ms apart
-    assert indeterminate_rules("; ".join(both)) == ["too_few_judged_samples", "coarse_sampling"]
-    _, reason = location_state({"fails": False, "released_at_s": None, "judged": False}, [])
-    assert indeterminate_rules(reason) == ["non_finite_loads"]
+    row = {}
+    mark(row, *location_state({"fails": False, "released_at_s": None, "judged": True}, both))
+    assert row["indeterminate_rules"] == ["too_few_judged_samples", "coarse_sampling"]
+    assert row["indeterminate_reason"] == "; ".join(g.reason for g in both)
+    mark(row, *location_state({"fails": False, "released_at_s": None, "judged": False}, []))
+    assert row["indeterminate_rules"] == ["non_finite_loads"] and row["state"] == "indeterminate"
+    mark(row, *location_state({"fails": True, "released_at_s": None, "judged": True}, both))
+    assert row == {"state": "fails", "indeterminate_reason": None, "indeterminate_rules": []}
     check = {"bodies": ["solar_array"], "most_threads": 17, "snapshots": 50, "first_s": 1.74, "last_s": 7.5,
              "force_bound_N": 80.0, "moment_bound_Nm": 355.0, "could_exceed": ["moment"], "worst_ratio": 1.2}
-    assert indeterminate_rules(pass_through_reason(check)) == ["thread_pass_through"]
+    assert pass_through_reason(check).rule == "thread_pass_through"
     row = {"name": "a", "state": "holds", "indeterminate_reason": None, "criteria": {"moment": {"peak": 100.0}}}
     verdict = apply_twin({"debris_state": "no_debris", "secondary_debris": False, "locations": [row]}, [None],
                          {}, None, 0.25, "low", note="no time left")
     assert verdict["debris_state"] == "indeterminate"
-    assert indeterminate_rules(row["indeterminate_reason"]) == ["twin_not_run"]
-    assert indeterminate_rules(None) == [] and indeterminate_rules("a reason nobody wrote") == ["other"]
+    assert row["indeterminate_rules"] == ["twin_not_run"] and "no time left" in row["indeterminate_reason"]
+    # one rule per reason, each once, in RULES' order; a rule no sweep count knows is refused
+    assert rules_of([Indeterminacy("chaotic_peak", "b"), Indeterminacy("twin_exceeds", "a"),
+                     Indeterminacy("chaotic_peak", "c")]) == ["twin_exceeds", "chaotic_peak"]
+    assert rules_of([]) == [] and len(set(RULES)) == len(RULES)
+    with pytest.raises(ValueError, match="unknown indeterminacy rule"):
+        rules_of([Indeterminacy("a_rule_nobody_counts", "x")])
