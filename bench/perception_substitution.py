@@ -26,12 +26,11 @@ import pickle
 import sys
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from perception import momentum
 from perception.free_flight import fit_free_motion
 from perception.momentum import point_masses_momentum, rigid_body_momentum, smallest_moment_from_angular_momentum
-from perception.momentum_balance import _line_covariances, _mean_and_covariance_of_mean, _orbital_per_mass, momentum_step
+from perception.momentum_balance import _mean_and_covariance_of_mean, _orbital_per_mass, momentum_step
 from perception.net_tracking import node_velocities
 
 
