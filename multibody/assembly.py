@@ -122,6 +122,8 @@ class ContactLaw:
     mu_static: float = 0.19
     mu_kinetic: float = 0.152
     transition_speed: float = 0.01    # V_t0 (m/s)
+    # threads touch the box shapes too, not only the nodes (multibody.contact_segment); off: the seed paper's model
+    thread_segments: bool = False
 
     @property
     def damping(self) -> float:

@@ -172,6 +172,7 @@ def kernel_data(assembly: ImpactAssembly) -> KernelData:
                          if assembly.solver.integrator == "VelocityVerlet" else np.inf),
         stage_weight=1.0 / INTEGRATORS[assembly.solver.integrator][1],
         mounts=_mounts(assembly.mount),
+        thread_segments=bool(law.thread_segments),
     )
 
 

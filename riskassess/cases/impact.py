@@ -182,6 +182,13 @@ class Contact(Strict):
     mu_static: NonNegative = Field(description="Static friction coefficient (-).")
     mu_kinetic: NonNegative = Field(description="Kinetic friction coefficient (-).")
     transition_speed: Positive = Field(description="Static-to-kinetic transition slip speed V_t0 (m/s).")
+    thread_segments: bool = Field(
+        False, description="Threads touch the box shapes too, not only the nodes: the segment between a thread's two "
+                           "nodes takes the same contact law at its deepest point, the force split over the two "
+                           "nodes (multibody/contact_segment.py), so a thread cannot pass through a thin part (the "
+                           "solar array, the ASAR) between its nodes. false: node contact alone, the seed paper's "
+                           "model (docs/model.md, 'Contact'). Other shapes (cylinders, spheres, meshes) keep node "
+                           "contact alone either way.")
 
     @model_validator(mode="after")
     def _friction_order(self):
