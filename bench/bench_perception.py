@@ -19,6 +19,10 @@ depend on the LiDAR noise (``perception.seed``) nor on the tracker (``perception
 simulated once per case and observation time and replayed for the other seeds and models
 (``--simulate-each`` simulates every run; the figures are the same).
 
+``--capture DIR`` also keeps, per run, what its momentum step was made of
+(``DIR/<model>_obs<observation>_seed<seed>.pkl``, bench/perception_capture.py), for the substitution
+experiments of bench/perception_substitution.py.
+
 ``--save DIR`` writes each run's answer (perception.json, with the process CPU time of the run and
 the load average before and after) to ``DIR/<model>_obs<observation>_seed<seed>.json`` as it comes,
 and skips a run whose file is already there: a long bench resumes where it stopped. ``--table DIR``
@@ -31,10 +35,14 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import tempfile
 import time
 import tomllib
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import perception_capture  # noqa: E402
 
 from riskassess.cases.impact import validate_case
 from riskassess.products.results import atomic_write_json
@@ -81,6 +89,8 @@ def main():
                         help="simulate the collision in every run (default: once per observation time)")
     parser.add_argument("--save", type=Path, default=None,
                         help="folder: write each answer as it comes, skip runs already saved there")
+    parser.add_argument("--capture", type=Path, default=None,
+                        help="folder: keep each run's momentum-step inputs (pickle) for bench/perception_substitution.py")
     parser.add_argument("--table", type=Path, default=None,
                         help="folder of saved answers: print the blocks and the table, run nothing")
     args = parser.parse_args()
@@ -89,6 +99,9 @@ def main():
         return
     if not args.simulate_each:
         reuse_collision_runs()
+    store = {}
+    if args.capture is not None:
+        perception_capture.capture_hooks(store)
     path = Path(args.case)
     raw = tomllib.loads(path.read_text())
     worst = {}
@@ -102,9 +115,12 @@ def main():
                     a = json.loads(saved.read_text())
                     print(f"\n(seed {seed}, model '{model}', {observation:g} s: saved in {saved})")
                 else:
+                    store.clear()
                     a = _run(path, raw)
                     if saved is not None:
                         _save(saved, a)
+                    if args.capture is not None:
+                        perception_capture.write_capture(args.capture / f"{model}_obs{observation:g}_seed{seed}.pkl", store, a)
                 answers.append((model, observation, a))
                 _report(a, observation, seed)
                 errors = a.get("principal_moments_error_percent") or [float("inf")]   # not observable
@@ -247,7 +263,9 @@ def _report(a, observation, seed):
     else:
         print(f"mass {a['mass_kg']:.2f} +- {a['mass_std_kg']:.2f} kg (error {a['mass_error_signed_percent']:+.3f} %); "
               f"principal moments {_fmt(a['principal_moments_kg_m2'], 2)} kg m^2, errors "
-              f"{_fmt(a['principal_moments_error_percent'])} %")
+              f"{_fmt(a['principal_moments_error_percent'])} % (1-sigma "
+              f"{100 * a['principal_moments_std_kg_m2'][2] / a['principal_moments_kg_m2'][2]:.2f} % on the smallest; "
+              f"angular balance misfit {a['angular_balance_misfit_N_m_s']:.1f} N m s, chi2 {a.get('angular_balance_chi2', float('nan')):.2f})")
         print(f"free flight used after the collision {a['free_flight_after_s'][0]:.1f}-{a['free_flight_after_s'][1]:.1f} s; "
               f"observation time used {a['observation_time_s']:.1f} s (paper: 300 s + 12.5 s)")
     if "net" not in a:

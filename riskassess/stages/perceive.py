@@ -914,6 +914,7 @@ def estimates(scene: Scene, before: FreeMotion, after: FreeMotion | None, step: 
         "kinetic_energy_rotational_J": energy,
         "angular_momentum_world_N_m_s": (c.value * before.spin_per_c).tolist(),
         "linear_balance_misfit_N_s": mass.misfit, "angular_balance_misfit_N_m_s": c.misfit,
+        "linear_balance_chi2": mass.chi2, "angular_balance_chi2": c.chi2,
     })
     return out
 
