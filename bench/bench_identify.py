@@ -232,7 +232,7 @@ def print_tables(rows):
             error = np.abs(np.subtract(paper[1], PAPER_TRUTH)) / np.abs(PAPER_TRUTH)
             print(f"| paper {label.split()[0].split('+')[0]} {cost} | " + " | ".join(f"{v:.7f}" for v in paper[1])
                   + f" | {error.max():.1e} | {error[:3].max():.1e} |")
-            print(f"| ours - paper | " + " | ".join(f"{a - b:+.2e}" for a, b in zip(run["s"], paper[1])) + " | | |")
+            print("| ours - paper | " + " | ".join(f"{a - b:+.2e}" for a, b in zip(run["s"], paper[1])) + " | | |")
 
 
 if __name__ == "__main__":
