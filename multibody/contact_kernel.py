@@ -49,6 +49,28 @@ def _effective_mass_along_normal(rot, inverse_inertia_body, mass, ax, ay, az, nx
     return _effective_mass_of_body(rot[np.newaxis], inverse_inertia_body[np.newaxis], 0, mass, ax, ay, az, nx, ny, nz)
 
 
+@njit(cache=True, inline="always")
+def add_body_reaction(b, fx, fy, fz, arm_x, arm_y, arm_z, weight, body_force_lvlh, torque_lvlh, out_body_impulse):
+    """The reaction -f of a contact force f = (fx, fy, fz) (N, LVLH) on body ``b``, acting at ``arm`` from its CoM
+    (m, LVLH): its force, its moment arm x (-f) about the CoM, and both times ``weight`` into the body's impulse
+    (N s, N m s). One place for a node's contact and a thread's (:mod:`multibody.contact_segment`)."""
+    body_force_lvlh[b, 0] -= fx
+    body_force_lvlh[b, 1] -= fy
+    body_force_lvlh[b, 2] -= fz
+    mx = -(arm_y * fz - arm_z * fy)
+    my = -(arm_z * fx - arm_x * fz)
+    mz = -(arm_x * fy - arm_y * fx)
+    torque_lvlh[b, 0] += mx
+    torque_lvlh[b, 1] += my
+    torque_lvlh[b, 2] += mz
+    out_body_impulse[b, 0] -= fx * weight
+    out_body_impulse[b, 1] -= fy * weight
+    out_body_impulse[b, 2] -= fz * weight
+    out_body_impulse[b, 3] += mx * weight
+    out_body_impulse[b, 4] += my * weight
+    out_body_impulse[b, 5] += mz * weight
+
+
 # inlined (numba IR): as a call, each of its seven array arguments was reference-counted per contact
 # and step; with the other per-contact inlines this took NRT_incref/decref from 7 % to 4 % of a run
 @njit(cache=True, inline="always")
@@ -60,25 +82,8 @@ def _apply_contact_pair(i, b, fx, fy, fz, com_lvlh, weight, x, net_force_lvlh, b
     net_force_lvlh[0, i] += fx
     net_force_lvlh[1, i] += fy
     net_force_lvlh[2, i] += fz
-    body_force_lvlh[b, 0] -= fx
-    body_force_lvlh[b, 1] -= fy
-    body_force_lvlh[b, 2] -= fz
-    ax = x[0, i] - com_lvlh[b, 0]
-    ay = x[1, i] - com_lvlh[b, 1]
-    az = x[2, i] - com_lvlh[b, 2]
-    # moment of the reaction -f about the body CoM: a x (-f)
-    mx = -(ay * fz - az * fy)
-    my = -(az * fx - ax * fz)
-    mz = -(ax * fy - ay * fx)
-    torque_lvlh[b, 0] += mx
-    torque_lvlh[b, 1] += my
-    torque_lvlh[b, 2] += mz
-    out_body_impulse[b, 0] -= fx * weight
-    out_body_impulse[b, 1] -= fy * weight
-    out_body_impulse[b, 2] -= fz * weight
-    out_body_impulse[b, 3] += mx * weight
-    out_body_impulse[b, 4] += my * weight
-    out_body_impulse[b, 5] += mz * weight
+    add_body_reaction(b, fx, fy, fz, x[0, i] - com_lvlh[b, 0], x[1, i] - com_lvlh[b, 1], x[2, i] - com_lvlh[b, 2],
+                      weight, body_force_lvlh, torque_lvlh, out_body_impulse)
     out_node_impulse[i, 0] += fx * weight
     out_node_impulse[i, 1] += fy * weight
     out_node_impulse[i, 2] += fz * weight

@@ -62,7 +62,7 @@ from numba import njit
 from multibody.broad_phase import box_signed_distance
 from multibody.contact import contact_over_step, hertz_elastic_energy
 from multibody.contact_implicit import contact_implicit_step_xyz
-from multibody.contact_kernel import _effective_mass_of_body, _substeps_to_resolve_contact
+from multibody.contact_kernel import _effective_mass_of_body, _substeps_to_resolve_contact, add_body_reaction
 from multibody.segment_box import (
     MAX_BREAKPOINTS,
     TIE_DISTANCE,
@@ -141,22 +141,7 @@ def _apply_at_point(a, b, split, body, fx, fy, fz, arm_x, arm_y, arm_z, weight, 
     node_force_lvlh[0, b] += wb * fx
     node_force_lvlh[1, b] += wb * fy
     node_force_lvlh[2, b] += wb * fz
-    body_force_lvlh[body, 0] -= fx
-    body_force_lvlh[body, 1] -= fy
-    body_force_lvlh[body, 2] -= fz
-    # moment of the reaction -f about the body CoM: arm x (-f)
-    mx = -(arm_y * fz - arm_z * fy)
-    my = -(arm_z * fx - arm_x * fz)
-    mz = -(arm_x * fy - arm_y * fx)
-    torque_lvlh[body, 0] += mx
-    torque_lvlh[body, 1] += my
-    torque_lvlh[body, 2] += mz
-    out_body_impulse[body, 0] -= fx * weight
-    out_body_impulse[body, 1] -= fy * weight
-    out_body_impulse[body, 2] -= fz * weight
-    out_body_impulse[body, 3] += mx * weight
-    out_body_impulse[body, 4] += my * weight
-    out_body_impulse[body, 5] += mz * weight
+    add_body_reaction(body, fx, fy, fz, arm_x, arm_y, arm_z, weight, body_force_lvlh, torque_lvlh, out_body_impulse)
     out_node_impulse[a, 0] += wa * fx * weight
     out_node_impulse[a, 1] += wa * fy * weight
     out_node_impulse[a, 2] += wa * fz * weight
