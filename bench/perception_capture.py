@@ -91,3 +91,19 @@ def write_capture(path, store: dict, answer: dict) -> None:
     with open(temporary, "wb") as f:
         pickle.dump(kept, f)
     os.replace(temporary, path)
+
+
+def main() -> None:
+    """``python3 bench/perception_capture.py [bench_perception.py's arguments]``: bench/bench_perception.py with
+    ``--capture runs/captures`` unless a ``--capture`` folder is given (the module doc)."""
+    import sys
+
+    import bench_perception
+
+    if "--capture" not in sys.argv[1:]:
+        sys.argv += ["--capture", "runs/captures"]
+    bench_perception.main()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,6 +1,7 @@
 """Every benchmark script still imports against the current packages (a layout move broke
 bench/bench_impact.py once without any test noticing) and has a ``main`` to run."""
 import importlib.util
+import sys
 from pathlib import Path
 
 import pytest
@@ -10,9 +11,16 @@ BENCH = Path(__file__).resolve().parents[1] / "bench"
 
 @pytest.mark.parametrize("script", sorted(BENCH.glob("*.py")), ids=lambda p: p.name)
 def test_bench_script_imports(script):
-    spec = importlib.util.spec_from_file_location(f"bench_{script.stem}", script)
+    name = f"bench_{script.stem}"
+    spec = importlib.util.spec_from_file_location(name, script)
     module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)          # top level only: every script guards main()
+    # registered as importlib's recipe does: a dataclass under "from __future__ import annotations" looks its
+    # module up in sys.modules while the class is made
+    sys.modules[name] = module
+    try:
+        spec.loader.exec_module(module)      # top level only: every script guards main()
+    finally:
+        sys.modules.pop(name, None)
     assert callable(getattr(module, "main", None)), f"{script.name} has no main()"
 
 
