@@ -160,6 +160,8 @@ SKIN_ROUNDING_M = 1e-6
 SKIN_MAX_AGE = 200
 #: A new skin when this many more nodes need the exact test than right after the last one.
 SKIN_GROWTH_NODES = 64
+#: The full pass instead while more than 1 / this of the nodes needed the test right after the skin was made.
+SKIN_FULL_PASS_SHARE = 8
 
 
 class BroadPhaseSkin(NamedTuple):
@@ -236,7 +238,10 @@ def flag_candidates_skin(x_lvlh_soa, reach, body_to_lvlh, com_lvlh, shape_body, 
     distance from the kept box is at most sqrt(3) e + growth + moved. The skin is made again (one pass
     like :func:`flag_candidates`'s, without the rotation) when it is :data:`SKIN_MAX_AGE` evaluations old
     or :data:`SKIN_GROWTH_NODES` more nodes need the test than right after it was made. A node moving at
-    20 m/s covers 2 mm in a 1e-4 s step, so a node 1 m from every box skips hundreds of box tests.
+    20 m/s covers 2 mm in a 1e-4 s step, so a node 1 m from every box skips hundreds of box tests. While more
+    than 1 / :data:`SKIN_FULL_PASS_SHARE` of the nodes needed the test right after the skin was made (a net
+    wrapped around a tilted body, whose LVLH box holds hundreds of nodes), the full pass runs instead: it
+    costs less then (docs/model.md, Speed, helper "speed8").
 
     Parameters
     ----------
@@ -266,6 +271,13 @@ def flag_candidates_skin(x_lvlh_soa, reach, body_to_lvlh, com_lvlh, shape_body, 
                      need, skin)
         return
     rebuild = counts[0] > SKIN_MAX_AGE
+    if not rebuild and counts[1] > n // SKIN_FULL_PASS_SHARE:
+        # too many nodes near the boxes right after the skin was made (a net wrapped around a body): the full
+        # pass, vectorized over every node, costs less than the skin's pass and the gathered test; until the
+        # skin is due again
+        counts[0] += 1
+        flag_candidates(x_lvlh_soa, reach, body_to_lvlh, com_lvlh, shape_body, box_min, box_max, shape_reach, flags)
+        return
     if not rebuild:
         growth = 0.0
         for s in range(n_shapes):

@@ -6,24 +6,32 @@ the full pass's to the bit. Checked on a moving cloud of nodes around two boxes 
 over enough evaluations to cross skins made for age and for growth, and with a non-finite body.
 """
 import numpy as np
+import pytest
 
-from multibody.broad_phase import SKIN_MAX_AGE, broad_phase_skin, flag_candidates, flag_candidates_skin
+from multibody.broad_phase import (
+    SKIN_FULL_PASS_SHARE,
+    SKIN_MAX_AGE,
+    broad_phase_skin,
+    flag_candidates,
+    flag_candidates_skin,
+)
 from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 
 
-def _scene(rng, n_nodes):
+def _scene(rng, n_nodes, half_width=4.0):
     """Two bodies with one box each, a node cloud around them (m), reaches of a few mm to a few cm."""
     box_min = np.array([[-1.0, -0.4, -0.3], [-3.0, -0.05, -1.0]])
     box_max = np.array([[1.0, 0.6, 0.3], [3.0, 0.05, 1.0]])
-    x = rng.uniform(-4.0, 4.0, (3, n_nodes))
+    x = rng.uniform(-half_width, half_width, (3, n_nodes))
     velocity = rng.normal(0.0, 2.0, (3, n_nodes))
     return box_min, box_max, x, velocity
 
 
-def test_skin_flags_equal_the_full_pass_while_nodes_and_bodies_move():
+@pytest.mark.parametrize("half_width", [4.0, 1.5])   # few nodes near the boxes (the skin), many (the full pass)
+def test_skin_flags_equal_the_full_pass_while_nodes_and_bodies_move(half_width):
     rng = np.random.default_rng(7)
     n_nodes, dt = 600, 2e-3
-    box_min, box_max, x, velocity = _scene(rng, n_nodes)
+    box_min, box_max, x, velocity = _scene(rng, n_nodes, half_width)
     shape_body = np.array([0, 1])
     com = np.array([[0.0, 0.0, 0.0], [0.5, 1.5, 0.0]])
     com_rate = np.array([[0.3, -0.2, 0.1], [-0.5, 0.0, 0.4]])
@@ -49,7 +57,10 @@ def test_skin_flags_equal_the_full_pass_while_nodes_and_bodies_move():
         rotation_vector += rate * dt
     assert flagged > 1000                   # the scene has near nodes to find
     assert skin.counts[2] >= 2              # more than one skin made (age or growth)
-    assert skin.counts[3] < steps * n_nodes / 2   # and most node tests were skipped
+    if half_width > 2.0:                    # the skin's own path: most node tests skipped
+        assert 0 < skin.counts[3] < steps * n_nodes / 4
+    else:                                   # crowded: the full pass ran instead
+        assert skin.counts[1] > n_nodes // SKIN_FULL_PASS_SHARE
 
 
 def test_skin_with_a_non_finite_body_flags_as_the_full_pass():
