@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit
 
-from multibody.broad_phase import box_signed_distance, flag_candidates_skin
+from multibody.broad_phase import box_signed_distance, flag_candidates
 from multibody.contact import (
     contact_over_step,
     hertz_elastic_energy,
@@ -221,8 +221,8 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
     shape_reach = work_shape_scalar[5]
     for s in range(n_shapes):
         shape_reach[s] = step * shape_speed[s]
-    flag_candidates_skin(x, reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max, shape_reach,
-                         candidates, buffers.skin)
+    flag_candidates(x, reach, body_to_lvlh, com_lvlh, shape_body, shape_box_min, shape_box_max, shape_reach,
+                    candidates)
     # per-node contact lists and sub-cycle work space, reused
     c_body = buffers.contact_body
     c_pen, c_mass, impulse_norm, work_delta = (work_shape_scalar[0], work_shape_scalar[1], work_shape_scalar[2],

@@ -30,7 +30,6 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from multibody.broad_phase import BroadPhaseSkin, broad_phase_skin
 from multibody.contact_kernel import add_contact_forces
 from multibody.contact_segment import SegmentBuffers, add_segment_contact_forces, segment_buffers
 from multibody.net import ThreadRuns, add_bending_forces, add_thread_forces_runs
@@ -185,7 +184,6 @@ class KernelBuffers(NamedTuple):
     work_body: np.ndarray          # (2, nb, 3) the bodies' force and torque accumulators (LVLH)
     states: "BodyStates"           # the bodies' state at the evaluation (body_states_into)
     segments: SegmentBuffers       # the threads' contact (multibody.contact_segment): switch, carried impulses
-    skin: BroadPhaseSkin           # the broad phase's skin, carried between evaluations (multibody.broad_phase)
 
 
 def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int, thread_segments: bool = False) -> KernelBuffers:
@@ -212,8 +210,7 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int, thread_segments
                          states=BodyStates(np.zeros((n_bodies, 3, 3)), np.zeros((n_bodies, 3)),
                                            np.zeros((n_bodies, 3)), np.zeros((n_bodies, 3)),
                                            np.zeros((n_bodies, 3, 3)), np.zeros((n_bodies, 3))),
-                         segments=segment_buffers(len(net.threads), n, n_shapes, thread_segments),
-                         skin=broad_phase_skin(n, n_shapes))
+                         segments=segment_buffers(len(net.threads), n, n_shapes, thread_segments))
 
 
 class BodyStates(NamedTuple):
