@@ -353,7 +353,7 @@ def _thread_on_box(j, a, c, s, b, pa, pc, reach, x, v, net_force_lvlh, net, stat
     if penetration + reach - thread_radius <= 0.0:
         return 0.0, 0, 0.0
     # where the force acts: the centre of the part pressed at least half as deep as the deepest point
-    t_low, t_high = segment_box_sublevel(pa, d, lo, hi, distance + 0.5 * max(depth, 0.0) + TIE_DISTANCE,
+    t_low, t_high = segment_box_sublevel(pa, d, lo, hi, distance + TIE_DISTANCE,
                                          seg.breakpoints)
     split = 0.5 * (t_low + t_high) if t_low <= t_high else t_deepest
     rot, com_lvlh = states.body_to_lvlh, states.com_lvlh
