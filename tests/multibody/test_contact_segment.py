@@ -6,7 +6,8 @@
   thread can touch): its point of contact is the middle, where it shows the mass 2 m of its two nodes; the
   relative normal speed reverses with the Hunt-Crossley restitution e of the law (the closed-form phase plane of
   tests/multibody/test_contact.py, the same for any mass) and the momentum 2 m v is shared with the plate as
-  in a two-body collision.
+  in a two-body collision; on a fixed plate the kinetic energy left is e^2 of the launch's and the dissipation
+  the contact books is what the thread lost (its energy balance).
 - A taut thread pulled over a thin plate's edge by two threads to fixed anchors: at rest the plate takes the
   pull the threads' turn implies, 2 T sin(theta), and the thread does not pass through it (it does with
   node contact alone: multibody/thread_crossing.py finds it).
