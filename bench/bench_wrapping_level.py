@@ -35,7 +35,13 @@ Items (changes to the case; ``nominal`` is the case itself):
 - ``mesh_25``: 25 x 25 nodes, the same net mass, thread EA and damping per unit length (mesh 1.25 m);
 - ``hub_loads``: no new wall run: the kept ``nominal`` wall run's loads drive the free debris with the *total*
   contact wrench on the main body (its eqs. 9 and 12 sum every contact into one force at the CG and one moment
-  about it; the array then follows through the hinge) instead of each body's own contact on that body (ours).
+  about it; the array then follows through the hinge) instead of each body's own contact on that body (ours);
+- ``samplings``: no new run: the kept ``paper_step`` wall run read as the paper might have written it out (means
+  over 0.1-1 ms, point samples every 4-40 steps): which reading gives its first impact and its band at once;
+- ``bullets_outward``: the bullets given 5 m/s outward along the net diagonals at launch (a net pulled taut by
+  its bullets, as one still deploying; the paper's ejection is not given: a sensitivity);
+- ``paper_step_1ms_loads``: the ``paper_step`` wall loads averaged over 1 ms, applied at the case's 1e-4 s step:
+  whether the hinge follows the load's bandwidth or its level.
 
 Results: ``bench/results/wrapping_level.json`` (resumable per item), with CPU time and load per run.
 """
@@ -148,8 +154,13 @@ def hinge_figures(series: dict) -> dict:
 
 def wrapping_figures(run: Path, case) -> dict:
     """Every reading of one kept sequential run (module docstring)."""
-    wall = dict(np.load(run / "wall_timeseries.npz"))
-    driven = dict(np.load(run / "timeseries.npz"))
+    return series_figures(dict(np.load(run / "wall_timeseries.npz")), dict(np.load(run / "net.npz")),
+                          dict(np.load(run / "timeseries.npz")), case)
+
+
+def series_figures(wall: dict, net: dict, driven: dict, case) -> dict:
+    """Every reading (module docstring) of a sequential run's wall series, net snapshots and driven series (the
+    latter with ``joint_names``)."""
     t = wall["time"]
     force, moment = contact_totals_debris(wall)
     inside = (t > WINDOW_S[0]) & (t <= WINDOW_S[1])
@@ -171,7 +182,7 @@ def wrapping_figures(run: Path, case) -> dict:
         "plot band of the moment, native output (N m)": plot_band(t, moment, WINDOW_S),
         "along-track impulse 1-7.5 s (N s)": float(force[inside, 1].sum() * np.median(np.diff(t))),
     }
-    out |= net_figures(dict(np.load(run / "net.npz")), WINDOW_S)
+    out |= net_figures(net, WINDOW_S)
     threads = 2 * n * (n - 1) + 4
     out |= energy_figures(wall, WINDOW_S, threads, case.net.thread.stiffness)
     out |= hinge_figures(driven)
@@ -219,7 +230,7 @@ def item_case(item: str):
 
 
 ITEMS = ("nominal", "paper_step", "thread_segments", "contact_stiffness_x10", "threads_x4", "short_tether",
-         "mesh_25", "hub_loads")
+         "mesh_25", "hub_loads", "samplings", "bullets_outward", "paper_step_1ms_loads")
 
 
 def hub_wrench(wall: dict, main: int) -> tuple[np.ndarray, np.ndarray]:
@@ -251,11 +262,114 @@ def hub_loads(keep: Path) -> dict:
                               reference_energy=float(wall["energy_net_kinetic"][0]))
     load = os.getloadavg()[0]
     cpu = time.process_time()
-    series = _simulation(driven_inputs(model_inputs(case, CASE.parent), loads)).run().series
+    simulation = _simulation(driven_inputs(model_inputs(case, CASE.parent), loads))
+    series = dict(simulation.run().series)
+    series["joint_names"] = np.array([j.name for j in simulation.assembly.joints])
     out = {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]]}
     out |= hinge_figures(series)
     per_body = hinge_figures(dict(np.load(keep / "nominal" / "timeseries.npz")))
     return out | {f"per-body loads (nominal): {k}": v for k, v in per_body.items()}
+
+
+def samplings(keep: Path) -> dict:
+    """The kept ``paper_step`` wall run (contact force at every 2.5e-5 s step) read as the paper might have written
+    it out: means over 0.1-1 ms and point samples every 4-40 steps (every offset; median [range]): the first-impact
+    peak force (kN) and moment (kN m) (first 0.3 s), the wrapping 95th percentile of |F_i| (N) and the plot band
+    (median over 7.5 ms columns of the column's largest |F_i|, N) over 1-7.5 s."""
+    wall = dict(np.load(keep / "paper_step" / "wall_timeseries.npz"))
+    force, moment = contact_totals_debris(wall)
+    t = wall["time"]
+    rows = {}
+    for steps in (1, 4, 10, 20, 24, 40):
+        width = steps * float(np.median(np.diff(t)))
+        tm, fm = block_means(t, force, width)
+        _, mm = block_means(t, moment, width)
+        first, wrap = tm <= 0.3, (tm > WINDOW_S[0]) & (tm <= WINDOW_S[1])
+        rows[f"means over {1e3 * width:.3g} ms"] = {
+            "first-impact peak force (kN) / moment (kN m)": [1e-3 * float(np.linalg.norm(fm[first], axis=1).max()),
+                                                            1e-3 * float(np.linalg.norm(mm[first], axis=1).max())],
+            "wrapping p95 |F_i| (N)": np.percentile(np.abs(fm[wrap]), 95, axis=0).tolist(),
+            "plot band median |F_i| (N)": plot_band(tm, fm, WINDOW_S)["median"],
+            "plot band p90 |F_i| (N)": plot_band(tm, fm, WINDOW_S)["p90"],
+            "plot band median / p90 |M_i| (N m)": [plot_band(tm, mm, WINDOW_S)["median"],
+                                                    plot_band(tm, mm, WINDOW_S)["p90"]]}
+        if steps == 1:
+            continue
+        peaks, bands = [], []
+        for offset in range(steps):
+            idx = np.arange(offset, len(t), steps)
+            first, wrap = t[idx] <= 0.3, (t[idx] > WINDOW_S[0]) & (t[idx] <= WINDOW_S[1])
+            peaks.append([1e-3 * np.linalg.norm(force[idx][first], axis=1).max(),
+                          1e-3 * np.linalg.norm(moment[idx][first], axis=1).max()])
+            bands.append(plot_band(t[idx], force[idx], WINDOW_S)["median"] + [
+                float(np.percentile(np.abs(force[idx][wrap][:, 1]), 95))])
+        peaks, bands = np.array(peaks), np.array(bands)
+        rows[f"point samples every {1e3 * width:.3g} ms"] = {
+            "first-impact peak force (kN) / moment (kN m), median [min, max] over offsets": [
+                [float(np.median(peaks[:, k])), float(peaks[:, k].min()), float(peaks[:, k].max())] for k in (0, 1)],
+            "plot band median |F_i| (N) and wrapping p95 |F_y| (N), median over offsets":
+                np.median(bands, axis=0).tolist()}
+    return rows
+
+
+def bullets_outward(speed: float = 5.0) -> dict:
+    """One sequential run (in memory) with each bullet given an extra ``speed`` (m/s) outward along its net diagonal
+    at launch: a net pulled taut by its bullets, as a net still deploying would be (the paper's net is ejected and
+    its energy first "decreases due to the net deployment energy damping", Sec. 3.5; its bullets' ejection velocity
+    is not given: 5 m/s is a sensitivity, 14 deg off the launch axis)."""
+    import dataclasses
+
+    from riskassess.models.impact import model_inputs
+    from riskassess.models.impact_sequential import driven_inputs, recorded_loads, wall_inputs
+    from riskassess.stages.run import _simulation
+
+    HealthWatch.__init__.__defaults__ = (None, LIFTED_DRIFT_LIMIT)
+    case = item_case("nominal")
+    inputs = model_inputs(case, CASE.parent)
+    assembly = inputs.assembly
+    net = assembly.net
+    velocity = np.array(assembly.net_velocity, float)
+    centre = net.positions[:-net.n_bullets].mean(axis=0)
+    launch = np.asarray(case.launch.direction, float) / np.linalg.norm(case.launch.direction)
+    for k in range(len(velocity) - net.n_bullets, len(velocity)):
+        radial = net.positions[k] - centre
+        radial -= radial.dot(launch) * launch
+        velocity[k] += speed * radial / np.linalg.norm(radial)
+    inputs = dataclasses.replace(inputs, assembly=dataclasses.replace(assembly, net_velocity=velocity))
+    load = os.getloadavg()[0]
+    cpu = time.process_time()
+    wall = _simulation(wall_inputs(inputs))
+    wall_recorder = wall.run()
+    loads = recorded_loads(wall_recorder.series, wall.health.reference_energy)
+    driven = _simulation(driven_inputs(inputs, loads))
+    series = dict(driven.run().series)
+    series["joint_names"] = np.array([j.name for j in driven.assembly.joints])
+    out = {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]], "bullet outward speed (m/s)": speed}
+    return out | series_figures(dict(wall_recorder.series), dict(wall_recorder.net), series, case)
+
+
+def paper_step_1ms_loads(keep: Path) -> dict:
+    """The kept ``paper_step`` wall run's loads (every 2.5e-5 s) averaged over 1 ms and applied to the free debris at
+    the case's own step (1e-4 s): does the hinge follow the load's level or its bandwidth?"""
+    from multibody.recorded_loads import RecordedBodyLoads
+    from riskassess.models.impact import model_inputs
+    from riskassess.models.impact_sequential import driven_inputs
+    from riskassess.stages.run import _simulation
+
+    HealthWatch.__init__.__defaults__ = (None, LIFTED_DRIFT_LIMIT)
+    case = item_case("nominal")
+    wall = dict(np.load(keep / "paper_step" / "wall_timeseries.npz"))
+    t = wall["time"][1:]
+    t_ms, force = block_means(t, wall["contact_force_lvlh"][1:], 1e-3)
+    _, moment = block_means(t, wall["contact_moment_body"][1:], 1e-3)
+    loads = RecordedBodyLoads(time=t_ms, force_lvlh=force, moment_body=moment,
+                              reference_energy=float(wall["energy_net_kinetic"][0]))
+    load = os.getloadavg()[0]
+    cpu = time.process_time()
+    simulation = _simulation(driven_inputs(model_inputs(case, CASE.parent), loads))
+    series = dict(simulation.run().series)
+    series["joint_names"] = np.array([j.name for j in simulation.assembly.joints])
+    return {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]]} | hinge_figures(series)
 
 
 def run_item(item: str, keep: Path | None) -> dict:
@@ -285,7 +399,10 @@ def main() -> None:
     for item in args.only.split(","):
         if args.table_only or item in store:
             continue
-        store[item] = hub_loads(args.keep) if item == "hub_loads" else run_item(item, args.keep)
+        special = {"hub_loads": lambda: hub_loads(args.keep), "samplings": lambda: samplings(args.keep),
+                   "bullets_outward": bullets_outward,
+                   "paper_step_1ms_loads": lambda: paper_step_1ms_loads(args.keep)}
+        store[item] = special[item]() if item in special else run_item(item, args.keep)
         print(f"{item}: {json.dumps(store[item])}", flush=True)
         tmp = STORE.with_suffix(".tmp")
         tmp.write_text(json.dumps(store, indent=1))
