@@ -114,7 +114,7 @@ def main():
                   + _figures(times, body_to_world, free.world_to_body, free.ok,
                              np.array([a.information for a in records]), free.cpu_seconds), flush=True)
             for length in args.prefixes or []:
-                k = int(round(length * LIDAR.rate)) + 1
+                k = round(length * LIDAR.rate) + 1
                 print(f"  first {length:g} s: " + _figures(times[:k], body_to_world[:k], free.world_to_body[:k],
                                                            free.ok[:k], np.array([a.information for a in records[:k]]),
                                                            free.cpu_seconds[:k]), flush=True)
