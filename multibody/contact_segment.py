@@ -11,10 +11,13 @@ it touches a box shape under the same law as the nodes:
   a square root of a quadratic or a maximum of lines between the points where the segment crosses the
   box's slab planes and mid-planes, so :func:`multibody.segment_box.segment_box_deepest` finds the minimum
   exactly). The force
-  acts at the centre of the part of the segment pressed at least half as deep as that point (the part
-  within :data:`TIE_DISTANCE` of it while in a gap): a thread lying flat across a plate narrower than the
-  net's mesh (the ASAR under the reduced net) takes its load at the middle of the overlap, and the point
-  moves continuously as the thread tilts.
+  acts at that point (the middle of the part within :data:`TIE_DISTANCE` of it when several points tie, so a
+  thread lying exactly flat across a plate narrower than the net's mesh takes its load at the middle of the
+  overlap): there the force is the gradient of the contact's energy (envelope theorem: the depth's derivative
+  along the segment is zero at its minimum). Until 2026-11-27 it acted at the centre of the part pressed at
+  least half as deep, which is not that gradient: a thread turned by its contact (force off its nodes' centre
+  of mass) gained energy (one thread falling flat at 20 m/s across a plate off its middle, s = 0.625: +33 % of
+  its launch energy; helper peaks10, docs/model.md "Contact").
 * **how much**: Hunt-Crossley normal force and the case's Hollar friction, as a node with the thread's
   radius at that point, through the node contact's own integration over the step (the implicit step of
   :mod:`multibody.contact_implicit` for a slow contact, the sub-cycle of :func:`multibody.contact.contact_over_step`
@@ -352,8 +355,9 @@ def _thread_on_box(j, a, c, s, b, pa, pc, reach, x, v, net_force_lvlh, net, stat
     penetration = depth - max(0.0, depth_a, depth_c)
     if penetration + reach - thread_radius <= 0.0:
         return 0.0, 0, 0.0
-    # where the force acts: the centre of the part pressed at least half as deep as the deepest point
-    t_low, t_high = segment_box_sublevel(pa, d, lo, hi, distance + 0.5 * max(depth, 0.0) + TIE_DISTANCE,
+    # where the force acts: the deepest point (the middle of the tied part when several points are as deep); there
+    # the force is the gradient of the contact energy (module doc)
+    t_low, t_high = segment_box_sublevel(pa, d, lo, hi, distance + TIE_DISTANCE,
                                          seg.breakpoints)
     split = 0.5 * (t_low + t_high) if t_low <= t_high else t_deepest
     rot, com_lvlh = states.body_to_lvlh, states.com_lvlh

@@ -15,10 +15,11 @@ from typing import NamedTuple
 #: The rules that make a location indeterminate, in the order a location lists them:
 #: too few judged samples, samples too far apart, no contact load in the judged window (evidence gaps of
 #: the run); loads that are not finite; net threads through the part that could take it past its allowable
-#: (structures.thread_gaps); the twin run exceeding the allowable, the peak one draw of a chaotic capture,
+#: (structures.thread_gaps); the threads' own contact on with an energy error past its limit (structures.verdict.
+#: thread_contact_energy_gap); the twin run exceeding the allowable, the peak one draw of a chaotic capture,
 #: the twin not run (structures.twin).
 RULES = ("too_few_judged_samples", "coarse_sampling", "no_capture_load", "non_finite_loads", "thread_pass_through",
-         "twin_exceeds", "chaotic_peak", "twin_not_run")
+         "thread_contact_energy", "twin_exceeds", "chaotic_peak", "twin_not_run")
 
 
 class Indeterminacy(NamedTuple):

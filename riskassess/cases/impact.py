@@ -188,7 +188,9 @@ class Contact(Strict):
                            "nodes (multibody/contact_segment.py), so a thread cannot pass through a thin part (the "
                            "solar array, the ASAR) between its nodes. false: node contact alone, the seed paper's "
                            "model (docs/model.md, 'Contact'). Other shapes (cylinders, spheres, meshes) keep node "
-                           "contact alone either way.")
+                           "contact alone either way. Its strikes are not yet energy-consistent: with it on, a location "
+                           "holds only if the run's energy balance closes within 1 % (else indeterminate, rule "
+                           "thread_contact_energy; docs/structures.md).")
 
     @model_validator(mode="after")
     def _friction_order(self):

@@ -116,7 +116,9 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
             verdict = structures_verdict(
                 locations, recorder.series, simulation.assembly, monitor.events if monitor else [],
                 net_positions_final, case.structures.skip_initial, case.structures.release, pass_throughs,
-                judge_pass_throughs=case.structures.thread_pass_through == "bound")
+                judge_pass_throughs=case.structures.thread_pass_through == "bound",
+                thread_contact_drift=summary.get("checks", {}).get("energy_balance_relative_drift"),
+                thread_segments=case.contact.thread_segments)
             if case.structures.twin:
                 verdict = _with_twin(verdict, locations, recorder.series, case, case_path)
             results.atomic_write_npz(folder.path / "structures.npz", demand_series(locations, recorder.series))

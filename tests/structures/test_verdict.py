@@ -96,3 +96,17 @@ def test_each_indeterminate_reason_comes_with_its_rule():
     assert rules_of([]) == [] and len(set(RULES)) == len(RULES)
     with pytest.raises(ValueError, match="unknown indeterminacy rule"):
         rules_of([Indeterminacy("a_rule_nobody_counts", "x")])
+
+
+def test_the_threads_contact_with_an_energy_error_never_reads_holds():
+    """With contact.thread_segments on, a run whose energy balance drifted past THREAD_CONTACT_DRIFT_LIMIT (1 %) or
+    was not recorded cannot say a location holds (rule thread_contact_energy): the 2 m/s envelope run's 2.38 %
+    (docs/structures.md) is indeterminate; 0.5 % is judged as recorded."""
+    from structures.verdict import THREAD_CONTACT_DRIFT_LIMIT, thread_contact_energy_gap
+
+    assert THREAD_CONTACT_DRIFT_LIMIT == 0.01
+    gap = thread_contact_energy_gap(0.0238)
+    assert gap.rule == "thread_contact_energy" and "2.38 %" in gap.reason
+    assert thread_contact_energy_gap(None).rule == "thread_contact_energy"
+    assert thread_contact_energy_gap(float("nan")).rule == "thread_contact_energy"
+    assert thread_contact_energy_gap(0.005) is None
