@@ -14,6 +14,12 @@ the world at t = 0, and the inertia-ratio errors of the torque-free fit.
 
     python bench/bench_scan_to_map.py [--seeds 0 1 2 3 4] [--duration 20] [--body featured|ellipsoid]
                                       [--models none known] [--settled 1e-4 1e-3] [--tukey 0.5 1]
+                                      [--prefixes 5 10 20 30 60]
+
+``--prefixes``: the data-length study (Tang et al. 2023, Table 4) from one tracked run per seed: the
+fits redone on the first T s of the frames, for each T. The track of frame k uses only frames up to k
+(the map is built from the frames registered before it), so a prefix is exactly what a T-s observation
+would have given.
 """
 from __future__ import annotations
 
@@ -84,6 +90,8 @@ def main():
     parser.add_argument("--tukey", type=float, nargs="+", default=None,
                         help="scan-to-map Tukey cut-offs to compare (share of the correspondence distance, "
                              "scan_to_map.TUKEY_CUTOFF); each seed is tracked once per value, back to back")
+    parser.add_argument("--prefixes", type=float, nargs="+", default=None,
+                        help="data lengths (s): the fits also redone on the first T s of each track (Table 4)")
     args = parser.parse_args()
     times = np.arange(int(round(args.duration * LIDAR.rate)) + 1) / LIDAR.rate
     quaternions, _ = propagate_torque_free(np.array([1.0, 0, 0, 0]), OMEGA0, MOMENTS / MOMENTS[2], times, 0.005)
@@ -105,6 +113,11 @@ def main():
             print(f"seed {seed} none, settled {1e3 * settled:g} mm, Tukey {tukey:g} x distance: "
                   + _figures(times, body_to_world, free.world_to_body, free.ok,
                              np.array([a.information for a in records]), free.cpu_seconds), flush=True)
+            for length in args.prefixes or []:
+                k = round(length * LIDAR.rate) + 1
+                print(f"  first {length:g} s: " + _figures(times[:k], body_to_world[:k], free.world_to_body[:k],
+                                                           free.ok[:k], np.array([a.information for a in records[:k]]),
+                                                           free.cpu_seconds[:k]), flush=True)
         if "known" not in args.models:
             continue
         known = DebrisTracker(VOXEL, CORRESPONDENCE, 30, *known_shape_model(mesh, VOXEL, seed), seed=seed)

@@ -172,6 +172,7 @@ class CellList:
         self.order = np.argsort(keys, kind="stable")
         self.sorted_points = self.points[self.order]
         self.starts = np.searchsorted(keys[self.order], np.arange(int(np.prod(self.shape)) + 1))
+        self.largest_cell = int(np.diff(self.starts).max()) if len(self.points) else 0
 
     def query(self, points, distance_upper_bound=np.inf) -> tuple[np.ndarray, np.ndarray]:
         """Distance (m) to and index of the nearest point within ``distance_upper_bound`` for
@@ -233,3 +234,94 @@ def _nearest_in_cells(points, low, cell, shape, starts, sorted_points, upper, sh
             gap[k] = np.sqrt(best_d2)
             index[k] = best
     return gap, index
+
+
+@njit(cache=True)
+def nearest_in_cells_kept(points, low, cell, shape, starts, sorted_points, upper, shells,
+                          kept_points, kept_index, kept_safe, gap, index):
+    """:meth:`CellList.query` for points that move a little between calls (the iterations of an ICP):
+    the same nearest point within ``upper``, looked up again only for the points that moved far enough
+    for it to change.
+
+    Each full look-up keeps, per query point, its position, its nearest point (row of
+    ``sorted_points``) and a safe radius: half the gap between the nearest distance d1 and a lower
+    bound L on every other point's distance (the second nearest examined, or the searched block's
+    half width). While the point stays within that radius of where it was looked up, no other point
+    can become nearer (d1 + move < L - move), so its nearest is the kept one and only its distance is
+    recomputed; the answer is exactly the full look-up's (but for exact ties). A point that found
+    nothing keeps ``L - upper``: it stays unmatched while it moves less.
+
+    Parameters
+    ----------
+    points : (n, 3) float
+        Query points (m), the frame of the cell list's points.
+    low, cell, shape, starts, sorted_points
+        The :class:`CellList`'s arrays (its ``low``, ``cell``, ``shape``, ``starts``, ``sorted_points``).
+    upper : float
+        Largest distance looked for (m).
+    shells : int
+        Shells of cells searched at most (``ceil(upper / cell)``).
+    kept_points : (n, 3) float
+        In/out: where each point was last looked up (m).
+    kept_index : (n,) int
+        In/out: its nearest point then (row of ``sorted_points``; -1: none examined).
+    kept_safe : (n,) float
+        In/out: the safe radius (m); a negative value forces a full look-up (set it so before the
+        first call).
+    gap : (n,) float
+        Out: distance to the nearest point within ``upper`` (m); inf without one.
+    index : (n,) int
+        Out: its row of ``sorted_points``; len(sorted_points) without one.
+    """
+    n_model = len(sorted_points)
+    upper2 = upper * upper
+    for k in range(len(points)):
+        moved2 = ((points[k, 0] - kept_points[k, 0]) ** 2 + (points[k, 1] - kept_points[k, 1]) ** 2
+                  + (points[k, 2] - kept_points[k, 2]) ** 2)
+        if kept_safe[k] > 0.0 and moved2 < kept_safe[k] * kept_safe[k]:
+            j = kept_index[k]
+            d2 = _distance2(points, k, sorted_points, j) if j >= 0 else np.inf
+        else:
+            j, d2, safe = _nearest_and_margin(points, k, low, cell, shape, starts, sorted_points, shells)
+            kept_points[k, 0], kept_points[k, 1], kept_points[k, 2] = points[k, 0], points[k, 1], points[k, 2]
+            kept_index[k], kept_safe[k] = j, safe if j >= 0 else safe - upper
+        if j >= 0 and d2 <= upper2:
+            gap[k] = np.sqrt(d2)
+            index[k] = j
+        else:
+            gap[k] = np.inf
+            index[k] = n_model
+
+
+@njit(cache=True, inline="always")
+def _nearest_and_margin(points, k, low, cell, shape, starts, sorted_points, shells):
+    """Nearest examined point of query ``k`` (row, squared distance; -1, inf if none) in cell shells
+    1..``shells`` (stopping as :func:`_nearest_in_cells` does), and the safe radius: (L - d1) / 2 with L
+    the second nearest examined or the searched block's half width, whichever is smaller; with no point
+    examined, the half width itself."""
+    c0 = int(np.floor((points[k, 0] - low[0]) / cell))
+    c1 = int(np.floor((points[k, 1] - low[1]) / cell))
+    c2 = int(np.floor((points[k, 2] - low[2]) / cell))
+    best, best_d2, second_d2 = -1, np.inf, np.inf
+    searched = 0
+    for r in range(1, shells + 1):
+        searched = r
+        for a in range(max(c0 - r, 0), min(c0 + r + 1, shape[0])):
+            for b in range(max(c1 - r, 0), min(c1 + r + 1, shape[1])):
+                row = (a * shape[1] + b) * shape[2]
+                inner = abs(a - c0) < r and abs(b - c1) < r
+                for c in range(max(c2 - r, 0), min(c2 + r + 1, shape[2])):
+                    if inner and abs(c - c2) < r and r > 1:
+                        continue
+                    for j in range(starts[row + c], starts[row + c + 1]):
+                        d2 = _distance2(points, k, sorted_points, j)
+                        if d2 <= best_d2:
+                            best, best_d2, second_d2 = j, d2, best_d2
+                        elif d2 < second_d2:
+                            second_d2 = d2
+        if best >= 0 and best_d2 <= (r * cell) ** 2:
+            break
+    bound = min(np.sqrt(second_d2), searched * cell)
+    if best < 0:
+        return best, best_d2, bound
+    return best, best_d2, 0.5 * (bound - np.sqrt(best_d2))

@@ -6,7 +6,11 @@ of B that moves on a straight line, :func:`perception.motion.center_of_mass_line
 registered to a map of the debris surface in B, built from the scans already registered and
 thinned to one point per voxel (point-to-plane Gauss-Newton ICP with a Tukey kernel, on an exact
 cell-list nearest-point index of the map, :class:`perception.nearest_grid.CellList`), starting
-from the pose predicted at constant rotation and translation rates. The map grows with every registered scan, so a frame is registered to all the
+from the pose predicted at constant rotation and translation rates. Each ICP level is one compiled loop; a
+scan point's nearest map point is looked up again only once it has moved far enough for it to change
+(:func:`perception.nearest_grid.nearest_in_cells_kept`), and a rebuilt map's normals are computed when first
+matched (:class:`LazyNormals`): the same track, 2-2.4 times less CPU (docs/perception.md, "Registration
+speed"). The map grows with every registered scan, so a frame is registered to all the
 surface seen before, not to its predecessor alone: the error does not accumulate from frame to
 frame once the body has shown all its sides (one tumble period).
 
@@ -27,12 +31,16 @@ from dataclasses import dataclass
 
 import numpy as np
 import open3d as o3d
+from numba import njit
 
-from multibody.maths.rotations import rotation_vector_from_matrix
-from perception.nearest_grid import CellList
-from perception.normals import surface_normals
+from multibody.maths.rotations import (
+    rotation_matrix_from_rotation_vector,
+    rotation_vector_from_matrix,
+)
+from perception.nearest_grid import CellList, nearest_in_cells_kept
+from perception.normals import fill_normals, surface_normals
 from perception.point_to_plane import point_to_plane_information, tukey_normal_equations
-from perception.registration import Alignment, _rigid_inverse, _turn_candidates, _twist
+from perception.registration import Alignment, _rigid_inverse, _turn_candidates
 
 #: Largest turn between the first two frames searched without a motion prediction (rad): 3 rad/s at
 #: 10 Hz (Tang et al. 2023, Sec. 2, the tumble rates considered).
@@ -99,6 +107,46 @@ class MapTrack:
     map_points: np.ndarray
     map_normals: np.ndarray
     cpu_seconds: np.ndarray | None = None
+
+
+@dataclass
+class LazyNormals:
+    """Unit normals of a map's points (frame B), by row of its index's sorted points
+    (:class:`perception.nearest_grid.CellList`), computed when a scan point is first matched to them.
+
+    A map rebuild changes every point (the voxel means are re-averaged), and estimating all ~20 000-50 000
+    normals took ~0.2-0.5 s CPU a rebuild, ~25 ms a frame on average; a frame's scan meets a few thousand
+    of them. Each normal is the one :func:`surface_map` gives (PCA of the ``max_nn`` nearest within
+    ``radius``; :func:`perception.normals.fill_normals`).
+
+    Attributes
+    ----------
+    sorted_normals : (n, 3) float   Normals by sorted row (rows not ``known``: undefined).
+    known : (n,) bool               Rows computed.
+    radius : float                  Neighbourhood radius (m).
+    max_nn : int                    Most neighbours.
+    """
+
+    sorted_normals: np.ndarray
+    known: np.ndarray
+    radius: float
+    max_nn: int
+
+    @classmethod
+    def given(cls, normals, index) -> LazyNormals:
+        """Every normal known: ``normals`` (n, 3) in the order of the index's points, resorted.
+
+        Parameters
+        ----------
+        normals : (n, 3) float       Unit normals of the map points (frame B).
+        index : CellList             The map's index (:func:`map_index`).
+
+        Returns
+        -------
+        LazyNormals
+        """
+        return cls(np.ascontiguousarray(np.asarray(normals, float)[index.order]), np.ones(len(index.order), np.bool_),
+                   0.0, 0)
 
 
 def _cloud(points) -> o3d.geometry.PointCloud:
@@ -181,16 +229,7 @@ def register_to_map(scan_world, map_points, map_normals, initial_world_to_body, 
     within the fine distance of a map point and their RMS distance (m), as Open3D's ICP reports them.
     """
     index = map_index(map_points, max_correspondence) if index is None else index
-    pose = register_with_motion_prior(scan_world, map_points, map_normals, initial_world_to_body, max_correspondence,
-                                      None, index)
-    fitness, rmse = map_fit(scan_world, pose, index, max_correspondence / 3)
-    return pose, fitness, rmse
-
-
-def _pose_difference(pose, reference_inverse) -> np.ndarray:
-    """(rotation vector, translation) (6,) of ``pose @ reference^-1`` (left, frame B): rad, m."""
-    delta = pose @ reference_inverse
-    return np.r_[rotation_vector_from_matrix(np.ascontiguousarray(delta[:3, :3])), delta[:3, 3]]
+    return _register(scan_world, map_points, map_normals, initial_world_to_body, max_correspondence, None, index)
 
 
 def register_with_motion_prior(scan_world, map_points, map_normals, predicted_world_to_body, max_correspondence,
@@ -222,32 +261,101 @@ def register_with_motion_prior(scan_world, map_points, map_normals, predicted_wo
     -------
     world_to_body : (4, 4) float
     """
+    return _register(scan_world, map_points, map_normals, predicted_world_to_body, max_correspondence, prior_sigma,
+                     index)[0]
+
+
+def _register(scan_world, map_points, map_normals, predicted_world_to_body, max_correspondence, prior_sigma, index):
+    """:func:`register_with_motion_prior`'s pose, and :func:`map_fit`'s fitness and RMS distance at it
+    (from the fine level's last look-up when that level used every scan point)."""
     index = map_index(map_points, max_correspondence) if index is None else index
-    pose = np.asarray(predicted_world_to_body, float)
-    reference_inverse = _rigid_inverse(pose)
+    pose = np.array(predicted_world_to_body, float)
     prior_information = np.zeros(6) if prior_sigma is None else 1.0 / np.asarray(prior_sigma, float) ** 2
-    coarse = scan_world[::max(1, len(scan_world) // COARSE_POINTS)]
-    fine = scan_world[::max(1, len(scan_world) // FINE_POINTS)]
-    for points, distance, iterations in ((coarse, max_correspondence, COARSE_ITERATIONS),
-                                         (fine, max_correspondence / 3, FINE_ITERATIONS)):
-        cutoff = TUKEY_CUTOFF * distance
-        scatter2 = (cutoff / 3) ** 2      # the Tukey cut-off at 3 scatters
-        for _ in range(iterations):
-            body = _transform(points, pose)
-            _, nearest = index.query(body, distance_upper_bound=distance)
-            hessian, gradient, _, count = tukey_normal_equations(body, nearest, map_points, map_normals, cutoff)
-            if count < 6:
-                break
-            difference = _pose_difference(pose, reference_inverse) if prior_sigma is not None else np.zeros(6)
-            try:
-                step = np.linalg.solve(hessian / scatter2 + np.diag(prior_information),
-                                       -(gradient / scatter2 + prior_information * difference))
-            except np.linalg.LinAlgError:   # degenerate matches (all on one plane) and no prior
-                break
-            pose = _twist(step) @ pose
-            if np.linalg.norm(step[:3]) * BODY_SIZE + np.linalg.norm(step[3:]) < SETTLED:
-                break
-    return pose
+    scan_world = np.ascontiguousarray(scan_world, dtype=float)
+    if not isinstance(map_normals, LazyNormals):
+        map_normals = LazyNormals.given(map_normals, index)
+    for step, distance, iterations in ((max(1, len(scan_world) // COARSE_POINTS), max_correspondence, COARSE_ITERATIONS),
+                                       (max(1, len(scan_world) // FINE_POINTS), max_correspondence / 3,
+                                        FINE_ITERATIONS)):
+        shells = max(int(np.ceil(distance / index.cell)), 1)
+        pose, fitness, rmse = _icp_level(np.ascontiguousarray(scan_world[::step]), pose, _rigid_inverse(predicted_world_to_body),
+                          prior_information, prior_sigma is not None, distance, TUKEY_CUTOFF * distance, iterations,
+                          BODY_SIZE, SETTLED, index.low, index.cell, index.shape, index.starts,
+                          index.sorted_points, shells, map_normals.sorted_normals, map_normals.known,
+                          index.largest_cell, map_normals.radius, map_normals.max_nn)
+    if step > 1:
+        fitness, rmse = map_fit(scan_world, pose, index, max_correspondence / 3)
+    return pose, fitness, rmse
+
+
+@njit(cache=True)
+def _icp_level(points_world, pose, reference_inverse, prior_information, with_prior, distance, cutoff, iterations,
+               body_size, settled, low, cell, shape, starts, map_points, shells, map_normals, normal_known,
+               largest_cell, normal_radius, normal_neighbours):
+    """One ICP level of :func:`register_with_motion_prior`, compiled: per iteration the points posed,
+    their nearest map points within ``distance`` (exact: :func:`perception.nearest_grid.nearest_in_cells_kept`
+    looks a point up again only when it moved far enough for its nearest point to change), the Tukey
+    normal equations, the regularized Gauss-Newton step (left, frame B), and the stop once a step's
+    rotation (rad) times ``body_size`` (m) plus its translation is below ``settled`` (m). Returns the
+    pose, and the share of the points within ``distance`` of the map at it and their RMS distance (m;
+    NaN without any), as :func:`map_fit`.
+    ``map_points``: the cell list's sorted points; ``map_normals``: their normals (same order), those
+    not ``normal_known`` computed (:func:`perception.normals.fill_normals`) once a point is matched."""
+    n = len(points_world)
+    body = np.empty((n, 3))
+    kept_points, kept_index, kept_safe = np.zeros((n, 3)), np.full(n, -1, np.int64), np.full(n, -1.0)
+    gap, nearest = np.empty(n), np.empty(n, np.int64)
+    scatter2 = (cutoff / 3) ** 2      # the Tukey cut-off at 3 scatters
+    difference = np.zeros(6)
+    for _ in range(iterations):
+        for k in range(n):
+            for a in range(3):
+                body[k, a] = (pose[a, 0] * points_world[k, 0] + pose[a, 1] * points_world[k, 1]
+                              + pose[a, 2] * points_world[k, 2] + pose[a, 3])
+        nearest_in_cells_kept(body, low, cell, shape, starts, map_points, distance, shells,
+                              kept_points, kept_index, kept_safe, gap, nearest)
+        fill_normals(nearest, map_points, low, cell, shape, starts, largest_cell, normal_radius, normal_neighbours,
+                     map_normals, normal_known)
+        hessian, gradient, _, count = tukey_normal_equations(body, nearest, map_points, map_normals, cutoff)
+        if count < 6:
+            break
+        if with_prior:
+            delta = pose @ reference_inverse
+            difference[:3] = rotation_vector_from_matrix(np.ascontiguousarray(delta[:3, :3]))
+            difference[3:] = delta[:3, 3]
+        system = hessian / scatter2
+        for a in range(6):
+            system[a, a] += prior_information[a]
+        rhs = -(gradient / scatter2 + prior_information * difference)
+        if not _solvable(system):   # degenerate matches (all on one plane) and no prior
+            break
+        step = np.linalg.solve(system, rhs)
+        twist = np.eye(4)
+        twist[:3, :3] = rotation_matrix_from_rotation_vector(step[:3])
+        twist[:3, 3] = step[3:]
+        pose = twist @ pose
+        if np.sqrt(step[0] ** 2 + step[1] ** 2 + step[2] ** 2) * body_size \
+                + np.sqrt(step[3] ** 2 + step[4] ** 2 + step[5] ** 2) < settled:
+            break
+    for k in range(n):
+        for a in range(3):
+            body[k, a] = (pose[a, 0] * points_world[k, 0] + pose[a, 1] * points_world[k, 1]
+                          + pose[a, 2] * points_world[k, 2] + pose[a, 3])
+    nearest_in_cells_kept(body, low, cell, shape, starts, map_points, distance, shells,
+                          kept_points, kept_index, kept_safe, gap, nearest)
+    inside, squares = 0, 0.0
+    for k in range(n):
+        if np.isfinite(gap[k]):
+            inside += 1
+            squares += gap[k] ** 2
+    return pose, inside / max(n, 1), np.sqrt(squares / inside) if inside else np.nan
+
+
+@njit(cache=True)
+def _solvable(system) -> bool:
+    """Whether a (6, 6) normal matrix is invertible (numpy's solve would raise LinAlgError): its
+    LU pivots all nonzero, which numba's solve checks the same way."""
+    return abs(np.linalg.det(system)) > 0.0
 
 
 def map_fit(scan_world, world_to_body, map_tree, distance) -> tuple[float, float]:
@@ -393,13 +501,13 @@ def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA,
             continue
         good = np.flatnonzero(ok[:i])
         if len(good) >= 2 and good[-1] == i - 1 and good[-2] == i - 2:
-            pose = register_with_motion_prior(scan, points, normals, predict_world_to_body(poses[i - 1], poses[i - 2]),
-                                              max_correspondence, prior_sigma, index)
+            pose, fitness[i], rmse[i] = _register(scan, points, normals,
+                                                  predict_world_to_body(poses[i - 1], poses[i - 2]),
+                                                  max_correspondence, prior_sigma, index)
         elif second_pose is not None and len(good) == 1:
-            pose, _, _ = register_to_map(scan, points, normals, second_pose, max_correspondence, index)
+            pose, fitness[i], rmse[i] = register_to_map(scan, points, normals, second_pose, max_correspondence, index)
         else:
-            pose, _, _ = search_pose(scan, points, normals, poses[good[-1]], max_correspondence, index)
-        fitness[i], rmse[i] = map_fit(scan, pose, index, max_correspondence / 3)
+            pose, fitness[i], rmse[i] = search_pose(scan, points, normals, poses[good[-1]], max_correspondence, index)
         poses[i] = pose
         ok[i] = fitness[i] >= MIN_FITNESS
         if ok[i]:
@@ -415,16 +523,19 @@ def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA,
 
 
 def _built_map(points_body, voxel, max_correspondence):
-    """Map points (n, 3) and normals (n, 3) (frame B, m) of registered surface points, and their index."""
-    cloud = surface_map(points_body, voxel)
-    points, normals = np.asarray(cloud.points), np.asarray(cloud.normals)
-    return points, normals, map_index(points, max_correspondence)
+    """Map points (n, 3) (frame B, m) of registered surface points, their normals (:class:`LazyNormals`,
+    as :func:`surface_map`'s) and their index."""
+    points = thinned_scan(points_body, voxel)
+    index = map_index(points, max_correspondence)
+    normals = LazyNormals(np.empty((len(points), 3)), np.zeros(len(points), np.bool_), 4 * voxel, 30)
+    return points, normals, index
 
 
 def _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence, cpu=None) -> MapTrack:
     """The track with the map rebuilt from all registered scans and each frame's information."""
-    points, normals, index = _built_map(np.vstack([_transform(thin[i], poses[i]) for i in np.flatnonzero(ok)]),
-                                        voxel, max_correspondence)
+    cloud = surface_map(np.vstack([_transform(thin[i], poses[i]) for i in np.flatnonzero(ok)]), voxel)
+    points, normals = np.asarray(cloud.points), np.asarray(cloud.normals)
+    index = map_index(points, max_correspondence)
     information = np.array([map_information(thin[i], poses[i], points, normals, max_correspondence, index) if ok[i]
                             else np.zeros((6, 6)) for i in range(len(thin))])
     return MapTrack(poses, ok, fitness, rmse, information, seconds, points, normals, cpu)

@@ -48,3 +48,56 @@ def test_step_refinement_springs_alone_is_minus_k_times_the_joint_offset():
     offset_joint = turn_z.T @ offset_lvlh                      # (-2e-3, -1e-3, 3e-3)
     assert np.allclose(force[0, 0], -stiffness[0, :3] * offset_joint, rtol=1e-12, atol=0.0)
     assert np.allclose(moment[0, 0], -stiffness[0, 3:] * series["joint_rotation_joint"][0, 0], rtol=1e-12, atol=0.0)
+
+
+def _bench_module(name):
+    spec = importlib.util.spec_from_file_location(f"bench_{name}", BENCH / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        sys.modules.pop(spec.name, None)
+    return module
+
+
+def test_wrapping_level_hub_wrench_keeps_the_total_wrench():
+    """bench_wrapping_level.py's ``hub_loads`` moves every body's contact onto the main body: statics says the total
+    force and the total moment about any point are unchanged (here about the main body's CoM, checked to 1e-9
+    relative on random loads, positions and attitudes), and the other bodies carry nothing."""
+    import numpy as np
+
+    module = _bench_module("bench_wrapping_level")
+    rng = np.random.default_rng(3)
+    k, nb = 4, 3
+    q, r = np.linalg.qr(rng.normal(size=(k, nb, 3, 3)))
+    to_lvlh = q * np.sign(np.diagonal(r, axis1=-2, axis2=-1))[..., None, :]    # orthonormal
+    to_lvlh[..., 2] *= np.linalg.det(to_lvlh)[..., None]                      # proper rotations
+    wall = {"contact_force_lvlh": rng.normal(size=(k, nb, 3)), "contact_moment_body": rng.normal(size=(k, nb, 3)),
+            "body_to_lvlh": to_lvlh, "body_com_lvlh": rng.normal(size=(k, nb, 3))}
+    force, moment_body = module.hub_wrench(wall, 1)
+    com = wall["body_com_lvlh"][:, 1:2]
+    moment_lvlh = np.einsum("kbij,kbj->kbi", to_lvlh, wall["contact_moment_body"])
+    expected = (moment_lvlh + np.cross(wall["body_com_lvlh"] - com, wall["contact_force_lvlh"])).sum(axis=1)
+    assert np.allclose(force.sum(axis=1), wall["contact_force_lvlh"].sum(axis=1), rtol=1e-9, atol=1e-12)
+    assert np.allclose(np.einsum("kij,kj->ki", to_lvlh[:, 1], moment_body[:, 1]), expected, rtol=1e-9, atol=1e-12)
+    assert not force[:, [0, 2]].any() and not moment_body[:, [0, 2]].any()
+
+
+def test_wrapping_level_plot_band_reads_a_sine_amplitude():
+    """The plot band (per 7.5 ms column the largest |value|) of a 50 Hz sine of amplitude 1.5 kN sampled at 40 kHz
+    is its amplitude within 1 % in the median column (|sin| repeats every 10 ms, so 3 columns in 4 hold a peak and
+    the others at least cos(pi / 8) = 0.92 of it), and 1 ms block means keep the sine's mean (0) and RMS (A / sqrt 2,
+    less 0.4 % for the averaging) within 1 %."""
+    import numpy as np
+
+    module = _bench_module("bench_wrapping_level")
+    t = np.arange(1, 300001) * 2.5e-5
+    values = np.stack([1500.0 * np.sin(2 * np.pi * 50.0 * t)] * 3, axis=1)
+    band = module.plot_band(t, values, (1.0, 7.5))
+    assert abs(band["largest"][0] - 1500.0) < 15.0
+    assert abs(band["median"][0] - 1500.0) < 15.0
+    assert min(band["p90"]) >= 0.92 * 1500.0
+    _, means = module.block_means(t, values, 1e-3)
+    assert abs(means[:, 0].mean()) < 15.0
+    assert abs(np.sqrt((means[:, 0] ** 2).mean()) - 1500.0 / np.sqrt(2)) < 0.01 * 1500.0 / np.sqrt(2)

@@ -60,3 +60,40 @@ def test_cell_list_is_the_kd_tree_within_any_bound():
             exact_gap, exact_index = tree.query(queries, distance_upper_bound=bound)
             assert np.array_equal(index, exact_index), bound
             assert np.array_equal(gap, exact_gap), bound
+
+
+def test_kept_look_up_is_the_kd_tree_while_points_creep():
+    # nearest_in_cells_kept (the compiled scan-to-map ICP's look-up) looks a point up again only once it
+    # has moved past its safe radius (half the gap between its nearest and its second nearest, or the
+    # searched block): the answer must be the exact nearest within the bound at every step. Points near
+    # the surface (2 cm noise) and off it creep in small random steps (0.1-3 mm, an ICP's iterations)
+    # and jump once (5 cm, a new level's start); compared with scipy's exact KD-tree at every step.
+    from perception.nearest_grid import nearest_in_cells_kept
+    points, _ = _sphere_model()
+    cells = CellList(points, 0.1 / 3, 0.1)
+    tree = cKDTree(points)
+    rng = np.random.default_rng(3)
+    queries = np.vstack([points[rng.choice(len(points), 1500)] + rng.normal(0.0, 0.02, (1500, 3)),
+                         rng.uniform(-1.0, 1.0, (300, 3))])
+    n = len(queries)
+    for bound in (0.1 / 3, 0.1):
+        shells = int(np.ceil(bound / cells.cell))
+        kept_points, kept_index, kept_safe = np.zeros((n, 3)), np.full(n, -1, np.int64), np.full(n, -1.0)
+        gap, index = np.empty(n), np.empty(n, np.int64)
+        moving = queries.copy()
+        looked_up = []
+        for step in range(12):
+            size = 0.05 if step == 6 else (1e-4 if step < 6 else 3e-3)
+            moving = moving + rng.normal(0.0, size / np.sqrt(3), (n, 3))
+            before = kept_points.copy()
+            nearest_in_cells_kept(moving, cells.low, cells.cell, cells.shape, cells.starts, cells.sorted_points,
+                                  bound, shells, kept_points, kept_index, kept_safe, gap, index)
+            looked_up.append(np.mean(np.any(kept_points != before, axis=1)))
+            exact_gap, exact_index = tree.query(moving, distance_upper_bound=bound)
+            found = index < len(points)
+            answer = np.where(found, cells.order[np.minimum(index, len(points) - 1)], len(points))
+            assert np.array_equal(answer, exact_index), (bound, step)
+            assert np.allclose(gap, exact_gap, rtol=0, atol=1e-12) and np.array_equal(np.isinf(gap), np.isinf(exact_gap))
+        # the point of it: after 0.1 mm steps (the fine level's late iterations) most points need no new
+        # look-up (this model's samples are 1.2 cm apart, so the safe radii are a few mm)
+        assert np.median(looked_up[1:6]) < 0.5

@@ -36,3 +36,25 @@ def test_same_normals_as_open3d():
     cosine = np.abs(np.einsum("ij,ij->i", ours, np.asarray(cloud.normals)))
     assert np.mean(cosine > 1 - 1e-9) > 0.999   # ties among equal distances may pick another neighbour
     assert cosine.min() > np.cos(np.radians(1.0))
+
+
+def test_normals_filled_on_the_icp_index_as_they_are_matched():
+    # The scan-to-map track computes a map point's normal only when a scan point is first matched to it,
+    # on the ICP's cell list (cells of 1/3 of the correspondence distance, not of the normal radius):
+    # the neighbour search goes shell by shell until the 30 nearest are inside, so the same neighbours
+    # and the same normals as surface_normals, whatever the cells and in whatever order they are asked.
+    from perception.nearest_grid import CellList
+    from perception.normals import fill_normals
+    rng = np.random.default_rng(1)
+    points = trimesh.sample.sample_surface(trimesh.creation.box([1.2, 3.0, 1.6]), 20000, seed=2)[0]
+    cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points + rng.normal(0.0, 0.01, points.shape)))
+    points = np.asarray(cloud.voxel_down_sample(VOXEL).points)
+    full = surface_normals(points, 4 * VOXEL, 30)
+    cells = CellList(points, 0.1 / 3, 0.1)
+    normals, known = np.empty_like(points), np.zeros(len(points), np.bool_)
+    for batch in np.array_split(rng.permutation(len(points) + 50), 5):   # rows >= n: unmatched, skipped
+        fill_normals(batch, cells.sorted_points, cells.low, cells.cell, cells.shape, cells.starts, cells.largest_cell,
+                     4 * VOXEL, 30, normals, known)
+    assert known.all()
+    cosine = np.abs(np.einsum("ij,ij->i", normals, full[cells.order]))
+    assert cosine.min() > 1 - 1e-9   # same neighbours; the sums' order differs by round-off only

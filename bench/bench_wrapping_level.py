@@ -1,0 +1,419 @@
+"""Why the wrapping contact level of the sequential reproduction sits below the paper's band: one cause at a time.
+
+    python3 bench/bench_wrapping_level.py [--only nominal,paper_step,...] [--keep runs/wrapping] [--table-only]
+
+Cuadrat-Grzybowski & Gill (2024), Sec. 3.2: after the first impact the contact forces "fluctuate around -1.5
+and 1.5 kN" (Fig. 6, LVLH) and the moments -15 to 15 kN m (Fig. 7) during the ~6 s of wrapping, and the solar
+array hinge carries "+-4 kN m (M_S,h1) and +-5 kN m (M_S,h3) consistently from t ~ 0.25 s" (Fig. 12). The
+sequential reproduction (``cases/envisat_paper_sequential.toml``, docs/model.md "Each published figure against
+the sequential reproduction") stays 2-10x below in force. Each item below is one 7.5 s sequential run of that
+case with one change (nice 10, one at a time), read the same way (:func:`wrapping_figures`):
+
+- the contact level during 1-7.5 s per LVLH component in every reading of the paper's plotted quantity we can
+  form: the resultant's components (its eq. 9 sum; 1 ms means and the native output rate), the band a line plot
+  of that series shows (per 7.5 ms column, 1000 columns over 7.5 s, the column's largest |F_i|: what the eye
+  reads off a dense figure), the magnitude of the resultant, the sum over bodies of each body's |F|, the sum over
+  net nodes of each node's |F| (net snapshots, 5 ms means) and the mean force per node in contact;
+- the contact moment about the debris CoM (LVLH) the same way;
+- the net's state: nodes in contact, stored thread energy and the RMS thread tension it implies, net kinetic energy;
+- the driven run's solar-array hinge moments about h1 / h3 after 0.25 s (RMS, largest) and over 1-7.5 s (RMS).
+
+Items (changes to the case; ``nominal`` is the case itself):
+
+- ``nominal``: 10 kHz output (the step), net snapshots at 200 Hz;
+- ``paper_step``: the paper's numerics: step 2.5e-5 s (its Sec. 3.1), contact force evaluated once per step
+  (``contact_substep`` = step: no sub-cycle; ``implicit_contact_speed`` = 0: no implicit resting step), output at
+  every step (40 kHz): a penalty contact integrated as the paper states it, with no impulse averaging. Its energy
+  balance drifts past the health check's 5 % (the plain contact at this step gains energy: docs/model.md "Contact"),
+  as the thread contact's may: for these measurements the limit is lifted to 50 % in every item
+  (:data:`LIFTED_DRIFT_LIMIT`) and each run's drift is reported with its figures;
+- ``thread_segments``: threads touch the box shapes too (the paper: node contact only, its Sec. 2.3.2);
+- ``contact_stiffness_x10``: k_n x 10 (the paper's k_n and n are ours: this checks whether the level is set by
+  the contact law at all, or by the net pressing on the body);
+- ``threads_x4``: thread stiffness x 4, damping x 2 (the same fraction of critical): a tauter net (step 5e-5 s:
+  at the case's 1e-4 s it drifted past 50 % at 6.84 s);
+- ``short_tether``: bullets on 5 cm tethers (ours: one mesh size, 0.88 m; the paper gives none);
+- ``mesh_25``: 25 x 25 nodes, the same net mass, thread EA and damping per unit length (mesh 1.25 m);
+- ``hub_loads``: no new wall run: the kept ``nominal`` wall run's loads drive the free debris with the *total*
+  contact wrench on the main body (its eqs. 9 and 12 sum every contact into one force at the CG and one moment
+  about it; the array then follows through the hinge) instead of each body's own contact on that body (ours);
+- ``samplings``: no new run: the kept ``paper_step`` wall run read as the paper might have written it out (means
+  over 0.1-1 ms, point samples every 4-40 steps): which reading gives its first impact and its band at once;
+- ``bullets_outward``: the bullets given 5 m/s outward along the net diagonals at launch (a net pulled taut by
+  its bullets, as one still deploying; the paper's ejection is not given: a sensitivity);
+- ``paper_step_1ms_loads``: the ``paper_step`` wall loads averaged over 1 ms, applied at the case's 1e-4 s step:
+  whether the hinge follows the load's bandwidth or its level.
+
+Results: ``bench/results/wrapping_level.json`` (resumable per item), with CPU time and load per run.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+from bench_paper_gaps import CASE, _case  # noqa: E402
+
+from multibody.health import HealthWatch  # noqa: E402
+from riskassess.products.summary import contact_totals_debris  # noqa: E402
+from riskassess.stages.run import run_case  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+STORE = ROOT / "bench" / "results" / "wrapping_level.json"
+#: the paper's wrapping window: after the first impact (its forces "decrease substantially") to the end of its 7.5 s
+WINDOW_S = (1.0, 7.5)
+SKIP_S = 0.25            # the paper's hinge moments are read "from t ~ 0.25 s onwards" [Sec. 3.3.3]
+#: a line plot of 7.5 s drawn ~1000 pixels wide shows, per pixel column, the range of the samples in 7.5 ms
+PLOT_COLUMN_S = 7.5e-3
+#: the health check's drift limit in these measurements (the paper's plain contact gains energy; drift reported)
+LIFTED_DRIFT_LIMIT = 0.5
+IN_CONTACT_N = 0.01      # a node with a larger mean contact force over a snapshot interval counts as in contact
+
+
+def block_means(t: np.ndarray, values: np.ndarray, width_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Means of ``values`` (k, ...) over consecutive blocks of ``width_s`` (the samples are interval means, so a
+    block mean is the mean over the block); returns the blocks' end times and means."""
+    dt = float(np.median(np.diff(t)))
+    n = max(1, int(round(width_s / dt)))
+    k = (len(t) // n) * n
+    return t[n - 1:k:n], values[:k].reshape(k // n, n, *values.shape[1:]).mean(axis=1)
+
+
+def plot_band(t: np.ndarray, values: np.ndarray, window: tuple[float, float]) -> dict:
+    """What a line plot of ``values`` (k, 3) shows: per 7.5 ms column the largest |value| per component; the median
+    and 90th percentile of that over the columns inside ``window`` (the band the eye reads), and the largest."""
+    dt = float(np.median(np.diff(t)))
+    n = max(1, int(round(PLOT_COLUMN_S / dt)))
+    inside = (t > window[0]) & (t <= window[1])
+    v = np.abs(values[inside])
+    k = (len(v) // n) * n
+    column = v[:k].reshape(k // n, n, 3).max(axis=1)
+    return {"median": np.median(column, axis=0).tolist(), "p90": np.percentile(column, 90, axis=0).tolist(),
+            "largest": column.max(axis=0).tolist()}
+
+
+def component_stats(values: np.ndarray) -> dict:
+    """Mean, RMS and 95th percentile of |value| per component of ``values`` (k, 3)."""
+    return {"mean": values.mean(axis=0).tolist(), "rms": np.sqrt((values ** 2).mean(axis=0)).tolist(),
+            "p95 abs": np.percentile(np.abs(values), 95, axis=0).tolist()}
+
+
+def scalar_stats(values: np.ndarray) -> dict:
+    """Mean, RMS and 95th percentile of a (k,) series."""
+    return {"mean": float(values.mean()), "rms": float(np.sqrt((values ** 2).mean())),
+            "p95": float(np.percentile(values, 95))}
+
+
+def net_figures(net: dict, window: tuple[float, float]) -> dict:
+    """Per-node readings of the wall run's net snapshots: the sum over nodes of |F_node| (N; 5 ms means at 200 Hz),
+    the sum of |F_node,i| per LVLH component, the number of nodes in contact and the mean force per node in
+    contact."""
+    t = net["time"]
+    inside = (t > window[0]) & (t <= window[1])
+    f = np.asarray(net["contact_force_lvlh"][inside], float)
+    magnitude = np.linalg.norm(f, axis=2)
+    touching = magnitude > IN_CONTACT_N
+    count = touching.sum(axis=1)
+    total = magnitude.sum(axis=1)
+    return {"snapshot interval (s)": float(np.median(np.diff(t))),
+            "sum over nodes of |F_node| (N)": scalar_stats(total),
+            "sum over nodes of |F_node,i| per LVLH axis, mean (N)": np.abs(f).sum(axis=1).mean(axis=0).tolist(),
+            "nodes in contact, mean / largest": [float(count.mean()), int(count.max())],
+            "force per node in contact, mean (N)": float(total.sum() / max(count.sum(), 1)),
+            "largest node force (N)": float(magnitude.max())}
+
+
+def energy_figures(wall: dict, window: tuple[float, float], threads: int, stiffness: float) -> dict:
+    """The net's state in the wall run: mean kinetic and thread-elastic energy (J) over ``window`` and the RMS
+    thread tension that elastic energy implies, sqrt(2 k U / threads) (N)."""
+    t = wall["time"]
+    inside = (t > window[0]) & (t <= window[1])
+    elastic = float(wall["energy_net_elastic"][inside].mean())
+    return {"net kinetic energy, mean (J)": float(wall["energy_net_kinetic"][inside].mean()),
+            "net thread energy, mean (J)": elastic,
+            "RMS thread tension from it (N)": float(np.sqrt(2.0 * stiffness * elastic / threads))}
+
+
+def hinge_figures(series: dict) -> dict:
+    """Solar-array hinge moments about h1 / h3 (N m, joint frame) of the driven run: RMS and largest after 0.25 s,
+    RMS over the wrapping window."""
+    hinge = list(series["joint_names"]).index("solar_array_hinge")
+    t = series["time"]
+    m = series["joint_moment_joint"][:, hinge]
+    judged, inside = t >= SKIP_S, (t > WINDOW_S[0]) & (t <= WINDOW_S[1])
+    return {"h1 / h3 RMS after 0.25 s (N m)": np.sqrt((m[judged][:, [0, 2]] ** 2).mean(axis=0)).tolist(),
+            "h1 / h3 largest after 0.25 s (N m)": np.abs(m[judged][:, [0, 2]]).max(axis=0).tolist(),
+            "h1 / h3 RMS 1-7.5 s (N m)": np.sqrt((m[inside][:, [0, 2]] ** 2).mean(axis=0)).tolist()}
+
+
+def wrapping_figures(run: Path, case) -> dict:
+    """Every reading of one kept sequential run (module docstring)."""
+    return series_figures(dict(np.load(run / "wall_timeseries.npz")), dict(np.load(run / "net.npz")),
+                          dict(np.load(run / "timeseries.npz")), case)
+
+
+def series_figures(wall: dict, net: dict, driven: dict, case) -> dict:
+    """Every reading (module docstring) of a sequential run's wall series, net snapshots and driven series (the
+    latter with ``joint_names``)."""
+    t = wall["time"]
+    force, moment = contact_totals_debris(wall)
+    inside = (t > WINDOW_S[0]) & (t <= WINDOW_S[1])
+    t1, force_1ms = block_means(t, force, 1e-3)
+    _, moment_1ms = block_means(t, moment, 1e-3)
+    inside_1ms = (t1 > WINDOW_S[0]) & (t1 <= WINDOW_S[1])
+    body_sum = np.linalg.norm(wall["contact_force_lvlh"], axis=2).sum(axis=1)
+    n = case.net.nodes_per_side
+    out = {
+        "output interval (s)": float(np.median(np.diff(t))),
+        "resultant force per LVLH axis, 1 ms means (N)": component_stats(force_1ms[inside_1ms]),
+        "resultant force per LVLH axis, native output (N)": component_stats(force[inside]),
+        "plot band of the force, 1 ms means (N)": plot_band(t1, force_1ms, WINDOW_S),
+        "plot band of the force, native output (N)": plot_band(t, force, WINDOW_S),
+        "|resultant force|, 1 ms means (N)": scalar_stats(np.linalg.norm(force_1ms[inside_1ms], axis=1)),
+        "sum over bodies of |F_body|, native output (N)": scalar_stats(body_sum[inside]),
+        "resultant moment per LVLH axis, 1 ms means (N m)": component_stats(moment_1ms[inside_1ms]),
+        "plot band of the moment, 1 ms means (N m)": plot_band(t1, moment_1ms, WINDOW_S),
+        "plot band of the moment, native output (N m)": plot_band(t, moment, WINDOW_S),
+        "along-track impulse 1-7.5 s (N s)": float(force[inside, 1].sum() * np.median(np.diff(t))),
+    }
+    out |= net_figures(net, WINDOW_S)
+    threads = 2 * n * (n - 1) + 4
+    out |= energy_figures(wall, WINDOW_S, threads, case.net.thread.stiffness)
+    out |= hinge_figures(driven)
+    drift = (wall["energy_total"] - wall["energy_total"][0]) / wall["energy_net_kinetic"][0]
+    out["wall run energy balance, largest drift / at the end (% of the launch energy)"] = [
+        100.0 * float(np.abs(drift).max()), 100.0 * float(drift[-1])]
+    return out
+
+
+def _with(case, section: str, **update):
+    return case.model_copy(update={section: getattr(case, section).model_copy(update=update)})
+
+
+def _mesh(case, nodes_per_side: int):
+    """The case's net on ``nodes_per_side`` nodes: the same net mass, EA and damping per unit length."""
+    old, new = case.net.nodes_per_side - 1, nodes_per_side - 1
+    thread = case.net.thread.model_copy(update={"stiffness": case.net.thread.stiffness * new / old,
+                                                "damping": case.net.thread.damping * new / old})
+    mass = case.net.node_mass * case.net.nodes_per_side ** 2 / nodes_per_side ** 2
+    return case.model_copy(update={"net": case.net.model_copy(update={
+        "nodes_per_side": nodes_per_side, "node_mass": mass, "thread": thread})})
+
+
+def item_case(item: str):
+    """The paper case with item ``item``'s change (module docstring)."""
+    case = _with(_case(output_rate=10000.0), "simulation", net_output_rate=200.0)
+    if item == "paper_step":
+        return _with(case, "simulation", step=2.5e-5, contact_substep=2.5e-5, implicit_contact_speed=0.0,
+                     output_rate=40000.0)
+    if item == "thread_segments":
+        return _with(case, "contact", thread_segments=True)
+    if item == "contact_stiffness_x10":
+        return _with(case, "contact", stiffness=10.0 * case.contact.stiffness)
+    if item == "threads_x4":       # at 1e-4 s this net failed the (lifted) energy check at 6.84 s: half the step
+        thread = case.net.thread.model_copy(update={"stiffness": 4.0 * case.net.thread.stiffness,
+                                                    "damping": 2.0 * case.net.thread.damping})
+        case = _with(case, "simulation", step=5e-5)
+        return case.model_copy(update={"net": case.net.model_copy(update={"thread": thread})})
+    if item == "short_tether":
+        return _with(case, "bullets", tether_length=0.05)
+    if item == "mesh_25":
+        return _mesh(case, 25)
+    if item == "nominal":
+        return case
+    raise KeyError(item)
+
+
+ITEMS = ("nominal", "paper_step", "thread_segments", "contact_stiffness_x10", "threads_x4", "short_tether",
+         "mesh_25", "hub_loads", "samplings", "bullets_outward", "paper_step_1ms_loads")
+
+
+def hub_wrench(wall: dict, main: int) -> tuple[np.ndarray, np.ndarray]:
+    """The recorded contact loads of all bodies moved onto body ``main``: total force (k, nb, 3) N LVLH on ``main``
+    only, and the total moment about its CoM (k, nb, 3) N m in its body frame on ``main`` only."""
+    force, moment_body = wall["contact_force_lvlh"], wall["contact_moment_body"]
+    to_lvlh = wall["body_to_lvlh"]
+    moment_lvlh = np.einsum("kbij,kbj->kbi", to_lvlh, moment_body)
+    arms = wall["body_com_lvlh"] - wall["body_com_lvlh"][:, main:main + 1]
+    total_moment_lvlh = (moment_lvlh + np.cross(arms, force)).sum(axis=1)
+    hub_force, hub_moment = np.zeros_like(force), np.zeros_like(moment_body)
+    hub_force[:, main] = force.sum(axis=1)
+    hub_moment[:, main] = np.einsum("kji,kj->ki", to_lvlh[:, main], total_moment_lvlh)
+    return hub_force, hub_moment
+
+
+def hub_loads(keep: Path) -> dict:
+    """The free debris driven by the kept nominal wall run's total wrench on the main body (module docstring)."""
+    from multibody.recorded_loads import RecordedBodyLoads
+    from riskassess.models.impact import model_inputs
+    from riskassess.models.impact_sequential import driven_inputs
+    from riskassess.stages.run import _simulation
+
+    case = item_case("nominal")
+    wall = dict(np.load(keep / "nominal" / "wall_timeseries.npz"))
+    main = list(np.load(keep / "nominal" / "timeseries.npz")["body_names"]).index("main_body")
+    force, moment = hub_wrench(wall, main)
+    loads = RecordedBodyLoads(time=wall["time"][1:], force_lvlh=force[1:], moment_body=moment[1:],
+                              reference_energy=float(wall["energy_net_kinetic"][0]))
+    load = os.getloadavg()[0]
+    cpu = time.process_time()
+    simulation = _simulation(driven_inputs(model_inputs(case, CASE.parent), loads))
+    series = dict(simulation.run().series)
+    series["joint_names"] = np.array([j.name for j in simulation.assembly.joints])
+    out = {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]]}
+    out |= hinge_figures(series)
+    per_body = hinge_figures(dict(np.load(keep / "nominal" / "timeseries.npz")))
+    return out | {f"per-body loads (nominal): {k}": v for k, v in per_body.items()}
+
+
+def samplings(keep: Path) -> dict:
+    """The kept ``paper_step`` wall run (contact force at every 2.5e-5 s step) read as the paper might have written
+    it out: means over 0.1-1 ms and point samples every 4-40 steps (every offset; median [range]): the first-impact
+    peak force (kN) and moment (kN m) (first 0.3 s), the wrapping 95th percentile of |F_i| (N) and the plot band
+    (median over 7.5 ms columns of the column's largest |F_i|, N) over 1-7.5 s."""
+    wall = dict(np.load(keep / "paper_step" / "wall_timeseries.npz"))
+    force, moment = contact_totals_debris(wall)
+    t = wall["time"]
+    rows = {}
+    for steps in (1, 4, 10, 20, 24, 40):
+        width = steps * float(np.median(np.diff(t)))
+        tm, fm = block_means(t, force, width)
+        _, mm = block_means(t, moment, width)
+        first, wrap = tm <= 0.3, (tm > WINDOW_S[0]) & (tm <= WINDOW_S[1])
+        rows[f"means over {1e3 * width:.3g} ms"] = {
+            "first-impact peak force (kN) / moment (kN m)": [1e-3 * float(np.linalg.norm(fm[first], axis=1).max()),
+                                                            1e-3 * float(np.linalg.norm(mm[first], axis=1).max())],
+            "wrapping p95 |F_i| (N)": np.percentile(np.abs(fm[wrap]), 95, axis=0).tolist(),
+            "plot band median |F_i| (N)": plot_band(tm, fm, WINDOW_S)["median"],
+            "plot band p90 |F_i| (N)": plot_band(tm, fm, WINDOW_S)["p90"],
+            "plot band median / p90 |M_i| (N m)": [plot_band(tm, mm, WINDOW_S)["median"],
+                                                    plot_band(tm, mm, WINDOW_S)["p90"]]}
+        if steps == 1:
+            continue
+        peaks, bands = [], []
+        for offset in range(steps):
+            idx = np.arange(offset, len(t), steps)
+            first, wrap = t[idx] <= 0.3, (t[idx] > WINDOW_S[0]) & (t[idx] <= WINDOW_S[1])
+            peaks.append([1e-3 * np.linalg.norm(force[idx][first], axis=1).max(),
+                          1e-3 * np.linalg.norm(moment[idx][first], axis=1).max()])
+            bands.append(plot_band(t[idx], force[idx], WINDOW_S)["median"] + [
+                float(np.percentile(np.abs(force[idx][wrap][:, 1]), 95))])
+        peaks, bands = np.array(peaks), np.array(bands)
+        rows[f"point samples every {1e3 * width:.3g} ms"] = {
+            "first-impact peak force (kN) / moment (kN m), median [min, max] over offsets": [
+                [float(np.median(peaks[:, k])), float(peaks[:, k].min()), float(peaks[:, k].max())] for k in (0, 1)],
+            "plot band median |F_i| (N) and wrapping p95 |F_y| (N), median over offsets":
+                np.median(bands, axis=0).tolist()}
+    return rows
+
+
+def bullets_outward(speed: float = 5.0) -> dict:
+    """One sequential run (in memory) with each bullet given an extra ``speed`` (m/s) outward along its net diagonal
+    at launch: a net pulled taut by its bullets, as a net still deploying would be (the paper's net is ejected and
+    its energy first "decreases due to the net deployment energy damping", Sec. 3.5; its bullets' ejection velocity
+    is not given: 5 m/s is a sensitivity, 14 deg off the launch axis)."""
+    import dataclasses
+
+    from riskassess.models.impact import model_inputs
+    from riskassess.models.impact_sequential import driven_inputs, recorded_loads, wall_inputs
+    from riskassess.stages.run import _simulation
+
+    HealthWatch.__init__.__defaults__ = (None, LIFTED_DRIFT_LIMIT)
+    case = item_case("nominal")
+    inputs = model_inputs(case, CASE.parent)
+    assembly = inputs.assembly
+    net = assembly.net
+    velocity = np.array(assembly.net_velocity, float)
+    centre = net.positions[:-net.n_bullets].mean(axis=0)
+    launch = np.asarray(case.launch.direction, float) / np.linalg.norm(case.launch.direction)
+    for k in range(len(velocity) - net.n_bullets, len(velocity)):
+        radial = net.positions[k] - centre
+        radial -= radial.dot(launch) * launch
+        velocity[k] += speed * radial / np.linalg.norm(radial)
+    inputs = dataclasses.replace(inputs, assembly=dataclasses.replace(assembly, net_velocity=velocity))
+    load = os.getloadavg()[0]
+    cpu = time.process_time()
+    wall = _simulation(wall_inputs(inputs))
+    wall_recorder = wall.run()
+    loads = recorded_loads(wall_recorder.series, wall.health.reference_energy)
+    driven = _simulation(driven_inputs(inputs, loads))
+    series = dict(driven.run().series)
+    series["joint_names"] = np.array([j.name for j in driven.assembly.joints])
+    out = {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]], "bullet outward speed (m/s)": speed}
+    return out | series_figures(dict(wall_recorder.series), dict(wall_recorder.net), series, case)
+
+
+def paper_step_1ms_loads(keep: Path) -> dict:
+    """The kept ``paper_step`` wall run's loads (every 2.5e-5 s) averaged over 1 ms and applied to the free debris at
+    the case's own step (1e-4 s): does the hinge follow the load's level or its bandwidth?"""
+    from multibody.recorded_loads import RecordedBodyLoads
+    from riskassess.models.impact import model_inputs
+    from riskassess.models.impact_sequential import driven_inputs
+    from riskassess.stages.run import _simulation
+
+    HealthWatch.__init__.__defaults__ = (None, LIFTED_DRIFT_LIMIT)
+    case = item_case("nominal")
+    wall = dict(np.load(keep / "paper_step" / "wall_timeseries.npz"))
+    t = wall["time"][1:]
+    t_ms, force = block_means(t, wall["contact_force_lvlh"][1:], 1e-3)
+    _, moment = block_means(t, wall["contact_moment_body"][1:], 1e-3)
+    loads = RecordedBodyLoads(time=t_ms, force_lvlh=force, moment_body=moment,
+                              reference_energy=float(wall["energy_net_kinetic"][0]))
+    load = os.getloadavg()[0]
+    cpu = time.process_time()
+    simulation = _simulation(driven_inputs(model_inputs(case, CASE.parent), loads))
+    series = dict(simulation.run().series)
+    series["joint_names"] = np.array([j.name for j in simulation.assembly.joints])
+    return {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]]} | hinge_figures(series)
+
+
+def run_item(item: str, keep: Path | None) -> dict:
+    """One run of ``item``, its CPU time (s), load and figures; the run is kept under ``keep`` if given."""
+    case = item_case(item)
+    # a measurement device, not the tool's behaviour: each run's drift is reported with its figures
+    HealthWatch.__init__.__defaults__ = (None, LIFTED_DRIFT_LIMIT)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = (keep / item) if keep else Path(tmp) / "run"
+        load = os.getloadavg()[0]
+        cpu = time.process_time()
+        try:
+            run_case(CASE, out, case=case)
+        except Exception as error:   # a refused or failed run is a result too (e.g. the health check)
+            return {"failed": f"{type(error).__name__}: {error}", "cpu (s)": time.process_time() - cpu}
+        info = {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]]}
+        return info | wrapping_figures(out, case)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--only", default=",".join(ITEMS))
+    parser.add_argument("--keep", type=Path, default=None, help="keep each run's folder under this directory")
+    parser.add_argument("--table-only", action="store_true")
+    args = parser.parse_args()
+    store = json.loads(STORE.read_text()) if STORE.exists() else {}
+    for item in args.only.split(","):
+        if args.table_only or item in store:
+            continue
+        special = {"hub_loads": lambda: hub_loads(args.keep), "samplings": lambda: samplings(args.keep),
+                   "bullets_outward": bullets_outward,
+                   "paper_step_1ms_loads": lambda: paper_step_1ms_loads(args.keep)}
+        store[item] = special[item]() if item in special else run_item(item, args.keep)
+        print(f"{item}: {json.dumps(store[item])}", flush=True)
+        tmp = STORE.with_suffix(".tmp")
+        tmp.write_text(json.dumps(store, indent=1))
+        tmp.replace(STORE)
+    for item, rows in store.items():
+        print(f"\n== {item}")
+        for key, value in rows.items():
+            print(f"  {key}: {value}")
+
+
+if __name__ == "__main__":
+    main()
