@@ -54,4 +54,7 @@ fi
 extra=""
 [ "${1:-}" = "--test" ] && extra="[test]"
 "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e ".${extra}"
+# numba compiles the kernels once per install and source version (riskassess/warmup.py): here, in two
+# processes, rather than in the first run or in every test worker. A failure only costs that wait later.
+"$VENV/bin/python" -m riskassess.warmup || echo "install.sh: the kernels' warm-up failed; the first run compiles them instead" >&2
 echo "install.sh: ready in $VENV (Python $version); run .venv/bin/riskassess --help"
