@@ -288,6 +288,16 @@ def _register(scan_world, map_points, map_normals, predicted_world_to_body, max_
     return pose, fitness, rmse
 
 
+@njit(cache=True, inline="always")
+def _points_in_body_into(world_to_body, points_world, body):
+    """``body[k] = world_to_body @ [points_world[k], 1]`` for every point (a 4 x 4 homogeneous pose),
+    written out so numba keeps it one loop without temporaries."""
+    for k in range(len(points_world)):
+        for a in range(3):
+            body[k, a] = (world_to_body[a, 0] * points_world[k, 0] + world_to_body[a, 1] * points_world[k, 1]
+                          + world_to_body[a, 2] * points_world[k, 2] + world_to_body[a, 3])
+
+
 @njit(cache=True)
 def _icp_level(points_world, pose, reference_inverse, prior_information, with_prior, distance, cutoff, iterations,
                body_size, settled, low, cell, shape, starts, map_points, shells, map_normals, normal_known,
@@ -308,10 +318,7 @@ def _icp_level(points_world, pose, reference_inverse, prior_information, with_pr
     scatter2 = (cutoff / 3) ** 2      # the Tukey cut-off at 3 scatters
     difference = np.zeros(6)
     for _ in range(iterations):
-        for k in range(n):
-            for a in range(3):
-                body[k, a] = (pose[a, 0] * points_world[k, 0] + pose[a, 1] * points_world[k, 1]
-                              + pose[a, 2] * points_world[k, 2] + pose[a, 3])
+        _points_in_body_into(pose, points_world, body)
         nearest_in_cells_kept(body, low, cell, shape, starts, map_points, distance, shells,
                               kept_points, kept_index, kept_safe, gap, nearest)
         fill_normals(nearest, map_points, low, cell, shape, starts, largest_cell, normal_radius, normal_neighbours,
@@ -337,10 +344,7 @@ def _icp_level(points_world, pose, reference_inverse, prior_information, with_pr
         if np.sqrt(step[0] ** 2 + step[1] ** 2 + step[2] ** 2) * body_size \
                 + np.sqrt(step[3] ** 2 + step[4] ** 2 + step[5] ** 2) < settled:
             break
-    for k in range(n):
-        for a in range(3):
-            body[k, a] = (pose[a, 0] * points_world[k, 0] + pose[a, 1] * points_world[k, 1]
-                          + pose[a, 2] * points_world[k, 2] + pose[a, 3])
+    _points_in_body_into(pose, points_world, body)
     nearest_in_cells_kept(body, low, cell, shape, starts, map_points, distance, shells,
                           kept_points, kept_index, kept_safe, gap, nearest)
     inside, squares = 0, 0.0
