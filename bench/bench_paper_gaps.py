@@ -263,9 +263,19 @@ def main() -> None:
         if args.table_only or item in store:
             continue
         store[item] = ITEMS[item]()
-        tmp = STORE.with_suffix(".tmp")
-        tmp.write_text(json.dumps(store, indent=1))
-        tmp.replace(STORE)
+        save_store(store, STORE)
+    print_store(store)
+
+
+def save_store(store: dict, path: Path) -> None:
+    """Write the figures of every item done so far, atomically (a stopped bench resumes from them)."""
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(store, indent=1))
+    tmp.replace(path)
+
+
+def print_store(store: dict) -> None:
+    """Print each item's figures, one per line."""
     for item, rows in store.items():
         print(f"\n== {item}")
         for key, value in rows.items():

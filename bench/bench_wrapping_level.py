@@ -59,7 +59,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
-from bench_paper_gaps import CASE, _case  # noqa: E402
+from bench_paper_gaps import CASE, _case, print_store, save_store  # noqa: E402
 
 from multibody.health import HealthWatch  # noqa: E402
 from riskassess.products.summary import contact_totals_debris  # noqa: E402
@@ -252,9 +252,6 @@ def hub_wrench(wall: dict, main: int) -> tuple[np.ndarray, np.ndarray]:
 def hub_loads(keep: Path) -> dict:
     """The free debris driven by the kept nominal wall run's total wrench on the main body (module docstring)."""
     from multibody.recorded_loads import RecordedBodyLoads
-    from riskassess.models.impact import model_inputs
-    from riskassess.models.impact_sequential import driven_inputs
-    from riskassess.stages.run import _simulation
 
     case = item_case("nominal")
     wall = dict(np.load(keep / "nominal" / "wall_timeseries.npz"))
@@ -262,13 +259,7 @@ def hub_loads(keep: Path) -> dict:
     force, moment = hub_wrench(wall, main)
     loads = RecordedBodyLoads(time=wall["time"][1:], force_lvlh=force[1:], moment_body=moment[1:],
                               reference_energy=float(wall["energy_net_kinetic"][0]))
-    load = os.getloadavg()[0]
-    cpu = time.process_time()
-    simulation = _simulation(driven_inputs(model_inputs(case, CASE.parent), loads))
-    series = dict(simulation.run().series)
-    series["joint_names"] = np.array([j.name for j in simulation.assembly.joints])
-    out = {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]]}
-    out |= hinge_figures(series)
+    out = driven_hinge_figures(case, loads)
     per_body = hinge_figures(dict(np.load(keep / "nominal" / "timeseries.npz")))
     return out | {f"per-body loads (nominal): {k}": v for k, v in per_body.items()}
 
@@ -354,9 +345,6 @@ def paper_step_1ms_loads(keep: Path) -> dict:
     """The kept ``paper_step`` wall run's loads (every 2.5e-5 s) averaged over 1 ms and applied to the free debris at
     the case's own step (1e-4 s): does the hinge follow the load's level or its bandwidth?"""
     from multibody.recorded_loads import RecordedBodyLoads
-    from riskassess.models.impact import model_inputs
-    from riskassess.models.impact_sequential import driven_inputs
-    from riskassess.stages.run import _simulation
 
     HealthWatch.__init__.__defaults__ = (None, LIFTED_DRIFT_LIMIT)
     case = item_case("nominal")
@@ -366,6 +354,16 @@ def paper_step_1ms_loads(keep: Path) -> dict:
     _, moment = block_means(t, wall["contact_moment_body"][1:], 1e-3)
     loads = RecordedBodyLoads(time=t_ms, force_lvlh=force, moment_body=moment,
                               reference_energy=float(wall["energy_net_kinetic"][0]))
+    return driven_hinge_figures(case, loads)
+
+
+def driven_hinge_figures(case, loads) -> dict:
+    """The free debris of ``case`` driven by ``loads`` (the sequential method's second step): its CPU time (s),
+    the load before and after, and the hinge figures (:func:`hinge_figures`)."""
+    from riskassess.models.impact import model_inputs
+    from riskassess.models.impact_sequential import driven_inputs
+    from riskassess.stages.run import _simulation
+
     load = os.getloadavg()[0]
     cpu = time.process_time()
     simulation = _simulation(driven_inputs(model_inputs(case, CASE.parent), loads))
@@ -406,13 +404,8 @@ def main() -> None:
                    "paper_step_1ms_loads": lambda: paper_step_1ms_loads(args.keep)}
         store[item] = special[item]() if item in special else run_item(item, args.keep)
         print(f"{item}: {json.dumps(store[item])}", flush=True)
-        tmp = STORE.with_suffix(".tmp")
-        tmp.write_text(json.dumps(store, indent=1))
-        tmp.replace(STORE)
-    for item, rows in store.items():
-        print(f"\n== {item}")
-        for key, value in rows.items():
-            print(f"  {key}: {value}")
+        save_store(store, STORE)
+    print_store(store)
 
 
 if __name__ == "__main__":
