@@ -9,7 +9,8 @@ debris CoM and the debris' angular momentum (issue 27: why MRAC fails on the ful
     python bench/bench_mrac_probe.py --analyse bench/results/probe/*.npz      # the mechanism line of each run
 
 Writes one ``.npz`` (series below; SI, frames in the names) and prints a per-25-s table. ``--set``
-overrides case keys of ``[mrac]`` or ``[thrust]`` (numbers, booleans or lists as JSON).
+overrides case keys of ``[mrac]`` or ``[thrust]`` (numbers, booleans or lists as JSON), or
+``sub_tethers.attachment_points_body`` (where the full net's cylinder sits on the debris axis; diagnostic).
 
 Series: ``time``; ``tension``, ``elongation``, ``thrust``; ``law_state`` (k, j): the thrust law's state
 (``multibody.control.thrust_laws``: z_m, z_m rate, last elongation, rate estimate, adaptive parameters);
@@ -98,14 +99,17 @@ def _value(text):
 
 
 def overridden(case, settings):
-    """``case`` with ``[mrac]`` / ``[thrust]`` keys set from ``section.key=value`` strings (validated again)."""
+    """``case`` with ``[mrac]`` / ``[thrust]`` keys set from ``section.key=value`` strings (validated again); also
+    ``sub_tethers.attachment_points_body``, which places the full net's cylinder along the debris axis (a diagnostic:
+    symmetric points put the geometric centre on the CoM, ``riskassess.models.towing_fullnet.debris_geometry``)."""
     data = case.model_dump()
+    allowed = {"mrac": set(data["mrac"]), "thrust": set(data["thrust"]), "sub_tethers": {"attachment_points_body"}}
     for item in settings:
         key, value = item.split("=", 1)
         section, name = key.split(".", 1)
-        if section not in ("mrac", "thrust") or name not in data[section]:
+        if name not in allowed.get(section, ()):
             raise SystemExit(f"--set {item}: unknown key; allowed: mrac.* {sorted(data['mrac'])}, thrust.* "
-                             f"{sorted(data['thrust'])}")
+                             f"{sorted(data['thrust'])}, sub_tethers.attachment_points_body")
         data[section][name] = _value(value)
     return TowingCase.model_validate(data)
 
