@@ -101,3 +101,15 @@ def test_wrapping_level_plot_band_reads_a_sine_amplitude():
     _, means = module.block_means(t, values, 1e-3)
     assert abs(means[:, 0].mean()) < 15.0
     assert abs(np.sqrt((means[:, 0] ** 2).mean()) - 1500.0 / np.sqrt(2)) < 0.01 * 1500.0 / np.sqrt(2)
+
+
+def test_scan_to_map_constants_entry_is_checked_and_typed():
+    """bench_scan_to_map.py --constants: an entry sets only the scan-to-map constants it names, each with the
+    module's own type (an iteration cap stays an int), and a name the module does not tune is refused by name."""
+    module = _bench_module("bench_scan_to_map")
+    assert module._constants("") == {}
+    chosen = module._constants("FINE_POINTS=2000, SETTLED=1e-3")
+    assert chosen == {"FINE_POINTS": 2000, "SETTLED": 1e-3}
+    assert isinstance(chosen["FINE_POINTS"], int)
+    with pytest.raises(SystemExit, match="'FOO=1' is not NAME=VALUE"):
+        module._constants("FOO=1")
