@@ -164,9 +164,14 @@ def hinge_figures(series: dict) -> dict:
     t = series["time"]
     m = series["joint_moment_joint"][:, hinge]
     judged, inside = t >= SKIP_S, (t > WINDOW_S[0]) & (t <= WINDOW_S[1])
+    # what a line plot of the hinge moment shows (the paper's Fig. 12 is read off one): per 7.5 ms column the
+    # largest |M|; median and 90th percentile over the columns after 0.25 s
+    band = plot_band(t, m, (SKIP_S, float(t[-1])))
     return {"h1 / h3 RMS after 0.25 s (N m)": np.sqrt((m[judged][:, [0, 2]] ** 2).mean(axis=0)).tolist(),
             "h1 / h3 largest after 0.25 s (N m)": np.abs(m[judged][:, [0, 2]]).max(axis=0).tolist(),
-            "h1 / h3 RMS 1-7.5 s (N m)": np.sqrt((m[inside][:, [0, 2]] ** 2).mean(axis=0)).tolist()}
+            "h1 / h3 RMS 1-7.5 s (N m)": np.sqrt((m[inside][:, [0, 2]] ** 2).mean(axis=0)).tolist(),
+            "h1 / h3 plot band after 0.25 s, median (N m)": [band["median"][0], band["median"][2]],
+            "h1 / h3 plot band after 0.25 s, p90 (N m)": [band["p90"][0], band["p90"][2]]}
 
 
 def wrapping_figures(run: Path, case) -> dict:
