@@ -526,9 +526,9 @@ def first_impact_scan(end_time: float = 0.6) -> dict:
         load, cpu = os.getloadavg()[0], time.process_time()
         series = dict(_simulation(wall_inputs(inputs)).run().series)
         figures = impact_figures(series)
+        flat_span = np.ptp(model_inputs(case, CASE.parent).assembly.net.positions[:, 0])
         rows[name] = {"cpu (s)": time.process_time() - cpu, "load": load,
-                      "in-plane mouth scale": float(np.ptp(assembly.net.positions[:, 0]) /
-                                                    np.ptp(model_inputs(case, CASE.parent).assembly.net.positions[:, 0]))}
+                      "in-plane mouth scale": float(np.ptp(assembly.net.positions[:, 0]) / flat_span)}
         rows[name] |= {key: value for key, value in figures.items() if not key.startswith("after")}
         print(name, json.dumps(rows[name]), flush=True)
     return rows
