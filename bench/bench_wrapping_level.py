@@ -55,6 +55,8 @@ native output, 0.6 ms and 1 ms means):
 - ``arrival_bowl_2m`` / ``arrival_bowl_5m``: the net's centre trailing its corners by 2 / 5 m (:func:`bowl_arrival`);
 - ``arrival_closing``: 2 m sag, mouth closed to 0.8, nodes moving inward (5 m/s at the bullets): a net past its
   largest opening, as the paper's "decrease in the bullets' velocity" may be;
+- ``arrival_bowl_2m_hub``: ``arrival_bowl_2m`` again, its wall loads also applied as the whole wrench on the main body
+  (the paper's eqs. 9 and 12, as ``hub_loads``) in a second driven run: the paper's hinge procedure on its per-step loads;
 - ``paper_step_r+1`` / ``paper_step_r-1`` / ``arrival_bowl_2m_r+1``: replicas, launch speed x (1 + k 1e-7)
   (bench/bench_coupling_replicas.py), so a change is known to exceed the round-off spread;
 - ``wall_full_size_body`` / ``wall_appendages_075``: the first stage's wall of another size (:func:`scaled_target`;
@@ -255,7 +257,8 @@ def item_case(item: str):
 ITEMS = ("nominal", "paper_step", "thread_segments", "contact_stiffness_x10", "threads_x4", "short_tether",
          "mesh_25", "hub_loads", "samplings", "bullets_outward", "paper_step_1ms_loads",
          "first_impact_scan", "arrival_bowl_2m", "paper_step_r+1", "arrival_bowl_5m", "arrival_closing",
-         "paper_step_r-1", "arrival_bowl_2m_r+1", "wall_full_size_body", "wall_appendages_075")
+         "paper_step_r-1", "arrival_bowl_2m_r+1", "wall_full_size_body", "wall_appendages_075",
+         "arrival_bowl_2m_hub")
 
 
 def hub_wrench(wall: dict, main: int) -> tuple[np.ndarray, np.ndarray]:
@@ -344,10 +347,11 @@ def bullets_outward(speed: float = 5.0) -> dict:
     return {"bullet outward speed (m/s)": speed} | in_memory_run(item_case("nominal"), outward)
 
 
-def in_memory_run(case, arrival=None) -> dict:
+def in_memory_run(case, arrival=None, hub: bool = False) -> dict:
     """One sequential run of ``case`` in memory (wall run, then the driven debris), the net's launch state first
     changed by ``arrival(net, velocity, launch) -> (positions, velocity)`` (LVLH, m and m/s; ``launch`` the unit
-    launch direction) if given; its CPU time (s), load and figures (:func:`series_figures`, :func:`impact_figures`)."""
+    launch direction) if given; its CPU time (s), load and figures (:func:`series_figures`, :func:`impact_figures`);
+    with ``hub`` also the hinge figures of the same wall loads applied as the whole wrench on the main body."""
     import dataclasses
 
     from riskassess.models.impact import model_inputs
@@ -373,8 +377,16 @@ def in_memory_run(case, arrival=None) -> dict:
     except Exception as error:   # a refused or failed run is a result too (e.g. the health check)
         return {"failed": f"{type(error).__name__}: {error}", "cpu (s)": time.process_time() - cpu}
     series["joint_names"] = np.array([j.name for j in driven.assembly.joints])
-    out = {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]]}
     wall_series = dict(wall_recorder.series)
+    out = {}
+    if hub:      # the same wall loads moved onto the main body (hub_wrench), a second driven run
+        from multibody.recorded_loads import RecordedBodyLoads
+
+        force, moment = hub_wrench(wall_series, [b.name for b in assembly.bodies].index("main_body"))
+        on_main = RecordedBodyLoads(time=wall_series["time"][1:], force_lvlh=force[1:], moment_body=moment[1:],
+                                    reference_energy=loads.reference_energy)
+        out = {f"whole wrench on the main body: {k}": v for k, v in driven_hinge_figures(case, on_main).items()}
+    out = {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]]} | out
     return (out | impact_figures(wall_series)
             | series_figures(wall_series, dict(wall_recorder.net), series, case))
 
@@ -484,6 +496,7 @@ ARRIVALS = {
     "arrival_bowl_5m": (0, bowl_arrival(5.0)),
     "arrival_bowl_2m_r+1": (1, bowl_arrival(2.0)),
     "arrival_closing": (0, bowl_arrival(2.0, radial_speed=-5.0, mouth=0.8)),
+    "arrival_bowl_2m_hub": (0, bowl_arrival(2.0)),
 }
 #: the first stage's wall of another size (case numerics, like ``nominal``): (main body factor, appendage factor)
 #: relative to the case's geometry (main body already 0.75 of Envisat's envelope, appendages at their real sizes)
@@ -541,7 +554,7 @@ def arrival_item(item: str) -> dict:
         return {"scale (main body, appendages)": list(WALLS[item])} | in_memory_run(case)
     k, arrival = ARRIVALS[item]
     return {"replica k (launch speed x (1 + k 1e-7))": k} | in_memory_run(replica(item_case("paper_step"), k),
-                                                                          arrival)
+                                                                          arrival, hub=item.endswith("_hub"))
 
 
 def paper_step_1ms_loads(keep: Path) -> dict:
