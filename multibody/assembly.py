@@ -148,28 +148,10 @@ class SolverSpec:
     # resting contacts: a node's single contact whose normal speed is below this (m/s) takes one
     # implicit step instead of the sub-cycle (multibody.contact_implicit); 0 turns it off (the default)
     implicit_contact_speed: float = 0.0
-    # the net's steps per step of the bodies and joints (Exudyn's step is net_substeps * step); the kernel path
-    # only (multibody.kernel_net.kernel_net_step); the joints stay tuned to ``step`` unless joint_tuning_step says
-    net_substeps: int = 1
 
     @property
     def n_steps(self) -> int:
         return int(round(self.end_time / self.step))
-
-    def exudyn_step(self, kernel_net: bool) -> tuple[float, int]:
-        """Exudyn's step (s) and number of steps: ``net_substeps`` net steps each on the kernel path
-        (``kernel_net``), else the step itself.
-
-        Parameters
-        ----------
-        kernel_net : bool
-            The compiled kernel integrates the net (:func:`multibody.impact.uses_kernel_net`).
-        """
-        k = self.net_substeps if kernel_net else 1
-        if self.n_steps % k:
-            raise ValueError(f"simulation.net_substeps = {k} must divide the number of steps end_time / step = "
-                             f"{self.n_steps}")
-        return k * self.step, self.n_steps // k
 
 
 @dataclass

@@ -308,8 +308,7 @@ def build_impact_system(assembly: ImpactAssembly, rest_body_to_lvlh=None, rest_c
     # Exudyn's explicit Lie-group update loses turns below ~2e-8 rad a step (multibody.rotation_update)
     rotations = ExactRotations(3 * n_exudyn, len(body_nodes), state_index) if verlet else None
     if in_kernel:
-        kernel_net = KernelNet(mbs, coupled, kernel, assembly.net_velocity, state_index, rotations,
-                               assembly.solver.net_substeps)
+        kernel_net = KernelNet(mbs, coupled, kernel, assembly.net_velocity, state_index, rotations)
         mbs.SetPreStepUserFunction(kernel_net)
     elif verlet:
         mbs.SetPreStepUserFunction(VerletForces(mbs, coupled, kernel, assembly.solver.step, 3 * n,
@@ -424,7 +423,7 @@ def simulation_settings(assembly: ImpactAssembly) -> exu.SimulationSettings:
     assembly : ImpactAssembly
         The simulation's description (SI, LVLH).
     """
-    s = explicit_settings(*assembly.solver.exudyn_step(uses_kernel_net(assembly)))
+    s = explicit_settings(assembly.solver.step, assembly.solver.n_steps)
     s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     return s
 

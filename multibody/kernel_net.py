@@ -40,7 +40,6 @@ from multibody.kernel import (
     coupled_forces_soa,
     verlet_evaluation_state_into,
 )
-from multibody.maths.rotations import compose_rotation_vectors_into
 
 
 @structref.register
@@ -52,8 +51,7 @@ class NetStepModelType(UnliteralStructRef):
 #: (same names, same buffers: what the kernel accumulates there, the recorder reads there), then the
 #: net's state and the work vectors of this module.
 KERNEL_FIELDS = ("net", "bodies", "shapes", "law", "mounts", "mean_motion", "step", "stage_weight", "buffers")
-STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "qt_eval", "inverse_mass", "reference_soa", "net_substeps",
-                "q_sub_bodies", "force_sum_bodies")
+STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "qt_eval", "inverse_mass", "reference_soa")
 
 
 class NetStepModel(structref.StructRefProxy):
@@ -64,16 +62,14 @@ class NetStepModel(structref.StructRefProxy):
     state, coordinate-major, module doc; inside a step ``q`` holds the step's end, the evaluation state's
     positions), ``qt_eval`` ((3 n + 6 nb,) work space: the net's mid-step velocities (first 3 n), the bodies'
     (last 6 nb)), ``inverse_mass`` ((3 n,) 1 / node mass per coordinate (1/kg)), ``reference_soa`` ((3 n,)
-    the nodes' reference positions (m), LVLH), both coordinate-major, ``net_substeps`` (int, the net's steps per
-    step of the bodies, :func:`kernel_net_step`), ``q_sub_bodies``, ``force_sum_bodies`` ((6 nb,) work space: the
-    bodies' state at a net sub-step, the sum of their forces over the sub-steps).
+    the nodes' reference positions (m), LVLH), both coordinate-major.
     """
 
 
 structref.define_proxy(NetStepModel, NetStepModelType, KERNEL_FIELDS + STATE_FIELDS)
 
 
-def net_step_model(kernel: KernelData, net_velocity, net_substeps: int = 1) -> tuple:
+def net_step_model(kernel: KernelData, net_velocity) -> tuple:
     """The structref for ``kernel`` with the net in its reference position; returns it and its ``q``,
     ``qt`` arrays (a structref proxy has no Python attributes: its fields are read in compiled code).
 
@@ -82,8 +78,6 @@ def net_step_model(kernel: KernelData, net_velocity, net_substeps: int = 1) -> t
     kernel : KernelData
     net_velocity : (n, 3) float
         Initial node velocities (m/s), LVLH.
-    net_substeps : int
-        The net's steps (``kernel.step`` each) per step of the bodies (:func:`kernel_net_step`).
     """
     n, nb = kernel.n_nodes, kernel.n_bodies
     n_substeps = max(1, int(np.ceil(kernel.step / kernel.contact_substep - 1e-9))) if np.isfinite(
@@ -93,8 +87,7 @@ def net_step_model(kernel: KernelData, net_velocity, net_substeps: int = 1) -> t
     coordinate_major = np.ascontiguousarray(np.asarray(net_velocity, float).reshape(n, 3).T).reshape(3 * n)
     state = [n_substeps, np.zeros(3 * n), coordinate_major, np.zeros(3 * n), np.zeros(3 * n + 6 * nb),
              np.tile(1.0 / np.asarray(kernel.net.mass, float), 3),
-             np.ascontiguousarray(np.asarray(kernel.net.reference_lvlh, float).T).reshape(3 * n),
-             int(net_substeps), np.zeros(6 * nb), np.zeros(6 * nb)]
+             np.ascontiguousarray(np.asarray(kernel.net.reference_lvlh, float).T).reshape(3 * n)]
     return NetStepModel(*values, *state), state[1], state[2]
 
 
@@ -142,15 +135,8 @@ def kernel_net_start(m, q_bodies, qt_bodies):
 
 @njit(cache=True)
 def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies, force_bodies):
-    """One VelocityVerlet step of the bodies (Exudyn's) with the net's steps inside it (module doc); writes the
-    bodies' generalized forces (6 nb,) for that step, for Exudyn's coupled object, into ``force_bodies``.
-
-    With ``m.net_substeps`` = 1 (the default) the net takes one step with the bodies, at their evaluation state.
-    With K > 1 the bodies' step is K net steps long: the net takes K Verlet steps of ``m.step``, each with the
-    bodies at their Verlet drift within the bodies' step (the position after s net steps, ``q + s h v_half``,
-    the rotation vector composed with ``s h omega_half``; the mid-step velocities ``v_half`` of the bodies'
-    step), and the bodies receive the mean of the K forces: the same impulse over their step as the net's
-    reactions, so the momentum exchange stays exact (centred half a net step earlier than the bodies' kick).
+    """One VelocityVerlet step of the net inside the bodies' step (module doc); writes the bodies'
+    generalized forces (6 nb,) at the evaluation state, for Exudyn's coupled object, into ``force_bodies``.
 
     Parameters
     ----------
@@ -167,55 +153,11 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies, for
         Output: the bodies' generalized forces (a preallocated array: returning a new one cost its
         allocation and a Python object every step).
     """
-    n3 = m.q.shape[0]
-    nb = q_bodies.shape[0] // 6
-    step = m.step
-    n_contact = m.n_substeps if time > 0.0 else 1
-    k_net = m.net_substeps
-    v_half_bodies = m.qt_eval[n3:]   # the bodies' mid-step velocities (the tail of qt_eval, work space)
-    if k_net == 1:
-        # the bodies' evaluation state straight into the output
-        verlet_evaluation_state_into(q_bodies, qt_bodies, qtt_bodies, step, 0, nb, q_next_bodies, v_half_bodies)
-        _net_verlet_step(m, q_next_bodies, v_half_bodies, n_contact, force_bodies)
-        return
-    verlet_evaluation_state_into(q_bodies, qt_bodies, qtt_bodies, k_net * step, 0, nb, q_next_bodies, v_half_bodies)
-    q_sub, force_sum = m.q_sub_bodies, m.force_sum_bodies
-    force_sum[:] = 0.0
-    for s in range(1, k_net + 1):
-        if s == k_net:
-            q_sub[:] = q_next_bodies
-        else:
-            _bodies_drifted(q_bodies, v_half_bodies, s * step, nb, q_sub)
-        _net_verlet_step(m, q_sub, v_half_bodies, n_contact, force_bodies)
-        for k in range(force_sum.shape[0]):
-            force_sum[k] += force_bodies[k]
-    inverse = 1.0 / k_net
-    for k in range(force_sum.shape[0]):
-        force_bodies[k] = force_sum[k] * inverse
-
-
-@njit(cache=True, inline="always")
-def _bodies_drifted(q_bodies, v_half_bodies, tau, nb, out):
-    """The bodies' coordinates ``tau`` (s) into their Verlet drift (translations ``q + tau v_half``, rotation vectors
-    composed with ``tau omega_half``, node frame), as :func:`multibody.kernel.verlet_evaluation_state_into` does for
-    the whole step, into ``out`` (6 nb,)."""
-    for k in range(6 * nb):
-        out[k] = q_bodies[k] + tau * v_half_bodies[k]
-    for b in range(nb):
-        base = 6 * b + 3
-        compose_rotation_vectors_into(q_bodies[base], q_bodies[base + 1], q_bodies[base + 2], tau * v_half_bodies[base],
-                                      tau * v_half_bodies[base + 1], tau * v_half_bodies[base + 2], out, base)
-
-
-# inlined (numba IR): the K = 1 path is the step it was, operation for operation
-@njit(cache=True, inline="always")
-def _net_verlet_step(m, q_eval_bodies, v_half_bodies, n_contact, force_bodies):
-    """One Verlet step of the net with the bodies at ``q_eval_bodies`` (6 nb,) moving at ``v_half_bodies``; the
-    bodies' generalized forces there into ``force_bodies``."""
     # the structref's arrays as locals: a field read inside a loop is not hoisted (stores through the
     # other arrays may alias it), which cost about 5 ns per coordinate, 18 us a step for the reference net
     q, qt, qtt, qt_eval, reference = m.q, m.qt, m.qtt, m.qt_eval, m.reference_soa
     n3 = q.shape[0]
+    nb = q_bodies.shape[0] // 6
     step = m.step
     half = 0.5 * step
     x_flat = m.buffers.work_soa[0].reshape(n3)
@@ -229,7 +171,10 @@ def _net_verlet_step(m, q_eval_bodies, v_half_bodies, n_contact, force_bodies):
         q[k] = q[k] + step * qt_eval[k]
     for k in range(n3):
         x_flat[k] = reference[k] + q[k]
-    force, body_force = _forces(m, q_eval_bodies, v_half_bodies, n_contact)
+    # the bodies' evaluation state straight into the output and the tail of qt_eval (work space)
+    v_half_bodies = qt_eval[n3:]
+    verlet_evaluation_state_into(q_bodies, qt_bodies, qtt_bodies, step, 0, nb, q_next_bodies, v_half_bodies)
+    force, body_force = _forces(m, q_next_bodies, v_half_bodies, m.n_substeps if time > 0.0 else 1)
     # flat loops over the coordinates with few arrays each: the compiler vectorizes them (with more
     # arrays in one loop its run-time overlap checks give up and the loop stays scalar)
     inverse_mass = m.inverse_mass
@@ -257,23 +202,20 @@ class KernelNet:
     rotations : multibody.rotation_update.ExactRotations or None
         Keeps each step's exact end attitudes; they are written over Exudyn's at the start of the next
         pre-step, before :attr:`after_step` reads the state (and by :meth:`finish_steps` after the last step).
-    net_substeps : int
-        The net's steps (``kernel.step`` each) per Exudyn step (:func:`kernel_net_step`).
     """
 
-    def __init__(self, mbs, coupled_object, kernel: KernelData, net_velocity, state_index, rotations=None,
-                 net_substeps: int = 1):
+    def __init__(self, mbs, coupled_object, kernel: KernelData, net_velocity, state_index, rotations=None):
         self.mbs = mbs
         self.rotations = rotations
         self.coupled_object = coupled_object
         self.kernel = kernel
         self.state_index = state_index
-        self.model, self.q, self.qt = net_step_model(kernel, net_velocity, net_substeps)
+        self.model, self.q, self.qt = net_step_model(kernel, net_velocity)
         self._q_next_bodies = np.zeros(6 * kernel.n_bodies)  # the step's end coordinates of the bodies (m, rad)
         self._force_bodies = np.zeros(6 * kernel.n_bodies)   # the bodies' generalized forces of the step
         self._views = None
         self._last_time = -np.inf
-        self._view_window = 1.5 * kernel.step * net_substeps   # further on than this: a new solve (_state_views)
+        self._view_window = 1.5 * kernel.step   # a time further on than this starts a new solve (_state_views)
         #: optional ``after_step(mbs, t) -> bool``, the work of a post-step function for the step that ended at
         #: ``t`` (s), run at the start of the next step's pre-step instead (one Python call a step from Exudyn
         #: instead of two); False stops the solver. The last step's is left to :meth:`finish_steps`.

@@ -109,13 +109,12 @@ class Recorder:
         self._applied_work = 0.0        # J, by recorded loads (sequential method), since t = 0
         self._previous_body_state = None
         solver = assembly.solver
-        # Exudyn's step: the hooks run once per step of the bodies (net_substeps net steps on the kernel path)
-        self.step, n_steps = solver.exudyn_step(system.kernel_net is not None)
+        self.step = solver.step
         self.output_interval = 1.0 / solver.output_rate
         self.net_interval = 1.0 / solver.net_output_rate
         self._next_output = self.output_interval
-        self._end_time = n_steps * self.step
-        self._health_every = max(1, int(HEALTH_INTERVAL_S / self.step))
+        self._end_time = solver.n_steps * solver.step
+        self._health_every = max(1, int(HEALTH_INTERVAL_S / solver.step))
         self._steps_unchecked = 0   # steps since the state was last checked (by a sample or on its own)
         self._next_net = self.net_interval
         self._last_output_time = 0.0

@@ -82,11 +82,6 @@ class Simulation(Strict):
         0.15, description="A node's single contact approaching or separating slower than this (m/s) takes one "
                           "implicit step instead of the explicit sub-cycle (docs/model.md, 'Contact'); 0 sub-cycles "
                           "every contact (the reference path, about 2.4 times slower).")
-    net_substeps: Annotated[int, Field(ge=1, le=3)] = Field(
-        1, description="Net steps per step of the bodies and joints on the 'kernel' path: Exudyn steps the debris "
-                       "bodies and joints at net_substeps * step while the net takes its own steps inside each "
-                       "(docs/model.md, Speed); the joints stay tuned to step. Must divide end_time / step. "
-                       "The 'exudyn' path ignores it.")
     coupling: Literal["coupled", "sequential"] = Field(
         "coupled", description="'coupled': net and debris in one system (the tool's model); 'sequential': the seed "
                                "paper's method, the net against the debris held fixed, then the recorded contact "
@@ -98,10 +93,6 @@ class Simulation(Strict):
             raise ValueError(f"output_rate must be <= 1/step = {1 / self.step:g} Hz. Got {self.output_rate:g} instead")
         if self.end_time < self.step:
             raise ValueError(f"end_time must be >= step ({self.step:g} s). Got {self.end_time:g} instead")
-        n_steps = int(round(self.end_time / self.step))
-        if n_steps % self.net_substeps:
-            raise ValueError(f"net_substeps must divide the number of steps end_time / step = {n_steps}. "
-                             f"Got {self.net_substeps} instead")
         return self
 
 

@@ -329,7 +329,7 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
         solver=SolverSpec(end_time=sim.end_time, step=sim.step, integrator=sim.integrator,
                           output_rate=sim.output_rate, net_output_rate=sim.net_output_rate,
                           contact_substep=sim.contact_substep, net_integration=sim.net_integration,
-                          implicit_contact_speed=sim.implicit_contact_speed, net_substeps=sim.net_substeps),
+                          implicit_contact_speed=sim.implicit_contact_speed),
         mean_motion=mean_motion(case.orbit.altitude) if isinstance(case.orbit, CircularOrbit) else 0.0,
         mount=mount, chaser=chaser_index)
     return ModelInputs(assembly, rest_att, rest_com)
