@@ -242,11 +242,15 @@ class Recorder:
         """
         if not self.health.ok:
             return  # the run has stopped
-        data = self.system.mbs.systemData
-        # views (nothing here writes them; the row keeps what it needs)
-        q, qt = data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False)
+        # views (nothing here writes them; the row keeps what it needs): the kernel's, when it calls from its pre-step
+        views = self.system.kernel_net.step_views if self._net_in_kernel else None
+        if views is None:
+            data = self.system.mbs.systemData
+            q, qt = data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False)
+        else:
+            q, qt = views[0], views[1]
         net_q, net_qt = (self.system.kernel_net.q, self.system.kernel_net.qt) if self._net_in_kernel else (q, qt)
-        # the whole row but the joint loads in one compiled call; nothing is recorded from a lost state
+        # the whole row in one compiled call; nothing is recorded from a lost state
         finite, total_energy = sample_row(self._model, q, qt, net_q, net_qt, t, t - self._last_output_time)
         if not finite:
             self.health.state(t, *self.system.state_arrays())  # the full check, with its message

@@ -1,9 +1,10 @@
 """Compiled sums behind one output sample of the impact recorder (:mod:`multibody.recorder`).
 
 A sample used to be some 200 small NumPy operations (about 0.6 ms, 12 % of the reference case's
-run at one sample every 10 steps); :func:`sample_row` now computes the whole row but the joint loads in one
-compiled call (:func:`net_sums` and :func:`body_sample` in one pass each). Same definitions as before; frames
-in the names, SI units.
+run at one sample every 10 steps); :func:`sample_row` now computes the whole row in one compiled call
+(:func:`net_sums` and :func:`body_sample` in one pass each; the joint loads by :func:`connector_load_into`, Exudyn's
+connector law, which replaced eight ``GetObjectOutput`` calls a sample). Same definitions as before; frames in the
+names, SI units.
 """
 from __future__ import annotations
 
@@ -341,8 +342,8 @@ def _all_finite(values) -> bool:
 
 @njit(cache=True)
 def sample_row(m, q, qt, net_q, net_qt, t, interval):
-    """One output sample into ``m.row`` (:class:`RecorderModel`), all but the joint loads (Exudyn's connector outputs,
-    read by the recorder): the bodies and joints (:func:`body_sample`, which also zeroes the contact impulses), the
+    """One output sample into ``m.row`` (:class:`RecorderModel`): the bodies and joints with the joints' loads
+    (:func:`body_sample`, which also zeroes the contact impulses), the
     net's sums (:func:`net_sums`), the energy terms in the order of :data:`multibody.recorder.ENERGY_TERMS` (then the
     chaser's kinetic energy with a chaser) and their total, added in that order from 0.0 (as Python's ``sum`` of
     them), and the momenta. One compiled call instead of some 60 lines of Python and NumPy: inside the run, where the
