@@ -99,9 +99,40 @@ def _cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
+@njit(cache=True, inline="always")
+def _node_contact_force(depth, w, normal, mass, inverse_body_mass, stiffness, exponent, damping, mu_s, mu_k,
+                        inverse_transition_speed, dt, friction):
+    """A node's own contact force with the box at a sub-step (body frame, N): Hunt-Crossley along the box's normal
+    at the node and, when ``friction`` (an owned contact), Hollar friction against its slip (never reversing it
+    within the sub-step), as :func:`multibody.contact.contact_over_step`; with the energy it dissipates (J, zero
+    unless ``friction``: a predicted contact books nothing)."""
+    if depth <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    dn = _power(depth, exponent)
+    elastic = stiffness * dn
+    rate = -(w[0] * normal[0] + w[1] * normal[1] + w[2] * normal[2])
+    fn = max(elastic + damping * dn * rate, 0.0)
+    fx, fy, fz = fn * normal[0], fn * normal[1], fn * normal[2]
+    if not friction:
+        return fx, fy, fz, 0.0
+    lost = (fn - elastic) * rate * dt
+    gx, gy, gz = w[0] + rate * normal[0], w[1] + rate * normal[1], w[2] + rate * normal[2]
+    slip = math.sqrt(gx * gx + gy * gy + gz * gz)
+    if fn > 0.0 and slip > 0.0:
+        mu = hollar_friction_coefficient_inverse(slip, mu_s, mu_k, inverse_transition_speed)
+        reduced = 1.0 / (1.0 / mass + inverse_body_mass)
+        magnitude = min(mu * fn, reduced * slip / dt)
+        along = magnitude / slip
+        fx -= along * gx
+        fy -= along * gy
+        fz -= along * gz
+        lost += magnitude * slip * dt
+    return fx, fy, fz, lost
+
+
 @njit(cache=True)
 def thread_contact_over_step(pa, pc, va, vc, aa, ac, mass_a, mass_c, radius_a, radius_c, box_min, box_max, s,
-                             body_mass, inverse_inertia_body, b, law, step, n_substeps, work, out):
+                             body_mass, inverse_inertia_body, b, law, step, n_substeps, own_a, own_c, work, out):
     """Thread (nodes a, c) against box ``s`` of body ``b`` over one step, the contact re-evaluated at every
     sub-step from the nodes' state (module doc).
 
@@ -129,15 +160,19 @@ def thread_contact_over_step(pa, pc, va, vc, aa, ac, mass_a, mass_c, radius_a, r
         Integrator step (s).
     n_substeps : int
         Sub-steps (1: the plain force evaluation at the start).
+    own_a, own_c : bool
+        The node's own contact with this box is integrated here and its impulse returned with the thread's (the
+        node contact skips it this step); otherwise it only moves the node here (a prediction).
     work : (MAX_BREAKPOINTS,) float
         Work space.
     out : (4, 3) float
-        Output, body frame (m/s): node a's mean and end velocity change by the thread's contact, node c's.
+        Output, body frame (m/s): node a's mean and end velocity change by the thread's contact (and its own when
+        owned), node c's.
 
     Returns
     -------
     dissipated : float
-        Energy the thread's contact dissipated over the step (J).
+        Energy the thread's contact (and the owned node contacts) dissipated over the step (J).
     end_energy : float
         Its elastic energy at the end of the sub-cycle (J).
     touched : int
@@ -214,17 +249,11 @@ def thread_contact_over_step(pa, pc, va, vc, aa, ac, mass_a, mass_c, radius_a, r
             elif end == 1:
                 fc0, fc1, fc2 = fc0 - fn * me[0], fc1 - fn * me[1], fc2 - fn * me[2]
         # the nodes' own contacts with this box, for their motion only (module doc): Hunt-Crossley, no friction
-        ga0 = ga1 = ga2 = gc0 = gc1 = gc2 = 0.0
-        if depth_a > 0.0:
-            da = _power(depth_a, exponent)
-            rate_a = -(wa[0] * n_a[0] + wa[1] * n_a[1] + wa[2] * n_a[2])
-            fna = max(k_contact * da + damping * da * rate_a, 0.0)
-            ga0, ga1, ga2 = fna * n_a[0], fna * n_a[1], fna * n_a[2]
-        if depth_c > 0.0:
-            dc = _power(depth_c, exponent)
-            rate_c = -(wc[0] * n_c[0] + wc[1] * n_c[1] + wc[2] * n_c[2])
-            fnc = max(k_contact * dc + damping * dc * rate_c, 0.0)
-            gc0, gc1, gc2 = fnc * n_c[0], fnc * n_c[1], fnc * n_c[2]
+        ga0, ga1, ga2, lost_a = _node_contact_force(depth_a, wa, n_a, mass_a, inv_body, k_contact, exponent, damping,
+                                                    mu_s, mu_k, inverse_transition_speed, dt, own_a)
+        gc0, gc1, gc2, lost_c = _node_contact_force(depth_c, wc, n_c, mass_c, inv_body, k_contact, exponent, damping,
+                                                    mu_s, mu_k, inverse_transition_speed, dt, own_c)
+        dissipated += lost_a + lost_c
         # velocity updates (symplectic Euler, as the node contact's sub-cycle)
         ua0 += dt * fa0 * inv_a
         ua1 += dt * fa1 * inv_a
@@ -232,12 +261,22 @@ def thread_contact_over_step(pa, pc, va, vc, aa, ac, mass_a, mass_c, radius_a, r
         uc0 += dt * fc0 * inv_c
         uc1 += dt * fc1 * inv_c
         uc2 += dt * fc2 * inv_c
-        pa0 += dt * ga0 * inv_a
-        pa1 += dt * ga1 * inv_a
-        pa2 += dt * ga2 * inv_a
-        pc0 += dt * gc0 * inv_c
-        pc1 += dt * gc1 * inv_c
-        pc2 += dt * gc2 * inv_c
+        if own_a:
+            ua0 += dt * ga0 * inv_a
+            ua1 += dt * ga1 * inv_a
+            ua2 += dt * ga2 * inv_a
+        else:
+            pa0 += dt * ga0 * inv_a
+            pa1 += dt * ga1 * inv_a
+            pa2 += dt * ga2 * inv_a
+        if own_c:
+            uc0 += dt * gc0 * inv_c
+            uc1 += dt * gc1 * inv_c
+            uc2 += dt * gc2 * inv_c
+        else:
+            pc0 += dt * gc0 * inv_c
+            pc1 += dt * gc1 * inv_c
+            pc2 += dt * gc2 * inv_c
         # the body's recoil: every reaction acts at the node it came from
         ta0, ta1, ta2 = fa0 + ga0, fa1 + ga1, fa2 + ga2
         tc0, tc1, tc2 = fc0 + gc0, fc1 + gc1, fc2 + gc2
