@@ -19,18 +19,29 @@ it touches a box shape under the same law as the nodes:
   of mass) gained energy (one thread falling flat at 20 m/s across a plate off its middle, s = 0.625: +33 % of
   its launch energy; helper peaks10, docs/model.md "Contact").
 * **how much**: Hunt-Crossley normal force and the case's Hollar friction, as a node with the thread's
-  radius at that point, through the node contact's own integration over the step (the implicit step of
-  :mod:`multibody.contact_implicit` for a slow contact, the sub-cycle of :func:`multibody.contact.contact_over_step`
-  otherwise; one sub-step when sub-cycling is off).
+  radius at that point, integrated over the step by the thread's own sub-cycle (:mod:`multibody.segment_cycle`,
+  helper thread12): its state is the two nodes (positions and velocities relative to the body, body frame), and
+  at every sub-step the deepest point, its normal, its split and the excess q below are found again, so the
+  point follows the thread as it rocks on a plate's two edges or turns round an edge (held over the step until
+  2026-11-27, which made energy at each switch of the deepest point: +12 % of a 20 m/s strike's energy). The
+  sub-steps are the node contact's rule (:func:`multibody.contact_kernel._substeps_to_resolve_contact`) for the
+  point and for each node's own contact with the box; one sub-step when sub-cycling is off. Slow contacts are
+  sub-cycled too (the node contact's implicit step would hold the point over the step).
+* **the nodes' own contacts with the box**: integrated in the same sub-cycle, since the excess q depends on the
+  deeper node's penetration, which changes within its own 0.15 ms impact: the first thread of a step that takes
+  a node integrates that node's contact with the box and applies it (``SegmentBuffers.owned_shape``; the node
+  contact, :mod:`multibody.contact_kernel`, skips that node-box pair this step); the node's later threads in the
+  step only predict it (it moves their nodes, its impulse is not applied twice). Measured (one thread striking
+  over a plate's edge at 20 m/s, bench/bench_thread_strike_energy.py): the balance closes to +0.63 % with the
+  node's contact owned, +1.7 % with it only predicted, +15.6 % with the node in free flight in the sub-cycle.
 * **who carries it**: a force F at :math:`p = (1 - s) x_a + s x_b` is split (1 - s) F on node a and s F on
   node b, so the point's acceleration is F / m_p with the effective mass
 
   .. math:: m_p = \\Big(\\frac{(1 - s)^2}{m_a} + \\frac{s^2}{m_b}\\Big)^{-1}
 
-  (2 m for the middle of a thread between equal nodes): the contact's normal motion is that of a particle
-  of mass :math:`m_p` with the nodes' non-contact accelerations interpolated, :math:`f_p = m_p((1-s) f_a/m_a
-  + s f_b/m_b)`. The reaction -F acts on the body at p, on the same line, so linear and angular momentum are
-  exchanged exactly.
+  (2 m for the middle of a thread between equal nodes). The body takes each node's reaction at that node (the
+  same moment as -F at p for the split, so linear and angular momentum are exchanged exactly); within the
+  sub-cycle it recoils with its mass and inertia.
 * **no double count**: the node contact already carries the nodes' own spheres, so a thread adds only
   where its interior is deeper than both its ends (the deepest point is interior), and only by its excess
   over the deeper node e when that node's sphere penetrates, :math:`q = \delta(t^*) - \max(0, \delta_a,
@@ -38,15 +49,17 @@ it touches a box shape under the same law as the nodes:
   nothing; one bent over an edge, or across a plate narrower than the mesh, adds the whole contact. The
   forces are the gradient of the contact's energy :math:`k q^{n+1}/(n+1)`: besides F at the point, -F n_e on
   node e (it hands its load up to q over to the point) with its reaction on the body at the node, so the
-  contact is conservative in q and momentum stays exact; the coordinate moves as a particle of mass
-  :math:`(|J_a|^2/m_a + |J_b|^2/m_b)^{-1}`, J the nodes' shares of n (less n_e for node e).
+  contact is conservative in q and momentum stays exact.
 * **the normal**: from the box to the deepest point, perpendicular to the thread (outside the box the
   nearest-point direction is; inside, the combination of the two nearest faces that is), so the contact
   never pushes a thread along itself.
 
-As in the node contact, the velocity change over the step is applied as the kick that makes the
-integrator's next drift follow the contact's path, and its remainder (the end minus the mean change) is
-carried to the next evaluation, here per thread: impulse, body, split and point (body frame).
+As in the node contact, each node's velocity change over the step is applied as the kick that makes the
+integrator's next drift follow the sub-cycle's path, and its remainder (the end minus the mean change) is
+carried to the next evaluation, per thread and node. Each thread's contact energy at a step's start less the
+energy its sub-cycle ended the previous step with is summed per thread (``SegmentBuffers.energy_jump``: the
+energy the splitting into steps made, the cause measured above), with the energy it dissipated
+(``SegmentBuffers.dissipated``), so the balance can be checked contact by contact.
 
 Shapes: boxes only (``ShapeArrays.is_box``; the Envisat array, ASAR and main body). Cylinders, spheres,
 ellipsoids and mesh files keep node contact alone: their pass-throughs are still found and bounded by
@@ -391,7 +404,7 @@ def _thread_on_box(j, a, c, s, b, pa, pc, reach, x, v, net_force_lvlh, net, stat
             node_energy += hertz_elastic_energy(depth_c, law.stiffness, law.exponent)
             node_count += 1
     wa, wc = 1.0 - split, split
-    point_mass = 1.0 / (wa * wa / net_mass[a] + wc * wc / net_mass[c])
+    point_mass = point_effective_mass(net_mass[a], net_mass[c], split)
     # the point's relative velocity and the normal at the start (body frame): the slow-contact test, the sub-steps
     w = (wa * rel[0, 0] + wc * rel[1, 0], wa * rel[0, 1] + wc * rel[1, 1], wa * rel[0, 2] + wc * rel[1, 2])
     lo = (shapes.box_min_body[s, 0], shapes.box_min_body[s, 1], shapes.box_min_body[s, 2])
@@ -407,7 +420,6 @@ def _thread_on_box(j, a, c, s, b, pa, pc, reach, x, v, net_force_lvlh, net, stat
     nz = rot[b, 2, 0] * nbx + rot[b, 2, 1] * nby + rot[b, 2, 2] * nbz
     body_mass = _effective_mass_of_body(rot, bodies.inverse_inertia_body, b, bodies.mass[b], arm_x, arm_y, arm_z,
                                         nx, ny, nz)
-    normal_speed = w[0] * nbx + w[1] * nby + w[2] * nbz
     impulses = seg.cycle_out   # rows: node a's mean and end impulse (LVLH, N s), node c's
     # every thread contact is sub-cycled, slow ones too: the node contact's implicit step holds its point over the
     # step, which in a slow rocking or turning thread is the error this sub-cycle removes (measured: a thread striking
