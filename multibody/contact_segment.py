@@ -76,6 +76,7 @@ import numpy as np
 from numba import njit
 
 from multibody.contact import hertz_elastic_energy
+
 from multibody.contact_kernel import _effective_mass_of_body, _substeps_to_resolve_contact, add_body_reaction
 from multibody.segment_box import MAX_BREAKPOINTS, segment_box_normal
 from multibody.segment_cycle import thread_contact_geometry, thread_contact_over_step
@@ -107,6 +108,7 @@ class SegmentBuffers(NamedTuple):
     cycle_out: np.ndarray           # (4, 3) work: the sub-cycle's mean and end velocity changes of the nodes
     owned_shape: np.ndarray         # (n,) int64 the box whose contact with the node a thread's sub-cycle integrates
                                     # this step (the node contact skips that pair); -1: none
+    node_threads: np.ndarray        # (n,) int64 each node's threads in contact with a box this step
 
 
 def segment_buffers(n_threads: int, n_nodes: int, n_shapes: int, enabled: bool) -> SegmentBuffers:
@@ -126,7 +128,7 @@ def segment_buffers(n_threads: int, n_nodes: int, n_shapes: int, enabled: bool) 
                           centre_distance=np.zeros((ns, n)), node_speed=np.zeros(n), shape_work=np.zeros((2, ns)),
                           breakpoints=np.zeros(MAX_BREAKPOINTS), contact_scalar=np.zeros((5, 1)),
                           contact_vector=np.zeros((6, 1, 3)), external_force=np.zeros(3), cycle_out=np.zeros((4, 3)),
-                          owned_shape=np.full(n, -1, np.int64))
+                          owned_shape=np.full(n, -1, np.int64), node_threads=np.zeros(n, np.int64))
 
 
 @njit(cache=True, inline="always")
@@ -287,35 +289,40 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
     seg.end_energy[1, :] = 0.0
     seg.start_energy[:] = 0.0
     seg.owned_shape[:] = -1
+    seg.node_threads[:] = 0
     centre_distance, node_speed = seg.centre_distance, seg.node_speed
     sphere_radius, surface_speed = seg.shape_work[0], seg.shape_work[1]
     body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
     box_min, box_max, shape_body, is_box = shapes.box_min_body, shapes.box_max_body, shapes.body, shapes.is_box
-    for j in range(threads.shape[0]):
-        a, c = threads[j, 0], threads[j, 1]
-        length = math.sqrt((x[0, c] - x[0, a]) ** 2 + (x[1, c] - x[1, a]) ** 2 + (x[2, c] - x[2, a]) ** 2)
-        motion = step * max(node_speed[a], node_speed[c])
-        thread_radius = min(radius[a], radius[c])
-        for s in range(shape_body.shape[0]):
-            if is_box[s] == 0:
-                continue
-            # what the thread and the surface can close within the step, plus the thread's radius
-            reach = 1.001 * (thread_radius + motion + step * surface_speed[s])
-            # every point of the segment is at least (|a - o| + |b - o| - L) / 2 from the box's centre o
-            if 0.5 * (centre_distance[s, a] + centre_distance[s, c] - length) > sphere_radius[s] + reach:
-                continue
-            b = shape_body[s]
-            pa = _to_body(x, a, body_to_lvlh, com_lvlh, b)
-            pc = _to_body(x, c, body_to_lvlh, com_lvlh, b)
-            if (min(pa[0], pc[0]) > box_max[s, 0] + reach or max(pa[0], pc[0]) < box_min[s, 0] - reach
-                    or min(pa[1], pc[1]) > box_max[s, 1] + reach or max(pa[1], pc[1]) < box_min[s, 1] - reach
-                    or min(pa[2], pc[2]) > box_max[s, 2] + reach or max(pa[2], pc[2]) < box_min[s, 2] - reach):
-                continue
-            e, k, w = _thread_on_box(j, a, c, s, b, pa, pc, reach, x, v, net_force_lvlh, net, states, bodies, shapes,
-                                     law, step, n_substeps, stage_weight, buffers, body_force_lvlh, torque_lvlh)
-            energy += e
-            count += k
-            dissipated += w
+    # two passes: the first counts each node's threads in contact (a node with one integrates its own contact in that
+    # thread's sub-cycle), the second integrates
+    for count_only in range(1, -1, -1):
+        for j in range(threads.shape[0]):
+            a, c = threads[j, 0], threads[j, 1]
+            length = math.sqrt((x[0, c] - x[0, a]) ** 2 + (x[1, c] - x[1, a]) ** 2 + (x[2, c] - x[2, a]) ** 2)
+            motion = step * max(node_speed[a], node_speed[c])
+            thread_radius = min(radius[a], radius[c])
+            for s in range(shape_body.shape[0]):
+                if is_box[s] == 0:
+                    continue
+                # what the thread and the surface can close within the step, plus the thread's radius
+                reach = 1.001 * (thread_radius + motion + step * surface_speed[s])
+                # every point of the segment is at least (|a - o| + |b - o| - L) / 2 from the box's centre o
+                if 0.5 * (centre_distance[s, a] + centre_distance[s, c] - length) > sphere_radius[s] + reach:
+                    continue
+                b = shape_body[s]
+                pa = _to_body(x, a, body_to_lvlh, com_lvlh, b)
+                pc = _to_body(x, c, body_to_lvlh, com_lvlh, b)
+                if (min(pa[0], pc[0]) > box_max[s, 0] + reach or max(pa[0], pc[0]) < box_min[s, 0] - reach
+                        or min(pa[1], pc[1]) > box_max[s, 1] + reach or max(pa[1], pc[1]) < box_min[s, 1] - reach
+                        or min(pa[2], pc[2]) > box_max[s, 2] + reach or max(pa[2], pc[2]) < box_min[s, 2] - reach):
+                    continue
+                e, k, w = _thread_on_box(j, a, c, s, b, pa, pc, count_only == 1, x, v, net_force_lvlh, net, states,
+                                         bodies, shapes, law, step, n_substeps, stage_weight, buffers, body_force_lvlh,
+                                         torque_lvlh)
+                energy += e
+                count += k
+                dissipated += w
     net_force_lvlh += node_force
     if n_substeps > 1:
         # the energy each thread's contact starts this step with less what its sub-cycle ended the last with: the
@@ -336,7 +343,7 @@ def _to_body(x, i, body_to_lvlh, com_lvlh, b):
 
 
 @njit(cache=True)
-def _thread_on_box(j, a, c, s, b, pa, pc, reach, x, v, net_force_lvlh, net, states, bodies, shapes, law, step,
+def _thread_on_box(j, a, c, s, b, pa, pc, count_only, x, v, net_force_lvlh, net, states, bodies, shapes, law, step,
                    n_substeps, stage_weight, buffers, body_force_lvlh, torque_lvlh):
     """Thread ``j`` (nodes a, c; body-frame ends ``pa``, ``pc``) against box shape ``s`` of body ``b`` over the
     step (module doc); returns the contact's elastic energy (J), 1 if it penetrates (else 0), and the energy
@@ -386,12 +393,18 @@ def _thread_on_box(j, a, c, s, b, pa, pc, reach, x, v, net_force_lvlh, net, stat
                                         seg.breakpoints)
         if ahead[0] <= 0.0:
             return 0.0, 0, 0.0
+    if count_only:
+        # first pass: each node's threads in contact this step (who integrates its own contact)
+        seg.node_threads[a] += 1
+        seg.node_threads[c] += 1
+        return 0.0, 0, 0.0
     start_energy = hertz_elastic_energy(penetration, law.stiffness, law.exponent) if penetration > 0.0 else 0.0
     seg.start_energy[j] += start_energy
     # the nodes' own contacts with this box: integrated here with the thread's (the node contact skips them this
-    # step), by the first thread of the step that takes each node; later threads of that node only predict them
-    own_a = seg.owned_shape[a] < 0
-    own_c = seg.owned_shape[c] < 0 and c != a
+    # step) when this is the node's only thread in contact this step; otherwise the node contact integrates it
+    # with all its threads' forces and the sub-cycles only predict it
+    own_a = seg.node_threads[a] == 1
+    own_c = seg.node_threads[c] == 1 and c != a
     node_energy, node_count = 0.0, 0
     if own_a:
         seg.owned_shape[a] = s
