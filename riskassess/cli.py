@@ -13,8 +13,8 @@ from rich.text import Text
 from multibody.health import SimulationFailed
 from riskassess import __version__
 from riskassess.cases.impact import Case, CaseError, load_case
-from riskassess.cases.towing import SEARCHES
-from riskassess.stages.kinds import KINDS as CASE_KINDS
+from riskassess.cases.inputs import SEARCHES
+from riskassess.stages.kinds import KINDS as CASE_KINDS  # kind names only: each kind's schema loads when used
 from riskassess.products.outfolder import OutputRefused, default_out, step_done
 from riskassess.products.results import MissingData, RunFolder
 

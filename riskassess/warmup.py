@@ -9,7 +9,9 @@ once (one per part, so neither compiles what the other does), moves that wait ou
 ``riskassess run`` and out of every test worker.
 
 Parts:
-- ``import``: imports the command-line interface, which compiles every kernel with a stated signature;
+- ``import``: imports the command-line interface and every case kind's schema and loader (the towing and
+  diagnosis packages, which the CLI loads only for their own commands), which compiles every kernel with a
+  stated signature;
 - ``impact``: runs the shipped ``cases/envisat_small.toml`` for 0.06 s (the net's flight to the target
   plus one contact) into a temporary folder, without the diagnosis packages, which compiles the impact
   path's kernels (net step, contact, recorder row) with the types every impact case uses.
@@ -34,8 +36,12 @@ PARTS = ("import", "impact")
 
 
 def compile_at_import() -> None:
-    """Import the CLI and everything it loads: the kernels with stated signatures compile now."""
+    """Import the CLI and every case kind's schema and loader: the kernels with stated signatures compile now."""
     import riskassess.cli  # noqa: F401
+    from riskassess.stages.kinds import KINDS, schema_and_loader
+
+    for kind in KINDS:
+        schema_and_loader(kind)
 
 
 def compile_impact_path(project: Path) -> None:

@@ -14,9 +14,15 @@ import re
 import stat
 import tomllib
 from pathlib import Path, PurePosixPath
-from typing import Annotated
+from typing import Annotated, Literal, get_args
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, field_validator
+
+#: The optimizers a towing case or ``riskassess identify --optimizers`` may name (plug-ins of
+#: :mod:`riskassess.stages.optimizers`; the tests check each is there). Here rather than in the
+#: towing schema so the CLI's parser can list them without loading the towing models.
+Search = Literal["pso", "pattern", "mads"]
+SEARCHES = get_args(Search)
 
 #: Largest case file read (bytes). The largest shipped case is about 9 kB; 1 MB leaves a hundred
 #: times that for comments and long tables while ``riskassess validate /dev/zero`` stops at once.

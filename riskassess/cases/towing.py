@@ -10,14 +10,14 @@ from __future__ import annotations
 
 import math
 
-from typing import Annotated, Literal, get_args
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
 
 from multibody.control.thrust_laws import LAWS as THRUST_LAWS
 from riskassess.cases.impact import NonNegative, Positive, Strict, Vector3
-from riskassess.cases.inputs import KIND_NOTE, CaseName, Text
+from riskassess.cases.inputs import KIND_NOTE, CaseName, Search, Text
 
 Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
 PositiveVector3 = Annotated[list[Positive], Field(min_length=3, max_length=3)]
@@ -191,10 +191,6 @@ class Rates(Strict):
     validation_deg_s: Annotated[list[NonNegative], Field(min_length=1)] = Field(description="Table 3, validation (deg/s).")
 
 
-#: The optimizers a case or ``riskassess identify --optimizers`` may name (plug-ins of
-#: :mod:`riskassess.stages.optimizers`; the tests check each is there).
-Search = Literal["pso", "pattern", "mads"]
-SEARCHES = get_args(Search)
 
 
 class Optimizers(Strict):

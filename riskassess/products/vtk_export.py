@@ -56,7 +56,6 @@ import numpy as np
 
 from multibody.net import thread_tension_strain
 from riskassess.products.results import MissingData, RunFolder
-from riskassess.products.tow_vtk import export_tow_vtk
 from riskassess.products.vtk_frames import VtkExport, export_frames, nearest_samples, surface_lvlh, surface_velocity_lvlh
 from riskassess.products.vtk_markers import joint_markers
 
@@ -223,6 +222,8 @@ def export_vtk(run_dir: str | Path, out: str | Path | None = None, every: int | 
         Export folder, ``.pvd`` path, number of frames and their times (s).
     """
     if RunFolder(run_dir).stage == "tow":  # a full-net tow folder: its own layout
+        # imported here: it loads the towing models (and their compiled kernels), which an impact export never needs
+        from riskassess.products.tow_vtk import export_tow_vtk
         return export_tow_vtk(run_dir, out, every, progress, overwrite, max_frames)
     return export_frames(run_dir, out, every, progress, _Frames, ("net", "bodies", "bullets", "body_frames", "joints"),
                          "impact.pvd", "positions LVLH (m); body_index -> bodies.json, joint_index -> joints.json",

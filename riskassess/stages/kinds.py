@@ -9,19 +9,49 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from riskassess.cases.approach import ApproachCase
-from riskassess.cases.impact import Case, CaseError, load_case, load_model, read_toml
-from riskassess.cases.diagnosis import SCENARIOS, DiagnosisCaseFile
-from riskassess.diagnosis.cases import load_diagnosis_case
-from riskassess.cases.towing import TowingCase
+from riskassess.cases.impact import CaseError, read_toml
 
-#: Case kind -> (pydantic model of its file, loader of a file of that kind, command that runs it).
+#: Case kind -> the commands that run a case of that kind. Each kind's schema and loader are
+#: imported only when a file of that kind is read (:func:`schema_and_loader`): ``riskassess run``
+#: then never loads the towing and diagnosis packages (and their compiled kernels).
 KINDS = {
-    "impact": (Case, load_case, "run, assess, perceive, sweep"),
-    "towing": (TowingCase, lambda path: load_model(path, TowingCase), "tow, identify"),
-    "diagnosis": (DiagnosisCaseFile, load_diagnosis_case, "diagnose"),
-    "approach": (ApproachCase, lambda path: load_model(path, ApproachCase), "approach"),
+    "impact": "run, assess, perceive, sweep",
+    "towing": "tow, identify",
+    "diagnosis": "diagnose",
+    "approach": "approach",
 }
+
+
+def schema_and_loader(kind: str) -> tuple[type, object]:
+    """The pydantic model of a case file of ``kind`` and the loader of such a file.
+
+    Parameters
+    ----------
+    kind : str
+        One of :data:`KINDS`.
+
+    Returns
+    -------
+    model : type
+        The case file's pydantic model.
+    loader : callable
+        ``loader(path)`` -> the validated case; :class:`~riskassess.cases.impact.CaseError` naming the
+        file and keys when it is not valid.
+    """
+    _known(kind)
+    from riskassess.cases.impact import load_model
+    if kind == "impact":
+        from riskassess.cases.impact import Case, load_case
+        return Case, load_case
+    if kind == "towing":
+        from riskassess.cases.towing import TowingCase
+        return TowingCase, lambda path: load_model(path, TowingCase)
+    if kind == "diagnosis":
+        from riskassess.cases.diagnosis import DiagnosisCaseFile
+        from riskassess.diagnosis.cases import load_diagnosis_case
+        return DiagnosisCaseFile, load_diagnosis_case
+    from riskassess.cases.approach import ApproachCase
+    return ApproachCase, lambda path: load_model(path, ApproachCase)
 
 
 def case_kind(raw: dict) -> str:
@@ -49,6 +79,7 @@ def case_kind(raw: dict) -> str:
     if kind in KINDS and not (kind == "towing" and _legacy_diagnosis(raw)):
         return kind
     if kind is not None:
+        from riskassess.cases.diagnosis import SCENARIOS  # a diagnosis file names its scenario
         if kind in SCENARIOS:
             return "diagnosis"
         raise ValueError(f"kind: '{kind}' is not a case kind; the kinds are: {', '.join(KINDS)} "
@@ -96,7 +127,7 @@ def load_any_case(path: str | Path) -> tuple[str, object]:
         raise
     except ValueError as exc:
         raise CaseError(f"{path}: {exc}") from None
-    return kind, KINDS[kind][1](path)
+    return kind, schema_and_loader(kind)[1](path)
 
 
 def case_schema(kind: str = "impact") -> dict:
@@ -113,8 +144,8 @@ def case_schema(kind: str = "impact") -> dict:
     -------
     dict
     """
-    _known(kind)
-    model, _, commands = KINDS[kind]
+    model, _ = schema_and_loader(kind)
+    commands = KINDS[kind]
     schema = model.model_json_schema()
     schema.setdefault("title", model.__name__)
     schema["description"] = (f"riskassess {kind} case file (TOML), for: {commands}. "

@@ -131,7 +131,7 @@ def test_a_diverged_twin_run_scores_inf(monkeypatch):
 
 def test_optimizers_are_plug_ins_found_by_name_and_an_unknown_one_is_refused():
     """Issue 21: one file per optimizer; the case schema's and the CLI's names are the registry's."""
-    from riskassess.cases.towing import SEARCHES
+    from riskassess.cases.inputs import SEARCHES
     from riskassess.stages.optimizers import OPTIMIZERS
 
     assert set(OPTIMIZERS) == {"pso", "pattern", "polish", "mads"}
