@@ -14,12 +14,16 @@ the world at t = 0, and the inertia-ratio errors of the torque-free fit.
 
     python bench/bench_scan_to_map.py [--seeds 0 1 2 3 4] [--duration 20] [--body featured|ellipsoid]
                                       [--models none known] [--settled 1e-4 1e-3] [--tukey 0.5 1]
-                                      [--prefixes 5 10 20 30 60]
+                                      [--prefixes 5 10 20 30 60] [--constants "" "FINE_POINTS=2000"]
 
 ``--prefixes``: the data-length study (Tang et al. 2023, Table 4) from one tracked run per seed: the
 fits redone on the first T s of the frames, for each T. The track of frame k uses only frames up to k
 (the map is built from the frames registered before it), so a prefix is exactly what a T-s observation
 would have given.
+
+``--constants``: an A/B of any of the module's constants (perception/scan_to_map.py, e.g. ``COARSE_ITERATIONS=10``,
+``FINE_POINTS=2000,MAP_INTERVAL=20``; ``""`` is the module as it is): each seed's scans are tracked once per entry,
+back to back in one process, every constant back at the module's value before each entry.
 """
 from __future__ import annotations
 
@@ -77,6 +81,23 @@ def _figures(times, body_to_world_true, world_to_body, ok, information, seconds)
             f"CoM {com:.1f} mm; ratios {np.round(ratios, 3) if not isinstance(ratios, str) else ratios} %")
 
 
+#: Constants of perception/scan_to_map.py that ``--constants`` may set (reset to these before each entry).
+_TUNABLE = ("SETTLED", "TUKEY_CUTOFF", "COARSE_ITERATIONS", "FINE_ITERATIONS", "COARSE_POINTS", "FINE_POINTS",
+            "MAP_COVERED", "MAP_INTERVAL", "MIN_FITNESS")
+
+
+def _constants(entry):
+    """``"NAME=VALUE,NAME=VALUE"`` -> {NAME: value} (int or float as the module's own), checked against
+    :data:`_TUNABLE`; ``""`` -> {}."""
+    chosen = {}
+    for item in filter(None, (part.strip() for part in entry.split(","))):
+        name, _, value = item.partition("=")
+        if name not in _TUNABLE or not value:
+            raise SystemExit(f"--constants {entry!r}: {item!r} is not NAME=VALUE with NAME one of {', '.join(_TUNABLE)}")
+        chosen[name] = type(getattr(scan_to_map, name))(float(value))
+    return chosen
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
@@ -92,25 +113,32 @@ def main():
                              "scan_to_map.TUKEY_CUTOFF); each seed is tracked once per value, back to back")
     parser.add_argument("--prefixes", type=float, nargs="+", default=None,
                         help="data lengths (s): the fits also redone on the first T s of each track (Table 4)")
+    parser.add_argument("--constants", nargs="+", default=None,
+                        help='scan-to-map constants to compare, one entry per track: "NAME=VALUE,NAME=VALUE" '
+                             '(perception/scan_to_map.py; "" the module as it is); back to back per seed')
     args = parser.parse_args()
+    entries = [_constants(entry) for entry in args.constants or [""]]
     times = np.arange(int(round(args.duration * LIDAR.rate)) + 1) / LIDAR.rate
     quaternions, _ = propagate_torque_free(np.array([1.0, 0, 0, 0]), OMEGA0, MOMENTS / MOMENTS[2], times, 0.005)
     body_to_world = rotations_from_wxyz(quaternions).as_matrix()
     mesh = _body(args.body)
     o3d.utility.set_verbosity_level(o3d.utility.VerbosityLevel.Error)   # RANSAC re-acquisition warnings
+    defaults = {name: getattr(scan_to_map, name) for name in _TUNABLE}
     print(f"load {os.getloadavg()[0]:.2f}; {args.body} body, {args.duration:g} s at {LIDAR.rate:g} Hz")
     for seed in args.seeds:
         rng = np.random.default_rng(seed)
         scans = [cast(LIDAR, [(mesh.vertices @ r.T + COM0 + VELOCITY * t, mesh.faces)], t, rng).points_sensor
                  for t, r in zip(times, body_to_world)]
-        variants = [(settled, tukey) for settled in (args.settled or [scan_to_map.SETTLED])
-                    for tukey in (args.tukey or [scan_to_map.TUKEY_CUTOFF])]
-        for settled, tukey in variants if "none" in args.models else []:
-            scan_to_map.SETTLED, scan_to_map.TUKEY_CUTOFF = settled, tukey
+        variants = [(settled, tukey, entry) for settled in (args.settled or [defaults["SETTLED"]])
+                    for tukey in (args.tukey or [defaults["TUKEY_CUTOFF"]]) for entry in entries]
+        for settled, tukey, entry in variants if "none" in args.models else []:
+            for name, value in {**defaults, "SETTLED": settled, "TUKEY_CUTOFF": tukey, **entry}.items():
+                setattr(scan_to_map, name, value)
             free = track_scans(scans, VOXEL, CORRESPONDENCE)
             records = alignments(free, times)
             # B of the model-free track is the first scan's frame; the truth in it: R_k R_0^T (R_0 = I here)
-            print(f"seed {seed} none, settled {1e3 * settled:g} mm, Tukey {tukey:g} x distance: "
+            named = "".join(f", {name} {value:g}" for name, value in entry.items())
+            print(f"seed {seed} none, settled {1e3 * settled:g} mm, Tukey {tukey:g} x distance{named}: "
                   + _figures(times, body_to_world, free.world_to_body, free.ok,
                              np.array([a.information for a in records]), free.cpu_seconds), flush=True)
             for length in args.prefixes or []:

@@ -7,9 +7,11 @@ onto a fixed (1e12 kg) 0.4 x 0.05 x 0.4 m plate whose face is at y = -0.025 m: b
 under the thread's middle ("flat, s = 0.5") or off it ("flat, s = 0.625"), or one node over the face and the other
 0.3 m or 0.85 m beyond its edge ("edge"). For each step and key setting the bench prints the energy balance
 (kinetic + thread + contact elastic + dissipation the contacts book) against the launch energy: the largest drift
-and the drift at the end (4 ms, the contact over), and the kinetic energy left against the launch's. The health
-check's energy limit is lifted here so a drifting set-up is measured, not refused (docs/model.md, "Contact",
-"Where the strike's energy came from").
+and the drift at the end (4 ms, the contact over), the kinetic energy left against the launch's and, with the key
+on, the thread contact's own record: the energy made between steps (its contact energy at each step's start less
+what its sub-cycle ended the last step with, summed: ``SegmentBuffers.energy_jump``) and the energy it booked as
+dissipated. The health check's energy limit is lifted here so a drifting set-up is measured, not refused
+(docs/model.md, "Contact", "Where the strike's energy came from").
 """
 from __future__ import annotations
 
@@ -32,7 +34,8 @@ SETUPS = {"flat, s = 0.5": (-0.5, 0.5), "flat, s = 0.625": (-0.5, 0.3), "edge, 0
 
 def strike(x_a: float, x_b: float, speed: float, step: float, thread_segments: bool, end_time: float = 4e-3):
     """The recorded series of one thread (nodes at x_a, x_b, m) falling flat at ``speed`` (m/s) onto the plate,
-    its surface 2.5 steps of flight from the face at the start."""
+    its surface 2.5 steps of flight from the face at the start, and the thread contact's buffers
+    (:class:`multibody.contact_segment.SegmentBuffers`: its per-thread energy record)."""
     y0 = -0.025 - 0.001 - 2.5 * speed * step
     positions = np.array([[x_a, y0, 0.0], [x_b, y0, 0.0]])
     net = NetTopology(positions=positions, masses=np.full(2, 0.04223), radii=np.full(2, 0.001),
@@ -53,7 +56,8 @@ def strike(x_a: float, x_b: float, speed: float, step: float, thread_segments: b
                           implicit_contact_speed=0.15))
     simulation = ImpactSimulation(assembly)
     simulation.health.reference_energy = None       # measure the drift, do not refuse it
-    return simulation.run().series
+    series = simulation.run().series
+    return series, simulation.system.kernel.buffers.segments
 
 
 def main(argv=None) -> None:
@@ -66,12 +70,15 @@ def main(argv=None) -> None:
     for name, (x_a, x_b) in SETUPS.items():
         for step in (float(s) for s in args.steps.split(",")):
             for key in args.keys.split(","):
-                series = strike(x_a, x_b, args.speed, step, key == "on")
+                series, segments = strike(x_a, x_b, args.speed, step, key == "on")
                 launch = series["energy_net_kinetic"][0]
                 drift = (series["energy_total"] - series["energy_total"][0]) / launch
                 print(f"{name:22s} step {step:.1e} s  thread_segments {key:3s}: drift largest {100 * drift.max():+7.2f} %"
                       f", at the end {100 * drift[-1]:+7.3f} %; kinetic energy left "
-                      f"{series['energy_net_kinetic'][-1] / launch:.3f} of the launch's", flush=True)
+                      f"{series['energy_net_kinetic'][-1] / launch:.3f} of the launch's"
+                      + (f"; the thread contact made {100 * segments.energy_jump.sum() / launch:+.3f} % between steps, "
+                         f"dissipated {100 * segments.dissipated.sum() / launch:.2f} %" if key == "on" else ""),
+                      flush=True)
 
 
 if __name__ == "__main__":

@@ -44,6 +44,24 @@ Items (changes to the case; ``nominal`` is the case itself):
 - ``paper_step_1ms_loads``: the ``paper_step`` wall loads averaged over 1 ms, applied at the case's 1e-4 s step:
   whether the hinge follows the load's bandwidth or its level.
 
+The net's state at the first impact (helper wrap12; the paper's net is ejected and its energy first "decreases due to
+the net deployment energy damping", Sec. 3.5, but neither its shape nor its opening at the impact is stated; ours
+arrives flat and fully open). Each in memory with the paper's numerics (as ``paper_step``: one run gives every reading
+of both the first impact and the band), read also by :func:`impact_figures` (first impact and late strikes in the
+native output, 0.6 ms and 1 ms means):
+
+- ``first_impact_scan``: wall runs to 0.6 s only, over the arrival states of :data:`FIRST_IMPACT_SCAN` (bowl sag
+  0-5 m, mouth 0.8, opening / closing 5 m/s, replicas);
+- ``arrival_bowl_2m`` / ``arrival_bowl_5m``: the net's centre trailing its corners by 2 / 5 m (:func:`bowl_arrival`);
+- ``arrival_closing``: 2 m sag, mouth closed to 0.8, nodes moving inward (5 m/s at the bullets): a net past its
+  largest opening, as the paper's "decrease in the bullets' velocity" may be;
+- ``arrival_bowl_2m_hub``: ``arrival_bowl_2m`` again, its wall loads also applied as the whole wrench on the main body
+  (the paper's eqs. 9 and 12, as ``hub_loads``) in a second driven run: the paper's hinge procedure on its per-step loads;
+- ``paper_step_r+1`` / ``paper_step_r-1`` / ``arrival_bowl_2m_r+1``: replicas, launch speed x (1 + k 1e-7)
+  (bench/bench_coupling_replicas.py), so a change is known to exceed the round-off spread;
+- ``wall_full_size_body`` / ``wall_appendages_075``: the first stage's wall of another size (:func:`scaled_target`;
+  the paper's "reduction factor 0.75" does not say what it scales; case numerics, like ``nominal``).
+
 Results: ``bench/results/wrapping_level.json`` (resumable per item), with CPU time and load per run.
 """
 from __future__ import annotations
@@ -148,9 +166,14 @@ def hinge_figures(series: dict) -> dict:
     t = series["time"]
     m = series["joint_moment_joint"][:, hinge]
     judged, inside = t >= SKIP_S, (t > WINDOW_S[0]) & (t <= WINDOW_S[1])
+    # what a line plot of the hinge moment shows (the paper's Fig. 12 is read off one): per 7.5 ms column the
+    # largest |M|; median and 90th percentile over the columns after 0.25 s
+    band = plot_band(t, m, (SKIP_S, float(t[-1])))
     return {"h1 / h3 RMS after 0.25 s (N m)": np.sqrt((m[judged][:, [0, 2]] ** 2).mean(axis=0)).tolist(),
             "h1 / h3 largest after 0.25 s (N m)": np.abs(m[judged][:, [0, 2]]).max(axis=0).tolist(),
-            "h1 / h3 RMS 1-7.5 s (N m)": np.sqrt((m[inside][:, [0, 2]] ** 2).mean(axis=0)).tolist()}
+            "h1 / h3 RMS 1-7.5 s (N m)": np.sqrt((m[inside][:, [0, 2]] ** 2).mean(axis=0)).tolist(),
+            "h1 / h3 plot band after 0.25 s, median (N m)": [band["median"][0], band["median"][2]],
+            "h1 / h3 plot band after 0.25 s, p90 (N m)": [band["p90"][0], band["p90"][2]]}
 
 
 def wrapping_figures(run: Path, case) -> dict:
@@ -232,7 +255,10 @@ def item_case(item: str):
 
 
 ITEMS = ("nominal", "paper_step", "thread_segments", "contact_stiffness_x10", "threads_x4", "short_tether",
-         "mesh_25", "hub_loads", "samplings", "bullets_outward", "paper_step_1ms_loads")
+         "mesh_25", "hub_loads", "samplings", "bullets_outward", "paper_step_1ms_loads",
+         "first_impact_scan", "arrival_bowl_2m", "paper_step_r+1", "arrival_bowl_5m", "arrival_closing",
+         "paper_step_r-1", "arrival_bowl_2m_r+1", "wall_full_size_body", "wall_appendages_075",
+         "arrival_bowl_2m_hub")
 
 
 def hub_wrench(wall: dict, main: int) -> tuple[np.ndarray, np.ndarray]:
@@ -310,6 +336,22 @@ def bullets_outward(speed: float = 5.0) -> dict:
     at launch: a net pulled taut by its bullets, as a net still deploying would be (the paper's net is ejected and
     its energy first "decreases due to the net deployment energy damping", Sec. 3.5; its bullets' ejection velocity
     is not given: 5 m/s is a sensitivity, 14 deg off the launch axis)."""
+    def outward(net, velocity, launch):
+        centre = net.positions[:-net.n_bullets].mean(axis=0)
+        for k in range(len(velocity) - net.n_bullets, len(velocity)):
+            radial = net.positions[k] - centre
+            radial -= radial.dot(launch) * launch
+            velocity[k] += speed * radial / np.linalg.norm(radial)
+        return net.positions, velocity
+
+    return {"bullet outward speed (m/s)": speed} | in_memory_run(item_case("nominal"), outward)
+
+
+def in_memory_run(case, arrival=None, hub: bool = False) -> dict:
+    """One sequential run of ``case`` in memory (wall run, then the driven debris), the net's launch state first
+    changed by ``arrival(net, velocity, launch) -> (positions, velocity)`` (LVLH, m and m/s; ``launch`` the unit
+    launch direction) if given; its CPU time (s), load and figures (:func:`series_figures`, :func:`impact_figures`);
+    with ``hub`` also the hinge figures of the same wall loads applied as the whole wrench on the main body."""
     import dataclasses
 
     from riskassess.models.impact import model_inputs
@@ -317,28 +359,202 @@ def bullets_outward(speed: float = 5.0) -> dict:
     from riskassess.stages.run import _simulation
 
     HealthWatch.__init__.__defaults__ = (None, LIFTED_DRIFT_LIMIT)
-    case = item_case("nominal")
     inputs = model_inputs(case, CASE.parent)
     assembly = inputs.assembly
-    net = assembly.net
-    velocity = np.array(assembly.net_velocity, float)
-    centre = net.positions[:-net.n_bullets].mean(axis=0)
-    launch = np.asarray(case.launch.direction, float) / np.linalg.norm(case.launch.direction)
-    for k in range(len(velocity) - net.n_bullets, len(velocity)):
-        radial = net.positions[k] - centre
-        radial -= radial.dot(launch) * launch
-        velocity[k] += speed * radial / np.linalg.norm(radial)
-    inputs = dataclasses.replace(inputs, assembly=dataclasses.replace(assembly, net_velocity=velocity))
+    if arrival is not None:
+        launch = np.asarray(case.launch.direction, float) / np.linalg.norm(case.launch.direction)
+        positions, velocity = arrival(assembly.net, np.array(assembly.net_velocity, float), launch)
+        net = dataclasses.replace(assembly.net, positions=np.asarray(positions, float))
+        inputs = dataclasses.replace(inputs, assembly=dataclasses.replace(assembly, net=net, net_velocity=velocity))
     load = os.getloadavg()[0]
     cpu = time.process_time()
     wall = _simulation(wall_inputs(inputs))
-    wall_recorder = wall.run()
-    loads = recorded_loads(wall_recorder.series, wall.health.reference_energy)
-    driven = _simulation(driven_inputs(inputs, loads))
-    series = dict(driven.run().series)
+    try:
+        wall_recorder = wall.run()
+        loads = recorded_loads(wall_recorder.series, wall.health.reference_energy)
+        driven = _simulation(driven_inputs(inputs, loads))
+        series = dict(driven.run().series)
+    except Exception as error:   # a refused or failed run is a result too (e.g. the health check)
+        return {"failed": f"{type(error).__name__}: {error}", "cpu (s)": time.process_time() - cpu}
     series["joint_names"] = np.array([j.name for j in driven.assembly.joints])
-    out = {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]], "bullet outward speed (m/s)": speed}
-    return out | series_figures(dict(wall_recorder.series), dict(wall_recorder.net), series, case)
+    wall_series = dict(wall_recorder.series)
+    out = {}
+    if hub:      # the same wall loads moved onto the main body (hub_wrench), a second driven run
+        from multibody.recorded_loads import RecordedBodyLoads
+
+        force, moment = hub_wrench(wall_series, [b.name for b in assembly.bodies].index("main_body"))
+        on_main = RecordedBodyLoads(time=wall_series["time"][1:], force_lvlh=force[1:], moment_body=moment[1:],
+                                    reference_energy=loads.reference_energy)
+        out = {f"whole wrench on the main body: {k}": v for k, v in driven_hinge_figures(case, on_main).items()}
+    out = {"cpu (s)": time.process_time() - cpu, "load": [load, os.getloadavg()[0]]} | out
+    return (out | impact_figures(wall_series)
+            | series_figures(wall_series, dict(wall_recorder.net), series, case))
+
+
+#: a resultant larger than this (N) marks the first contact: the first-impact window starts there
+FIRST_CONTACT_N = 10.0
+#: the first impact's window after the first contact (s): the paper's peaks "at the impact moment ... (near t ~ 0)"
+FIRST_IMPACT_S = 0.3
+#: the readings the paper's plotted output may be (docs/model.md "What the paper's plotted quantity can be"): the
+#: native output and means over 0.6 ms (which give both first-impact peaks on a flat net) and 1 ms (the case's)
+IMPACT_WINDOWS_S = (None, 6e-4, 1e-3)
+
+
+def impact_figures(wall: dict) -> dict:
+    """The first impact and the late strikes of a wall run in each reading of :data:`IMPACT_WINDOWS_S`: the largest
+    |resultant force| (kN) and |moment about the debris CoM| (kN m) within :data:`FIRST_IMPACT_S` of the first
+    contact, and the largest |force| after the wrapping window's start with its time (the paper: 12 kN, 160 kN m
+    at the first impact; a bullet striking the ASAR with 4.5 kN at ~4.7 s, its Sec. 3.2)."""
+    t = wall["time"]
+    force, moment = contact_totals_debris(wall)
+    t0 = float(t[np.argmax(np.linalg.norm(force, axis=1) > FIRST_CONTACT_N)])
+    out = {"first contact (s)": t0}
+    for width in IMPACT_WINDOWS_S:
+        tm, fm, mm = (t, force, moment) if width is None else (block_means(t, force, width)[0],
+                                                            block_means(t, force, width)[1],
+                                                            block_means(t, moment, width)[1])
+        name = "native output" if width is None else f"{1e3 * width:.3g} ms means"
+        first, late = (tm >= t0) & (tm <= t0 + FIRST_IMPACT_S), tm > WINDOW_S[0]
+        f, m = np.linalg.norm(fm, axis=1), np.linalg.norm(mm, axis=1)
+        k = int(np.argmax(np.where(late, f, -1.0)))
+        out[f"first impact, largest force (kN) / moment (kN m), {name}"] = [
+            1e-3 * float(f[first].max()), 1e-3 * float(m[first].max())]
+        out[f"after {WINDOW_S[0]:g} s, largest force (kN) and its time (s), {name}"] = [1e-3 * float(f[k]),
+                                                                                      float(tm[k])]
+    return out
+
+
+def bowl_arrival(sag: float, radial_speed: float = 0.0, mouth: float = 1.0):
+    """A launch state of a net still in its deployment (the paper's net is ejected and its energy first "decreases
+    due to the net deployment energy damping", Sec. 3.5; it states neither the net's shape nor its opening at the
+    first impact): the net's centre trails its corners by ``sag`` (m; a paraboloid in the distance from the centre,
+    the bowl a net pulled open by leading corner masses takes), the mouth closed to ``mouth`` of its span (and
+    further as the sag needs, so that no thread starts stretched), every node at the launch velocity plus an
+    in-plane radial ``radial_speed`` (m/s, at the bullets; > 0 opening, < 0 closing) in proportion to its distance
+    from the centre. The along-track momentum is the flat net's (the paper's 32 mm/s exchange is kept)."""
+    def arrival(net, velocity, launch):
+        from multibody.net import bowl_net_positions
+
+        positions = bowl_net_positions(net, launch, sag, mouth)
+        centre = net.positions[:net.nodes_per_side ** 2].mean(axis=0)
+        in_plane = net.positions - centre - np.outer((net.positions - centre) @ launch, launch)
+        return positions, velocity + radial_speed * in_plane / np.linalg.norm(in_plane[-net.n_bullets:],
+                                                                             axis=1).mean()
+
+    return arrival
+
+
+def scaled_target(case, body_factor: float, appendage_factor: float):
+    """The case with the main body's box scaled by ``body_factor`` about its CoM and every appendage's shapes by
+    ``appendage_factor`` about its joint to its parent, each appendage kept on its parent at the same place of the
+    parent's (scaled) surface; masses kept, inertias scaled by the factors squared. The paper's mock-up has a
+    "reduction factor 0.75" (its Table 2) without saying what it scales: ours scales the main body only."""
+    data = case.model_dump()
+    bodies = {b["name"]: b for b in data["target"]["bodies"]}
+    joints = {j["child"]: j for j in data["target"]["joints"]}
+    main = next(name for name in bodies if name not in joints)
+    moved = {main: (np.zeros(3), np.zeros(3), body_factor)}     # body -> (old anchor, new anchor, factor)
+
+    def place(name):
+        if name not in moved:
+            joint = joints[name]
+            old_parent, new_parent, parent_factor = place(joint["parent"])
+            old = np.asarray(joint["position"], float)
+            new = new_parent + parent_factor * (old - old_parent)
+            joint["position"] = new.tolist()
+            moved[name] = (old, new, appendage_factor)
+        return moved[name]
+
+    for name, body in bodies.items():
+        old, new, factor = place(name)
+        body["center_of_mass"] = (new + factor * (np.asarray(body["center_of_mass"], float) - old)).tolist()
+        body["inertia"] = (factor ** 2 * np.asarray(body["inertia"], float)).tolist()
+        for shape in body["shapes"]:
+            shape["center"] = (new + factor * (np.asarray(shape["center"], float) - old)).tolist()
+            for key in ("size",):
+                if key in shape:
+                    shape[key] = (factor * np.asarray(shape[key], float)).tolist()
+            for key in ("radius", "length"):
+                if key in shape:
+                    shape[key] = factor * shape[key]
+    for joint in data["target"]["joints"]:     # joints whose child is main (none) or already placed
+        place(joint["child"])
+    return type(case).model_validate(data)
+
+
+def replica(case, k: int, eps: float = 1e-7):
+    """``case`` with the launch speed x (1 + k eps) (bench/bench_coupling_replicas.py's replicas)."""
+    return _with(case, "launch", velocity=case.launch.velocity * (1.0 + k * eps))
+
+
+#: the net's state at the first impact (in memory, the paper's numerics: its step, contact once a step, output at
+#: every step, so that one run gives every reading of the first impact and of the band) and the replicas
+ARRIVALS = {
+    "paper_step_r+1": (1, None),
+    "paper_step_r-1": (-1, None),
+    "arrival_bowl_2m": (0, bowl_arrival(2.0)),
+    "arrival_bowl_5m": (0, bowl_arrival(5.0)),
+    "arrival_bowl_2m_r+1": (1, bowl_arrival(2.0)),
+    "arrival_closing": (0, bowl_arrival(2.0, radial_speed=-5.0, mouth=0.8)),
+    "arrival_bowl_2m_hub": (0, bowl_arrival(2.0)),
+}
+#: the first stage's wall of another size (case numerics, like ``nominal``): (main body factor, appendage factor)
+#: relative to the case's geometry (main body already 0.75 of Envisat's envelope, appendages at their real sizes)
+WALLS = {"wall_full_size_body": (1.0 / 0.75, 1.0), "wall_appendages_075": (1.0, 0.75)}
+
+
+#: first-impact-only runs (0.6 s, wall run only, the paper's numerics): sag (m), radial speed (m/s), mouth, replica k
+FIRST_IMPACT_SCAN = {
+    "flat (the case)": (0.0, 0.0, 1.0, 0), "flat, k = +1": (0.0, 0.0, 1.0, 1),
+    "sag 0.1 m": (0.1, 0.0, 1.0, 0), "sag 0.25 m": (0.25, 0.0, 1.0, 0), "sag 0.5 m": (0.5, 0.0, 1.0, 0),
+    "sag 1 m": (1.0, 0.0, 1.0, 0), "sag 2 m": (2.0, 0.0, 1.0, 0), "sag 2 m, k = +1": (2.0, 0.0, 1.0, 1),
+    "sag 2 m, k = -1": (2.0, 0.0, 1.0, -1), "sag 3 m": (3.0, 0.0, 1.0, 0), "sag 5 m": (5.0, 0.0, 1.0, 0),
+    "flat, mouth 0.8": (0.0, 0.0, 0.8, 0), "sag 2 m, opening 5 m/s": (2.0, 5.0, 1.0, 0),
+    "sag 2 m, mouth 0.8, closing 5 m/s": (2.0, -5.0, 0.8, 0),
+}
+
+
+def first_impact_scan(end_time: float = 0.6) -> dict:
+    """The first impact in every reading (:func:`impact_figures`) over the net's arrival states of
+    :data:`FIRST_IMPACT_SCAN` (wall run only, to ``end_time``): the CPU time (s), load and figures of each."""
+    import dataclasses
+
+    from riskassess.models.impact import model_inputs
+    from riskassess.models.impact_sequential import wall_inputs
+    from riskassess.stages.run import _simulation
+
+    HealthWatch.__init__.__defaults__ = (None, LIFTED_DRIFT_LIMIT)
+    rows = {}
+    for name, (sag, radial, mouth, k) in FIRST_IMPACT_SCAN.items():
+        case = replica(_with(item_case("paper_step"), "simulation", end_time=end_time), k)
+        inputs = model_inputs(case, CASE.parent)
+        assembly = inputs.assembly
+        if (sag, radial, mouth) != (0.0, 0.0, 1.0):
+            launch = np.asarray(case.launch.direction, float) / np.linalg.norm(case.launch.direction)
+            positions, velocity = bowl_arrival(sag, radial, mouth)(assembly.net, np.array(assembly.net_velocity),
+                                                                  launch)
+            assembly = dataclasses.replace(assembly, net=dataclasses.replace(assembly.net, positions=positions),
+                                           net_velocity=velocity)
+            inputs = dataclasses.replace(inputs, assembly=assembly)
+        load, cpu = os.getloadavg()[0], time.process_time()
+        series = dict(_simulation(wall_inputs(inputs)).run().series)
+        figures = impact_figures(series)
+        flat_span = np.ptp(model_inputs(case, CASE.parent).assembly.net.positions[:, 0])
+        rows[name] = {"cpu (s)": time.process_time() - cpu, "load": load,
+                      "in-plane mouth scale": float(np.ptp(assembly.net.positions[:, 0]) / flat_span)}
+        rows[name] |= {key: value for key, value in figures.items() if not key.startswith("after")}
+        print(name, json.dumps(rows[name]), flush=True)
+    return rows
+
+
+def arrival_item(item: str) -> dict:
+    """One item of :data:`ARRIVALS` or :data:`WALLS`."""
+    if item in WALLS:
+        case = scaled_target(item_case("nominal"), *WALLS[item])
+        return {"scale (main body, appendages)": list(WALLS[item])} | in_memory_run(case)
+    k, arrival = ARRIVALS[item]
+    return {"replica k (launch speed x (1 + k 1e-7))": k} | in_memory_run(replica(item_case("paper_step"), k),
+                                                                          arrival, hub=item.endswith("_hub"))
 
 
 def paper_step_1ms_loads(keep: Path) -> dict:
@@ -400,8 +616,9 @@ def main() -> None:
         if args.table_only or item in store:
             continue
         special = {"hub_loads": lambda: hub_loads(args.keep), "samplings": lambda: samplings(args.keep),
-                   "bullets_outward": bullets_outward,
+                   "bullets_outward": bullets_outward, "first_impact_scan": first_impact_scan,
                    "paper_step_1ms_loads": lambda: paper_step_1ms_loads(args.keep)}
+        special |= {name: (lambda name=name: arrival_item(name)) for name in (*ARRIVALS, *WALLS)}
         store[item] = special[item]() if item in special else run_item(item, args.keep)
         print(f"{item}: {json.dumps(store[item])}", flush=True)
         save_store(store, STORE)

@@ -186,6 +186,8 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
     out_body_impulse, out_node_impulse = buffers.body_impulse_lvlh, buffers.node_impulse_lvlh
     non_contact_force_lvlh, start_velocity_lvlh = buffers.work[2], buffers.work[3]
     n = net_mass.shape[0]
+    # pairs a thread's sub-cycle integrated this step (multibody.contact_segment; none when thread contact is off)
+    segments_on, owned_shape = buffers.segments.enabled != 0, buffers.segments.owned_shape
     contact_energy = 0.0
     n_contacts = 0
     dissipated_total = 0.0
@@ -243,6 +245,8 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
         k = 0
         for s in range(n_shapes):
             if not candidates[s, i]:
+                continue
+            if segments_on and owned_shape[i] == s:
                 continue
             b = shape_body[s]
             # Broad phase in scalars: node in the body frame against the shape's box, grown by

@@ -214,6 +214,8 @@ class KernelNet:
         self._q_next_bodies = np.zeros(6 * kernel.n_bodies)  # the step's end coordinates of the bodies (m, rad)
         self._force_bodies = np.zeros(6 * kernel.n_bodies)   # the bodies' generalized forces of the step
         self._views = None
+        #: Exudyn's (q, qt, qtt) views while :attr:`after_step` runs from the pre-step function, else None
+        self.step_views = None
         self._last_time = -np.inf
         self._view_window = 1.5 * kernel.step   # a time further on than this starts a new solve (_state_views)
         #: optional ``after_step(mbs, t) -> bool``, the work of a post-step function for the step that ended at
@@ -253,7 +255,11 @@ class KernelNet:
             # through the view already at hand (fetching one was about 1 us of every step)
             rotations.restore_into(q)
         if self.after_step is not None:
+            # the views at hand for the post-step work (the recorder's sample: fetching them again was about 2 us
+            # of every step in the run, 20 us a sample); valid only inside this call
+            self.step_views = self._views
             keep = self.after_step(mbs, self._previous_end)
+            self.step_views = None
             self._previous_end = t
             if not keep:
                 return False

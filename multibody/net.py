@@ -143,6 +143,55 @@ def in_plane_axes(direction):
     return e1, np.cross(direction_unit, e1)
 
 
+def bowl_net_positions(net: NetTopology, direction, sag: float, mouth: float = 1.0) -> np.ndarray:
+    """Node positions of a net arriving as a bowl: its centre trailing its corners by ``sag``.
+
+    A net pulled open by leading corner masses does not arrive flat (its deployment's drag of the bullets
+    on the mesh; the seed paper's net is ejected and "deployment energy damping" precedes its impact, Sec. 3.5).
+    The offset along ``direction`` is a paraboloid in each node's distance rho from the grid centre,
+    -sag (1 - (rho / rho_corner)^2) (bullets beyond the corners lead slightly); the in-plane offsets are scaled
+    by ``mouth``, or less where the sag needs it, so that no thread is longer than its rest length: the bowl
+    starts without tension.
+
+    Parameters
+    ----------
+    net : NetTopology
+        A flat net (:func:`flat_square_net`), positions LVLH (m).
+    direction : (3,) float
+        Launch direction, LVLH (-), normal to the flat net.
+    sag : float
+        Depth of the bowl (m), the centre trailing the corners; 0 with ``mouth`` 1 gives the flat positions (to
+        round-off).
+    mouth : float
+        Largest in-plane scale (-), in (0, 1]: a mouth not fully open.
+
+    Returns
+    -------
+    (n, 3) float
+        Node positions, LVLH (m).
+
+    Raises
+    ------
+    ValueError
+        When the sag is too deep for any thread to keep its rest length (sag >= ~ rho_corner / 2).
+    """
+    direction = np.asarray(direction, float) / np.linalg.norm(direction)
+    grid = net.positions[: net.nodes_per_side ** 2]
+    centre = grid.mean(axis=0)
+    offset = net.positions - centre
+    in_plane = offset - np.outer(offset @ direction, direction)
+    rho = np.linalg.norm(in_plane, axis=1)
+    axial = -sag * (1.0 - (rho / rho[: len(grid)].max()) ** 2)
+    a, b = net.threads[:, 0], net.threads[:, 1]
+    room = net.rest_lengths ** 2 - (axial[a] - axial[b]) ** 2
+    if room.min() <= 0.0:
+        raise ValueError(f"a bowl of sag {sag:g} m is too deep for this net: a thread would be longer than its rest "
+                         "length at any opening (allowed: below about a third of the side length)")
+    span = np.linalg.norm(in_plane[a] - in_plane[b], axis=1)
+    scale = min(float(mouth), float(np.sqrt((room / span ** 2).min())))
+    return centre + scale * in_plane + np.outer(offset @ direction + axial, direction)
+
+
 def flat_square_net(center, direction, side_length, nodes_per_side, node_mass, node_radius,
                     thread_axial_rigidity, thread_damping, bullet_mass, bullet_radius,
                     bullet_tether_length, bending_rigidity=0.0) -> NetTopology:

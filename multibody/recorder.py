@@ -37,7 +37,6 @@ to ~5 um, a thread stretch worth ~0.3 N of tension.
 """
 from __future__ import annotations
 
-import exudyn as exu
 import numpy as np
 
 from multibody.health import HealthWatch
@@ -121,6 +120,7 @@ class Recorder:
         mbs = system.mbs
         self._body_index = [mbs.GetNodeODE2Index(nd) for nd in system.body_nodes]
         self._joint_stiffness = [np.diag(mbs.GetObjectParameter(obj, "stiffness")) for obj in system.joint_objects]
+        self._joint_damping = [np.diag(mbs.GetObjectParameter(obj, "damping")) for obj in system.joint_objects]
         self._preallocate(assembly, system)
         self.series: dict[str, np.ndarray] = {}
         self.net: dict[str, np.ndarray] = {}
@@ -173,14 +173,16 @@ class Recorder:
             joint_to_child=np.array(system.joint_to_child, float).reshape(nj, 3, 3),
             point_parent=np.array(system.joint_point_parent_body, float).reshape(nj, 3),
             point_child=np.array(system.joint_point_child_body, float).reshape(nj, 3),
-            stiffness=np.array(self._joint_stiffness, float).reshape(nj, 6))
+            stiffness=np.array(self._joint_stiffness, float).reshape(nj, 6),
+            damping=np.array(self._joint_damping, float).reshape(nj, 6))
         view = self._row_view
         self._body_out = body_sample_buffers(nb, nj)._replace(
             com_lvlh=view["body_com_lvlh"], velocity_lvlh=view["body_velocity_lvlh"],
             body_to_lvlh=view["body_to_lvlh"], omega_body=view["body_omega_body"],
             force_lvlh=view["contact_force_lvlh"], moment_lvlh=view["contact_moment_lvlh"],
             force_body=view["contact_force_body"], moment_body=view["contact_moment_body"],
-            joint_rotation=view["joint_rotation_joint"], joint_rate=view["joint_rate_joint"])
+            joint_rotation=view["joint_rotation_joint"], joint_rate=view["joint_rate_joint"],
+            joint_force=view["joint_force_joint"], joint_moment=view["joint_moment_joint"])
         self._joint_active_float = np.ones(nj)
         self._net_totals = np.zeros(8)
         data = system.mbs.systemData
@@ -197,13 +199,6 @@ class Recorder:
                                     np.array(net_layout, np.int64), self._net_totals, system.kernel.buffers.scalars,
                                     self._row, np.array(columns, np.int64), self._extras)
         self._net_in_kernel = system.kernel_net is not None
-        # the joints' forces and then their moments, next to each other in the row (series_layout): one (2 nj, 3) block
-        first, last = self._columns["joint_force_joint"][0], self._columns["joint_moment_joint"][1]
-        self._joint_loads_block = self._row[first:last].reshape(2 * nj, 3)
-        self._joint_force, self._joint_moment = self._joint_loads_block[:nj], self._joint_loads_block[nj:]
-        self._zero_load = np.zeros(3)
-        self._force_local = exu.OutputVariableType.ForceLocal
-        self._torque_local = exu.OutputVariableType.TorqueLocal
 
     # -- Exudyn hook -----------------------------------------------------------------
     def post_step(self, mbs, t):
@@ -247,17 +242,22 @@ class Recorder:
         """
         if not self.health.ok:
             return  # the run has stopped
-        data = self.system.mbs.systemData
-        # views (nothing here writes them; the row keeps what it needs)
-        q, qt = data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False)
+        # views (nothing here writes them; the row keeps what it needs): the kernel's, when it calls from its pre-step
+        views = self.system.kernel_net.step_views if self._net_in_kernel else None
+        if views is None:
+            data = self.system.mbs.systemData
+            q, qt = data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False)
+        else:
+            q, qt = views[0], views[1]
         net_q, net_qt = (self.system.kernel_net.q, self.system.kernel_net.qt) if self._net_in_kernel else (q, qt)
-        # the whole row but the joint loads in one compiled call; nothing is recorded from a lost state
+        # the whole row in one compiled call; nothing is recorded from a lost state
         finite, total_energy = sample_row(self._model, q, qt, net_q, net_qt, t, t - self._last_output_time)
         if not finite:
             self.health.state(t, *self.system.state_arrays())  # the full check, with its message
             return  # the run stops at this step
         self._last_output_time = t
-        forces_joint, moments_joint = self._joint_loads()
+        # the joints' loads: written by sample_row (recorder_kernel.connector_load_into, Exudyn's connector law)
+        forces_joint, moments_joint = self._body_out.joint_force, self._body_out.joint_moment
         if self.assembly.body_loads is not None:
             w = self._body_out
             work_term = -self._work_of_applied_loads(t, w.com_lvlh, w.velocity_lvlh, w.omega_body)
@@ -282,21 +282,6 @@ class Recorder:
                 self._next_net += self.net_interval
         if self.progress is not None:
             self.progress(t)
-
-    def _joint_loads(self):
-        """The joints' reaction forces and moments (N, N m, joint frame; the load the parent exerts on the child)
-        into the row; returns its (nj, 3) views. A released joint reads zero."""
-        get, joints, active = self.system.mbs.GetObjectOutput, self.system.joint_objects, self.joint_active
-        force, torque, zero = self._force_local, self._torque_local, self._zero_load
-        # Exudyn's connector force is the spring force acting on marker 1 (child) with reversed sign; the
-        # parent's load on the child is its negative. One assignment of all of them (one a row was 1 us each).
-        loads = self._joint_loads_block
-        if not len(joints):
-            return self._joint_force, self._joint_moment
-        loads[:] = ([get(obj, force) if active[j] else zero for j, obj in enumerate(joints)]
-                    + [get(obj, torque) if active[j] else zero for j, obj in enumerate(joints)])
-        np.negative(loads, out=loads)
-        return self._joint_force, self._joint_moment
 
     def _node_contact_force(self, t):
         """Contact force on each net node (N, LVLH), averaged since the previous net snapshot."""

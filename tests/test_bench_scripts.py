@@ -101,3 +101,42 @@ def test_wrapping_level_plot_band_reads_a_sine_amplitude():
     _, means = module.block_means(t, values, 1e-3)
     assert abs(means[:, 0].mean()) < 15.0
     assert abs(np.sqrt((means[:, 0] ** 2).mean()) - 1500.0 / np.sqrt(2)) < 0.01 * 1500.0 / np.sqrt(2)
+
+
+def test_scan_to_map_constants_entry_is_checked_and_typed():
+    """bench_scan_to_map.py --constants: an entry sets only the scan-to-map constants it names, each with the
+    module's own type (an iteration cap stays an int), and a name the module does not tune is refused by name."""
+    module = _bench_module("bench_scan_to_map")
+    assert module._constants("") == {}
+    chosen = module._constants("FINE_POINTS=2000, SETTLED=1e-3")
+    assert chosen == {"FINE_POINTS": 2000, "SETTLED": 1e-3}
+    assert isinstance(chosen["FINE_POINTS"], int)
+    with pytest.raises(SystemExit, match="'FOO=1' is not NAME=VALUE"):
+        module._constants("FOO=1")
+
+
+def test_wrapping_level_scaled_wall_keeps_the_appendages_attached():
+    """bench_wrapping_level.py's walls of another size: the main body's box x 4/3 (Envisat's full envelope) moves each
+    appendage with its joint to the same place of the scaled surface (the ASAR mount on the -y face at y = -2.5 m,
+    the array hinge 4/3 of its old offset), keeps each appendage's offsets from its joint, its masses, and scales
+    the inertias by the factor squared; appendages x 0.75 shrink about their joints (the ASAR 7.5 x 1.125 m)."""
+    import numpy as np
+
+    module = _bench_module("bench_wrapping_level")
+    case = module.item_case("nominal")
+    big = module.scaled_target(case, 4.0 / 3.0, 1.0)
+    bodies = {b.name: b for b in big.target.bodies}
+    joints = {j.name: j for j in big.target.joints}
+    old = {b.name: b for b in case.target.bodies}
+    assert np.allclose(bodies["main_body"].shapes[0].size, [4.5, 5.0, 10.5])
+    assert np.allclose(joints["asar_mount"].position, [0.0, -2.5, 0.0])
+    assert np.allclose(bodies["asar"].shapes[0].center, [0.0, -2.5 - 0.078, 0.0])
+    assert np.allclose(joints["solar_array_hinge"].position, [0.0, 0.0, 4.4375 * 4.0 / 3.0])
+    assert np.allclose(np.array(bodies["solar_array"].center_of_mass) - joints["solar_array_hinge"].position,
+                       [0.0, 0.0, 11.5875 - 4.4375])
+    assert all(bodies[n].mass == old[n].mass for n in bodies)
+    assert np.allclose(bodies["main_body"].inertia, np.array(old["main_body"].inertia) * 16.0 / 9.0)
+    assert np.allclose(bodies["asar"].inertia, old["asar"].inertia)
+    small = {b.name: b for b in module.scaled_target(case, 1.0, 0.75).target.bodies}
+    assert np.allclose(small["asar"].shapes[0].size, [1.125, 0.117, 7.5])
+    assert np.allclose(small["ka_band_dish"].shapes[0].center, [1.6875 + 0.75 * 1.95, 0.0, -3.0])

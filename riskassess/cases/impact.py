@@ -165,6 +165,12 @@ class Launch(Strict):
     velocity: Annotated[float, Field(gt=0, le=500)] = Field(description="Net speed along 'direction' (m/s).")
     direction: Vector3 = Field(description="Launch direction, LVLH (-), normalised on load.")
     aim_point: Vector3 = Field([0.0, 0.0, 0.0], description="Aim point, target frame (m).")
+    sag: Annotated[float, Field(ge=0.0, le=20.0)] = Field(
+        0.0, description="The net arrives as a bowl, its centre trailing its corners by this depth (m) along "
+                         "'direction' (a paraboloid; the mesh drawn in so that no thread starts stretched; "
+                         "'distance' places the corners' plane). 0: flat, the default. A flat net striking a "
+                         "face parallel to it is a singular case: all nodes over the face strike within one step "
+                         "(docs/model.md, 'The wrapping contact level'); the seed paper states no shape.")
 
     @field_validator("direction")
     @classmethod

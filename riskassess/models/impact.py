@@ -6,7 +6,7 @@ attitude at t = 0 is the target attitude (times the initial hinge rotation for a
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +16,7 @@ from multibody.assembly import (ContactLaw, ImpactAssembly, JointSpec, NetMount,
                                 subtree_bodies)
 from multibody.geometry import geometric_center_of_mass, uniform_density_inertia
 from multibody.hinge import hinge_frame_lvlh, structural_modes_hz
-from multibody.net import flat_square_net, thread_node_mass
+from multibody.net import bowl_net_positions, flat_square_net, thread_node_mass
 from multibody.orbit import mean_motion
 from riskassess.cases.impact import Case, CircularOrbit, section_properties
 from riskassess.cases.target_geometry import body_meshes_target_frame, target_points_lvlh, target_pose_lvlh
@@ -112,8 +112,9 @@ def build_net(case: Case):
     Returns
     -------
     topology : multibody.net.NetTopology
-        Flat square net centred ``launch.distance`` before the aim point, normal to the launch
-        direction, node positions in LVLH (m).
+        Square net centred ``launch.distance`` before the aim point, normal to the launch
+        direction, node positions in LVLH (m): flat, or a bowl ``launch.sag`` deep
+        (:func:`multibody.net.bowl_net_positions`).
     velocity : (n, 3) float
         Initial node velocities, all ``launch.velocity`` along the launch direction (m/s, LVLH).
     """
@@ -134,6 +135,11 @@ def build_net(case: Case):
         thread_axial_rigidity=axial_rigidity, thread_damping=thread.damping,
         bullet_mass=bullets.mass, bullet_radius=bullets.radius,
         bullet_tether_length=bullets.tether_length or mesh, bending_rigidity=bending_rigidity)
+    if launch.sag > 0.0:
+        try:
+            topology = replace(topology, positions=bowl_net_positions(topology, direction, launch.sag))
+        except ValueError as exc:
+            raise ValueError(f"launch.sag = {launch.sag:g} m: {exc}") from None
     velocity = np.tile(launch.velocity * direction, (topology.n_nodes, 1))
     return topology, velocity
 

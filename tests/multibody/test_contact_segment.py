@@ -74,16 +74,18 @@ def _plate(extents, mass, center=(0.0, 0.0, 0.0)) -> RigidBodySpec:
                          meshes_body=[trimesh.creation.box(extents=extents)])
 
 
-def _flat_fall(plate_mass, node_mass=0.05, v=2.0, alpha=0.05, step=1e-4):
-    """A 1 m thread along x, nodes at x = +-0.5 beside a 0.4 m wide plate whose -y face is at y = -0.025, falling
-    flat onto it at ``v``; the thread's surface (radius 1 mm) starts 2.5 steps of flight before the face."""
+def _flat_fall(plate_mass, node_mass=0.05, v=2.0, alpha=0.05, step=1e-4, ends=(-0.5, 0.5), end_time=3e-3):
+    """A thread along x, nodes at x = ``ends`` (default +-0.5, beside a 0.4 m wide plate whose -y face is at
+    y = -0.025), falling flat onto it at ``v``; the thread's surface (radius 1 mm) starts 2.5 steps of flight before
+    the face."""
     y0 = -0.025 - 0.001 - 2.5 * v * step
-    net = _thread_net([[-0.5, y0, 0.0], [0.5, y0, 0.0]], [node_mass, node_mass], [[0, 1]], [1.0], 5e4, 1.58)
+    net = _thread_net([[ends[0], y0, 0.0], [ends[1], y0, 0.0]], [node_mass, node_mass], [[0, 1]],
+                      [abs(ends[1] - ends[0])], 5e4, 1.58)
     assembly = ImpactAssembly(
         net=net, net_velocity=np.array([[0.0, v, 0.0], [0.0, v, 0.0]]), bodies=[_plate([0.4, 0.05, 0.4], plate_mass)],
         joints=[], contact=ContactLaw(stiffness=PAPER_CONTACT_STIFFNESS, hunt_crossley_alpha=alpha, mu_static=0.19,
                                       mu_kinetic=0.152, thread_segments=True),
-        solver=SolverSpec(end_time=3e-3, step=step, output_rate=1.0 / step, net_output_rate=1.0 / step))
+        solver=SolverSpec(end_time=end_time, step=step, output_rate=1.0 / step, net_output_rate=1.0 / step))
     return ImpactSimulation(assembly).run()
 
 
@@ -116,6 +118,28 @@ def test_thread_strike_on_a_fixed_plate_loses_only_the_law_energy():
     lost = launch - series["energy_net_kinetic"][-1] - series["energy_net_elastic"][-1]
     assert series["energy_dissipated_contact"][-1] == pytest.approx(lost, abs=5e-3 * launch)
     assert abs(series["energy_total"][-1] - series["energy_total"][0]) < 5e-3 * launch
+
+
+@pytest.mark.parametrize("ends, tolerance", [((-0.5, 0.3), 5e-3), ((-0.1, 0.5), 1e-2)],
+                         ids=["rocking on the two edges", "turning over an edge"])
+def test_rocking_or_turning_strike_loses_only_the_law_energy(ends, tolerance):
+    """A thread whose contact point moves within a step: falling flat with the plate off its middle (s = 0.625: the
+    force turns it, it rocks on the plate's two edges), or with one node on the face and the other 0.3 m beyond the
+    edge (it turns over the edge while that node rebounds). The only loss is Hunt-Crossley's (and friction's), which
+    the contact books: the energy balance (kinetic + thread + contact elastic + dissipated) stays at the launch
+    energy, and the energy left is below it. Before the deepest point was followed inside the step (helper
+    thread12), the rocking thread left with 0.99 of its launch energy, +17 % in the balance, and the turning one
+    +4.5 % (bench/bench_thread_strike_energy.py at 2 m/s). Tolerances: the rocking thread 0.5 % (the rebound's,
+    tests/multibody/test_contact.py; measured 0.04 %); the turning one 1 % (THREAD_CONTACT_DRIFT_LIMIT, the drift a
+    converged node-contact run stays within; measured 0.59 %: the sub-cycle integrates the node's own impact with
+    the thread's, but the kick and carried remainder still split it from the integrator's step)."""
+    rec = _flat_fall(1e12, node_mass=0.04223, v=2.0, ends=ends, end_time=6e-3)
+    series = rec.series
+    launch = series["energy_net_kinetic"][0]
+    assert series["contact_force_lvlh"][-1, 0] == pytest.approx([0.0, 0.0, 0.0], abs=1e-12)   # contact is over
+    assert series["energy_dissipated_contact"][-1] > 0.01 * launch                            # a real strike
+    assert abs(series["energy_total"][-1] - series["energy_total"][0]) < tolerance * launch
+    assert series["energy_net_kinetic"][-1] + series["energy_net_elastic"][-1] < launch
 
 
 def test_thread_falling_flat_shares_its_momentum_with_a_free_plate():

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from multibody.net import (add_bending_forces, add_thread_forces, add_thread_forces_runs, flat_square_net,
-                          square_grid_threads, thread_node_mass, thread_runs, thread_tension_strain)
+from multibody.net import (add_bending_forces, add_thread_forces, add_thread_forces_runs, bowl_net_positions,
+                          flat_square_net, square_grid_threads, thread_node_mass, thread_runs, thread_tension_strain)
 
 
 def test_node_mass_of_the_reference_net():
@@ -101,3 +101,27 @@ def test_thread_runs_give_the_sequential_loop_to_the_bit():
         assert 0 < elastic and 0 < power
     # the grid's threads are two runs (padded) plus the four tethers
     assert len(thread_runs(net.threads, net.rest_lengths, net.stiffness, net.damping).runs) == 6
+
+
+def test_bowl_net_trails_its_centre_by_the_sag_without_stretching_a_thread():
+    """bowl_net_positions (launch.sag): the grid centre trails the corners by exactly the sag along the launch
+    direction (its paraboloid: -sag at rho = 0, 0 at the corners), no thread starts longer than its rest length
+    (a bowl without tension; the mesh is drawn in just enough, so the tautest thread is exactly at rest), the
+    in-plane layout keeps its centre and symmetry, sag 0 returns the flat net, and a bowl deeper than the net
+    allows is refused."""
+    direction = np.array([0.0, 1.0, 0.0])
+    net = flat_square_net([0.3, -1.5, 0.2], direction, 8.0, 9, 0.01, 0.01, 6.2e4, 1.58, 1.8, 0.01, 1.0)
+    assert np.allclose(bowl_net_positions(net, direction, 0.0), net.positions, rtol=0.0, atol=1e-12)
+    for sag in (0.1, 1.0, 2.5):
+        x = bowl_net_positions(net, direction, sag)
+        corners, centre = [0, 8, 72, 80], 40
+        assert np.allclose(x[corners, 1], net.positions[corners, 1], atol=1e-12)
+        assert abs((x[centre, 1] - x[corners, 1].mean()) + sag) < 1e-12
+        assert np.allclose(x[centre, [0, 2]], net.positions[centre, [0, 2]], atol=1e-12)
+        ratio = np.linalg.norm(x[net.threads[:, 0]] - x[net.threads[:, 1]], axis=1) / net.rest_lengths
+        assert ratio.max() == pytest.approx(1.0, abs=1e-12)
+    # mouth < 1: every thread slack when the bowl alone would not need it
+    x = bowl_net_positions(net, direction, 0.1, mouth=0.8)
+    assert (np.linalg.norm(x[net.threads[:, 0]] - x[net.threads[:, 1]], axis=1) / net.rest_lengths).max() < 0.81
+    with pytest.raises(ValueError, match="too deep"):
+        bowl_net_positions(net, direction, 4.0)   # the 1 m bullet tethers need 0.385 sag < 1 m along the launch

@@ -179,3 +179,27 @@ def test_search_budget_has_defaults_and_is_checked(tmp_path, budget, expected):
     path.write_text(perception.read_text().replace("[perception.registration]", "[perception.registration]\n" + budget, 1))
     with pytest.raises(CaseError, match=expected):
         load_case(path)
+
+
+def test_launch_sag_builds_the_bowl_and_keeps_the_launch_momentum(tmp_path):
+    """launch.sag (off by default): the case's net is multibody.net.bowl_net_positions of its flat net, every node
+    keeps the launch velocity (so the paper's 32 mm/s momentum exchange is unchanged), and a bowl too deep for the
+    net is refused with the key's name before any run."""
+    import numpy as np
+
+    from multibody.net import bowl_net_positions
+    from riskassess.models.impact import build_net
+
+    case = load_case(CASES / "envisat_paper_sequential.toml")
+    assert case.launch.sag == 0.0
+    flat, v_flat = build_net(case)
+    bowl, v_bowl = build_net(case.model_copy(update={"launch": case.launch.model_copy(update={"sag": 2.0})}))
+    assert np.array_equal(bowl.positions, bowl_net_positions(flat, case.launch.direction, 2.0))
+    assert np.array_equal(v_bowl, v_flat)
+    assert np.array_equal(bowl.rest_lengths, flat.rest_lengths)
+    too_deep = case.model_copy(update={"launch": case.launch.model_copy(update={"sag": 15.0})})
+    with pytest.raises(ValueError, match="launch.sag = 15 m"):
+        build_net(too_deep)
+    path = tmp_path / "sag.toml"
+    path.write_text(REFERENCE.replace("velocity = 20.0 ", "sag = 2.0\nvelocity = 20.0 ", 1))
+    assert load_case(path).launch.sag == 2.0

@@ -1,0 +1,77 @@
+"""A case's energy balance over time with the threads' contact on, and the threads' own energy record.
+
+    python3 bench/thread_contact_drift.py [CASE] [--end-time T] [--velocity V] [--release never] [--key off]
+
+Runs the case's simulation (no pipeline products) with ``contact.thread_segments`` set as ``--key`` says and the
+health check's energy limit lifted (a drifting run is measured, not refused), and prints with the CPU time and the
+load: the largest drift of the energy balance (share of the health check's reference energy) and when, the drift at
+a few times, the ten largest gains between output samples and, with the key on, the thread contact's record
+(:class:`multibody.contact_segment.SegmentBuffers`): the energy made between steps (each thread's contact energy at
+a step's start less what its sub-cycle ended the last step with) in all and for the five threads with the most,
+and the energy the threads' contacts dissipated. Helper thread12 (docs/model.md, "The deepest point followed inside
+the step").
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script
+from bench_thread_segments import case_text  # noqa: E402
+
+from multibody.impact import ImpactSimulation  # noqa: E402
+from riskassess.cases.impact import load_case  # noqa: E402
+from riskassess.models.impact import model_inputs  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("case", nargs="?", default=str(ROOT / "cases" / "envisat_small.toml"))
+    parser.add_argument("--end-time", type=float, default=None)
+    parser.add_argument("--velocity", type=float, default=None)
+    parser.add_argument("--release", default=None, help='structures.release override, e.g. "never"')
+    parser.add_argument("--key", default="on", choices=("on", "off"))
+    args = parser.parse_args(argv)
+    case_path = Path(args.case)
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / case_path.name
+        path.write_text(case_text(case_path.read_text(), args.key == "on", args.end_time, args.velocity, args.release))
+        assembly = model_inputs(load_case(path), case_path.parent).assembly
+    simulation = ImpactSimulation(assembly)
+    reference = simulation.health.reference_energy
+    simulation.health.reference_energy = None       # measure the drift, do not refuse it
+    start = time.process_time()
+    series = simulation.run().series
+    cpu = time.process_time() - start
+    t, total = series["time"], series["energy_total"]
+    drift = (total - total[0]) / reference
+    worst = int(np.abs(drift).argmax())
+    print(f"{case_path.name} thread_segments {args.key}, end {t[-1]:.3f} s: CPU {cpu:.1f} s, load "
+          f"{os.getloadavg()[0]:.1f}; largest |drift| {100 * abs(drift[worst]):.2f} % at {t[worst]:.3f} s, at the end "
+          f"{100 * drift[-1]:+.2f} % of the reference energy {reference:.0f} J", flush=True)
+    for when in (0.1, 0.2, 0.5, 1, 2, 2.5, 3, 4, 5, 6, 7, 7.5):
+        k = int(np.searchsorted(t, when)) - 1
+        if 0 <= k < len(t) and t[k] > when - 0.01:
+            print(f"   t {t[k]:.3f} s  drift {100 * drift[k]:+.3f} %")
+    gains = np.diff(drift)
+    for k in np.argsort(-gains)[:10]:
+        print(f"   gain at t {t[k + 1]:.4f} s: {100 * gains[k]:+.3f} %")
+    segments = simulation.system.kernel.buffers.segments
+    if segments.enabled:
+        jump = segments.energy_jump
+        top = np.argsort(-np.abs(jump))[:5]
+        print(f"   threads' contacts: made between steps {100 * jump.sum() / reference:+.3f} %, dissipated "
+              f"{100 * segments.dissipated.sum() / reference:.2f} %; most: threads {top.tolist()} "
+              f"{(100 * jump[top] / reference).round(3).tolist()} %")
+
+
+if __name__ == "__main__":
+    main()
