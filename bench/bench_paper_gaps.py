@@ -258,12 +258,20 @@ def main() -> None:
     parser.add_argument("--only", default=",".join(ITEMS))
     parser.add_argument("--table-only", action="store_true")
     args = parser.parse_args()
-    store = json.loads(STORE.read_text()) if STORE.exists() else {}
-    for item in args.only.split(","):
-        if args.table_only or item in store:
+    run_store_items(ITEMS, args.only.split(","), args.table_only, STORE)
+
+
+def run_store_items(items: dict, names, table_only: bool, path: Path, echo: bool = False) -> None:
+    """Run each of ``names`` not yet in the result store at ``path`` (``items[name]()`` -> its figures), saving the
+    store after each so an interrupted bench resumes; then print the store. ``echo`` prints each new result."""
+    store = json.loads(path.read_text()) if path.exists() else {}
+    for name in names:
+        if table_only or name in store:
             continue
-        store[item] = ITEMS[item]()
-        save_store(store, STORE)
+        store[name] = items[name]()
+        if echo:
+            print(f"{name}: {json.dumps(store[name])}", flush=True)
+        save_store(store, path)
     print_store(store)
 
 

@@ -77,7 +77,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
-from bench_paper_gaps import CASE, _case, print_store, save_store  # noqa: E402
+from bench_paper_gaps import CASE, _case, run_store_items  # noqa: E402
 
 from multibody.health import HealthWatch  # noqa: E402
 from riskassess.products.summary import contact_totals_debris  # noqa: E402
@@ -611,18 +611,12 @@ def main() -> None:
     parser.add_argument("--keep", type=Path, default=None, help="keep each run's folder under this directory")
     parser.add_argument("--table-only", action="store_true")
     args = parser.parse_args()
-    store = json.loads(STORE.read_text()) if STORE.exists() else {}
-    for item in args.only.split(","):
-        if args.table_only or item in store:
-            continue
-        special = {"hub_loads": lambda: hub_loads(args.keep), "samplings": lambda: samplings(args.keep),
-                   "bullets_outward": bullets_outward, "first_impact_scan": first_impact_scan,
-                   "paper_step_1ms_loads": lambda: paper_step_1ms_loads(args.keep)}
-        special |= {name: (lambda name=name: arrival_item(name)) for name in (*ARRIVALS, *WALLS)}
-        store[item] = special[item]() if item in special else run_item(item, args.keep)
-        print(f"{item}: {json.dumps(store[item])}", flush=True)
-        save_store(store, STORE)
-    print_store(store)
+    items = {name: (lambda name=name: run_item(name, args.keep)) for name in ITEMS}
+    items |= {"hub_loads": lambda: hub_loads(args.keep), "samplings": lambda: samplings(args.keep),
+              "bullets_outward": bullets_outward, "first_impact_scan": first_impact_scan,
+              "paper_step_1ms_loads": lambda: paper_step_1ms_loads(args.keep)}
+    items |= {name: (lambda name=name: arrival_item(name)) for name in (*ARRIVALS, *WALLS)}
+    run_store_items(items, args.only.split(","), args.table_only, STORE, echo=True)
 
 
 if __name__ == "__main__":
