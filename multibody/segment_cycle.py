@@ -100,6 +100,16 @@ def _cross(a, b):
 
 
 @njit(cache=True, inline="always")
+def _own_contact_kick(u0, u1, u2, p0, p1, p2, g0, g1, g2, inverse_mass, dt, own):
+    """A node's own contact force ``g`` (body frame, N) over a sub-step: into the velocity change the sub-cycle
+    integrates (``u``, m/s) when the thread owns the contact, else into the predicted change (``p``) that only
+    moves the node here (the node contact integrates it). Returns the updated (u, p)."""
+    if own:
+        return u0 + dt * g0 * inverse_mass, u1 + dt * g1 * inverse_mass, u2 + dt * g2 * inverse_mass, p0, p1, p2
+    return u0, u1, u2, p0 + dt * g0 * inverse_mass, p1 + dt * g1 * inverse_mass, p2 + dt * g2 * inverse_mass
+
+
+@njit(cache=True, inline="always")
 def _node_contact_force(depth, w, normal, mass, inverse_body_mass, stiffness, exponent, damping, mu_s, mu_k,
                         inverse_transition_speed, dt, friction):
     """A node's own contact force with the box at a sub-step (body frame, N): Hunt-Crossley along the box's normal
@@ -261,22 +271,8 @@ def thread_contact_over_step(pa, pc, va, vc, aa, ac, mass_a, mass_c, radius_a, r
         uc0 += dt * fc0 * inv_c
         uc1 += dt * fc1 * inv_c
         uc2 += dt * fc2 * inv_c
-        if own_a:
-            ua0 += dt * ga0 * inv_a
-            ua1 += dt * ga1 * inv_a
-            ua2 += dt * ga2 * inv_a
-        else:
-            pa0 += dt * ga0 * inv_a
-            pa1 += dt * ga1 * inv_a
-            pa2 += dt * ga2 * inv_a
-        if own_c:
-            uc0 += dt * gc0 * inv_c
-            uc1 += dt * gc1 * inv_c
-            uc2 += dt * gc2 * inv_c
-        else:
-            pc0 += dt * gc0 * inv_c
-            pc1 += dt * gc1 * inv_c
-            pc2 += dt * gc2 * inv_c
+        ua0, ua1, ua2, pa0, pa1, pa2 = _own_contact_kick(ua0, ua1, ua2, pa0, pa1, pa2, ga0, ga1, ga2, inv_a, dt, own_a)
+        uc0, uc1, uc2, pc0, pc1, pc2 = _own_contact_kick(uc0, uc1, uc2, pc0, pc1, pc2, gc0, gc1, gc2, inv_c, dt, own_c)
         # the body's recoil: every reaction acts at the node it came from
         ta0, ta1, ta2 = fa0 + ga0, fa1 + ga1, fa2 + ga2
         tc0, tc1, tc2 = fc0 + gc0, fc1 + gc1, fc2 + gc2
