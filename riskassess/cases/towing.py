@@ -159,7 +159,7 @@ class Mrac(Strict):
                          "2 Q / omega_spin. 3: +-17 % about the spin rate, wide against the spin's change over a "
                          "failing tow (29.01 -> 28.0 deg/s, 3.5 %) and the line's measured spread (0.503-0.511 rad/s "
                          "for omega 0.506), while twice the spin rate (the breathing the range damping was sized "
-                         "for) passes with gain 0.98 (docs/towing.md).")
+                         "for) passes with gain 1.01 (docs/towing.md).")
     free_debris: bool = Field(
         False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
                            "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "
