@@ -13,7 +13,8 @@ line to ``--results`` (resumable: a run already there is not repeated) and its s
 thrust, debris spin, chaser-debris CoM distance; every output sample) to ``<results stem>/<label>_<plant>_<law>_<rate>_<j>.npz``.
 
 Per run: mean elongation over the last 100 s and its RMS error to the desired elongation (``mrac.desired_elongation``,
-the reference model's steady elongation with ``settle_at_desired``), slack time after engagement (T_MT <= 0, s), the
+the reference model's steady elongation with ``settle_at_desired``; with ``mrac.tow_point_offset`` the governed one at
+the run's spin rate), slack time after engagement (T_MT <= 0, s), the
 near-slack share (T_MT < 1 N after engagement: on the full net a slack tether still carries the node's pull of a few
 tenths of a newton), peak tension, debris spin at the end (deg/s), CPU time and load. ``--table`` prints per (label,
 plant, law, rate) the mean over the replicas and, in brackets, their range.
@@ -72,6 +73,12 @@ def figures(series: dict, target: float) -> dict:
             "end_time_s": float(t[-1])}
 
 
+def at_spin(case: TowingCase, spin_rate_deg_s: float) -> TowingCase:
+    """``case`` with the debris spinning at ``spin_rate_deg_s`` (deg/s), the rate the run is made at (as the model
+    builders set it for the thrust law)."""
+    return case.model_copy(update=dict(debris=case.debris.model_copy(update=dict(spin_rate_deg_s=spin_rate_deg_s))))
+
+
 def table(path: Path) -> None:
     """Print the replicas' summary of a results file (module doc).
 
@@ -123,7 +130,6 @@ def main():
             done = {json.loads(line)["key"] for line in handle if line.strip()}
     folder = args.results.with_suffix("")
     folder.mkdir(parents=True, exist_ok=True)
-    target = reference_elongation(case)
     wrapped = wrapped_net(case) if args.plant == "full-net" else None
     for rate in args.rate:
         for law in args.laws:
@@ -133,6 +139,7 @@ def main():
                     continue
                 run_case = overridden(case, [f"thrust.kind={json.dumps(law)}"])
                 spin = rate * (1.0 + j * args.perturbation)
+                target = reference_elongation(at_spin(run_case, spin))   # mrac.tow_point_offset governs it by spin
                 load0, start = os.getloadavg()[0], time.process_time()
                 if args.plant == "full-net":
                     series = run_full_net(full_net_model(run_case, spin, wrapped=wrapped)).series()

@@ -160,6 +160,14 @@ class Mrac(Strict):
                          "failing tow (29.01 -> 28.0 deg/s, 3.5 %) and the line's measured spread (0.503-0.511 rad/s "
                          "for omega 0.506), while twice the spin rate (the breathing the range damping was sized "
                          "for) passes with gain 1.01 (docs/towing.md).")
+    tow_point_offset: NonNegative | None = Field(
+        None, description="Once-per-turn thrust budget (m): the distance delta of the debris CoM from the middle of "
+                          "the netted body (perception's CoM estimate; Zenit-2, Table 1: 0.217 m), which moves the "
+                          "bag's tow point once per turn. With it the laws hold min(desired_elongation, (u_max - m_C "
+                          "omega^2 delta) / k) (k the abstracted stiffness, omega the tow's spin rate): the steady "
+                          "thrust leaves m_C omega^2 delta of headroom, the thrust the once-per-turn line asks for "
+                          "near the chaser-bag resonance. Default: none (desired_elongation at every rate). "
+                          "docs/towing.md, MRAC: a thrust budget for the once-per-turn line.")
     free_debris: bool = Field(
         False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
                            "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "
