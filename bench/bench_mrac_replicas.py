@@ -43,7 +43,8 @@ from bench_mrac_probe import overridden  # noqa: E402
 
 COLUMNS = (("mean_last_100_s_m", "mean z (m)", ".4f"), ("rms_error_m", "RMS z - z_d (m)", ".4f"),
            ("slack_s", "slack (s)", ".1f"), ("near_slack_share", "T < 1 N", ".2f"),
-           ("peak_tension_N", "peak T (N)", ".0f"),
+           ("peak_tension_N", "peak T (N)", ".0f"), ("thrust_peak_N", "peak F (N)", ".0f"),
+           ("at_thrust_peak_share", "F at its peak, 100-300 s", ".2f"),
            ("spin_end_deg_s", "spin end (deg/s)", ".2f"))
 
 
@@ -70,7 +71,31 @@ def figures(series: dict, target: float) -> dict:
             "slack_s": f["slack_after_engagement_s"], "near_slack_share": float(np.mean(tension[after] < 1.0)),
             "peak_tension_N": f["peak_tension_N"],
             "spin_end_deg_s": float(np.degrees(np.linalg.norm(series["debris_omega_body"][-1]))),
-            "end_time_s": float(t[-1])}
+            "end_time_s": float(t[-1]), **thrust_figures(t, series["thrust"])}
+
+
+def thrust_figures(t, thrust) -> dict:
+    """Peak thrust (N) and the share of the samples over 100-300 s at it (within 1e-6 N): the share of the time the
+    command sits at the actuator's upper bound when it saturates, ~0 when it does not.
+
+    Parameters
+    ----------
+    t : (k,) float
+        Time (s).
+    thrust : (k,) float
+        Thrust (N).
+    """
+    peak = float(thrust.max())
+    late = t >= 100.0
+    return {"thrust_peak_N": peak, "at_thrust_peak_share": float(np.mean(thrust[late] >= peak - 1e-6))}
+
+
+def with_thrust_figures(record: dict, folder: Path) -> dict:
+    """A results line with the thrust figures, taken from its stored series when the line predates them."""
+    if "thrust_peak_N" in record:
+        return record
+    d = np.load(folder / f"{record['label']}_{record['plant']}_{record['law']}_{record['rate_deg_s']:g}_{record['replica']}.npz")
+    return {**record, **thrust_figures(d["time"], d["thrust"])}
 
 
 def at_spin(case: TowingCase, spin_rate_deg_s: float) -> TowingCase:
@@ -88,7 +113,7 @@ def table(path: Path) -> None:
         A ``--results`` file of this bench.
     """
     with open(path, encoding="utf-8") as handle:
-        rows = [json.loads(line) for line in handle if line.strip()]
+        rows = [with_thrust_figures(json.loads(line), path.with_suffix("")) for line in handle if line.strip()]
     groups = {}
     for r in rows:
         groups.setdefault((r["label"], r["plant"], r["law"], r["rate_deg_s"]), []).append(r)
