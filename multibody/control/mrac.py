@@ -44,7 +44,14 @@ forced motion of the tow point, not the chaser-bag mode the range damping is the
 :math:`\omega_{spin}` (:math:`c_R \omega |\dot r|`-sized, the larger part of the thrust swing at 29.01 deg/s) and pulls
 on the tether once per turn. With the notch on, the range damping acts on the range rate through a second-order notch
 at the spin rate (the GNC's estimate, as for the breathing notch): it leaves the once-per-turn line to the laws'
-elongation feedback and damps every other frequency as before.
+elongation feedback and damps every other frequency as before. Measured on the full net (docs/towing.md, "A range-rate
+notch at the spin rate, and a thrust budget"): it does not hold 29.01 deg/s (MRAC-2 fails, MRAC-1 holds in 1 of 3
+replicas) and breaks 20.44 deg/s, so it is off in the shipped case.
+
+**Once-per-turn thrust budget** (``mrac.tow_point_offset``, :func:`governed_elongation`): the desired elongation is
+lowered where its steady thrust would not leave the once-per-turn thrust :math:`m_C\omega^2\delta` below u_max.
+Measured: with 87-89 N of headroom at 29.01 deg/s the once-per-turn line still grows and both laws fail (2 + 2
+replicas); off in the shipped case.
 
 This module holds what both laws share (parameter head, reference model); each law is a plug-in of
 :mod:`multibody.control.thrust_laws` (``mrac1.py``, ``mrac2.py``: its gains, ``command``, initial
@@ -224,7 +231,7 @@ def once_per_turn_thrust(case) -> float:
     sits on omega (29.01 deg/s on the Zenit-2 case), the thrust any damping law spends there in steady state: on
     resonance the separation's balance :math:`(K - \mu\omega^2) s = K x + \alpha F` leaves
     :math:`\alpha |F| = K |x|` with :math:`K = \mu\omega^2`, :math:`\mu/\alpha = m_C` (two-body reduction, alpha =
-    m_D/(m_C + m_D)) whatever the damping (docs/towing.md, "A thrust budget for the once-per-turn line").
+    m_D/(m_C + m_D)) whatever the damping (docs/towing.md, "A range-rate notch at the spin rate, and a thrust budget").
 
     Parameters
     ----------

@@ -152,8 +152,9 @@ class Mrac(Strict):
                            "GNC's estimate: debris.spin_rate_deg_s or the rate the run is made at): the stage's CoM, "
                            "0.217 m off its cylinder's middle, moves the bag's tow point once per turn, a forced "
                            "motion the chaser should follow rather than damp (damping it costs thrust at the spin "
-                           "rate, which met the 200 N limit at 29.01 deg/s). Needs range_damping > 0. docs/towing.md, "
-                           "MRAC: range-rate notch.")
+                           "rate, which met the 200 N limit at 29.01 deg/s). Needs range_damping > 0. Measured: it does not "
+                           "hold 29.01 deg/s and breaks 20.44 deg/s (docs/towing.md, MRAC: a range-rate notch at the "
+                           "spin rate, and a thrust budget).")
     range_notch_quality: Positive = Field(
         3.0, description="Quality Q of the range-rate notch (-): -3 dB width about omega_spin / Q, memory time "
                          "2 Q / omega_spin. 3: +-17 % about the spin rate, wide against the spin's change over a "
@@ -166,8 +167,9 @@ class Mrac(Strict):
                           "bag's tow point once per turn. With it the laws hold min(desired_elongation, (u_max - m_C "
                           "omega^2 delta) / k) (k the abstracted stiffness, omega the tow's spin rate): the steady "
                           "thrust leaves m_C omega^2 delta of headroom, the thrust the once-per-turn line asks for "
-                          "near the chaser-bag resonance. Default: none (desired_elongation at every rate). "
-                          "docs/towing.md, MRAC: a thrust budget for the once-per-turn line.")
+                          "near the chaser-bag resonance. Default: none (desired_elongation at every rate). Measured: the "
+                          "line still grows with that headroom and both laws fail at 29.01 deg/s (docs/towing.md, MRAC: "
+                          "a range-rate notch at the spin rate, and a thrust budget).")
     free_debris: bool = Field(
         False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
                            "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "
