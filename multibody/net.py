@@ -14,6 +14,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, uint64
 
+from multibody.jit_cache import NO_REFCOUNTS
+
 
 @dataclass(frozen=True)
 class NetTopology:
@@ -446,7 +448,7 @@ def _scatter(force, node0, work, first, count, sign):
 
 
 # error_model="numpy": with Python's, every division checks for zero and the loop stays scalar
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", **NO_REFCOUNTS)  # no reference counts (jit_cache.NO_REFCOUNTS)
 def add_thread_forces_runs(x, v, runs, force, work):
     """:func:`add_thread_forces` on coordinate-major arrays, run by run (:class:`ThreadRuns`): the same
     forces to the bit and the energies to round-off (:func:`sum_reassociated`), faster (the tension loop
