@@ -71,6 +71,11 @@ def main(argv=None) -> None:
         print(f"   threads' contacts: made between steps {100 * jump.sum() / reference:+.3f} %, dissipated "
               f"{100 * segments.dissipated.sum() / reference:.2f} %; most: threads {top.tolist()} "
               f"{(100 * jump[top] / reference).round(3).tolist()} %")
+        by_sharing = segments.jump_by_sharing
+        print("   made between steps by the threads' sharing the step before (most threads in contact at either node): "
+              + ", ".join(f"{label} {100 * by_sharing[0, k] / reference:+.3f} % ({int(by_sharing[1, k])} thread-steps)"
+                          for k, label in enumerate(("arrivals (nodes free)", "1", "2", "3", "4+",
+                                                                     "arrivals (a node in its own contact)"))))
 
 
 if __name__ == "__main__":

@@ -7,7 +7,7 @@ held was then shallower than the deepest one, the other edge sank unresisted for
 next step's contact started deeper than any force had paid for. The stored energy only jumped up (first order
 in the step: +12 % of a 20 m/s strike's launch energy at 1e-4 s, docs/model.md "Contact").
 
-Here the two nodes themselves are the sub-cycle's state (positions and velocities relative to the body, body
+Here the nodes themselves are the sub-cycle's state (positions and velocities relative to the body, body
 frame, the body's attitude held over the step as in the node contact), and at every sub-step the contact is
 evaluated again from them: the deepest point t* (:func:`multibody.segment_box.segment_box_deepest`, the middle
 of the tied part when points tie), its normal perpendicular to the thread, the excess q over the deeper node's
@@ -16,10 +16,20 @@ over the nodes. So the contact's potential k q^(n+1)/(n+1), a maximum over the s
 the maximum moves, and a switch of the deepest point costs at most one sub-step's error instead of one step's.
 
 The nodes' non-contact accelerations are held over the step (as every contact of the kernel holds them); each
-node's own contact against the same box is included in the nodes' motion here, as a prediction only (its
-impulse is applied by the node contact, :mod:`multibody.contact_kernel`), so that the excess q over a node in
-its own 0.15 ms impact follows that node's rebound instead of a free flight into the face. The body recoils
-with its mass and inertia (velocity and spin changes, body frame) at the nodes, where its reactions act.
+node's own contact against the same box is included in the nodes' motion here, so that the excess q over a node in
+its own 0.15 ms impact follows that node's rebound instead of a free flight into the face: integrated and applied
+here when all the node's threads in contact touch this box (the node contact, :mod:`multibody.contact_kernel`, skips
+the pair), predicted only otherwise (its impulse is applied by the node contact). The body recoils with its mass and
+inertia (velocity and spin changes, body frame) at the nodes, where its reactions act.
+
+Since helper thread13 (2026-11-27) the unit integrated is a cluster (:func:`cluster_contact_over_step`): the threads
+in contact with one box that share nodes, transitively (:mod:`multibody.thread_cluster`), with their nodes' own
+contacts, as one system. Before, each thread had its own sub-cycle and a node with two or more threads in contact
+had its own contact integrated by the node contact while each of its threads' sub-cycles predicted it without the
+other threads' pushes: the paths differed and the threads' contacts started each step away from where their
+sub-cycles ended them (docs/model.md, "Contact": the reference case's energy gain with the key on). A cluster of one
+thread is the earlier sub-cycle, operation for operation (the one-thread strikes of
+bench/bench_thread_strike_energy.py print the same figures).
 
 Returns each node's mean and end velocity change by the thread's contact over the step (the kick and the
 remainder carried to the next step, as the node contact), the energy the contact dissipated (Hunt-Crossley
@@ -31,11 +41,55 @@ from __future__ import annotations
 
 import math
 
+from typing import NamedTuple
+
+import numpy as np
 from numba import njit
 
 from multibody.broad_phase import box_signed_distance
 from multibody.contact import _power, hollar_friction_coefficient_inverse
 from multibody.segment_box import TIE_DISTANCE, segment_box_deepest, segment_box_normal, segment_box_sublevel
+
+
+class ClusterWork(NamedTuple):
+    """One cluster's nodes and threads for :func:`cluster_contact_over_step` (rows: the cluster's nodes, at most the
+    net's n, and its threads, at most m; body frame of the cluster's body, SI units)."""
+
+    n_nodes: np.ndarray         # (1,) int64 nodes in the cluster
+    n_threads: np.ndarray       # (1,) int64 threads in the cluster
+    node: np.ndarray            # (n,) int64 each row's net node
+    thread: np.ndarray          # (m,) int64 each thread row's net thread
+    threads: np.ndarray         # (m, 2) int64 each thread's two nodes as cluster rows
+    row: np.ndarray             # (n,) int64 each net node's cluster row, -1 when not in the cluster being built
+    carrier: np.ndarray         # (n,) int64 each node row's first thread row: the thread that carries its impulse
+    position: np.ndarray        # (n, 3) the nodes, body frame (m); the sub-cycle moves them
+    velocity: np.ndarray        # (n, 3) their start velocities relative to the body's material point (m/s)
+    acceleration: np.ndarray    # (n, 3) their non-contact accelerations, held over the step (m/s^2)
+    mass: np.ndarray            # (n,) node masses (kg)
+    radius: np.ndarray          # (n,) node contact radii (m)
+    own: np.ndarray             # (n,) int64 1: the node's own contact with the box is integrated here
+    mean_change: np.ndarray     # (n, 3) out: each node's mean velocity change over the step (m/s)
+    end_change: np.ndarray      # (n, 3) out: its velocity change at the step's end (m/s)
+    predicted: np.ndarray       # (n, 3) work: the velocity change by a predicted own contact (m/s)
+    relative: np.ndarray        # (n, 3) work: relative velocities at a sub-step (m/s)
+    force: np.ndarray           # (n, 3) work: the threads' contact forces at a sub-step (N)
+    own_force: np.ndarray       # (n, 3) work: the nodes' own contact forces at a sub-step (N)
+    thread_energy: np.ndarray   # (m,) out: each thread's contact energy at the end of the sub-cycle (J)
+    thread_lost: np.ndarray     # (m,) out: energy each thread's contact dissipated (J)
+    node_lost: np.ndarray       # (n,) out: energy each owned node contact dissipated (J)
+
+
+def cluster_work(n_nodes: int, n_threads: int) -> ClusterWork:
+    """Zeroed :class:`ClusterWork` for a net of ``n_nodes`` nodes and ``n_threads`` threads."""
+    n, m = n_nodes, n_threads
+    return ClusterWork(n_nodes=np.zeros(1, np.int64), n_threads=np.zeros(1, np.int64), node=np.zeros(n, np.int64),
+                       thread=np.zeros(m, np.int64), threads=np.zeros((m, 2), np.int64), row=np.full(n, -1, np.int64),
+                       carrier=np.zeros(n, np.int64), position=np.zeros((n, 3)), velocity=np.zeros((n, 3)),
+                       acceleration=np.zeros((n, 3)), mass=np.ones(n), radius=np.zeros(n), own=np.zeros(n, np.int64),
+                       mean_change=np.zeros((n, 3)),
+                       end_change=np.zeros((n, 3)), predicted=np.zeros((n, 3)), relative=np.zeros((n, 3)),
+                       force=np.zeros((n, 3)), own_force=np.zeros((n, 3)), thread_energy=np.zeros(m),
+                       thread_lost=np.zeros(m), node_lost=np.zeros(n))
 
 
 @njit(cache=True)
@@ -140,22 +194,105 @@ def _node_contact_force(depth, w, normal, mass, inverse_body_mass, stiffness, ex
     return fx, fy, fz, lost
 
 
+@njit(cache=True, inline="always")
+def _relative_velocity(rel, acc, u, p, x, i, t, bv0, bv1, bv2, bw0, bw1, bw2):
+    """Node ``i``'s velocity relative to the body's material point at it, sub-cycle time ``t`` (m/s, body frame):
+    start + non-contact + contact changes - the body's recoil there."""
+    return (rel[i, 0] + acc[i, 0] * t + u[i, 0] + p[i, 0] - (bv0 + bw1 * x[i, 2] - bw2 * x[i, 1]),
+            rel[i, 1] + acc[i, 1] * t + u[i, 1] + p[i, 1] - (bv1 + bw2 * x[i, 0] - bw0 * x[i, 2]),
+            rel[i, 2] + acc[i, 2] * t + u[i, 2] + p[i, 2] - (bv2 + bw0 * x[i, 1] - bw1 * x[i, 0]))
+
+
 @njit(cache=True)
-def thread_contact_over_step(pa, pc, va, vc, aa, ac, mass_a, mass_c, radius_a, radius_c, box_min, box_max, s,
-                             body_mass, inverse_inertia_body, b, law, step, n_substeps, own_a, own_c, work, out):
-    """Thread (nodes a, c) against box ``s`` of body ``b`` over one step, the contact re-evaluated at every
-    sub-step from the nodes' state (module doc).
+def _thread_contact_force(ka, kc, x, w, mass, box_min, box_max, s, radius, law, inverse_body_mass, dt, work, force):
+    """The thread (cluster nodes ``ka``, ``kc``) contact's forces on its nodes at a sub-step, added to ``force``
+    (body frame, N): F at the deepest point split (1 - s, s), and -(F . n) n_e on the deeper node e, which hands its
+    load up to q to the point (the gradient of k q^(n+1)/(n+1); module doc). Returns the energy it dissipated over
+    the sub-step (J) and 1 if it acted."""
+    pa = (x[ka, 0], x[ka, 1], x[ka, 2])
+    pc = (x[kc, 0], x[kc, 1], x[kc, 2])
+    geometry = thread_contact_geometry(pa, pc, box_min, box_max, s, radius[ka], radius[kc], work)
+    excess, depth, split, t_deepest, end, depth_a, depth_c, n_a, n_c = geometry
+    if excess <= 0.0:
+        return 0.0, 0
+    wa = (w[ka, 0], w[ka, 1], w[ka, 2])
+    wc = (w[kc, 0], w[kc, 1], w[kc, 2])
+    wp, wq = 1.0 - split, split
+    v = (wp * wa[0] + wq * wc[0], wp * wa[1] + wq * wc[1], wp * wa[2] + wq * wc[2])
+    d = (pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2])
+    lo = (box_min[s, 0], box_min[s, 1], box_min[s, 2])
+    hi = (box_max[s, 0], box_max[s, 1], box_max[s, 2])
+    nx, ny, nz = segment_box_normal(pa[0] + t_deepest * d[0], pa[1] + t_deepest * d[1], pa[2] + t_deepest * d[2],
+                                    d[0], d[1], d[2], lo, hi, v[0], v[1], v[2])
+    rate = -(v[0] * nx + v[1] * ny + v[2] * nz)          # q's rate: the point's closing speed ...
+    me = (0.0, 0.0, 0.0)
+    if end == 0:
+        me = n_a
+        rate += wa[0] * me[0] + wa[1] * me[1] + wa[2] * me[2]   # ... less node e's own
+    elif end == 1:
+        me = n_c
+        rate += wc[0] * me[0] + wc[1] * me[1] + wc[2] * me[2]
+    dn = _power(excess, law.exponent)
+    elastic = law.stiffness * dn
+    fn = max(elastic + law.damping * dn * rate, 0.0)
+    dissipated = (fn - elastic) * rate * dt
+    normal_speed = v[0] * nx + v[1] * ny + v[2] * nz
+    gx, gy, gz = v[0] - normal_speed * nx, v[1] - normal_speed * ny, v[2] - normal_speed * nz
+    fx, fy, fz = fn * nx, fn * ny, fn * nz
+    slip = math.sqrt(gx * gx + gy * gy + gz * gz)
+    if fn > 0.0 and slip > 0.0:
+        mu = hollar_friction_coefficient_inverse(slip, law.mu_static, law.mu_kinetic, 1.0 / law.transition_speed)
+        reduced = 1.0 / (wp * wp / mass[ka] + wq * wq / mass[kc] + inverse_body_mass)
+        magnitude = min(mu * fn, reduced * slip / dt)   # may stop the slip within a sub-step, not reverse it
+        along = magnitude / slip
+        fx -= along * gx
+        fy -= along * gy
+        fz -= along * gz
+        dissipated += magnitude * slip * dt
+    force[ka, 0] += wp * fx
+    force[ka, 1] += wp * fy
+    force[ka, 2] += wp * fz
+    force[kc, 0] += wq * fx
+    force[kc, 1] += wq * fy
+    force[kc, 2] += wq * fz
+    e = ka if end == 0 else kc
+    if end >= 0:
+        force[e, 0] -= fn * me[0]
+        force[e, 1] -= fn * me[1]
+        force[e, 2] -= fn * me[2]
+    return dissipated, 1
+
+
+@njit(cache=True)
+def thread_contact_energy(ka, kc, x, box_min, box_max, s, radius, law, work):
+    """The thread's (cluster nodes ``ka``, ``kc``) contact elastic energy k q^(n+1)/(n+1) at positions ``x`` (J)."""
+    geometry = thread_contact_geometry((x[ka, 0], x[ka, 1], x[ka, 2]), (x[kc, 0], x[kc, 1], x[kc, 2]), box_min,
+                                       box_max, s, radius[ka], radius[kc], work)
+    excess = geometry[0]
+    if excess <= 0.0:
+        return 0.0
+    return law.stiffness * _power(excess, law.exponent) * excess / (law.exponent + 1.0)
+
+
+@njit(cache=True)
+def cluster_contact_over_step(cluster, box_min, box_max, s, body_mass, inverse_inertia_body, b, law, step,
+                              n_substeps, work):
+    """A cluster of threads in contact with box ``s`` of body ``b`` (threads that share nodes, and those nodes'
+    own contacts with the box) over one step, as one system: every thread's contact and every node's own contact
+    re-evaluated at every sub-step from the nodes' state (module doc).
 
     Parameters
     ----------
-    pa, pc : tuple of 3 float
-        The nodes at the evaluation, body frame (m).
-    va, vc : tuple of 3 float
-        Their velocities relative to the body's material point at each (m/s), body frame, at the evaluation.
-    aa, ac : tuple of 3 float
-        Their non-contact accelerations (m/s^2), body frame, held over the step.
-    mass_a, mass_c, radius_a, radius_c : float
-        The nodes' masses (kg) and contact radii (m).
+    cluster : ClusterWork
+        The cluster's nodes and threads (:class:`ClusterWork`): in its first ``n_nodes`` rows the nodes at the
+        evaluation (``position``, body frame, m), their velocities relative to the body's material point at each
+        (``velocity``, m/s, body frame), their non-contact accelerations held over the step (``acceleration``,
+        m/s^2, body frame), masses (kg), contact radii (m) and whether each node's own contact with this box is
+        integrated here (``own``; else it only moves the node: a prediction); in its first ``n_threads`` rows the
+        threads' nodes as cluster rows. On return ``mean_change`` and ``end_change`` hold each node's mean and end
+        velocity change by the contacts integrated here (m/s, body frame), ``thread_energy`` each thread's contact
+        energy at the end of the sub-cycle (J), ``thread_lost`` the energy each thread's contact dissipated and
+        ``node_lost`` each owned node contact's (J).
     box_min, box_max : (ns, 3) float
         The shapes' corners, body frame (m); row ``s``.
     s : int
@@ -170,141 +307,85 @@ def thread_contact_over_step(pa, pc, va, vc, aa, ac, mass_a, mass_c, radius_a, r
         Integrator step (s).
     n_substeps : int
         Sub-steps (1: the plain force evaluation at the start).
-    own_a, own_c : bool
-        The node's own contact with this box is integrated here and its impulse returned with the thread's (the
-        node contact skips it this step); otherwise it only moves the node here (a prediction).
     work : (MAX_BREAKPOINTS,) float
         Work space.
-    out : (4, 3) float
-        Output, body frame (m/s): node a's mean and end velocity change by the thread's contact (and its own when
-        owned), node c's.
 
     Returns
     -------
-    dissipated : float
-        Energy the thread's contact (and the owned node contacts) dissipated over the step (J).
-    end_energy : float
-        Its elastic energy at the end of the sub-cycle (J).
     touched : int
-        1 if the thread's contact acted in any sub-step.
+        1 if a thread's contact acted in any sub-step.
     """
+    k, m = cluster.n_nodes[0], cluster.n_threads[0]
+    x, rel, acc, mass, radius = cluster.position, cluster.velocity, cluster.acceleration, cluster.mass, cluster.radius
+    u, p, integral = cluster.end_change, cluster.predicted, cluster.mean_change
+    w, force, own_force = cluster.relative, cluster.force, cluster.own_force
+    threads, own = cluster.threads, cluster.own
     k_contact, exponent, damping = law.stiffness, law.exponent, law.damping
     mu_s, mu_k = law.mu_static, law.mu_kinetic
     inverse_transition_speed = 1.0 / law.transition_speed
     dt = step / n_substeps
-    inv_a, inv_c, inv_body = 1.0 / mass_a, 1.0 / mass_c, 1.0 / body_mass
+    inv_body = 1.0 / body_mass
     j_inv = inverse_inertia_body
-    xa0, xa1, xa2 = pa
-    xc0, xc1, xc2 = pc
-    ua0 = ua1 = ua2 = uc0 = uc1 = uc2 = 0.0     # the thread contact's velocity change of each node
-    sa0 = sa1 = sa2 = sc0 = sc1 = sc2 = 0.0     # its time integral
-    pa0 = pa1 = pa2 = pc0 = pc1 = pc2 = 0.0     # the nodes' own contacts' velocity change (prediction only)
+    u[:k] = 0.0             # the velocity change of each node by the contacts integrated here
+    p[:k] = 0.0             # by its own contact when predicted only
+    integral[:k] = 0.0      # the time integral of u
+    cluster.thread_lost[:m] = 0.0
+    cluster.node_lost[:k] = 0.0
     bv0 = bv1 = bv2 = bw0 = bw1 = bw2 = 0.0     # the body's velocity and spin change (body frame)
-    dissipated = 0.0
     touched = 0
-    excess = -math.inf
     for j in range(n_substeps):
         t = j * dt
-        # relative velocities at the sub-step: start + non-contact + contact changes - the body's recoil there
-        wa = (va[0] + aa[0] * t + ua0 + pa0 - (bv0 + bw1 * xa2 - bw2 * xa1),
-              va[1] + aa[1] * t + ua1 + pa1 - (bv1 + bw2 * xa0 - bw0 * xa2),
-              va[2] + aa[2] * t + ua2 + pa2 - (bv2 + bw0 * xa1 - bw1 * xa0))
-        wc = (vc[0] + ac[0] * t + uc0 + pc0 - (bv0 + bw1 * xc2 - bw2 * xc1),
-              vc[1] + ac[1] * t + uc1 + pc1 - (bv1 + bw2 * xc0 - bw0 * xc2),
-              vc[2] + ac[2] * t + uc2 + pc2 - (bv2 + bw0 * xc1 - bw1 * xc0))
-        geometry = thread_contact_geometry((xa0, xa1, xa2), (xc0, xc1, xc2), box_min, box_max, s, radius_a,
-                                           radius_c, work)
-        excess, depth, split, t_deepest, end, depth_a, depth_c, n_a, n_c = geometry
-        fa0 = fa1 = fa2 = fc0 = fc1 = fc2 = 0.0      # the thread contact's forces on the nodes
-        if excess > 0.0:
-            touched = 1
-            wp, wq = 1.0 - split, split
-            w = (wp * wa[0] + wq * wc[0], wp * wa[1] + wq * wc[1], wp * wa[2] + wq * wc[2])
-            d = (xc0 - xa0, xc1 - xa1, xc2 - xa2)
-            lo = (box_min[s, 0], box_min[s, 1], box_min[s, 2])
-            hi = (box_max[s, 0], box_max[s, 1], box_max[s, 2])
-            nx, ny, nz = segment_box_normal(xa0 + t_deepest * d[0], xa1 + t_deepest * d[1], xa2 + t_deepest * d[2],
-                                            d[0], d[1], d[2], lo, hi, w[0], w[1], w[2])
-            rate = -(w[0] * nx + w[1] * ny + w[2] * nz)          # q's rate: the point's closing speed ...
-            inverse_point_mass = wp * wp * inv_a + wq * wq * inv_c
-            me = (0.0, 0.0, 0.0)
-            if end == 0:
-                me = n_a
-                rate += wa[0] * me[0] + wa[1] * me[1] + wa[2] * me[2]   # ... less node e's own
-            elif end == 1:
-                me = n_c
-                rate += wc[0] * me[0] + wc[1] * me[1] + wc[2] * me[2]
-            dn = _power(excess, exponent)
-            elastic = k_contact * dn
-            fn = max(elastic + damping * dn * rate, 0.0)
-            dissipated += (fn - elastic) * rate * dt
-            normal_speed = w[0] * nx + w[1] * ny + w[2] * nz
-            gx, gy, gz = w[0] - normal_speed * nx, w[1] - normal_speed * ny, w[2] - normal_speed * nz
-            fx, fy, fz = fn * nx, fn * ny, fn * nz
-            slip = math.sqrt(gx * gx + gy * gy + gz * gz)
-            if fn > 0.0 and slip > 0.0:
-                mu = hollar_friction_coefficient_inverse(slip, mu_s, mu_k, inverse_transition_speed)
-                reduced = 1.0 / (inverse_point_mass + inv_body)
-                magnitude = min(mu * fn, reduced * slip / dt)   # may stop the slip within a sub-step, not reverse it
-                along = magnitude / slip
-                fx -= along * gx
-                fy -= along * gy
-                fz -= along * gz
-                dissipated += magnitude * slip * dt
-            fa0, fa1, fa2 = wp * fx, wp * fy, wp * fz
-            fc0, fc1, fc2 = wq * fx, wq * fy, wq * fz
-            # node e hands its load up to q to the point: -(F . n) n_e on it (the gradient of k q^(n+1)/(n+1))
-            if end == 0:
-                fa0, fa1, fa2 = fa0 - fn * me[0], fa1 - fn * me[1], fa2 - fn * me[2]
-            elif end == 1:
-                fc0, fc1, fc2 = fc0 - fn * me[0], fc1 - fn * me[1], fc2 - fn * me[2]
-        # the nodes' own contacts with this box, for their motion only (module doc): Hunt-Crossley, no friction
-        ga0, ga1, ga2, lost_a = _node_contact_force(depth_a, wa, n_a, mass_a, inv_body, k_contact, exponent, damping,
-                                                    mu_s, mu_k, inverse_transition_speed, dt, own_a)
-        gc0, gc1, gc2, lost_c = _node_contact_force(depth_c, wc, n_c, mass_c, inv_body, k_contact, exponent, damping,
-                                                    mu_s, mu_k, inverse_transition_speed, dt, own_c)
-        dissipated += lost_a + lost_c
-        # velocity updates (symplectic Euler, as the node contact's sub-cycle)
-        ua0 += dt * fa0 * inv_a
-        ua1 += dt * fa1 * inv_a
-        ua2 += dt * fa2 * inv_a
-        uc0 += dt * fc0 * inv_c
-        uc1 += dt * fc1 * inv_c
-        uc2 += dt * fc2 * inv_c
-        ua0, ua1, ua2, pa0, pa1, pa2 = _own_contact_kick(ua0, ua1, ua2, pa0, pa1, pa2, ga0, ga1, ga2, inv_a, dt, own_a)
-        uc0, uc1, uc2, pc0, pc1, pc2 = _own_contact_kick(uc0, uc1, uc2, pc0, pc1, pc2, gc0, gc1, gc2, inv_c, dt, own_c)
-        # the body's recoil: every reaction acts at the node it came from
-        ta0, ta1, ta2 = fa0 + ga0, fa1 + ga1, fa2 + ga2
-        tc0, tc1, tc2 = fc0 + gc0, fc1 + gc1, fc2 + gc2
-        bv0 -= dt * (ta0 + tc0) * inv_body
-        bv1 -= dt * (ta1 + tc1) * inv_body
-        bv2 -= dt * (ta2 + tc2) * inv_body
-        ma = _cross((xa0, xa1, xa2), (ta0, ta1, ta2))
-        mc = _cross((xc0, xc1, xc2), (tc0, tc1, tc2))
-        l0, l1, l2 = ma[0] + mc[0], ma[1] + mc[1], ma[2] + mc[2]
+        for i in range(k):
+            w[i, 0], w[i, 1], w[i, 2] = _relative_velocity(rel, acc, u, p, x, i, t, bv0, bv1, bv2, bw0, bw1, bw2)
+        force[:k] = 0.0
+        for r in range(m):
+            lost, acted = _thread_contact_force(threads[r, 0], threads[r, 1], x, w, mass, box_min, box_max, s,
+                                                radius, law, inv_body, dt, work, force)
+            cluster.thread_lost[r] += lost
+            touched = max(touched, acted)
+        # each node's own contact with the box: integrated (owned) or predicted (module doc)
+        for i in range(k):
+            gap, nbx, nby, nbz = box_signed_distance(x[i, 0], x[i, 1], x[i, 2], box_min, box_max, s)
+            gx, gy, gz, lost = _node_contact_force(radius[i] - gap, (w[i, 0], w[i, 1], w[i, 2]), (nbx, nby, nbz),
+                                                   mass[i], inv_body, k_contact, exponent, damping, mu_s, mu_k,
+                                                   inverse_transition_speed, dt, own[i] != 0)
+            own_force[i, 0], own_force[i, 1], own_force[i, 2] = gx, gy, gz
+            cluster.node_lost[i] += lost
+        # velocity updates (symplectic Euler, as the node contact's sub-cycle) and the body's recoil: every reaction
+        # acts at the node it came from
+        f0 = f1 = f2 = l0 = l1 = l2 = 0.0
+        for i in range(k):
+            inverse_mass = 1.0 / mass[i]
+            u[i, 0] += dt * force[i, 0] * inverse_mass
+            u[i, 1] += dt * force[i, 1] * inverse_mass
+            u[i, 2] += dt * force[i, 2] * inverse_mass
+            u[i, 0], u[i, 1], u[i, 2], p[i, 0], p[i, 1], p[i, 2] = _own_contact_kick(
+                u[i, 0], u[i, 1], u[i, 2], p[i, 0], p[i, 1], p[i, 2], own_force[i, 0], own_force[i, 1],
+                own_force[i, 2], inverse_mass, dt, own[i] != 0)
+            total = (force[i, 0] + own_force[i, 0], force[i, 1] + own_force[i, 1], force[i, 2] + own_force[i, 2])
+            f0, f1, f2 = f0 + total[0], f1 + total[1], f2 + total[2]
+            moment = _cross((x[i, 0], x[i, 1], x[i, 2]), total)
+            l0, l1, l2 = l0 + moment[0], l1 + moment[1], l2 + moment[2]
+        bv0 -= dt * f0 * inv_body
+        bv1 -= dt * f1 * inv_body
+        bv2 -= dt * f2 * inv_body
         bw0 -= dt * (j_inv[b, 0, 0] * l0 + j_inv[b, 0, 1] * l1 + j_inv[b, 0, 2] * l2)
         bw1 -= dt * (j_inv[b, 1, 0] * l0 + j_inv[b, 1, 1] * l1 + j_inv[b, 1, 2] * l2)
         bw2 -= dt * (j_inv[b, 2, 0] * l0 + j_inv[b, 2, 1] * l1 + j_inv[b, 2, 2] * l2)
         # positions: the non-contact acceleration at mid-sub-step, the changes after the kick
         tm = t + 0.5 * dt
-        xa0 += dt * (va[0] + aa[0] * tm + ua0 + pa0 - (bv0 + bw1 * xa2 - bw2 * xa1))
-        xa1 += dt * (va[1] + aa[1] * tm + ua1 + pa1 - (bv1 + bw2 * xa0 - bw0 * xa2))
-        xa2 += dt * (va[2] + aa[2] * tm + ua2 + pa2 - (bv2 + bw0 * xa1 - bw1 * xa0))
-        xc0 += dt * (vc[0] + ac[0] * tm + uc0 + pc0 - (bv0 + bw1 * xc2 - bw2 * xc1))
-        xc1 += dt * (vc[1] + ac[1] * tm + uc1 + pc1 - (bv1 + bw2 * xc0 - bw0 * xc2))
-        xc2 += dt * (vc[2] + ac[2] * tm + uc2 + pc2 - (bv2 + bw0 * xc1 - bw1 * xc0))
-        sa0 += dt * ua0
-        sa1 += dt * ua1
-        sa2 += dt * ua2
-        sc0 += dt * uc0
-        sc1 += dt * uc1
-        sc2 += dt * uc2
-    out[0, 0], out[0, 1], out[0, 2] = sa0 / step, sa1 / step, sa2 / step
-    out[1, 0], out[1, 1], out[1, 2] = ua0, ua1, ua2
-    out[2, 0], out[2, 1], out[2, 2] = sc0 / step, sc1 / step, sc2 / step
-    out[3, 0], out[3, 1], out[3, 2] = uc0, uc1, uc2
-    end_geometry = thread_contact_geometry((xa0, xa1, xa2), (xc0, xc1, xc2), box_min, box_max, s, radius_a,
-                                           radius_c, work)
-    end_excess = end_geometry[0]
-    end_energy = k_contact * _power(end_excess, exponent) * end_excess / (exponent + 1.0) if end_excess > 0.0 else 0.0
-    return dissipated, end_energy, touched
+        for i in range(k):
+            x[i, 0] += dt * (rel[i, 0] + acc[i, 0] * tm + u[i, 0] + p[i, 0] - (bv0 + bw1 * x[i, 2] - bw2 * x[i, 1]))
+            x[i, 1] += dt * (rel[i, 1] + acc[i, 1] * tm + u[i, 1] + p[i, 1] - (bv1 + bw2 * x[i, 0] - bw0 * x[i, 2]))
+            x[i, 2] += dt * (rel[i, 2] + acc[i, 2] * tm + u[i, 2] + p[i, 2] - (bv2 + bw0 * x[i, 1] - bw1 * x[i, 0]))
+            integral[i, 0] += dt * u[i, 0]
+            integral[i, 1] += dt * u[i, 1]
+            integral[i, 2] += dt * u[i, 2]
+    for i in range(k):
+        integral[i, 0] /= step
+        integral[i, 1] /= step
+        integral[i, 2] /= step
+    for r in range(m):
+        cluster.thread_energy[r] = thread_contact_energy(threads[r, 0], threads[r, 1], x, box_min, box_max, s, radius,
+                                                         law, work)
+    return touched
