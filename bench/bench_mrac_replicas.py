@@ -13,7 +13,8 @@ line to ``--results`` (resumable: a run already there is not repeated) and its s
 thrust, debris spin, chaser-debris CoM distance; every output sample) to ``<results stem>/<label>_<plant>_<law>_<rate>_<j>.npz``.
 
 Per run: mean elongation over the last 100 s and its RMS error to the desired elongation (``mrac.desired_elongation``,
-the reference model's steady elongation with ``settle_at_desired``), slack time after engagement (T_MT <= 0, s), the
+the reference model's steady elongation with ``settle_at_desired``; with ``mrac.tow_point_offset`` the governed one at
+the run's spin rate), slack time after engagement (T_MT <= 0, s), the
 near-slack share (T_MT < 1 N after engagement: on the full net a slack tether still carries the node's pull of a few
 tenths of a newton), peak tension, debris spin at the end (deg/s), CPU time and load. ``--table`` prints per (label,
 plant, law, rate) the mean over the replicas and, in brackets, their range.
@@ -42,7 +43,8 @@ from bench_mrac_probe import overridden  # noqa: E402
 
 COLUMNS = (("mean_last_100_s_m", "mean z (m)", ".4f"), ("rms_error_m", "RMS z - z_d (m)", ".4f"),
            ("slack_s", "slack (s)", ".1f"), ("near_slack_share", "T < 1 N", ".2f"),
-           ("peak_tension_N", "peak T (N)", ".0f"),
+           ("peak_tension_N", "peak T (N)", ".0f"), ("thrust_peak_N", "peak F (N)", ".0f"),
+           ("at_thrust_peak_share", "F at its peak, 100-300 s", ".2f"),
            ("spin_end_deg_s", "spin end (deg/s)", ".2f"))
 
 
@@ -69,7 +71,37 @@ def figures(series: dict, target: float) -> dict:
             "slack_s": f["slack_after_engagement_s"], "near_slack_share": float(np.mean(tension[after] < 1.0)),
             "peak_tension_N": f["peak_tension_N"],
             "spin_end_deg_s": float(np.degrees(np.linalg.norm(series["debris_omega_body"][-1]))),
-            "end_time_s": float(t[-1])}
+            "end_time_s": float(t[-1]), **thrust_figures(t, series["thrust"])}
+
+
+def thrust_figures(t, thrust) -> dict:
+    """Peak thrust (N) and the share of the samples over 100-300 s at it (within 1e-6 N): the share of the time the
+    command sits at the actuator's upper bound when it saturates, ~0 when it does not.
+
+    Parameters
+    ----------
+    t : (k,) float
+        Time (s).
+    thrust : (k,) float
+        Thrust (N).
+    """
+    peak = float(thrust.max())
+    late = t >= 100.0
+    return {"thrust_peak_N": peak, "at_thrust_peak_share": float(np.mean(thrust[late] >= peak - 1e-6))}
+
+
+def with_thrust_figures(record: dict, folder: Path) -> dict:
+    """A results line with the thrust figures, taken from its stored series when the line predates them."""
+    if "thrust_peak_N" in record:
+        return record
+    d = np.load(folder / f"{record['label']}_{record['plant']}_{record['law']}_{record['rate_deg_s']:g}_{record['replica']}.npz")
+    return {**record, **thrust_figures(d["time"], d["thrust"])}
+
+
+def at_spin(case: TowingCase, spin_rate_deg_s: float) -> TowingCase:
+    """``case`` with the debris spinning at ``spin_rate_deg_s`` (deg/s), the rate the run is made at (as the model
+    builders set it for the thrust law)."""
+    return case.model_copy(update=dict(debris=case.debris.model_copy(update=dict(spin_rate_deg_s=spin_rate_deg_s))))
 
 
 def table(path: Path) -> None:
@@ -81,7 +113,7 @@ def table(path: Path) -> None:
         A ``--results`` file of this bench.
     """
     with open(path, encoding="utf-8") as handle:
-        rows = [json.loads(line) for line in handle if line.strip()]
+        rows = [with_thrust_figures(json.loads(line), path.with_suffix("")) for line in handle if line.strip()]
     groups = {}
     for r in rows:
         groups.setdefault((r["label"], r["plant"], r["law"], r["rate_deg_s"]), []).append(r)
@@ -123,7 +155,6 @@ def main():
             done = {json.loads(line)["key"] for line in handle if line.strip()}
     folder = args.results.with_suffix("")
     folder.mkdir(parents=True, exist_ok=True)
-    target = reference_elongation(case)
     wrapped = wrapped_net(case) if args.plant == "full-net" else None
     for rate in args.rate:
         for law in args.laws:
@@ -133,6 +164,7 @@ def main():
                     continue
                 run_case = overridden(case, [f"thrust.kind={json.dumps(law)}"])
                 spin = rate * (1.0 + j * args.perturbation)
+                target = reference_elongation(at_spin(run_case, spin))   # mrac.tow_point_offset governs it by spin
                 load0, start = os.getloadavg()[0], time.process_time()
                 if args.plant == "full-net":
                     series = run_full_net(full_net_model(run_case, spin, wrapped=wrapped)).series()

@@ -202,16 +202,59 @@ def side_by_side(answers) -> str:
     for name, paper, key, fmt in rows:
         lines.append(f"| {name} | {paper} | " + " | ".join(_worst(pick(m, key), fmt) for m in models) + " |")
     if len(observations) > 1:
-        lines += ["", "Data length (paper Table 4: identification error against data collected):", "",
-                  "| observation (s) | paper | " + " | ".join(f"model '{m}': ratios / moments (%)" for m in models) + " |",
-                  "|" + "---|" * (2 + len(models))]
-        for obs in observations:
-            cells = []
-            for m in models:
-                ratios = _worst(pick(m, lambda a: absmax(a.get("inertia_ratio_error_percent")), obs), lambda v: f"{v:.2f}")
-                moments = _worst(pick(m, lambda a: a.get("inertia_error_percent"), obs), lambda v: f"{v:.2f}")
-                cells.append(f"{ratios} / {moments}")
-            lines.append(f"| {obs:g} | {PAPER['T4'].get(int(obs), '-')} | " + " | ".join(cells) + " |")
+        lines += ["", data_length_table(answers)]
+    return "\n".join(lines)
+
+
+def _span(values, fmt):
+    """'lo-hi' of the values (or the one value), 'not observable' if none."""
+    values = [v for v in values if v is not None]
+    if not values:
+        return "not observable"
+    lo, hi = fmt(min(values)), fmt(max(values))
+    return lo if lo == hi else f"{lo}-{hi}"
+
+
+def _moment_c_sigma_percent(a):
+    """1-sigma of the smallest principal moment C (% of it), None if not observable."""
+    if a.get("principal_moments_std_kg_m2") is None:
+        return None
+    return 100.0 * a["principal_moments_std_kg_m2"][2] / a["principal_moments_kg_m2"][2]
+
+
+def data_length_table(answers) -> str:
+    """Markdown table of the data-length study (the paper's Table 4): per model and observation time,
+    the seeds run, the data used (observation plus the collision run up to the last free-flight frame,
+    ``observation_time_s``), the worst mass and principal-moment errors over the seeds with the range
+    of their stated 1-sigma, the worst inertia-ratio error and the stage CPU.
+
+    Parameters
+    ----------
+    answers : list of (str, float, dict)
+        perception.model, observation time (s) and perception.json content of each run.
+    """
+    paper = ", ".join(f"{v} at {t} s" for t, v in PAPER["T4"].items())
+    lines = [f"Data length (the paper's Table 4, identification error against the data collected: {paper}):", "",
+             "| model | observation (s) | seeds | data used (s) | mass error, worst (%) | mass 1-sigma (%) "
+             "| principal moment error, worst (%) | 1-sigma of C (%) | inertia ratio error, worst (%) "
+             "| stage CPU (s) |",
+             "|" + "---|" * 10]
+    for model, obs in sorted({(m, o) for m, o, _ in answers}, key=lambda k: (["known", "none"].index(k[0]), k[1])):
+        runs = [a for m, o, a in answers if (m, o) == (model, obs)]
+        observable = [a for a in runs if not a.get("not_observable")]
+        cells = [
+            model, f"{obs:g}", " ".join(str(a.get("bench_seed", "?")) for a in runs)
+            + (f" ({len(runs) - len(observable)} not observable)" if len(observable) < len(runs) else ""),
+            _span([a["observation_time_s"] for a in observable], lambda v: f"{v:.1f}"),
+            _worst([a.get("mass_error_percent") for a in observable], lambda v: f"{v:.3f}"),
+            _span([100.0 * a["mass_std_kg"] / a["mass_kg"] for a in observable], lambda v: f"{v:.2f}"),
+            _worst([a.get("inertia_error_percent") for a in observable], lambda v: f"{v:.3f}"),
+            _span([_moment_c_sigma_percent(a) for a in observable], lambda v: f"{v:.2f}"),
+            _worst([max(abs(e) for e in a["inertia_ratio_error_percent"]) for a in runs
+                    if a.get("inertia_ratio_error_percent")], lambda v: f"{v:.3f}"),
+            _span([a.get("bench_cpu_s") for a in runs], lambda v: f"{v:.0f}"),
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 

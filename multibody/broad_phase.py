@@ -18,6 +18,8 @@ import math
 import numpy as np
 from numba import njit
 
+from multibody.jit_cache import NO_REFCOUNTS
+
 
 def box_shape_flags(triangles, triangle_range, box_min, box_max) -> np.ndarray:
     """(ns,) int64: 1 where a shape is the axis-aligned box of its body-frame bounds (12 triangles, every
@@ -88,7 +90,7 @@ def box_signed_distance(px, py, pz, box_min, box_max, s):
     return 0.0, fx, fy, fz
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)  # no reference counts (jit_cache.NO_REFCOUNTS)
 def flag_candidates(x_lvlh_soa, reach, body_to_lvlh, com_lvlh, shape_body, box_min, box_max, shape_reach, flags):
     """``flags[s, i]`` = 1 where node ``i`` (LVLH position ``x_lvlh[i]`` (m)) is inside shape ``s``'s body-frame
     bounding box grown by ``reach[i] + shape_reach[s]`` (m: what node and shape can close within the

@@ -24,6 +24,8 @@ import math
 import numpy as np
 from numba import njit
 
+from multibody.jit_cache import WITH_REFCOUNTS
+
 
 @njit(cache=True, inline="always")
 def hertz_hunt_crossley_normal_force(penetration, penetration_rate, stiffness, exponent, damping):
@@ -270,7 +272,7 @@ def _free_flight_substeps(delta, relative_velocities, normals, recoil, n_contact
     return min(remaining, int(earliest / dt))
 
 
-@njit(cache=True)
+@njit(cache=True, **WITH_REFCOUNTS)  # allocates; called from a NO_REFCOUNTS kernel (jit_cache)
 def contact_over_step(penetrations, relative_velocities, normals, external_force, node_mass, body_masses, step,
                       n_substeps, stiffness, exponent, damping, mu_static, mu_kinetic, transition_speed,
                       impulses, delta, recoil, forces):

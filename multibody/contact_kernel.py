@@ -20,6 +20,7 @@ from multibody.contact import (
     signed_distance_to_mesh,
 )
 from multibody.contact_implicit import contact_implicit_step_xyz
+from multibody.jit_cache import NO_REFCOUNTS
 
 
 @njit(cache=True, inline="always")
@@ -126,7 +127,8 @@ def _substeps_to_resolve_contact(penetrations, relative_velocities, normals, bod
     return max(1, int(math.ceil(step * rate / CONTACT_PHASE_PER_SUBSTEP)))
 
 
-@njit(cache=True)
+# no reference counts (jit_cache.NO_REFCOUNTS): its entry and exits counted 70 arrays each a step
+@njit(cache=True, **NO_REFCOUNTS)
 def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, net_force_lvlh,
                        body_force_lvlh,
                        torque_lvlh):

@@ -83,6 +83,7 @@ from multibody.broad_phase import box_signed_distance
 from multibody.contact import hertz_elastic_energy
 
 from multibody.contact_kernel import _effective_mass_of_body, _substeps_to_resolve_contact, add_body_reaction
+from multibody.jit_cache import WITH_REFCOUNTS
 from multibody.segment_box import MAX_BREAKPOINTS, segment_box_normal
 from multibody.segment_cycle import ClusterWork, cluster_contact_over_step, cluster_work, thread_contact_geometry
 from multibody.thread_cluster import group_pairs
@@ -261,7 +262,7 @@ def _near_shapes(x, v, net_force_lvlh, net_mass, velocity_lag, seg, states, shap
             row[i] = math.sqrt((x0[i] - cx) ** 2 + (x1[i] - cy) ** 2 + (x2[i] - cz) ** 2)
 
 
-@njit(cache=True)
+@njit(cache=True, **WITH_REFCOUNTS)  # allocates; called from a NO_REFCOUNTS kernel (jit_cache)
 def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers,
                                net_force_lvlh, body_force_lvlh, torque_lvlh):
     """Add the threads' contact forces with the box shapes (module doc) to ``net_force_lvlh`` and their

@@ -32,6 +32,20 @@ STALE_CACHE_AGE_S = 14 * 86400.0
 
 _cache_folder: Path | None = None
 
+#: numba options of a per-step kernel that allocates nothing and returns no array: no reference counting in its
+#: body (numba's ``_nrt`` option). numba compiles a callee that states no setting with its caller's, so a callee
+#: that allocates states :data:`WITH_REFCOUNTS`; one that does not runs without counts too, which is safe as long as
+#: it returns no array (each function's counts balance on their own).
+#: numba otherwise takes and drops a reference to every array of every named tuple a function is handed or reads
+#: from a structref, at its entry and exits: some 500 atomic counts a step of the reference case, 6.4 % of its solve
+#: (perf, docs/model.md, Speed, helper "speed10"). Safe only where every array the function touches is held by its
+#: caller for the whole call, nothing is allocated (numba then refuses to compile it) and no array is returned to
+#: a caller that would drop a reference it was never given.
+NO_REFCOUNTS = {"_nrt": False}
+#: numba options of a kernel that a :data:`NO_REFCOUNTS` kernel calls and that allocates (or calls what does): numba
+#: compiles a callee with its caller's runtime setting unless the callee states its own, and allocating needs it.
+WITH_REFCOUNTS = {"_nrt": True}
+
 
 def source_key(roots) -> str:
     """Hex SHA-256 (first 16 digits) of the relative path and bytes of every ``.py`` file under ``roots``.

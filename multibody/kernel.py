@@ -33,6 +33,7 @@ from numba import njit
 from multibody.contact_kernel import add_contact_forces
 from multibody.contact_segment import SegmentBuffers, add_segment_contact_forces, segment_buffers
 from multibody.net import ThreadRuns, add_bending_forces, add_thread_forces_runs
+from multibody.jit_cache import NO_REFCOUNTS, WITH_REFCOUNTS
 from multibody.orbit import clohessy_wiltshire_acceleration_xyz
 from multibody.maths.rotations import compose_rotation_vectors_into
 from multibody.node_frame import body_state_into
@@ -70,7 +71,7 @@ def verlet_evaluation_state(q, qt, qtt, step, n_net_coordinates, n_bodies):
     return q_next, v_half
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)  # no reference counts (jit_cache.NO_REFCOUNTS)
 def verlet_evaluation_state_into(q, qt, qtt, step, n_net_coordinates, n_bodies, q_next, v_half):
     """:func:`verlet_evaluation_state` into ``q_next`` and ``v_half`` ((N,) float, preallocated): the net step
     calls it every step (its arrays and the per-body compositions were about 12 allocations a step).
@@ -326,9 +327,10 @@ def coupled_generalized_forces(q, qt, net, bodies, shapes, law, mounts, n_orbit,
     return out_force
 
 
-# inlined into its callers at numba's IR level (called once a step): as a call, the some 50 arrays of the named
-# tuples it is handed were reference-counted at its entry and exit, about 100 atomic counts a step
-@njit(cache=True, inline="always")
+# no reference counts (jit_cache.NO_REFCOUNTS), and so a call again: inlined into its callers (as until now), its
+# reads of the named tuples' arrays were still counted, some 100 a step, and as a counted call it counted every
+# array it was handed at its entry and exit
+@njit(cache=True, **NO_REFCOUNTS)
 def coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, net, bodies, shapes, law, mounts, n_orbit, step,
                        n_substeps, stage_weight, buffers, force_soa, body_force):
     """The coupled forces with the net coordinate-major: ``force_soa`` (3, n) on the nodes (N, LVLH),
@@ -408,7 +410,8 @@ def coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, net, bodies, shapes, l
     contact_dissipated += thread_dissipated
     for b in range(nb):
         base = 6 * b
-        body_force[base:base + 3] = body_force_lvlh[b]
+        for r in range(3):  # element by element: a slice assignment allocates (its overlap copy)
+            body_force[base + r] = body_force_lvlh[b, r]
         for r in range(3):  # node-frame torque R^T t, in scalars (no BLAS call)
             body_force[base + 3 + r] = (node_to_lvlh[b, 0, r] * torque_lvlh[b, 0]
                                         + node_to_lvlh[b, 1, r] * torque_lvlh[b, 1]
@@ -418,7 +421,7 @@ def coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, net, bodies, shapes, l
     out_scalars[CONTACT_DISSIPATED] += contact_dissipated
 
 
-@njit(cache=True)
+@njit(cache=True, **WITH_REFCOUNTS)  # allocates; called from a NO_REFCOUNTS kernel (jit_cache)
 def _add_bending_forces_soa(x_soa, triples, bending_stiffness, force_soa, x_work, force_work):
     """:func:`multibody.net.add_bending_forces` on coordinate-major arrays, through node-major copies
     (``x_work``, ``force_work``: (n, 3) work space), so each node's sum is the same to the bit; nothing
@@ -443,7 +446,7 @@ def _add_bending_forces_soa(x_soa, triples, bending_stiffness, force_soa, x_work
     return energy
 
 
-@njit(cache=True)
+@njit(cache=True, **WITH_REFCOUNTS)  # allocates; called from a NO_REFCOUNTS kernel (jit_cache)
 def add_mount_forces(x, v, states, mounts, net_force_lvlh, body_force_lvlh, torque_lvlh):
     """Spring-dampers from mounted net nodes to their points on a body, all LVLH.
 
@@ -513,7 +516,7 @@ def body_states(q, qt, n_nodes, reference_com_lvlh, node_to_body):
     return states
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)  # no reference counts (jit_cache.NO_REFCOUNTS)
 def body_states_into(q, qt, n_nodes, reference_com_lvlh, node_to_body, states):
     """:func:`body_states` into ``states`` (:class:`BodyStates`, preallocated: the kernel's buffers).
 

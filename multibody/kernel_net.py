@@ -91,22 +91,28 @@ def net_step_model(kernel: KernelData, net_velocity) -> tuple:
     return NetStepModel(*values, *state), state[1], state[2]
 
 
-@njit(cache=True)
-def _forces(m, q_bodies, qt_bodies, n_substeps):
-    """The coupled forces at the net's evaluation state (positions in ``m.buffers.work_soa[0]``, written by the
+# inlined (numba IR), with the buffers its caller already read: each read of the structref's buffers counts their
+# 40 arrays in and out (reference counts; the force pass itself counts none, multibody.jit_cache.NO_REFCOUNTS)
+@njit(cache=True, inline="always")
+def _forces(m, buffers, q_bodies, qt_bodies, n_substeps):
+    """The coupled forces at the net's evaluation state (positions in ``buffers.work_soa[0]``, written by the
     caller; velocities ``m.qt_eval``, coordinate-major) and the bodies' (``q_bodies``, ``qt_bodies``):
-    :func:`multibody.kernel.coupled_forces_soa` on the structref. Returns the nodes' forces (3 n,) coordinate-major
-    (N, LVLH; the kernel's work space) and the bodies' generalized forces (6 nb,) (a view of the kernel's force
-    buffer)."""
-    buffers = m.buffers
+    :func:`multibody.kernel.coupled_forces_soa` on the structref ``m`` and its ``buffers`` (``m.buffers``). Writes
+    the nodes' forces into ``buffers.work_soa[2]`` ((3, n) coordinate-major, N, LVLH) and the bodies' generalized
+    forces into the last 6 nb entries of ``buffers.force`` (:func:`_body_forces`)."""
     n3 = m.q.shape[0]
     n = n3 // 3
     x_soa, force_soa = buffers.work_soa[0], buffers.work_soa[2]
     v_soa = m.qt_eval[:n3].reshape(3, n)
-    body_force = buffers.force[buffers.force.shape[0] - q_bodies.shape[0]:]
+    body_force = _body_forces(buffers.force, q_bodies.shape[0])
     coupled_forces_soa(x_soa, v_soa, q_bodies, qt_bodies, m.net, m.bodies, m.shapes, m.law, m.mounts,
                        m.mean_motion, m.step, n_substeps, m.stage_weight, buffers, force_soa, body_force)
-    return force_soa.reshape(n3), body_force
+
+
+@njit(cache=True, inline="always")
+def _body_forces(force, n_body_coordinates):
+    """The bodies' generalized forces (6 nb,): the tail of the kernel's force buffer ``force``."""
+    return force[force.shape[0] - n_body_coordinates:]
 
 
 @njit(cache=True)
@@ -127,10 +133,12 @@ def kernel_net_start(m, q_bodies, qt_bodies):
     for k in range(n3):
         x_flat[k] = reference[k] + q[k]
     m.qt_eval[:n3] = m.qt
-    force, body_force = _forces(m, q_bodies, qt_bodies, 1)
+    buffers = m.buffers
+    _forces(m, buffers, q_bodies, qt_bodies, 1)
+    force = buffers.work_soa[2].reshape(n3)
     for k in range(n3):
         m.qtt[k] = force[k] / m.net.mass[k % n]
-    return body_force.copy()
+    return _body_forces(buffers.force, q_bodies.shape[0]).copy()
 
 
 @njit(cache=True)
@@ -160,7 +168,10 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies, for
     nb = q_bodies.shape[0] // 6
     step = m.step
     half = 0.5 * step
-    x_flat = m.buffers.work_soa[0].reshape(n3)
+    # the buffers read once (each read of the group counts its 40 arrays here, where counting is on)
+    buffers = m.buffers
+    work_soa, force_buffer = buffers.work_soa, buffers.force
+    x_flat = work_soa[0].reshape(n3)
     # Verlet's half kick and drift, and the positions the forces take: q is the step's end position from here
     # on (nothing in the force evaluation reads the start's), so it is advanced in place, with no copy back.
     # One loop per array written: fused, these loops took longer (offline, 3675 coordinates: 8.6-9.5 us
@@ -174,7 +185,8 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies, for
     # the bodies' evaluation state straight into the output and the tail of qt_eval (work space)
     v_half_bodies = qt_eval[n3:]
     verlet_evaluation_state_into(q_bodies, qt_bodies, qtt_bodies, step, 0, nb, q_next_bodies, v_half_bodies)
-    force, body_force = _forces(m, q_next_bodies, v_half_bodies, m.n_substeps if time > 0.0 else 1)
+    _forces(m, buffers, q_next_bodies, v_half_bodies, m.n_substeps if time > 0.0 else 1)
+    force = work_soa[2].reshape(n3)
     # flat loops over the coordinates with few arrays each: the compiler vectorizes them (with more
     # arrays in one loop its run-time overlap checks give up and the loop stays scalar)
     inverse_mass = m.inverse_mass
@@ -182,7 +194,7 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies, for
         qtt[k] = force[k] * inverse_mass[k]
     for k in range(n3):
         qt[k] = qt_eval[k] + half * qtt[k]
-    force_bodies[:] = body_force
+    force_bodies[:] = _body_forces(force_buffer, q_bodies.shape[0])
 
 
 class KernelNet:

@@ -14,6 +14,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, uint64
 
+from multibody.jit_cache import NO_REFCOUNTS
+
 
 @dataclass(frozen=True)
 class NetTopology:
@@ -446,10 +448,11 @@ def _scatter(force, node0, work, first, count, sign):
 
 
 # error_model="numpy": with Python's, every division checks for zero and the loop stays scalar
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", **NO_REFCOUNTS)  # no reference counts (jit_cache.NO_REFCOUNTS)
 def add_thread_forces_runs(x, v, runs, force, work):
     """:func:`add_thread_forces` on coordinate-major arrays, run by run (:class:`ThreadRuns`): the same
-    forces and energies to the bit, faster (the tension loop vectorizes).
+    forces to the bit and the energies to round-off (:func:`sum_reassociated`), faster (the tension loop
+    vectorizes).
 
     Parameters
     ----------
@@ -481,13 +484,22 @@ def add_thread_forces_runs(x, v, runs, force, work):
         else:
             _scatter(force, a0, work, first, count, 1.0)
             _scatter(force, b0, work, first, count, -1.0)
-    # the energies in the thread list's order (padding adds exact zeros)
-    elastic = 0.0
-    power = 0.0
-    for t in range(work.shape[1]):
-        elastic += work[3, t]
-        power += work[4, t]
-    return elastic, power
+    # the energies' totals (padding adds exact zeros): partial sums, not the thread list's order (below)
+    return sum_reassociated(work[3]), sum_reassociated(work[4])
+
+
+# fastmath "reassoc" only (no other fast-math licence), and only here: the compiler may split the sum into
+# partial sums, so the loop vectorizes instead of waiting on one addition after the other (offline, 2 x 2451
+# padded threads: 1.15 us a step for the two sequential sums against 0.15 us; docs/model.md, Speed, helper
+# "speed10"). The totals then differ from the sequential sum's at round-off (a few ulp of the total); they
+# are recorded energies, read by nothing that feeds the dynamics.
+@njit(cache=True, fastmath={"reassoc"})
+def sum_reassociated(values):
+    """Sum (in the values' unit) of ``values`` ((m,) float), in an order the compiler picks (partial sums)."""
+    total = 0.0
+    for t in range(values.shape[0]):
+        total += values[t]
+    return total
 
 
 def thread_tension_strain(x, v, threads, rest_lengths, stiffness, damping):

@@ -140,3 +140,34 @@ def test_wrapping_level_scaled_wall_keeps_the_appendages_attached():
     small = {b.name: b for b in module.scaled_target(case, 1.0, 0.75).target.bodies}
     assert np.allclose(small["asar"].shapes[0].size, [1.125, 0.117, 7.5])
     assert np.allclose(small["ka_band_dish"].shapes[0].center, [1.6875 + 0.75 * 1.95, 0.0, -3.0])
+
+
+def test_data_length_table_states_the_worst_error_and_the_data_used_per_observation_time():
+    """bench_perception.py's Table 4 (data length): per observation time, the worst |error| over the seeds
+    (not the last seed's, not a signed maximum), the data used as the stage reports it (observation plus
+    the free flight after the collision, perception.json ``observation_time_s``), the range of the stated
+    1-sigma in % (mass_std / mass, C's std / C), and a not-observable seed counted, never read as a small
+    error. The answers are hand-made, so each expected cell is the arithmetic below."""
+    spec = importlib.util.spec_from_file_location("bench_perception_table", BENCH / "bench_perception.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+
+    def answer(seed, data_s, mass_error, moment_error, mass_std_kg, c_std_kg_m2, ratio_errors, cpu_s):
+        return {"bench_seed": seed, "not_observable": None, "observation_time_s": data_s,
+                "mass_error_percent": mass_error, "inertia_error_percent": moment_error,
+                "mass_kg": 2000.0, "mass_std_kg": mass_std_kg,
+                "principal_moments_kg_m2": [700.0, 600.0, 500.0], "principal_moments_std_kg_m2": [1.0, 1.0, c_std_kg_m2],
+                "inertia_ratio_error_percent": ratio_errors, "bench_cpu_s": cpu_s}
+
+    lost = {"bench_seed": 2, "not_observable": "after the collision: no free flight",
+            "inertia_ratio_error_percent": [0.9, -1.1], "bench_cpu_s": 300.0}
+    answers = [("none", 10.0, answer(0, 21.5, 0.30, 0.40, 4.0, 2.5, [0.2, -0.35], 200.0)),
+               ("none", 10.0, answer(1, 22.0, 0.10, 0.45, 2.0, 5.0, [-0.5, 0.1], 250.0)),
+               ("none", 10.0, lost),
+               ("none", 20.0, answer(0, 31.5, 0.05, 0.20, 6.0, 5.0, [0.07, 0.12], 360.0))]
+    rows = [line for line in module.data_length_table(answers).splitlines() if line.startswith("| none")]
+    # mass 1-sigma: 4/2000 = 0.20 %, 2/2000 = 0.10 %; C's: 2.5/500 = 0.50 %, 5/500 = 1.00 %;
+    # ratios: the worst |error| over every run, the not-observable one included (its track was made): 1.1 %
+    assert rows[0] == ("| none | 10 | 0 1 2 (1 not observable) | 21.5-22.0 | 0.300 | 0.10-0.20 | 0.450 | 0.50-1.00 "
+                       "| 1.100 | 200-300 |")
+    assert rows[1] == "| none | 20 | 0 | 31.5 | 0.050 | 0.30 | 0.200 | 1.00 | 0.120 | 360 |"

@@ -37,6 +37,22 @@ resonance at 20.44 deg/s, is damped weakly and through a saturating channel. Bot
 :math:`\dot r` the chaser-debris range rate (zero in steady towing); with it the rate estimate's corner can sit at
 :math:`\omega_m` (docs/towing.md, MRAC: "Why the taut-phase swing grows at 20.44 deg/s").
 
+**Range-rate notch at the spin rate** (``mrac.range_notch``, :func:`range_rate_seen`). The Zenit-2 stage's CoM sits
+0.217 m off the middle of its cylinder, so the bag's tow point moves relative to the CoM once per turn: the range rate
+carries a line at :math:`\omega_{spin}` (docs/towing.md, "What grows the swing at 29.01 deg/s"). That line is a
+forced motion of the tow point, not the chaser-bag mode the range damping is there for; damping it costs thrust at
+:math:`\omega_{spin}` (:math:`c_R \omega |\dot r|`-sized, the larger part of the thrust swing at 29.01 deg/s) and pulls
+on the tether once per turn. With the notch on, the range damping acts on the range rate through a second-order notch
+at the spin rate (the GNC's estimate, as for the breathing notch): it leaves the once-per-turn line to the laws'
+elongation feedback and damps every other frequency as before. Measured on the full net (docs/towing.md, "A range-rate
+notch at the spin rate, and a thrust budget"): it does not hold 29.01 deg/s (MRAC-2 fails, MRAC-1 holds in 1 of 3
+replicas) and breaks 20.44 deg/s, so it is off in the shipped case.
+
+**Once-per-turn thrust budget** (``mrac.tow_point_offset``, :func:`governed_elongation`): the desired elongation is
+lowered where its steady thrust would not leave the once-per-turn thrust :math:`m_C\omega^2\delta` below u_max.
+Measured: with 87-89 N of headroom at 29.01 deg/s the once-per-turn line still grows and both laws fail (2 + 2
+replicas); off in the shipped case.
+
 This module holds what both laws share (parameter head, reference model); each law is a plug-in of
 :mod:`multibody.control.thrust_laws` (``mrac1.py``, ``mrac2.py``: its gains, ``command``, initial
 state); ``params`` and ``state`` are flat float arrays for the compiled towing kernels, the common
@@ -50,11 +66,13 @@ from numba import njit
 
 # params indices common to both laws; each law appends its gains (thrust_laws/mrac1.py, mrac2.py)
 (T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN, Z_SLACK, F_STEADY, NOTCH_W, NOTCH_SIGMA,
- HOLD_TIME, C_RANGE) = range(16)
-N_COMMON = 16
+ HOLD_TIME, C_RANGE, RANGE_NOTCH_W, RANGE_NOTCH_SIGMA) = range(18)
+N_COMMON = 18
 # state: reference model z_m, z_m rate, the rate estimate's last elongation and last rate, the breathing notch's last
-# two inputs and outputs, the time of the last slack sample, then adaptive parameters
-ZM, ZM_RATE, Z_LAST, RATE_LAST, NOTCH_X1, NOTCH_X2, NOTCH_Y1, NOTCH_Y2, SLACK_AT, A0 = range(10)
+# two inputs and outputs, the time of the last slack sample, the range-rate notch's last two inputs and outputs, then
+# adaptive parameters
+(ZM, ZM_RATE, Z_LAST, RATE_LAST, NOTCH_X1, NOTCH_X2, NOTCH_Y1, NOTCH_Y2, SLACK_AT, RANGE_X1, RANGE_X2, RANGE_Y1,
+ RANGE_Y2, A0) = range(14)
 NEVER = -1e30   # SLACK_AT before any slack sample (s)
 
 
@@ -127,8 +145,9 @@ def common_params(case, tether) -> list:
     z_d (m), K_P (N/m), K_D (N s/m), the rate estimate's time constant (s, 0: the measured rate), the
     saturation's lower bound u_min (N; :func:`actuator_range`, default -u_max: the paper's symmetric sat), the
     slack threshold (m; ``mrac.slack_elongation``, -1: off) and the steady thrust (N; :func:`steady_thrust`), which
-    :func:`slack_hold` commands below that threshold, and the range damping c_R (N s/m; ``mrac.range_damping``,
-    :func:`range_damping_force`).
+    :func:`slack_hold` commands below that threshold, the range damping c_R (N s/m; ``mrac.range_damping``,
+    :func:`range_damping_force`) and its notch's centre (rad/s, 0: off; :func:`range_notch_frequency`) and pole decay
+    rate (1/s).
 
     Parameters
     ----------
@@ -139,14 +158,16 @@ def common_params(case, tether) -> list:
     """
     th, m = case.thrust, case.mrac
     k_mt, c_mt = abstracted_tether(case, tether)
-    z_d = command_elongation(m.desired_elongation, k_mt, m.k_p, m.settle_at_desired)
-    f_steady = steady_thrust(k_mt, m.desired_elongation)
+    desired = governed_elongation(case, k_mt)
+    z_d = command_elongation(desired, k_mt, m.k_p, m.settle_at_desired)
+    f_steady = steady_thrust(k_mt, desired)
     u_min, u_max = actuator_range(case, f_steady)
     z_slack = -1.0 if m.slack_elongation is None else m.slack_elongation
     omega_notch = notch_frequency(case)
+    omega_range = range_notch_frequency(case)
     return [th.t_on, u_max, 1.0 / case.chaser.mass, k_mt, c_mt, z_d, m.k_p, m.k_d,
             m.rate_filter_time, u_min, z_slack, f_steady, omega_notch, omega_notch / (2.0 * m.notch_quality),
-            hold_time(case), m.range_damping]
+            hold_time(case), m.range_damping, omega_range, omega_range / (2.0 * m.range_notch_quality)]
 
 
 def hold_time(case) -> float:
@@ -201,6 +222,81 @@ def notch_frequency(case) -> float:
     return 2.0 * math.radians(case.debris.spin_rate_deg_s)
 
 
+def once_per_turn_thrust(case) -> float:
+    """Thrust amplitude (N) the once-per-turn motion of the tow point asks of the chaser: with ``mrac.tow_point_offset``
+    = delta (m, the debris CoM's distance from the middle of the netted body, which the bag's tow point circles once
+    per turn), :math:`m_C \omega^2 \delta` at the tow's spin rate omega; 0 without it.
+
+    It is both the thrust that lets the chaser follow the tow point at constant tension and, when the chaser-bag mode
+    sits on omega (29.01 deg/s on the Zenit-2 case), the thrust any damping law spends there in steady state: on
+    resonance the separation's balance :math:`(K - \mu\omega^2) s = K x + \alpha F` leaves
+    :math:`\alpha |F| = K |x|` with :math:`K = \mu\omega^2`, :math:`\mu/\alpha = m_C` (two-body reduction, alpha =
+    m_D/(m_C + m_D)) whatever the damping (docs/towing.md, "A range-rate notch at the spin rate, and a thrust budget").
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        Read: ``mrac.tow_point_offset``, ``chaser.mass``, ``debris.spin_rate_deg_s`` (the tow's spin, the GNC's
+        estimate).
+    """
+    delta = case.mrac.tow_point_offset
+    if delta is None:
+        return 0.0
+    return case.chaser.mass * math.radians(case.debris.spin_rate_deg_s) ** 2 * delta
+
+
+def governed_elongation(case, k_abstracted) -> float:
+    """The elongation the laws are asked to hold (m): ``mrac.desired_elongation``, lowered where its steady thrust
+    :math:`k z_d` would not leave the once-per-turn thrust (:func:`once_per_turn_thrust`) inside the actuator's upper
+    bound: :math:`\min(z_d, (u_{max} - m_C\omega^2\delta) / k)`, a reference governor on the thrust budget. Without
+    ``mrac.tow_point_offset``, or where the budget holds (Zenit-2: up to 23.5 deg/s for delta = 0.217 m), it is
+    ``mrac.desired_elongation`` itself.
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        Read: ``mrac.desired_elongation``, ``mrac.max_thrust``, ``thrust.max_force`` and :func:`once_per_turn_thrust`'s.
+    k_abstracted : float
+        The abstracted model's tether stiffness (N/m), :func:`abstracted_tether`.
+
+    Raises
+    ------
+    ValueError
+        The once-per-turn thrust alone reaches the upper bound: no elongation leaves it room.
+    """
+    m = case.mrac
+    u_max = case.thrust.max_force if m.max_thrust is None else m.max_thrust
+    room = u_max - once_per_turn_thrust(case)
+    if room <= 0.0:
+        raise ValueError(f"mrac.tow_point_offset: the once-per-turn thrust m_C omega^2 delta = "
+                         f"{once_per_turn_thrust(case):g} N at {case.debris.spin_rate_deg_s:g} deg/s reaches the "
+                         f"upper thrust bound {u_max:g} N; no desired elongation leaves room for it")
+    return min(m.desired_elongation, room / k_abstracted)
+
+
+def range_notch_frequency(case) -> float:
+    """Centre of the range-rate notch (rad/s): the tow's spin rate (``debris.spin_rate_deg_s``, which the model builders
+    set to the rate the run is made at: the GNC's estimate from perception), the once-per-turn line the stage's CoM
+    offset drives; 0 with ``mrac.range_notch`` off (the range damping sees the measured range rate).
+
+    Parameters
+    ----------
+    case : riskassess.cases.towing.TowingCase
+        Read: ``mrac.range_notch``, ``debris.spin_rate_deg_s``.
+
+    Raises
+    ------
+    ValueError
+        The notch is on and the debris does not spin.
+    """
+    if not case.mrac.range_notch:
+        return 0.0
+    if case.debris.spin_rate_deg_s <= 0.0:
+        raise ValueError("mrac.range_notch: the debris does not spin (debris.spin_rate_deg_s = 0), so there is no "
+                         "once-per-turn line to leave out; set mrac.range_notch = false")
+    return math.radians(case.debris.spin_rate_deg_s)
+
+
 def steady_thrust(k_abstracted, desired) -> float:
     """Thrust (N) that holds the abstracted model at the desired elongation in steady towing: the tether force
     :math:`k z_d` with the abstracted stiffness (with ``mrac.free_debris``, :math:`(1 + m_C/m_D) k_{MT} z_d`: the
@@ -238,14 +334,14 @@ def actuator_range(case, f_steady) -> tuple[float, float]:
 def initial_state(z0, z_rate0) -> list:
     """The shared head of a law's state: reference model on the measured state (z0 (m), z_rate0 (m/s)),
     the rate estimate and the breathing notch started on it (the notch at rest on z0: its output is z0), no slack
-    sample yet.
+    sample yet, the range-rate notch at rest on a zero range rate (the chaser and the debris start co-moving).
 
     Parameters
     ----------
     z0, z_rate0 : float
         Elongation (m) and its rate (m/s) at the start.
     """
-    return [z0, z_rate0, z0, z_rate0, z0, z0, z0, z0, NEVER]
+    return [z0, z_rate0, z0, z_rate0, z0, z0, z0, z0, NEVER, 0.0, 0.0, 0.0, 0.0]
 
 
 def reference_steady_elongation(k_mt, k_p, z_d) -> float:
@@ -506,6 +602,46 @@ def notch_coefficients(omega, sigma, step):
 
 
 @njit(cache=True)
+def notch_output(omega, sigma, state, first, x, step):
+    """One sample of the notch at ``omega`` (rad/s) with pole decay rate ``sigma`` (1/s) (:func:`notch_coefficients`)
+    for the input ``x``: its last two inputs and outputs are ``state[first:first + 4]`` (x_{k-1}, x_{k-2}, y_{k-1},
+    y_{k-2}); :func:`shift_notch` writes this sample's.
+
+    Parameters
+    ----------
+    omega, sigma : float
+        Notch frequency (rad/s) and pole decay rate (1/s).
+    state : (j,) float
+        The law's state (the notch's memory read).
+    first : int
+        Index of x_{k-1} in ``state``.
+    x : float
+        This sample's input (any unit; the output has the same).
+    step : float
+        Sampling step (s).
+    """
+    g, b1, a1, a2 = notch_coefficients(omega, sigma, step)
+    return g * (x + b1 * state[first] + state[first + 1]) - a1 * state[first + 2] - a2 * state[first + 3]
+
+
+@njit(cache=True)
+def shift_notch(state, first, x, y):
+    """Shift a notch's memory ``state[first:first + 4]`` by one sample: input ``x`` and output ``y`` become the last.
+
+    Parameters
+    ----------
+    state : (j,) float
+        The law's state, written in place.
+    first : int
+        Index of x_{k-1} in ``state``.
+    x, y : float
+        This sample's input and output.
+    """
+    state[first + 1], state[first] = state[first], x
+    state[first + 3], state[first + 2] = state[first + 2], y
+
+
+@njit(cache=True)
 def breathing_notch(params, state, z, step):
     """The elongation the laws see (m): ``z`` through the notch at ``params[NOTCH_W]`` (:func:`notch_coefficients`),
     or ``z`` itself with the notch off (``NOTCH_W`` = 0). The notch's past samples are read from ``state``;
@@ -524,8 +660,7 @@ def breathing_notch(params, state, z, step):
     """
     if params[NOTCH_W] <= 0.0:
         return z
-    g, b1, a1, a2 = notch_coefficients(params[NOTCH_W], params[NOTCH_SIGMA], step)
-    return g * (z + b1 * state[NOTCH_X1] + state[NOTCH_X2]) - a1 * state[NOTCH_Y1] - a2 * state[NOTCH_Y2]
+    return notch_output(params[NOTCH_W], params[NOTCH_SIGMA], state, NOTCH_X1, z, step)
 
 
 @njit(cache=True)
@@ -539,8 +674,7 @@ def store_notch(state, z, z_seen):
     z, z_seen : float
         This sample's measured and notched elongation (m).
     """
-    state[NOTCH_X2], state[NOTCH_X1] = state[NOTCH_X1], z
-    state[NOTCH_Y2], state[NOTCH_Y1] = state[NOTCH_Y1], z_seen
+    shift_notch(state, NOTCH_X1, z, z_seen)
 
 
 @njit(cache=True)
@@ -575,3 +709,35 @@ def law_measurement(params, state, z, z_rate, step, advance):
             store_notch(state, z, z_seen)
         store_rate(state, z_seen, rate)
     return z_seen, rate
+
+
+@njit(cache=True)
+def range_rate_seen(params, state, range_rate, step, advance):
+    """The range rate the range damping acts on (m/s): the measured one, or with the range-rate notch on
+    (``params[RANGE_NOTCH_W]`` > 0, ``mrac.range_notch``) the measured one through a notch at the spin rate
+    (:func:`notch_output`, :func:`notch_coefficients`): the once-per-turn line of the tow point is removed, every
+    other frequency passes (unit gain at zero frequency and, within the pole decay rate, far from the notch). The
+    notch's memory advances when ``advance``, also before thrust-on, so its start transient (decaying as
+    :math:`e^{-\sigma t}`) is over when the range damping comes in.
+
+    .. math:: \dot r_{seen} = H(z)\,\dot r,\qquad H(e^{j\omega_{spin} h}) = 0
+
+    Parameters
+    ----------
+    params : (k,) float
+        The law's parameters (``RANGE_NOTCH_W``, ``RANGE_NOTCH_SIGMA`` used).
+    state : (j,) float
+        The law's state (``RANGE_X1`` ... ``RANGE_Y2``: the notch's memory).
+    range_rate : float
+        Measured chaser-debris range rate (m/s), :func:`multibody.control.thrust.range_rate`.
+    step : float
+        Sampling step (s).
+    advance : bool
+        A new sample (shift the memory).
+    """
+    if params[RANGE_NOTCH_W] <= 0.0:
+        return range_rate
+    seen = notch_output(params[RANGE_NOTCH_W], params[RANGE_NOTCH_SIGMA], state, RANGE_X1, range_rate, step)
+    if advance:
+        shift_notch(state, RANGE_X1, range_rate, seen)
+    return seen

@@ -147,6 +147,29 @@ class Mrac(Strict):
                          "2 Q / omega_notch. 4: +-12.5 % about twice the spin rate, wide against the spin estimate's "
                          "error and the spin's change over a steady tow (< 1 %), narrow enough to leave the tow's "
                          "own bounce (~0.3 rad/s) mostly alone (docs/towing.md).")
+    range_notch: bool = Field(
+        False, description="The range damping acts on the range rate through a notch at the debris spin rate (the "
+                           "GNC's estimate: debris.spin_rate_deg_s or the rate the run is made at): the stage's CoM, "
+                           "0.217 m off its cylinder's middle, moves the bag's tow point once per turn, a forced "
+                           "motion the chaser should follow rather than damp (damping it costs thrust at the spin "
+                           "rate, which met the 200 N limit at 29.01 deg/s). Needs range_damping > 0. Measured: it does not "
+                           "hold 29.01 deg/s and breaks 20.44 deg/s (docs/towing.md, MRAC: a range-rate notch at the "
+                           "spin rate, and a thrust budget).")
+    range_notch_quality: Positive = Field(
+        3.0, description="Quality Q of the range-rate notch (-): -3 dB width about omega_spin / Q, memory time "
+                         "2 Q / omega_spin. 3: +-17 % about the spin rate, wide against the spin's change over a "
+                         "failing tow (29.01 -> 28.0 deg/s, 3.5 %) and the line's measured spread (0.503-0.511 rad/s "
+                         "for omega 0.506), while twice the spin rate (the breathing the range damping was sized "
+                         "for) passes with gain 1.01 (docs/towing.md).")
+    tow_point_offset: NonNegative | None = Field(
+        None, description="Once-per-turn thrust budget (m): the distance delta of the debris CoM from the middle of "
+                          "the netted body (perception's CoM estimate; Zenit-2, Table 1: 0.217 m), which moves the "
+                          "bag's tow point once per turn. With it the laws hold min(desired_elongation, (u_max - m_C "
+                          "omega^2 delta) / k) (k the abstracted stiffness, omega the tow's spin rate): the steady "
+                          "thrust leaves m_C omega^2 delta of headroom, the thrust the once-per-turn line asks for "
+                          "near the chaser-bag resonance. Default: none (desired_elongation at every rate). Measured: the "
+                          "line still grows with that headroom and both laws fail at 29.01 deg/s (docs/towing.md, MRAC: "
+                          "a range-rate notch at the spin rate, and a thrust budget).")
     free_debris: bool = Field(
         False, description="Abstracted model (eq. 9) of the chaser relative to a free debris: tether terms scaled by "
                            "1 + m_C/m_D (two-body reduction along the tether); false: the paper's wall "
@@ -371,6 +394,21 @@ class TowingCase(Strict):
                              f"Nyquist frequency pi / step = {math.pi / step:g} rad/s of the controller's step "
                              f"{step:g} s")
 
+    def _check_range_notch(self, m):
+        """The range-rate notch's settings: a range damping to notch, a spinning debris, the spin rate below the
+        Nyquist frequency of the coarser of the two plants' steps."""
+        if m.range_damping <= 0.0:
+            raise ValueError("mrac.range_notch filters the range damping's range rate, but mrac.range_damping = "
+                             f"{m.range_damping:g}; give range_damping > 0 or set mrac.range_notch = false")
+        if self.debris.spin_rate_deg_s <= 0.0:
+            raise ValueError("mrac.range_notch: debris.spin_rate_deg_s = 0, so there is no once-per-turn line to "
+                             "leave out; set mrac.range_notch = false")
+        omega = math.radians(self.debris.spin_rate_deg_s)
+        step = max(self.simulation.step, self.full_net.step if self.full_net is not None else 0.0)
+        if omega * step >= math.pi:
+            raise ValueError(f"mrac.range_notch: debris.spin_rate_deg_s = {omega:g} rad/s is above the Nyquist "
+                             f"frequency pi / step = {math.pi / step:g} rad/s of the controller's step {step:g} s")
+
     @model_validator(mode="after")
     def _mrac_given(self):
         for section in THRUST_LAWS[self.thrust.kind].CASE_SECTIONS:
@@ -402,6 +440,8 @@ class TowingCase(Strict):
                                  f"{self.thrust.max_force:g}] N. Got {m.max_thrust:g} instead")
         if m is not None and m.breathing_notch:
             self._check_notch(m)
+        if m is not None and m.range_notch:
+            self._check_range_notch(m)
         if m is not None and m.slack_hold_periods > 0 and m.slack_elongation is None:
             raise ValueError("mrac.slack_hold_periods needs mrac.slack_elongation (the elongation below which the "
                              "tether counts as slack and the hold starts)")

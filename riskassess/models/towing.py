@@ -13,7 +13,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from multibody.control.attitude import sampled_boundary_layer
 from multibody.maths.rotations import quaternion_to_matrix
-from multibody.control.mrac import abstracted_tether, command_elongation
+from multibody.control.mrac import abstracted_tether, command_elongation, governed_elongation
 from multibody.control.thrust_laws import LAWS
 from multibody.towing import TowingModel
 from riskassess.cases.towing import TowingCase
@@ -125,7 +125,7 @@ def reference_command(case: TowingCase) -> float:
     """
     m, mt = case.mrac, case.main_tether
     k_mt, _ = abstracted_tether(case, [mt.stiffness, mt.damping])
-    return command_elongation(m.desired_elongation, k_mt, m.k_p, m.settle_at_desired)
+    return command_elongation(governed_elongation(case, k_mt), k_mt, m.k_p, m.settle_at_desired)
 
 
 def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None, step: float | None = None,

@@ -18,8 +18,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from numba.core.runtime import _nrt_python, rtsys
 
 from multibody.impact import ImpactSimulation
+from multibody.kernel import N_CONTACTS
+from multibody.kernel_net import kernel_net_step
 from riskassess.models.impact import model_inputs
 from riskassess.cases.impact import load_case
 
@@ -113,3 +116,38 @@ def test_a_sample_stores_nothing_from_a_lost_net_state(both_paths):
     finally:
         node_velocities[7] = saved
         recorder.health, recorder._n_rows = kept_watch, rows
+
+
+def test_kernel_steps_keep_numbas_reference_counts_balanced():
+    """The step's kernels that skip numba's reference counting (multibody.jit_cache.NO_REFCOUNTS: the force pass,
+    the contact pass, the threads, the box flags, the bodies' states) must neither keep an array alive nor let one
+    be freed that the structref still holds: over 200 more steps of a short kernel-path run (envisat_small, 0.3 s,
+    then the bodies frozen, so the net keeps striking them and the contact pass and its sub-cycle run), numba's
+    runtime frees exactly as many blocks as it allocates (the sub-cycle's work arrays: none kept, and none of the
+    structref's arrays freed, which would count a free without an allocation), and the state stays finite. A count
+    taken without being released (a leak of a count, not of memory) is not seen by this test."""
+    case = load_case(CASES / "envisat_small.toml")
+    inputs = model_inputs(case, CASES)
+    inputs.assembly.solver = dataclasses.replace(inputs.assembly.solver, end_time=0.3, net_integration="kernel")
+    simulation = ImpactSimulation(inputs.assembly, inputs.rest_attitudes, inputs.rest_coms)
+    simulation.run()
+    kernel_net = simulation.system.kernel_net
+    data = simulation.system.mbs.systemData
+    q, qt, qtt = (kernel_net._bodies(np.array(v)) for v in (data.GetODE2Coordinates(), data.GetODE2Coordinates_t(),
+                                                             data.GetODE2Coordinates_tt()))
+    q_next, force = np.zeros_like(q), np.zeros_like(q)
+    kernel_net_step(kernel_net.model, q, qt, qtt, 0.3, q_next, force)   # compiled before the count
+    counting = _nrt_python.memsys_stats_enabled()
+    _nrt_python.memsys_enable_stats()
+    try:
+        before = rtsys.get_allocation_stats()
+        for k in range(200):
+            kernel_net_step(kernel_net.model, q, qt, qtt, 0.3 + 1e-4 * k, q_next, force)
+        after = rtsys.get_allocation_stats()
+    finally:
+        if not counting:
+            _nrt_python.memsys_disable_stats()
+    assert after.alloc - before.alloc == after.free - before.free
+    assert after.mi_alloc - before.mi_alloc == after.mi_free - before.mi_free
+    assert np.isfinite(kernel_net.q).all() and np.isfinite(force).all()
+    assert kernel_net.kernel.buffers.scalars[N_CONTACTS] > 0   # the contact pass had work

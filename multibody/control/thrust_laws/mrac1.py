@@ -2,10 +2,10 @@
 ``towing-mrac-tether-control``): thrust along the chaser's body z; shared parts (abstracted model,
 reference model, parameter head) in :mod:`multibody.control.mrac`.
 
-``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``HOLD_TIME``), then lambda_0 (1/s),
+``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``RANGE_NOTCH_SIGMA``), then lambda_0 (1/s),
 k_s (N s/m), gamma, xi_h, xi_a (2) (-); ``state`` = [z_m (m), z_m rate (m/s), last elongation (m), last
 rate estimate (m/s), the breathing notch's last two inputs and outputs (m), the last slack
-sample's time (s), h (kg), a1 (N/m),
+sample's time (s), the range-rate notch's last two inputs and outputs (m/s), h (kg), a1 (N/m),
 a2 (N s/m)]. The elongation and its rate are :func:`multibody.control.mrac.law_measurement`'s.
 """
 from __future__ import annotations
@@ -15,7 +15,7 @@ from numba import njit
 
 from multibody.control.mrac import (A0, B, C_MT, K_MT, N_COMMON, T_ON, ZM, ZM_RATE, actuate, advance_reference,
                                     common_params, initial_state, law_measurement, pulling,
-                                    range_damping_force, reference_acceleration, slack_hold)
+                                    range_damping_force, range_rate_seen, reference_acceleration, slack_hold)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac1"
@@ -34,15 +34,16 @@ def command(t, z, z_rate, range_rate, params, state, step, advance):
         As in the thrust-law interface (:mod:`multibody.control.thrust`): time (s), main-tether
         elongation (m) and rate (m/s), chaser-debris range rate (m/s), sampling step (s), whether to advance the
         states.
-    params : (22,) float
+    params : (24,) float
         The common head (:mod:`multibody.control.mrac`), then lambda_0 (1/s), k_s (N s/m), gamma, xi_h, xi_a (2) (-).
-    state : (12,) float
+    state : (16,) float
         z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), notch memory (4, m), last slack
-        sample (s), h (kg), a1 (N/m), a2 (N s/m);
+        sample (s), range-rate notch memory (4, m/s), h (kg), a1 (N/m), a2 (N s/m);
         advanced in place when ``advance``.
     """
     hold = slack_hold(t, z, params, state, advance)                        # on the measured elongation
     z, z_rate = law_measurement(params, state, z, z_rate, step, advance)   # notched (mrac.breathing_notch) or not
+    range_rate = range_rate_seen(params, state, range_rate, step, advance)  # notched at the spin (mrac.range_notch) or not
     if t < params[T_ON]:
         return 0.0
     zm_acc = reference_acceleration(params, state[ZM], state[ZM_RATE])

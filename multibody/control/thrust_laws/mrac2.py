@@ -2,10 +2,10 @@
 ``towing-mrac-tether-control``): thrust along the chaser's body z; shared parts (abstracted model,
 reference model, parameter head) in :mod:`multibody.control.mrac`.
 
-``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``HOLD_TIME``), then Gamma_z (2),
+``params`` = the common head (:data:`multibody.control.mrac.T_ON` ... ``RANGE_NOTCH_SIGMA``), then Gamma_z (2),
 gamma_r, Gamma_theta (2), xi_2 (-) and P (2x2 row-major, eq. 21a); ``state`` = [z_m (m), z_m rate
 (m/s), last elongation (m), last rate estimate (m/s), the breathing notch's last two inputs and
-outputs (m), the last slack sample's time (s), Kz1 (N/m), Kz2 (N s/m), kr (N/m), theta1 (N/m),
+outputs (m), the last slack sample's time (s), the range-rate notch's last two inputs and outputs (m/s), Kz1 (N/m), Kz2 (N s/m), kr (N/m), theta1 (N/m),
 theta2 (N s/m)]. The elongation and its rate are
 :func:`multibody.control.mrac.law_measurement`'s.
 """
@@ -17,7 +17,7 @@ from scipy.linalg import solve_continuous_lyapunov
 
 from multibody.control.mrac import (A0, B, C_MT, K_D, K_MT, K_P, N_COMMON, T_ON, Z_D, ZM, ZM_RATE, actuate,
                                     advance_reference, common_params, initial_state, law_measurement, pulling,
-                                    range_damping_force, reference_acceleration, slack_hold)
+                                    range_damping_force, range_rate_seen, reference_acceleration, slack_hold)
 from multibody.control.thrust import THRUST_SIGNATURE
 
 NAME = "mrac2"
@@ -41,15 +41,16 @@ def command(t, z, z_rate, range_rate, params, state, step, advance):
     ----------
     t, z, z_rate, range_rate, step, advance
         As :func:`multibody.control.thrust_laws.mrac1.command` takes them (s, m, m/s, m/s, s, bool).
-    params : (26,) float
+    params : (28,) float
         The common head (:mod:`multibody.control.mrac`), then Gamma_z (2), gamma_r, Gamma_theta (2), xi_2, P (2x2).
-    state : (14,) float
+    state : (18,) float
         z_m (m), z_m rate (m/s), last elongation (m) and rate estimate (m/s), notch memory (4, m), last slack
-        sample (s), Kz (2), kr, Theta (2); advanced
+        sample (s), range-rate notch memory (4, m/s), Kz (2), kr, Theta (2); advanced
         in place when ``advance``.
     """
     hold = slack_hold(t, z, params, state, advance)                        # on the measured elongation
     z, z_rate = law_measurement(params, state, z, z_rate, step, advance)   # notched (mrac.breathing_notch) or not
+    range_rate = range_rate_seen(params, state, range_rate, step, advance)  # notched at the spin (mrac.range_notch) or not
     if t < params[T_ON]:
         return 0.0
     zm_acc = reference_acceleration(params, state[ZM], state[ZM_RATE])
