@@ -1,0 +1,139 @@
+"""One run of a safe-velocity study, replayed with its load history: when the net reaches, wraps and loads the target.
+
+    python3 bench/bench_safe_velocity_history.py CASE --store STORE --sample N [--velocity V] [--end-time T]
+                                                 [--release never] [--keep DIR]
+
+The run of Monte Carlo sample ``N`` of a store written by ``bench/bench_safe_velocity.py`` (its uncertain inputs:
+friction, Hunt-Crossley damping, aim point), at the store's velocity or ``--velocity``, over the case's end time or
+``--end-time``, with ``structures.release`` = ``--release`` (default ``never``: every joint holds, its peak is the
+demand it would see if it held), through the impact pipeline (:func:`riskassess.stages.run.run_case`) in a
+temporary folder (or ``--keep DIR``). Prints, with the CPU time and the load:
+
+- the first contact of the net with each body (s): flight distance / velocity;
+- per 0.5 s window: the largest demand of the weak location on ``--joint`` (default the solar-array hinge; the
+  resultant of the joint-frame moment components h1 and h3, the axes a revolute joint's location judges by default)
+  and the largest contact force on each body (1 ms impulse means);
+- the peak demand and its time, and the samples around it (h1, h3, the contact force on the joint's child);
+- the wrapping: the bullets' along-track position beyond the main body's centre and the net's kinetic energy relative
+  to the debris' centre of mass, at 16 times;
+- the run's answer, each location's state and the energy balance's largest drift.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sqlite3
+import tempfile
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from riskassess.cases.impact import validate_case
+from riskassess.stages.run import run_case
+from riskassess.sweep.spec import case_with
+
+WINDOW_S = 0.5   # s, the load-history table's window
+HALF_SPAN = 12   # samples either side of the peak printed (1 ms each at the case's 1 kHz output)
+
+
+def sample_overrides(store: Path, sample: int) -> dict:
+    """The overrides (dotted key -> SI value) of Monte Carlo sample ``sample`` at the store's first grid point."""
+    with sqlite3.connect(store) as con:
+        row = con.execute("select overrides from runs where sample = ? order by grid_index limit 1", (sample,)).fetchone()
+    if row is None:
+        raise SystemExit(f"{store}: no run of sample {sample}")
+    return json.loads(row[0])
+
+
+def first_contacts(series) -> dict:
+    """Body name -> time of its first contact force (s), None if never touched."""
+    force = np.linalg.norm(series["contact_force_lvlh"], axis=2)
+    return {str(name): (float(series["time"][np.argmax(force[:, i] > 0)]) if (force[:, i] > 0).any() else None)
+            for i, name in enumerate(series["body_names"])}
+
+
+def hinge_demand(series, joint: str) -> np.ndarray:
+    """(n,) resultant of the joint-frame moment components h1 and h3 (N m) of ``joint``."""
+    moment_joint = series["joint_moment_joint"][:, list(series["joint_names"]).index(joint), :]
+    return np.hypot(moment_joint[:, 0], moment_joint[:, 2])
+
+
+def print_windows(series, demand: np.ndarray) -> None:
+    """Per window: the largest demand and the largest contact force on each body."""
+    t, names = series["time"], [str(n) for n in series["body_names"]]
+    force = np.linalg.norm(series["contact_force_lvlh"], axis=2)
+    for start in np.arange(0.0, t[-1], WINDOW_S):
+        inside = (t >= start) & (t < start + WINDOW_S)
+        forces = ", ".join(f"{n} {force[inside, i].max():.0f}" for i, n in enumerate(names))
+        print(f"  {start:5.1f}-{start + WINDOW_S:5.1f} s: demand {demand[inside].max():7.1f} N m; contact force (N) {forces}")
+
+
+def print_peak(series, demand: np.ndarray, joint: str, child: int, skip_s: float) -> None:
+    """The judged peak (after ``skip_s``) and the samples around it."""
+    t = series["time"]
+    k = int(np.argmax(np.where(t >= skip_s, demand, -np.inf)))
+    moment_joint = series["joint_moment_joint"][:, list(series["joint_names"]).index(joint), :]
+    force_child = np.linalg.norm(series["contact_force_lvlh"][:, child, :], axis=1)
+    print(f"peak demand {demand[k]:.1f} N m at {t[k]:.3f} s; around it (h1, h3 N m; contact force on the child N):")
+    for j in range(max(k - HALF_SPAN, 0), min(k + HALF_SPAN + 1, len(t))):
+        print(f"  {t[j]:.3f} s  {moment_joint[j, 0]:8.1f} {moment_joint[j, 2]:8.1f}  {force_child[j]:7.1f}")
+
+
+def print_wrapping(net, series) -> None:
+    """The bullets' along-track position beyond the main body's centre (m) and the net's kinetic energy relative to
+    the debris' centre of mass (J), at 16 times."""
+    t, x, v, m = net["time"], net["positions_lvlh"], net["velocities_lvlh"], net["masses"]
+    body = list(series["body_names"]).index("main_body")
+    y_body = np.interp(t, series["time"], series["body_com_lvlh"][:, body, 1])
+    v_debris = np.stack([np.interp(t, series["time"], series["debris_velocity_lvlh"][:, k]) for k in range(3)], axis=1)
+    kinetic = 0.5 * np.einsum("n,tnk->t", m, (v - v_debris[:, None, :]) ** 2)
+    bullets = slice(x.shape[1] - int(net["n_bullets"]), None)
+    for k in np.linspace(0, len(t) - 1, 16).astype(int):
+        beyond = np.round(x[k, bullets, 1] - y_body[k], 1)
+        print(f"  {t[k]:6.2f} s: bullets beyond the body centre (m) {beyond}; net kinetic energy {kinetic[k]:6.2f} J")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("case")
+    parser.add_argument("--store", required=True)
+    parser.add_argument("--sample", type=int, default=0)
+    parser.add_argument("--velocity", type=float, default=None)
+    parser.add_argument("--end-time", type=float, default=None)
+    parser.add_argument("--release", default="never")
+    parser.add_argument("--joint", default="solar_array_hinge")
+    parser.add_argument("--keep", default=None)
+    args = parser.parse_args()
+    overrides = sample_overrides(Path(args.store), args.sample) | {"structures.release": args.release}
+    if args.velocity is not None:
+        overrides["launch.velocity"] = args.velocity
+    if args.end_time is not None:
+        overrides["simulation.end_time"] = args.end_time
+    case = validate_case(case_with(tomllib.loads(Path(args.case).read_text()), overrides), args.case)
+    print(f"{args.case}, sample {args.sample}: {overrides}")
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(args.keep) if args.keep else Path(tmp) / "run"
+        load, start = os.getloadavg()[0], time.process_time()
+        run_case(args.case, out, case=case, overwrite=True)
+        print(f"CPU {time.process_time() - start:.1f} s, load average {load:.1f} -> {os.getloadavg()[0]:.1f}")
+        series, net = np.load(out / "timeseries.npz"), np.load(out / "net.npz")
+        structures = json.loads((out / "structures.json").read_text())
+        drift = json.loads((out / "summary.json").read_text())["checks"]["energy_balance_relative_drift"]
+        joint = next(j for j in case.target.joints if j.name == args.joint)
+        child = [str(n) for n in series["body_names"]].index(joint.child)
+        demand = hinge_demand(series, args.joint)
+        print("first contact (s):", {n: (None if t is None else round(t, 3)) for n, t in first_contacts(series).items()})
+        print(f"{args.joint}: demand (h1, h3 resultant) and contact forces per {WINDOW_S} s window:")
+        print_windows(series, demand)
+        print_peak(series, demand, args.joint, child, structures["skip_initial_s"])
+        print("wrapping:")
+        print_wrapping(net, series)
+    states = ", ".join(f"{row['name']} {row['state']}" for row in structures["locations"])
+    print(f"answer {structures['debris_state']}: {states}; energy balance largest drift {100 * drift:.2f} %")
+
+
+if __name__ == "__main__":
+    main()
