@@ -14,6 +14,18 @@ Two kinds of substitution:
   replaced by its value from the simulated truth): the spin per C before (h0) and after (h1), the
   debris' orbital term, the net's angular momentum after, the mass.
 
+* **the observation's registered poses, in parts**: the true rotations with the registered CoM track; the true
+  poses turned by the registered rotation errors, all of them, their constant part in B (a turn of the map
+  frame, which the torque-free fit takes into its axes and which leaves h0 alone), their constant part in the
+  world (seen from the sensor) and the rest;
+* **the observation fit's quantities** at the collision time t = 0, h0 = R_B->W T diag(J) T^T omega_B: the
+  principal axes T, the ratios J, the rate's magnitude and direction in B, the attitude (the rotation phase),
+  one at a time (the after fit redone when T or J change, since it takes them as known); and the observation
+  fit redone with T and J held at the truth. Printed beside them: the axes' error against their stated
+  1-sigma, the correlation time of the registered errors against that of the fit's residuals (which scales
+  the fit's covariance), and C's 1-sigma from the observation fit's covariance through h0 alone (as the
+  stage counts it) and through h0 and the after fit.
+
 The truth is read from the collision run's record (debris attitude, rates, CoM and velocity; net
 nodes with their velocities); the estimators never see it.
 """
@@ -114,10 +126,10 @@ def attitude_error_parts(cap, indices) -> dict:
     errors_world = np.array([r @ e for r, e in zip(true_rotations, errors_body)])
     mean_body, mean_world = errors_body.mean(axis=0), errors_world.mean(axis=0)
     world_mean_in_body = np.array([r.T @ mean_world for r in true_rotations])
-    return {"registered rotation errors (all)": errors_body,
-            "their mean in B only (constant turn of the map frame)": np.tile(mean_body, (len(indices), 1)),
+    return {"all of them": errors_body,
+            "their mean in B only (a constant turn of the map frame)": np.tile(mean_body, (len(indices), 1)),
             "all minus their mean in B": errors_body - mean_body,
-            "their mean in the world only (constant turn seen from the sensor)": world_mean_in_body,
+            "their mean in the world only (a constant turn seen from the sensor)": world_mean_in_body,
             "all minus their mean in the world": errors_body - world_mean_in_body}
 
 
@@ -284,7 +296,7 @@ def report(path):
         before_tracker=with_registered_com_track(cap, before_idx))
     parts = attitude_error_parts(cap, before_idx)
     for name, errors in parts.items():
-        row(f"attitudes before: true poses turned by the {name}",
+        row(f"attitudes before: true poses turned by the registered rotation errors, {name}",
             before_tracker=with_attitude_errors(cap, before_idx, errors))
     row("CoM in B: truth", com_body=true_com_body(cap))
     row("attitudes before and after (same frames) and CoM: truth", before_tracker=with_true_poses(cap, before_idx),
