@@ -25,7 +25,8 @@ Two kinds of substitution:
   1-sigma, the correlation time of the registered errors against that of the fit's residuals (which scales
   the fit's covariance), and C's 1-sigma from the observation fit's covariance through h0 alone (as the
   stage counts it) and through h0 and the after fit; and a delete-a-block jackknife of the observation fit
-  (the covariance of h0 and of the axes from refits without each 2 s block) against the errors.
+  (the covariance of h0 and of the axes from refits without each 2 s block) against the errors; the after
+  stretch's own fit with the ratios and axes free (could it help fix the axes?).
 
 The truth is read from the collision run's record (debris attitude, rates, CoM and velocity; net
 nodes with their velocities); the estimators never see it.
@@ -515,6 +516,7 @@ def report_observation_quantities(cap, before, after):
                      c_true, refit.spin_per_c - h0_true, sigma0, h1 - h1_true)
     print_error_correlation(cap, before)
     print_jackknife(cap, before, estimate, truth)
+    print_after_fit_free_shape(cap, before, after, estimate, truth)
     c0 = replay_with_spin_before(cap, before, before.spin_per_c)[0]
     sigma_h0, sigma_both = c_sigma_from_observation_parameters(cap, before, c0)
     print(f"1-sigma of C from the observation fit's covariance, first order: through h0 only {100 * sigma_h0 / c0:.2f} %, "
@@ -573,6 +575,23 @@ def print_jackknife(cap, before, estimate, truth):
           f"{dh0 @ np.linalg.solve(before.spin_per_c_cov, dh0):.1f}, jackknife {dh0 @ np.linalg.solve(cov_h0, dh0):.1f}; "
           f"axes' turn {_vec(np.degrees(axes_error))} deg, 1-sigma stated {_vec(np.degrees(axes_sigma))}, jackknife "
           f"{_vec(np.degrees(np.sqrt(np.diag(cov_axes))))} deg")
+
+
+def print_after_fit_free_shape(cap, before, after, estimate, truth):
+    """Could the after-collision stretch help fix the axes? Its torque-free fit with the ratios and axes free
+    (started from the observation's): the axes' turn against the truth and its stated 1-sigma (deg)."""
+    times = np.asarray(cap["frames"]["time"])
+    used = np.array([int(np.argmin(np.abs(times - t))) for t in after.times])
+    attitudes = Rotation.from_matrix([cap["alignments"][k].body_to_world[:3, :3] for k in used])
+    weights = isotropic_attitude_weights(attitude_sqrt_information([cap["alignments"][k].information for k in used]))
+    t2b = estimate.principal_to_body
+    fit = TorqueFreeFit().fit(times[used], attitudes, weights, after.fit.rate_body_at(times[used][0]),
+                              before.fit.moments_, t2b)
+    turn = t2b.T @ Rotation.from_matrix(truth.principal_to_body @ fit.principal_to_body_.T).as_rotvec()
+    sigma = np.sqrt(np.diag(t2b.T @ fit.covariance_[8:11, 8:11] @ t2b))
+    print(f"after-collision stretch alone, ratios and axes free ({len(used)} frames): axes turned by "
+          f"{_vec(np.degrees(turn))} deg from the truth, stated 1-sigma {_vec(np.degrees(sigma))} deg, ratios "
+          f"{_vec(fit.moments_[:2])} (true {_vec(truth.moments[:2])})")
 
 
 def _observation_row(name, c, sigma, c_true, dh0, sigma0, dh1):
