@@ -40,6 +40,11 @@ from perception_substitution import (Tracker, _vec, load, others_after, replay, 
                                      true_com_body, true_terms, with_true_poses)
 
 
+#: Contiguous blocks of the delete-a-block jackknife of the observation fit (2 s each over 20 s of
+#: observation, longer than the registration errors' correlation times measured here, 0.4-1.9 s).
+JACKKNIFE_BLOCKS = 10
+
+
 def registered_attitude_errors(cap, indices) -> np.ndarray:
     """Each frame's registered attitude against the truth, e = rotvec(R_true^T R_registered) (k, 3) (rad, frame B)."""
     return np.array([Rotation.from_matrix(true_body_to_world(cap, k)[:3, :3].T
@@ -217,7 +222,7 @@ def c_sigma_from_observation_parameters(cap, before, c0):
     return float(np.sqrt(g_h0 @ cov @ g_h0)), float(np.sqrt(g_both @ cov @ g_both))
 
 
-def report_observation_quantities(cap, before, after):
+def report_observation_quantities(cap, before, after, blocks=JACKKNIFE_BLOCKS):
     """The table: each of the observation fit's quantities replaced by its truth -> C error, h0, h1."""
     c_true = true_c(cap)
     estimate = fitted_spin_state(before.fit)
@@ -253,7 +258,7 @@ def report_observation_quantities(cap, before, after):
     _observation_row("axes and ratios held at the truth, observation (phase, rate) and after fits redone", c, sigma,
                      c_true, refit.spin_per_c - h0_true, sigma0, h1 - h1_true)
     print_error_correlation(cap, before)
-    print_jackknife(cap, before, estimate, truth)
+    print_jackknife(cap, before, estimate, truth, blocks)
     print_after_fit_free_shape(cap, before, after, estimate, truth)
     c0 = replay_with_spin_before(cap, before, before.spin_per_c)[0]
     sigma_h0, sigma_both = c_sigma_from_observation_parameters(cap, before, c0)
@@ -278,11 +283,6 @@ def print_error_correlation(cap, before):
           f"{_vec(np.degrees(fit_error.std(axis=0)))} deg")
 
 
-#: Contiguous blocks of the delete-a-block jackknife of the observation fit (2 s each over 20 s of
-#: observation, longer than the registration errors' correlation times measured here, 0.4-1.9 s).
-JACKKNIFE_BLOCKS = 10
-
-
 def jackknife_observation_fit(cap, before, blocks=JACKKNIFE_BLOCKS):
     """Delete-a-block jackknife of the observation's torque-free fit: refitted without each of ``blocks``
     contiguous blocks of its frames (from the full fit's state), the covariance (G - 1)/G sum (x_i - x_bar)^2
@@ -303,12 +303,12 @@ def jackknife_observation_fit(cap, before, blocks=JACKKNIFE_BLOCKS):
     return (blocks - 1) * np.cov(np.array(spins).T, bias=True), (blocks - 1) * np.cov(np.array(turns).T, bias=True)
 
 
-def print_jackknife(cap, before, estimate, truth):
+def print_jackknife(cap, before, estimate, truth, blocks=JACKKNIFE_BLOCKS):
     """h0's and the axes' errors against the fit's stated 1-sigma and the jackknife's (chi2 over 3 dof)."""
-    cov_h0, cov_axes = jackknife_observation_fit(cap, before)
+    cov_h0, cov_axes = jackknife_observation_fit(cap, before, blocks)
     dh0 = before.spin_per_c - truth.spin_per_c()
     axes_error, axes_sigma, _ = axes_error_principal(estimate, truth, before.fit)
-    print(f"jackknife of the observation fit ({JACKKNIFE_BLOCKS} blocks): h0 - true {_vec(dh0)} rad/s, 1-sigma stated "
+    print(f"jackknife of the observation fit ({blocks} blocks): h0 - true {_vec(dh0)} rad/s, 1-sigma stated "
           f"{_vec(np.sqrt(np.diag(before.spin_per_c_cov)))}, jackknife {_vec(np.sqrt(np.diag(cov_h0)))}, chi2 stated "
           f"{dh0 @ np.linalg.solve(before.spin_per_c_cov, dh0):.1f}, jackknife {dh0 @ np.linalg.solve(cov_h0, dh0):.1f}; "
           f"axes' turn {_vec(np.degrees(axes_error))} deg, 1-sigma stated {_vec(np.degrees(axes_sigma))}, jackknife "
@@ -357,23 +357,25 @@ def report_pose_parts(cap):
               f"{100 * (mass - mass_true) / mass_true:+.3f} |")
 
 
-def report(path):
+def report(path, blocks=JACKKNIFE_BLOCKS):
     cap = load(path)
     answer = cap["answer"]
     print(f"\n== {path}: seed {answer['bench_seed']}, stage C error "
           f"{answer['principal_moments_error_percent'][2]:+.2f} %, true C {true_c(cap):.3f} kg m^2")
     report_pose_parts(cap)
     _, _, _, before, after, *_ = replay(cap)
-    report_observation_quantities(cap, before, after)
+    report_observation_quantities(cap, before, after, blocks)
 
 
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("captures", nargs="+")
+    parser.add_argument("--blocks", type=int, default=JACKKNIFE_BLOCKS,
+                        help="contiguous blocks of the observation fit's jackknife")
     args = parser.parse_args()
     np.set_printoptions(precision=4, suppress=True)
     for path in args.captures:
-        report(path)
+        report(path, args.blocks)
     sys.stdout.flush()
 
 
