@@ -40,6 +40,17 @@ from perception_substitution import (Tracker, _vec, load, others_after, replay, 
                                      true_com_body, true_terms, with_true_poses)
 
 
+def slow_error_share(errors, frame_interval, rate):
+    """Share of each component's variance (3,) (-) of per-frame errors (k, 3) below half the tumble
+    frequency |omega| / (4 pi) (Hz), and each component's strongest frequency (3,) (Hz): an error that
+    follows the view comes back with the tumble, one below it is a drift the fit can take for motion."""
+    errors = errors - errors.mean(axis=0)
+    frequencies = np.fft.rfftfreq(len(errors), frame_interval)
+    power = np.abs(np.fft.rfft(errors, axis=0)) ** 2
+    slow = frequencies < np.linalg.norm(rate) / (4.0 * np.pi)
+    return power[slow].sum(axis=0) / power.sum(axis=0), frequencies[np.argmax(power[1:], axis=0) + 1]
+
+
 #: Contiguous blocks of the delete-a-block jackknife of the observation fit (2 s each over 20 s of
 #: observation, longer than the registration errors' correlation times measured here, 0.4-1.9 s).
 JACKKNIFE_BLOCKS = 10
@@ -281,6 +292,10 @@ def print_error_correlation(cap, before):
           f"frames; the fit's residuals' correlation time {before.fit.correlation_time_:.1f} frames; the fitted motion "
           f"against the truth: mean {_vec(np.degrees(fit_error.mean(axis=0)))} deg, rms about the mean "
           f"{_vec(np.degrees(fit_error.std(axis=0)))} deg")
+    rate = before.fit.rate_body_at(before.times[0])
+    share, peak = slow_error_share(errors, float(np.median(np.diff(before.times))), rate)
+    print(f"  their variance below half the tumble frequency ({np.linalg.norm(rate) / (4 * np.pi):.3f} Hz), per B axis: "
+          f"{_vec(share)}; strongest frequency {_vec(peak)} Hz")
 
 
 def jackknife_observation_fit(cap, before, blocks=JACKKNIFE_BLOCKS):
