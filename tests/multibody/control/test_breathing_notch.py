@@ -2,7 +2,6 @@
 transfer function (a sinusoid at the notch frequency removed, a constant passed, another frequency scaled by
 |H(e^{j omega h})|), what the laws then see, where its frequency comes from, and the case checks."""
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,17 +10,14 @@ from multibody.control.mrac import (NOTCH_SIGMA, NOTCH_W, law_measurement, notch
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing import case_thrust_law
+from tests.multibody.control.notch_cases import CASE, mrac2_case_with, spinless_case_data
 
-CASE = Path(__file__).parents[3] / "cases" / "zenit2_towing.toml"
 OMEGA = 2.0 * math.radians(20.44)          # twice the Table 3 spin rate (rad/s), the breathing of the full net
 H = 0.01                                   # sampling step (s)
 
 
 def _case(**mrac):
-    """The shipped case with MRAC-2 and the notch on (``mrac`` keys changed)."""
-    case = load_model(CASE, TowingCase)
-    return case.model_copy(update=dict(thrust=case.thrust.model_copy(update=dict(kind="mrac2")),
-                                       mrac=case.mrac.model_copy(update=dict(breathing_notch=True) | mrac)))
+    return mrac2_case_with("breathing_notch", **mrac)
 
 
 def _law(case, spin_rate_deg_s=20.44, z0=0.04):
@@ -111,10 +107,6 @@ def test_bad_notch_settings_are_refused_naming_the_key(change, words):
 
 
 def test_a_notch_without_spin_or_frequency_is_refused_naming_the_key():
-    data = load_model(CASE, TowingCase).model_dump()
-    data["mrac"]["breathing_notch"] = True
-    data["debris"]["spin_rate_deg_s"] = 0.0
-    if data.get("full_net") is not None:
-        data["full_net"]["switch_to_lower_order"] = False
+    data = spinless_case_data("breathing_notch")
     with pytest.raises(ValueError, match="mrac.notch_frequency"):
         TowingCase.model_validate(data)

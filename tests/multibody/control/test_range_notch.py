@@ -3,7 +3,6 @@ through a notch at the debris spin rate, against its analytic transfer function 
 a constant and twice the spin rate passed as |H(e^{j omega h})| says), the laws' thrust changed by exactly the range
 term, where the frequency comes from, and the case checks."""
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,18 +11,15 @@ from multibody.control.mrac import (C_RANGE, RANGE_NOTCH_SIGMA, RANGE_NOTCH_W, n
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing import case_thrust_law
+from tests.multibody.control.notch_cases import CASE, mrac2_case_with, spinless_case_data
 
-CASE = Path(__file__).parents[3] / "cases" / "zenit2_towing.toml"
 SPIN = 29.01                               # deg/s, the Table 3 rate at which the once-per-turn line failed the laws
 OMEGA = math.radians(SPIN)                 # rad/s, the notch's centre
 H = 0.01                                   # sampling step (s)
 
 
 def _case(**mrac):
-    """The shipped case with MRAC-2 and the range-rate notch on (``mrac`` keys changed)."""
-    case = load_model(CASE, TowingCase)
-    return case.model_copy(update=dict(thrust=case.thrust.model_copy(update=dict(kind="mrac2")),
-                                       mrac=case.mrac.model_copy(update=dict(range_notch=True) | mrac)))
+    return mrac2_case_with("range_notch", **mrac)
 
 
 def _law(case, spin_rate_deg_s=SPIN, z0=0.04):
@@ -125,10 +121,6 @@ def test_a_notch_without_range_damping_is_refused_naming_the_key():
 
 
 def test_a_notch_without_spin_is_refused_naming_the_key():
-    data = load_model(CASE, TowingCase).model_dump()
-    data["mrac"]["range_notch"] = True
-    data["debris"]["spin_rate_deg_s"] = 0.0
-    if data.get("full_net") is not None:
-        data["full_net"]["switch_to_lower_order"] = False
+    data = spinless_case_data("range_notch")
     with pytest.raises(ValueError, match="mrac.range_notch"):
         TowingCase.model_validate(data)
