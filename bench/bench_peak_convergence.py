@@ -5,6 +5,7 @@ and through the structure's first mode.
     python3 bench/bench_peak_convergence.py [CASE] [--end-time T] [--replicas R] [--first-mode HZ]
                                             [--mode HZ | --mode LOW,HIGH ...] [--skip S] [--cache DIR]
                                             [--workers N] [--markdown]
+                                            [--store STORE --sample N [--velocity V]] [--peak-times LOCATION]
 
 Runs the case (default ``cases/envisat_small.toml``) with joint release off (every peak is then the
 demand the intact joint carries, not cut at a release) at a baseline and one change at a time:
@@ -24,6 +25,12 @@ below any physical uncertainty: the net's contacts make the capture sensitive to
 so a single run's peak is one sample of a spread. The raw joint reactions of every run are kept in
 ``--cache`` (default: a folder under the system's temporary directory named for the case), so
 readings can be compared without running again.
+
+``--store STORE --sample N`` runs Monte Carlo sample ``N`` of a store written by ``bench/bench_safe_velocity.py``
+(its uncertain inputs and launch velocity, or ``--velocity``; the replicas' offsets on that velocity) instead of
+the case's nominal inputs: a run of a safe-velocity row, variant by variant. ``--peak-times LOCATION`` prints,
+per reading, variant and replica, that location's judged peak (after the skip), its time and its utilization
+against the allowable's low end.
 
 ``--against CACHE`` adds the baseline runs of another cache (the same case with one physical input
 changed, e.g. ``--member-damping 0.05``) as one more column.
@@ -45,6 +52,7 @@ import hashlib
 import json
 import os
 import re
+import sys
 import tempfile
 import time
 import tomllib
@@ -61,7 +69,11 @@ from riskassess.models.impact import model_inputs, weak_locations
 from riskassess.stages.run import run_case
 from structures.modal_load import mode_grid
 from structures.reproducibility import REPRODUCIBLE_TOLERANCE, TWIN_OFFSET, parting_time
+from riskassess.sweep.spec import case_with
 from structures.weak_location import judged_demands
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+from bench_safe_velocity_history import sample_overrides  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 TOLERANCE = REPRODUCIBLE_TOLERANCE
@@ -121,9 +133,19 @@ def with_members(text: str, specs: list[str], modulus: float, shear_modulus: flo
     return text
 
 
-def simulate(text: str, base_dir: str, stiffness_scale: float, out: str) -> str:
-    """Run one case text and keep its raw joint reactions in ``out`` (.npz: time, force, moment, cpu);
-    returns ``out``, or the failure message of a run the model cannot finish."""
+def replica_overrides(overrides: dict, replica: int, velocity: float | None) -> dict:
+    """A store sample's overrides (dotted key -> SI value) for one replica: its launch velocity (m/s; or
+    ``velocity``) times 1 + replica x REPLICA_OFFSET, as :func:`case_text` offsets the case's own."""
+    if not overrides:
+        return {}
+    nominal = overrides["launch.velocity"] if velocity is None else velocity
+    return overrides | {"launch.velocity": nominal * (1 + replica * REPLICA_OFFSET)}
+
+
+def simulate(text: str, base_dir: str, stiffness_scale: float, out: str, overrides: dict | None = None) -> str:
+    """Run one case text (with ``overrides``, dotted key -> SI value, applied to it) and keep its raw joint
+    reactions in ``out`` (.npz: time, force, moment, cpu); returns ``out``, or the failure message of a run the
+    model cannot finish."""
     if Path(out).exists():
         return out
     factor, cap_t, cap_r = AUTOMATIC_PENALTY          # every automatic joint axis scaled, capped or not
@@ -133,8 +155,9 @@ def simulate(text: str, base_dir: str, stiffness_scale: float, out: str) -> str:
     with tempfile.TemporaryDirectory(dir=base_dir) as tmp:      # mesh and data paths stay relative
         case = Path(tmp) / "case.toml"
         case.write_text(text)
+        validated = validate_case(case_with(tomllib.loads(text), overrides), case) if overrides else None
         try:
-            run_case(case, Path(tmp) / "run")
+            run_case(case, Path(tmp) / "run", case=validated)
         except SimulationFailed as exc:     # a variant the model cannot run is a finding, not a crash
             return f"failed: {exc}"
         with np.load(Path(tmp) / "run" / "timeseries.npz") as data:
@@ -273,6 +296,27 @@ def report(results: dict, replicas: int, locations, readings: dict, skip: float,
                     "[90 % bootstrap interval]; 'median known to': half-width of the baseline median's interval)")
 
 
+def peak_times(results: dict, replicas: int, locations, readings: dict, skip: float, in_dynamics: set,
+               name: str) -> None:
+    """Per reading, variant and replica: the judged peak (after ``skip``) of location ``name``, its time and its
+    utilization against the allowable's low end (each criterion)."""
+    location = next((loc for loc in locations if loc.name == name), None)
+    if location is None:
+        raise SystemExit(f"--peak-times: no weak location '{name}' (known: {', '.join(l.name for l in locations)})")
+    print(f"\n{name}: judged peak (t >= {skip:g} s), its time and utilization (peak / allowable low end)")
+    for reading, (modes, damping) in readings.items():
+        for (variant, replica), run in results.items():
+            if isinstance(run, str):
+                continue
+            for key, series in histories([location], run, modes, damping, in_dynamics).items():
+                criterion = key.split(" / ")[1]
+                judged = np.where(run["time"] >= skip, series, -np.inf)
+                k = int(np.argmax(judged))
+                low = location.criteria()[criterion].low
+                print(f"  {reading:34s} {variant:12s} r{replica}  {criterion}: {series[k]:8.1f} at {run['time'][k]:.3f} s, "
+                      f"utilization {series[k] / low:.3f}")
+
+
 def parse_mode(text: str) -> tuple[str, np.ndarray]:
     """'2' or '0.5,2' -> (label, grid of modes in Hz)."""
     values = [float(v) for v in text.split(",")]
@@ -309,6 +353,11 @@ def main() -> None:
     parser.add_argument("--against", default=None, metavar="CACHE",
                         help="also report the baseline runs of another cache (a physical change, e.g. "
                              "--member-damping) as one more column, judged in this cache's windows")
+    parser.add_argument("--store", default=None, help="run a Monte Carlo sample of this safe-velocity store")
+    parser.add_argument("--sample", type=int, default=0, help="the store's sample (with --store)")
+    parser.add_argument("--velocity", type=float, default=None, help="launch velocity (m/s) instead of the store's")
+    parser.add_argument("--peak-times", default=None, metavar="LOCATION",
+                        help="print this location's judged peak, time and utilization per variant and replica")
     parser.add_argument("--variants", default=",".join(VARIANTS),
                         help="comma list of the configurations to run (default: all); the others are reported missing")
     args = parser.parse_args()
@@ -324,12 +373,19 @@ def main() -> None:
         text = _sub(r"^output_rate = [0-9.e]+", f"output_rate = {args.output_rate:g}", text)
     if args.end_time:
         text = _sub(r"^end_time = [0-9.e]+", f"end_time = {args.end_time:g}", text)
-    tag = hashlib.sha256(f"{text}{args.first_mode}".encode()).hexdigest()[:12]
+    overrides = sample_overrides(Path(args.store), args.sample) if args.store else {}
+    if args.velocity is not None and not overrides:
+        raise SystemExit("--velocity: with --store only (the case's own velocity is its [launch] velocity)")
+    if overrides:
+        print(f"{args.store}, sample {args.sample}: {replica_overrides(overrides, 0, args.velocity)}")
+    tag = hashlib.sha256(f"{text}{args.first_mode}{replica_overrides(overrides, 0, args.velocity)}".encode()
+                         ).hexdigest()[:12]
     cache = Path(args.cache or Path(tempfile.gettempdir()) / f"peak-convergence-{case_path.stem}-{tag}")
     cache.mkdir(parents=True, exist_ok=True)
     jobs = {(v, r): (case_text(text, v, r, args.first_mode), str(case_path.parent),
                      0.25 if v == "stiffness/4" and not args.first_mode else 1.0,
-                     str(cache / f"{v.replace('/', '_').replace(' ', '_')}-{r}.npz"))
+                     str(cache / f"{v.replace('/', '_').replace(' ', '_')}-{r}.npz"),
+                     replica_overrides(overrides, r, args.velocity))
             for v in VARIANTS for r in range(args.replicas)}
     start, load = time.perf_counter(), os.getloadavg()[0]
     chosen = set(args.variants.split(","))
@@ -376,6 +432,8 @@ def main() -> None:
     readings.update({label: (tuple(grid), args.mode_damping) for label, grid in map(parse_mode, args.mode)})
     in_dynamics = {i for i, j in enumerate(case.target.joints) if j.member is not None}
     report(results, args.replicas, locations, readings, skip, in_dynamics, args.markdown, args.edge_margin)
+    if args.peak_times:
+        peak_times(results, args.replicas, locations, readings, skip, in_dynamics, args.peak_times)
 
 
 if __name__ == "__main__":

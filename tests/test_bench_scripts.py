@@ -171,3 +171,28 @@ def test_data_length_table_states_the_worst_error_and_the_data_used_per_observat
     assert rows[0] == ("| none | 10 | 0 1 2 (1 not observable) | 21.5-22.0 | 0.300 | 0.10-0.20 | 0.450 | 0.50-1.00 "
                        "| 1.100 | 200-300 |")
     assert rows[1] == "| none | 20 | 0 | 31.5 | 0.050 | 0.30 | 0.200 | 1.00 | 0.120 | 360 |"
+
+
+def test_peak_convergence_replays_a_store_sample_with_the_replica_offsets(tmp_path):
+    """bench_peak_convergence.py --store/--sample: the replicas of a Monte Carlo sample keep its uncertain inputs and
+    offset its launch velocity by k x 1e-7 (structures.reproducibility.TWIN_OFFSET), as the case's own velocity is
+    offset; ``--velocity`` replaces the stored velocity; without a store nothing is overridden."""
+    import json
+    import sqlite3
+
+    module = _bench_module("bench_peak_convergence")
+    store = tmp_path / "store"
+    stored = {"launch.velocity": 2.0, "contact.mu_static": 0.178, "launch.aim_point[2]": 6.552}
+    with sqlite3.connect(store) as con:      # the columns bench_safe_velocity_history.sample_overrides reads
+        con.execute("create table runs (grid_index integer, sample integer, overrides text)")
+        con.execute("insert into runs values (0, 1, ?)", (json.dumps(stored),))
+    con.close()
+    overrides = module.sample_overrides(store, 1)
+    assert module.replica_overrides(overrides, 0, None) == stored
+    replica = module.replica_overrides(overrides, 2, None)
+    assert replica["launch.velocity"] == pytest.approx(2.0000004, rel=1e-15, abs=0.0)    # 2 m/s x (1 + 2e-7)
+    assert {k: v for k, v in replica.items() if k != "launch.velocity"} == {k: v for k, v in stored.items()
+                                                                           if k != "launch.velocity"}
+    assert module.replica_overrides(overrides, 1, 1.75)["launch.velocity"] == pytest.approx(1.750000175, rel=1e-15,
+                                                                                          abs=0.0)
+    assert module.replica_overrides({}, 3, None) == {}
