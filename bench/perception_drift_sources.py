@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+from scipy.stats import f as f_distribution
 
 from perception.motion import integrated_autocorrelation_time
 from perception.scan_to_map import MAP_COVERED, MAP_INTERVAL
@@ -96,8 +97,8 @@ def attitude_errors(cap, indices) -> np.ndarray:
 def map_batch_view(line_of_sight, rebuilt) -> np.ndarray:
     """For each frame (k, 3): the line of sight in B averaged over the scans added to the map at its last
     rebuild before the frame (the scans that dominate the rebuilt map: a rebuild thins the old map's points,
-    one a voxel, together with every pending scan's, so each voxel seen by the ~10 pending scans keeps ~1/11
-    of its old position)."""
+    one a voxel, together with every pending scan's, so in a voxel seen by the ~10 pending scans the old map
+    point weighs about 1/11 of the new mean)."""
     rebuilt = np.unique(rebuilt)
     bounds = np.r_[0, rebuilt]
     batches = [line_of_sight[0]] + [line_of_sight[bounds[j - 1] + 1:bounds[j] + 1].mean(axis=0)
@@ -195,6 +196,8 @@ def report(path, rng) -> None:
     print(f"    step of the B3 error onto a new map: rms {np.sqrt(np.mean(steps[on_new] ** 2)):.3f} deg, mean "
           f"{steps[on_new].mean():+.4f} deg ({on_new.sum()} steps); between rebuilds: rms "
           f"{np.sqrt(np.mean(steps[~on_new] ** 2)):.3f} deg, mean {steps[~on_new].mean():+.4f} deg ({(~on_new).sum()})")
+    ratio = np.mean(steps[on_new] ** 2) / np.mean(steps[~on_new] ** 2)
+    print(f"    their variance ratio {ratio:.2f}, one-sided F test p {f_distribution.sf(ratio, on_new.sum(), (~on_new).sum()):.3f}")
     r, null50, null95 = rebuild_step_correlation(e3, first_on_new, slow, rng)
     print(f"    slow B3 error vs the slow part of the steps onto new maps, cumulated: r {r:+.2f} (random frame sets "
           f"of the same size: median {null50:+.2f}, 95th percentile {null95:+.2f})")
