@@ -13,7 +13,13 @@ the truth (frame B) are set beside, frame by frame:
 * **the registration**: fitness, CPU time (a proxy for the ICP's iterations; the capture holds neither the
   iterations nor the inlier RMSE), the stated 1-sigma about B's third axis from the frame's information.
 
-    python bench/perception_drift_sources.py runs/captures/none_obs20_seed2.pkl [...]
+    python bench/perception_drift_sources.py runs/captures/none_obs20_seed2.pkl [...] [--fixed-map]
+
+With ``--fixed-map`` (~20 s CPU a capture), the observation's scans are made again (the capture's case, seed and
+observation time; the stage's online track is redone and checked against the captured poses) and each scan is
+registered, as the stage does (motion prior, the two first frames at their true poses), to one **fixed** map
+built from all the observation's scans at their true poses in the capture's B: a slow error that stays is the
+registration's own on these views, one that goes was the online map's.
 
 The truth is read from the capture; nothing is refitted.
 """
@@ -139,6 +145,66 @@ def strongest_slow_frequencies(series, frame_interval, cutoff_hz) -> list[tuple[
     slow = np.flatnonzero((frequencies > 0) & (frequencies < cutoff_hz))
     top = slow[np.argsort(power[slow])[::-1][:2]]
     return [(float(frequencies[i]), float(power[i] / power[1:].sum())) for i in top]
+
+
+def fixed_map_errors(cap) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The observation's attitude errors (k, 3) (rad, frame B) of the stage's online track, made again from the
+    capture's case, seed and observation time, and of the same scans registered to a fixed map of the scans at
+    their true poses, with the stage's motion prior and without; and the largest difference (-) of the online poses from the captured ones (0: the same run)."""
+    from riskassess.cases.impact import load_case
+    from riskassess.stages.perceive import Frames, Scene, observe_tumble_model_free
+    from perception import scan_to_map
+
+    answer = cap["answer"]
+    case = load_case(CASE)
+    perception = case.perception.model_copy(update={"seed": int(answer["bench_seed"]), "model": "none",
+                                                    "observation_time": float(answer["bench_observation_s"])})
+    case = case.model_copy(update={"perception": perception})
+    scene = Scene.from_case(case, CASE.parent, str(CASE))
+    frames = Frames()
+    _, tracker, _ = observe_tumble_model_free(scene, frames, np.random.default_rng(perception.seed))
+    k = len(frames.scans)
+    online = [a.world_to_body for a in tracker.alignments[:k]]
+    difference = max(float(np.abs(online[i] - cap["alignments"][i].world_to_body).max()) for i in range(k))
+    reg = perception.registration
+    thin = [scan_to_map.thinned_scan(scan, reg.voxel) for scan in frames.scans]
+    true_world_to_body = [np.linalg.inv(true_body_to_world(cap, i)) for i in range(k)]
+    points, normals, index = scan_to_map._built_map(
+        np.vstack([scan_to_map._transform(thin[i], true_world_to_body[i]) for i in range(k)]), reg.voxel,
+        reg.max_correspondence)
+    def registered(prior_sigma):
+        poses = true_world_to_body[:2]
+        for i in range(2, k):
+            pose, _, _ = scan_to_map._register(thin[i], points, normals,
+                                               scan_to_map.predict_world_to_body(poses[i - 1], poses[i - 2]),
+                                               reg.max_correspondence, prior_sigma, index)
+            poses.append(pose)
+        return poses
+
+    def errors(world_to_body):
+        return np.array([Rotation.from_matrix(true_body_to_world(cap, i)[:3, :3].T
+                                              @ np.linalg.inv(world_to_body[i])[:3, :3]).as_rotvec() for i in range(k)])
+
+    return errors(online), errors(registered(scan_to_map.PRIOR_SIGMA)), errors(registered(None)), difference
+
+
+def report_fixed_map(path) -> None:
+    cap = load(path)
+    online, fixed, fixed_no_prior, difference = fixed_map_errors(cap)
+    dt = float(np.median(np.diff(np.asarray(cap["frames"]["time"])[:len(online)])))
+    cutoff = 2.29 / (4.0 * np.pi)
+    print(f"== {path}, the scans made again: the online track's largest pose difference from the capture {difference:.1e}")
+    slow_b3 = {}
+    for name, errors in [("online map (the stage)", online), ("fixed map, true poses", fixed),
+                         ("fixed map, no motion prior", fixed_no_prior)]:
+        errors = np.degrees(errors - errors.mean(axis=0))
+        slow = np.array([slow_part(errors[:, i], dt, cutoff) for i in range(3)]).T
+        slow_b3[name] = slow[:, 2]
+        print(f"    {name}: errors rms {_vec(errors.std(axis=0))} deg, slow part rms {_vec(slow.std(axis=0))} deg; "
+              f"slow B3 every 1 s {np.array2string(slow[::10, 2], precision=2, max_line_width=200)}")
+    a, b, c = slow_b3.values()
+    print(f"    slow B3 error, online vs fixed map: r {correlation(a, b):+.2f}; fixed map with vs without the prior: r "
+          f"{correlation(b, c):+.2f}")
 
 
 def report_across_captures(paths) -> None:
@@ -270,6 +336,8 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("captures", nargs="+")
     parser.add_argument("--seed", type=int, default=0, help="random frame sets of the null distribution")
+    parser.add_argument("--fixed-map", action="store_true",
+                        help="make the scans again and register them to a fixed map of their true poses")
     args = parser.parse_args()
     np.set_printoptions(precision=4, suppress=True)
     rng = np.random.default_rng(args.seed)
@@ -277,6 +345,9 @@ def main():
         report(path, rng)
     if len(args.captures) > 1:
         report_across_captures(args.captures)
+    if args.fixed_map:
+        for path in args.captures:
+            report_fixed_map(path)
     sys.stdout.flush()
 
 
