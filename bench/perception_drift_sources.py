@@ -18,8 +18,9 @@ the truth (frame B) are set beside, frame by frame:
 With ``--fixed-map`` (~20 s CPU a capture), the observation's scans are made again (the capture's case, seed and
 observation time; the stage's online track is redone and checked against the captured poses) and each scan is
 registered, as the stage does (motion prior, the two first frames at their true poses), to one **fixed** map
-built from all the observation's scans at their true poses in the capture's B: a slow error that stays is the
-registration's own on these views, one that goes was the online map's.
+built from all the observation's scans at their true poses in the capture's B (with and without the motion
+prior), and to a noise-free map of the debris mesh: a slow error that stays on the true-pose map is not the
+online map's build-up; one that stays on the mesh map would be the registration's own on these views.
 
 The truth is read from the capture; nothing is refitted.
 """
@@ -147,13 +148,15 @@ def strongest_slow_frequencies(series, frame_interval, cutoff_hz) -> list[tuple[
     return [(float(frequencies[i]), float(power[i] / power[1:].sum())) for i in top]
 
 
-def fixed_map_errors(cap) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+def fixed_map_errors(cap) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
     """The observation's attitude errors (k, 3) (rad, frame B) of the stage's online track, made again from the
     capture's case, seed and observation time, and of the same scans registered to a fixed map of the scans at
-    their true poses, with the stage's motion prior and without; and the largest difference (-) of the online poses from the captured ones (0: the same run)."""
+    their true poses, with the stage's motion prior and without, and to a noise-free map of the mesh (with the prior);
+    and the largest difference (-) of the online poses from the captured ones (0: the same run)."""
     from riskassess.cases.impact import load_case
     from riskassess.stages.perceive import Frames, Scene, observe_tumble_model_free
     from perception import scan_to_map
+    from perception.registration import known_shape_model
 
     answer = cap["answer"]
     case = load_case(CASE)
@@ -172,37 +175,43 @@ def fixed_map_errors(cap) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     points, normals, index = scan_to_map._built_map(
         np.vstack([scan_to_map._transform(thin[i], true_world_to_body[i]) for i in range(k)]), reg.voxel,
         reg.max_correspondence)
-    def registered(prior_sigma):
+    def registered(prior_sigma, built=(points, normals, index)):
         poses = true_world_to_body[:2]
         for i in range(2, k):
-            pose, _, _ = scan_to_map._register(thin[i], points, normals,
+            pose, _, _ = scan_to_map._register(thin[i], built[0], built[1],
                                                scan_to_map.predict_world_to_body(poses[i - 1], poses[i - 2]),
-                                               reg.max_correspondence, prior_sigma, index)
+                                               reg.max_correspondence, prior_sigma, built[2])
             poses.append(pose)
         return poses
+
+    # the noise-free map: the debris mesh sampled densely (known_shape_model), in B, thinned as the stage's map
+    mesh_points_target, _ = known_shape_model(scene.mesh_target, reg.voxel, 0)
+    mesh_map = scan_to_map._built_map(scan_to_map._transform(mesh_points_target, cap["target_to_body"]), reg.voxel,
+                                      reg.max_correspondence)
 
     def errors(world_to_body):
         return np.array([Rotation.from_matrix(true_body_to_world(cap, i)[:3, :3].T
                                               @ np.linalg.inv(world_to_body[i])[:3, :3]).as_rotvec() for i in range(k)])
 
-    return errors(online), errors(registered(scan_to_map.PRIOR_SIGMA)), errors(registered(None)), difference
+    return (errors(online), errors(registered(scan_to_map.PRIOR_SIGMA)), errors(registered(None)),
+            errors(registered(scan_to_map.PRIOR_SIGMA, mesh_map)), difference)
 
 
 def report_fixed_map(path) -> None:
     cap = load(path)
-    online, fixed, fixed_no_prior, difference = fixed_map_errors(cap)
+    online, fixed, fixed_no_prior, mesh, difference = fixed_map_errors(cap)
     dt = float(np.median(np.diff(np.asarray(cap["frames"]["time"])[:len(online)])))
     cutoff = 2.29 / (4.0 * np.pi)
     print(f"== {path}, the scans made again: the online track's largest pose difference from the capture {difference:.1e}")
     slow_b3 = {}
     for name, errors in [("online map (the stage)", online), ("fixed map, true poses", fixed),
-                         ("fixed map, no motion prior", fixed_no_prior)]:
+                         ("fixed map, no motion prior", fixed_no_prior), ("noise-free mesh map", mesh)]:
         errors = np.degrees(errors - errors.mean(axis=0))
         slow = np.array([slow_part(errors[:, i], dt, cutoff) for i in range(3)]).T
         slow_b3[name] = slow[:, 2]
         print(f"    {name}: errors rms {_vec(errors.std(axis=0))} deg, slow part rms {_vec(slow.std(axis=0))} deg; "
               f"slow B3 every 1 s {np.array2string(slow[::10, 2], precision=2, max_line_width=200)}")
-    a, b, c = slow_b3.values()
+    a, b, c, _ = slow_b3.values()
     print(f"    slow B3 error, online vs fixed map: r {correlation(a, b):+.2f}; fixed map with vs without the prior: r "
           f"{correlation(b, c):+.2f}")
 
