@@ -26,6 +26,7 @@ import argparse
 import copy
 import dataclasses
 import sys
+from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -36,7 +37,9 @@ from perception.momentum import point_masses_momentum, rigid_body_momentum
 from perception.momentum_balance import momentum_step
 from perception.motion import attitude_sqrt_information, integrated_autocorrelation_time, isotropic_attitude_weights
 
-from perception_substitution import (Tracker, _vec, load, others_after, replay, true_body_to_world, true_c,
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+
+from perception_substitution import (Tracker, _vec, load, others_after, replay, true_body_to_world, true_c,  # noqa: E402
                                      true_com_body, true_terms, with_true_poses)
 
 
