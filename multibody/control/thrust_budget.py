@@ -12,7 +12,7 @@ import math
 
 
 def once_per_turn_thrust(case) -> float:
-    """Thrust amplitude (N) the once-per-turn motion of the tow point asks of the chaser: with ``mrac.tow_point_offset``
+    r"""Thrust amplitude (N) the once-per-turn motion of the tow point asks of the chaser: with ``mrac.tow_point_offset``
     = delta (m, the debris CoM's distance from the middle of the netted body, which the bag's tow point circles once
     per turn), :math:`m_C \omega^2 \delta` at the tow's spin rate omega; 0 without it.
 
@@ -35,7 +35,7 @@ def once_per_turn_thrust(case) -> float:
 
 
 def governed_elongation(case, k_abstracted) -> float:
-    """The elongation the laws are asked to hold (m): ``mrac.desired_elongation``, lowered where its steady thrust
+    r"""The elongation the laws are asked to hold (m): ``mrac.desired_elongation``, lowered where its steady thrust
     :math:`k z_d` would not leave the once-per-turn thrust (:func:`once_per_turn_thrust`) inside the actuator's upper
     bound: :math:`\min(z_d, (u_{max} - m_C\omega^2\delta) / k)`, a reference governor on the thrust budget. Without
     ``mrac.tow_point_offset``, or where the budget holds (Zenit-2: up to 23.5 deg/s for delta = 0.217 m), it is
