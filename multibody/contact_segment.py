@@ -69,11 +69,13 @@ Shapes: boxes only (``ShapeArrays.is_box``; the Envisat array, ASAR and main bod
 ellipsoids and mesh files keep node contact alone: their pass-throughs are still found and bounded by
 :mod:`multibody.thread_crossing` and :mod:`structures.thread_gaps` (the Ka-band boom and dish).
 
+Which threads may touch which boxes within the step (broad and narrow phase) is found in
+:mod:`multibody.segment_pairs`.
+
 Frames: LVLH unless named; the shapes in their body frames (origin at the body's CoM). SI units.
 """
 from __future__ import annotations
 
-import math
 from typing import NamedTuple
 
 import numpy as np
@@ -86,6 +88,7 @@ from multibody.contact_kernel import _effective_mass_of_body, _substeps_to_resol
 from multibody.jit_cache import WITH_REFCOUNTS
 from multibody.segment_box import MAX_BREAKPOINTS, segment_box_normal
 from multibody.segment_cycle import ClusterWork, cluster_contact_over_step, cluster_work, thread_contact_geometry
+from multibody.segment_pairs import _contact_pairs, _near_shapes, _node_motion, _to_body
 from multibody.thread_cluster import group_pairs
 
 
@@ -223,45 +226,6 @@ def _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body
         seg.lag_body[j] = -1
 
 
-@njit(cache=True)
-def _near_shapes(x, v, net_force_lvlh, net_mass, velocity_lag, seg, states, shapes, step):
-    """Each node's speed bound over the step (``seg.node_speed``, m/s: L1 norms, an upper bound), each box
-    shape's bounding sphere (radius) and surface speed bound (``seg.shape_work``), and each node's distance
-    to each box's centre (``seg.centre_distance``, m), for the thread broad phase."""
-    n = x.shape[1]
-    speed = seg.node_speed
-    lag = seg.lag_velocity_lvlh
-    for i in range(n):
-        speed[i] = (abs(v[0, i] + velocity_lag[0, i] + lag[0, i]) + abs(v[1, i] + velocity_lag[1, i] + lag[1, i])
-                    + abs(v[2, i] + velocity_lag[2, i] + lag[2, i])
-                    + step * (abs(net_force_lvlh[0, i]) + abs(net_force_lvlh[1, i]) + abs(net_force_lvlh[2, i]))
-                    / net_mass[i])
-    body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
-    velocity_lvlh, omega_lvlh = states.velocity_lvlh, states.omega_lvlh
-    box_min, box_max = shapes.box_min_body, shapes.box_max_body
-    for s in range(shapes.body.shape[0]):
-        if shapes.is_box[s] == 0:
-            continue
-        b = shapes.body[s]
-        mx, my, mz = (0.5 * (box_min[s, 0] + box_max[s, 0]), 0.5 * (box_min[s, 1] + box_max[s, 1]),
-                      0.5 * (box_min[s, 2] + box_max[s, 2]))
-        cx = com_lvlh[b, 0] + body_to_lvlh[b, 0, 0] * mx + body_to_lvlh[b, 0, 1] * my + body_to_lvlh[b, 0, 2] * mz
-        cy = com_lvlh[b, 1] + body_to_lvlh[b, 1, 0] * mx + body_to_lvlh[b, 1, 1] * my + body_to_lvlh[b, 1, 2] * mz
-        cz = com_lvlh[b, 2] + body_to_lvlh[b, 2, 0] * mx + body_to_lvlh[b, 2, 1] * my + body_to_lvlh[b, 2, 2] * mz
-        seg.shape_work[0, s] = 0.5 * math.sqrt((box_max[s, 0] - box_min[s, 0]) ** 2
-                                               + (box_max[s, 1] - box_min[s, 1]) ** 2
-                                               + (box_max[s, 2] - box_min[s, 2]) ** 2)
-        extent = math.sqrt(max(box_min[s, 0] ** 2 + box_min[s, 1] ** 2 + box_min[s, 2] ** 2,
-                               box_max[s, 0] ** 2 + box_max[s, 1] ** 2 + box_max[s, 2] ** 2))
-        speed_b = math.sqrt(velocity_lvlh[b, 0] ** 2 + velocity_lvlh[b, 1] ** 2 + velocity_lvlh[b, 2] ** 2)
-        spin_b = math.sqrt(omega_lvlh[b, 0] ** 2 + omega_lvlh[b, 1] ** 2 + omega_lvlh[b, 2] ** 2)
-        seg.shape_work[1, s] = speed_b + spin_b * extent
-        row = seg.centre_distance[s]
-        x0, x1, x2 = x[0], x[1], x[2]
-        for i in range(n):
-            row[i] = math.sqrt((x0[i] - cx) ** 2 + (x1[i] - cy) ** 2 + (x2[i] - cz) ** 2)
-
-
 @njit(cache=True, **WITH_REFCOUNTS)  # allocates; called from a NO_REFCOUNTS kernel (jit_cache)
 def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers,
                                net_force_lvlh, body_force_lvlh, torque_lvlh):
@@ -344,119 +308,6 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
                     seg.jump_by_sharing[0, column] += jump
                     seg.jump_by_sharing[1, column] += 1.0
     return energy, count, dissipated
-
-
-@njit(cache=True, inline="always")
-def _to_body(x, i, body_to_lvlh, com_lvlh, b):
-    """Node ``i`` of the coordinate-major LVLH positions ``x`` in body ``b``'s frame (m), as a tuple."""
-    ax, ay, az = x[0, i] - com_lvlh[b, 0], x[1, i] - com_lvlh[b, 1], x[2, i] - com_lvlh[b, 2]
-    return (body_to_lvlh[b, 0, 0] * ax + body_to_lvlh[b, 1, 0] * ay + body_to_lvlh[b, 2, 0] * az,
-            body_to_lvlh[b, 0, 1] * ax + body_to_lvlh[b, 1, 1] * ay + body_to_lvlh[b, 2, 1] * az,
-            body_to_lvlh[b, 0, 2] * ax + body_to_lvlh[b, 1, 2] * ay + body_to_lvlh[b, 2, 2] * az)
-
-
-@njit(cache=True, inline="always")
-def _node_motion(i, b, x, v, net_force_lvlh, net_mass, node_lag, lag, states, half_kick):
-    """Node ``i``'s start velocity relative to body ``b``'s material point at it (as the node contact's, m/s) and its
-    non-contact acceleration (m/s^2), both in the body frame, as two tuples."""
-    rot, com_lvlh = states.body_to_lvlh, states.com_lvlh
-    velocity_lvlh, omega_lvlh = states.velocity_lvlh, states.omega_lvlh
-    ux = v[0, i] + node_lag[0, i] + lag[0, i] + half_kick * net_force_lvlh[0, i] / net_mass[i]
-    uy = v[1, i] + node_lag[1, i] + lag[1, i] + half_kick * net_force_lvlh[1, i] / net_mass[i]
-    uz = v[2, i] + node_lag[2, i] + lag[2, i] + half_kick * net_force_lvlh[2, i] / net_mass[i]
-    rx, ry, rz = x[0, i] - com_lvlh[b, 0], x[1, i] - com_lvlh[b, 1], x[2, i] - com_lvlh[b, 2]
-    wx = ux - velocity_lvlh[b, 0] - (omega_lvlh[b, 1] * rz - omega_lvlh[b, 2] * ry)
-    wy = uy - velocity_lvlh[b, 1] - (omega_lvlh[b, 2] * rx - omega_lvlh[b, 0] * rz)
-    wz = uz - velocity_lvlh[b, 2] - (omega_lvlh[b, 0] * ry - omega_lvlh[b, 1] * rx)
-    fx, fy = net_force_lvlh[0, i] / net_mass[i], net_force_lvlh[1, i] / net_mass[i]
-    fz = net_force_lvlh[2, i] / net_mass[i]
-    rel = (rot[b, 0, 0] * wx + rot[b, 1, 0] * wy + rot[b, 2, 0] * wz,
-           rot[b, 0, 1] * wx + rot[b, 1, 1] * wy + rot[b, 2, 1] * wz,
-           rot[b, 0, 2] * wx + rot[b, 1, 2] * wy + rot[b, 2, 2] * wz)
-    acc = (rot[b, 0, 0] * fx + rot[b, 1, 0] * fy + rot[b, 2, 0] * fz,
-           rot[b, 0, 1] * fx + rot[b, 1, 1] * fy + rot[b, 2, 1] * fz,
-           rot[b, 0, 2] * fx + rot[b, 1, 2] * fy + rot[b, 2, 2] * fz)
-    return rel, acc
-
-
-@njit(cache=True)
-def _contact_pairs(x, v, net_force_lvlh, net, states, shapes, step, n_substeps, buffers):
-    """This step's (thread, box) contact pairs into ``seg.pair_thread`` / ``seg.pair_shape``: the thread's deepest
-    point is interior and penetrates now, or does at the end of the step's free motion (a thread turning over an
-    edge). Counts each node's threads in contact (``seg.node_threads``) and notes the box they touch
-    (``seg.node_shape``). Returns the number of pairs."""
-    seg = buffers.segments
-    threads, net_mass, radius = net.threads, net.mass, net.radius
-    centre_distance, node_speed = seg.centre_distance, seg.node_speed
-    sphere_radius, surface_speed = seg.shape_work[0], seg.shape_work[1]
-    body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
-    box_min, box_max, shape_body, is_box = shapes.box_min_body, shapes.box_max_body, shapes.body, shapes.is_box
-    n_pairs = 0
-    for j in range(threads.shape[0]):
-        a, c = threads[j, 0], threads[j, 1]
-        length = math.sqrt((x[0, c] - x[0, a]) ** 2 + (x[1, c] - x[1, a]) ** 2 + (x[2, c] - x[2, a]) ** 2)
-        motion = step * max(node_speed[a], node_speed[c])
-        thread_radius = min(radius[a], radius[c])
-        for s in range(shape_body.shape[0]):
-            if is_box[s] == 0:
-                continue
-            # what the thread and the surface can close within the step, plus the thread's radius
-            reach = 1.001 * (thread_radius + motion + step * surface_speed[s])
-            # every point of the segment is at least (|a - o| + |b - o| - L) / 2 from the box's centre o
-            if 0.5 * (centre_distance[s, a] + centre_distance[s, c] - length) > sphere_radius[s] + reach:
-                continue
-            b = shape_body[s]
-            pa = _to_body(x, a, body_to_lvlh, com_lvlh, b)
-            pc = _to_body(x, c, body_to_lvlh, com_lvlh, b)
-            if (min(pa[0], pc[0]) > box_max[s, 0] + reach or max(pa[0], pc[0]) < box_min[s, 0] - reach
-                    or min(pa[1], pc[1]) > box_max[s, 1] + reach or max(pa[1], pc[1]) < box_min[s, 1] - reach
-                    or min(pa[2], pc[2]) > box_max[s, 2] + reach or max(pa[2], pc[2]) < box_min[s, 2] - reach):
-                continue
-            if not _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, radius, states, shapes,
-                                        step, n_substeps, buffers):
-                continue
-            seg.pair_thread[n_pairs] = j
-            seg.pair_shape[n_pairs] = s
-            n_pairs += 1
-            for i in (a, c):
-                seg.node_threads[i] += 1
-                if seg.node_shape[i] == -1:
-                    seg.node_shape[i] = s
-                elif seg.node_shape[i] != s:
-                    seg.node_shape[i] = -2
-    return n_pairs
-
-
-@njit(cache=True)
-def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, radius, states, shapes, step, n_substeps,
-                         buffers):
-    """Whether thread (a, c)'s contact with box ``s`` can act within the step: it penetrates now, or at the end of
-    the step's free motion (a thread turning over an edge, whose deepest point is not yet interior at the start), or
-    exactly one of its nodes is in its own contact with the box now or then.
-
-    The last: a thread with one node striking a face and the other beyond the face's edge lies flat at first (its
-    deepest point ties with the node: no excess), then turns over the edge within the node's own 0.15 ms impact,
-    which the free motion does not foresee (the node's rebound raises the edge point's excess over it). Found late,
-    such a thread started the next step up to about a millimetre into its contact, energy no force paid for:
-    measured, 24 such arrivals made +2.87 % of the reference case's energy at its ASAR strike (0.049 s; helper
-    thread13, bench/thread_contact_drift.py, the record's "arrivals (a node in its own contact)")."""
-    seg = buffers.segments
-    box_min, box_max = shapes.box_min_body, shapes.box_max_body
-    now = thread_contact_geometry(pa, pc, box_min, box_max, s, radius[a], radius[c], seg.breakpoints)
-    if now[0] > 0.0 or (now[5] > 0.0) != (now[6] > 0.0):
-        return True
-    half_kick = 0.5 * step if n_substeps > 1 else 0.0
-    rel_a, acc_a = _node_motion(a, b, x, v, net_force_lvlh, net_mass, buffers.velocity_lag, seg.lag_velocity_lvlh,
-                                states, half_kick)
-    rel_c, acc_c = _node_motion(c, b, x, v, net_force_lvlh, net_mass, buffers.velocity_lag, seg.lag_velocity_lvlh,
-                                states, half_kick)
-    h2 = 0.5 * step * step
-    qa = (pa[0] + step * rel_a[0] + h2 * acc_a[0], pa[1] + step * rel_a[1] + h2 * acc_a[1],
-          pa[2] + step * rel_a[2] + h2 * acc_a[2])
-    qc = (pc[0] + step * rel_c[0] + h2 * acc_c[0], pc[1] + step * rel_c[1] + h2 * acc_c[1],
-          pc[2] + step * rel_c[2] + h2 * acc_c[2])
-    ahead = thread_contact_geometry(qa, qc, box_min, box_max, s, radius[a], radius[c], seg.breakpoints)
-    return ahead[0] > 0.0 or (ahead[5] > 0.0) != (ahead[6] > 0.0)
 
 
 @njit(cache=True)

@@ -48,7 +48,8 @@ elongation feedback and damps every other frequency as before. Measured on the f
 notch at the spin rate, and a thrust budget"): it does not hold 29.01 deg/s (MRAC-2 fails, MRAC-1 holds in 1 of 3
 replicas) and breaks 20.44 deg/s, so it is off in the shipped case.
 
-**Once-per-turn thrust budget** (``mrac.tow_point_offset``, :func:`governed_elongation`): the desired elongation is
+**Once-per-turn thrust budget** (``mrac.tow_point_offset``,
+:func:`multibody.control.thrust_budget.governed_elongation`): the desired elongation is
 lowered where its steady thrust would not leave the once-per-turn thrust :math:`m_C\omega^2\delta` below u_max.
 Measured: with 87-89 N of headroom at 29.01 deg/s the once-per-turn line still grows and both laws fail (2 + 2
 replicas); off in the shipped case.
@@ -60,9 +61,10 @@ interface is described in :mod:`multibody.control.thrust`.
 """
 from __future__ import annotations
 
-import math
-
 from numba import njit
+
+from multibody.control.notch import notch_frequency, notch_output, range_notch_frequency, shift_notch
+from multibody.control.thrust_budget import governed_elongation
 
 # params indices common to both laws; each law appends its gains (thrust_laws/mrac1.py, mrac2.py)
 (T_ON, U_MAX, B, K_MT, C_MT, Z_D, K_P, K_D, RATE_TAU, U_MIN, Z_SLACK, F_STEADY, NOTCH_W, NOTCH_SIGMA,
@@ -146,7 +148,8 @@ def common_params(case, tether) -> list:
     saturation's lower bound u_min (N; :func:`actuator_range`, default -u_max: the paper's symmetric sat), the
     slack threshold (m; ``mrac.slack_elongation``, -1: off) and the steady thrust (N; :func:`steady_thrust`), which
     :func:`slack_hold` commands below that threshold, the range damping c_R (N s/m; ``mrac.range_damping``,
-    :func:`range_damping_force`) and its notch's centre (rad/s, 0: off; :func:`range_notch_frequency`) and pole decay
+    :func:`range_damping_force`) and its notch's centre (rad/s, 0: off;
+    :func:`multibody.control.notch.range_notch_frequency`) and pole decay
     rate (1/s).
 
     Parameters
@@ -193,108 +196,6 @@ def hold_time(case) -> float:
         raise ValueError("mrac.slack_hold_periods counts breathing periods (half a spin period), but the debris does "
                          "not spin (debris.spin_rate_deg_s = 0); set mrac.slack_hold_periods = 0")
     return periods * 180.0 / case.debris.spin_rate_deg_s
-
-
-def notch_frequency(case) -> float:
-    """Centre of the breathing notch (rad/s): ``mrac.notch_frequency`` if given, else twice the tow's spin rate
-    (``debris.spin_rate_deg_s``, which the model builders set to the rate the run is made at); 0 with
-    ``mrac.breathing_notch`` off (the laws see the measured elongation).
-
-    Parameters
-    ----------
-    case : riskassess.cases.towing.TowingCase
-        Read: ``mrac.breathing_notch``, ``mrac.notch_frequency``, ``debris.spin_rate_deg_s``.
-
-    Raises
-    ------
-    ValueError
-        The notch is on, no frequency is stated and the debris does not spin.
-    """
-    m = case.mrac
-    if not m.breathing_notch:
-        return 0.0
-    if m.notch_frequency is not None:
-        return float(m.notch_frequency)
-    if case.debris.spin_rate_deg_s <= 0.0:
-        raise ValueError("mrac.breathing_notch: the debris does not spin (debris.spin_rate_deg_s = 0), so there is no "
-                         "breathing at twice the spin rate; give mrac.notch_frequency (rad/s) or set "
-                         "mrac.breathing_notch = false")
-    return 2.0 * math.radians(case.debris.spin_rate_deg_s)
-
-
-def once_per_turn_thrust(case) -> float:
-    """Thrust amplitude (N) the once-per-turn motion of the tow point asks of the chaser: with ``mrac.tow_point_offset``
-    = delta (m, the debris CoM's distance from the middle of the netted body, which the bag's tow point circles once
-    per turn), :math:`m_C \omega^2 \delta` at the tow's spin rate omega; 0 without it.
-
-    It is both the thrust that lets the chaser follow the tow point at constant tension and, when the chaser-bag mode
-    sits on omega (29.01 deg/s on the Zenit-2 case), the thrust any damping law spends there in steady state: on
-    resonance the separation's balance :math:`(K - \mu\omega^2) s = K x + \alpha F` leaves
-    :math:`\alpha |F| = K |x|` with :math:`K = \mu\omega^2`, :math:`\mu/\alpha = m_C` (two-body reduction, alpha =
-    m_D/(m_C + m_D)) whatever the damping (docs/towing.md, "A range-rate notch at the spin rate, and a thrust budget").
-
-    Parameters
-    ----------
-    case : riskassess.cases.towing.TowingCase
-        Read: ``mrac.tow_point_offset``, ``chaser.mass``, ``debris.spin_rate_deg_s`` (the tow's spin, the GNC's
-        estimate).
-    """
-    delta = case.mrac.tow_point_offset
-    if delta is None:
-        return 0.0
-    return case.chaser.mass * math.radians(case.debris.spin_rate_deg_s) ** 2 * delta
-
-
-def governed_elongation(case, k_abstracted) -> float:
-    """The elongation the laws are asked to hold (m): ``mrac.desired_elongation``, lowered where its steady thrust
-    :math:`k z_d` would not leave the once-per-turn thrust (:func:`once_per_turn_thrust`) inside the actuator's upper
-    bound: :math:`\min(z_d, (u_{max} - m_C\omega^2\delta) / k)`, a reference governor on the thrust budget. Without
-    ``mrac.tow_point_offset``, or where the budget holds (Zenit-2: up to 23.5 deg/s for delta = 0.217 m), it is
-    ``mrac.desired_elongation`` itself.
-
-    Parameters
-    ----------
-    case : riskassess.cases.towing.TowingCase
-        Read: ``mrac.desired_elongation``, ``mrac.max_thrust``, ``thrust.max_force`` and :func:`once_per_turn_thrust`'s.
-    k_abstracted : float
-        The abstracted model's tether stiffness (N/m), :func:`abstracted_tether`.
-
-    Raises
-    ------
-    ValueError
-        The once-per-turn thrust alone reaches the upper bound: no elongation leaves it room.
-    """
-    m = case.mrac
-    u_max = case.thrust.max_force if m.max_thrust is None else m.max_thrust
-    room = u_max - once_per_turn_thrust(case)
-    if room <= 0.0:
-        raise ValueError(f"mrac.tow_point_offset: the once-per-turn thrust m_C omega^2 delta = "
-                         f"{once_per_turn_thrust(case):g} N at {case.debris.spin_rate_deg_s:g} deg/s reaches the "
-                         f"upper thrust bound {u_max:g} N; no desired elongation leaves room for it")
-    return min(m.desired_elongation, room / k_abstracted)
-
-
-def range_notch_frequency(case) -> float:
-    """Centre of the range-rate notch (rad/s): the tow's spin rate (``debris.spin_rate_deg_s``, which the model builders
-    set to the rate the run is made at: the GNC's estimate from perception), the once-per-turn line the stage's CoM
-    offset drives; 0 with ``mrac.range_notch`` off (the range damping sees the measured range rate).
-
-    Parameters
-    ----------
-    case : riskassess.cases.towing.TowingCase
-        Read: ``mrac.range_notch``, ``debris.spin_rate_deg_s``.
-
-    Raises
-    ------
-    ValueError
-        The notch is on and the debris does not spin.
-    """
-    if not case.mrac.range_notch:
-        return 0.0
-    if case.debris.spin_rate_deg_s <= 0.0:
-        raise ValueError("mrac.range_notch: the debris does not spin (debris.spin_rate_deg_s = 0), so there is no "
-                         "once-per-turn line to leave out; set mrac.range_notch = false")
-    return math.radians(case.debris.spin_rate_deg_s)
 
 
 def steady_thrust(k_abstracted, desired) -> float:
@@ -568,82 +469,9 @@ def store_rate(state, z, rate):
 
 
 @njit(cache=True)
-def notch_coefficients(omega, sigma, step):
-    """Second-order digital notch at ``omega`` (rad/s) for the sampling step ``step`` (s), by pole-zero placement:
-    zeros on the unit circle at :math:`e^{\\pm j\\omega h}` (a sampled sinusoid of that frequency is removed
-    exactly in steady state), poles at :math:`r e^{\\pm j\\omega h}` with :math:`r = e^{-\\sigma h}` (the -3 dB
-    width is about :math:`2\\sigma`, and the filter forgets its past with :math:`e^{-\\sigma t}`), gain g that
-    makes the zero-frequency gain exactly 1:
-
-    .. math:: H(z) = g \\frac{1 - 2\\cos\\theta\\,z^{-1} + z^{-2}}{1 - 2r\\cos\\theta\\,z^{-1} + r^2 z^{-2}},
-              \\quad g = \\frac{(1 - r)^2 + 4r\\sin^2(\\theta/2)}{4\\sin^2(\\theta/2)},\\quad \\theta = \\omega h
-
-    (both sums written without the cancellation of 1 - cos theta at small theta h).
-
-    Parameters
-    ----------
-    omega : float
-        Notch frequency (rad/s), 0 < omega h < pi.
-    sigma : float
-        Pole decay rate (1/s): omega / (2 Q).
-    step : float
-        Sampling step h (s).
-
-    Returns
-    -------
-    g, b1, a1, a2 : float
-        y_k = g (x_k + b1 x_{k-1} + x_{k-2}) - a1 y_{k-1} - a2 y_{k-2}.
-    """
-    theta = omega * step
-    r = math.exp(-sigma * step)
-    half = math.sin(0.5 * theta) ** 2
-    g = ((1.0 - r) ** 2 + 4.0 * r * half) / (4.0 * half)
-    return g, -2.0 * math.cos(theta), -2.0 * r * math.cos(theta), r * r
-
-
-@njit(cache=True)
-def notch_output(omega, sigma, state, first, x, step):
-    """One sample of the notch at ``omega`` (rad/s) with pole decay rate ``sigma`` (1/s) (:func:`notch_coefficients`)
-    for the input ``x``: its last two inputs and outputs are ``state[first:first + 4]`` (x_{k-1}, x_{k-2}, y_{k-1},
-    y_{k-2}); :func:`shift_notch` writes this sample's.
-
-    Parameters
-    ----------
-    omega, sigma : float
-        Notch frequency (rad/s) and pole decay rate (1/s).
-    state : (j,) float
-        The law's state (the notch's memory read).
-    first : int
-        Index of x_{k-1} in ``state``.
-    x : float
-        This sample's input (any unit; the output has the same).
-    step : float
-        Sampling step (s).
-    """
-    g, b1, a1, a2 = notch_coefficients(omega, sigma, step)
-    return g * (x + b1 * state[first] + state[first + 1]) - a1 * state[first + 2] - a2 * state[first + 3]
-
-
-@njit(cache=True)
-def shift_notch(state, first, x, y):
-    """Shift a notch's memory ``state[first:first + 4]`` by one sample: input ``x`` and output ``y`` become the last.
-
-    Parameters
-    ----------
-    state : (j,) float
-        The law's state, written in place.
-    first : int
-        Index of x_{k-1} in ``state``.
-    x, y : float
-        This sample's input and output.
-    """
-    state[first + 1], state[first] = state[first], x
-    state[first + 3], state[first + 2] = state[first + 2], y
-
-
-@njit(cache=True)
 def breathing_notch(params, state, z, step):
-    """The elongation the laws see (m): ``z`` through the notch at ``params[NOTCH_W]`` (:func:`notch_coefficients`),
+    """The elongation the laws see (m): ``z`` through the notch at ``params[NOTCH_W]``
+    (:func:`multibody.control.notch.notch_coefficients`),
     or ``z`` itself with the notch off (``NOTCH_W`` = 0). The notch's past samples are read from ``state``;
     :func:`store_notch` writes this sample's.
 
@@ -715,7 +543,8 @@ def law_measurement(params, state, z, z_rate, step, advance):
 def range_rate_seen(params, state, range_rate, step, advance):
     """The range rate the range damping acts on (m/s): the measured one, or with the range-rate notch on
     (``params[RANGE_NOTCH_W]`` > 0, ``mrac.range_notch``) the measured one through a notch at the spin rate
-    (:func:`notch_output`, :func:`notch_coefficients`): the once-per-turn line of the tow point is removed, every
+    (:func:`multibody.control.notch.notch_output`, :func:`~multibody.control.notch.notch_coefficients`): the once-per-turn
+    line of the tow point is removed, every
     other frequency passes (unit gain at zero frequency and, within the pole decay rate, far from the notch). The
     notch's memory advances when ``advance``, also before thrust-on, so its start transient (decaying as
     :math:`e^{-\sigma t}`) is over when the range damping comes in.

@@ -13,7 +13,8 @@ from scipy.optimize import brentq, minimize_scalar
 
 from multibody.control.attitude import sampled_boundary_layer
 from multibody.maths.rotations import quaternion_to_matrix
-from multibody.control.mrac import abstracted_tether, command_elongation, governed_elongation
+from multibody.control.mrac import abstracted_tether, command_elongation
+from multibody.control.thrust_budget import governed_elongation
 from multibody.control.thrust_laws import LAWS
 from multibody.towing import TowingModel
 from riskassess.cases.towing import TowingCase

@@ -6,7 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from multibody.control.mrac import (NOTCH_SIGMA, NOTCH_W, law_measurement, notch_coefficients)
+from multibody.control.mrac import NOTCH_SIGMA, NOTCH_W, law_measurement
+from multibody.control.notch import notch_coefficients
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing import case_thrust_law

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from multibody.control.mrac import (C_RANGE, RANGE_NOTCH_SIGMA, RANGE_NOTCH_W, notch_coefficients, range_rate_seen)
+from multibody.control.mrac import C_RANGE, RANGE_NOTCH_SIGMA, RANGE_NOTCH_W, range_rate_seen
+from multibody.control.notch import notch_coefficients
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing import case_thrust_law

@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from multibody.control.mrac import (F_STEADY, K_MT, K_P, Z_D, abstracted_tether, governed_elongation,
-                                    once_per_turn_thrust)
+from multibody.control.mrac import F_STEADY, K_MT, K_P, Z_D, abstracted_tether
+from multibody.control.thrust_budget import governed_elongation, once_per_turn_thrust
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing import case_thrust_law
