@@ -388,11 +388,15 @@ class TowingCase(Strict):
             raise ValueError("mrac.breathing_notch: debris.spin_rate_deg_s = 0, so there is no breathing at twice the "
                              "spin rate; give mrac.notch_frequency (rad/s) or set mrac.breathing_notch = false")
         omega = m.notch_frequency if m.notch_frequency is not None else 2.0 * math.radians(self.debris.spin_rate_deg_s)
+        self._check_below_nyquist(omega, "mrac.notch_frequency (or twice debris.spin_rate_deg_s)")
+
+    def _check_below_nyquist(self, omega, named):
+        """A notch centre ``omega`` (rad/s, ``named`` in the message) below the Nyquist frequency of the coarser of
+        the two plants' steps (the controller samples at that step)."""
         step = max(self.simulation.step, self.full_net.step if self.full_net is not None else 0.0)
         if omega * step >= math.pi:
-            raise ValueError(f"mrac.notch_frequency (or twice debris.spin_rate_deg_s) = {omega:g} rad/s is above the "
-                             f"Nyquist frequency pi / step = {math.pi / step:g} rad/s of the controller's step "
-                             f"{step:g} s")
+            raise ValueError(f"{named} = {omega:g} rad/s is above the Nyquist frequency pi / step = "
+                             f"{math.pi / step:g} rad/s of the controller's step {step:g} s")
 
     def _check_range_notch(self, m):
         """The range-rate notch's settings: a range damping to notch, a spinning debris, the spin rate below the
@@ -403,11 +407,8 @@ class TowingCase(Strict):
         if self.debris.spin_rate_deg_s <= 0.0:
             raise ValueError("mrac.range_notch: debris.spin_rate_deg_s = 0, so there is no once-per-turn line to "
                              "leave out; set mrac.range_notch = false")
-        omega = math.radians(self.debris.spin_rate_deg_s)
-        step = max(self.simulation.step, self.full_net.step if self.full_net is not None else 0.0)
-        if omega * step >= math.pi:
-            raise ValueError(f"mrac.range_notch: debris.spin_rate_deg_s = {omega:g} rad/s is above the Nyquist "
-                             f"frequency pi / step = {math.pi / step:g} rad/s of the controller's step {step:g} s")
+        self._check_below_nyquist(math.radians(self.debris.spin_rate_deg_s),
+                                  "mrac.range_notch: the spin rate debris.spin_rate_deg_s")
 
     @model_validator(mode="after")
     def _mrac_given(self):
