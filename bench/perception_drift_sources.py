@@ -265,15 +265,17 @@ def _voxel_sums(points_body, voxel):
     return keys, sums, counts
 
 
-def _map_from_means(points, voxel, max_correspondence, normals=None):
-    """(points, normals, index) of map points (n, 3) (m, frame B); ``normals`` (n, 3) given, or estimated
-    lazily as the stage's (4 voxels, 30 neighbours)."""
+def _map_from_means(points, voxel, max_correspondence, normals=None, on_planes=False):
+    """(points, normals, index) of map points (n, 3) (m, frame B). ``on_planes``: as the stage's map, normals
+    estimated lazily (4 voxels, 30 neighbours) and the residuals taken to the points projected on their fitted
+    planes; otherwise to the points themselves, with the given ``normals`` (n, 3) or the same estimated ones."""
     points = np.ascontiguousarray(points)
     index = scan_to_map.map_index(points, max_correspondence)
-    if normals is not None:
-        return points, scan_to_map.LazyNormals.given(normals, index), index
-    return points, scan_to_map.LazyNormals(np.empty((len(points), 3)), np.zeros(len(points), np.bool_),
-                                           4 * voxel, 30), index
+    if on_planes:
+        return points, scan_to_map.LazyNormals(np.empty((len(points), 3)), np.zeros(len(points), np.bool_),
+                                               4 * voxel, 30), index
+    normals = surface_normals(points, 4 * voxel, 30) if normals is None else normals
+    return points, scan_to_map.LazyNormals.given(normals, index), index
 
 
 def mesh_normals_at(scene, target_to_body, points_body) -> np.ndarray:
@@ -344,9 +346,11 @@ def map_property_errors(cap) -> dict:
             thin, truth, _map_from_means(noisy_points, voxel, distance, mesh_normals_at(scene, cap["target_to_body"], noisy_points)), distance)),
         "fixed noise-free map's points, the noisy map's normals": errors(_registered_to(
             thin, truth, _map_from_means(clean_points, voxel, distance, noisy_normals[nearest_noisy]), distance)),
-        "fixed noisy map's points projected on their fitted planes": errors(_registered_to(
+        "fixed noisy map's points projected on their fitted planes (numpy)": errors(_registered_to(
             thin, truth, _map_from_means(projected_on_fitted_planes(noisy_points, 4 * voxel)[0], voxel, distance),
             distance)),
+        "fixed noisy map's points projected on their fitted planes (the stage's LazyNormals)": errors(_registered_to(
+            thin, truth, _map_from_means(noisy_points, voxel, distance, on_planes=True), distance)),
         "noise-free scans on the fixed map of the noise-free scans": errors(_registered_to(
             clean_thin, truth, _map_from_means(clean_points, voxel, distance), distance)),
     }
