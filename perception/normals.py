@@ -12,6 +12,11 @@ point), more than all the frame's ICP. Here the neighbours come from a cell list
 (:class:`perception.nearest_grid.CellList`) and the eigenvector from the closed form of a
 symmetric 3 x 3 matrix (trigonometric eigenvalues, then the largest cross product of two rows of
 C - lambda I), compiled with numba.
+
+The same fit gives each point's projection on its plane (the plane through the neighbours' mean,
+:func:`surface_planes`): the map of noisy scans thinned to voxel means is a slab a few voxels thick
+about the surface, and the ICP's residuals are taken to the projections (docs/perception.md, "Which
+property of the scan-made map").
 """
 from __future__ import annotations
 
