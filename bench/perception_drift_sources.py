@@ -13,7 +13,7 @@ the truth (frame B) are set beside, frame by frame:
 * **the registration**: fitness, CPU time (a proxy for the ICP's iterations; the capture holds neither the
   iterations nor the inlier RMSE), the stated 1-sigma about B's third axis from the frame's information.
 
-    python bench/perception_drift_sources.py runs/captures/none_obs20_seed2.pkl [...] [--fixed-map]
+    python bench/perception_drift_sources.py runs/captures/none_obs20_seed2.pkl [...] [--fixed-map | --map-properties]
 
 With ``--fixed-map`` (~20 s CPU a capture), the observation's scans are made again (the capture's case, seed and
 observation time; the stage's online track is redone and checked against the captured poses) and each scan is
@@ -21,6 +21,14 @@ registered, as the stage does (motion prior, the two first frames at their true 
 built from all the observation's scans at their true poses in the capture's B (with and without the motion
 prior), and to a noise-free map of the debris mesh: a slow error that stays on the true-pose map is not the
 online map's build-up; one that stays on the mesh map would be the registration's own on these views.
+
+With ``--map-properties`` (~2-4 min CPU a capture; only this report), the observation made again with and without
+the LiDAR's range noise, and the noisy scans registered (the stage's prior) to fixed maps at the true poses that
+differ from the map of the noisy scans (voxel means on a grid anchored in B, residuals to the means) in one
+property each: made of the noise-free scans; without the frame being registered; with the mesh's exact normals;
+the noise-free map's points with the noisy map's normals; the means projected on their fitted planes (in numpy,
+and as the stage's map does it, :class:`perception.scan_to_map.LazyNormals`); beside the stage's online track of
+the noisy and of the noise-free scans (the current code).
 
 The truth is read from the capture; nothing is refitted.
 """
