@@ -80,6 +80,18 @@ def lateral_params(enabled: bool, target: str, natural_frequency: float, damping
     return np.array([1.0, TARGETS[target], natural_frequency, damping_ratio, max_force, t_on, chaser_mass], float)
 
 
+def tow_point_line_force(offset: float, tow_point_distance: float, chaser_distance: float, spin_rate: float,
+                         chaser_mass: float) -> float:
+    """Lateral force (N) the ``"tow_point"`` target asks in steady state: the tow point turns at ``spin_rate``
+    (rad/s) on a circle of radius ``offset`` (m) about the spin axis at ``tow_point_distance`` (m) from the debris
+    CoM, so the target point at ``chaser_distance`` (m) turns on a circle ``chaser_distance / tow_point_distance``
+    times larger, and a chaser of ``chaser_mass`` (kg) that follows it needs the centripetal force
+
+    .. math:: F = m_C \\omega^2 \\delta \\, |C - G| / |P - G|.
+    """
+    return chaser_mass * spin_rate ** 2 * offset * chaser_distance / tow_point_distance
+
+
 @njit(cache=True)
 def target_axis(target, com_d, vel_d, tow_point, tow_point_vel, momentum_d, com_c):
     """Unit direction n of the target line through the debris CoM and its rate (1/s), inertial (module doc).

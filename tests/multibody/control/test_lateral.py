@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from multibody.control.lateral import (L_SIZE, TARGETS, lateral_error, lateral_params, lateral_thrust, side_thrust,
-                                       target_axis)
+                                       target_axis, tow_point_line_force)
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing import towing_model
@@ -143,3 +143,14 @@ def test_case_checks():
         TowingCase.model_validate(_case_data(max_force=-5.0))
     with pytest.raises(ValueError, match="full-net plant only"):
         towing_model(TowingCase.model_validate(_case_data()))
+
+
+def test_tow_point_line_force_of_the_shipped_case():
+    """What following the tow-point line costs at 29.01 deg/s: the shipped wrapped start has the tow point 0.232 m
+    off the spin axis (body x 0.074, z -0.220 m) at |P - G| = 1.967 m, the chaser at |C - G| = 17.46 m -> a 2.06 m
+    circle at 0.506 rad/s: m_C omega^2 r = 1600 x 0.2563 x 2.06 = 845 N (hand arithmetic; four times the 200 N
+    tether-axis thrust)."""
+    omega = math.radians(29.01)
+    force = tow_point_line_force(0.2321, 1.9673, 17.463, omega, M_C)
+    assert force == pytest.approx(M_C * omega ** 2 * 0.2321 * 17.463 / 1.9673, rel=1e-15)
+    assert 835.0 < force < 855.0
