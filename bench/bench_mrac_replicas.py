@@ -50,7 +50,7 @@ COLUMNS = (("mean_last_100_s_m", "mean z (m)", ".4f"), ("rms_error_m", "RMS z - 
 LATERAL_COLUMNS = (("thrust_mean_last_100_s_N", "mean F, last 100 s (N)", ".1f"),
                    ("lateral_mean_last_100_s_N", "mean lateral F, last 100 s (N)", ".1f"),
                    ("lateral_peak_N", "peak lateral F (N)", ".1f"),
-                   ("lateral_error_rms_last_100_s_m", "RMS lateral error, last 100 s (m)", ".3f"))
+                   ("lateral_error_rms_last_100_s_m", "chaser off the debris' omega axis, RMS last 100 s (m)", ".3f"))
 
 
 def figures(series: dict, target: float) -> dict:
@@ -81,8 +81,10 @@ def figures(series: dict, target: float) -> dict:
 
 def lateral_figures(series: dict) -> dict:
     """Tether-axis thrust and lateral station-keeping force (N) over the last 100 s (mean magnitude) and over the
-    run (peak), and the RMS distance (m) of the chaser from the debris' angular-momentum axis over the last 100 s
-    (the axis through the debris CoM; what the ``momentum_axis`` target holds, and the tow-point line's mean).
+    run (peak), and the RMS distance (m) of the chaser from the line through the debris CoM along its angular
+    velocity over the last 100 s (the series hold no inertia: omega stands for the angular momentum H the
+    ``momentum_axis`` target uses, exact while omega lies in the body x-y plane, I_x = I_y; a nutation tilts them
+    apart).
 
     Parameters
     ----------
@@ -122,10 +124,11 @@ def thrust_figures(t, thrust) -> dict:
 
 def with_thrust_figures(record: dict, folder: Path) -> dict:
     """A results line with the thrust figures, taken from its stored series when the line predates them."""
-    if "thrust_peak_N" in record:
+    if "thrust_peak_N" in record and "thrust_mean_last_100_s_N" in record:
         return record
     d = np.load(folder / f"{record['label']}_{record['plant']}_{record['law']}_{record['rate_deg_s']:g}_{record['replica']}.npz")
-    return {**record, **thrust_figures(d["time"], d["thrust"])}
+    t, thrust = d["time"], d["thrust"]
+    return {**thrust_figures(t, thrust), "thrust_mean_last_100_s_N": float(thrust[t > t[-1] - 100.0].mean()), **record}
 
 
 def at_spin(case: TowingCase, spin_rate_deg_s: float) -> TowingCase:
@@ -156,6 +159,9 @@ def table(path: Path) -> None:
         cells = []
         for key, _, fmt in columns:
             v = np.array([r.get(key, np.nan) for r in runs], float)
+            if np.isnan(v).all():
+                cells.append("-")     # a run without the lateral law
+                continue
             cells.append(f"{v.mean():{fmt}} [{v.min():{fmt}}, {v.max():{fmt}}]" if len(v) > 1 else f"{v[0]:{fmt}}")
         cpu = np.mean([r["cpu_s"] for r in runs])
         print(f"| {label} | {plant} | {law} | {rate:g} | {len(runs)} | " + " | ".join(cells) + f" | {cpu:.0f} |")
@@ -168,6 +174,8 @@ def main():
     parser.add_argument("--rate", type=float, nargs="+", default=[20.44, 10.71], help="spin rates (deg/s)")
     parser.add_argument("--laws", nargs="+", choices=("ramp", "mrac1", "mrac2"), default=("mrac2", "mrac1"))
     parser.add_argument("--replicas", type=int, default=3)
+    parser.add_argument("--first-replica", type=int, default=0,
+                        help="run replicas first..replicas-1 only (another process runs the lower ones)")
     parser.add_argument("--perturbation", type=float, default=1e-3, help="relative spin-rate step between replicas")
     parser.add_argument("--label", default="shipped")
     parser.add_argument("--set", nargs="*", default=[])
@@ -189,7 +197,7 @@ def main():
     wrapped = wrapped_net(case) if args.plant == "full-net" else None
     for rate in args.rate:
         for law in args.laws:
-            for j in range(args.replicas):
+            for j in range(args.first_replica, args.replicas):
                 key = f"{args.label}|{args.plant}|{law}|{rate:g}|{j}"
                 if key in done:
                     continue
