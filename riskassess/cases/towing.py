@@ -188,9 +188,10 @@ class Lateral(Strict):
                                              "chaser's body x-y plane) holding the chaser on a line through the "
                                              "debris CoM. Full-net plant only (the lower-order model refuses it).")
     target: Literal[tuple(LATERAL_TARGETS)] = Field(
-        "tow_point", description="'tow_point': the line debris CoM -> tow point (the main tether's line through the "
-                                 "debris CoM: no moment from the tow point's offset); 'momentum_axis': the debris' "
-                                 "angular-momentum axis (the tow point's once-per-turn circle across the tether).")
+        "momentum_axis", description="'momentum_axis' (default): the debris' angular-momentum axis (the tow "
+                                     "point's once-per-turn circle across the tether; holds 29.01 deg/s with 7-8 N, "
+                                     "docs/towing.md); 'tow_point': the line debris CoM -> tow point (no moment from "
+                                     "the tow point's offset, but 845 N of side thrust at 29.01 deg/s: fails).")
     natural_frequency_rad_s: Positive = Field(0.2, description="omega_L of F = -m_C (omega_L^2 e + 2 zeta_L omega_L "
                                                                 "e') (rad/s).")
     damping_ratio: Positive = Field(1.0, description="zeta_L (-): the lateral error decays as exp(-zeta_L omega_L t).")
