@@ -126,10 +126,11 @@ def main(argv=None) -> None:
             half = len(rec.series["time"]) // 2
             for label, k in (("whole run", 0), ("second half", half)):
                 f = balance_figures(rec.series, rec.net, segments, k)
+                share = f"{100 * f['drift'] / f['booked']:+.2f} % of the booked" if f["booked"] > 1e-9 else "no contact"
                 print(f"step {step:.0e} s key {key:3s} {label:11s}: load {f['load']:6.2f} N, slip {f['slip']:.3f} m/s;"
                       f" friction work {f['friction']:8.4f} J, booked by the contacts {f['booked']:8.4f} J "
                       f"(dampers {f['dampers']:.4f} J); balance drift {f['drift']:+9.5f} J "
-                      f"({100 * f['drift'] / max(f['booked'], 1e-12):+.2f} % of the booked); thread contact made "
+                      f"({share}); thread contact made "
                       f"between steps {f['made']:+.5f} J (whole run); CPU {cpu:.1f} s", flush=True)
 
 
