@@ -134,8 +134,7 @@ def main():
         for settled, tukey, entry in variants if "none" in args.models else []:
             for name, value in {**defaults, "SETTLED": settled, "TUKEY_CUTOFF": tukey, **entry}.items():
                 setattr(scan_to_map, name, value)
-            # the scans are in the sensor frame, which is the world here: every sensor origin is 0
-            free = track_scans(scans, VOXEL, CORRESPONDENCE, sensors_world=np.zeros((len(scans), 3)))
+            free = track_scans(scans, VOXEL, CORRESPONDENCE)
             records = alignments(free, times)
             # B of the model-free track is the first scan's frame; the truth in it: R_k R_0^T (R_0 = I here)
             named = "".join(f", {name} {value:g}" for name, value in entry.items())

@@ -406,8 +406,7 @@ def track_model_free(scene: Scene, frames: Frames):
     com_target = scene.truth["com_target"]
     origins = [com - rot @ com_target for rot, com in zip(frames.true_target_to_world, frames.true_com_world)]
     reg = p.registration
-    track = track_scans(frames.scans, reg.voxel, reg.max_correspondence,
-                        sensors_world=np.array([sensor_world for sensor_world, _ in frames.sensor_poses]))
+    track = track_scans(frames.scans, reg.voxel, reg.max_correspondence)
     # No registered frame (e.g. empty scans): no map; the fits below answer "not observable".
     tracker = DebrisTracker(reg.voxel, reg.max_correspondence, reg.model_frames,
                             *((track.map_points, track.map_normals) if track.ok.any() else ()), seed=p.seed,
