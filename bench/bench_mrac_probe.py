@@ -99,17 +99,19 @@ def _value(text):
 
 
 def overridden(case, settings):
-    """``case`` with ``[mrac]`` / ``[thrust]`` keys set from ``section.key=value`` strings (validated again); also
+    """``case`` with ``[mrac]`` / ``[thrust]`` / ``[lateral]`` keys set from ``section.key=value`` strings (validated again); also
     ``sub_tethers.attachment_points_body``, which places the full net's cylinder along the debris axis (a diagnostic:
     symmetric points put the geometric centre on the CoM, ``riskassess.models.towing_fullnet.debris_geometry``)."""
     data = case.model_dump()
-    allowed = {"mrac": set(data["mrac"]), "thrust": set(data["thrust"]), "sub_tethers": {"attachment_points_body"}}
+    allowed = {"mrac": set(data["mrac"]), "thrust": set(data["thrust"]), "lateral": set(data["lateral"]),
+               "sub_tethers": {"attachment_points_body"}}
     for item in settings:
         key, value = item.split("=", 1)
         section, name = key.split(".", 1)
         if name not in allowed.get(section, ()):
             raise SystemExit(f"--set {item}: unknown key; allowed: mrac.* {sorted(data['mrac'])}, thrust.* "
-                             f"{sorted(data['thrust'])}, sub_tethers.attachment_points_body")
+                             f"{sorted(data['thrust'])}, lateral.* {sorted(data['lateral'])}, "
+                             "sub_tethers.attachment_points_body")
         data[section][name] = _value(value)
     return TowingCase.model_validate(data)
 

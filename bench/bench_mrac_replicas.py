@@ -46,6 +46,11 @@ COLUMNS = (("mean_last_100_s_m", "mean z (m)", ".4f"), ("rms_error_m", "RMS z - 
            ("peak_tension_N", "peak T (N)", ".0f"), ("thrust_peak_N", "peak F (N)", ".0f"),
            ("at_thrust_peak_share", "F at its peak, 100-300 s", ".2f"),
            ("spin_end_deg_s", "spin end (deg/s)", ".2f"))
+#: Columns of runs with the lateral station-keeping law (``--set lateral.enabled=true``), printed when a row has them.
+LATERAL_COLUMNS = (("thrust_mean_last_100_s_N", "mean F, last 100 s (N)", ".1f"),
+                   ("lateral_mean_last_100_s_N", "mean lateral F, last 100 s (N)", ".1f"),
+                   ("lateral_peak_N", "peak lateral F (N)", ".1f"),
+                   ("lateral_error_rms_last_100_s_m", "chaser off the debris' omega axis, RMS last 100 s (m)", ".3f"))
 
 
 def figures(series: dict, target: float) -> dict:
@@ -71,7 +76,34 @@ def figures(series: dict, target: float) -> dict:
             "slack_s": f["slack_after_engagement_s"], "near_slack_share": float(np.mean(tension[after] < 1.0)),
             "peak_tension_N": f["peak_tension_N"],
             "spin_end_deg_s": float(np.degrees(np.linalg.norm(series["debris_omega_body"][-1]))),
-            "end_time_s": float(t[-1]), **thrust_figures(t, series["thrust"])}
+            "end_time_s": float(t[-1]), **thrust_figures(t, series["thrust"]), **lateral_figures(series)}
+
+
+def lateral_figures(series: dict) -> dict:
+    """Tether-axis thrust and lateral station-keeping force (N) over the last 100 s (mean magnitude) and over the
+    run (peak), and the RMS distance (m) of the chaser from the line through the debris CoM along its angular
+    velocity over the last 100 s (the series hold no inertia: omega stands for the angular momentum H the
+    ``momentum_axis`` target uses, exact while omega lies in the body x-y plane, I_x = I_y; a nutation tilts them
+    apart).
+
+    Parameters
+    ----------
+    series : dict
+        A full-net tow's series (:meth:`multibody.net_towing.NetTowResult.series`).
+    """
+    t = series["time"]
+    last = t > t[-1] - 100.0
+    out = {"thrust_mean_last_100_s_N": float(series["thrust"][last].mean())}
+    if "lateral_thrust_inertial" not in series:
+        return out
+    side = np.linalg.norm(series["lateral_thrust_inertial"], axis=1)
+    rot_d = series["debris_to_inertial"]
+    axis = np.einsum("kij,kj->ki", rot_d, series["debris_omega_body"])     # H is along omega: I_x = I_y, omega in x-y
+    axis /= np.linalg.norm(axis, axis=1)[:, None]
+    d = series["chaser_com_inertial"] - series["debris_com_inertial"]
+    off = d - np.sum(d * axis, axis=1)[:, None] * axis
+    return {**out, "lateral_mean_last_100_s_N": float(side[last].mean()), "lateral_peak_N": float(side.max()),
+            "lateral_error_rms_last_100_s_m": float(np.sqrt(np.mean(np.sum(off[last] ** 2, axis=1))))}
 
 
 def thrust_figures(t, thrust) -> dict:
@@ -92,10 +124,11 @@ def thrust_figures(t, thrust) -> dict:
 
 def with_thrust_figures(record: dict, folder: Path) -> dict:
     """A results line with the thrust figures, taken from its stored series when the line predates them."""
-    if "thrust_peak_N" in record:
+    if "thrust_peak_N" in record and "thrust_mean_last_100_s_N" in record:
         return record
     d = np.load(folder / f"{record['label']}_{record['plant']}_{record['law']}_{record['rate_deg_s']:g}_{record['replica']}.npz")
-    return {**record, **thrust_figures(d["time"], d["thrust"])}
+    t, thrust = d["time"], d["thrust"]
+    return {**thrust_figures(t, thrust), "thrust_mean_last_100_s_N": float(thrust[t > t[-1] - 100.0].mean()), **record}
 
 
 def at_spin(case: TowingCase, spin_rate_deg_s: float) -> TowingCase:
@@ -117,14 +150,18 @@ def table(path: Path) -> None:
     groups = {}
     for r in rows:
         groups.setdefault((r["label"], r["plant"], r["law"], r["rate_deg_s"]), []).append(r)
-    names = " | ".join(name for _, name, _ in COLUMNS)
+    columns = COLUMNS + (LATERAL_COLUMNS if any("lateral_peak_N" in r for r in rows) else ())
+    names = " | ".join(name for _, name, _ in columns)
     print(f"| setting | plant | law | rate (deg/s) | runs | {names} | CPU s a run |")
-    print("|---" * (6 + len(COLUMNS)) + "|")
+    print("|---" * (6 + len(columns)) + "|")
     order = sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1], kv[0][3], kv[0][2]))
     for (label, plant, law, rate), runs in order:
         cells = []
-        for key, _, fmt in COLUMNS:
-            v = np.array([r[key] for r in runs], float)
+        for key, _, fmt in columns:
+            v = np.array([r.get(key, np.nan) for r in runs], float)
+            if np.isnan(v).all():
+                cells.append("-")     # a run without the lateral law
+                continue
             cells.append(f"{v.mean():{fmt}} [{v.min():{fmt}}, {v.max():{fmt}}]" if len(v) > 1 else f"{v[0]:{fmt}}")
         cpu = np.mean([r["cpu_s"] for r in runs])
         print(f"| {label} | {plant} | {law} | {rate:g} | {len(runs)} | " + " | ".join(cells) + f" | {cpu:.0f} |")
@@ -137,6 +174,8 @@ def main():
     parser.add_argument("--rate", type=float, nargs="+", default=[20.44, 10.71], help="spin rates (deg/s)")
     parser.add_argument("--laws", nargs="+", choices=("ramp", "mrac1", "mrac2"), default=("mrac2", "mrac1"))
     parser.add_argument("--replicas", type=int, default=3)
+    parser.add_argument("--first-replica", type=int, default=0,
+                        help="run replicas first..replicas-1 only (another process runs the lower ones)")
     parser.add_argument("--perturbation", type=float, default=1e-3, help="relative spin-rate step between replicas")
     parser.add_argument("--label", default="shipped")
     parser.add_argument("--set", nargs="*", default=[])
@@ -158,7 +197,7 @@ def main():
     wrapped = wrapped_net(case) if args.plant == "full-net" else None
     for rate in args.rate:
         for law in args.laws:
-            for j in range(args.replicas):
+            for j in range(args.first_replica, args.replicas):
                 key = f"{args.label}|{args.plant}|{law}|{rate:g}|{j}"
                 if key in done:
                     continue
@@ -174,10 +213,11 @@ def main():
                 record = {"key": key, "label": args.label, "set": args.set, "plant": args.plant, "law": law,
                           "rate_deg_s": rate, "replica": j, "spin_start_deg_s": spin, "target_m": target,
                           **figures(series, target), "cpu_s": cpu, "load": [load0, os.getloadavg()[0]]}
-                keys = ("time", "main_tether_tension", "main_tether_elongation", "thrust", "debris_omega_body")
+                keys = ("time", "main_tether_tension", "main_tether_elongation", "thrust", "debris_omega_body",
+                        "lateral_thrust_inertial")
                 separation = np.linalg.norm(series["debris_com_inertial"] - series["chaser_com_inertial"], axis=1)
                 results.atomic_write_npz(folder / f"{args.label}_{args.plant}_{law}_{rate:g}_{j}.npz",
-                                         {**{k: series[k] for k in keys}, "separation": separation})
+                                         {**{k: series[k] for k in keys if k in series}, "separation": separation})
                 with open(args.results, "a", encoding="utf-8") as handle:
                     handle.write(json.dumps(record) + "\n")
                 print(f"{key}: " + ", ".join(f"{name} {record[k]:{fmt}}" for k, name, fmt in COLUMNS) +

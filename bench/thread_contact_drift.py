@@ -1,6 +1,7 @@
 """A case's energy balance over time with the threads' contact on, and the threads' own energy record.
 
     python3 bench/thread_contact_drift.py [CASE] [--end-time T] [--velocity V] [--release never] [--key off]
+                                          [--set contact.mu_static=0 ...]
 
 Runs the case's simulation (no pipeline products) with ``contact.thread_segments`` set as ``--key`` says and the
 health check's energy limit lifted (a drifting run is measured, not refused), and prints with the CPU time and the
@@ -25,11 +26,59 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script
 from bench_thread_segments import case_text  # noqa: E402
 
+from multibody.hinge import joint_damping_joint_frame, joint_stiffness_joint_frame  # noqa: E402
 from multibody.impact import ImpactSimulation  # noqa: E402
 from riskassess.cases.impact import load_case  # noqa: E402
 from riskassess.models.impact import model_inputs  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
+
+
+def with_overrides(text: str, overrides: list) -> str:
+    """The case text with each ``SECTION.KEY=VALUE`` replacing the key's line in that section, or added to it."""
+    lines = text.splitlines()
+    for item in overrides:
+        name, value = item.split("=", 1)
+        section, key = name.rsplit(".", 1)
+        start = lines.index(f"[{section}]")
+        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("[")), len(lines))
+        k = next((i for i in range(start + 1, end) if lines[i].split("=")[0].strip() == key), None)
+        if k is None:
+            lines.insert(start + 1, f"{key} = {value}")     # a key the case leaves at its default
+        else:
+            lines[k] = f"{key} = {value}"
+    return "\n".join(lines) + "\n"
+
+
+def print_energy_terms(series: dict, t: np.ndarray, reference: float) -> None:
+    """Each energy term's change from 2 s (or the start) to the end, % of the reference energy: where the balance's
+    drift sits among the terms it sums (multibody.recorder.ENERGY_TERMS)."""
+    k0 = max(int(np.searchsorted(t, 2.0)) - 1, 0)
+    terms = [key for key in series if key.startswith("energy_")]
+    print(f"   energy terms, change {t[k0]:.3f} -> {t[-1]:.3f} s (% of the reference energy): " + ", ".join(
+        f"{key[7:]} {100 * (series[key][-1] - series[key][k0]) / reference:+.3f}" for key in terms))
+
+
+def joint_rotation_damping_work(series: dict, assembly) -> list:
+    """Per joint, the work its rotational dampers took (J), estimated from the sampled relative angular velocity:
+    the sum over the joint frame's axes of c_k times the trapezoid integral of (rate_k)^2 (the hinge axis h2 of a
+    revolute joint carries its torsional damping, the other axes the penalty damping,
+    :func:`multibody.hinge.joint_damping_joint_frame`). The energy balance books none of it (an experiment: the
+    joints' dampers are not in multibody.recorder.ENERGY_TERMS). An estimate only: the sampled rate resolves the
+    slow hinge motion, not the penalty springs' ringing at the step's frequency, and the translational dampers
+    (the joint point's relative velocity is not recorded) are left out. Returns (name, hinge-axis J, other J)."""
+    t, rate = series["time"], series["joint_rate_joint"]
+    step = assembly.solver.joint_tuning_step or assembly.solver.step
+    out = []
+    for k, joint in enumerate(assembly.joints):
+        parent, child = assembly.bodies[joint.parent], assembly.bodies[joint.child]
+        damping = joint_damping_joint_frame(joint, parent, child, joint_stiffness_joint_frame(joint, parent, child,
+                                                                                              step))[3:]
+        squared = rate[:, k, :] ** 2
+        integral = np.sum(0.5 * (squared[1:] + squared[:-1]) * np.diff(t)[:, None], axis=0)
+        work = damping * integral
+        out.append((joint.name, float(work[1]), float(work[0] + work[2])))
+    return out
 
 
 def main(argv=None) -> None:
@@ -39,11 +88,14 @@ def main(argv=None) -> None:
     parser.add_argument("--velocity", type=float, default=None)
     parser.add_argument("--release", default=None, help='structures.release override, e.g. "never"')
     parser.add_argument("--key", default="on", choices=("on", "off"))
+    parser.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                        help="a case value overridden, e.g. contact.mu_static=0 (an experiment, repeatable)")
     args = parser.parse_args(argv)
     case_path = Path(args.case)
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / case_path.name
-        path.write_text(case_text(case_path.read_text(), args.key == "on", args.end_time, args.velocity, args.release))
+        text = case_text(case_path.read_text(), args.key == "on", args.end_time, args.velocity, args.release)
+        path.write_text(with_overrides(text, args.set))
         assembly = model_inputs(load_case(path), case_path.parent).assembly
     simulation = ImpactSimulation(assembly)
     reference = simulation.health.reference_energy
@@ -61,6 +113,10 @@ def main(argv=None) -> None:
         k = int(np.searchsorted(t, when)) - 1
         if 0 <= k < len(t) and t[k] > when - 0.01:
             print(f"   t {t[k]:.3f} s  drift {100 * drift[k]:+.3f} %")
+    print_energy_terms(series, t, reference)
+    print("   joints' rotational dampers, work estimated from the samples (not booked; % of the reference energy): "
+          + ", ".join(f"{name} hinge axis {100 * hinge / reference:.3f}, other axes {100 * other / reference:.3f}"
+                      for name, hinge, other in joint_rotation_damping_work(series, assembly)))
     gains = np.diff(drift)
     for k in np.argsort(-gains)[:10]:
         print(f"   gain at t {t[k + 1]:.4f} s: {100 * gains[k]:+.3f} %")

@@ -128,6 +128,20 @@ def _substeps_to_resolve_contact(penetrations, relative_velocities, normals, bod
 
 
 # no reference counts (jit_cache.NO_REFCOUNTS): its entry and exits counted 70 arrays each a step
+@njit(cache=True, inline="always")
+def _thread_lag_in_start_velocity(i, thread_lag, node_mass, step, non_contact_force_lvlh, start_velocity_lvlh):
+    """Node ``i``'s start velocity and non-contact force with the threads' carried remainders as the clusters see
+    them (:func:`multibody.segment_pairs._node_motion`): the remainder r (m/s, LVLH, ``thread_lag``) is velocity the
+    node already has at the step's start (the end of the last step's sub-cycle), so all of it is in the start
+    velocity and none in the force held over the step. Released as the force m r / step
+    (:func:`multibody.contact_segment._release_carried`), it entered the start velocity half (the half kick) and the
+    held force whole: a node whose own contact moved from a cluster to the node contact saw r / 2 at the start and
+    r more by the end (helper thread13's "known inconsistency"; helper thread14 removed it)."""
+    for d in range(3):
+        non_contact_force_lvlh[i, d] -= node_mass * thread_lag[d, i] / step
+        start_velocity_lvlh[i, d] += 0.5 * thread_lag[d, i]
+
+
 @njit(cache=True, **NO_REFCOUNTS)
 def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers, net_force_lvlh,
                        body_force_lvlh,
@@ -190,6 +204,7 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
     n = net_mass.shape[0]
     # pairs a thread's sub-cycle integrated this step (multibody.contact_segment; none when thread contact is off)
     segments_on, owned_shape = buffers.segments.enabled != 0, buffers.segments.owned_shape
+    thread_lag = buffers.segments.lag_velocity_lvlh
     contact_energy = 0.0
     n_contacts = 0
     dissipated_total = 0.0
@@ -240,6 +255,9 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
         for d in range(3):
             non_contact_force_lvlh[i, d] = net_force_lvlh[d, i]
             start_velocity_lvlh[i, d] = v[d, i] + velocity_lag[d, i] + half_kick * net_force_lvlh[d, i] / net_mass[i]
+        if segments_on and half_kick > 0.0:
+            _thread_lag_in_start_velocity(i, thread_lag, net_mass[i], step, non_contact_force_lvlh,
+                                          start_velocity_lvlh)
         speed[i] = math.sqrt(start_velocity_lvlh[i, 0] ** 2 + start_velocity_lvlh[i, 1] ** 2
                              + start_velocity_lvlh[i, 2] ** 2)
         push[i] = math.sqrt(net_force_lvlh[0, i] ** 2 + net_force_lvlh[1, i] ** 2

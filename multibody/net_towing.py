@@ -13,7 +13,7 @@ Frame: Earth-centred inertial; angular velocities in the body frames.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import exudyn as exu
 import numpy as np
@@ -24,6 +24,7 @@ from scipy.spatial.transform import Rotation
 
 from multibody.health import HealthWatch
 from multibody.impact import checked_post_step, explicit_settings, solve_checked
+from multibody.control.lateral import L_ON, L_SIZE, lateral_thrust
 from multibody.control.thrust import range_rate
 from multibody.maths.rotations import rotation_matrix_from_rotation_vector
 from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING, ACC_CONTACT_F, ACC_CONTACTS,
@@ -33,7 +34,7 @@ from multibody.net_towing_kernel import (ACC_CHASER_F, ACC_CHASER_T, ACC_CLOSING
                                          chaser_control, net_forces)
 from multibody.net_wrap import TowingNet
 from multibody.towing import HEALTH_EVERY_STEPS, TowedBodies, tow_failure_cause
-from multibody.net_towing_kernel import D_SLIDING, D_THRUST, D_TORQUE
+from multibody.net_towing_kernel import D_LATERAL, D_SLIDING, D_THRUST, D_TORQUE
 from multibody.orbit import add_body_gravity
 from multibody.health import SimulationFailed
 from multibody.tow_switch import (QuasiSteadyWatch, SwitchCriterion, net_internal_kinetic_energy,
@@ -67,6 +68,8 @@ class FullNetModel(TowedBodies):
     state_at : float or None           Keep the full state at the first sample at or after this time (s)
                                        without stopping (``NetTowResult.state_at``): the start state of
                                        lower-order runs compared with this one (identification, Sec. 4.1).
+    lateral : (L_SIZE,) float          Lateral station-keeping law of the chaser
+                                       (:func:`multibody.control.lateral.lateral_params`); zeros: off.
     """
 
     net: TowingNet
@@ -82,6 +85,7 @@ class FullNetModel(TowedBodies):
     closing_duration: float | None = None
     switch: SwitchCriterion | None = None
     state_at: float | None = None
+    lateral: np.ndarray = field(default_factory=lambda: np.zeros(L_SIZE))
 
     @property
     def net_every(self) -> int:
@@ -226,6 +230,11 @@ def step_forces(q, v, t, advance, main_tether, tow):
                                             relative[2]),
                      u, rot_c, bodies[0, 0:3], bodies[0, 6:9], bodies[0, 9:12], inertia[0], control, step, advance,
                      chaser, diag)
+    if control.lateral[L_ON] != 0.0:   # off: not even a + 0.0, so the default path stays bit-identical
+        side = lateral_thrust(t, control.lateral, bodies[0, 0:3], bodies[0, 6:9], rot_c, bodies[1, 0:3],
+                              bodies[1, 6:9], reference + x[central], xv[central], rot_d @ (inertia[1] @ bodies[1, 9:12]))
+        chaser[0:3] += side
+        diag[D_LATERAL:D_LATERAL + 3] = side
     debris = force[6:12]
     add_body_gravity(chaser, 0, bodies[0, 0], bodies[0, 1], bodies[0, 2], body_masses[0], mu)
     add_body_gravity(debris, 0, bodies[1, 0], bodies[1, 1], bodies[1, 2], body_masses[1], mu)
@@ -251,7 +260,7 @@ class NetTowState:
         self.thrust_state = np.array(model.thrust_state, float)
         self.control = chaser_control(np.ascontiguousarray(model.attitude, float), model.thrust_command,
                                       bool(model.thrust_along_body_z), np.ascontiguousarray(model.thrust_params, float),
-                                      self.thrust_state)
+                                      self.thrust_state, np.ascontiguousarray(model.lateral, float))
         self.acc, self.diag = np.zeros(ACC_SIZE), np.zeros(D_SIZE)
         self.f, self.work, self.lag = np.zeros_like(self.x), np.zeros(21), np.zeros_like(self.x)
         self.tether_on = np.array(model.main_tether, float)
@@ -383,6 +392,7 @@ class NetTowResult:
             "main_tether_tension": self.diag[:, D_TENSION], "main_tether_elongation": self.diag[:, D_ELONGATION],
             "main_tether_elongation_rate": self.diag[:, D_RATE],
             "thrust": self.diag[:, D_THRUST], "control_torque_body": self.diag[:, D_TORQUE:D_TORQUE + 3],
+            "lateral_thrust_inertial": self.diag[:, D_LATERAL:D_LATERAL + 3],
             "sliding_variable": self.diag[:, D_SLIDING:D_SLIDING + 3],
             "net_contacts": self.diag[:, D_CONTACTS], "net_contact_force": self.diag[:, D_CONTACT_F],
             "closing_thread_peak_tension": self.diag[:, D_CLOSING],

@@ -42,9 +42,10 @@ from multibody.orbit import two_body_acceleration_xyz
 ACC_DEBRIS_F, ACC_DEBRIS_T, ACC_CHASER_F, ACC_CHASER_T = 0, 3, 6, 9
 ACC_TENSION, ACC_CONTACTS, ACC_CONTACT_F, ACC_CLOSING, ACC_EXTERNAL, ACC_DISSIPATED, ACC_SIZE = 12, 13, 14, 15, 16, 19, 20
 #: Diagnostics of one step (``diag``): MT mean tension, elongation, elongation rate, thrust, control
-#: torque (3, chaser body), sliding variable (3), mean contacts, mean contact force, largest closing tension.
-D_TENSION, D_ELONGATION, D_RATE, D_THRUST, D_TORQUE, D_SLIDING, D_CONTACTS, D_CONTACT_F, D_CLOSING, D_SIZE = (
-    0, 1, 2, 3, 4, 7, 10, 11, 12, 13)
+#: torque (3, chaser body), sliding variable (3), mean contacts, mean contact force, largest closing tension,
+#: lateral station-keeping force (3, N, inertial; :mod:`multibody.control.lateral`).
+D_TENSION, D_ELONGATION, D_RATE, D_THRUST, D_TORQUE, D_SLIDING, D_CONTACTS, D_CONTACT_F, D_CLOSING, D_LATERAL, D_SIZE = (
+    0, 1, 2, 3, 4, 7, 10, 11, 12, 13, 16)
 #: Cylinder geometry: radius (m), half length (m), axial centre z (m) in the debris frame.
 CYL_RADIUS, CYL_HALF, CYL_Z = 0, 1, 2
 #: Contact law: k_n (N/m^n), n, d_n, mu_s, mu_k, V_t0 (see multibody.assembly.ContactLaw).
@@ -418,18 +419,20 @@ class ChaserControl(structref.StructRefProxy):
     along_body_z : bool         Thrust along the chaser's body z (True) or against its inertial velocity.
     thrust_params : (k,) float  The law's constants; ``thrust_state`` (j,) float its states, advanced
                                 in place (shared with the array given, not copied).
+    lateral : (L_SIZE,) float   Lateral station-keeping law's constants (:func:`multibody.control.lateral.lateral_params`;
+                                all zero: off).
     """
 
 
 structref.define_proxy(ChaserControl, ChaserControlType, ["attitude", "thrust", "along_body_z", "thrust_params",
-                                                          "thrust_state"])
+                                                          "thrust_state", "lateral"])
 #: numba type of the kernels' chaser-control argument.
 CHASER_CONTROL = ChaserControlType([("attitude", _VECTOR), ("thrust", THRUST_LAW), ("along_body_z", types.boolean),
-                                    ("thrust_params", _VECTOR), ("thrust_state", _VECTOR)])
+                                    ("thrust_params", _VECTOR), ("thrust_state", _VECTOR), ("lateral", _VECTOR)])
 
 
-@njit(CHASER_CONTROL(_VECTOR, THRUST_LAW, types.boolean, _VECTOR, _VECTOR), cache=True)
-def chaser_control(attitude, thrust, along_body_z, thrust_params, thrust_state):
+@njit(CHASER_CONTROL(_VECTOR, THRUST_LAW, types.boolean, _VECTOR, _VECTOR, _VECTOR), cache=True)
+def chaser_control(attitude, thrust, along_body_z, thrust_params, thrust_state, lateral):
     """The :class:`ChaserControl` of these fields (arrays shared, not copied).
 
     Parameters
@@ -442,6 +445,8 @@ def chaser_control(attitude, thrust, along_body_z, thrust_params, thrust_state):
         Thrust along the chaser's body z (True) or against its inertial velocity.
     thrust_params, thrust_state : (k,), (j,) float
         The law's constants and states (states advanced in place).
+    lateral : (L_SIZE,) float
+        Lateral station-keeping constants (:func:`multibody.control.lateral.lateral_params`; zeros: off).
     """
     control = structref.new(CHASER_CONTROL)
     control.attitude = attitude
@@ -449,6 +454,7 @@ def chaser_control(attitude, thrust, along_body_z, thrust_params, thrust_state):
     control.along_body_z = along_body_z
     control.thrust_params = thrust_params
     control.thrust_state = thrust_state
+    control.lateral = lateral
     return control
 
 

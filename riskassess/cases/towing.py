@@ -15,6 +15,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
+from multibody.control.lateral import TARGETS as LATERAL_TARGETS
 from multibody.control.thrust_laws import LAWS as THRUST_LAWS
 from riskassess.cases.impact import NonNegative, Positive, Strict, Vector3
 from riskassess.cases.inputs import KIND_NOTE, CaseName, Search, Text
@@ -178,6 +179,24 @@ class Mrac(Strict):
         False, description="Command the reference model (eq. 13) with z_d (k_MT + K_P) / K_P so that it settles at "
                           "desired_elongation; false: the paper's command z_d, with which it settles at "
                           "K_P z_d / (k_MT + K_P) (eq. 13 has no integral action).")
+
+
+class Lateral(Strict):
+    """Lateral station keeping of the chaser on the full-net plant (multibody/control/lateral.py; docs/towing.md,
+    "A lateral station-keeping law"). Off by default: the runs are then bit-identical to those without it."""
+    enabled: bool = Field(False, description="A thrust component across the main tether (side thrusters in the "
+                                             "chaser's body x-y plane) holding the chaser on a line through the "
+                                             "debris CoM. Full-net plant only (the lower-order model refuses it).")
+    target: Literal[tuple(LATERAL_TARGETS)] = Field(
+        "momentum_axis", description="'momentum_axis' (default): the debris' angular-momentum axis (the tow "
+                                     "point's once-per-turn circle across the tether; holds 29.01 deg/s with 7-8 N, "
+                                     "docs/towing.md); 'tow_point': the line debris CoM -> tow point (no moment from "
+                                     "the tow point's offset, but 845 N of side thrust at 29.01 deg/s: fails).")
+    natural_frequency_rad_s: Positive = Field(0.2, description="omega_L of F = -m_C (omega_L^2 e + 2 zeta_L omega_L "
+                                                                "e') (rad/s).")
+    damping_ratio: Positive = Field(1.0, description="zeta_L (-): the lateral error decays as exp(-zeta_L omega_L t).")
+    max_force: Positive = Field(50.0, description="Largest lateral force (N), in the chaser's body x-y plane; apart "
+                                                  "from thrust.max_force, which is the tether-axis thrust's.")
 
 
 class AttitudeControl(Strict):
@@ -373,6 +392,7 @@ class TowingCase(Strict):
     thrust: Thrust
     mrac: Mrac | None = None
     attitude_control: AttitudeControl
+    lateral: Lateral = Field(default_factory=Lateral)
     rates: Rates
     identification: Identification
     full_net: FullNet | None = None
@@ -449,6 +469,9 @@ class TowingCase(Strict):
         if m is not None and m.slack_hold_periods > 0 and self.debris.spin_rate_deg_s <= 0.0:
             raise ValueError("mrac.slack_hold_periods counts breathing periods (half a spin period), but "
                              "debris.spin_rate_deg_s = 0; set mrac.slack_hold_periods = 0")
+        if self.lateral.enabled and not self.attitude_control.enabled:
+            raise ValueError("lateral.enabled acts in the chaser's body x-y plane, across the tether only while the "
+                             "attitude control holds body z along it: set attitude_control.enabled = true")
         if self.full_net is not None and 4 * self.full_net.corner_mass >= self.net_mass:
             raise ValueError(f"full_net.corner_mass must be < net_mass / 4 ({self.net_mass / 4:g} kg). "
                              f"Got {self.full_net.corner_mass:g} instead")

@@ -153,6 +153,10 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
     -------
     multibody.towing.TowingModel
     """
+    if case.lateral.enabled:
+        raise ValueError("lateral.enabled: the lateral station-keeping law (multibody/control/lateral.py) acts on the "
+                         "full-net plant only; the lower-order model's chaser has no lateral thrust. Set "
+                         "lateral.enabled = false, or run the full net (simulation.model = 'full-net')")
     s = case_decision_vector(case) if s is None else np.asarray(s, float)
     sim, ch, de = case.simulation, case.chaser, case.debris
     mt = case.main_tether

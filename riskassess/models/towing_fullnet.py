@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from multibody.control.attitude import sampled_boundary_layer
+from multibody.control.lateral import lateral_params
 from multibody.maths.rotations import quaternion_to_matrix, rotation_matrix_from_rotation_vector
 from multibody.net_towing import FullNetModel
 from multibody.net_wrap import drape_and_close, towing_net
@@ -240,7 +241,15 @@ def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapp
         start_time=start, end_time=sim.end_time if end_time is None else end_time, step=h,
         substeps=fn.substeps if substeps is None else substeps, output_interval=sim.output_interval,
         net_output_interval=fn.net_output_interval, closing_time=fn.closing_time, closing_duration=closing_duration,
-        switch=switch_criterion(case))
+        switch=switch_criterion(case), lateral=case_lateral(case))
+
+
+def case_lateral(case: TowingCase) -> np.ndarray:
+    """The case's ``[lateral]`` law as the kernel takes it (:func:`multibody.control.lateral.lateral_params`; zeros
+    when off), acting from ``thrust.t_on``."""
+    la = case.lateral
+    return lateral_params(la.enabled, la.target, la.natural_frequency_rad_s, la.damping_ratio, la.max_force,
+                          case.thrust.t_on, case.chaser.mass)
 
 
 def switch_criterion(case: TowingCase):

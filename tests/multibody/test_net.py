@@ -3,10 +3,14 @@ import math
 
 import numpy as np
 import pytest
+import trimesh
 
-from multibody.net import (add_bending_forces, add_thread_forces, add_thread_forces_runs, bowl_net_positions,
+from multibody.assembly import ContactLaw, ImpactAssembly, RigidBodySpec, SolverSpec
+from multibody.impact import ImpactSimulation
+from multibody.net import (NetTopology, add_bending_forces, add_thread_forces, add_thread_forces_runs, bowl_net_positions,
                           flat_square_net, square_grid_threads, sum_reassociated, thread_node_mass, thread_runs,
                           thread_tension_strain)
+from tests.conftest import PAPER_CONTACT_STIFFNESS
 
 
 def test_node_mass_of_the_reference_net():
@@ -29,6 +33,61 @@ def test_thread_is_tension_only_kelvin_voigt():
     f[:] = 0.0
     add_thread_forces(np.array([[0.0, 0, 0], [0.9, 0, 0]]), v, *args, f)
     assert np.all(f == 0.0), "a slack thread pushes nothing"
+
+
+def test_a_clipped_thread_books_the_spring_energy_it_gives_up():
+    """A stretched thread shortening faster than k s / c: the damper would push, the law clips the tension to zero
+    (tension-only), and the spring energy the thread gives up is lost: P = T l' - k s l' = -k s l' (module's
+    kelvin_voigt_dissipated_power; with T > 0 it is c l'^2, as before)."""
+    args = (np.array([[0, 1]]), np.array([1.0]), np.array([1000.0]), np.array([2.0]))
+    x = np.array([[0.0, 0.0, 0.0], [1.01, 0.0, 0.0]])               # s = 0.01 m: k s = 10 N
+    v = np.array([[0.0, 0.0, 0.0], [-8.0, 0.0, 0.0]])               # c l' = -16 N: clipped
+    f = np.zeros((2, 3))
+    elastic, power = add_thread_forces(x, v, *args, f)
+    assert np.all(f == 0.0)
+    assert power == pytest.approx(1000.0 * 0.01 * 8.0, rel=1e-12)   # -k s l' = 80 W
+    runs = thread_runs(*args)
+    _, power_runs = add_thread_forces_runs(np.ascontiguousarray(x.T), np.ascontiguousarray(v.T), runs,
+                                           np.zeros((3, 2)), np.zeros((5, len(runs.rest_lengths))))
+    assert power_runs == pytest.approx(80.0, rel=1e-12)
+
+
+def _released_thread(damping, step, stretch=0.01, stiffness=1000.0, node_mass=0.04, end_time=0.05):
+    """Two 0.04 kg nodes joined by a 1 m thread stretched by ``stretch`` (m) and let go at rest, far (10 m) from a
+    fixed 0.1 m box they never reach; the recorded series."""
+    positions = np.array([[-0.5 - stretch / 2, 0.0, 0.0], [0.5 + stretch / 2, 0.0, 0.0]])
+    net = NetTopology(positions=positions, masses=np.full(2, node_mass), radii=np.full(2, 0.001),
+                      threads=np.array([[0, 1]]), rest_lengths=np.array([1.0]), stiffness=np.array([stiffness]),
+                      damping=np.array([damping]), bending_triples=np.zeros((0, 3), np.int64),
+                      bending_stiffness=np.zeros(0), nodes_per_side=0, n_bullets=0)
+    box_mass = 1e12
+    box = RigidBodySpec(name="box", mass=box_mass, inertia_body=box_mass * 0.01 / 6.0 * np.eye(3),
+                        com_lvlh=np.array([0.0, 10.0, 0.0]), meshes_body=[trimesh.creation.box(extents=[0.1] * 3)])
+    assembly = ImpactAssembly(
+        net=net, net_velocity=np.zeros((2, 3)), bodies=[box], joints=[],
+        contact=ContactLaw(stiffness=PAPER_CONTACT_STIFFNESS, hunt_crossley_alpha=0.05, mu_static=0.19,
+                           mu_kinetic=0.152),
+        solver=SolverSpec(end_time=end_time, step=step, output_rate=1.0 / step, net_output_rate=1000.0))
+    simulation = ImpactSimulation(assembly)
+    simulation.health.reference_energy = None       # measure the balance, do not refuse it
+    return simulation.run().series
+
+
+@pytest.mark.parametrize("damping", [1.0, 10.0])
+def test_a_released_thread_closes_its_energy_balance(damping):
+    """The stored energy k s^2 / 2 = 0.05 J of a thread let go at rest ends as kinetic energy and booked dissipation.
+    With 10 N s/m (the critical damping of the pair is 2 sqrt(k m / 2) = 8.9 N s/m) the tension clips to zero while
+    the thread still holds most of its stretch, and the booking of c l'^2 alone (before helper thread14) closed the
+    balance to -58.6 % at 1e-4 s and -58.2 % at 1e-5 s (1 N s/m: -3.8 %, -3.6 %): a missing term, not a step error.
+    Tolerance 1 % of the stored energy: what is left is the damper's power booked at the mid-step velocity, first
+    order in the step (measured -0.29 % and -0.18 % at 1e-4 s, -0.029 % and -0.018 % at 1e-5 s)."""
+    series = _released_thread(damping, 1e-4)
+    stored = 0.5 * 1000.0 * 0.01 ** 2
+    assert series["energy_total"][0] == pytest.approx(stored, rel=1e-12)
+    assert series["energy_net_elastic"][-1] == 0.0                          # slack: the nodes fly apart
+    assert np.abs(series["energy_total"] - stored).max() < 1e-2 * stored
+    if damping == 10.0:   # c l'^2 alone books 30 % of the stored energy here; the clipped part is the rest
+        assert series["energy_dissipated_threads"][-1] > 0.8 * stored
 
 
 def test_bending_forces_are_the_energy_gradient_and_free_of_net_force_and_moment():
