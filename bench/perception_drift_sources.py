@@ -13,7 +13,7 @@ the truth (frame B) are set beside, frame by frame:
 * **the registration**: fitness, CPU time (a proxy for the ICP's iterations; the capture holds neither the
   iterations nor the inlier RMSE), the stated 1-sigma about B's third axis from the frame's information.
 
-    python bench/perception_drift_sources.py runs/captures/none_obs20_seed2.pkl [...] [--fixed-map]
+    python bench/perception_drift_sources.py runs/captures/none_obs20_seed2.pkl [...] [--fixed-map | --map-properties]
 
 With ``--fixed-map`` (~20 s CPU a capture), the observation's scans are made again (the capture's case, seed and
 observation time; the stage's online track is redone and checked against the captured poses) and each scan is
@@ -22,19 +22,31 @@ built from all the observation's scans at their true poses in the capture's B (w
 prior), and to a noise-free map of the debris mesh: a slow error that stays on the true-pose map is not the
 online map's build-up; one that stays on the mesh map would be the registration's own on these views.
 
+With ``--map-properties`` (~2-4 min CPU a capture; only this report), the observation made again with and without
+the LiDAR's range noise, and the noisy scans registered (the stage's prior) to fixed maps at the true poses that
+differ from the map of the noisy scans (voxel means on a grid anchored in B, residuals to the means) in one
+property each: made of the noise-free scans; without the frame being registered; with the mesh's exact normals;
+the noise-free map's points with the noisy map's normals; the means projected on their fitted planes (in numpy,
+and as the stage's map does it, :class:`perception.scan_to_map.LazyNormals`); beside the stage's online track of
+the noisy and of the noise-free scans (the current code).
+
 The truth is read from the capture; nothing is refitted.
 """
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+from scipy.spatial import cKDTree
 from scipy.stats import f as f_distribution
 
 from perception.motion import integrated_autocorrelation_time
+from perception.normals import surface_normals
+from perception import scan_to_map
 from perception.scan_to_map import MAP_COVERED, MAP_INTERVAL
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
@@ -216,6 +228,155 @@ def report_fixed_map(path) -> None:
           f"{correlation(b, c):+.2f}")
 
 
+def _observation_scans(cap, range_noise=None):
+    """The capture's observation made again (its case, seed and observation time): the scene, the scans (m,
+    world) and the stage's online track's poses world -> B; ``range_noise`` (m) replaces the LiDAR's."""
+    from riskassess.cases.impact import load_case
+    from riskassess.stages.perceive import Frames, Scene, observe_tumble_model_free
+
+    answer = cap["answer"]
+    case = load_case(CASE)
+    perception = case.perception.model_copy(update={"seed": int(answer["bench_seed"]), "model": "none",
+                                                    "observation_time": float(answer["bench_observation_s"])})
+    case = case.model_copy(update={"perception": perception})
+    scene = Scene.from_case(case, CASE.parent, str(CASE))
+    if range_noise is not None:
+        scene = dataclasses.replace(scene, spec=dataclasses.replace(scene.spec, range_noise=range_noise))
+    frames = Frames()
+    _, tracker, _ = observe_tumble_model_free(scene, frames, np.random.default_rng(perception.seed))
+    k = len(frames.scans)
+    return scene, frames.scans, [a.world_to_body for a in tracker.alignments[:k]]
+
+
+def _registered_to(thin, true_world_to_body, built, max_correspondence, prior_sigma=None):
+    """Each thinned scan (world) registered as the stage does (motion prior from the two previous poses, the first
+    two frames at their true poses) to a fixed map ``built`` = (points, normals, index) or, when ``built`` is a
+    callable, to the map ``built(i)`` of frame i."""
+    prior_sigma = scan_to_map.PRIOR_SIGMA if prior_sigma is None else prior_sigma
+    poses = list(true_world_to_body[:2])
+    for i in range(2, len(thin)):
+        points, normals, index = built(i) if callable(built) else built
+        pose, _, _ = scan_to_map._register(thin[i], points, normals,
+                                           scan_to_map.predict_world_to_body(poses[i - 1], poses[i - 2]),
+                                           max_correspondence, prior_sigma, index)
+        poses.append(pose)
+    return poses
+
+
+def _voxel_sums(points_body, voxel):
+    """Voxel keys (v, 3) int, point sums (v, 3) (m) and counts (v,) of points (n, 3) (m, frame B) on a grid anchored
+    at the origin of B (the leave-one-out map subtracts one scan's sums)."""
+    keys, inverse, counts = np.unique(np.floor(points_body / voxel).astype(np.int64), axis=0, return_inverse=True,
+                                      return_counts=True)
+    sums = np.zeros((len(keys), 3))
+    np.add.at(sums, inverse.ravel(), points_body)
+    return keys, sums, counts
+
+
+def _map_from_means(points, voxel, max_correspondence, normals=None, on_planes=False):
+    """(points, normals, index) of map points (n, 3) (m, frame B). ``on_planes``: as the stage's map, normals
+    estimated lazily (4 voxels, 30 neighbours) and the residuals taken to the points projected on their fitted
+    planes; otherwise to the points themselves, with the given ``normals`` (n, 3) or the same estimated ones."""
+    points = np.ascontiguousarray(points)
+    index = scan_to_map.map_index(points, max_correspondence)
+    if on_planes:
+        return points, scan_to_map.LazyNormals(np.empty((len(points), 3)), np.zeros(len(points), np.bool_),
+                                               4 * voxel, 30), index
+    normals = surface_normals(points, 4 * voxel, 30) if normals is None else normals
+    return points, scan_to_map.LazyNormals.given(normals, index), index
+
+
+def mesh_normals_at(scene, target_to_body, points_body) -> np.ndarray:
+    """The debris mesh's face normals (n, 3) (frame B) at the nearest surface point of each map point (n, 3) (m, B)."""
+    body_to_target = np.linalg.inv(target_to_body)
+    _, _, triangles = scene.mesh_target.nearest.on_surface(scan_to_map._transform(points_body, body_to_target))
+    return np.asarray(scene.mesh_target.face_normals)[triangles] @ target_to_body[:3, :3].T
+
+
+def projected_on_fitted_planes(points, radius, max_nn=30) -> tuple[np.ndarray, np.ndarray]:
+    """Each point (n, 3) (m) moved along its normal onto the plane fitted (PCA) to its ``max_nn`` nearest within
+    ``radius`` (m): the plane through their mean; and those normals (n, 3)."""
+    gap, near = cKDTree(points).query(points, max_nn, distance_upper_bound=radius)
+    found = np.isfinite(gap)
+    near = np.where(found, near, np.arange(len(points))[:, None])
+    weight = found / found.sum(axis=1, keepdims=True)
+    mean = np.einsum("nk,nki->ni", weight, points[near])
+    centred = points[near] - mean[:, None, :]
+    covariance = np.einsum("nk,nki,nkj->nij", weight, centred, centred)
+    normals = np.linalg.eigh(covariance)[1][:, :, 0]
+    return points - np.einsum("ni,ni->n", points - mean, normals)[:, None] * normals, normals
+
+
+def map_property_errors(cap) -> dict:
+    """Attitude errors (k, 3) (rad, frame B) of the observation's noisy scans registered (the stage's prior) to fixed
+    maps at the true poses that differ in one property each from the map of the noisy scans (voxel means on a grid
+    anchored in B, lazily estimated normals): the map of the noise-free scans; the noisy map without the frame
+    being registered; the noisy map's points with the mesh's exact normals; the noise-free map's points with the
+    normals estimated from the noisy map; and the online tracks of the noisy and noise-free scans."""
+    scene, scans, online = _observation_scans(cap)
+    _, clean_scans, clean_online = _observation_scans(cap, range_noise=0.0)
+    reg = scene.case.perception.registration
+    voxel, distance = reg.voxel, reg.max_correspondence
+    k = len(scans)
+    truth = [np.linalg.inv(true_body_to_world(cap, i)) for i in range(k)]
+    thin = [scan_to_map.thinned_scan(s, voxel) for s in scans]
+    clean_thin = [scan_to_map.thinned_scan(s, voxel) for s in clean_scans]
+    body = [scan_to_map._transform(thin[i], truth[i]) for i in range(k)]
+    keys, sums, counts = _voxel_sums(np.vstack(body), voxel)
+    noisy_points = sums / counts[:, None]
+    noisy = _map_from_means(noisy_points, voxel, distance)
+    clean_keys, clean_sums, clean_counts = _voxel_sums(
+        np.vstack([scan_to_map._transform(clean_thin[i], truth[i]) for i in range(k)]), voxel)
+    clean_points = clean_sums / clean_counts[:, None]
+    row = {tuple(key): j for j, key in enumerate(keys)}
+
+    def left_out(i):
+        own_keys, own_sums, own_counts = _voxel_sums(body[i], voxel)
+        rows = np.array([row[tuple(key)] for key in own_keys])
+        s, c = sums.copy(), counts.astype(float).copy()
+        s[rows] -= own_sums
+        c[rows] -= own_counts
+        keep = c > 0
+        return _map_from_means(s[keep] / c[keep, None], voxel, distance)
+
+    noisy_normals = surface_normals(noisy_points, 4 * voxel, 30)
+    nearest_noisy = cKDTree(noisy_points).query(clean_points)[1]
+    errors = lambda poses: np.array([Rotation.from_matrix(true_body_to_world(cap, i)[:3, :3].T   # noqa: E731
+                                                          @ np.linalg.inv(poses[i])[:3, :3]).as_rotvec()
+                                     for i in range(k)])
+    return {
+        "online map (the stage), noisy scans": errors(online),
+        "online map, noise-free scans (their own track)": errors(clean_online),
+        "fixed map of the noisy scans": errors(_registered_to(thin, truth, noisy, distance)),
+        "fixed map of the noise-free scans": errors(_registered_to(thin, truth, _map_from_means(clean_points, voxel, distance), distance)),
+        "fixed noisy map, the registered frame left out": errors(_registered_to(thin, truth, left_out, distance)),
+        "fixed noisy map's points, the mesh's exact normals": errors(_registered_to(
+            thin, truth, _map_from_means(noisy_points, voxel, distance, mesh_normals_at(scene, cap["target_to_body"], noisy_points)), distance)),
+        "fixed noise-free map's points, the noisy map's normals": errors(_registered_to(
+            thin, truth, _map_from_means(clean_points, voxel, distance, noisy_normals[nearest_noisy]), distance)),
+        "fixed noisy map's points projected on their fitted planes (numpy)": errors(_registered_to(
+            thin, truth, _map_from_means(projected_on_fitted_planes(noisy_points, 4 * voxel)[0], voxel, distance),
+            distance)),
+        "fixed noisy map's points projected on their fitted planes (the stage's LazyNormals)": errors(_registered_to(
+            thin, truth, _map_from_means(noisy_points, voxel, distance, on_planes=True), distance)),
+        "noise-free scans on the fixed map of the noise-free scans": errors(_registered_to(
+            clean_thin, truth, _map_from_means(clean_points, voxel, distance), distance)),
+    }
+
+
+def report_map_properties(path) -> None:
+    cap = load(path)
+    dt = float(np.median(np.diff(np.asarray(cap["frames"]["time"])[:201])))
+    cutoff = 2.29 / (4.0 * np.pi)
+    print(f"== {path}: which property of the scan-made map (fixed maps at the true poses, the stage's prior)")
+    for name, errors in map_property_errors(cap).items():
+        errors = np.degrees(errors[2:] - errors[2:].mean(axis=0))
+        slow = np.array([slow_part(errors[:, i], dt, cutoff) for i in range(3)]).T
+        print(f"    {name}: errors rms {_vec(errors.std(axis=0))} deg, slow part rms {_vec(slow.std(axis=0))} deg; "
+              f"slow B3 every 2 s {np.array2string(slow[::20, 2], precision=2, max_line_width=200)}")
+    sys.stdout.flush()
+
+
 def report_across_captures(paths) -> None:
     """The slow B3 errors of several captures of the same case (the same tumble, another noise seed) against
     each other: a drift common to all is set by what the seeds share (the tumble, the view, the rebuild
@@ -347,7 +508,13 @@ def main():
     parser.add_argument("--seed", type=int, default=0, help="random frame sets of the null distribution")
     parser.add_argument("--fixed-map", action="store_true",
                         help="make the scans again and register them to a fixed map of their true poses")
+    parser.add_argument("--map-properties", action="store_true",
+                        help="register the noisy scans to fixed true-pose maps differing in one property each")
     args = parser.parse_args()
+    if args.map_properties:
+        for path in args.captures:
+            report_map_properties(path)
+        return
     np.set_printoptions(precision=4, suppress=True)
     rng = np.random.default_rng(args.seed)
     for path in args.captures:

@@ -264,8 +264,11 @@ class TorqueFreeFit:
         self._t2w_ref = body_to_world[0] * Rotation.from_matrix(t2b)
         p0 = np.r_[np.zeros(3), t2b.T @ omega0_body]
         if self.moments is None:
-            # The rate-based starting ratios can fall outside the bounds on short or noisy spans.
-            ratios0 = np.clip(np.log(moments0[:2]), np.log(0.5) + 1e-3, np.log(2.0) - 1e-3)
+            # The rate-based starting ratios can fall outside the bounds on short or noisy spans, and are
+            # undefined (not positive) for a debris that does not turn: then start from a sphere (ratios 1).
+            with np.errstate(invalid="ignore", divide="ignore"):
+                ratios0 = np.log(np.asarray(moments0[:2], float))
+            ratios0 = np.clip(np.where(np.isfinite(ratios0), ratios0, 0.0), np.log(0.5) + 1e-3, np.log(2.0) - 1e-3)
             p0 = np.r_[p0, ratios0, np.zeros(3)]
         measured_inv = body_to_world.inv()
         # Continuation: the attitude error of a wrong inertia grows with time, so a long span

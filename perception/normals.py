@@ -12,6 +12,11 @@ point), more than all the frame's ICP. Here the neighbours come from a cell list
 (:class:`perception.nearest_grid.CellList`) and the eigenvector from the closed form of a
 symmetric 3 x 3 matrix (trigonometric eigenvalues, then the largest cross product of two rows of
 C - lambda I), compiled with numba.
+
+The same fit gives each point's projection on its plane (the plane through the neighbours' mean,
+:func:`surface_planes`): the map of noisy scans thinned to voxel means is a slab a few voxels thick
+about the surface, and the ICP's residuals are taken to the projections (docs/perception.md, "Which
+property of the scan-made map").
 """
 from __future__ import annotations
 
@@ -41,14 +46,40 @@ def surface_normals(points, radius, max_nn=30) -> np.ndarray:
     (n, 3) float
         Unit normals, same frame; signs arbitrary.
     """
+    return surface_planes(points, radius, max_nn)[1]
+
+
+def surface_planes(points, radius, max_nn=30) -> tuple[np.ndarray, np.ndarray]:
+    """The plane fitted (PCA) to each point's ``max_nn`` nearest within ``radius`` (m): the point moved
+    along the plane's normal onto it, and the unit normal (:func:`surface_normals`).
+
+    Parameters
+    ----------
+    points : (n, 3) float
+        Surface points (m, any frame).
+    radius : float
+        Neighbourhood radius (m).
+    max_nn : int
+        Most neighbours used (the nearest).
+
+    Returns
+    -------
+    plane_points : (n, 3) float
+        Each point projected on its fitted plane (the plane through its neighbours' mean), m, same frame;
+        the point itself where no plane is defined (fewer than 3 neighbours, isotropic spread).
+    normals : (n, 3) float
+        Unit normals, same frame; signs arbitrary.
+    """
     cells = CellList(points, radius / SHELLS, radius)
     sorted_normals = np.empty_like(cells.sorted_points)
+    sorted_planes = np.empty_like(cells.sorted_points)
     known = np.zeros(len(points), np.bool_)
-    fill_normals(np.arange(len(points)), cells.sorted_points, cells.low, cells.cell, cells.shape, cells.starts,
-                 cells.largest_cell, float(radius), int(max_nn), sorted_normals, known)
-    normals = np.empty_like(sorted_normals)
+    fill_planes(np.arange(len(points)), cells.sorted_points, cells.low, cells.cell, cells.shape, cells.starts,
+                cells.largest_cell, float(radius), int(max_nn), sorted_normals, sorted_planes, known)
+    normals, plane_points = np.empty_like(sorted_normals), np.empty_like(sorted_planes)
     normals[cells.order] = sorted_normals
-    return normals
+    plane_points[cells.order] = sorted_planes
+    return plane_points, normals
 
 
 #: Cell edge of :func:`surface_normals`' neighbour search as a share of the radius (any edge gives the
@@ -60,7 +91,14 @@ SHELLS = 1
 
 @njit(cache=True)
 def fill_normals(rows, points, low, cell, shape, starts, largest_cell, radius, max_nn, normals, known):
-    """Normals of the cell-sorted points ``points[rows]`` not yet ``known``, into ``normals`` (rows of
+    """:func:`fill_planes`' normals alone (the projections are computed and dropped)."""
+    fill_planes(rows, points, low, cell, shape, starts, largest_cell, radius, max_nn, normals, np.empty_like(normals),
+                known)
+
+
+@njit(cache=True)
+def fill_planes(rows, points, low, cell, shape, starts, largest_cell, radius, max_nn, normals, plane_points, known):
+    """Normals and projections on the fitted planes (:func:`surface_planes`) of the cell-sorted points ``points[rows]`` not yet ``known``, into ``normals`` (rows of
     ``points``, the arrays of a :class:`perception.nearest_grid.CellList`), as :func:`surface_normals`:
     PCA of the ``max_nn`` nearest points within ``radius`` (m). The neighbours are gathered in growing
     shells of cells (3 x 3 x 3, then 5 x 5 x 5, ...) until ``max_nn`` lie within the searched shells'
@@ -80,8 +118,10 @@ def fill_normals(rows, points, low, cell, shape, starts, largest_cell, radius, m
         Most neighbours used (the nearest).
     normals : (n, 3) float
         In/out: unit normals by row of ``points``; signs arbitrary.
+    plane_points : (n, 3) float
+        In/out: each row's point moved along its normal onto the plane through its neighbours' mean (m).
     known : (n,) bool
-        In/out: which rows of ``normals`` are computed.
+        In/out: which rows of ``normals`` and ``plane_points`` are computed.
     """
     shells = max(int(np.ceil(radius / cell)), 1)
     size = (2 * shells + 1) ** 3 * largest_cell
@@ -107,7 +147,13 @@ def fill_normals(rows, points, low, cell, shape, starts, largest_cell, radius, m
         if count > max_nn:
             _select_nearest(found_d2, found, count, max_nn)
             count = max_nn
-        _least_spread_direction(points, found, count, normals[row])
+        m0, m1, m2 = _least_spread_direction(points, found, count, normals[row])
+        offset = ((points[row, 0] - m0) * normals[row, 0] + (points[row, 1] - m1) * normals[row, 1]
+                  + (points[row, 2] - m2) * normals[row, 2])
+        if not math.isfinite(offset):   # no plane: the point stays
+            offset = 0.0
+        for a in range(3):
+            plane_points[row, a] = points[row, a] - offset * normals[row, a]
         known[row] = True
 
 
@@ -160,10 +206,12 @@ def _select_nearest(d2, rows, count, kept):
 
 @njit(cache=True)
 def _least_spread_direction(points, rows, count, out):
-    """Eigenvector of the smallest eigenvalue of the covariance of points[rows[:count]] into ``out`` (3,)."""
+    """Eigenvector of the smallest eigenvalue of the covariance of points[rows[:count]] into ``out`` (3,);
+    returns the points' mean (m0, m1, m2), NaN when no plane is defined (fewer than 3 points, isotropic
+    spread: ``out`` is (0, 0, 1))."""
     out[0], out[1], out[2] = 0.0, 0.0, 1.0
     if count < 3:
-        return
+        return math.nan, math.nan, math.nan
     m0 = m1 = m2 = 0.0
     for i in range(count):
         j = rows[i]
@@ -183,14 +231,14 @@ def _least_spread_direction(points, rows, count, out):
         a22 += z * z
     scale = max(a00, a11, a22, abs(a01), abs(a02), abs(a12))
     if scale <= 0.0:
-        return
+        return math.nan, math.nan, math.nan
     a00, a01, a02, a11, a12, a22 = a00 / scale, a01 / scale, a02 / scale, a11 / scale, a12 / scale, a22 / scale
     # smallest eigenvalue, trigonometric form (Smith 1961)
     q = (a00 + a11 + a22) / 3.0
     p1 = a01 * a01 + a02 * a02 + a12 * a12
     p2 = (a00 - q) ** 2 + (a11 - q) ** 2 + (a22 - q) ** 2 + 2.0 * p1
     if p2 <= 1e-30:
-        return   # isotropic spread: no preferred direction
+        return math.nan, math.nan, math.nan   # isotropic: no preferred direction
     p = math.sqrt(p2 / 6.0)
     b00, b11, b22 = (a00 - q) / p, (a11 - q) / p, (a22 - q) / p
     b01, b02, b12 = a01 / p, a02 / p, a12 / p
@@ -214,3 +262,4 @@ def _least_spread_direction(points, rows, count, out):
             best_norm2 = norm2
             norm = math.sqrt(norm2)
             out[0], out[1], out[2] = c0 / norm, c1 / norm, c2 / norm
+    return m0, m1, m2

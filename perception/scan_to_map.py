@@ -38,7 +38,7 @@ from multibody.maths.rotations import (
     rotation_vector_from_matrix,
 )
 from perception.nearest_grid import CellList, nearest_in_cells_kept
-from perception.normals import fill_normals, surface_normals
+from perception.normals import fill_planes, surface_planes
 from perception.point_to_plane import point_to_plane_information, tukey_normal_equations
 from perception.registration import Alignment, _rigid_inverse, _turn_candidates
 
@@ -111,13 +111,21 @@ class MapTrack:
 
 @dataclass
 class LazyNormals:
-    """Unit normals of a map's points (frame B), by row of its index's sorted points
-    (:class:`perception.nearest_grid.CellList`), computed when a scan point is first matched to them.
+    """Unit normals of a map's points (frame B) and the points projected on their fitted planes, by row
+    of its index's sorted points (:class:`perception.nearest_grid.CellList`), computed when a scan point
+    is first matched to them.
 
     A map rebuild changes every point (the voxel means are re-averaged), and estimating all ~20 000-50 000
     normals took ~0.2-0.5 s CPU a rebuild, ~25 ms a frame on average; a frame's scan meets a few thousand
-    of them. Each normal is the one :func:`surface_map` gives (PCA of the ``max_nn`` nearest within
-    ``radius``; :func:`perception.normals.fill_normals`).
+    of them. Each normal and plane point is the one :func:`surface_map` gives (PCA of the ``max_nn``
+    nearest within ``radius``; :func:`perception.normals.fill_planes`).
+
+    The ICP's point-to-plane residuals are taken to the plane points, not to the voxel means: a map
+    of scans with 2 cm range noise thinned to 3 cm voxels is a slab of voxel means a few layers thick
+    about the surface, and a scan registered to the raw means carries a slow, view-dependent attitude
+    error (0.23-0.35 deg rms about B's third axis against a fixed map of the scans at their true poses;
+    0.018 deg with the means projected on their fitted planes; docs/perception.md, "Which property of
+    the scan-made map", helper percep14). The nearest-point search stays on the voxel means.
 
     Attributes
     ----------
@@ -125,12 +133,19 @@ class LazyNormals:
     known : (n,) bool               Rows computed.
     radius : float                  Neighbourhood radius (m).
     max_nn : int                    Most neighbours.
+    sorted_plane_points : (n, 3) float   Each sorted point moved along its normal onto its fitted plane
+                                    (m, frame B; rows not ``known``: undefined); allocated when not given.
     """
 
     sorted_normals: np.ndarray
     known: np.ndarray
     radius: float
     max_nn: int
+    sorted_plane_points: np.ndarray = None
+
+    def __post_init__(self):
+        if self.sorted_plane_points is None:
+            self.sorted_plane_points = np.empty_like(self.sorted_normals)
 
     @classmethod
     def given(cls, normals, index) -> LazyNormals:
@@ -143,10 +158,11 @@ class LazyNormals:
 
         Returns
         -------
-        LazyNormals
+        LazyNormals                  The plane points are the map points themselves (a map given with its normals
+                                     is taken as the surface).
         """
         return cls(np.ascontiguousarray(np.asarray(normals, float)[index.order]), np.ones(len(index.order), np.bool_),
-                   0.0, 0)
+                   0.0, 0, np.ascontiguousarray(index.sorted_points))
 
 
 def _cloud(points) -> o3d.geometry.PointCloud:
@@ -174,8 +190,9 @@ def thinned_scan(points_world, voxel) -> np.ndarray:
 
 def surface_map(points_body, voxel) -> o3d.geometry.PointCloud:
     """Map cloud of surface points (n, 3) (m, frame B): one point (the mean) per ``voxel`` cell,
-    normals from the 4-voxel neighbourhood. The mean over a cell averages the range noise of the
-    scans merged into it.
+    moved along its normal onto the plane fitted to its 4-voxel neighbourhood (30 nearest), with that
+    normal. The mean over a cell averages the range noise of the scans merged into it; the
+    projection takes out what is left across the surface (:class:`LazyNormals`).
 
     Parameters
     ----------
@@ -184,12 +201,14 @@ def surface_map(points_body, voxel) -> o3d.geometry.PointCloud:
 
     Returns
     -------
-    open3d PointCloud              Voxel means with unit normals, frame B (m).
+    open3d PointCloud              Voxel means on their fitted planes with unit normals, frame B (m).
     """
     cloud = _cloud(points_body).voxel_down_sample(voxel)
     # Open3D's estimate_normals(KDTreeSearchParamHybrid(4 voxel, 30)) gives the same normals, in
     # 1.3-1.5 times the CPU time (perception/normals.py)
-    cloud.normals = o3d.utility.Vector3dVector(surface_normals(np.asarray(cloud.points), 4 * voxel, 30))
+    plane_points, normals = surface_planes(np.asarray(cloud.points), 4 * voxel, 30)
+    cloud.points = o3d.utility.Vector3dVector(plane_points)
+    cloud.normals = o3d.utility.Vector3dVector(normals)
     return cloud
 
 
@@ -281,8 +300,8 @@ def _register(scan_world, map_points, map_normals, predicted_world_to_body, max_
         pose, fitness, rmse = _icp_level(np.ascontiguousarray(scan_world[::step]), pose, _rigid_inverse(predicted_world_to_body),
                           prior_information, prior_sigma is not None, distance, TUKEY_CUTOFF * distance, iterations,
                           BODY_SIZE, SETTLED, index.low, index.cell, index.shape, index.starts,
-                          index.sorted_points, shells, map_normals.sorted_normals, map_normals.known,
-                          index.largest_cell, map_normals.radius, map_normals.max_nn)
+                          index.sorted_points, shells, map_normals.sorted_normals, map_normals.sorted_plane_points,
+                          map_normals.known, index.largest_cell, map_normals.radius, map_normals.max_nn)
     if step > 1:
         fitness, rmse = map_fit(scan_world, pose, index, max_correspondence / 3)
     return pose, fitness, rmse
@@ -300,8 +319,8 @@ def _points_in_body_into(world_to_body, points_world, body):
 
 @njit(cache=True)
 def _icp_level(points_world, pose, reference_inverse, prior_information, with_prior, distance, cutoff, iterations,
-               body_size, settled, low, cell, shape, starts, map_points, shells, map_normals, normal_known,
-               largest_cell, normal_radius, normal_neighbours):
+               body_size, settled, low, cell, shape, starts, map_points, shells, map_normals, plane_points,
+               normal_known, largest_cell, normal_radius, normal_neighbours):
     """One ICP level of :func:`register_with_motion_prior`, compiled: per iteration the points posed,
     their nearest map points within ``distance`` (exact: :func:`perception.nearest_grid.nearest_in_cells_kept`
     looks a point up again only when it moved far enough for its nearest point to change), the Tukey
@@ -309,8 +328,10 @@ def _icp_level(points_world, pose, reference_inverse, prior_information, with_pr
     rotation (rad) times ``body_size`` (m) plus its translation is below ``settled`` (m). Returns the
     pose, and the share of the points within ``distance`` of the map at it and their RMS distance (m;
     NaN without any), as :func:`map_fit`.
-    ``map_points``: the cell list's sorted points; ``map_normals``: their normals (same order), those
-    not ``normal_known`` computed (:func:`perception.normals.fill_normals`) once a point is matched."""
+    ``map_points``: the cell list's sorted points (the nearest-point search); ``map_normals`` and
+    ``plane_points``: their normals and their projections on their fitted planes (same order; the
+    point-to-plane residuals), those not ``normal_known`` computed (:func:`perception.normals.fill_planes`)
+    once a point is matched."""
     n = len(points_world)
     body = np.empty((n, 3))
     kept_points, kept_index, kept_safe = np.zeros((n, 3)), np.full(n, -1, np.int64), np.full(n, -1.0)
@@ -321,9 +342,9 @@ def _icp_level(points_world, pose, reference_inverse, prior_information, with_pr
         _points_in_body_into(pose, points_world, body)
         nearest_in_cells_kept(body, low, cell, shape, starts, map_points, distance, shells,
                               kept_points, kept_index, kept_safe, gap, nearest)
-        fill_normals(nearest, map_points, low, cell, shape, starts, largest_cell, normal_radius, normal_neighbours,
-                     map_normals, normal_known)
-        hessian, gradient, _, count = tukey_normal_equations(body, nearest, map_points, map_normals, cutoff)
+        fill_planes(nearest, map_points, low, cell, shape, starts, largest_cell, normal_radius, normal_neighbours,
+                    map_normals, plane_points, normal_known)
+        hessian, gradient, _, count = tukey_normal_equations(body, nearest, plane_points, map_normals, cutoff)
         if count < 6:
             break
         if with_prior:

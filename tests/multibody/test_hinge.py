@@ -130,6 +130,38 @@ def test_structural_first_mode_must_be_resolved_by_the_step():
         joint_stiffness_joint_frame(assembly.joints[0], *assembly.bodies, 1e-4)
 
 
+def test_rotation_modes_set_the_named_axes_only():
+    """``rotation_modes_hz`` on a clamp: the named rotation rings alone at its frequency with its own damping
+    ratio; the translations and the other rotations keep the automatic penalty of the same joint without it."""
+    from multibody.hinge import joint_damping_joint_frame, joint_stiffness_joint_frame, structural_modes_hz
+    f, step = 2.0, 1e-3                                           # Hz, s
+    assembly, rest_att, rest_com = ring_down_assembly(0.002)
+    joint, (main, array) = assembly.joints[0], assembly.bodies
+    joint.kind, joint.torsional_stiffness, joint.penalty_damping_ratio = "clamped", 0.0, 0.05
+    automatic = joint_stiffness_joint_frame(joint, main, array, step)
+    joint.rotation_modes_hz, joint.rotation_modes_damping_ratio = np.array([np.nan, f, np.nan]), 0.0
+    k = joint_stiffness_joint_frame(joint, main, array, step)
+    np.testing.assert_array_equal(np.delete(k, 4), np.delete(automatic, 4))
+    assert structural_modes_hz(joint, main, array, step)[4] == pytest.approx(f, rel=1e-12)
+    damping = joint_damping_joint_frame(joint, main, array, k)
+    assert damping[4] == 0.0 and np.all(np.delete(damping, 4) > 0.0)   # the structure's 0 on h2, 0.05 elsewhere
+    assembly.solver.end_time = 3.0
+    rec = ImpactSimulation(assembly, rest_att, rest_com).run()
+    measured = measured_frequency(rec.series["time"], rec.series["joint_rotation_joint"][:, 0, 1])
+    # 1 %: the automatic translational penalty (tuned to 0.5 / step = 500 rad/s on the reduced mass, 40x the
+    # 12.6 rad/s mode: (1/40)^2 of compliance) and Verlet's phase error ((omega h)^2 / 24 < 1e-5), as above
+    assert measured == pytest.approx(2 * np.pi * f, rel=0.01)
+
+
+def test_rotation_modes_must_be_resolved_by_the_step():
+    from multibody.hinge import joint_stiffness_joint_frame
+    assembly, _, _ = ring_down_assembly(0.0)
+    joint = assembly.joints[0]
+    joint.rotation_modes_hz = np.array([600.0, np.nan, np.nan])   # 16.7 steps of 1e-4 s per period < 20
+    with pytest.raises(ValueError, match="rotation_modes up to 600 Hz have fewer than 20 steps"):
+        joint_stiffness_joint_frame(joint, *assembly.bodies, 1e-4)
+
+
 def damped_ring_down(step, net_integration="kernel", damping_ratio=0.1):
     """The free pair above with the hinge's torsional damper at ``damping_ratio`` of the hinge mode's critical
     damping and the penalty springs at 5 %, from 0.05 rad, for 4 s (3.4 periods at 2.15 rad/s); the net (one far

@@ -60,7 +60,10 @@ def test_attitudes_follow_the_tumble_without_the_mesh(tumble):
     # hundredths of a degree by ~3000 points with 2 cm noise on faces ~1 m across (2 cm / (1 m
     # sqrt(3000)) ~ 0.02 deg); the map, built from scans registered before and thinned to 3 cm
     # voxels (1.7 deg at 1 m), carries their errors. Measured: here 1.1 deg mean, 2.4 deg worst;
-    # bench/bench_scan_to_map.py over 5 seeds x 20 s: means 0.65-2.5 deg, worst frame 3.5 deg.
+    # bench/bench_scan_to_map.py over 5 seeds x 20 s: means 0.65-2.5 deg, worst frame 3.5 deg. With the
+    # residuals taken to the map points' fitted planes (2026-11-27): here 1.07 deg mean, 1.44 deg worst;
+    # rng seeds 0-6: means 0.24-1.15 deg, worst frame 1.46 deg (mostly the map's constant turn, which
+    # B carries and the fits do not see).
     # Bounds: 3 deg on average (under two voxels at 1 m), 4.5 deg for every frame.
     track = tumble.track
     assert track.ok.all()
@@ -78,12 +81,16 @@ def test_center_of_mass_and_inertia_ratios_without_the_mesh(tumble):
     # map's constant turn). Tolerances: attitude errors of 1-2.5 deg over the up to 2.5 m between
     # scan points (array tip) and CoM move the fitted line by centimetres: 16 mm at t = 0 here,
     # 9-82 mm over the bench's 5 seeds x 20 s: 10 cm (12 cm in B, plus the map's constant turn).
-    # The ratios: 0.6 and 0.8 % here (10 s), at most 0.38 % over the bench's 20 s runs: errors
-    # of ~1 deg correlated over a tumble period (~3 s) leave a few independent samples in 10 s: 2 %.
+    # The ratios: 0.6 and 0.8 % here (10 s) while the ICP's residuals went to the raw voxel means of the
+    # map; with them taken to the means projected on their fitted planes (perception.normals.surface_planes:
+    # the means of noisy returns form a slab a few voxels thick, which gave a slow, view-dependent attitude
+    # error, docs/perception.md "Which property of the scan-made map") 0.10 and 0.14 % here, at most 0.27 %
+    # over rng seeds 0-6 (the fixture with another rng). Bound 0.5 %: issue 26's goal for
+    # the principal moments, of which the ratios are the observation's part (the old map's 0.6-0.9 % fail it).
     track = tumble.track
     tracker = SimpleNamespace(alignments=alignments(track, tumble.times))
     motion = fit_free_motion(tracker, np.flatnonzero(track.ok), tumble.times)
     assert np.linalg.norm(motion.line.position_world([0.0])[0] - COM0) < 0.10
     assert np.linalg.norm(motion.line.com_body - tumble.com_body) < 0.12
     np.testing.assert_allclose(motion.line.velocity_world, VELOCITY, atol=0.005)
-    np.testing.assert_allclose(motion.fit.moments_, PAPER_MOMENTS / PAPER_MOMENTS[2], rtol=0.02)
+    np.testing.assert_allclose(motion.fit.moments_, PAPER_MOMENTS / PAPER_MOMENTS[2], rtol=0.005)

@@ -90,7 +90,14 @@ def test_a_debris_that_does_not_turn_is_not_observable(tmp_path, capsys, model):
     case = _shortened(tmp_path, 3.0, 1.0, angular_velocity="[0.0, 0.0, 0.0]", seed=f'0\nmodel = "{model}"')
     assert main(["perceive", str(case), "--out", str(tmp_path / "run"), "--json"]) == 3
     answer = json.loads(capsys.readouterr().out)
-    assert "turn" in answer["not_observable"]
+    # With the mesh the attitudes hold still and the CoM check says the body did not turn. Without it,
+    # on the paper's featureless ellipsoid, the scan-to-map track of a still body slides: on the map's
+    # fitted planes (percep14, docs/perception.md "Which property of the scan-made map") by more than the
+    # CoM check's 5 deg in 3 s, so the model-free check answers first (attitudes 5.3 deg rms from the
+    # torque-free fit: "too few features"); on the raw voxel means it slid less and the CoM check answered.
+    # Either way: not observable, no estimate.
+    reasons = ("turn",) if model == "known" else ("turn", "too few features")
+    assert any(reason in answer["not_observable"] for reason in reasons)
     assert "mass_estimate" not in answer
 
 
