@@ -414,7 +414,8 @@ def main() -> None:
     results = {k: (v if v.startswith(("failed", "missing")) else dict(np.load(v))) for k, v in results.items()}
     cpu = [float(v["cpu"]) for v in results.values() if not isinstance(v, str)]
     print(f"{args.case}, release off, joints: "
-          + (f"first_mode_hz = {args.first_mode:g}" if args.first_mode else "automatic penalty")
+          + (f"first_mode_hz = {args.first_mode:g}" if args.first_mode else
+             "automatic penalty where the case gives no first_mode_hz, member or rotation_modes")
           + (f", members {', '.join(args.member)} (E, G = {args.member_moduli} Pa, damping {args.member_damping:g})"
              if args.member else "")
           + (f", output {args.output_rate:g} Hz" if args.output_rate else "")

@@ -23,8 +23,9 @@ from bench_impact import sized_inputs  # noqa: E402
 from multibody.impact import ImpactSimulation  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-#: The series a change of the energy booking alone changes (helper thread14 booked the clipped threads' loss).
-BOOKED_ENERGIES = ("energy_dissipated_threads", "energy_total")
+#: The series a change of the energy booking alone changes (helper thread14 booked the clipped threads' loss, helper
+#: joints15 the joints' dampers).
+BOOKED_ENERGIES = ("energy_dissipated_threads", "energy_dissipated_joints", "energy_total")
 
 
 def digest(arrays) -> str:

@@ -63,8 +63,8 @@ def joint_rotation_damping_work(series: dict, assembly) -> list:
     """Per joint, the work its rotational dampers took (J), estimated from the sampled relative angular velocity:
     the sum over the joint frame's axes of c_k times the trapezoid integral of (rate_k)^2 (the hinge axis h2 of a
     revolute joint carries its torsional damping, the other axes the penalty damping,
-    :func:`multibody.hinge.joint_damping_joint_frame`). The energy balance books none of it (an experiment: the
-    joints' dampers are not in multibody.recorder.ENERGY_TERMS). An estimate only: the sampled rate resolves the
+    :func:`multibody.hinge.joint_damping_joint_frame`). A cross-check of the balance's ``dissipated_joints`` (booked
+    every step since helper joints15, multibody.recorder_kernel.book_joint_dampers). An estimate only: the sampled rate resolves the
     slow hinge motion, not the penalty springs' ringing at the step's frequency, and the translational dampers
     (the joint point's relative velocity is not recorded) are left out. Returns (name, hinge-axis J, other J)."""
     t, rate = series["time"], series["joint_rate_joint"]
@@ -114,7 +114,10 @@ def main(argv=None) -> None:
         if 0 <= k < len(t) and t[k] > when - 0.01:
             print(f"   t {t[k]:.3f} s  drift {100 * drift[k]:+.3f} %")
     print_energy_terms(series, t, reference)
-    print("   joints' rotational dampers, work estimated from the samples (not booked; % of the reference energy): "
+    if "energy_dissipated_joints" in series:
+        print(f"   joints' dampers, booked every step (energy_dissipated_joints, all joints, all axes): "
+              f"{100 * series['energy_dissipated_joints'][-1] / reference:.3f} % of the reference energy")
+    print("   joints' rotational dampers, work estimated from the samples (a cross-check; % of the reference energy): "
           + ", ".join(f"{name} hinge axis {100 * hinge / reference:.3f}, other axes {100 * other / reference:.3f}"
                       for name, hinge, other in joint_rotation_damping_work(series, assembly)))
     gains = np.diff(drift)

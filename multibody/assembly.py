@@ -67,6 +67,10 @@ class JointSpec:
     first_mode_hz : float or None     The structure's own first mode on this joint (Hz): the
                                       penalty springs not given explicitly are set from it instead
                                       of from the step (multibody.hinge.joint_stiffness_joint_frame).
+    rotation_modes_hz : (3,) float or None   The structure's own modes about h1, h2, h3 (Hz, each axis
+                                      alone), NaN where the axis keeps its automatic penalty; the
+                                      translations keep theirs (multibody.hinge).
+    rotation_modes_damping_ratio : float   Damping of those axes, fraction of critical (-).
     structural_stiffness : (6,) float or None   The structure's own springs on [x, y, z] (N/m) and
                                       [rot h1, rot h2, rot h3] (N m/rad), joint frame, e.g. a member's
                                       compliance lumped at its root (structures.member); replaces
@@ -85,6 +89,8 @@ class JointSpec:
     penalty_rotational: float | None = None
     penalty_damping_ratio: float = 0.05
     first_mode_hz: float | None = None
+    rotation_modes_hz: np.ndarray | None = None
+    rotation_modes_damping_ratio: float = 0.0
     structural_stiffness: np.ndarray | None = None
 
 

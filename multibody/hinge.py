@@ -193,6 +193,8 @@ def joint_stiffness_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: 
         k[:3] = joint.penalty_translational
     if joint.penalty_rotational is not None:
         k[3:] = joint.penalty_rotational
+    if joint.rotation_modes_hz is not None:
+        k[3:] = _rotation_mode_springs(joint, parent, child, step, k[3:])
     if joint.kind == "revolute":
         k[4] = joint.torsional_stiffness
     omega_step = np.sqrt(k / inertia) * step
@@ -203,6 +205,23 @@ def joint_stiffness_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: 
             f"{omega_step.max() / step:.3g} rad/s, too fast for the step {step:g} s (limit 1/step); "
             f"lower the penalty stiffness (or omit it for the automatic value) or reduce simulation.step")
     return k
+
+
+def _rotation_mode_springs(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec, step: float,
+                           automatic: np.ndarray) -> np.ndarray:
+    """Springs about h1, h2, h3 (N m/rad): each axis the joint's ``rotation_modes_hz`` names rings alone at that
+    frequency (:func:`coupled_mode_inertia_joint_frame`), the others keep ``automatic``; a mode with fewer than
+    ``STRUCTURAL_STEPS_PER_PERIOD`` steps per period is refused."""
+    frequency_hz = np.asarray(joint.rotation_modes_hz, float)
+    named = ~np.isnan(frequency_hz)
+    fastest = frequency_hz[named].max()
+    if fastest * step * STRUCTURAL_STEPS_PER_PERIOD > 1.0:
+        raise ValueError(
+            f"joint '{joint.name}': rotation_modes up to {fastest:g} Hz have fewer than {STRUCTURAL_STEPS_PER_PERIOD} "
+            f"steps of {step:g} s per period; reduce simulation.step below "
+            f"{1.0 / (STRUCTURAL_STEPS_PER_PERIOD * fastest):.3g} s")
+    structural = coupled_mode_inertia_joint_frame(joint, parent, child)[3:] * (2.0 * np.pi * frequency_hz) ** 2
+    return np.where(named, structural, automatic)
 
 
 def _resolved_structural_stiffness(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec,
@@ -243,7 +262,8 @@ def structural_modes_hz(joint: JointSpec, parent: RigidBodySpec, child: RigidBod
 
 def joint_damping_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: RigidBodySpec,
                               stiffness: np.ndarray) -> np.ndarray:
-    """Diagonal damping: each penalty spring gets ``penalty_damping_ratio`` of critical damping.
+    """Diagonal damping: each penalty spring gets ``penalty_damping_ratio`` of critical damping, each axis
+    that carries one of the joint's ``rotation_modes_hz`` its ``rotation_modes_damping_ratio``.
 
     Parameters
     ----------
@@ -261,7 +281,10 @@ def joint_damping_joint_frame(joint: JointSpec, parent: RigidBodySpec, child: Ri
         axis h2 gets the joint's torsional damping instead.
     """
     inertia = effective_mass_joint_frame(joint, parent, child)
-    c = 2.0 * joint.penalty_damping_ratio * np.sqrt(stiffness * inertia)
+    ratio = np.full(6, joint.penalty_damping_ratio)
+    if joint.rotation_modes_hz is not None:      # the structure's damping on the axes that carry its modes
+        ratio[3:] = np.where(np.isnan(joint.rotation_modes_hz), ratio[3:], joint.rotation_modes_damping_ratio)
+    c = 2.0 * ratio * np.sqrt(stiffness * inertia)
     if joint.kind == "revolute":
         c[4] = joint.torsional_damping
     return c

@@ -21,9 +21,10 @@ joint_force_joint, joint_moment_joint   (k, nj, 3) connector reaction (N, N m), 
 energy_*                                (k,) J: net_kinetic, net_elastic (threads), net_bending,
                                         contact_elastic, debris_translational, debris_rotational,
                                         joint_elastic, orbital_potential (CW), dissipated_threads,
-                                        dissipated_contact, released_joints (penalty energy held
-                                        by joints when a failure released them), total
-                                        (mechanical + dissipated + released)
+                                        dissipated_contact, dissipated_joints (the joints'
+                                        dampers, booked every step), released_joints (penalty
+                                        energy held by joints when a failure released them),
+                                        total (mechanical + dissipated + released)
 momentum_linear_lvlh                    (k, 3) total of net and debris (kg m/s)
 momentum_angular_lvlh                   (k, 3) about the LVLH origin (kg m^2/s)
 ======================================  =========================================================
@@ -42,11 +43,15 @@ import numpy as np
 from multibody.health import HealthWatch
 from multibody.recorded_loads import applied_work
 from multibody.recorder_kernel import (
+    EXTRA_MEAN_MOTION,
     EXTRA_RELEASED_ENERGY,
+    N_EXTRAS,
     RecorderModel,
     SampledBodies,
     SampledJoints,
     body_sample_buffers,
+    book_joint_dampers,
+    damper_work_buffers,
     sample_row,
 )
 
@@ -58,7 +63,7 @@ HEALTH_INTERVAL_S = 1e-3
 #: ``applied_loads_work`` with recorded loads, and ``total``).
 ENERGY_TERMS = ("net_kinetic", "net_elastic", "net_bending", "contact_elastic", "debris_translational",
                 "debris_rotational", "joint_elastic", "released_joints", "orbital_potential", "dissipated_threads",
-                "dissipated_contact")
+                "dissipated_contact", "dissipated_joints")
 
 
 def series_layout(n_bodies: int, n_joints: int, chaser: bool, applied_loads: bool) -> list:
@@ -114,6 +119,7 @@ class Recorder:
         self._next_output = self.output_interval
         self._end_time = solver.n_steps * solver.step
         self._health_every = max(1, int(HEALTH_INTERVAL_S / solver.step))
+        self._previous_call = np.inf  # time of the last post-step call (s): a solve's first call books no step
         self._steps_unchecked = 0   # steps since the state was last checked (by a sample or on its own)
         self._next_net = self.net_interval
         self._last_output_time = 0.0
@@ -192,12 +198,18 @@ class Recorder:
         columns = [self._columns[key][0] for key in ("time", "debris_com_lvlh", "debris_velocity_lvlh")]
         columns += [self._energy_slice.start, self._energy_slice.stop - 1]
         columns += [self._columns[key][0] for key in ("momentum_linear_lvlh", "momentum_angular_lvlh")]
-        self._extras = np.array([0.0, float(assembly.mean_motion)])  # recorder_kernel.EXTRA_*
+        self._extras = np.zeros(N_EXTRAS)  # recorder_kernel.EXTRA_*
+        self._extras[EXTRA_MEAN_MOTION] = float(assembly.mean_motion)
+        # the joints' dampers booked every step (book_joint_dampers), when a joint has one
+        self._book_dampers = bool(nj) and bool(np.any(self._joints.damping != 0.0))
+        self._half_kick = 0.5 * assembly.solver.step if assembly.solver.integrator == "VelocityVerlet" else 0.0
+        n_coordinates = len(data.GetODE2Coordinates_t(copy=False))
         self._model = RecorderModel(self._bodies, self._joints, self._joint_active_float,
                                     system.kernel.buffers.body_impulse_lvlh, self._body_out, self._net_masses,
                                     np.ascontiguousarray(system.kernel.net.reference_lvlh, float),
                                     np.array(net_layout, np.int64), self._net_totals, system.kernel.buffers.scalars,
-                                    self._row, np.array(columns, np.int64), self._extras)
+                                    self._row, np.array(columns, np.int64), self._extras,
+                                    damper_work_buffers(n_coordinates, nb))
         self._net_in_kernel = system.kernel_net is not None
 
     # -- Exudyn hook -----------------------------------------------------------------
@@ -218,6 +230,9 @@ class Recorder:
         """
         half = 0.5 * self.step
         self._steps_unchecked += 1
+        if self._book_dampers and t > self._previous_call + half:
+            self._book_joint_dampers()   # not at a solve's start, where Exudyn calls once before any step
+        self._previous_call = t
         if t >= self._next_output - half or t >= self._end_time - half:
             # the last step is always sampled, so a run's series ends at its end time whatever the rate
             self.sample(t)
@@ -228,6 +243,17 @@ class Recorder:
             self._steps_unchecked = 0
             self.health.state(t, *self.system.state_arrays())
         return self.health.ok
+
+    def _book_joint_dampers(self):
+        """The joints' dampers' work over the step that just ended, into the balance's ``dissipated_joints``
+        (:func:`multibody.recorder_kernel.book_joint_dampers`); every step, not every sample: the penalty modes
+        ring at 15-800 Hz."""
+        views = self.system.kernel_net.step_views if self._net_in_kernel else None
+        if views is None:
+            data = self.system.mbs.systemData
+            views = (data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False),
+                     data.GetODE2Coordinates_tt(copy=False))
+        book_joint_dampers(self._model, views[0], views[1], views[2], self._half_kick, self.step)
 
     # -- sampling --------------------------------------------------------------------
     def sample(self, t):

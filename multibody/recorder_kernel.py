@@ -174,16 +174,75 @@ def connector_load_into(frame, offset_joint, rotation, relative_velocity, relati
     u0 = b * t0 - 0.5 * (r1 * t2 - r2 * t1) + c * r0 * along
     u1 = b * t1 - 0.5 * (r2 * t0 - r0 * t2) + c * r1 * along
     u2 = b * t2 - 0.5 * (r0 * t1 - r1 * t0) + c * r2 * along
-    half_turn = np.empty((1, 3, 3))
-    rotation_matrix_from_rotation_vector_into(0.5 * r0, 0.5 * r1, 0.5 * r2, half_turn, 0)
-    mid = matmat3(frame, half_turn[0])
-    v = mattvec3(mid, relative_velocity)
-    w = mattvec3(mid, relative_omega)
+    v, w = mid_frame_velocities(frame, rotation, relative_velocity, relative_omega)
     force[0] = -(stiffness[0] * u0 + damping[0] * v[0])
     force[1] = -(stiffness[1] * u1 + damping[1] * v[1])
     force[2] = -(stiffness[2] * u2 + damping[2] * v[2])
     for d in range(3):
         moment[d] = -(stiffness[3 + d] * rotation[d] + damping[3 + d] * w[d])
+
+
+@njit(cache=True)
+def mid_frame_velocities(frame, rotation, relative_velocity, relative_omega):
+    """The relative velocities a penalty joint's dampers see: read in the mid frame ``frame Exp(r / 2)`` of Exudyn's
+    intrinsic formulation (:func:`connector_load_into`).
+
+    Parameters
+    ----------
+    frame : (3, 3) float
+        The parent's joint frame in LVLH (columns: its axes).
+    rotation : (3,) float
+        Rotation vector of the child's joint frame relative to the parent's (rad).
+    relative_velocity, relative_omega : (3,) float
+        The child's joint point's velocity (m/s) and angular velocity (rad/s) relative to the parent's, LVLH.
+
+    Returns
+    -------
+    velocity_mid, omega_mid : (3,) float
+        The same, mid frame (m/s, rad/s).
+    """
+    half_turn = np.empty((1, 3, 3))
+    rotation_matrix_from_rotation_vector_into(0.5 * rotation[0], 0.5 * rotation[1], 0.5 * rotation[2], half_turn, 0)
+    mid = matmat3(frame, half_turn[0])
+    return mattvec3(mid, relative_velocity), mattvec3(mid, relative_omega)
+
+
+@njit(cache=True)
+def joint_relative_motion_into(j, joints, com, vel, rot, omega, rotation_joint):
+    """Joint ``j``'s relative motion from its bodies' states; its relative rotation vector into ``rotation_joint``.
+
+    Parameters
+    ----------
+    j : int
+    joints : SampledJoints
+    com, vel : (nb, 3) float
+        CoM (m) and CoM velocity (m/s), LVLH.
+    rot : (nb, 3, 3) float
+        Body to LVLH.
+    omega : (nb, 3) float
+        Angular velocity (rad/s), body frame.
+    rotation_joint : (3,) float
+        Output: rotation vector of the child's joint frame relative to the parent's (rad), joint frame.
+
+    Returns
+    -------
+    frame : (3, 3) float
+        The parent's joint frame in LVLH.
+    offset_joint : (3,) float
+        The child's joint point relative to the parent's (m), parent's joint frame.
+    relative_velocity, relative_omega : (3,) float
+        The child's joint point's velocity (m/s) and angular velocity (rad/s) relative to the parent's, LVLH.
+    """
+    p, c = joints.parent[j], joints.child[j]
+    frame = matmat3(rot[p], joints.joint_to_parent[j])  # joint frame (parent side) in LVLH
+    relative = mattmat3(frame, matmat3(rot[c], joints.joint_to_child[j]))
+    rotation_vector_from_matrix_into(relative, rotation_joint)
+    w = matvec3(rot[c], omega[c]) - matvec3(rot[p], omega[p])
+    arm_child, arm_parent = matvec3(rot[c], joints.point_child[j]), matvec3(rot[p], joints.point_parent[j])
+    offset = arm_child + com[c] - arm_parent - com[p]
+    relative_velocity = (vel[c] + cross3(matvec3(rot[c], omega[c]), arm_child) - vel[p]
+                         - cross3(matvec3(rot[p], omega[p]), arm_parent))
+    return frame, mattvec3(frame, offset), relative_velocity, w
 
 
 def body_sample_buffers(n_bodies: int, n_joints: int) -> BodySample:
@@ -225,8 +284,7 @@ def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
     """
     body_reference, body_mass, inertia = bodies.reference_com_lvlh, bodies.mass, bodies.inertia_body
     body_index, debris_mask, chaser = bodies.index, bodies.debris_mask, bodies.chaser
-    joint_parent, joint_child, to_parent, to_child = joints.parent, joints.child, joints.joint_to_parent, joints.joint_to_child
-    point_parent, point_child, joint_stiffness = joints.point_parent, joints.point_child, joints.stiffness
+    joint_parent, joint_stiffness = joints.parent, joints.stiffness
     com, vel, rot, omega = out.com_lvlh, out.velocity_lvlh, out.body_to_lvlh, out.omega_body
     force_lvlh, moment_lvlh, force_body, moment_body = out.force_lvlh, out.moment_lvlh, out.force_body, out.moment_body
     body_totals, joint_rotation, joint_rate = out.body_totals, out.joint_rotation, out.joint_rate
@@ -255,15 +313,9 @@ def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
         body_totals[b, 7] = m * (com[b, 2] * vel[b, 0] - com[b, 0] * vel[b, 2]) + spin_lvlh[1]
         body_totals[b, 8] = m * (com[b, 0] * vel[b, 1] - com[b, 1] * vel[b, 0]) + spin_lvlh[2]
     for j in range(joint_parent.shape[0]):
-        p, c = joint_parent[j], joint_child[j]
-        frame = matmat3(rot[p], to_parent[j])  # joint frame (parent side) in LVLH
-        relative = mattmat3(frame, matmat3(rot[c], to_child[j]))
-        rotation_vector_from_matrix_into(relative, joint_rotation[j])
-        w = matvec3(rot[c], omega[c]) - matvec3(rot[p], omega[p])
+        frame, offset_joint, relative_velocity, w = joint_relative_motion_into(j, joints, com, vel, rot, omega,
+                                                                               joint_rotation[j])
         joint_rate[j] = mattvec3(frame, w)
-        arm_child, arm_parent = matvec3(rot[c], point_child[j]), matvec3(rot[p], point_parent[j])
-        offset = arm_child + com[c] - arm_parent - com[p]
-        offset_joint = mattvec3(frame, offset)
         energy = 0.0
         for d in range(3):
             energy += joint_stiffness[j, d] * offset_joint[d] ** 2 + joint_stiffness[j, 3 + d] * joint_rotation[j, d] ** 2
@@ -272,8 +324,6 @@ def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
             out.joint_force[j] = 0.0   # released: the connector is off
             out.joint_moment[j] = 0.0
             continue
-        relative_velocity = (vel[c] + cross3(matvec3(rot[c], omega[c]), arm_child) - vel[p]
-                             - cross3(matvec3(rot[p], omega[p]), arm_parent))
         connector_load_into(frame, offset_joint, joint_rotation[j], relative_velocity, w, joint_stiffness[j],
                             joints.damping[j], out.joint_force[j], out.joint_moment[j])
     for k in range(17):
@@ -303,8 +353,41 @@ def body_sample(q, qt, bodies, joints, active, impulse, interval, n_orbit, out):
 #: time, debris CoM, debris CoM velocity, the first energy term, the energy total, linear and angular momentum.
 (COLUMN_TIME, COLUMN_DEBRIS_COM, COLUMN_DEBRIS_VELOCITY, COLUMN_ENERGY, COLUMN_ENERGY_TOTAL, COLUMN_MOMENTUM_LINEAR,
  COLUMN_MOMENTUM_ANGULAR) = range(7)
-#: ``RecorderModel.extras``: the energy released by failed joints so far (J), the mean motion (rad/s, 0 without orbit).
-EXTRA_RELEASED_ENERGY, EXTRA_MEAN_MOTION = range(2)
+#: ``RecorderModel.extras``: the energy released by failed joints so far (J), the mean motion (rad/s, 0 without orbit),
+#: the energy the joints' dampers dissipated so far (J, :func:`book_joint_dampers`).
+EXTRA_RELEASED_ENERGY, EXTRA_MEAN_MOTION, EXTRA_JOINTS_DISSIPATED = range(3)
+N_EXTRAS = 3
+
+
+class DamperWork(NamedTuple):
+    """Work space of :func:`book_joint_dampers` (preallocated; N Exudyn coordinates, nb bodies)."""
+
+    velocity: np.ndarray              # (N,) the step's evaluation velocities (only the bodies' entries are written)
+    com_lvlh: np.ndarray              # (nb, 3) CoM (m)
+    velocity_lvlh: np.ndarray         # (nb, 3) CoM velocity (m/s)
+    node_to_lvlh: np.ndarray          # (nb, 3, 3)
+    body_to_lvlh: np.ndarray          # (nb, 3, 3)
+    omega_lvlh: np.ndarray            # (nb, 3) (rad/s)
+    omega_body: np.ndarray            # (nb, 3) (rad/s), body frame
+    rotation_joint: np.ndarray        # (3,) a joint's relative rotation vector (rad)
+    frames: np.ndarray                # (4, 3, 3) a joint's parent frame, child frame, relative rotation, mid frame
+    half_turn: np.ndarray             # (1, 3, 3) Exp(r / 2)
+    vectors: np.ndarray               # (4, 3) the arms on child and parent (m), relative velocity (m/s) and omega
+
+
+def damper_work_buffers(n_coordinates: int, n_bodies: int) -> DamperWork:
+    """Zeroed :class:`DamperWork` arrays.
+
+    Parameters
+    ----------
+    n_coordinates : int
+        Length of Exudyn's velocity vector the recorder reads.
+    n_bodies : int
+    """
+    nb = n_bodies
+    return DamperWork(np.zeros(n_coordinates), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3, 3)),
+                      np.zeros((nb, 3, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros(3), np.zeros((4, 3, 3)),
+                      np.zeros((1, 3, 3)), np.zeros((4, 3)))
 
 
 @structref.register
@@ -320,8 +403,8 @@ class RecorderModel(structref.StructRefProxy):
     net's state vectors, ``[offset, node_stride, coordinate_stride]``, :func:`net_sums`), ``net_totals`` ((8,) the
     net's sums, :func:`net_sums`), ``scalars`` (the force kernel's energies and contact count,
     :data:`multibody.kernel.N_SCALARS`), ``row`` (the recorder's flat row; ``out``'s arrays are views of it),
-    ``columns`` ((7,) int64, :data:`COLUMN_TIME` ...) and ``extras`` ((2,) float, :data:`EXTRA_RELEASED_ENERGY`,
-    :data:`EXTRA_MEAN_MOTION`). The same buffers as the recorder's and the kernel's: nothing is copied in or out.
+    ``columns`` ((7,) int64, :data:`COLUMN_TIME` ...), ``extras`` ((N_EXTRAS,) float, :data:`EXTRA_RELEASED_ENERGY`,
+    :data:`EXTRA_MEAN_MOTION`, :data:`EXTRA_JOINTS_DISSIPATED`) and ``damper_work`` (:class:`DamperWork`). The same buffers as the recorder's and the kernel's: nothing is copied in or out.
     Handing numba the named tuples themselves cost its dispatcher about 10 us a sample (each tuple's 6-13 arrays
     typed and unboxed from Python); a structref is about 1 us.
     """
@@ -329,7 +412,7 @@ class RecorderModel(structref.StructRefProxy):
 
 structref.define_proxy(RecorderModel, RecorderModelType,
                        ("bodies", "joints", "active", "impulse", "out", "net_mass", "net_reference", "net_layout",
-                        "net_totals", "scalars", "row", "columns", "extras"))
+                        "net_totals", "scalars", "row", "columns", "extras", "damper_work"))
 
 
 @njit(cache=True)
@@ -396,10 +479,11 @@ def sample_row(m, q, qt, net_q, net_qt, t, interval):
     row[e + 8] = totals[1] + summary[8] if n_orbit != 0.0 else 0.0
     row[e + 9] = scalars[THREAD_DISSIPATED]
     row[e + 10] = scalars[CONTACT_DISSIPATED]
-    n_terms = 11
+    row[e + 11] = extras[EXTRA_JOINTS_DISSIPATED]
+    n_terms = 12
     if m.bodies.chaser >= 0:
-        row[e + 11] = summary[9]
-        n_terms = 12
+        row[e + 12] = summary[9]
+        n_terms = 13
     total = 0.0
     for k in range(n_terms):
         total += row[e + k]
@@ -408,3 +492,97 @@ def sample_row(m, q, qt, net_q, net_qt, t, interval):
         row[columns[COLUMN_MOMENTUM_LINEAR] + d] = totals[2 + d] + summary[10 + d]
         row[columns[COLUMN_MOMENTUM_ANGULAR] + d] = totals[5 + d] + summary[13 + d]
     return True, total
+
+
+@njit(cache=True)
+def book_joint_dampers(m, q, qt, qtt, half_kick, step):
+    """Add the energy the joints' dampers dissipated over the step that just ended to
+    ``m.extras[EXTRA_JOINTS_DISSIPATED]`` (J) and return it.
+
+    Exudyn's VelocityVerlet evaluates every force of a step, its connectors' included, once, at the end position
+    ``q`` and the mid-step velocity ``v = qt - h/2 qtt`` (``qt``, ``qtt``: the step's end velocity and the
+    acceleration of that evaluation; :class:`multibody.impact.VerletForces`): the damping force ``-D v`` acts over
+    the step's displacement ``h v``, so the step's damper work is :func:`_joint_damper_power` at that state times ``h``,
+    the same rule as the threads' Kelvin-Voigt dampers (:func:`multibody.net.kelvin_voigt_dissipated_power`).
+    A joint released (``m.active`` 0) dissipates nothing. With another integrator (``half_kick`` 0) the end-of-step
+    velocity stands for the step's: first order in the step.
+
+    Parameters
+    ----------
+    m : RecorderModel
+    q, qt, qtt : (N,) float
+        Exudyn's coordinates (the step's end), velocities and accelerations (:func:`body_sample`'s layout).
+    half_kick : float
+        Half the step for VelocityVerlet, 0 for another integrator (s).
+    step : float
+        (s).
+
+    Returns
+    -------
+    float
+        The step's dissipated energy (J).
+    """
+    bodies, joints, work = m.bodies, m.joints, m.damper_work
+    velocity = work.velocity
+    for b in range(bodies.mass.shape[0]):
+        i = bodies.index[b]
+        for k in range(6):
+            velocity[i + k] = qt[i + k] - half_kick * qtt[i + k]
+        body_state_into(q, velocity, i, b, bodies.reference_com_lvlh, bodies.node_to_body, work.com_lvlh,
+                        work.velocity_lvlh, work.node_to_lvlh, work.body_to_lvlh, work.omega_lvlh, work.omega_body)
+    power = 0.0
+    for j in range(joints.parent.shape[0]):
+        if m.active[j] != 0.0:
+            power += _joint_damper_power(j, joints, work)
+    m.extras[EXTRA_JOINTS_DISSIPATED] += power * step
+    return power * step
+
+
+@njit(cache=True)
+def _matmat_into(a, b, out):
+    """``out = a b`` for (3, 3) arrays, without allocating."""
+    for i in range(3):
+        for k in range(3):
+            out[i, k] = a[i, 0] * b[0, k] + a[i, 1] * b[1, k] + a[i, 2] * b[2, k]
+
+
+@njit(cache=True)
+def _joint_damper_power(j, joints, work) -> float:
+    """Power joint ``j``'s dampers dissipate (W) at the bodies' state in ``work`` (:class:`DamperWork`): with the
+    connector's diagonal damping ``D`` and the relative velocities ``v``, ``w`` in the mid frame (the kinematics of
+    :func:`joint_relative_motion_into` and :func:`mid_frame_velocities`, written out into ``work`` because the
+    booking runs every step and their small arrays were some 20 allocations a joint, about 5 us a step on the
+    reference case), the damping force is ``-D (v, w)`` (:func:`connector_load_into`), so
+
+    .. math:: P = \\sum_{k=1}^{3} D_k v_k^2 + \\sum_{k=1}^{3} D_{3+k} w_k^2 \\geq 0.
+    """
+    p, c = joints.parent[j], joints.child[j]
+    rot, omega, vel = work.body_to_lvlh, work.omega_lvlh, work.velocity_lvlh
+    frame, child_frame, relative, mid = work.frames[0], work.frames[1], work.frames[2], work.frames[3]
+    arm_child, arm_parent, relative_velocity, relative_omega = (work.vectors[0], work.vectors[1], work.vectors[2],
+                                                                work.vectors[3])
+    _matmat_into(rot[p], joints.joint_to_parent[j], frame)       # the parent's joint frame in LVLH
+    _matmat_into(rot[c], joints.joint_to_child[j], child_frame)
+    for i in range(3):
+        for k in range(3):
+            relative[i, k] = frame[0, i] * child_frame[0, k] + frame[1, i] * child_frame[1, k] + frame[2, i] * child_frame[2, k]
+    r = work.rotation_joint
+    rotation_vector_from_matrix_into(relative, r)
+    rotation_matrix_from_rotation_vector_into(0.5 * r[0], 0.5 * r[1], 0.5 * r[2], work.half_turn, 0)
+    _matmat_into(frame, work.half_turn[0], mid)
+    point_child, point_parent = joints.point_child[j], joints.point_parent[j]
+    for d in range(3):
+        arm_child[d] = rot[c, d, 0] * point_child[0] + rot[c, d, 1] * point_child[1] + rot[c, d, 2] * point_child[2]
+        arm_parent[d] = rot[p, d, 0] * point_parent[0] + rot[p, d, 1] * point_parent[1] + rot[p, d, 2] * point_parent[2]
+    for d in range(3):   # v_c + w_c x a_c - v_p - w_p x a_p and w_c - w_p, LVLH
+        e, f = (d + 1) % 3, (d + 2) % 3
+        relative_velocity[d] = (vel[c, d] + omega[c, e] * arm_child[f] - omega[c, f] * arm_child[e] - vel[p, d]
+                                - (omega[p, e] * arm_parent[f] - omega[p, f] * arm_parent[e]))
+        relative_omega[d] = omega[c, d] - omega[p, d]
+    damping = joints.damping[j]
+    power = 0.0
+    for d in range(3):   # mid^T (v, w): the mid frame's components
+        v = mid[0, d] * relative_velocity[0] + mid[1, d] * relative_velocity[1] + mid[2, d] * relative_velocity[2]
+        w = mid[0, d] * relative_omega[0] + mid[1, d] * relative_omega[1] + mid[2, d] * relative_omega[2]
+        power += damping[d] * v * v + damping[3 + d] * w * w
+    return power

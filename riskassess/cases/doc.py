@@ -73,6 +73,7 @@ SECTIONS = [
     ("[contact]", c.Contact), ("[target]", c.Target), ("[[target.bodies]]", c.Body),
     *((f'shapes: kind = "{name}"', model) for name, model in c.SHAPE_MODELS.items()),
     ("[[target.joints]]", c.Joint), ("member (optional, in a clamped joint)", c.Member),
+    ("rotation_modes (optional, in a joint)", c.RotationModes),
     ("[chaser] (optional)", c.Chaser),
     ("[perception] (optional; for riskassess perceive)", c.Perception), ("[perception.lidar]", c.Lidar),
     ("[perception.registration]", c.Registration), ("[perception.truth_damage] (optional)", c.TruthDamage),

@@ -309,6 +309,31 @@ class Member(Strict):
         return section
 
 
+class RotationModes(Strict):
+    """The structure's own modes about a joint's locked rotation axes (each axis alone, the others rigid), e.g. a
+    solar array's torsion (about h1, along the array) and in-plane bending (about h3) lumped at its root: those
+    axes carry the structure's compliance, the translations and the axes not named keep the automatic penalty."""
+
+    h1_hz: Positive | None = Field(None, description="Mode about h1 (Hz); omitted: the automatic penalty.")
+    h2_hz: Positive | None = Field(None, description="Mode about h2 (Hz), clamped joints only (a revolute joint's h2 "
+                                                     "is its hinge spring); omitted: the automatic penalty.")
+    h3_hz: Positive | None = Field(None, description="Mode about h3 (Hz); omitted: the automatic penalty.")
+    damping_ratio: Annotated[float, Field(ge=0, le=1)] = Field(
+        0.02, description="The structure's damping on these axes, fraction of critical (-).")
+    source: Text = Field(description="Where the frequencies come from (an FE model, a test, an analogue and why): "
+                                     "the joint's loads rest on them.")
+
+    @model_validator(mode="after")
+    def _some_axis(self):
+        if self.h1_hz is None and self.h2_hz is None and self.h3_hz is None:
+            raise ValueError("rotation_modes names no axis; give h1_hz, h2_hz or h3_hz")
+        return self
+
+    def frequencies_hz(self) -> np.ndarray:
+        """(3,) float: the modes about h1, h2, h3 (Hz), NaN where the axis keeps the automatic penalty."""
+        return np.array([np.nan if f is None else f for f in (self.h1_hz, self.h2_hz, self.h3_hz)])
+
+
 class Joint(Strict):
     name: ItemName = Field(description="Joint name; weak locations name it.")
     kind: Literal["revolute", "clamped"] = Field(description="Hinge with torsional spring-damper, or clamped.")
@@ -335,6 +360,11 @@ class Joint(Strict):
                           "torsion and bending compliance, lumped at the root, become the joint's six springs, so its "
                           "loads no longer rest on a penalty stiffness (docs/structures.md); penalty_damping_ratio is "
                           "then the member's damping. Not with first_mode_hz or the penalty keys.")
+    rotation_modes: RotationModes | None = Field(
+        None, description="The structure's own modes about the joint's locked rotation axes (Hz, each axis alone), "
+                          "with their damping and source: those axes carry the structure's compliance (needs at least "
+                          "20 steps per period), the translations keep the automatic penalty. Not with first_mode_hz, "
+                          "member or penalty_rotational.")
 
     @model_validator(mode="after")
     def _revolute_fields(self):
@@ -349,6 +379,13 @@ class Joint(Strict):
                      if getattr(self, k) is not None]
             if given:
                 raise ValueError(f"'member' sets all six springs of the joint; remove {', '.join(given)}")
+        if self.rotation_modes is not None:
+            given = [k for k in ("first_mode_hz", "member", "penalty_rotational") if getattr(self, k) is not None]
+            if given:
+                raise ValueError(f"'rotation_modes' sets the joint's rotation springs; remove {', '.join(given)}")
+            if self.kind == "revolute" and self.rotation_modes.h2_hz is not None:
+                raise ValueError("rotation_modes.h2_hz: a revolute joint's h2 is its hinge spring "
+                                 "(torsional_stiffness)")
         return self
 
 
@@ -629,6 +666,10 @@ class Case(Strict):
             raise ValueError(f"structures: weak location '{loc.name}': structural_mode_hz reads the loads of joint "
                              f"'{joint.name}' through a mode, but that joint already has first_mode_hz = "
                              f"{joint.first_mode_hz:g} Hz in the dynamics; give the structure's mode in one place")
+        if joint.rotation_modes is not None:
+            raise ValueError(f"structures: weak location '{loc.name}': structural_mode_hz reads the loads of joint "
+                             f"'{joint.name}' through a mode, but that joint already has rotation_modes in the "
+                             f"dynamics; give the structure's mode in one place")
         high = max(np.atleast_1d(loc.structural_mode_hz))
         if self.simulation.output_rate < SAMPLES_PER_MODE_PERIOD * high:
             raise ValueError(f"structures: weak location '{loc.name}': structural_mode_hz up to {high:g} Hz needs "

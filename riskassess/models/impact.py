@@ -195,6 +195,8 @@ def build_bodies_and_joints(case: Case, base: Path):
             torsional_stiffness=j.torsional_stiffness, torsional_damping=j.torsional_damping,
             penalty_translational=j.penalty_translational, penalty_rotational=j.penalty_rotational,
             penalty_damping_ratio=j.penalty_damping_ratio, first_mode_hz=j.first_mode_hz,
+            rotation_modes_hz=None if j.rotation_modes is None else j.rotation_modes.frequencies_hz(),
+            rotation_modes_damping_ratio=0.0 if j.rotation_modes is None else j.rotation_modes.damping_ratio,
             structural_stiffness=_member_springs(j, frame, target_to_lvlh)))
         if j.initial_angle or j.initial_rate:
             _apply_initial_hinge_state(bodies, joints, len(joints) - 1, j.initial_angle, j.initial_rate)

@@ -110,3 +110,28 @@ def test_a_healthy_run_reports_its_drift(small_net_on_box):
     assert np.array_equal(total, e)
     # the last step is always sampled
     assert recorder.series["time"][-1] == pytest.approx(0.1, abs=1e-9)
+
+
+@pytest.mark.slow  # envisat_small for 7.5 s with the threads' contact on: 24-29 s of CPU
+def test_envisat_small_with_the_threads_contact_closes_its_balance_once_the_joints_dampers_are_booked(tmp_path):
+    """Helper thread14 found envisat_small's key-on balance losing 1.94 % of the reference energy, the solar-array
+    hinge's torsional damper's work (about 2.2 %, estimated from the samples: docs/model.md, "Where envisat_small's
+    steady loss goes"). Booked every step (``energy_dissipated_joints``), the dampers take more than 1.5 % and the
+    balance stays within the 1 % the rule thread_contact_energy asks (structures.verdict.THREAD_CONTACT_DRIFT_LIMIT;
+    measured 0.42 % largest, +0.30 % at the end, on this machine at 2026-11-27; chaotic: another CPU's round-off
+    gives another trajectory, hence the margin)."""
+    from pathlib import Path
+
+    from riskassess.cases.impact import load_case
+    from riskassess.models.impact import model_inputs
+    from structures.verdict import THREAD_CONTACT_DRIFT_LIMIT
+
+    case = Path(__file__).resolve().parents[2] / "cases" / "envisat_small.toml"
+    text = case.read_text().replace("[contact]\n", "[contact]\nthread_segments = true\n", 1)
+    (tmp_path / case.name).write_text(text)
+    simulation = ImpactSimulation(model_inputs(load_case(tmp_path / case.name), case.parent).assembly)
+    series = simulation.run().series
+    health = simulation.health.summary()
+    assert health["healthy"]
+    assert series["energy_dissipated_joints"][-1] > 0.015 * health["energy_reference_J"]
+    assert health["energy_max_drift"] < THREAD_CONTACT_DRIFT_LIMIT

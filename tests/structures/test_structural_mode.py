@@ -54,6 +54,31 @@ def test_a_mode_given_twice_is_refused(tmp_path):
     assert "already has first_mode_hz = 20 Hz in the dynamics; give the structure's mode in one place" in str(info.value)
 
 
+ROTATION_MODES = 'rotation_modes = { h1_hz = 5.74, h3_hz = 3.2, source = "test" }'
+ARRAY_HINGE_DAMPING = 'torsional_damping = 1.4e3     # N m s/rad [assumed]: 2 % of critical'
+
+
+@pytest.mark.parametrize("extra, expected", [
+    (ROTATION_MODES + "\npenalty_rotational = 1e7", "'rotation_modes' sets the joint's rotation springs; remove "
+                                                    "penalty_rotational"),
+    ('rotation_modes = { h2_hz = 1.0, source = "test" }', "a revolute joint's h2 is its hinge spring"),
+    ('rotation_modes = { source = "test" }', "rotation_modes names no axis"),
+])
+def test_bad_rotation_modes_are_refused(tmp_path, extra, expected):
+    text = SMALL.replace(ARRAY_HINGE_DAMPING, "torsional_damping = 1.4e3\n" + extra)
+    with pytest.raises(CaseError) as info:
+        load_case(_write(tmp_path, text))
+    assert expected in str(info.value)
+
+
+def test_rotation_modes_and_a_modal_reading_of_the_same_joint_are_refused(tmp_path):
+    text = SMALL.replace(ARRAY_LOCATION, ARRAY_LOCATION + "\nstructural_mode_hz = 1.0")
+    text = text.replace(ARRAY_HINGE_DAMPING, "torsional_damping = 1.4e3\n" + ROTATION_MODES)
+    with pytest.raises(CaseError) as info:
+        load_case(_write(tmp_path, text))
+    assert "already has rotation_modes in the dynamics; give the structure's mode in one place" in str(info.value)
+
+
 def test_release_monitor_judges_the_modal_load_as_the_verdict_does():
     # a 1 kN m moment applied suddenly at 0.2 s on a 5 Hz, 2 % mode: the mode carries up to
     # 1 + exp(-0.02 pi / sqrt(1 - 0.02^2)) = 1.94 kN m (step response), first at half a period, 0.3 s.
