@@ -101,8 +101,8 @@ def test_own_side_planes_keep_the_track(tumble):
     # origins; the scans are in the sensor frame, the world here, so every origin is 0). The featured body's
     # faces are each seen from one side here, so the rule changes the map by tenths of a mm and the track must
     # stay within the same bounds as without it (test_attitudes_follow_the_tumble_without_the_mesh); measured on
-    # these 40 frames: 1.20 deg mean, 1.50 deg worst (all neighbours 1.16 and 1.44). The rule's own effect is tested on a plate seen from both
-    # sides (tests/perception/test_normals.py).
+    # these 40 frames: 1.20 deg mean, 1.50 deg worst (all neighbours 1.16 and 1.44). The rule's own effect is
+    # tested on a plate seen from both sides (tests/perception/test_normals.py).
     frames = 40
     track = track_scans(tumble.scans[:frames], VOXEL, CORRESPONDENCE, sensors_world=np.zeros((frames, 3)))
     errors = np.degrees([Rotation.from_matrix(np.linalg.inv(pose)[:3, :3] @ truth.T).magnitude()
