@@ -184,7 +184,7 @@ def fixed_map_errors(cap) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarra
     reg = perception.registration
     thin = [scan_to_map.thinned_scan(scan, reg.voxel) for scan in frames.scans]
     true_world_to_body = [np.linalg.inv(true_body_to_world(cap, i)) for i in range(k)]
-    points, normals, index = scan_to_map._built_map(
+    points, normals, index, _ = scan_to_map._built_map(
         np.vstack([scan_to_map._transform(thin[i], true_world_to_body[i]) for i in range(k)]), reg.voxel,
         reg.max_correspondence)
     def registered(prior_sigma, built=(points, normals, index)):
@@ -199,7 +199,7 @@ def fixed_map_errors(cap) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarra
     # the noise-free map: the debris mesh sampled densely (known_shape_model), in B, thinned as the stage's map
     mesh_points_target, _ = known_shape_model(scene.mesh_target, reg.voxel, 0)
     mesh_map = scan_to_map._built_map(scan_to_map._transform(mesh_points_target, cap["target_to_body"]), reg.voxel,
-                                      reg.max_correspondence)
+                                      reg.max_correspondence)[:3]
 
     def errors(world_to_body):
         return np.array([Rotation.from_matrix(true_body_to_world(cap, i)[:3, :3].T

@@ -135,6 +135,9 @@ class LazyNormals:
     max_nn : int                    Most neighbours.
     sorted_plane_points : (n, 3) float   Each sorted point moved along its normal onto its fitted plane
                                     (m, frame B; rows not ``known``: undefined); allocated when not given.
+    sorted_views : (n, 3) float     Each sorted point's mean direction towards the sensor (frame B): the planes are
+                                    fitted to the neighbours seen from the point's side
+                                    (:func:`perception.normals.fill_planes`); zeros (side unknown) when not given.
     """
 
     sorted_normals: np.ndarray
@@ -142,10 +145,13 @@ class LazyNormals:
     radius: float
     max_nn: int
     sorted_plane_points: np.ndarray = None
+    sorted_views: np.ndarray = None
 
     def __post_init__(self):
         if self.sorted_plane_points is None:
             self.sorted_plane_points = np.empty_like(self.sorted_normals)
+        if self.sorted_views is None:
+            self.sorted_views = np.zeros_like(self.sorted_normals)
 
     @classmethod
     def given(cls, normals, index) -> LazyNormals:
@@ -173,6 +179,26 @@ def _transform(points, matrix) -> np.ndarray:
     return np.asarray(points) @ matrix[:3, :3].T + matrix[:3, 3]
 
 
+def views_towards(points, sensor) -> np.ndarray:
+    """Unit directions (n, 3) from points (n, 3) (m) to the sensor origin (3,) (m, same frame) that saw them."""
+    towards = np.asarray(sensor, float) - np.asarray(points, float)
+    return towards / np.maximum(np.linalg.norm(towards, axis=1, keepdims=True), 1e-12)
+
+
+def voxel_means(points, voxel, views) -> tuple[np.ndarray, np.ndarray]:
+    """One point (the mean) per ``voxel`` (m) cell of points (n, 3) (m), with the mean of their ``views``
+    (n, 3) (directions towards the sensor, same frame): Open3D's voxel thinning, the views carried as its normals.
+
+    Returns
+    -------
+    points : (p, 3) float, views : (p, 3) float    Voxel means (m) and their mean views (not normalized), same frame.
+    """
+    cloud = _cloud(points)
+    cloud.normals = o3d.utility.Vector3dVector(np.asarray(views, float))
+    cloud = cloud.voxel_down_sample(voxel)
+    return np.asarray(cloud.points), np.nan_to_num(np.asarray(cloud.normals))   # zero views may come back 0/0
+
+
 def thinned_scan(points_world, voxel) -> np.ndarray:
     """One point (the mean) per ``voxel`` (m) cell of a scan (n, 3) (m, world): the points ICP uses.
 
@@ -188,9 +214,10 @@ def thinned_scan(points_world, voxel) -> np.ndarray:
     return np.asarray(_cloud(points_world).voxel_down_sample(voxel).points)
 
 
-def surface_map(points_body, voxel) -> o3d.geometry.PointCloud:
+def surface_map(points_body, voxel, views_body=None) -> o3d.geometry.PointCloud:
     """Map cloud of surface points (n, 3) (m, frame B): one point (the mean) per ``voxel`` cell,
-    moved along its normal onto the plane fitted to its 4-voxel neighbourhood (30 nearest), with that
+    moved along its normal onto the plane fitted to its 4-voxel neighbourhood (30 nearest; with
+    ``views_body``, those seen from the point's side, :func:`perception.normals.fill_planes`), with that
     normal. The mean over a cell averages the range noise of the scans merged into it; the
     projection takes out what is left across the surface (:class:`LazyNormals`).
 
@@ -198,16 +225,20 @@ def surface_map(points_body, voxel) -> o3d.geometry.PointCloud:
     ----------
     points_body : (n, 3) float     Registered surface points, frame B (m).
     voxel : float                  Voxel edge (m); the normals use a radius of 4 voxels.
+    views_body : (n, 3) float, optional   Directions from the points towards the sensor that saw them, frame B.
 
     Returns
     -------
     open3d PointCloud              Voxel means on their fitted planes with unit normals, frame B (m).
     """
-    cloud = _cloud(points_body).voxel_down_sample(voxel)
+    if views_body is None:
+        means, views = np.asarray(_cloud(points_body).voxel_down_sample(voxel).points), None
+    else:
+        means, views = voxel_means(points_body, voxel, views_body)
     # Open3D's estimate_normals(KDTreeSearchParamHybrid(4 voxel, 30)) gives the same normals, in
     # 1.3-1.5 times the CPU time (perception/normals.py)
-    plane_points, normals = surface_planes(np.asarray(cloud.points), 4 * voxel, 30)
-    cloud.points = o3d.utility.Vector3dVector(plane_points)
+    plane_points, normals = surface_planes(means, 4 * voxel, 30, views)
+    cloud = _cloud(plane_points)
     cloud.normals = o3d.utility.Vector3dVector(normals)
     return cloud
 
@@ -301,7 +332,8 @@ def _register(scan_world, map_points, map_normals, predicted_world_to_body, max_
                           prior_information, prior_sigma is not None, distance, TUKEY_CUTOFF * distance, iterations,
                           BODY_SIZE, SETTLED, index.low, index.cell, index.shape, index.starts,
                           index.sorted_points, shells, map_normals.sorted_normals, map_normals.sorted_plane_points,
-                          map_normals.known, index.largest_cell, map_normals.radius, map_normals.max_nn)
+                          map_normals.known, index.largest_cell, map_normals.radius, map_normals.max_nn,
+                          map_normals.sorted_views)
     if step > 1:
         fitness, rmse = map_fit(scan_world, pose, index, max_correspondence / 3)
     return pose, fitness, rmse
@@ -320,7 +352,7 @@ def _points_in_body_into(world_to_body, points_world, body):
 @njit(cache=True)
 def _icp_level(points_world, pose, reference_inverse, prior_information, with_prior, distance, cutoff, iterations,
                body_size, settled, low, cell, shape, starts, map_points, shells, map_normals, plane_points,
-               normal_known, largest_cell, normal_radius, normal_neighbours):
+               normal_known, largest_cell, normal_radius, normal_neighbours, map_views):
     """One ICP level of :func:`register_with_motion_prior`, compiled: per iteration the points posed,
     their nearest map points within ``distance`` (exact: :func:`perception.nearest_grid.nearest_in_cells_kept`
     looks a point up again only when it moved far enough for its nearest point to change), the Tukey
@@ -331,7 +363,7 @@ def _icp_level(points_world, pose, reference_inverse, prior_information, with_pr
     ``map_points``: the cell list's sorted points (the nearest-point search); ``map_normals`` and
     ``plane_points``: their normals and their projections on their fitted planes (same order; the
     point-to-plane residuals), those not ``normal_known`` computed (:func:`perception.normals.fill_planes`)
-    once a point is matched."""
+    once a point is matched, from the neighbours seen from its side (``map_views``, sorted order)."""
     n = len(points_world)
     body = np.empty((n, 3))
     kept_points, kept_index, kept_safe = np.zeros((n, 3)), np.full(n, -1, np.int64), np.full(n, -1.0)
@@ -343,7 +375,7 @@ def _icp_level(points_world, pose, reference_inverse, prior_information, with_pr
         nearest_in_cells_kept(body, low, cell, shape, starts, map_points, distance, shells,
                               kept_points, kept_index, kept_safe, gap, nearest)
         fill_planes(nearest, map_points, low, cell, shape, starts, largest_cell, normal_radius, normal_neighbours,
-                    map_normals, plane_points, normal_known)
+                    map_normals, plane_points, normal_known, map_views)
         hessian, gradient, _, count = tukey_normal_equations(body, nearest, plane_points, map_normals, cutoff)
         if count < 6:
             break
@@ -488,7 +520,8 @@ def map_information(scan_world, world_to_body, map_points, map_normals, max_corr
 PRIOR_SIGMA = np.r_[np.full(3, np.radians(1.0)), np.full(3, 0.01)]
 
 
-def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA, second_pose=None) -> MapTrack:
+def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA, second_pose=None,
+                sensors_world=None) -> MapTrack:
     """Scan-to-map tracking of a sequence of scans (frames equally spaced in time).
 
     Parameters
@@ -500,18 +533,27 @@ def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA,
                                            :func:`register_with_motion_prior`.
     second_pose : (4, 4) float, optional   world -> B of the second registered frame, instead of
                                            the search (a pose known from elsewhere).
+    sensors_world : (k, 3) float, optional  Sensor origin of each scan, world frame (m): the map keeps each
+                                           point's mean direction to the sensor and fits its plane to the
+                                           neighbours seen from its side (the two faces of a thin part apart;
+                                           :func:`perception.normals.fill_planes`). None: all neighbours (the
+                                           stage's choice: on the featured debris the rule changed the map by
+                                           < 0.3 mm rms and did not help; docs/perception.md, "The thin array's
+                                           two faces").
 
     Returns
     -------
     MapTrack
     """
     thin = [thinned_scan(s, voxel) if len(s) else np.zeros((0, 3)) for s in scans_world]
+    views = ([np.zeros_like(t) for t in thin] if sensors_world is None
+             else [views_towards(t, sensor) for t, sensor in zip(thin, np.asarray(sensors_world, float))])
     k = len(thin)
     poses = np.tile(np.eye(4), (k, 1, 1))
     ok = np.zeros(k, bool)
     fitness, rmse, seconds, cpu = np.zeros(k), np.full(k, np.nan), np.zeros(k), np.zeros(k)
-    points = normals = index = None
-    pending, built = [], 0
+    points = normals = index = map_views = None
+    pending, pending_views, built = [], [], 0
     for i, scan in enumerate(thin):
         tic, cpu_tic = time.perf_counter(), time.process_time()
         if len(scan) < MIN_POINTS:
@@ -519,7 +561,8 @@ def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA,
             continue
         if points is None:   # the first scan defines B: world axes, origin at its centroid
             poses[i, :3, 3] = -scan.mean(axis=0)
-            points, normals, index = _built_map(_transform(scan, poses[i]), voxel, max_correspondence)
+            points, normals, index, map_views = _built_map(_transform(scan, poses[i]), voxel, max_correspondence,
+                                                           views[i] @ poses[i][:3, :3].T)
             built = i
             ok[i], fitness[i], rmse[i] = True, 1.0, 0.0
             seconds[i] = time.perf_counter() - tic
@@ -537,28 +580,37 @@ def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA,
         ok[i] = fitness[i] >= MIN_FITNESS
         if ok[i]:
             pending.append(_transform(scan, pose))
+            pending_views.append(views[i] @ pose[:3, :3].T)
             if fitness[i] < MAP_COVERED or i - built >= MAP_INTERVAL:
-                points, normals, index = _built_map(np.vstack([points] + pending), voxel, max_correspondence)
-                pending, built = [], i
+                points, normals, index, map_views = _built_map(np.vstack([points] + pending), voxel, max_correspondence,
+                                                               np.vstack([map_views] + pending_views))
+                pending, pending_views, built = [], [], i
         seconds[i] = time.perf_counter() - tic
         cpu[i] = time.process_time() - cpu_tic
     if points is None:
         return MapTrack(poses, ok, fitness, rmse, np.zeros((k, 6, 6)), seconds, np.zeros((0, 3)), np.zeros((0, 3)), cpu)
-    return _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence, cpu)
+    return _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence, cpu,
+                     None if sensors_world is None else views)
 
 
-def _built_map(points_body, voxel, max_correspondence):
+def _built_map(points_body, voxel, max_correspondence, views_body=None):
     """Map points (n, 3) (frame B, m) of registered surface points, their normals (:class:`LazyNormals`,
-    as :func:`surface_map`'s) and their index."""
-    points = thinned_scan(points_body, voxel)
+    as :func:`surface_map`'s), their index and their mean views towards the sensor (frame B; zeros
+    without ``views_body``)."""
+    views_body = np.zeros_like(points_body) if views_body is None else views_body
+    points, views = voxel_means(points_body, voxel, views_body)
     index = map_index(points, max_correspondence)
-    normals = LazyNormals(np.empty((len(points), 3)), np.zeros(len(points), np.bool_), 4 * voxel, 30)
-    return points, normals, index
+    normals = LazyNormals(np.empty((len(points), 3)), np.zeros(len(points), np.bool_), 4 * voxel, 30,
+                          sorted_views=np.ascontiguousarray(views[index.order]))
+    return points, normals, index, views
 
 
-def _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence, cpu=None) -> MapTrack:
-    """The track with the map rebuilt from all registered scans and each frame's information."""
-    cloud = surface_map(np.vstack([_transform(thin[i], poses[i]) for i in np.flatnonzero(ok)]), voxel)
+def _with_map(thin, poses, ok, fitness, rmse, seconds, voxel, max_correspondence, cpu=None, views=None) -> MapTrack:
+    """The track with the map rebuilt from all registered scans and each frame's information; ``views``: each
+    thinned scan's directions to the sensor (world), for :func:`surface_map`'s own-side planes."""
+    registered = np.flatnonzero(ok)
+    cloud = surface_map(np.vstack([_transform(thin[i], poses[i]) for i in registered]), voxel,
+                        None if views is None else np.vstack([views[i] @ poses[i][:3, :3].T for i in registered]))
     points, normals = np.asarray(cloud.points), np.asarray(cloud.normals)
     index = map_index(points, max_correspondence)
     information = np.array([map_information(thin[i], poses[i], points, normals, max_correspondence, index) if ok[i]
