@@ -119,6 +119,14 @@ MAX_CHAINS = 3          # candidate poses of a re-acquisition followed through t
 # Best refined candidates of a search after a lost track searched again over small turns about themselves
 # (_polished); 0: off. Tried offline, not adopted (docs/perception.md, "Free-space refinement, tried offline").
 POLISHED = 0
+# A lost track's re-acquisition is chosen by continuity with the attitude propagated at the last registered
+# rates (DebrisTracker's continuity_turn) only this long (s) after the last registered frame. Measured on 10
+# re-acquisitions after the net contact of the featured debris (model-free, percep14's and percep15's captures,
+# bench/perception_reacquire_continuity.py): the debris turns at 1.1-1.6 rad/s, the net changes the rate by
+# ~0.25 rad/s, the two-frame rate is off by up to 0.22 rad/s; the propagation lay 4-56 deg from the truth for
+# gaps 0.3-2.1 s, but 48-104 deg for gaps 3.2-3.7 s. Beyond 2.5 s the truth may lie nearer the half turn of the
+# propagation than the propagation: no choice by continuity there.
+CONTINUITY_GAP = 2.5
 SEARCH_SCREENED = 40    # best-fitting distinct seeds of a search over all attitudes screened by the check before refining
 AMBIGUOUS_TURN = np.radians(15.0)  # rad; passing poses this far apart (beyond the known symmetries) start chains of their own
 
@@ -792,9 +800,11 @@ class DebrisTracker:
         """A lost track's search result ``found`` and its other passing poses, joined by a small-turn
         search about the propagated attitude, kept only within ``continuity_turn`` of it
         (:func:`nearer_propagation`); the best-scored kept one is returned (the others in
-        ``_passing_alignments``), or ``found`` marked failed when none is kept."""
+        ``_passing_alignments``), or ``found`` marked failed when none is kept. More than
+        CONTINUITY_GAP after the last good frame, ``found`` as it is (the propagation no longer tells)."""
         propagated = self.propagated_world_to_body(time_s)
-        if propagated is None:
+        last_good = next((a.time for a in reversed(self.alignments) if a.ok), None)
+        if propagated is None or time_s - last_good > CONTINUITY_GAP:
             return found
         candidates = [found] + self._passing_alignments
         from_propagation = self._search(time_s, scan, propagated, _turn_candidates(SEARCH_TURN), sensor_world,
