@@ -168,6 +168,9 @@ def test_the_branch_nearer_the_propagated_attitude_is_kept_when_its_half_turn_fi
                           Alignment(0.1, propagated, np.eye(6), 1.0, 0.0, 0.0, True, False, 0.0, 0),
                           Alignment(0.2, propagated, np.eye(6), 0.0, 1.0, 0.0, False, False, 0.0, 0)]
     tracker._passing_alignments = []
+    # more than CONTINUITY_GAP after the last good frame the propagation no longer tells: left as found
+    late = tracker._continuous_candidates(0.1 + registration.CONTINUITY_GAP + 0.1, scan, flipped, SENSOR)
+    assert late is flipped
     kept = tracker._continuous_candidates(0.1, scan, flipped, SENSOR)   # the propagation over zero time
     assert kept.ok
     assert np.degrees(rotation_error(kept.body_to_world[:3, :3], rotation, [np.eye(3)])) < 3.0
