@@ -119,6 +119,14 @@ MAX_CHAINS = 3          # candidate poses of a re-acquisition followed through t
 # Best refined candidates of a search after a lost track searched again over small turns about themselves
 # (_polished); 0: off. Tried offline, not adopted (docs/perception.md, "Free-space refinement, tried offline").
 POLISHED = 0
+# A lost track's re-acquisition is chosen by continuity with the attitude propagated at the last registered
+# rates (DebrisTracker's continuity_turn) only this long (s) after the last registered frame. Measured on 10
+# re-acquisitions after the net contact of the featured debris (model-free, percep14's and percep15's captures,
+# bench/perception_reacquire_continuity.py): the debris turns at 1.1-1.6 rad/s, the net changes the rate by
+# ~0.25 rad/s, the two-frame rate is off by up to 0.22 rad/s; the propagation lay 4-56 deg from the truth for
+# gaps 0.3-2.1 s, but 48-104 deg for gaps 3.2-3.7 s. Beyond 2.5 s the truth may lie nearer the half turn of the
+# propagation than the propagation: no choice by continuity there.
+CONTINUITY_GAP = 2.5
 SEARCH_SCREENED = 40    # best-fitting distinct seeds of a search over all attitudes screened by the check before refining
 AMBIGUOUS_TURN = np.radians(15.0)  # rad; passing poses this far apart (beyond the known symmetries) start chains of their own
 
@@ -472,6 +480,51 @@ def predict_pose(previous, before) -> np.ndarray:
     return previous @ np.linalg.inv(before) @ previous
 
 
+def propagate_pose(previous, before, steps) -> np.ndarray:
+    """world_to_body ``steps`` frame spacings (any real number) after ``previous``, at the constant
+    rates of the two frames: the attitude turned on at the constant rotation rate, the frame B's
+    origin moved on at its constant velocity (for steps = 1 the rotation of :func:`predict_pose`).
+
+    .. math:: R(t) = \\exp(n \\log(R_1 R_0^T)) R_1, \\quad p(t) = p_1 + n (p_1 - p_0)
+
+    with R the body -> world rotation, p the origin of B in the world frame and n = ``steps``. Exact for a
+    turn at a constant rate about a fixed axis through B's origin moving at a constant velocity (a
+    torque-free tumble about a principal axis, B's origin at the CoM); with B's origin off the CoM the
+    place is off by the turned offset (the re-acquisition's search places the body itself; only the
+    attitude is used to choose).
+
+    Parameters
+    ----------
+    previous, before : (4, 4) float
+        world_to_body at the last good frame and at the good frame before it (m).
+    steps : float
+        Time from ``previous`` over the time between the two (-).
+
+    Returns
+    -------
+    (4, 4) float
+        Propagated world_to_body (m).
+    """
+    body_to_world_1, body_to_world_0 = np.linalg.inv(previous), np.linalg.inv(before)
+    turn = Rotation.from_matrix(body_to_world_1[:3, :3] @ body_to_world_0[:3, :3].T).as_rotvec()
+    propagated = np.eye(4)
+    propagated[:3, :3] = Rotation.from_rotvec(steps * turn).as_matrix() @ body_to_world_1[:3, :3]
+    propagated[:3, 3] = body_to_world_1[:3, 3] + steps * (body_to_world_1[:3, 3] - body_to_world_0[:3, 3])
+    return np.linalg.inv(propagated)
+
+
+def nearer_propagation(candidates, propagated, limit) -> list:
+    """The candidate alignments whose attitude lies within ``limit`` (rad) of ``propagated``
+    (world_to_body, (4, 4)), best-scored first (:func:`_score`).
+
+    A half turn that maps a box-like body onto itself fits the scans as well as the truth; what tells
+    them apart is the motion: the attitude cannot jump by more than the rates' error times the time
+    lost. With ``limit`` below 90 deg only one of a pose and its half turn about any axis can be kept.
+    """
+    kept = [c for c in candidates if _turn_angle(c.world_to_body[:3, :3], propagated[:3, :3]) <= limit]
+    return sorted(kept, key=_score, reverse=True)
+
+
 class DebrisTracker:
     """Frame-to-model registration of one rigid debris (see module docstring).
 
@@ -513,12 +566,21 @@ class DebrisTracker:
                                 Viewing bins about a model point that the free-space check also
                                 compares it with (``free_space_violation``'s ``lateral_bins``): 0 for
                                 an exact mesh, :data:`MAP_LATERAL_BINS` for a map built from scans.
+    continuity_turn : float, optional
+                                Largest turn (rad) between a re-acquired attitude after a lost track and
+                                the attitude propagated at the last registered rates
+                                (:meth:`propagated_world_to_body`): the search also starts from the
+                                propagation, and candidates beyond it start no chain. A box-like body's
+                                half turn fits the scans as well as the truth; the rates do not allow it
+                                (:func:`nearer_propagation`). Default None: off.
     """
 
     def __init__(self, voxel=0.03, max_correspondence=0.1, model_frames=30, model_points_body=None,
                  model_normals_body=None, symmetries_body=None, seed=0, field_of_view=None, ray_spacing=0.0,
-                 search_cpu_per_frame=np.inf, search_cpu_per_run=np.inf, free_space_lateral_bins=0):
+                 search_cpu_per_frame=np.inf, search_cpu_per_run=np.inf, free_space_lateral_bins=0,
+                 continuity_turn=None):
         self.voxel = voxel
+        self.continuity_turn = continuity_turn
         self.free_space_lateral_bins = int(free_space_lateral_bins)
         self.search_cpu_per_frame = float(search_cpu_per_frame)
         self.search_cpu_per_run = float(search_cpu_per_run)
@@ -717,11 +779,43 @@ class DebrisTracker:
             alignment = self._search(time_s, scan, self._acquisition_start(points, predicted),
                                      _orientation_candidates(LOST_SEEDS if self.alignments else 240), sensor_world,
                                      visible_side=True, polish=bool(self.alignments))
+            if self.continuity_turn is not None and any(a.ok for a in self.alignments):
+                alignment = self._continuous_candidates(time_s, scan, alignment, sensor_world)
             if alignment.ok and any(a.ok for a in self.alignments):
                 return self._start_chains(alignment)   # a lost track: the motion decides (_continue_chains)
         if not alignment.ok:
             alignment = self._retry_from_global(time_s, scan, alignment, predicted, has_motion, sensor_world)
         return alignment
+
+    def propagated_world_to_body(self, time_s) -> np.ndarray | None:
+        """world_to_body at ``time_s`` (s) carried from the last two consecutive good frames at their
+        constant rotation and translation rates (:func:`propagate_pose`); None without such a pair."""
+        for later, earlier in zip(self.alignments[::-1], self.alignments[-2::-1]):
+            if later.ok and earlier.ok and later.time > earlier.time:
+                return propagate_pose(later.world_to_body, earlier.world_to_body,
+                                      (time_s - later.time) / (later.time - earlier.time))
+        return None
+
+    def _continuous_candidates(self, time_s, scan, found, sensor_world) -> Alignment:
+        """A lost track's search result ``found`` and its other passing poses, joined by a small-turn
+        search about the propagated attitude, kept only within ``continuity_turn`` of it
+        (:func:`nearer_propagation`); the best-scored kept one is returned (the others in
+        ``_passing_alignments``), or ``found`` marked failed when none is kept. More than
+        CONTINUITY_GAP after the last good frame, ``found`` as it is (the propagation no longer tells)."""
+        propagated = self.propagated_world_to_body(time_s)
+        last_good = next((a.time for a in reversed(self.alignments) if a.ok), None)
+        if propagated is None or time_s - last_good > CONTINUITY_GAP:
+            return found
+        candidates = [found] + self._passing_alignments
+        from_propagation = self._search(time_s, scan, propagated, _turn_candidates(SEARCH_TURN), sensor_world,
+                                        visible_side=True)
+        candidates += [from_propagation] + self._passing_alignments
+        kept = nearer_propagation([c for c in candidates if c.ok], propagated, self.continuity_turn)
+        if not kept:
+            self._passing_alignments = []
+            return Alignment(**{**found.__dict__, "ok": False})
+        self._passing_alignments = kept[1:]
+        return kept[0]
 
     def _start_chains(self, alignment) -> Alignment:
         """The passing poses of a search after a lost track (the kept one and the others, one per

@@ -474,6 +474,10 @@ class Registration(Strict):
         300.0, description="Largest CPU time of all searches of a perceive run together (s); once spent, frames "
                            "of a lost track are not registered (their estimates then say 'not observable'). "
                            "0: no search at all.")
+    reacquire_continuity_turn: Annotated[float, Field(gt=0, le=np.pi)] | None = Field(
+        None, description="Largest turn (rad) between a re-acquired debris attitude after a lost track and the "
+                          "attitude propagated from the last registered rates; candidates beyond it are dropped, "
+                          "a search from the propagated attitude is added (issue 26). None: off.")
 
     @model_validator(mode="after")
     def _budget(self):

@@ -424,10 +424,12 @@ def track_model_free(scene: Scene, frames: Frames):
 
 def _search_budget(registration) -> dict:
     """The tracker's CPU limits of the search for a lost track (``perception.registration``'s
-    ``search_cpu_per_frame`` and ``search_cpu_per_run``, s), as keyword arguments of
+    ``search_cpu_per_frame`` and ``search_cpu_per_run``, s) and its continuity limit of a
+    re-acquisition (``reacquire_continuity_turn``, rad), as keyword arguments of
     :class:`perception.registration.DebrisTracker`."""
     return {"search_cpu_per_frame": registration.search_cpu_per_frame,
-            "search_cpu_per_run": registration.search_cpu_per_run}
+            "search_cpu_per_run": registration.search_cpu_per_run,
+            "continuity_turn": registration.reacquire_continuity_turn}
 
 
 def _search_budget_figures(tracker: DebrisTracker, frames: Frames) -> dict:
