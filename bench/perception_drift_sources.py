@@ -165,24 +165,14 @@ def fixed_map_errors(cap) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarra
     capture's case, seed and observation time, and of the same scans registered to a fixed map of the scans at
     their true poses, with the stage's motion prior and without, and to a noise-free map of the mesh (with the prior);
     and the largest difference (-) of the online poses from the captured ones (0: the same run)."""
-    from riskassess.cases.impact import load_case
-    from riskassess.stages.perceive import Frames, Scene, observe_tumble_model_free
     from perception import scan_to_map
     from perception.registration import known_shape_model
 
-    answer = cap["answer"]
-    case = load_case(CASE)
-    perception = case.perception.model_copy(update={"seed": int(answer["bench_seed"]), "model": "none",
-                                                    "observation_time": float(answer["bench_observation_s"])})
-    case = case.model_copy(update={"perception": perception})
-    scene = Scene.from_case(case, CASE.parent, str(CASE))
-    frames = Frames()
-    _, tracker, _ = observe_tumble_model_free(scene, frames, np.random.default_rng(perception.seed))
-    k = len(frames.scans)
-    online = [a.world_to_body for a in tracker.alignments[:k]]
+    scene, scans, online = _observation_scans(cap)
+    k = len(scans)
     difference = max(float(np.abs(online[i] - cap["alignments"][i].world_to_body).max()) for i in range(k))
-    reg = perception.registration
-    thin = [scan_to_map.thinned_scan(scan, reg.voxel) for scan in frames.scans]
+    reg = scene.case.perception.registration
+    thin = [scan_to_map.thinned_scan(scan, reg.voxel) for scan in scans]
     true_world_to_body = [np.linalg.inv(true_body_to_world(cap, i)) for i in range(k)]
     points, normals, index, _ = scan_to_map._built_map(
         np.vstack([scan_to_map._transform(thin[i], true_world_to_body[i]) for i in range(k)]), reg.voxel,
