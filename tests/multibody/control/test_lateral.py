@@ -134,7 +134,9 @@ def _case_data(**lateral):
 
 
 def test_case_checks():
-    assert not load_model(CASE, TowingCase).lateral.enabled             # off in the shipped case
+    shipped = load_model(CASE, TowingCase).lateral
+    assert shipped.enabled and shipped.target == "momentum_axis"        # on in the shipped case (docs/towing.md)
+    assert shipped.thrust_laws == ["mrac1", "mrac2"]                    # with the elongation laws only
     data = _case_data()
     data["attitude_control"]["enabled"] = False
     with pytest.raises(ValueError, match="attitude_control.enabled"):
