@@ -90,8 +90,9 @@ def fitted_propagation_errors(path, frame_counts) -> list[dict]:
         for index in [back[0]] + [int(np.argmin(np.abs(times - times[last] - gap))) for gap in (1, 2, 3, 4, 5)]:
             propagated = np.linalg.inv(propagate_fitted_pose(times[used], poses, times[index]))[:3, :3]
             at[round(float(times[index] - times[last]), 1)] = _angle_deg(propagated, truth[index])
-        one_step = np.linalg.inv(propagate_fitted_pose(times[used], poses, times[last] + 0.1))[:3, :3]
-        rate = Rotation.from_matrix(one_step @ alignments[last].body_to_world[:3, :3].T).magnitude() / 0.1
+        # the fitted rate: between two propagated poses (the fit's line need not pass through the last pose)
+        one, two = (np.linalg.inv(propagate_fitted_pose(times[used], poses, times[last] + step))[:3, :3] for step in (0.1, 0.2))
+        rate = Rotation.from_matrix(two @ one.T).magnitude() / 0.1
         rows.append({"frames": count, "rate": rate, "reacquired_gap_s": round(float(times[back[0]] - times[last]), 1),
                      "to_truth_deg": at})
     return rows

@@ -582,6 +582,17 @@ def nearer_propagation(candidates, propagated, limit) -> list:
     return sorted(kept, key=_score, reverse=True)
 
 
+def _chain_prediction(chain, time_s) -> np.ndarray:
+    """world_to_body of a candidate chain (a list of :class:`Alignment`, at least two) at ``time_s`` (s):
+    :func:`predict_pose` from its last two frames at the next frame, :func:`propagate_pose` at their
+    rates across frames the chain missed."""
+    last, before = chain[-1], chain[-2]
+    steps = (time_s - last.time) / (last.time - before.time)
+    if abs(steps - 1.0) < 1e-6:
+        return predict_pose(last.world_to_body, before.world_to_body)
+    return propagate_pose(last.world_to_body, before.world_to_body, steps)
+
+
 class DebrisTracker:
     """Frame-to-model registration of one rigid debris (see module docstring).
 
@@ -630,14 +641,19 @@ class DebrisTracker:
                                 propagation, and candidates beyond it start no chain. A box-like body's
                                 half turn fits the scans as well as the truth; the rates do not allow it
                                 (:func:`nearer_propagation`). Default None: off.
+    chain_missed_frames : int   Consecutive frames a candidate chain after a lost track (of at least two
+                                frames, so with a motion) may fail and still go on, its next frame predicted
+                                across the gap; the failed frames stay failed. 0 (default): a chain is
+                                dropped at its first failed frame.
     """
 
     def __init__(self, voxel=0.03, max_correspondence=0.1, model_frames=30, model_points_body=None,
                  model_normals_body=None, symmetries_body=None, seed=0, field_of_view=None, ray_spacing=0.0,
                  search_cpu_per_frame=np.inf, search_cpu_per_run=np.inf, free_space_lateral_bins=0,
-                 continuity_turn=None):
+                 continuity_turn=None, chain_missed_frames=0):
         self.voxel = voxel
         self.continuity_turn = continuity_turn
+        self.chain_missed_frames = int(chain_missed_frames)
         # None: off; a list: every candidate pose a lost track's search or chain produced, one dict each
         # (:meth:`_log_candidates`), to see offline why a pose was or was not re-acquired
         self.candidate_log = None
@@ -652,6 +668,7 @@ class DebrisTracker:
         self._passing_alignments = []        # passing alignments of the last search other than the kept one
         self._searched = False               # the frame being registered has done search work
         self._chains = []                    # candidate pose sequences after a lost track (see _continue_chains)
+        self._chain_misses = []              # consecutive frames each chain has failed (at most chain_missed_frames)
         self.revised = []                    # indices of earlier frames whose alignment the last update replaced
         self.symmetries_body = [np.eye(4)] if symmetries_body is None else [np.asarray(s, float) for s in symmetries_body]
         self.seed = seed
@@ -806,7 +823,7 @@ class DebrisTracker:
         try:
             alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
         except SearchBudgetSpent:
-            self._chains, self._passing_alignments = [], []
+            self._chains, self._chain_misses, self._passing_alignments = [], [], []
             pose = predicted if predicted is not None else np.eye(4)
             alignment = Alignment(time_s, pose, np.zeros((6, 6)), 0.0, 1.0, np.inf, False, False, 0.0,
                                   len(scan.points), over_budget=True)
@@ -824,7 +841,7 @@ class DebrisTracker:
         # one spacing per frame for every check of it (a search checks up to SEARCH_REFINED poses)
         self._frame_spacing = _sample_spacing(points) if len(points) >= MIN_POINTS else None
         if len(points) < MIN_POINTS:   # e.g. everything gated away: record the frame as failed, do not guess
-            self._chains = []          # a chain continues frame by frame only
+            self._chains, self._chain_misses = [], []   # a chain continues frame by frame only
             pose = predicted if predicted is not None else np.eye(4)
             return Alignment(time_s, pose, np.zeros((6, 6)), 0.0, 1.0, np.inf, False, False, 0.0, len(points))
         if self._chains:
@@ -911,6 +928,7 @@ class DebrisTracker:
                         for symmetry in self.symmetries_body) > AMBIGUOUS_TURN for kept in starts):
                 starts.append(other)
         self._chains = [[start] for start in starts]
+        self._chain_misses = [0] * len(self._chains)
         return Alignment(**{**alignment.__dict__, "ok": False})
 
     def _continue_chains(self, time_s, scan, sensor_world) -> Alignment:
@@ -930,8 +948,8 @@ class DebrisTracker:
         continue as one rigid motion is much rarer than one that fits one frame.
         """
         points = np.asarray(scan.points)
-        survivors, tried = [], []
-        for chain in self._chains:
+        alive, misses, tried = [], [], []
+        for chain, missed in zip(self._chains, self._chain_misses):
             self._spend()
             if len(chain) == 1:
                 # seeds on the visible side: the debris may have moved beyond the coarse ICP's reach in
@@ -940,29 +958,40 @@ class DebrisTracker:
                 candidate = self._search(time_s, scan, chain[-1].world_to_body, _turn_candidates(SEARCH_TURN),
                                          sensor_world, visible_side=True, label="chain's second frame")
             else:
-                predicted = predict_pose(chain[-1].world_to_body, chain[-2].world_to_body)
+                predicted = _chain_prediction(chain, time_s)
                 candidate = self._judge(time_s, points, self._icp(scan, predicted), predicted, sensor_world, True)
                 self._log_candidates(time_s, f"chain's frame {len(chain) + 1}", [candidate], has_motion=True)
             tried.append(candidate)
             if candidate.ok:
-                survivors.append(chain + [candidate])
-        self._chains = survivors
-        self._log_chains(time_s, survivors)
+                alive.append(chain + [candidate])
+                misses.append(0)
+            elif len(chain) >= 2 and missed < self.chain_missed_frames:
+                alive.append(chain)   # carried over this failed frame
+                misses.append(missed + 1)
+        self._chains, self._chain_misses = alive, misses
+        self._log_chains(time_s, alive)
+        survivors = [chain for chain in alive if any(chain[-1] is candidate for candidate in tried)]   # passed this frame
         if not survivors:
             best = max(tried, key=_score)
             return Alignment(**{**best.__dict__, "ok": False})
         if len(survivors[0]) < CONFIRMING_FRAMES or _view_turn(survivors[0]) < CONFIRMING_VIEW_TURN:
             return Alignment(**{**survivors[0][-1].__dict__, "ok": False})
-        self._chains = []
-        if len(survivors) > 1:   # two rigid motions explain the scans: no answer rather than a guess
+        self._chains, self._chain_misses = [], []
+        if len(alive) > 1:   # two rigid motions explain the scans: no answer rather than a guess
             return Alignment(**{**survivors[0][-1].__dict__, "ok": False})
-        first = len(self.alignments) - (len(survivors[0]) - 1)
-        for index, confirmed in zip(range(first, len(self.alignments)), survivors[0]):
+        self._revise(survivors[0][:-1])
+        return survivors[0][-1]
+
+    def _revise(self, confirmed) -> None:
+        """The pending frames of a confirmed chain (its alignments but the current frame's) replace the
+        frames registered at their times (indices in ``revised``)."""
+        index_at = {alignment.time: index for index, alignment in enumerate(self.alignments)}
+        for alignment in confirmed:
+            index = index_at[alignment.time]
             previous = self.alignments[index]
-            self.alignments[index] = Alignment(**{**confirmed.__dict__, "time": previous.time,
+            self.alignments[index] = Alignment(**{**alignment.__dict__, "time": previous.time,
                                                   "seconds": previous.seconds, "cpu_seconds": previous.cpu_seconds})
             self.revised.append(index)
-        return survivors[0][-1]
 
     def _retry_from_global(self, time_s, scan, failed, predicted, has_motion, sensor_world) -> Alignment:
         """The frame again from FPFH + RANSAC; kept when it passes or fits tighter than ``failed``."""
