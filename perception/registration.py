@@ -935,7 +935,9 @@ class DebrisTracker:
         """One more frame for each candidate chain after a lost track: the second frame by the
         small-turn search from the chain's pose, the third by ICP from the constant-rate prediction
         of the two (the check with the innovation limit: one angular velocity). Chains failing the
-        check are dropped. After CONFIRMING_FRAMES frames, and once the chain's view of the body has
+        check are dropped, or, with ``chain_missed_frames``, carried over up to that many consecutive failed
+        frames (predicted across them, :func:`_chain_prediction`; a chain then alive without this frame still
+        counts as an alternative). After CONFIRMING_FRAMES frames, and once the chain's view of the body has
         turned by CONFIRMING_VIEW_TURN (a half turn of a box-like body moves rigidly too and is told apart
         only when the differing side comes into view), a single surviving chain is the track: its
         frames replace the pending ones (their indices in ``revised``). Several surviving chains are
