@@ -321,8 +321,9 @@ def report(results: dict, replicas: int, locations, readings: dict, skip: float,
 
 def peak_times(results: dict, replicas: int, locations, readings: dict, skip: float, in_dynamics: set,
                name: str) -> None:
-    """Per reading, variant and replica: the judged peak (after ``skip``) of location ``name``, its time and its
-    utilization against the allowable's low end (each criterion)."""
+    """Per reading, variant and replica: the judged peak (after ``skip``) of location ``name``, its time, its
+    utilization against the allowable's low end (each criterion) and the joint's recorded moment there (N m, joint
+    frame axes h1, h2, h3: which axis carries the peak)."""
     location = next((loc for loc in locations if loc.name == name), None)
     if location is None:
         raise SystemExit(f"--peak-times: no weak location '{name}' (known: {', '.join(l.name for l in locations)})")
@@ -336,8 +337,10 @@ def peak_times(results: dict, replicas: int, locations, readings: dict, skip: fl
                 judged = np.where(run["time"] >= skip, series, -np.inf)
                 k = int(np.argmax(judged))
                 low = location.criteria()[criterion].low
+                moment_joint = run["moment"][k, location.joint]
                 print(f"  {reading:34s} {variant:12s} r{replica}  {criterion}: {series[k]:8.1f} at {run['time'][k]:.3f} s, "
-                      f"utilization {series[k] / low:.3f}")
+                      f"utilization {series[k] / low:.3f}; moment h1 h2 h3 {moment_joint[0]:+.0f} "
+                      f"{moment_joint[1]:+.0f} {moment_joint[2]:+.0f} N m")
 
 
 def parse_mode(text: str) -> tuple[str, np.ndarray]:
