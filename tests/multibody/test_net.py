@@ -60,11 +60,17 @@ def _released_thread(damping, step, stretch=0.01, stiffness=1000.0, node_mass=0.
                       threads=np.array([[0, 1]]), rest_lengths=np.array([1.0]), stiffness=np.array([stiffness]),
                       damping=np.array([damping]), bending_triples=np.zeros((0, 3), np.int64),
                       bending_stiffness=np.zeros(0), nodes_per_side=0, n_bullets=0)
+    return _series_beside_a_far_box(net, np.zeros((2, 3)), step, end_time)
+
+
+def _series_beside_a_far_box(net, net_velocity, step, end_time):
+    """The recorded series (every step) of ``net`` launched at ``net_velocity`` (n, 3) (m/s) with a fixed box 10 m
+    away as the only body (no contact happens: the scene needs a body), the balance measured, not refused."""
     box_mass = 1e12
     box = RigidBodySpec(name="box", mass=box_mass, inertia_body=box_mass * 0.01 / 6.0 * np.eye(3),
                         com_lvlh=np.array([0.0, 10.0, 0.0]), meshes_body=[trimesh.creation.box(extents=[0.1] * 3)])
     assembly = ImpactAssembly(
-        net=net, net_velocity=np.zeros((2, 3)), bodies=[box], joints=[],
+        net=net, net_velocity=net_velocity, bodies=[box], joints=[],
         contact=ContactLaw(stiffness=PAPER_CONTACT_STIFFNESS, hunt_crossley_alpha=0.05, mu_static=0.19,
                            mu_kinetic=0.152),
         solver=SolverSpec(end_time=end_time, step=step, output_rate=1.0 / step, net_output_rate=1000.0))
@@ -102,19 +108,9 @@ def _kicked_thread_mode(step, speed=4.0, stiffness=62308.25, damping=1.58, node_
                       threads=np.array([[0, 1], [1, 2]]), rest_lengths=np.ones(2), stiffness=np.full(2, stiffness),
                       damping=np.full(2, damping), bending_triples=np.zeros((0, 3), np.int64),
                       bending_stiffness=np.zeros(0), nodes_per_side=0, n_bullets=0)
-    box_mass = 1e12
-    box = RigidBodySpec(name="box", mass=box_mass, inertia_body=box_mass * 0.01 / 6.0 * np.eye(3),
-                        com_lvlh=np.array([0.0, 10.0, 0.0]), meshes_body=[trimesh.creation.box(extents=[0.1] * 3)])
     velocity = np.zeros((3, 3))
     velocity[1, 0] = speed
-    assembly = ImpactAssembly(
-        net=net, net_velocity=velocity, bodies=[box], joints=[],
-        contact=ContactLaw(stiffness=PAPER_CONTACT_STIFFNESS, hunt_crossley_alpha=0.05, mu_static=0.19,
-                           mu_kinetic=0.152),
-        solver=SolverSpec(end_time=end_time, step=step, output_rate=1.0 / step, net_output_rate=1000.0))
-    simulation = ImpactSimulation(assembly)
-    simulation.health.reference_energy = None       # measure the balance, do not refuse it
-    return simulation.run().series
+    return _series_beside_a_far_box(net, velocity, step, end_time)
 
 
 def _verlet_kicked_mode_booking(step, omega, zeta, end_time):
