@@ -18,7 +18,8 @@ from numba.experimental import structref
 from multibody.jit_cache import UnliteralStructRef
 from multibody.kernel import BENDING_ELASTIC, CONTACT_DISSIPATED, CONTACT_ELASTIC, THREAD_DISSIPATED, THREAD_ELASTIC
 from multibody.maths.linalg3 import cross3, matmat3, mattmat3, mattvec3, matvec3
-from multibody.maths.rotations import rotation_matrix_from_rotation_vector_into, rotation_vector_from_matrix_into
+from multibody.maths.rotations import (half_rotation_matrix_into, rotation_matrix_from_rotation_vector_into,
+                                      rotation_vector_from_matrix_into)
 from multibody.node_frame import body_state_into
 
 
@@ -369,7 +370,6 @@ class DamperWork(NamedTuple):
     body_to_lvlh: np.ndarray          # (nb, 3, 3)
     omega_lvlh: np.ndarray            # (nb, 3) (rad/s)
     omega_body: np.ndarray            # (nb, 3) (rad/s), body frame
-    rotation_joint: np.ndarray        # (3,) a joint's relative rotation vector (rad)
     frames: np.ndarray                # (4, 3, 3) a joint's parent frame, child frame, relative rotation, mid frame
     half_turn: np.ndarray             # (1, 3, 3) Exp(r / 2)
     vectors: np.ndarray               # (4, 3) the arms on child and parent (m), relative velocity (m/s) and omega
@@ -386,7 +386,7 @@ def damper_work_buffers(n_coordinates: int, n_bodies: int) -> DamperWork:
     """
     nb = n_bodies
     return DamperWork(np.zeros(n_coordinates), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3, 3)),
-                      np.zeros((nb, 3, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros(3), np.zeros((4, 3, 3)),
+                      np.zeros((nb, 3, 3)), np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((4, 3, 3)),
                       np.zeros((1, 3, 3)), np.zeros((4, 3)))
 
 
@@ -566,9 +566,7 @@ def _joint_damper_power(j, joints, work) -> float:
     for i in range(3):
         for k in range(3):
             relative[i, k] = frame[0, i] * child_frame[0, k] + frame[1, i] * child_frame[1, k] + frame[2, i] * child_frame[2, k]
-    r = work.rotation_joint
-    rotation_vector_from_matrix_into(relative, r)
-    rotation_matrix_from_rotation_vector_into(0.5 * r[0], 0.5 * r[1], 0.5 * r[2], work.half_turn, 0)
+    half_rotation_matrix_into(relative, work.half_turn, 0)   # Exp(r / 2), r the relative rotation vector
     _matmat_into(frame, work.half_turn[0], mid)
     point_child, point_parent = joints.point_child[j], joints.point_parent[j]
     for d in range(3):
