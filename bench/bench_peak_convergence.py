@@ -6,6 +6,7 @@ and through the structure's first mode.
                                             [--mode HZ | --mode LOW,HIGH ...] [--skip S] [--cache DIR]
                                             [--workers N] [--markdown]
                                             [--store STORE --sample N [--velocity V]] [--peak-times LOCATION]
+                                            [--quantile Q ...] [--variants V1,V2,...]
 
 Runs the case (default ``cases/envisat_small.toml``) with joint release off (every peak is then the
 demand the intact joint carries, not cut at a release) at a baseline and one change at a time:
@@ -43,7 +44,11 @@ over it, as a location with ``structural_mode_hz = [LOW, HIGH]``). Windows: the 
 location and criterion, the baseline's median peak over the replicas, its spread (max - min) / median,
 and each variant's change of the median with a 90 % bootstrap interval (replicas resampled): "ok" when
 the change and its interval are within +-5 %, "NOT CONVERGED" when the interval lies beyond, "unresolved"
-when the interval straddles 5 % (more replicas needed). Prints the CPU time per run and the load.
+when the interval straddles 5 % (more replicas needed). ``--quantile 0.9`` compares the 0.9 quantile of the
+peak over the replicas the same way (for a chaotic capture the distribution of the peak is what can converge,
+and a verdict's probability rests on its upper tail, not on one run). Prints the CPU time per run and the load.
+``--variants`` runs only some configurations, replica by replica over them (a study stopped early stays
+balanced), and reports the others missing.
 """
 from __future__ import annotations
 
@@ -195,22 +200,35 @@ def window_peaks(time, series, skip: float, parting: float, margin: float = 0.0)
     return {w: float(series[m].max()) if m.any() else float("nan") for w, m in windows.items()}
 
 
-def median_change(base: np.ndarray, variant: np.ndarray, rng) -> tuple[float, float, float]:
-    """Change of the median (variant / baseline - 1) and its 90 % bootstrap interval."""
-    change = np.median(variant) / np.median(base) - 1.0
+def quantile_change(base: np.ndarray, variant: np.ndarray, rng, q: float = 0.5) -> tuple[float, float, float]:
+    """Change of the ``q`` quantile over the replicas (variant / baseline - 1) and its 90 % bootstrap interval (both
+    sets resampled). The quantile interpolates linearly between order statistics (numpy's default, Hyndman & Fan
+    type 7): with ``n`` replicas the 0.9 quantile lies between the two largest values when ``n`` <= 11, so it
+    resolves the upper tail only as far as that many draws do."""
+    change = np.quantile(variant, q) / np.quantile(base, q) - 1.0
     b = rng.choice(base, (BOOTSTRAP_DRAWS, base.size))
     v = rng.choice(variant, (BOOTSTRAP_DRAWS, variant.size))
-    draws = np.median(v, axis=1) / np.median(b, axis=1) - 1.0
+    draws = np.quantile(v, q, axis=1) / np.quantile(b, q, axis=1) - 1.0
     low, high = np.percentile(draws, [5, 95])
     return change, low, high
 
 
-def median_precision(base: np.ndarray, rng) -> float:
-    """Half-width of the 90 % bootstrap interval of the baseline's median, relative to it: how well the
-    replicas know the median at all."""
-    draws = np.median(rng.choice(base, (BOOTSTRAP_DRAWS, base.size)), axis=1) / np.median(base) - 1.0
+def median_change(base: np.ndarray, variant: np.ndarray, rng) -> tuple[float, float, float]:
+    """Change of the median (variant / baseline - 1) and its 90 % bootstrap interval."""
+    return quantile_change(base, variant, rng, 0.5)
+
+
+def quantile_precision(base: np.ndarray, rng, q: float = 0.5) -> float:
+    """Half-width of the 90 % bootstrap interval of the baseline's ``q`` quantile, relative to it: how well the
+    replicas know that quantile at all."""
+    draws = np.quantile(rng.choice(base, (BOOTSTRAP_DRAWS, base.size)), q, axis=1) / np.quantile(base, q) - 1.0
     low, high = np.percentile(draws, [5, 95])
     return float(max(-low, high))
+
+
+def statistic_name(q: float) -> str:
+    """'median' or e.g. 'q90' for the 0.9 quantile."""
+    return "median" if q == 0.5 else f"q{100 * q:g}"
 
 
 def verdict(change: float, low: float, high: float) -> str:
@@ -246,16 +264,18 @@ def reading_table(results: dict, replicas: int, locations, modes, damping, skip:
 
 
 def report(results: dict, replicas: int, locations, readings: dict, skip: float, in_dynamics: set,
-           markdown: bool = False, margin: float = 0.0) -> None:
-    """Per reading, location and criterion: when the replicas part, and in each window the baseline's
-    median peak [range], its spread and precision, each variant's change of the median with its bootstrap
-    interval and verdict (``markdown``: one table for docs/structures.md)."""
+           markdown: bool = False, margin: float = 0.0, quantiles: tuple = (0.5,)) -> None:
+    """Per reading, location and criterion: when the replicas part, and in each window, for each quantile of the
+    peak over the replicas (``quantiles``; 0.5: the median), the baseline's value [range], its spread and
+    precision, each variant's change of that quantile with its bootstrap interval and verdict (``markdown``: one
+    table for docs/structures.md)."""
     rng = np.random.default_rng(0)
     names = [v for v in VARIANTS if v != "baseline"
              and any(not isinstance(results[(v, r)], str) for r in range(replicas))]
+    only_median = tuple(quantiles) == (0.5,)
     if markdown:
-        print("\n| reading | location / criterion | window | baseline median [range] | spread | median known to | "
-              + " | ".join(names) + " |")
+        print(f"\n| reading | location / criterion | window | baseline {'median' if only_median else 'value'} [range] | "
+              f"spread | {'median' if only_median else 'value'} known to | " + " | ".join(names) + " |")
         print("|" + "---|" * (6 + len(names)))
     members = {f"{loc.name} / " for loc in locations if loc.joint in in_dynamics}
     for index, (reading, (modes, damping)) in enumerate(readings.items()):
@@ -271,35 +291,39 @@ def report(results: dict, replicas: int, locations, readings: dict, skip: float,
                 values = np.array([p[window] for p in row["peaks"]["baseline"]])
                 if np.isnan(values).any():
                     continue
-                med = np.median(values)
-                cells = []
-                for n in names:
-                    variant = np.array([p[window] for p in row["peaks"][n]])
-                    change, low, high = median_change(values, variant, rng)
-                    state = verdict(change, low, high)
-                    counts[state] += 1
-                    cells.append(f"{change:+.0%} [{low:+.0%}, {high:+.0%}]{MARKS[state]}")
                 label = {"deterministic": f"deterministic, t < {row['parting'] - margin:.3f} s",
                          "chaotic": f"chaotic, t >= {max(skip, row['parting']):.2f} s",
                          "judged": f"judged, t >= {skip:g} s"}[window]
-                spread = (values.max() - values.min()) / med if med else float("nan")
-                known = median_precision(values, rng) if med else float("nan")
-                if markdown:
-                    print(f"| {'member in the dynamics' if member else reading} | {key} | {label} | {med:.3g} [{values.min():.3g}, {values.max():.3g}] | "
-                          f"{spread:.0%} | +-{known:.0%} | " + " | ".join(cells) + " |")
-                else:
-                    print(f"  {key:36s} {label:26s} {f'{med:.4g} [{values.min():.3g}, {values.max():.3g}]':>30s} "
-                          f"{spread:6.0%} +-{known:4.0%}  " + "  ".join(f"{n}: {c}" for n, c in zip(names, cells)))
+                for q in quantiles:
+                    value = np.quantile(values, q)
+                    cells = []
+                    for n in names:
+                        variant = np.array([p[window] for p in row["peaks"][n]])
+                        change, low, high = quantile_change(values, variant, rng, q)
+                        state = verdict(change, low, high)
+                        counts[state] += 1
+                        cells.append(f"{change:+.0%} [{low:+.0%}, {high:+.0%}]{MARKS[state]}")
+                    stat = "" if only_median else f", {statistic_name(q)}"
+                    spread = (values.max() - values.min()) / np.median(values) if value else float("nan")
+                    known = quantile_precision(values, rng, q) if value else float("nan")
+                    if markdown:
+                        print(f"| {'member in the dynamics' if member else reading} | {key} | {label}{stat} | "
+                              f"{value:.3g} [{values.min():.3g}, {values.max():.3g}] | "
+                              f"{spread:.0%} | +-{known:.0%} | " + " | ".join(cells) + " |")
+                    else:
+                        print(f"  {key:36s} {label + stat:26s} {f'{value:.4g} [{values.min():.3g}, {values.max():.3g}]':>30s} "
+                              f"{spread:6.0%} +-{known:4.0%}  " + "  ".join(f"{n}: {c}" for n, c in zip(names, cells)))
         if not markdown:
             print(f"  {reading}: " + ", ".join(f"{c} {s}" for s, c in counts.items())
                   + f" (tolerance {TOLERANCE:.0%}; spread = (max - min) / median over the replicas; "
-                    "[90 % bootstrap interval]; 'median known to': half-width of the baseline median's interval)")
+                    "[90 % bootstrap interval]; 'known to': half-width of the baseline value's interval)")
 
 
 def peak_times(results: dict, replicas: int, locations, readings: dict, skip: float, in_dynamics: set,
                name: str) -> None:
-    """Per reading, variant and replica: the judged peak (after ``skip``) of location ``name``, its time and its
-    utilization against the allowable's low end (each criterion)."""
+    """Per reading, variant and replica: the judged peak (after ``skip``) of location ``name``, its time, its
+    utilization against the allowable's low end (each criterion) and the joint's recorded moment there (N m, joint
+    frame axes h1, h2, h3: which axis carries the peak)."""
     location = next((loc for loc in locations if loc.name == name), None)
     if location is None:
         raise SystemExit(f"--peak-times: no weak location '{name}' (known: {', '.join(l.name for l in locations)})")
@@ -313,8 +337,10 @@ def peak_times(results: dict, replicas: int, locations, readings: dict, skip: fl
                 judged = np.where(run["time"] >= skip, series, -np.inf)
                 k = int(np.argmax(judged))
                 low = location.criteria()[criterion].low
+                moment_joint = run["moment"][k, location.joint]
                 print(f"  {reading:34s} {variant:12s} r{replica}  {criterion}: {series[k]:8.1f} at {run['time'][k]:.3f} s, "
-                      f"utilization {series[k] / low:.3f}")
+                      f"utilization {series[k] / low:.3f}; moment h1 h2 h3 {moment_joint[0]:+.0f} "
+                      f"{moment_joint[1]:+.0f} {moment_joint[2]:+.0f} N m")
 
 
 def parse_mode(text: str) -> tuple[str, np.ndarray]:
@@ -358,6 +384,9 @@ def main() -> None:
     parser.add_argument("--velocity", type=float, default=None, help="launch velocity (m/s) instead of the store's")
     parser.add_argument("--peak-times", default=None, metavar="LOCATION",
                         help="print this location's judged peak, time and utilization per variant and replica")
+    parser.add_argument("--quantile", type=float, action="append", default=[], metavar="Q",
+                        help="also compare this quantile (0 < Q < 1) of the peak over the replicas, e.g. 0.9 (what a "
+                             "verdict's probability uses: the upper tail, not one run)")
     parser.add_argument("--variants", default=",".join(VARIANTS),
                         help="comma list of the configurations to run (default: all); the others are reported missing")
     args = parser.parse_args()
@@ -394,7 +423,8 @@ def main() -> None:
     if args.report_only or chosen != set(VARIANTS):   # what the cache holds (a partial table while runs go on)
         if not args.report_only:
             with ProcessPoolExecutor(args.workers) as pool:
-                for key in [k for k in jobs if k[0] in chosen]:
+                # replica by replica over the variants: a study stopped early keeps the variants' counts even
+                for key in sorted((k for k in jobs if k[0] in chosen), key=lambda k: (k[1], VARIANTS.index(k[0]))):
                     print(f"{key} {pool.submit(simulate, *jobs[key]).result()}", flush=True)
         results = {key: job[3] if Path(job[3]).exists() else "missing: not run yet" for key, job in jobs.items()}
     else:
@@ -432,7 +462,10 @@ def main() -> None:
     readings = {"as recorded": ((), 0.0)}
     readings.update({label: (tuple(grid), args.mode_damping) for label, grid in map(parse_mode, args.mode)})
     in_dynamics = {i for i, j in enumerate(case.target.joints) if j.member is not None}
-    report(results, args.replicas, locations, readings, skip, in_dynamics, args.markdown, args.edge_margin)
+    if any(not 0.0 < q < 1.0 for q in args.quantile):
+        raise SystemExit(f"--quantile: a fraction between 0 and 1, got {args.quantile}")
+    quantiles = (0.5,) + tuple(q for q in args.quantile if q != 0.5)
+    report(results, args.replicas, locations, readings, skip, in_dynamics, args.markdown, args.edge_margin, quantiles)
     if args.peak_times:
         peak_times(results, args.replicas, locations, readings, skip, in_dynamics, args.peak_times)
 

@@ -1,19 +1,23 @@
 """One run of a safe-velocity study, replayed with its load history: when the net reaches, wraps and loads the target.
 
     python3 bench/bench_safe_velocity_history.py CASE --store STORE --sample N [--velocity V] [--end-time T]
-                                                 [--release never] [--keep DIR]
+                                                 [--release never] [--keep DIR | --kept DIR] [--judge-until T ...]
 
 The run of Monte Carlo sample ``N`` of a store written by ``bench/bench_safe_velocity.py`` (its uncertain inputs:
 friction, Hunt-Crossley damping, aim point), at the store's velocity or ``--velocity``, over the case's end time or
 ``--end-time``, with ``structures.release`` = ``--release`` (default ``never``: every joint holds, its peak is the
 demand it would see if it held), through the impact pipeline (:func:`riskassess.stages.run.run_case`) in a
-temporary folder (or ``--keep DIR``). Prints, with the CPU time and the load:
+temporary folder (or ``--keep DIR``; ``--kept DIR`` reads a folder kept so and runs nothing). Prints, with the CPU time and the load:
 
 - the first contact of the net with each body (s): flight distance / velocity;
 - per 0.5 s window: the largest demand of the weak location on ``--joint`` (default the solar-array hinge; the
   resultant of the joint-frame moment components h1 and h3, the axes a revolute joint's location judges by default)
   and the largest contact force on each body (1 ms impulse means);
 - the peak demand and its time, and the samples around it (h1, h3, the contact force on the joint's child);
+- with ``--judge-until T`` (repeatable): the peak demand over the judged part of [0, T] and its time, and its
+  utilization against the decisive allowable of the location's moment criterion, so that a
+  run continued past a row's end time shows the row's own peak (the same run up to T) next to the later load;
+  then the peak over (T, end] the same way;
 - the wrapping: the bullets' along-track position beyond the main body's centre and the net's kinetic energy relative
   to the debris' centre of mass, at 16 times;
 - the run's answer, each location's state and the energy balance's largest drift.
@@ -82,6 +86,31 @@ def print_peak(series, demand: np.ndarray, joint: str, child: int, skip_s: float
         print(f"  {t[j]:.3f} s  {moment_joint[j, 0]:8.1f} {moment_joint[j, 2]:8.1f}  {force_child[j]:7.1f}")
 
 
+def print_peaks_until(series, demand: np.ndarray, skip_s: float, ends_s: list, allowable: float) -> None:
+    """Per T in ``ends_s``: the peak demand (N m) over [skip_s, T] and over (T, end], each with its time and
+    utilization (/ ``allowable``, N m)."""
+    t = series["time"]
+    for end in ends_s:
+        for label, inside in ((f"[{skip_s:g}, {end:g}] s", (t >= skip_s) & (t <= end)),
+                              (f"({end:g}, {t[-1]:.2f}] s", t > end)):
+            if inside.any():
+                k = int(np.argmax(np.where(inside, demand, -np.inf)))
+                print(f"peak demand over {label}: {demand[k]:.1f} N m at {t[k]:.3f} s, "
+                      f"utilization {demand[k] / allowable:.3f}")
+
+
+def location_utilization(row: dict) -> float:
+    """A location's utilization in ``structures.json``: its largest judged peak over decisive allowable (-)."""
+    return max((c["peak"] / c["decisive_allowable"] for c in row["criteria"].values() if c["peak"] is not None),
+               default=float("nan"))
+
+
+def decisive_allowable(structures: dict, joint: str) -> float:
+    """The decisive allowable (N m) of the weak location on ``joint`` (its moment criterion, as the demand here)."""
+    row = next(r for r in structures["locations"] if r["joint"] == joint)
+    return row["criteria"]["moment"]["decisive_allowable"]
+
+
 def print_wrapping(net, series) -> None:
     """The bullets' along-track position beyond the main body's centre (m) and the net's kinetic energy relative to
     the debris' centre of mass (J), at 16 times."""
@@ -106,6 +135,9 @@ def main() -> None:
     parser.add_argument("--release", default="never")
     parser.add_argument("--joint", default="solar_array_hinge")
     parser.add_argument("--keep", default=None)
+    parser.add_argument("--kept", default=None, help="a folder kept by --keep: print its history, run nothing")
+    parser.add_argument("--judge-until", type=float, action="append", default=[],
+                        help="also print the peak demand up to this time (s); repeatable")
     args = parser.parse_args()
     overrides = sample_overrides(Path(args.store), args.sample) | {"structures.release": args.release}
     if args.velocity is not None:
@@ -115,25 +147,34 @@ def main() -> None:
     case = validate_case(case_with(tomllib.loads(Path(args.case).read_text()), overrides), args.case)
     print(f"{args.case}, sample {args.sample}: {overrides}")
     with tempfile.TemporaryDirectory() as tmp:
-        out = Path(args.keep) if args.keep else Path(tmp) / "run"
-        load, start = os.getloadavg()[0], time.process_time()
-        run_case(args.case, out, case=case, overwrite=True)
-        print(f"CPU {time.process_time() - start:.1f} s, load average {load:.1f} -> {os.getloadavg()[0]:.1f}")
-        series, net = np.load(out / "timeseries.npz"), np.load(out / "net.npz")
-        structures = json.loads((out / "structures.json").read_text())
-        drift = json.loads((out / "summary.json").read_text())["checks"]["energy_balance_relative_drift"]
-        joint = next(j for j in case.target.joints if j.name == args.joint)
-        child = [str(n) for n in series["body_names"]].index(joint.child)
-        demand = hinge_demand(series, args.joint)
-        print("first contact (s):", {n: (None if t is None else round(t, 3)) for n, t in first_contacts(series).items()})
-        print(f"{args.joint}: demand (h1, h3 resultant) and contact forces per {WINDOW_S} s window:")
-        print_windows(series, demand)
-        print_peak(series, demand, args.joint, child, structures["skip_initial_s"])
-        print("wrapping:")
-        print_wrapping(net, series)
-    states = ", ".join(f"{row['name']} {row['state']}" for row in structures["locations"])
-    print(f"answer {structures['debris_state']}: {states}; energy balance largest drift {100 * drift:.2f} %")
+        out = Path(args.kept or args.keep or Path(tmp) / "run")
+        if args.kept is None:
+            load, start = os.getloadavg()[0], time.process_time()
+            run_case(args.case, out, case=case, overwrite=True)
+            print(f"CPU {time.process_time() - start:.1f} s, load average {load:.1f} -> {os.getloadavg()[0]:.1f}")
+        else:
+            print(f"read from {out} (kept by an earlier run of the same command with --keep); nothing run")
+        print_history(out, next(j for j in case.target.joints if j.name == args.joint), args.judge_until)
 
+
+def print_history(out: Path, joint, judge_until: list) -> None:
+    """Everything printed about the run in folder ``out``, for the weak location on ``joint`` (a case joint)."""
+    series, net = np.load(out / "timeseries.npz"), np.load(out / "net.npz")
+    structures = json.loads((out / "structures.json").read_text())
+    drift = json.loads((out / "summary.json").read_text())["checks"]["energy_balance_relative_drift"]
+    child = [str(n) for n in series["body_names"]].index(joint.child)
+    demand = hinge_demand(series, joint.name)
+    print("first contact (s):", {n: (None if t is None else round(t, 3)) for n, t in first_contacts(series).items()})
+    print(f"{joint.name}: demand (h1, h3 resultant) and contact forces per {WINDOW_S} s window:")
+    print_windows(series, demand)
+    print_peak(series, demand, joint.name, child, structures["skip_initial_s"])
+    print_peaks_until(series, demand, structures["skip_initial_s"], judge_until,
+                      decisive_allowable(structures, joint.name))
+    print("wrapping:")
+    print_wrapping(net, series)
+    states = ", ".join(f"{row['name']} {row['state']} (utilization {location_utilization(row):.3f})"
+                       for row in structures["locations"])
+    print(f"answer {structures['debris_state']}: {states}; energy balance largest drift {100 * drift:.2f} %")
 
 if __name__ == "__main__":
     main()

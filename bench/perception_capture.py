@@ -37,7 +37,9 @@ def capture_hooks(store: dict):
         return state, tracker, target_to_body
 
     def observe_collision(scene, tracker, frames, *args, **kwargs):
+        keep_collision_inputs(store, tracker)
         track = collide(scene, tracker, frames, *args, **kwargs)
+        store["candidate_log"] = tracker.candidate_log
         store["frames"] = {name: list(getattr(frames, name)) for name in
                            ("time", "phase", "n_points", "rotation_error", "true_target_to_world", "true_com_world")}
         store["truth"] = scene.truth
@@ -64,6 +66,32 @@ def capture_hooks(store: dict):
     perceive.observe_collision = observe_collision
     perceive.others_momentum_after = others_momentum_after
     perceive.momentum_step = momentum_step
+
+
+def keep_collision_inputs(store: dict, tracker) -> None:
+    """The tracker as the collision phase starts (its settings, map and alignments) and, through a
+    wrapper of this tracker's ``update``, every collision frame's registration inputs, into ``store``;
+    the tracker's candidate log switched on. Enough to replay the collision phase's registration offline
+    (bench/perception_reacquire_candidates.py); the wrapped ``update`` returns what the tracker's does."""
+    store["collision_tracker"] = {
+        "settings": {"voxel": tracker.voxel, "max_correspondence": tracker.max_correspondence,
+                     "model_frames": tracker.model_frames, "seed": tracker.seed,
+                     "free_space_lateral_bins": tracker.free_space_lateral_bins,
+                     "search_cpu_per_frame": tracker.search_cpu_per_frame,
+                     "search_cpu_per_run": tracker.search_cpu_per_run, "continuity_turn": tracker.continuity_turn},
+        "map_points_body": np.array(tracker.model_points_body), "map_normals_body": np.array(tracker._model_normals),
+        "alignments": list(tracker.alignments), "search_cpu_spent": tracker.search_cpu_spent}
+    updates = store["collision_updates"] = []
+    tracker.candidate_log = []
+    update = tracker.update
+
+    def recorded_update(time_s, points_world, sensor_world, **kwargs):
+        updates.append({"time": time_s, "points_world": np.array(points_world), "sensor_world": np.array(sensor_world),
+                        "field_of_view": tracker.field_of_view, "ray_spacing": tracker.ray_spacing,
+                        **{key: (None if value is None else np.array(value)) for key, value in kwargs.items()}})
+        return update(time_s, points_world, sensor_world, **kwargs)
+
+    tracker.update = recorded_update
 
 
 def _assembly_parts(assembly):

@@ -10,6 +10,11 @@ propagation's error, which the continuity limit must exceed), accepted pose to t
 rates just before the loss and at the re-acquisition (from the truth's attitudes, 0.1 s apart).
 
     python bench/perception_reacquire_continuity.py /tmp/percep15_captures/none_obs20_seed*.pkl
+
+``--rate-frames N [N ...]`` adds, for each N, the propagation from constant rates fitted to the last N
+registered frames before the loss (:func:`perception.registration.propagate_fitted_pose`; N = 2 is the
+two-frame propagation): its angle to the truth at the re-acquisition and at every whole second of the gap,
+and the fitted rate against the true one.
 """
 import argparse
 import pickle
@@ -17,7 +22,7 @@ import pickle
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from perception.registration import propagate_pose
+from perception.registration import propagate_fitted_pose, propagate_pose
 
 
 def _angle_deg(a, b) -> float:
@@ -59,9 +64,44 @@ def reacquisition_figures(path) -> dict | None:
             "propagation_to_accepted_deg": _angle_deg(propagated, accepted)}
 
 
+def fitted_propagation_errors(path, frame_counts) -> list[dict]:
+    """Per N of ``frame_counts``: the fitted rate (rad/s) from the last N registered frames before the
+    collision phase's first loss, and the propagation's angle to the truth (deg) at the re-acquisition
+    and 1, 2, 3, 4, 5 s after the last registered frame."""
+    capture = pickle.load(open(path, "rb"))
+    frames, alignments = capture["frames"], capture["alignments"]
+    target_to_body = capture["target_to_body"][:3, :3]
+    times, phase = np.array(frames["time"]), np.array(frames["phase"])
+    ok = np.array([a.ok for a in alignments])
+    truth = [np.asarray(r) @ target_to_body.T for r in frames["true_target_to_world"]]
+    collision = np.flatnonzero(phase == 1)
+    lost = [i for i in collision if not ok[i] and ok[i - 1]]
+    back = [i for i in collision if lost and i > lost[0] and ok[i]]
+    if not back:
+        return []
+    last = lost[0] - 1
+    rows = []
+    for count in frame_counts:
+        used = list(range(last - count + 1, last + 1))
+        if not ok[used].all():
+            continue
+        poses = [alignments[i].world_to_body for i in used]
+        at = {}
+        for index in [back[0]] + [int(np.argmin(np.abs(times - times[last] - gap))) for gap in (1, 2, 3, 4, 5)]:
+            propagated = np.linalg.inv(propagate_fitted_pose(times[used], poses, times[index]))[:3, :3]
+            at[round(float(times[index] - times[last]), 1)] = _angle_deg(propagated, truth[index])
+        # the fitted rate: between two propagated poses (the fit's line need not pass through the last pose)
+        one, two = (np.linalg.inv(propagate_fitted_pose(times[used], poses, times[last] + step))[:3, :3] for step in (0.1, 0.2))
+        rate = Rotation.from_matrix(two @ one.T).magnitude() / 0.1
+        rows.append({"frames": count, "rate": rate, "reacquired_gap_s": round(float(times[back[0]] - times[last]), 1),
+                     "to_truth_deg": at})
+    return rows
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("captures", nargs="+")
+    parser.add_argument("--rate-frames", type=int, nargs="+", default=[])
     args = parser.parse_args(argv)
     for path in args.captures:
         figures = reacquisition_figures(path)
@@ -71,6 +111,10 @@ def main(argv=None):
         print(path, "lost %.1f s, re-acquired %.1f s (gap %.1f s); rate registered before %.3f rad/s, true before "
               "%.3f, true at re-acquisition %.3f; propagation -> truth %.1f deg, accepted -> truth %.1f deg, "
               "propagation -> accepted %.1f deg" % tuple(figures.values()))
+        for row in fitted_propagation_errors(path, args.rate_frames):
+            print("    rate fitted to %d frames: %.3f rad/s; propagation -> truth (deg) at gap (s): %s (re-acquired at %.1f)"
+                  % (row["frames"], row["rate"], ", ".join(f"{gap:g}: {angle:.1f}" for gap, angle in row["to_truth_deg"].items()),
+                     row["reacquired_gap_s"]))
 
 
 if __name__ == "__main__":

@@ -59,6 +59,14 @@ def print_energy_terms(series: dict, t: np.ndarray, reference: float) -> None:
         f"{key[7:]} {100 * (series[key][-1] - series[key][k0]) / reference:+.3f}" for key in terms))
 
 
+def gain_split(series: dict, k: int, reference: float, smallest: float = 5e-4) -> str:
+    """The change of each energy term between samples ``k`` and ``k + 1`` (% of the reference energy), those of at
+    least ``smallest`` % in size: which terms a one-sample gain of the total is made of."""
+    parts = [(key[7:], 100 * (series[key][k + 1] - series[key][k]) / reference) for key in series
+             if key.startswith("energy_") and key != "energy_total"]
+    return ", ".join(f"{name} {change:+.3f}" for name, change in parts if abs(change) >= smallest)
+
+
 def joint_rotation_damping_work(series: dict, assembly) -> list:
     """Per joint, the work its rotational dampers took (J), estimated from the sampled relative angular velocity:
     the sum over the joint frame's axes of c_k times the trapezoid integral of (rate_k)^2 (the hinge axis h2 of a
@@ -90,6 +98,8 @@ def main(argv=None) -> None:
     parser.add_argument("--key", default="on", choices=("on", "off"))
     parser.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                         help="a case value overridden, e.g. contact.mu_static=0 (an experiment, repeatable)")
+    parser.add_argument("--save", default=None, metavar="NPZ",
+                        help="write the run's time series (every key of Recorder.series) to this .npz file")
     args = parser.parse_args(argv)
     case_path = Path(args.case)
     with tempfile.TemporaryDirectory() as folder:
@@ -114,6 +124,8 @@ def main(argv=None) -> None:
         if 0 <= k < len(t) and t[k] > when - 0.01:
             print(f"   t {t[k]:.3f} s  drift {100 * drift[k]:+.3f} %")
     print_energy_terms(series, t, reference)
+    if args.save:
+        np.savez_compressed(args.save, reference_energy=reference, **series)
     if "energy_dissipated_joints" in series:
         print(f"   joints' dampers, booked every step (energy_dissipated_joints, all joints, all axes): "
               f"{100 * series['energy_dissipated_joints'][-1] / reference:.3f} % of the reference energy")
@@ -122,7 +134,7 @@ def main(argv=None) -> None:
                       for name, hinge, other in joint_rotation_damping_work(series, assembly)))
     gains = np.diff(drift)
     for k in np.argsort(-gains)[:10]:
-        print(f"   gain at t {t[k + 1]:.4f} s: {100 * gains[k]:+.3f} %")
+        print(f"   gain at t {t[k + 1]:.4f} s: {100 * gains[k]:+.3f} %; " + gain_split(series, k, reference))
     segments = simulation.system.kernel.buffers.segments
     if segments.enabled:
         jump = segments.energy_jump

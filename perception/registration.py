@@ -200,6 +200,18 @@ def _score(alignment) -> float:
     return float(alignment.ok) + alignment.tight_fitness - alignment.free_space_violation - alignment.unseen
 
 
+def failed_checks(alignment, has_motion) -> list[str]:
+    """Names of the checks of the frame (module docstring) that ``alignment`` fails: "fitness" (tight
+    fitness below MIN_TIGHT_FITNESS), "free space" (violation above MAX_FREE_SPACE_VIOLATION), "unseen"
+    (unseen model share above MAX_UNSEEN), "innovation" (turn from the prediction above MAX_INNOVATION,
+    judged only ``has_motion``); empty for a passing alignment."""
+    failed = [name for name, bad in (("fitness", alignment.tight_fitness < MIN_TIGHT_FITNESS),
+                                     ("free space", alignment.free_space_violation > MAX_FREE_SPACE_VIOLATION),
+                                     ("unseen", alignment.unseen > MAX_UNSEEN),
+                                     ("innovation", has_motion and alignment.innovation > MAX_INNOVATION)) if bad]
+    return failed
+
+
 @dataclass
 class Alignment:
     """One frame's registration.
@@ -513,6 +525,51 @@ def propagate_pose(previous, before, steps) -> np.ndarray:
     return np.linalg.inv(propagated)
 
 
+def propagate_fitted_pose(times, world_to_body, time_s) -> np.ndarray:
+    """world_to_body at ``time_s`` from constant rotation and translation rates fitted by least squares
+    to registered frames: with the last frame k as reference, the rotation vectors
+    x_i = log(R_i R_k^T) and the positions p_i are fitted by straight lines in t_i - t_k,
+
+    .. math:: x_i \approx a + \omega (t_i - t_k), \quad p_i \approx b + v (t_i - t_k),
+              \quad R(t) = \exp(a + \omega (t - t_k)) R_k, \quad p(t) = b + v (t - t_k)
+
+    with R the body -> world rotation and p the origin of B in the world frame (m). Exact for a turn at a
+    constant rate about a fixed axis (x_i is then exactly linear); with two frames the line passes
+    through both and this is :func:`propagate_pose`. With more frames the rate's error from the frames'
+    attitude errors falls (1-sigma sigma_R sqrt(12 / (n (n^2 - 1))) / dt for n frames dt apart, against
+    sigma_R sqrt(2) / dt for two).
+
+    Parameters
+    ----------
+    times : (n,) float
+        Times of the registered frames (s), n >= 2, increasing.
+    world_to_body : sequence of n (4, 4) float
+        Their world_to_body transforms (m).
+    time_s : float
+        Time of the propagated pose (s).
+
+    Returns
+    -------
+    (4, 4) float
+        Propagated world_to_body (m).
+    """
+    times = np.asarray(times, float)
+    if len(times) < 2 or len(times) != len(world_to_body):
+        raise ValueError(f"propagate_fitted_pose needs n >= 2 times and as many poses; got {len(times)} "
+                         f"times and {len(world_to_body)} poses")
+    body_to_world = [np.linalg.inv(pose) for pose in world_to_body]
+    reference = body_to_world[-1][:3, :3]
+    elapsed = times - times[-1]
+    turns = Rotation.from_matrix(np.array([pose[:3, :3] @ reference.T for pose in body_to_world])).as_rotvec()
+    places = np.array([pose[:3, 3] for pose in body_to_world])
+    design = np.column_stack([np.ones_like(elapsed), elapsed])
+    (turn_0, rate), (place_0, velocity) = (np.linalg.lstsq(design, values, rcond=None)[0] for values in (turns, places))
+    propagated = np.eye(4)
+    propagated[:3, :3] = Rotation.from_rotvec(turn_0 + rate * (time_s - times[-1])).as_matrix() @ reference
+    propagated[:3, 3] = place_0 + velocity * (time_s - times[-1])
+    return np.linalg.inv(propagated)
+
+
 def nearer_propagation(candidates, propagated, limit) -> list:
     """The candidate alignments whose attitude lies within ``limit`` (rad) of ``propagated``
     (world_to_body, (4, 4)), best-scored first (:func:`_score`).
@@ -523,6 +580,17 @@ def nearer_propagation(candidates, propagated, limit) -> list:
     """
     kept = [c for c in candidates if _turn_angle(c.world_to_body[:3, :3], propagated[:3, :3]) <= limit]
     return sorted(kept, key=_score, reverse=True)
+
+
+def _chain_prediction(chain, time_s) -> np.ndarray:
+    """world_to_body of a candidate chain (a list of :class:`Alignment`, at least two) at ``time_s`` (s):
+    :func:`predict_pose` from its last two frames at the next frame, :func:`propagate_pose` at their
+    rates across frames the chain missed."""
+    last, before = chain[-1], chain[-2]
+    steps = (time_s - last.time) / (last.time - before.time)
+    if abs(steps - 1.0) < 1e-6:
+        return predict_pose(last.world_to_body, before.world_to_body)
+    return propagate_pose(last.world_to_body, before.world_to_body, steps)
 
 
 class DebrisTracker:
@@ -573,14 +641,22 @@ class DebrisTracker:
                                 propagation, and candidates beyond it start no chain. A box-like body's
                                 half turn fits the scans as well as the truth; the rates do not allow it
                                 (:func:`nearer_propagation`). Default None: off.
+    chain_missed_frames : int   Consecutive frames a candidate chain after a lost track (of at least two
+                                frames, so with a motion) may fail and still go on, its next frame predicted
+                                across the gap; the failed frames stay failed. 0 (default): a chain is
+                                dropped at its first failed frame.
     """
 
     def __init__(self, voxel=0.03, max_correspondence=0.1, model_frames=30, model_points_body=None,
                  model_normals_body=None, symmetries_body=None, seed=0, field_of_view=None, ray_spacing=0.0,
                  search_cpu_per_frame=np.inf, search_cpu_per_run=np.inf, free_space_lateral_bins=0,
-                 continuity_turn=None):
+                 continuity_turn=None, chain_missed_frames=0):
         self.voxel = voxel
         self.continuity_turn = continuity_turn
+        self.chain_missed_frames = int(chain_missed_frames)
+        # None: off; a list: every candidate pose a lost track's search or chain produced, one dict each
+        # (:meth:`_log_candidates`), to see offline why a pose was or was not re-acquired
+        self.candidate_log = None
         self.free_space_lateral_bins = int(free_space_lateral_bins)
         self.search_cpu_per_frame = float(search_cpu_per_frame)
         self.search_cpu_per_run = float(search_cpu_per_run)
@@ -592,6 +668,7 @@ class DebrisTracker:
         self._passing_alignments = []        # passing alignments of the last search other than the kept one
         self._searched = False               # the frame being registered has done search work
         self._chains = []                    # candidate pose sequences after a lost track (see _continue_chains)
+        self._chain_misses = []              # consecutive frames each chain has failed (at most chain_missed_frames)
         self.revised = []                    # indices of earlier frames whose alignment the last update replaced
         self.symmetries_body = [np.eye(4)] if symmetries_body is None else [np.asarray(s, float) for s in symmetries_body]
         self.seed = seed
@@ -746,7 +823,7 @@ class DebrisTracker:
         try:
             alignment = self._track(time_s, scan, predicted, has_motion, sensor_world)
         except SearchBudgetSpent:
-            self._chains, self._passing_alignments = [], []
+            self._chains, self._chain_misses, self._passing_alignments = [], [], []
             pose = predicted if predicted is not None else np.eye(4)
             alignment = Alignment(time_s, pose, np.zeros((6, 6)), 0.0, 1.0, np.inf, False, False, 0.0,
                                   len(scan.points), over_budget=True)
@@ -764,7 +841,7 @@ class DebrisTracker:
         # one spacing per frame for every check of it (a search checks up to SEARCH_REFINED poses)
         self._frame_spacing = _sample_spacing(points) if len(points) >= MIN_POINTS else None
         if len(points) < MIN_POINTS:   # e.g. everything gated away: record the frame as failed, do not guess
-            self._chains = []          # a chain continues frame by frame only
+            self._chains, self._chain_misses = [], []   # a chain continues frame by frame only
             pose = predicted if predicted is not None else np.eye(4)
             return Alignment(time_s, pose, np.zeros((6, 6)), 0.0, 1.0, np.inf, False, False, 0.0, len(points))
         if self._chains:
@@ -773,12 +850,13 @@ class DebrisTracker:
             alignment = self._judge(time_s, points, self._icp(scan, predicted), predicted, sensor_world, True)
         elif self.alignments and self.alignments[-1].ok:
             # One frame since the last good pose: the body turned by at most SEARCH_TURN.
-            alignment = self._search(time_s, scan, predicted, _turn_candidates(SEARCH_TURN), sensor_world)
+            alignment = self._search(time_s, scan, predicted, _turn_candidates(SEARCH_TURN), sensor_world,
+                                     label="one frame after a good one")
         else:
             # No pose yet, or the track was lost for frames (a collision may have changed the spin a lot).
             alignment = self._search(time_s, scan, self._acquisition_start(points, predicted),
                                      _orientation_candidates(LOST_SEEDS if self.alignments else 240), sensor_world,
-                                     visible_side=True, polish=bool(self.alignments))
+                                     visible_side=True, polish=bool(self.alignments), label="all attitudes")
             if self.continuity_turn is not None and any(a.ok for a in self.alignments):
                 alignment = self._continuous_candidates(time_s, scan, alignment, sensor_world)
             if alignment.ok and any(a.ok for a in self.alignments):
@@ -808,7 +886,7 @@ class DebrisTracker:
             return found
         candidates = [found] + self._passing_alignments
         from_propagation = self._search(time_s, scan, propagated, _turn_candidates(SEARCH_TURN), sensor_world,
-                                        visible_side=True)
+                                        visible_side=True, label="small turns of the propagation")
         candidates += [from_propagation] + self._passing_alignments
         kept = nearer_propagation([c for c in candidates if c.ok], propagated, self.continuity_turn)
         if not kept:
@@ -816,6 +894,28 @@ class DebrisTracker:
             return Alignment(**{**found.__dict__, "ok": False})
         self._passing_alignments = kept[1:]
         return kept[0]
+
+    def _log_candidates(self, time_s, stage, candidates, has_motion) -> None:
+        """Appends to ``candidate_log`` (when on) one dict per candidate: time (s), stage, world_to_body,
+        the check's figures, the checks failed (:func:`failed_checks`) and the turn from the attitude
+        propagated at the last registered rates (rad; NaN without it)."""
+        if self.candidate_log is None:
+            return
+        propagated = self.propagated_world_to_body(time_s)
+        for candidate in candidates:
+            turn = np.nan if propagated is None else _turn_angle(candidate.world_to_body[:3, :3], propagated[:3, :3])
+            self.candidate_log.append({
+                "time": time_s, "stage": stage, "world_to_body": candidate.world_to_body.copy(), "ok": candidate.ok,
+                "tight_fitness": candidate.tight_fitness, "free_space_violation": candidate.free_space_violation,
+                "unseen": candidate.unseen, "innovation": candidate.innovation,
+                "failed": failed_checks(candidate, has_motion), "turn_from_propagation": turn})
+
+    def _log_chains(self, time_s, survivors) -> None:
+        """Appends to ``candidate_log`` (when on) the chains surviving a frame: their lengths and view
+        turns (rad, :func:`_view_turn`), the numbers a confirmation waits for."""
+        if self.candidate_log is not None:
+            self.candidate_log.append({"time": time_s, "stage": "chains", "lengths": [len(c) for c in survivors],
+                                       "view_turns": [_view_turn(c) for c in survivors]})
 
     def _start_chains(self, alignment) -> Alignment:
         """The passing poses of a search after a lost track (the kept one and the others, one per
@@ -828,13 +928,16 @@ class DebrisTracker:
                         for symmetry in self.symmetries_body) > AMBIGUOUS_TURN for kept in starts):
                 starts.append(other)
         self._chains = [[start] for start in starts]
+        self._chain_misses = [0] * len(self._chains)
         return Alignment(**{**alignment.__dict__, "ok": False})
 
     def _continue_chains(self, time_s, scan, sensor_world) -> Alignment:
         """One more frame for each candidate chain after a lost track: the second frame by the
         small-turn search from the chain's pose, the third by ICP from the constant-rate prediction
         of the two (the check with the innovation limit: one angular velocity). Chains failing the
-        check are dropped. After CONFIRMING_FRAMES frames, and once the chain's view of the body has
+        check are dropped, or, with ``chain_missed_frames``, carried over up to that many consecutive failed
+        frames (predicted across them, :func:`_chain_prediction`; a chain then alive without this frame still
+        counts as an alternative). After CONFIRMING_FRAMES frames, and once the chain's view of the body has
         turned by CONFIRMING_VIEW_TURN (a half turn of a box-like body moves rigidly too and is told apart
         only when the differing side comes into view), a single surviving chain is the track: its
         frames replace the pending ones (their indices in ``revised``). Several surviving chains are
@@ -847,37 +950,50 @@ class DebrisTracker:
         continue as one rigid motion is much rarer than one that fits one frame.
         """
         points = np.asarray(scan.points)
-        survivors, tried = [], []
-        for chain in self._chains:
+        alive, misses, tried = [], [], []
+        for chain, missed in zip(self._chains, self._chain_misses):
             self._spend()
             if len(chain) == 1:
                 # seeds on the visible side: the debris may have moved beyond the coarse ICP's reach in
                 # one frame (0.3 m at the featured debris' 3.15 m/s after the contact; seeds at the
                 # last pose's place ended 30 deg off the truth there)
                 candidate = self._search(time_s, scan, chain[-1].world_to_body, _turn_candidates(SEARCH_TURN),
-                                         sensor_world, visible_side=True)
+                                         sensor_world, visible_side=True, label="chain's second frame")
             else:
-                predicted = predict_pose(chain[-1].world_to_body, chain[-2].world_to_body)
+                predicted = _chain_prediction(chain, time_s)
                 candidate = self._judge(time_s, points, self._icp(scan, predicted), predicted, sensor_world, True)
+                self._log_candidates(time_s, f"chain's frame {len(chain) + 1}", [candidate], has_motion=True)
             tried.append(candidate)
             if candidate.ok:
-                survivors.append(chain + [candidate])
-        self._chains = survivors
+                alive.append(chain + [candidate])
+                misses.append(0)
+            elif len(chain) >= 2 and missed < self.chain_missed_frames:
+                alive.append(chain)   # carried over this failed frame
+                misses.append(missed + 1)
+        self._chains, self._chain_misses = alive, misses
+        self._log_chains(time_s, alive)
+        survivors = [chain for chain in alive if any(chain[-1] is candidate for candidate in tried)]   # passed this frame
         if not survivors:
             best = max(tried, key=_score)
             return Alignment(**{**best.__dict__, "ok": False})
         if len(survivors[0]) < CONFIRMING_FRAMES or _view_turn(survivors[0]) < CONFIRMING_VIEW_TURN:
             return Alignment(**{**survivors[0][-1].__dict__, "ok": False})
-        self._chains = []
-        if len(survivors) > 1:   # two rigid motions explain the scans: no answer rather than a guess
+        self._chains, self._chain_misses = [], []
+        if len(alive) > 1:   # two rigid motions explain the scans: no answer rather than a guess
             return Alignment(**{**survivors[0][-1].__dict__, "ok": False})
-        first = len(self.alignments) - (len(survivors[0]) - 1)
-        for index, confirmed in zip(range(first, len(self.alignments)), survivors[0]):
+        self._revise(survivors[0][:-1])
+        return survivors[0][-1]
+
+    def _revise(self, confirmed) -> None:
+        """The pending frames of a confirmed chain (its alignments but the current frame's) replace the
+        frames registered at their times (indices in ``revised``)."""
+        index_at = {alignment.time: index for index, alignment in enumerate(self.alignments)}
+        for alignment in confirmed:
+            index = index_at[alignment.time]
             previous = self.alignments[index]
-            self.alignments[index] = Alignment(**{**confirmed.__dict__, "time": previous.time,
+            self.alignments[index] = Alignment(**{**alignment.__dict__, "time": previous.time,
                                                   "seconds": previous.seconds, "cpu_seconds": previous.cpu_seconds})
             self.revised.append(index)
-        return survivors[0][-1]
 
     def _retry_from_global(self, time_s, scan, failed, predicted, has_motion, sensor_world) -> Alignment:
         """The frame again from FPFH + RANSAC; kept when it passes or fits tighter than ``failed``."""
@@ -886,6 +1002,7 @@ class DebrisTracker:
         pose = self._nearest_variant(self._icp(scan, self._global(scan, reference)), reference)
         points = np.asarray(scan.points)
         retry = self._judge(time_s, points, pose, reference, sensor_world, has_motion, global_init=True)
+        self._log_candidates(time_s, "global (FPFH + RANSAC)", [retry], has_motion)
         return retry if retry.ok or retry.tight_fitness > failed.tight_fitness else failed
 
     def predicted_world_to_body(self) -> np.ndarray | None:
@@ -909,14 +1026,16 @@ class DebrisTracker:
         start[:3, 3] = self._model_points.mean(axis=0) - start[:3, :3] @ points.mean(axis=0)
         return start
 
-    def _search(self, time_s, scan, start, turns, sensor_world, visible_side=False, polish=False) -> Alignment:
+    def _search(self, time_s, scan, start, turns, sensor_world, visible_side=False, polish=False,
+                label="search") -> Alignment:
         """Without a motion prediction: ``start`` turned by each of ``turns`` about the scan
         centroid (a smooth body, the paper's ellipsoid, gives ICP a basin of only a few degrees),
         each seed ranked by one coarse ICP level on a heavily thinned scan; the best SEARCH_REFINED
         distinct results are refined and checked, the best-checked kept (the other passing ones in
         ``self._passing_alignments``). With ``visible_side`` each seed's scan centroid is put on the centroid of
         the model's side the sensor sees at that attitude (:meth:`_visible_side_seeds`). With ``polish``
-        the best refined results are searched again about themselves (:meth:`_polished`)."""
+        the best refined results are searched again about themselves (:meth:`_polished`). ``label`` names
+        the search in ``candidate_log``."""
         points = np.asarray(scan.points)
         thin = np.asarray(scan.voxel_down_sample(SEARCH_VOXELS * self.voxel).points)
         seeds = (self._visible_side_seeds(start, points, sensor_world, turns) if visible_side
@@ -945,6 +1064,7 @@ class DebrisTracker:
             refined += self._polished(time_s, scan, refined, sensor_world)
         best = max(refined, key=_score)
         self._passing_alignments = [candidate for candidate in refined if candidate.ok and candidate is not best]
+        self._log_candidates(time_s, label, refined, has_motion=False)
         return best
 
     def _polished(self, time_s, scan, refined, sensor_world) -> list[Alignment]:
@@ -956,7 +1076,7 @@ class DebrisTracker:
         polished = []
         for candidate in sorted(refined, key=_score, reverse=True)[:POLISHED]:
             polished.append(self._search(time_s, scan, candidate.world_to_body, _turn_candidates(SEARCH_TURN),
-                                         sensor_world, visible_side=True))
+                                         sensor_world, visible_side=True, label="polish"))
             polished += self._passing_alignments
         return polished
 

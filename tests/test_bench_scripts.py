@@ -196,3 +196,53 @@ def test_peak_convergence_replays_a_store_sample_with_the_replica_offsets(tmp_pa
     assert module.replica_overrides(overrides, 1, 1.75)["launch.velocity"] == pytest.approx(1.750000175, rel=1e-15,
                                                                                           abs=0.0)
     assert module.replica_overrides({}, 3, None) == {}
+
+
+def test_safe_velocity_history_splits_the_judged_peak_at_the_row_end(capsys):
+    """bench_safe_velocity_history.py --judge-until T: the peak of the h1-h3 resultant over [skip, T] and over (T, end],
+    each with its time and utilization. A demand of 3-4-5 triangles' known apexes (h1 = 30, h3 = 40 N m at 2 s: 50 N m;
+    h3 = 150 N m at 6 s) against a 200 N m allowable: 0.25 before T = 4 s, 0.75 after; the skipped start (a 300 N m
+    spike at 0.1 s) is not judged."""
+    import numpy as np
+
+    module = _bench_module("bench_safe_velocity_history")
+    time = np.arange(0.0, 8.0005, 0.001)
+    moment_joint = np.zeros((time.size, 1, 3))
+    moment_joint[:, 0, 0] = 30.0 * np.clip(1 - abs(time - 2.0), 0, None)
+    moment_joint[:, 0, 2] = 40.0 * np.clip(1 - abs(time - 2.0), 0, None) + 150.0 * np.clip(1 - abs(time - 6.0), 0, None)
+    moment_joint[100, 0, 2] = 300.0
+    series = {"time": time, "joint_moment_joint": moment_joint, "joint_names": np.array(["hinge"])}
+    demand = module.hinge_demand(series, "hinge")
+    module.print_peaks_until(series, demand, 0.25, [4.0], 200.0)
+    lines = capsys.readouterr().out.splitlines()
+    assert lines == ["peak demand over [0.25, 4] s: 50.0 N m at 2.000 s, utilization 0.250",
+                     "peak demand over (4, 8.00] s: 150.0 N m at 6.000 s, utilization 0.750"]
+
+
+def test_peak_convergence_quantile_change_sees_the_tail_the_median_does_not():
+    """bench_peak_convergence.quantile_change: the change of a quantile of the replicas' peaks and its 90 % bootstrap
+    interval. Expected values by hand: numpy's linear quantile (Hyndman & Fan type 7) of 1..11 at 0.9 sits at order
+    position 0.9 x 10 = 9, the value 10; every value scaled by 1.1 scales every quantile and every bootstrap draw's
+    ratio only when the draws cannot differ (constant sets), so there the interval is the change itself, +10 %
+    exactly (round-off only: 1e-12). Doubling the two largest of 1..11 leaves the median (6) unchanged and moves the
+    0.9 quantile from 10 to 20 (+100 %)."""
+    import numpy as np
+
+    module = _bench_module("bench_peak_convergence")
+    rng = np.random.default_rng(0)
+    base = np.arange(1.0, 12.0)
+    assert np.quantile(base, 0.9) == 10.0
+    change, low, high = module.quantile_change(np.full(8, 2.0), np.full(8, 2.2), rng, 0.9)
+    assert (change, low, high) == pytest.approx((0.1, 0.1, 0.1), rel=0.0, abs=1e-12)
+    assert module.verdict(change, low, high) == "NOT CONVERGED"
+    tail = base.copy()
+    tail[-2:] *= 2.0
+    median, _, _ = module.quantile_change(base, tail, rng, 0.5)
+    upper, low, high = module.quantile_change(base, tail, rng, 0.9)
+    assert median == 0.0
+    assert upper == pytest.approx(1.0, rel=0.0, abs=1e-12)
+    assert low <= upper <= high          # the interval holds the change it is drawn around
+    # the median's change is the 0.5 quantile's, draw for draw (the same generator state)
+    assert module.median_change(base, tail, np.random.default_rng(3)) == module.quantile_change(
+        base, tail, np.random.default_rng(3), 0.5)
+    assert module.statistic_name(0.5) == "median" and module.statistic_name(0.9) == "q90"

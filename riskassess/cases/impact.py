@@ -478,6 +478,10 @@ class Registration(Strict):
         None, description="Largest turn (rad) between a re-acquired debris attitude after a lost track and the "
                           "attitude propagated from the last registered rates; candidates beyond it are dropped, "
                           "a search from the propagated attitude is added (issue 26). None: off.")
+    reacquire_chain_missed_frames: Annotated[int, Field(ge=0)] = Field(
+        0, description="Consecutive frames a candidate pose chain after a lost debris track may fail and still go "
+                       "on, predicted across the gap (-); the failed frames stay failed (issue 26). 0: a chain "
+                       "ends at its first failed frame.")
 
     @model_validator(mode="after")
     def _budget(self):

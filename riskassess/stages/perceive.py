@@ -425,11 +425,13 @@ def track_model_free(scene: Scene, frames: Frames):
 def _search_budget(registration) -> dict:
     """The tracker's CPU limits of the search for a lost track (``perception.registration``'s
     ``search_cpu_per_frame`` and ``search_cpu_per_run``, s) and its continuity limit of a
-    re-acquisition (``reacquire_continuity_turn``, rad), as keyword arguments of
+    re-acquisition (``reacquire_continuity_turn``, rad) and the frames a candidate chain may miss
+    (``reacquire_chain_missed_frames``), as keyword arguments of
     :class:`perception.registration.DebrisTracker`."""
     return {"search_cpu_per_frame": registration.search_cpu_per_frame,
             "search_cpu_per_run": registration.search_cpu_per_run,
-            "continuity_turn": registration.reacquire_continuity_turn}
+            "continuity_turn": registration.reacquire_continuity_turn,
+            "chain_missed_frames": registration.reacquire_chain_missed_frames}
 
 
 def _search_budget_figures(tracker: DebrisTracker, frames: Frames) -> dict:
