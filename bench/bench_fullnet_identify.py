@@ -6,7 +6,7 @@ from the capture start, each identified model scored on the training and the uns
     python bench/bench_fullnet_identify.py --out DIR [--case cases/zenit2_towing.toml]
         [--starts wrapped capture] [--training N] [--validation N] [--end T]
         [--optimizers pso pattern mads] [--cost f1 f1_inertial f2] [--mads-starts s0 table6] [--workers N]
-        [--table-only] [--rescore]
+        [--table-only] [--rescore] [--score LABEL S1 S2 S3 S4]
 
 The full-net runs (the first N training and validation rates of Table 3, to T) are cached in
 ``DIR/<start>/fullnet/rate_<deg_s>_end_<T>[_capture].npz``, the same files ``riskassess identify`` writes:
@@ -17,7 +17,8 @@ done, for the same held runs and settings); ``--table-only`` prints the tables f
 does, a run whose debris was not held (a failed capture, :func:`riskassess.stages.identify_fullnet.not_held`) is
 left out of training and validation and named in each answer's ``excluded_runs``. The second table gives f1
 per run with the angular velocities compared in body components (the cost ``f1``), in inertial components
-(``f1_inertial``: runs cached since 2026-11-27 store the attitudes; '-' for older runs) and roll-blind. CPU time counts this
+(``f1_inertial``: runs cached since 2026-11-27 store the attitudes; '-' for older runs) and roll-blind. ``--score LABEL S1 S2 S3 S4`` scores a given s (an
+answer found on other runs or with older code) on these runs, without a search. CPU time counts this
 process and its worker processes (the machine may be shared; wall times are printed with the load average).
 """
 from __future__ import annotations
@@ -130,6 +131,17 @@ def rescore(case: TowingCase, done: dict, start: str, train, valid, held, end, r
         print(f"  rescored {key}", flush=True)
 
 
+def score_given(case: TowingCase, train, valid, s, end) -> dict:
+    """The entry of a given ``s`` (e.g. an answer found on other runs, or with older code) scored on these held
+    training and validation runs, as a search's answer is (no search: 0 evaluations; ``cpu_s`` the scoring's)."""
+    cpu, lower = cpu_seconds(), lower_order_case(case, train[0])
+    rows = {role: comparison_rows(lower, list(s), runs, end) for role, runs in (("training", train),
+                                                                               ("validation", valid))}
+    return {"s": list(s), "cost": None, "optimizer": "given", "evaluations": 0, "wall_s": 0.0,
+            "training_totals": _totals(rows["training"]), "validation_totals": _totals(rows["validation"]),
+            "training": rows["training"], "validation": rows["validation"], "cpu_s": cpu_seconds() - cpu}
+
+
 def free_roll(totals: dict, n: int) -> str:
     """' (x.xxx)': f1 per run with omega_D compared blind to a roll about the debris' symmetry axis (the
     diagnostic of identify_fullnet.comparison_rows), or '' when not computed."""
@@ -207,6 +219,8 @@ def main():
     parser.add_argument("--rescore", action="store_true",
                         help="score every answer of DIR/results.json for these runs again with today's comparison "
                              "(no search; e.g. to add a diagnostic column)")
+    parser.add_argument("--score", nargs=5, metavar=("LABEL", "S1", "S2", "S3", "S4"),
+                        help="score this s on the runs (no search), kept in DIR/results.json as '<start>|given|LABEL'")
     args = parser.parse_args()
     out = Path(args.out)
     store = out / "results.json"
@@ -238,6 +252,12 @@ def main():
         for why in excluded:
             print(f"  left out {why['rate_deg_s']:g} deg/s: {why['reason']}", flush=True)
         held = [float(r["rate_deg_s"]) for r in train + valid]
+        if args.score:
+            entry = score_given(run_case, train, valid, [float(v) for v in args.score[1:]], args.end)
+            entry.update(rates=held, end_s=args.end, excluded_runs=excluded, reconstructed_attitudes=rebuilt)
+            done[f"{start}|given|{args.score[0]}"] = entry
+            results.atomic_write_json(store, done)
+            continue
         if args.rescore:
             rescore(run_case, done, start, train, valid, held, args.end, rebuilt)
             results.atomic_write_json(store, done)

@@ -186,7 +186,13 @@ class Lateral(Strict):
     "A lateral station-keeping law"). Off by default: the runs are then bit-identical to those without it."""
     enabled: bool = Field(False, description="A thrust component across the main tether (side thrusters in the "
                                              "chaser's body x-y plane) holding the chaser on a line through the "
-                                             "debris CoM. Full-net plant only (the lower-order model refuses it).")
+                                             "debris CoM. Full-net plant only: the lower-order model's chaser has no "
+                                             "lateral thrust, and that model runs without it.")
+    thrust_laws: Annotated[list[Literal[tuple(THRUST_LAWS)]], Field(min_length=1)] = Field(
+        ["mrac1", "mrac2"], description="The thrust laws (thrust.kind) the lateral law acts with. Default the two "
+                                        "elongation laws, the tows it was measured with (docs/towing.md); the ramp, "
+                                        "the papers' open-loop thrust of the identification runs, keeps the papers' "
+                                        "chaser (no side thrust), so its runs and their caches do not change.")
     target: Literal[tuple(LATERAL_TARGETS)] = Field(
         "momentum_axis", description="'momentum_axis' (default): the debris' angular-momentum axis (the tow "
                                      "point's once-per-turn circle across the tether; holds 29.01 deg/s with 7-8 N, "

@@ -134,7 +134,9 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
     """The lower-order model of ``case`` with the debris spinning at ``spin_rate_deg_s`` (default: the
     case's) and sub-tethers ``s`` (default: the case's). The step is the case's (or ``step``),
     reduced to a divisor of the output interval. The connection point is implicit
-    (:mod:`multibody.connection_point`), so the step does not depend on ``s``.
+    (:mod:`multibody.connection_point`), so the step does not depend on ``s``. The case's ``[lateral]`` law is
+    not part of this model (its chaser has no lateral thrust; both elongation laws hold z_d on it without one,
+    docs/towing.md, "MRAC on both plants"): the model is the same with the law on or off.
 
     Parameters
     ----------
@@ -153,10 +155,6 @@ def towing_model(case: TowingCase, spin_rate_deg_s: float | None = None, s=None,
     -------
     multibody.towing.TowingModel
     """
-    if case.lateral.enabled:
-        raise ValueError("lateral.enabled: the lateral station-keeping law (multibody/control/lateral.py) acts on the "
-                         "full-net plant only; the lower-order model's chaser has no lateral thrust. Set "
-                         "lateral.enabled = false, or run the full net (simulation.model = 'full-net')")
     s = case_decision_vector(case) if s is None else np.asarray(s, float)
     sim, ch, de = case.simulation, case.chaser, case.debris
     mt = case.main_tether

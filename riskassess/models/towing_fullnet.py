@@ -246,9 +246,9 @@ def full_net_model(case: TowingCase, spin_rate_deg_s: float | None = None, wrapp
 
 def case_lateral(case: TowingCase) -> np.ndarray:
     """The case's ``[lateral]`` law as the kernel takes it (:func:`multibody.control.lateral.lateral_params`; zeros
-    when off), acting from ``thrust.t_on``."""
+    when off or when ``thrust.kind`` is not one of ``lateral.thrust_laws``), acting from ``thrust.t_on``."""
     la = case.lateral
-    return lateral_params(la.enabled, la.target, la.natural_frequency_rad_s, la.damping_ratio, la.max_force,
+    return lateral_params(la.enabled and case.thrust.kind in la.thrust_laws, la.target, la.natural_frequency_rad_s, la.damping_ratio, la.max_force,
                           case.thrust.t_on, case.chaser.mass)
 
 

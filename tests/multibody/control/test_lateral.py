@@ -10,11 +10,13 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
-from multibody.control.lateral import (L_SIZE, TARGETS, lateral_error, lateral_params, lateral_thrust, side_thrust,
-                                       target_axis, tow_point_line_force)
+from multibody.control.lateral import (L_MASS, L_MAX, L_ON, L_SIZE, TARGETS, lateral_error, lateral_params,
+                                       lateral_thrust, side_thrust, target_axis, tow_point_line_force)
+from multibody.towing import packed
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing import towing_model
+from riskassess.models.towing_fullnet import case_lateral
 from tests.multibody.control.notch_cases import CASE
 
 M_C = 1600.0          # chaser mass (kg), Boonrath et al. 2024 Table 1
@@ -132,7 +134,9 @@ def _case_data(**lateral):
 
 
 def test_case_checks():
-    assert not load_model(CASE, TowingCase).lateral.enabled             # off in the shipped case
+    shipped = load_model(CASE, TowingCase).lateral
+    assert shipped.enabled and shipped.target == "momentum_axis"        # on in the shipped case (docs/towing.md)
+    assert shipped.thrust_laws == ["mrac1", "mrac2"]                    # with the elongation laws only
     data = _case_data()
     data["attitude_control"]["enabled"] = False
     with pytest.raises(ValueError, match="attitude_control.enabled"):
@@ -141,8 +145,36 @@ def test_case_checks():
         TowingCase.model_validate(_case_data(target="centre"))
     with pytest.raises(ValueError, match="max_force"):
         TowingCase.model_validate(_case_data(max_force=-5.0))
-    with pytest.raises(ValueError, match="full-net plant only"):
-        towing_model(TowingCase.model_validate(_case_data()))
+    with pytest.raises(ValueError, match="thrust_laws"):
+        TowingCase.model_validate(_case_data(thrust_laws=["mrac3"]))
+    with pytest.raises(ValueError, match="thrust_laws"):
+        TowingCase.model_validate(_case_data(thrust_laws=[]))
+
+
+def _with_law(kind: str, enabled: bool) -> TowingCase:
+    """The shipped case with ``thrust.kind = kind`` and the lateral law on or off (other keys as shipped)."""
+    case = load_model(CASE, TowingCase)
+    return case.model_copy(update=dict(thrust=case.thrust.model_copy(update=dict(kind=kind)),
+                                       lateral=case.lateral.model_copy(update=dict(enabled=enabled))))
+
+
+@pytest.mark.parametrize("kind, acts", [("ramp", False), ("mrac1", True), ("mrac2", True)])
+def test_the_law_acts_with_the_elongation_laws_only(kind, acts):
+    """``lateral.thrust_laws`` (default mrac1, mrac2): with the ramp, the papers' open-loop thrust of the
+    identification runs, the full-net kernel gets the all-zero vector it skips (the runs, and the identification cache
+    keyed on rate and end time, stay what they were); with either elongation law it gets the law's constants."""
+    params = case_lateral(_with_law(kind, True))
+    assert np.array_equal(params, np.zeros(L_SIZE)) is not acts
+    if acts:
+        assert params[L_ON] == 1.0 and params[L_MAX] == 50.0 and params[L_MASS] == M_C
+
+
+@pytest.mark.parametrize("kind", ["ramp", "mrac1", "mrac2"])
+def test_the_lower_order_model_is_the_same_with_the_law_on(kind):
+    """The lateral law is the full-net plant's: the lower-order model (no lateral thrust on its chaser) packs the same
+    array, bit for bit, with ``[lateral]`` on and off, so its runs of the shipped case do not change."""
+    on, off = (packed(towing_model(_with_law(kind, enabled), 29.01)).work for enabled in (True, False))
+    assert np.array_equal(on, off)
 
 
 def test_tow_point_line_force_of_the_shipped_case():

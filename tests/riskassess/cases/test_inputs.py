@@ -95,7 +95,8 @@ def test_non_finite_numbers_are_refused(tmp_path, shipped, old, new, expected):
     (IMPACT, "nodes_per_side = 15", "nodes_per_side = 15.0",
      "net.nodes_per_side: Input should be a valid integer. Got 15.0 instead"),
     (IMPACT, "mass = 350.0", "mass = true", "target.bodies[1].mass: Input should be a valid number. Got True instead"),
-    (TOWING, "enabled = true", 'enabled = "yes"', "attitude_control.enabled: Input should be a valid boolean"),
+    (TOWING, "enabled = true\nk_gain", 'enabled = "yes"\nk_gain',   # [attitude_control]'s (not [lateral]'s) flag
+     "attitude_control.enabled: Input should be a valid boolean"),
     (APPROACH, "final_at_rest = false", "final_at_rest = 1",
      "collocation.final_at_rest: Input should be a valid boolean. Got 1 instead"),
 ])

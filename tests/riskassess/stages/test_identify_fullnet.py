@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from bench.bench_fullnet_identify import score_given
 from riskassess.products import results
 from riskassess.cases.impact import CaseError, load_model
 from riskassess.stages.identify import MissingAttitude, claim_identify_folder, cost_f1, cost_f1_inertial, identify, simulate
@@ -284,3 +285,23 @@ def test_a_cached_full_net_run_keeps_the_attitudes_from_the_start_time_on():
     np.testing.assert_array_equal(kept["main_tether_tension"], time[5:])
     assert set(kept) == {"relative_position", "chaser_omega_body", "debris_omega_body", "main_tether_tension",
                          "chaser_to_inertial", "debris_to_inertial"}
+
+
+def test_a_given_s_is_scored_as_a_search_answer_is(tmp_path):
+    """``bench/bench_fullnet_identify.py --score``: a given s scored on the held runs without a search. On the
+    stand-in data (the lower-order model's own runs at s_true, from the same start state) s_true reproduces the
+    training and the unseen validation run: f1 = f2 = 0 (measured exactly 0; 1e-9 allows round-off in the RMSEs of
+    identical runs); the small case's initial guess, off s_true in every component, scores above it on both
+    (measured f1 0.83-0.88, f2 26.3-26.6 N: a tenth of each is the bound)."""
+    case = _small_case("f1")
+    _stand_in_full_net_runs(case, tmp_path)
+    train, valid = (full_net_runs(case, rates, tmp_path, END, 1)
+                    for rates in (case.rates.training_deg_s, case.rates.validation_deg_s))
+    truth = score_given(case, train, valid, case.identification.benchmark_truth, END)
+    guess = score_given(case, train, valid, case.identification.initial_guess, END)
+    assert truth["optimizer"] == "given" and truth["evaluations"] == 0
+    assert [row["rate_deg_s"] for row in truth["validation"]] == case.rates.validation_deg_s
+    for totals in (truth["training_totals"], truth["validation_totals"]):
+        assert totals["f1"] < 1e-9 and totals["f2"] < 1e-9
+    for role in ("training_totals", "validation_totals"):
+        assert guess[role]["f2"] > 2.6 and guess[role]["f1"] > 0.08
