@@ -4,7 +4,7 @@ last registered pre-contact poses lies from the truth, and from the pose the tra
 For each capture of ``bench_perception.py --capture`` (model-free stage, collision phase = phase 1):
 the first frame registered after the first lost stretch of the collision phase (the re-acquisition),
 the attitude propagated to it at the constant rates of the last two registered frames before the loss
-(:func:`perception.registration.propagate_pose`), and three angles: propagation to truth (the
+(:func:`perception.pose_motion.propagate_pose`), and three angles: propagation to truth (the
 propagation's error, which the continuity limit must exceed), accepted pose to truth (a flip is
 ~180 deg), propagation to the accepted pose; with the rates before the loss (registered) and the true
 rates just before the loss and at the re-acquisition (from the truth's attitudes, 0.1 s apart).
@@ -12,7 +12,7 @@ rates just before the loss and at the re-acquisition (from the truth's attitudes
     python bench/perception_reacquire_continuity.py /tmp/percep15_captures/none_obs20_seed*.pkl
 
 ``--rate-frames N [N ...]`` adds, for each N, the propagation from constant rates fitted to the last N
-registered frames before the loss (:func:`perception.registration.propagate_fitted_pose`; N = 2 is the
+registered frames before the loss (:func:`perception.pose_motion.propagate_fitted_pose`; N = 2 is the
 two-frame propagation): its angle to the truth at the re-acquisition and at every whole second of the gap,
 and the fitted rate against the true one.
 """
@@ -22,7 +22,7 @@ import pickle
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from perception.registration import propagate_fitted_pose, propagate_pose
+from perception.pose_motion import propagate_fitted_pose, propagate_pose
 
 
 def _angle_deg(a, b) -> float:

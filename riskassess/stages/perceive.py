@@ -630,7 +630,7 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
     pointing = _pointing(tracker, frames, com_body)
     # The mount turns through the run: a lost track is searched over all attitudes, and a box-like
     # debris' half turns pass the surface checks; the directions where the rays met nothing tell them
-    # apart (perception.registration.unseen_model_share).
+    # apart (perception.visibility.unseen_model_share).
     tracker.field_of_view = np.array([scene.spec.fov_azimuth, scene.spec.fov_elevation])
     tracker.ray_spacing = max(scene.spec.resolution_azimuth, scene.spec.resolution_elevation)
     # the debris' reach about its CoM (m), plus a margin for the map's and the scan's errors

@@ -6,6 +6,7 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 import perception.registration as registration
+import perception.pose_motion as pose_motion
 from multibody.geometry import shape_mesh
 from perception.lidar import cast, sensor_to_platform
 from perception.registration import MAX_UNSEEN, Alignment, DebrisTracker, _cloud, known_shape_model
@@ -194,12 +195,12 @@ def test_fitted_propagation_is_exact_for_a_constant_rate_and_the_two_frame_one_f
     start = Rotation.from_rotvec([0.1, 0.2, 0.3]).as_matrix()
     times = np.arange(6) * 0.1
     poses = [_turning_pose(t, omega_world, start, velocity) for t in times]
-    np.testing.assert_allclose(registration.propagate_fitted_pose(times, poses, 2.9),
+    np.testing.assert_allclose(pose_motion.propagate_fitted_pose(times, poses, 2.9),
                                _turning_pose(2.9, omega_world, start, velocity), atol=1e-9)
-    np.testing.assert_allclose(registration.propagate_fitted_pose(times[-2:], poses[-2:], 2.9),
-                               registration.propagate_pose(poses[-1], poses[-2], 24.0), atol=1e-9)
+    np.testing.assert_allclose(pose_motion.propagate_fitted_pose(times[-2:], poses[-2:], 2.9),
+                               pose_motion.propagate_pose(poses[-1], poses[-2], 24.0), atol=1e-9)
     with pytest.raises(ValueError, match="n >= 2"):
-        registration.propagate_fitted_pose(times[:1], poses[:1], 1.0)
+        pose_motion.propagate_fitted_pose(times[:1], poses[:1], 1.0)
 
 
 def test_fitted_rate_error_falls_as_the_least_squares_slope_says():
@@ -221,8 +222,8 @@ def test_fitted_rate_error_falls_as_the_least_squares_slope_says():
                 noise = Rotation.from_rotvec(rng.normal(0.0, sigma, 3)).as_matrix()
                 pose[:3, :3] = pose[:3, :3] @ noise.T    # body -> world turned by the noise (world frame)
                 poses.append(pose)
-            later = np.linalg.inv(registration.propagate_fitted_pose(times, poses, times[-1] + 1.0))[:3, :3]
-            last = np.linalg.inv(registration.propagate_fitted_pose(times, poses, times[-1]))[:3, :3]
+            later = np.linalg.inv(pose_motion.propagate_fitted_pose(times, poses, times[-1] + 1.0))[:3, :3]
+            last = np.linalg.inv(pose_motion.propagate_fitted_pose(times, poses, times[-1]))[:3, :3]
             errors.append(Rotation.from_matrix(later @ last.T).as_rotvec() - omega_world)
         expected = sigma * np.sqrt(12.0 / (count * (count**2 - 1))) / dt
         assert np.sqrt(np.mean(np.square(errors))) == pytest.approx(expected, rel=0.10)
@@ -288,4 +289,4 @@ def test_a_chain_is_predicted_across_the_frames_it_missed():
     np.testing.assert_allclose(registration._chain_prediction(chain, 1.4)[:3, :3],
                                _turning_pose(1.4, omega_world, start, np.zeros(3))[:3, :3], atol=1e-9)
     np.testing.assert_array_equal(registration._chain_prediction(chain, 1.2),
-                                  registration.predict_pose(chain[1].world_to_body, chain[0].world_to_body))
+                                  pose_motion.predict_pose(chain[1].world_to_body, chain[0].world_to_body))

@@ -5,7 +5,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from perception.lidar import cast
-from perception.registration import Alignment, DebrisTracker, _cloud, free_space_violation, known_shape_model
+from perception.registration import Alignment, DebrisTracker, _cloud, known_shape_model
+from perception.visibility import free_space_violation
 from perception.shape import half_turn_symmetry_transforms
 
 SENSOR = np.zeros(3)
