@@ -455,8 +455,8 @@ def _run_tensions(x, v, a0, b0, first, count, rest, stiffness, damping, work):
         tension = tension if pulling else 0.0
         # the stretch of a pulling thread, 0 for a slack one: the energies below are then exact zeros without a
         # select of their own. Selecting each energy (``... if pulling else 0.0``) cost 2.5x the whole pass (35 x 35
-        # net, 2384 threads: 15.6 against 6.1 us before thread14's booking and 7.4 us this way; bench/bench_kernel_step.py
-        # and the stop of 2026-11-27 evening), although both forms vectorize.
+        # net, 2384 threads: 15.6 against 6.1 us before thread14's booking and 7.4 us this way; the compiled net
+        # step 50 -> 36 us, bench/bench_kernel_step.py; docs/model.md "Speed"), although both forms vectorize.
         pulled = stretch if pulling else 0.0
         work[0, t] = tension * ex
         work[1, t] = tension * ey

@@ -206,11 +206,12 @@ def failed_checks(alignment, has_motion) -> list[str]:
     """Names of the checks of the frame (module docstring) that ``alignment`` fails: "fitness" (tight
     fitness below MIN_TIGHT_FITNESS), "free space" (violation above MAX_FREE_SPACE_VIOLATION), "unseen"
     (unseen model share above MAX_UNSEEN), "innovation" (turn from the prediction above MAX_INNOVATION,
-    judged only ``has_motion``); empty for a passing alignment."""
-    failed = [name for name, bad in (("fitness", alignment.tight_fitness < MIN_TIGHT_FITNESS),
-                                     ("free space", alignment.free_space_violation > MAX_FREE_SPACE_VIOLATION),
-                                     ("unseen", alignment.unseen > MAX_UNSEEN),
-                                     ("innovation", has_motion and alignment.innovation > MAX_INNOVATION)) if bad]
+    judged only ``has_motion``); empty for a passing alignment, which is how :meth:`DebrisTracker._judge` sets
+    ``ok``. Written as "not within the limit", so a non-finite figure fails its check."""
+    failed = [name for name, bad in (("fitness", not alignment.tight_fitness >= MIN_TIGHT_FITNESS),
+                                     ("free space", not alignment.free_space_violation <= MAX_FREE_SPACE_VIOLATION),
+                                     ("unseen", not alignment.unseen <= MAX_UNSEEN),
+                                     ("innovation", has_motion and not alignment.innovation <= MAX_INNOVATION)) if bad]
     return failed
 
 
@@ -909,11 +910,12 @@ class DebrisTracker:
         if self.field_of_view is not None and self._frame_sensor_to_world is not None:
             unseen = unseen_model_share(model_world, returns, sensor_world, self._frame_sensor_to_world,
                                         self.field_of_view, max(2 * self.voxel / range_scale, 3 * self.ray_spacing))
-        ok = (tight >= MIN_TIGHT_FITNESS and violation <= MAX_FREE_SPACE_VIOLATION and unseen <= MAX_UNSEEN
-              and (innovation <= MAX_INNOVATION or not has_motion))
         view = points_world.mean(axis=0) - sensor_world
-        return Alignment(time_s, pose, information, tight, violation, innovation, bool(ok), global_init, 0.0,
-                         len(points_world), unseen=unseen, view_body=pose[:3, :3] @ view / max(np.linalg.norm(view), 1e-12))
+        alignment = Alignment(time_s, pose, information, tight, violation, innovation, False, global_init, 0.0,
+                              len(points_world), unseen=unseen,
+                              view_body=pose[:3, :3] @ view / max(np.linalg.norm(view), 1e-12))
+        alignment.ok = not failed_checks(alignment, has_motion)
+        return alignment
 
     def _surface_fit(self, points_world, pose) -> tuple[float, float, np.ndarray]:
         """Tight fitness, point-to-plane scatter sigma (m) and information of the posed scan, from

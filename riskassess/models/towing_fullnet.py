@@ -248,7 +248,8 @@ def case_lateral(case: TowingCase) -> np.ndarray:
     """The case's ``[lateral]`` law as the kernel takes it (:func:`multibody.control.lateral.lateral_params`; zeros
     when off or when ``thrust.kind`` is not one of ``lateral.thrust_laws``), acting from ``thrust.t_on``."""
     la = case.lateral
-    return lateral_params(la.enabled and case.thrust.kind in la.thrust_laws, la.target, la.natural_frequency_rad_s, la.damping_ratio, la.max_force,
+    acting = la.enabled and case.thrust.kind in la.thrust_laws
+    return lateral_params(acting, la.target, la.natural_frequency_rad_s, la.damping_ratio, la.max_force,
                           case.thrust.t_on, case.chaser.mass)
 
 
