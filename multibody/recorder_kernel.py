@@ -16,6 +16,7 @@ from numba import njit
 from numba.experimental import structref
 
 from multibody.jit_cache import UnliteralStructRef
+from multibody.load_filter import advance, rest_at
 from multibody.kernel import BENDING_ELASTIC, CONTACT_DISSIPATED, CONTACT_ELASTIC, THREAD_DISSIPATED, THREAD_ELASTIC
 from multibody.maths.linalg3 import cross3, matmat3, mattmat3, mattvec3, matvec3
 from multibody.maths.rotations import (half_rotation_matrix_into, rotation_matrix_from_rotation_vector_into,
@@ -584,3 +585,51 @@ def _joint_damper_power(j, joints, work) -> float:
         w = mid[0, d] * relative_omega[0] + mid[1, d] * relative_omega[1] + mid[2, d] * relative_omega[2]
         power += damping[d] * v * v + damping[3 + d] * w * w
     return power
+
+
+@njit(cache=True)
+def filter_joint_loads(m, bank, q, qt, qtt, half_kick, first):
+    """Advance the joints' load filters (:mod:`multibody.load_filter`) by the step that just ended: each joint's
+    load (:func:`connector_load_into`, the load the parent exerts on the child, joint frame) at the state Exudyn's
+    VelocityVerlet evaluated the step's forces at (the end position, the mid-step velocity ``qt - h/2 qtt``, as
+    :func:`book_joint_dampers`), through its row of ``bank``. A released joint (``m.active`` 0) feeds 0 (the
+    connector is off). Run every step, so the filter sees the penalty modes the output would alias.
+
+    Parameters
+    ----------
+    m : RecorderModel
+    bank : (nj, 6, 8) float
+        The filter bank (:func:`multibody.load_filter.filter_bank`); its ``OUTPUT`` column holds the filtered
+        force (N, axes 0-2) and moment (N m, axes 3-5), joint frame.
+    q, qt, qtt : (N,) float
+        Exudyn's coordinates (the step's end), velocities and accelerations (:func:`body_sample`'s layout).
+    half_kick : float
+        Half the step for VelocityVerlet, 0 for another integrator (s).
+    first : bool
+        The first step: each filter starts at rest under its first load (no start-up transient).
+    """
+    bodies, joints, work = m.bodies, m.joints, m.damper_work
+    velocity = work.velocity
+    for b in range(bodies.mass.shape[0]):
+        i = bodies.index[b]
+        for k in range(6):
+            velocity[i + k] = qt[i + k] - half_kick * qtt[i + k]
+        body_state_into(q, velocity, i, b, bodies.reference_com_lvlh, bodies.node_to_body, work.com_lvlh,
+                        work.velocity_lvlh, work.node_to_lvlh, work.body_to_lvlh, work.omega_lvlh, work.omega_body)
+    load = work.vectors    # rows 0-1: the joint's force and moment (work space)
+    rotation = np.empty(3)
+    for j in range(joints.parent.shape[0]):
+        if m.active[j] != 0.0:
+            frame, offset_joint, relative_velocity, w = joint_relative_motion_into(
+                j, joints, work.com_lvlh, work.velocity_lvlh, work.body_to_lvlh, work.omega_body, rotation)
+            connector_load_into(frame, offset_joint, rotation, relative_velocity, w, joints.stiffness[j],
+                                joints.damping[j], load[0], load[1])
+        else:
+            for d in range(3):
+                load[0, d] = 0.0
+                load[1, d] = 0.0
+        for axis in range(6):
+            value = load[axis // 3, axis % 3]
+            if first:
+                rest_at(bank, j, axis, value)
+            advance(bank, j, axis, value)
