@@ -157,9 +157,11 @@ class Recorder:
         self._capacity = int(np.ceil(self._end_time / self.output_interval)) + 3
         nb, nj = len(assembly.bodies), len(assembly.joints)
         cutoffs_hz = [j.load_filter_hz for j in assembly.joints]
-        #: the joints' load filters ((nj, 6, 8), multibody.load_filter), None when no joint has a cut-off
-        self._load_filter = filter_bank(cutoffs_hz, assembly.solver.step) if any(cutoffs_hz) else None
+        #: the joints' load filters ((nj, 6, S, 8), multibody.load_filter), None when no joint has a cut-off
+        self._load_filter = (filter_bank(cutoffs_hz, assembly.solver.step, [j.load_filter_order for j in assembly.joints])
+                             if any(cutoffs_hz) else None)
         self._filter_started = False
+        self._filter_scratch = np.zeros((6, 3))
         self._unfiltered = np.array([not c for c in cutoffs_hz], bool)
         self._layout = series_layout(nb, nj, assembly.chaser is not None, assembly.body_loads is not None,
                                      self._load_filter is not None)
@@ -288,8 +290,8 @@ class Recorder:
             data = self.system.mbs.systemData
             views = (data.GetODE2Coordinates(copy=False), data.GetODE2Coordinates_t(copy=False),
                      data.GetODE2Coordinates_tt(copy=False))
-        filter_joint_loads(self._model, self._load_filter, views[0], views[1], views[2], self._half_kick,
-                           not self._filter_started)
+        filter_joint_loads(self._model, self._load_filter, self._filter_scratch, views[0], views[1], views[2],
+                           self._half_kick, not self._filter_started)
         self._filter_started = True
 
     # -- sampling --------------------------------------------------------------------
@@ -324,8 +326,8 @@ class Recorder:
         if self._load_filter is not None:
             # the filtered loads beside the raw ones; the release monitor judges them, as the verdict does
             forces_joint, moments_joint = self._row_view[FILTERED_LOADS[0]], self._row_view[FILTERED_LOADS[1]]
-            forces_joint[:] = self._load_filter[:, :3, OUTPUT]
-            moments_joint[:] = self._load_filter[:, 3:, OUTPUT]
+            forces_joint[:] = self._load_filter[:, :3, -1, OUTPUT]
+            moments_joint[:] = self._load_filter[:, 3:, -1, OUTPUT]
             raw = self._unfiltered       # a joint without a cut-off records its raw load there too
             forces_joint[raw] = self._body_out.joint_force[raw]
             moments_joint[raw] = self._body_out.joint_moment[raw]

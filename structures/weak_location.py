@@ -52,6 +52,7 @@ class WeakLocation:
     structural_modes_hz: tuple = ()      # modes (Hz) the loads are read through; empty: as recorded
     structural_damping_ratio: float = 0.02   # their damping, fraction of critical (-)
     load_filter_hz: float = 0.0          # cut-off (Hz) of the joint's load filter (multibody.load_filter); 0: none
+    load_filter_order: int = 4           # its order (2 or 4)
 
     def criteria(self) -> dict:
         """Criterion name -> allowable, for the criteria this location has."""
@@ -239,8 +240,9 @@ def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0
 def reading(location: WeakLocation) -> str:
     """How the location's loads are read, in words (``reading`` in structures.json)."""
     modes = location.structural_modes_hz
-    filtered = (f"through a 2nd-order Butterworth low-pass at {location.load_filter_hz:g} Hz run every step on the "
-                f"joint's load (the penalty joint's own modes removed)") if location.load_filter_hz else ""
+    order = {2: "2nd", 4: "4th"}.get(location.load_filter_order, f"order-{location.load_filter_order}")
+    filtered = (f"through a {order}-order Butterworth low-pass at {location.load_filter_hz:g} Hz run every step on "
+                f"the joint's load (the penalty joint's own modes removed)") if location.load_filter_hz else ""
     if not modes:
         return filtered or "as recorded (the stiff joint's reaction)"
     span = f"{modes[0]:.3g} Hz" if len(modes) == 1 else f"every first mode in {modes[0]:.3g}-{modes[-1]:.3g} Hz (envelope)"

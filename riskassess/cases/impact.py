@@ -362,8 +362,8 @@ class Joint(Strict):
                           "loads no longer rest on a penalty stiffness (docs/structures.md); penalty_damping_ratio is "
                           "then the member's damping. Not with first_mode_hz or the penalty keys.")
     load_filter_hz: Positive | None = Field(
-        None, description="Cut-off (Hz) of the 2nd-order Butterworth low-pass this joint's loads are read through, "
-                          "run every simulation step (overrides structures.load_filter_hz for this joint; "
+        None, description="Cut-off (Hz) of the Butterworth low-pass this joint's loads are read through, "
+                          "run every simulation step (structures.load_filter_order; overrides structures.load_filter_hz for this joint; "
                           "docs/structures.md, 'Loads through a stated low-pass filter').")
     rotation_modes: RotationModes | None = Field(
         None, description="The structure's own modes about the joint's locked rotation axes (Hz, each axis alone), "
@@ -610,8 +610,11 @@ class Structures(Strict):
                              "node-contact loads alone, as the seed paper's model, and reports the threads without "
                              "judging them.")
     weak_locations: Annotated[list[WeakLocationSpec], Field(min_length=1)]
+    load_filter_order: Literal[2, 4] = Field(
+        4, description="Order of the joints' Butterworth load filters (load_filter_hz): 4 takes a penalty mode 4x "
+                       "above the cut-off down by 256, 2 by 16 (docs/structures.md).")
     load_filter_hz: Positive | None = Field(
-        None, description="Cut-off (Hz) of a 2nd-order Butterworth low-pass run on every joint's loads at every "
+        None, description="Cut-off (Hz) of a Butterworth low-pass (load_filter_order) run on every joint's loads at every "
                           "simulation step (before the output's decimation): the verdict and the release judge the "
                           "filtered loads, recorded beside the raw ones. A penalty joint's own spring modes "
                           "(15-1500 Hz) are numerical; give a cut-off above the structure's physical content and well "

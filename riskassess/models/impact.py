@@ -198,7 +198,8 @@ def build_bodies_and_joints(case: Case, base: Path):
             rotation_modes_hz=None if j.rotation_modes is None else j.rotation_modes.frequencies_hz(),
             rotation_modes_damping_ratio=0.0 if j.rotation_modes is None else j.rotation_modes.damping_ratio,
             structural_stiffness=_member_springs(j, frame, target_to_lvlh),
-            load_filter_hz=load_filter_hz(case, j)))
+            load_filter_hz=load_filter_hz(case, j),
+            load_filter_order=case.structures.load_filter_order if case.structures is not None else 4))
         if j.initial_angle or j.initial_rate:
             _apply_initial_hinge_state(bodies, joints, len(joints) - 1, j.initial_angle, j.initial_rate)
     return bodies, joints, rest_attitudes, rest_coms
@@ -398,7 +399,8 @@ def weak_locations(case: Case, assembly) -> list:
             ultimate_shear=Allowable.of(material.ultimate_shear) if material else None,
             allowable_moment=Allowable.of(spec.allowable_moment) if spec.allowable_moment is not None else None,
             allowable_force=Allowable.of(spec.allowable_force) if spec.allowable_force is not None else None,
-            moment_axes=axes, load_filter_hz=joint.load_filter_hz, **_structural_modes(spec)))
+            moment_axes=axes, load_filter_hz=joint.load_filter_hz, load_filter_order=joint.load_filter_order,
+            **_structural_modes(spec)))
     return out
 
 

@@ -10,7 +10,7 @@ import trimesh
 from multibody.assembly import ContactLaw, ImpactAssembly, JointSpec, RigidBodySpec, SolverSpec
 from multibody.hinge import hinge_frame_lvlh
 from multibody.impact import ImpactSimulation
-from multibody.load_filter import butterworth2_coefficients, filter_bank, filter_signal
+from multibody.load_filter import butterworth_sections, filter_bank, filter_signal, section_quality_factors
 from multibody.recorded_loads import RecordedBodyLoads
 from tests.conftest import single_node
 
@@ -18,18 +18,30 @@ STEP = 1e-4          # (s) the simulation step
 CUTOFF_HZ = 20.0
 
 
-def test_gain_at_the_cutoff_is_the_analogue_filters():
-    """Pre-warped bilinear transform: |H| at the cut-off is exactly 1/sqrt(2), as the analogue Butterworth's; one
-    decade above, the analogue 1/sqrt(1 + 10^4) = 0.0100 (the discrete filter is 1 % lower there: the warping
-    tan(x) / x at 200 Hz with a 1e-4 s step, second order in f h)."""
-    b0, b1, b2, a1, a2 = butterworth2_coefficients(CUTOFF_HZ, STEP)
-    for f, analogue, tolerance in ((CUTOFF_HZ, 1 / math.sqrt(2), 1e-12), (10 * CUTOFF_HZ, 1 / math.sqrt(1 + 1e4), 0.02)):
-        z = np.exp(-2j * math.pi * f * STEP)       # z^-1 on the unit circle
-        gain = abs((b0 + b1 * z + b2 * z * z) / (1 + a1 * z + a2 * z * z))
-        assert gain == pytest.approx(analogue, rel=tolerance)
+def discrete_gain(sections, f):
+    """|H(exp(j 2 pi f h))| of a cascade of biquads."""
+    z = np.exp(-2j * math.pi * f * STEP)       # z^-1 on the unit circle
+    return np.prod([abs((b0 + b1 * z + b2 * z * z) / (1 + a1 * z + a2 * z * z)) for b0, b1, b2, a1, a2 in sections])
+
+
+def test_quality_factors_are_butterworths():
+    # Butterworth pole pairs: Q = 1/sqrt(2) (order 2); 1 / (2 cos(pi/8)) = 0.5412, 1 / (2 cos(3 pi/8)) = 1.3066 (order 4)
+    np.testing.assert_allclose(section_quality_factors(2), [1 / math.sqrt(2)], rtol=1e-14)
+    np.testing.assert_allclose(sorted(section_quality_factors(4)), [0.5411961, 1.3065630], rtol=1e-6)
+
+
+@pytest.mark.parametrize("order", [2, 4])
+def test_gain_at_the_cutoff_is_the_analogue_filters(order):
+    """Pre-warped bilinear transform: |H| at the cut-off is exactly 1/sqrt(2), as the analogue Butterworth's
+    1 / sqrt(1 + (f / fc)^(2 n)); one decade above, 1/sqrt(1 + 10^(2 n)) (the discrete filter is 1-2 % lower
+    there per order pair: the warping tan(x) / x at 200 Hz with a 1e-4 s step, second order in f h)."""
+    sections = butterworth_sections(CUTOFF_HZ, STEP, order)
+    for f, tolerance in ((CUTOFF_HZ, 1e-12), (0.3 * CUTOFF_HZ, 1e-3), (10 * CUTOFF_HZ, 0.03 * order / 2)):
+        analogue = 1 / math.sqrt(1 + (f / CUTOFF_HZ) ** (2 * order))
+        assert discrete_gain(sections, f) == pytest.approx(analogue, rel=tolerance)
     # the same gain measured on a simulated sinusoid at the cut-off, after the start-up transient (20 periods)
     t = np.arange(int(40 / CUTOFF_HZ / STEP)) * STEP
-    out = filter_signal(butterworth2_coefficients(CUTOFF_HZ, STEP), np.sin(2 * math.pi * CUTOFF_HZ * t))
+    out = filter_signal(sections, np.sin(2 * math.pi * CUTOFF_HZ * t))
     # 1e-3: the sampled crest misses the true one by at most 1 - cos(pi f h) = 2e-5; the transient has decayed by
     # exp(-zeta omega_c t) = exp(-0.707 * 125.7 * 1 s) ~ 1e-38
     assert np.abs(out[t > 20 / CUTOFF_HZ]).max() == pytest.approx(1 / math.sqrt(2), rel=1e-3)
@@ -41,7 +53,7 @@ def test_step_response_is_the_analogue_butterworths():
     t = np.arange(int(0.5 / STEP)) * STEP
     values = np.ones_like(t)
     values[0] = 0.0                          # at rest at 0, the step at the second sample
-    out = filter_signal(butterworth2_coefficients(CUTOFF_HZ, STEP), values)
+    out = filter_signal(butterworth_sections(CUTOFF_HZ, STEP, 2), values)
     w, zeta = 2 * math.pi * CUTOFF_HZ, 1 / math.sqrt(2)
     wd, tau = w * math.sqrt(1 - zeta**2), t - STEP
     analogue = np.where(tau >= 0, 1 - np.exp(-zeta * w * tau) * (np.cos(wd * tau) + zeta / math.sqrt(1 - zeta**2)
@@ -52,14 +64,39 @@ def test_step_response_is_the_analogue_butterworths():
     assert out.max() == pytest.approx(1 + math.exp(-math.pi), abs=1e-3)
 
 
+def test_fourth_order_step_response_is_the_analogue_butterworths():
+    """Unit step through the 4th-order filter against the analogue Butterworth's, summed from its partial fractions
+    (poles p_k = omega_c exp(j pi (2k + n - 1) / (2 n)), k = 1..4: y = 1 + sum_k Re(r_k exp(p_k t) / p_k) with
+    r_k = omega_c^4 / prod_{m != k} (p_k - p_m)); its overshoot is 10.8 %."""
+    t = np.arange(int(0.5 / STEP)) * STEP
+    values = np.ones_like(t)
+    values[0] = 0.0
+    out = filter_signal(butterworth_sections(CUTOFF_HZ, STEP, 4), values)
+    w = 2 * math.pi * CUTOFF_HZ
+    poles = w * np.exp(1j * np.pi * (2 * np.arange(1, 5) + 3) / 8)
+    tau = np.maximum(t - STEP, 0.0)
+    analogue = np.ones_like(t, dtype=complex)
+    for k, p in enumerate(poles):
+        residue = w**4 / np.prod([p - q for m, q in enumerate(poles) if m != k])
+        analogue += residue * np.exp(p * tau) / p
+    analogue = np.where(t >= STEP, analogue.real, 0.0)
+    # 3e-3: the bilinear transform's error, of order omega_c h = 0.013 over the first sample (measured below 1e-3)
+    np.testing.assert_allclose(out, analogue, atol=3e-3)
+    assert out.max() == pytest.approx(analogue.max(), abs=1e-3)
+    assert analogue.max() == pytest.approx(1.108, abs=1e-3)
+
+
 def test_a_bank_starts_at_rest_and_a_zero_cutoff_passes_through():
-    bank = filter_bank([0.0, CUTOFF_HZ], STEP)
-    assert bank.shape == (2, 6, 8)
-    np.testing.assert_array_equal(bank[0, :, :5], [[1.0, 0.0, 0.0, 0.0, 0.0]] * 6)
+    bank = filter_bank([0.0, CUTOFF_HZ, CUTOFF_HZ], STEP, [4, 4, 2])
+    assert bank.shape == (3, 6, 2, 8)
+    np.testing.assert_array_equal(bank[0, :, :, :5], [[[1.0, 0.0, 0.0, 0.0, 0.0]] * 2] * 6)
+    np.testing.assert_array_equal(bank[2, :, 1, :5], [[1.0, 0.0, 0.0, 0.0, 0.0]] * 6)   # order 2: one section
     signal = np.full(100, 3.7)
-    np.testing.assert_allclose(filter_signal(bank[1, 0, :5], signal), signal, rtol=1e-12)   # at rest: no transient
+    np.testing.assert_allclose(filter_signal(bank[1, 0, :, :5], signal), signal, rtol=1e-12)   # at rest: no transient
     with pytest.raises(ValueError, match="cut-off must be in"):
-        butterworth2_coefficients(600.0, STEP)       # above 1/10 of the step's 5 kHz Nyquist frequency
+        butterworth_sections(600.0, STEP)       # above 1/10 of the step's 5 kHz Nyquist frequency
+    with pytest.raises(ValueError, match="order is one of"):
+        butterworth_sections(CUTOFF_HZ, STEP, 3)
 
 
 # -- a penalty joint under a known load ----------------------------------------------------------------------------
@@ -74,7 +111,7 @@ def _box(mass, size):
                          com_lvlh=np.zeros(3), meshes_body=[trimesh.creation.box(extents=[size] * 3)])
 
 
-def pushed_pair(penalty: float, cutoff_hz: float, end_time=0.1):
+def pushed_pair(penalty: float, cutoff_hz: float, end_time=0.1, order=2):
     """A 50 kg boom clamped to a 500 kg bus by a penalty joint (translational stiffness ``penalty`` N/m), the bus
     pushed along the line of the two CoMs through the joint, so the ideal joint carries no moment and its force is
     the boom's share of the push, m_boom / (m_bus + m_boom) F(t)."""
@@ -83,7 +120,8 @@ def pushed_pair(penalty: float, cutoff_hz: float, end_time=0.1):
     point = np.array([0.5, 30.0, 0.0])
     joint = JointSpec(name="root", kind="clamped", parent=0, child=1, point_lvlh=point,
                       hinge_to_lvlh=hinge_frame_lvlh(np.array([0.0, 0.0, 1.0]), point, boom.com_lvlh),
-                      penalty_translational=penalty, penalty_rotational=penalty, load_filter_hz=cutoff_hz)
+                      penalty_translational=penalty, penalty_rotational=penalty, load_filter_hz=cutoff_hz,
+                      load_filter_order=order)
     time = np.arange(1, int(round(end_time * RATE)) + 1) / RATE
     force_lvlh = np.zeros((time.size, 2, 3))
     force_lvlh[:, 0, 0] = FORCE * np.minimum(time / RISE, 1.0)     # held over each output interval
@@ -101,7 +139,7 @@ def ideal_force_filtered(loads, times):
     steps = np.arange(1, int(round(times[-1] / STEP)) + 1) * STEP
     held = loads.force_lvlh[np.minimum(np.searchsorted(loads.time, steps - 1e-9), loads.time.size - 1), 0, 0]
     ideal = BOOM_MASS / (BUS_MASS + BOOM_MASS) * held
-    out = filter_signal(butterworth2_coefficients(CUTOFF_HZ, STEP), np.concatenate([[0.0], ideal]))
+    out = filter_signal(butterworth_sections(CUTOFF_HZ, STEP, 2), np.concatenate([[0.0], ideal]))
     return np.interp(times, np.concatenate([[0.0], steps]), out)
 
 
