@@ -729,7 +729,7 @@ class Case(Strict):
     @model_validator(mode="after")
     def _load_filters(self):
         """Every load filter's cut-off within 1/10 of the step's Nyquist frequency (the discrete filter follows the
-        analogue one there) and sampled 10 times per period by the output (its peak read within 5 %)."""
+        analogue one there) and sampled SAMPLES_PER_MODE_PERIOD (20) times per period by the output, as a modal reading."""
         default = self.structures.load_filter_hz if self.structures is not None else None
         for joint in self.target.joints:
             cutoff = joint.load_filter_hz or default
