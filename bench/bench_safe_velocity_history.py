@@ -24,8 +24,9 @@ temporary folder (or ``--keep DIR``; ``--kept DIR`` reads a folder kept so and r
   body with its rigid motion removed and the hinge's demand so far; then, per pair of ``--capture-energy`` (J) and
   ``--capture-hold`` (s) (defaults: the case's ``structures.capture_energy_J`` and ``capture_hold_s``), the time
   t_s the capture is over (None: not over by the run's end) and the largest demand over the judged part of
-  [0, t_s] and after it; and per 1 s window the largest demand against the smallest relative energy in it (the
-  demand a given relative energy has been seen to bring);
+  [0, t_s] and after it; the smallest relative energy at which the demand reached 0.25, 0.5 and 1 of its allowable;
+  and per 1 s window the largest demand against the smallest relative energy in it (the demand a given relative
+  energy has been seen to bring);
 - the run's answer, each location's state and the energy balance's largest drift.
 """
 from __future__ import annotations
@@ -201,6 +202,13 @@ def print_capture(out: Path, case, case_path: str, joint, energies: list, holds:
             late = f"{demand[after].max():.1f} N m" if after.any() else "-"
             print(f"  threshold {threshold:g} J, hold {hold:g} s: t_s = {t_s:.2f} s; peak up to t_s "
                   f"{demand[before].max():.1f} N m ({demand[before].max() / allowable:.3f}), after it {late}")
+    energy_at = np.interp(t, t_energy, energy)
+    for fraction in (0.25, 0.5, 1.0):
+        hit = np.flatnonzero((t >= skip) & (demand >= fraction * allowable))
+        if hit.size:
+            k = hit[np.argmin(energy_at[hit])]
+            print(f"  smallest relative energy with the demand at {fraction:g} of the allowable: {energy_at[k]:.1f} J at "
+                  f"{t[k]:.2f} s ({demand[k]:.0f} N m)")
     print("  per 1 s window: smallest relative energy (J) and largest demand (N m):")
     for start in np.arange(0.0, t[-1], 1.0):
         inside_e = (t_energy >= start) & (t_energy < start + 1.0)

@@ -347,6 +347,7 @@ class CaptureMonitor:
         self.check_interval_s = check_interval_s
         self._modal = {loc.name: online_modal_loads(loc, interval_s) for loc in locations}
         self._loads, self._times = [], []       # joint loads since the last check
+        self._modal_loads = {loc.name: [] for loc in locations}
         self._peaks = None                       # running peak of every judged demand
         self.rises: list[float] = []
         self.energy_time: list[float] = []
@@ -355,24 +356,31 @@ class CaptureMonitor:
         self.settled_at_s: float | None = None
 
     def sample(self, t: float, force_joint, moment_joint) -> None:
-        """One output sample's joint loads ((nj, 3) each: N, N m, joint frame)."""
-        row = []
-        for loc in self.locations:
-            loads = np.stack([force_joint[loc.joint], moment_joint[loc.joint]])
-            modal = self._modal[loc.name]
-            row.append(modal.update(loads) if modal is not None else loads[None])
+        """One output sample's joint loads ((nj, 3) each: N, N m, joint frame); the demands are computed in batches
+        at the settle checks (one array copy a sample; the modal filters of locations read through structural
+        modes are fed here, as they must see every sample)."""
         self._times.append(t)
-        self._loads.append(row)
+        self._loads.append(np.stack([force_joint, moment_joint], axis=1))      # (nj, 2, 3)
+        for loc in self.locations:
+            modal = self._modal[loc.name]
+            if modal is not None:
+                self._modal_loads[loc.name].append(modal.update(np.stack([force_joint[loc.joint],
+                                                                          moment_joint[loc.joint]])))
 
     def _update_rises(self) -> None:
         """Fold the buffered samples' demands into the running peaks (the rises after ``judged_from_s``)."""
         if not self._times:
             return
+        loads_all = np.asarray(self._loads, float)                               # (k, nj, 2, 3)
         columns = []
-        for j, loc in enumerate(self.locations):
-            loads = [row[j] for row in self._loads]           # each (modes, 2, 3)
-            n_modes = loads[0].shape[0]
-            stacked = np.asarray(loads, float).reshape(-1, 2, 3)
+        for loc in self.locations:
+            if self._modal[loc.name] is not None:
+                loads = np.asarray(self._modal_loads[loc.name], float)          # (k, modes, 2, 3)
+                self._modal_loads[loc.name] = []
+            else:
+                loads = loads_all[:, loc.joint][:, None]                        # (k, 1, 2, 3)
+            n_modes = loads.shape[1]
+            stacked = loads.reshape(-1, 2, 3)
             values = demands(loc, stacked[:, 0], stacked[:, 1])
             for criterion in loc.criteria():
                 columns.append(np.asarray(values[criterion], float).reshape(-1, n_modes).max(axis=1))
