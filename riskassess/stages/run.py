@@ -167,11 +167,20 @@ def _with_twin(verdict: dict, locations, series: dict, case: Case, case_path: Pa
                            "note": "not run: the run shows debris"}
         return verdict
     launch = case.launch.model_copy(update={"velocity": case.launch.velocity * (1.0 + TWIN_OFFSET)})
-    twin = _simulation(model_inputs(case.model_copy(update={"launch": launch}), case_path.parent))
+    # the twin covers the run's own window: a capture window may have stopped the run before its end time (the cap)
+    end = float(series["time"][-1])
+    simulation = case.simulation
+    if end < simulation.end_time - 0.5 * simulation.step:
+        simulation = simulation.model_copy(update={"end_time": end})
+    twin_case = case.model_copy(update={"launch": launch, "simulation": simulation})
+    twin = _simulation(model_inputs(twin_case, case_path.parent))
     try:
         twin_series = twin.run().series
     except SimulationFailed as exc:
         return apply_twin(verdict, locations, series, None, skip, policy, f"the twin run failed: {exc}")
+    if twin_series["time"].shape != series["time"].shape:
+        return apply_twin(verdict, locations, series, None, skip, policy,
+                          f"the twin run's {twin_series['time'].size} samples do not match the run's {series['time'].size}")
     return apply_twin(verdict, locations, series, twin_series, skip, policy)
 
 

@@ -178,3 +178,14 @@ def test_a_capture_window_of_a_sequential_run_is_refused(tmp_path):
                                              'integrator = "VelocityVerlet"\ncoupling = "sequential"'))
     with pytest.raises(CaseError, match="window = 'capture' follows the net's motion"):
         load_case(path)
+
+
+def test_a_twin_of_a_run_stopped_by_the_capture_covers_the_same_window(tmp_path):
+    # the capture "over" early (threshold 1e9 J, hold 0.05 s): the twin runs to the run's own end, not to the cap,
+    # so every judged peak gets its label (a twin to the cap had a longer series than the run)
+    extra = "\ncapture_energy_J = 1e9\ncapture_hold_s = 0.05\ntwin = true"
+    verdict = run_case(_capture_case(tmp_path, 0.6, extra), tmp_path / "run").structures
+    assert verdict["capture_window"]["stopped_early"]
+    assert verdict["twin"]["ran"] is True, verdict["twin"]
+    for row in verdict["locations"]:
+        assert all(c["twin"] is not None for c in row["criteria"].values() if c["peak"] is not None)
