@@ -22,7 +22,8 @@ temporary folder (or ``--keep DIR``; ``--kept DIR`` reads a folder kept so and r
   to the debris' centre of mass, at 16 times;
 - the capture (:mod:`structures.capture_window`): every 5 s, the net's kinetic energy relative to the debris' main
   body with its rigid motion removed and the hinge's demand so far; then, per pair of ``--capture-energy`` (J) and
-  ``--capture-hold`` (s) (defaults: the case's ``structures.capture_energy_J`` and ``capture_hold_s``), the time
+  ``--capture-hold`` (s) (defaults: the case's threshold, ``structures.capture_energy_J`` or else
+  ``capture_energy_fraction`` of the launch's relative energy, and its hold), the time
   t_s the capture is over (None: not over by the run's end) and the largest demand over the judged part of
   [0, t_s] and after it; the smallest relative energy at which the demand reached 0.25, 0.5 and 1 of its allowable;
   and per 1 s window the largest demand against the smallest relative energy in it (the demand a given relative
@@ -46,7 +47,8 @@ from riskassess.cases.impact import validate_case
 from riskassess.stages.run import run_case
 from riskassess.models.impact import model_inputs, weak_locations
 from riskassess.sweep.spec import case_with
-from structures.capture_window import judged_rise_times, reference_body, relative_energy_history, settle_time
+from structures.capture_window import (energy_threshold, hold_time, judged_rise_times, reference_body,
+                                      relative_energy_history, settle_time)
 
 WINDOW_S = 0.5   # s, the load-history table's window
 HALF_SPAN = 12   # samples either side of the peak printed (1 ms each at the case's 1 kHz output)
@@ -168,8 +170,8 @@ def main() -> None:
         else:
             print(f"read from {out} (kept by an earlier run of the same command with --keep); nothing run")
         print_history(out, next(j for j in case.target.joints if j.name == args.joint), args.judge_until)
-        energies = args.capture_energy or [case.structures.capture_energy_J]
-        holds = args.capture_hold or [case.structures.capture_hold_s]
+        energies = args.capture_energy or [case.structures.capture_energy_J]      # None: the case's energy fraction
+        holds = args.capture_hold or [hold_time(case.structures.capture_hold_s, case.launch.velocity)]
         print_capture(out, case, args.case, next(j for j in case.target.joints if j.name == args.joint), energies, holds)
 
 
@@ -192,6 +194,7 @@ def print_capture(out: Path, case, case_path: str, joint, energies: list, holds:
         print(f"  {t_energy[k]:6.2f} s: {energy[k]:8.2f} J; demand so far {so_far.max() if so_far.size else 0.0:7.1f} N m")
     print(f"  last judged running-peak rise (any location) at {rises[-1] if rises.size else float('nan'):.3f} s")
     for threshold in energies:
+        threshold = energy_threshold(energy[0], case.structures.capture_energy_fraction, threshold)
         for hold in holds:
             t_s = settle_time(t_energy, energy, rises, threshold, hold, skip)
             if t_s is None:

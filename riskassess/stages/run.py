@@ -20,7 +20,7 @@ from riskassess.models.impact_sequential import applied_contact_series, driven_i
 from riskassess.cases.impact import Case, load_case
 from riskassess.products.outfolder import OutputFolder, claim
 from riskassess.products.summary import run_summary, sequential_summary
-from structures.capture_window import CaptureMonitor, capture_window, reference_body
+from structures.capture_window import CaptureMonitor, capture_window, hold_time, reference_body
 from structures.release import ReleaseMonitor
 from structures.reproducibility import TWIN_OFFSET
 from structures.verdict import DEBRIS, INDETERMINATE, apply_twin, demand_series, structures_verdict
@@ -141,8 +141,9 @@ def capture_monitor(case: Case, locations, assembly) -> CaptureMonitor | None:
         return None
     s = case.structures
     body = reference_body(assembly.bodies, assembly.joints, assembly.debris_indices)
-    return CaptureMonitor(locations, assembly.net.masses, body, s.skip_initial, s.capture_energy_J, s.capture_hold_s,
-                          interval_s=1.0 / case.simulation.output_rate)
+    return CaptureMonitor(locations, assembly.net.masses, body, s.skip_initial, s.capture_energy_J,
+                          hold_time(s.capture_hold_s, case.launch.velocity), interval_s=1.0 / case.simulation.output_rate,
+                          energy_fraction=s.capture_energy_fraction)
 
 
 def recorded_capture_window(case: Case, locations, assembly, recorder) -> dict:
@@ -151,7 +152,8 @@ def recorded_capture_window(case: Case, locations, assembly, recorder) -> dict:
     s = case.structures
     body = reference_body(assembly.bodies, assembly.joints, assembly.debris_indices)
     window = capture_window(locations, recorder.series, recorder.net, assembly.net.masses, body,
-                            assembly.bodies[body].name, s.skip_initial, s.capture_energy_J, s.capture_hold_s)
+                            assembly.bodies[body].name, s.skip_initial, s.capture_energy_J,
+                            hold_time(s.capture_hold_s, case.launch.velocity), s.capture_energy_fraction)
     window["end_time_cap_s"] = case.simulation.end_time
     window["stopped_early"] = bool(recorder.stopped_early)
     return window

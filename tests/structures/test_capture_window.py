@@ -11,8 +11,8 @@ from scipy.spatial.transform import Rotation
 
 from riskassess.cases.impact import CaseError, load_case
 from riskassess.stages.run import run_case
-from structures.capture_window import (capture_gap, net_energy_relative_to_body, omega_lvlh, rise_times,
-                                       settle_time)
+from structures.capture_window import (CAPTURE_ENERGY_FRACTION, CAPTURE_HOLD_TRAVEL_M, capture_gap, energy_threshold,
+                                       hold_time, net_energy_relative_to_body, omega_lvlh, rise_times, settle_time)
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 SNAPSHOT_S = 0.02   # s, the shipped cases' net snapshots (50 Hz): the settle test's time resolution
@@ -170,6 +170,24 @@ def test_a_settled_capture_stops_the_run_and_its_series_is_the_uncapped_runs_pre
     assert window["settled_at_s"] <= series_stopped["time"][-1] <= window["settled_at_s"] + 0.1 + 1e-9
     for key in ("time", "joint_moment_joint", "body_com_lvlh", "energy_total"):
         np.testing.assert_array_equal(series_stopped[key], series_full[key][:k])
+
+
+def test_the_threshold_is_a_share_of_the_launch_energy_and_the_hold_a_travel_unless_the_case_gives_them():
+    # defaults scale with the launch: the capture keeps its shape in units of net travel and its strikes' demand
+    # grows with the launch speed (docs/structures.md); an explicit value wins
+    assert energy_threshold(74.91, CAPTURE_ENERGY_FRACTION) == pytest.approx(74.91 * 0.005, rel=1e-15)
+    assert energy_threshold(74.91, CAPTURE_ENERGY_FRACTION, threshold_J=3.0) == 3.0
+    assert hold_time(None, 4.5) == pytest.approx(7.0, rel=1e-15)           # 31.5 m at 4.5 m/s: window19's 7 s
+    assert hold_time(None, 2.0) == pytest.approx(CAPTURE_HOLD_TRAVEL_M / 2.0, rel=1e-15)
+    assert hold_time(12.0, 2.0) == 12.0
+
+
+def test_coupled_cases_judge_the_capture_and_sequential_ones_their_fixed_window_by_default():
+    # a hold seen over part of a coupled capture is not a hold: the default window is "capture" for coupled runs
+    coupled = load_case(CASES / "envisat_small.toml").structures
+    assert coupled.window == "capture" and coupled.capture_energy_J is None and coupled.capture_hold_s is None
+    assert coupled.capture_energy_fraction == CAPTURE_ENERGY_FRACTION
+    assert load_case(CASES / "envisat_paper_sequential.toml").structures.window == "fixed"
 
 
 def test_a_capture_window_of_a_sequential_run_is_refused(tmp_path):

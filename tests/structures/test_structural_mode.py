@@ -203,6 +203,8 @@ def test_a_run_judges_and_reports_the_modal_reading(tmp_path):
     # is about the reading, so it judges the node-contact loads alone
     text = text.replace('release = "low"', 'release = "low"\nthread_pass_through = "ignore"', 1)
     assert 'thread_pass_through = "ignore"' in text
+    # and over its 0.3 s alone (the default "capture" window would call a 0.3 s hold indeterminate)
+    text = text.replace('release = "low"', 'release = "low"\nwindow = "fixed"', 1)
     (tmp_path / "case").mkdir()
     case_path = tmp_path / "case" / "case.toml"
     case_path.write_text(text)
