@@ -103,9 +103,45 @@ def test_a_face_seen_only_after_the_reacquisition_joins_the_map(bus, c_fans_lida
 
 
 def test_a_frame_that_failed_its_checks_adds_nothing(bus, c_fans_lidar):
-    # One frame cluttered (two thirds of its returns spread over a 3 m box: fails the tight fitness, 0.8):
-    # it is not registered and grows nothing, while its unmapped points lie within the growth's reach.
-    times = 0.1 * np.arange(1, 5)
-    tracker = _tracked(bus, c_fans_lidar, True, times, clutter_at=1)
-    assert not tracker.alignments[3].ok
-    assert all(growth["time"] != pytest.approx(times[1]) for growth in tracker.map_growth)
+    # The last frame cluttered (two thirds of its returns spread over a 3 m box: fails the tight fitness, 0.8):
+    # it is not registered and grows nothing, while the frames before it, passed, grew the map.
+    times = 0.1 * np.arange(1, 4)
+    tracker = _tracked(bus, c_fans_lidar, True, times, clutter_at=2)
+    assert all(a.ok for a in tracker.alignments[2:4]) and not tracker.alignments[4].ok
+    assert [growth["time"] for growth in tracker.map_growth] == pytest.approx(times[:2])
+
+
+def _frame(bus, lidar, t, ok):
+    """A frame of the turning bus at ``t`` (s) registered at its true pose (passed or not), and its thinned scan."""
+    points, _, truth = _scan(bus, lidar, _rotation(t), int(10 * t))
+    scan = np.asarray(registration._cloud(points).voxel_down_sample(0.03).points)
+    return Alignment(t, truth, np.eye(6), 1.0 if ok else 0.5, 0.0, 0.0, ok, False, 0.0, len(scan)), scan
+
+
+@pytest.mark.parametrize("confirmed", [True, False])
+def test_a_chain_grows_the_map_only_once_confirmed(bus, c_fans_lidar, confirmed):
+    # The growth rule at a re-acquisition (DebrisTracker._grow_after_reacquisition): the frames of a pending chain
+    # (failed until the motion confirms them) keep their scans and grow nothing; when the chain is confirmed
+    # (its frames revised to passed), they and the confirming frame grow the map with the -x face they show
+    # (frames at 1.0-1.3 s of the turn above: the face in view); a chain dropped instead grows nothing.
+    tracker = DebrisTracker(0.03, 0.1, 30, *_one_sided_map(bus), seed=0, grow_map=True)
+    times = (1.0, 1.1, 1.2)
+    for t in times:   # pending chain frames: failed, a chain alive
+        tracker._chains = [["a chain"]]
+        alignment, scan = _frame(bus, c_fans_lidar, t, ok=False)
+        tracker.alignments.append(alignment)
+        tracker._grow_after_reacquisition(alignment, scan, tracked_with_motion=False)
+    assert not tracker.map_growth and len(tracker._chain_scans) == 3
+    tracker._chains = []
+    confirming, scan = _frame(bus, c_fans_lidar, 1.3, ok=confirmed)
+    if confirmed:   # _continue_chains revised the pending frames to their chain's passing alignments
+        tracker.revised = [0, 1, 2]
+        tracker.alignments[:3] = [_frame(bus, c_fans_lidar, t, ok=True)[0] for t in times]
+    tracker.alignments.append(confirming)
+    tracker._grow_after_reacquisition(confirming, scan, tracked_with_motion=False)
+    assert not tracker._chain_scans
+    if not confirmed:
+        assert not tracker.map_growth and tracker._reacquired is False
+        return
+    assert tracker._reacquired and [g["time"] for g in tracker.map_growth] == [1.0, 1.1, 1.2, 1.3]
+    assert _on_minus_x_face(tracker.model_points_body).sum() > 300
