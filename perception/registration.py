@@ -72,7 +72,7 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from perception.nearest_grid import NearestPointGrid
-from perception.normals import surface_planes
+from perception.map_growth import unmapped_surface
 from perception.point_to_plane import point_to_plane_information, tukey_normal_equations
 from perception.pose_motion import predict_pose, propagate_pose
 from perception.visibility import free_space_violation, unseen_model_share, visible_side_centroid
@@ -130,15 +130,6 @@ POLISHED = 0
 # gaps 0.3-2.1 s, but 48-104 deg for gaps 3.2-3.7 s. Beyond 2.5 s the truth may lie nearer the half turn of the
 # propagation than the propagation: no choice by continuity there.
 CONTINUITY_GAP = 2.5
-#: Map growth after a confirmed re-acquisition (DebrisTracker's grow_map): a frame adds the points of its scan
-#: that lie beyond the fine correspondence distance (max_correspondence / 3) of the map, the rule of the map's
-#: first build (perception.scan_to_map: a scan shows new surface when fewer than MAP_COVERED of its points lie
-#: within that distance; tests/perception/test_map_growth.py checks the two values agree) ...
-MAP_GROWTH_COVERED = 0.95
-#: ... but only those within this many coarse correspondence distances (max_correspondence) of the map: new
-#: surface adjoins the surface mapped (a face turning into view grows from its edges frame by frame), while a
-#: net thread's return a few decimetres off the debris, which the net gate missed, does not join the map.
-MAP_GROWTH_REACH = 1.0
 SEARCH_SCREENED = 40    # best-fitting distinct seeds of a search over all attitudes screened by the check before refining
 AMBIGUOUS_TURN = np.radians(15.0)  # rad; passing poses this far apart (beyond the known symmetries) start chains of their own
 
@@ -537,27 +528,17 @@ class DebrisTracker:
                 self._grow_map(confirmed.time, _transform(points, confirmed.world_to_body))
 
     def _grow_map(self, time_s, points_body) -> int:
-        """Adds to the map (the model, frame B) the surface a registered scan (n, 3) (m, frame B) shows and
-        the map lacks: its points beyond the fine correspondence distance of the map and within
-        MAP_GROWTH_REACH coarse ones, when they are more than 1 - MAP_GROWTH_COVERED of the scan (else the
-        frame shows nothing new). They are thinned to one mean per voxel, put on the plane fitted to their
-        4-voxel neighbourhood of map and new points (:func:`perception.normals.surface_planes`, as the map's
-        first build) with its normal; the points already in the map are kept as they are. Returns the
-        number of points added (recorded in ``map_growth``)."""
-        gap = self._tree.query(points_body, distance_upper_bound=MAP_GROWTH_REACH * self.max_correspondence)[0]
-        unmapped = points_body[np.isfinite(gap) & (gap > self.max_correspondence / 3)]
-        if len(unmapped) <= (1 - MAP_GROWTH_COVERED) * len(points_body):
+        """Adds to the map (the model, frame B) the surface a registered scan (n, 3) (m, frame B) shows and the
+        map lacks (:func:`perception.map_growth.unmapped_surface`); the points already in the map are kept as
+        they are. Returns the number of points added (each growth recorded in ``map_growth``)."""
+        points, normals = unmapped_surface(points_body, self._model_points, self._tree, self.voxel,
+                                           self.max_correspondence)
+        if not len(points):
             return 0
-        means = np.asarray(_cloud(unmapped).voxel_down_sample(self.voxel).points)
-        radius = 4 * self.voxel
-        near = np.isfinite(cKDTree(means).query(self._model_points, distance_upper_bound=radius)[0])
-        planes, normals = surface_planes(np.vstack([self._model_points[near], means]), radius, 30)
-        added = len(means)
-        self._set_model(np.vstack([self._model_points, planes[-added:]]),
-                        np.vstack([self._model_normals, normals[-added:]]))
+        self._set_model(np.vstack([self._model_points, points]), np.vstack([self._model_normals, normals]))
         self._freeze_model()
-        self.map_growth.append({"time": float(time_s), "points_added": added, "map_points": len(self._model_points)})
-        return added
+        self.map_growth.append({"time": float(time_s), "points_added": len(points), "map_points": len(self._model_points)})
+        return len(points)
 
     # -- one frame -------------------------------------------------------------------
     def update(self, time_s, points_world, sensor_world, gate=None, all_returns_world=None,

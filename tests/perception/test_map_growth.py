@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+import perception.map_growth as map_growth
 import perception.registration as registration
 import perception.scan_to_map as scan_to_map
 from multibody.geometry import shape_mesh
@@ -74,7 +75,7 @@ def _on_minus_x_face(points_body):
 
 def test_growth_rule_is_the_first_builds():
     # The growth's "shows new surface" share is the map's first build's (perception.scan_to_map.MAP_COVERED).
-    assert registration.MAP_GROWTH_COVERED == scan_to_map.MAP_COVERED
+    assert map_growth.MAP_GROWTH_COVERED == scan_to_map.MAP_COVERED
 
 
 def test_a_face_seen_only_after_the_reacquisition_joins_the_map(bus, c_fans_lidar):
