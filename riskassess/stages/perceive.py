@@ -1131,7 +1131,7 @@ def _conclude(folder, answer, tracker, frames, track: NetTrack, assembly, wall, 
     answer["tracking"] = _tracking_figures(tracker, frames)
     answer["search_budget"] = _search_budget_figures(tracker, frames)
     if tracker.grow_map:   # the map's growth after re-acquisitions (perception.registration.reacquire_grow_map)
-        answer["tracking"]["map_growth"] = tracker.map_growth
+        answer["map_growth"] = tracker.map_growth
     if assembly is not None:
         answer["net"] = _net_figures(track, assembly)
         _name_budget_cuts(answer)
