@@ -31,18 +31,12 @@ MAP_GROWTH_COVERED = 0.95
 #: New points join the map only within this many coarse correspondence distances of it [assumed: the coarse
 #: ICP's own reach, 0.1 m on the featured debris; a 1.0 x 1.6 m face then fills in over ~5-8 frames].
 MAP_GROWTH_REACH = 1.0
-#: A scan point within this many of its frame's point-to-plane scatters of the map lies on mapped surface (the
-#: tight fitness's inlier bound, perception.registration). Without it, at 15-30 m (the featured debris late in its
-#: free flight, range noise 2 cm, the thinned scan's scatter ~2 cm) a few per cent of every scan lay beyond the fine
-#: distance by noise alone, and the map "grew" on every frame at 11.2-12.0 s (63-116 points each, seeds 3 and 4;
-#: docs/perception.md, "The map grown after a re-acquisition").
-NOISE_SIGMAS = 3.0
 #: Neighbours of a new point's plane fit, and its radius in voxels (as the map's first build, surface_map).
 PLANE_NEIGHBOURS = 30
 PLANE_RADIUS_VOXELS = 4
 
 
-def unmapped_surface(points_body, map_points_body, map_tree, voxel, max_correspondence, scatter=0.0):
+def unmapped_surface(points_body, map_points_body, map_tree, voxel, max_correspondence):
     """The surface of a registered scan that the map lacks, as map points with their normals.
 
     Parameters
@@ -52,9 +46,6 @@ def unmapped_surface(points_body, map_points_body, map_tree, voxel, max_correspo
     map_tree : scipy.spatial.cKDTree  Nearest-point index of ``map_points_body``.
     voxel : float                     Map spacing (m).
     max_correspondence : float        Coarse ICP correspondence distance (m); the fine one is a third of it.
-    scatter : float                   The frame's point-to-plane scatter about the map (m, the check's sigma): a
-                                      point within NOISE_SIGMAS of it from the map is noise on mapped surface, not
-                                      new surface, whatever the fine distance.
 
     Returns
     -------
@@ -64,7 +55,7 @@ def unmapped_surface(points_body, map_points_body, map_tree, voxel, max_correspo
     """
     points_body = np.asarray(points_body, float).reshape(-1, 3)
     gap = map_tree.query(points_body, distance_upper_bound=MAP_GROWTH_REACH * max_correspondence)[0]
-    unmapped = points_body[np.isfinite(gap) & (gap > max(max_correspondence / 3, NOISE_SIGMAS * scatter))]
+    unmapped = points_body[np.isfinite(gap) & (gap > max_correspondence / 3)]
     if len(unmapped) <= (1 - MAP_GROWTH_COVERED) * len(points_body):
         return np.zeros((0, 3)), np.zeros((0, 3))
     cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(unmapped))

@@ -525,16 +525,14 @@ class DebrisTracker:
             self._chain_scans = {}
         for confirmed, points in frames:
             if points is not None and confirmed.ok:
-                self._grow_map(confirmed.time, _transform(points, confirmed.world_to_body),
-                               self._surface_fit(points, confirmed.world_to_body)[1])
+                self._grow_map(confirmed.time, _transform(points, confirmed.world_to_body))
 
-    def _grow_map(self, time_s, points_body, scatter=0.0) -> int:
+    def _grow_map(self, time_s, points_body) -> int:
         """Adds to the map (the model, frame B) the surface a registered scan (n, 3) (m, frame B) shows and the
-        map lacks (:func:`perception.map_growth.unmapped_surface`; ``scatter`` (m) the frame's point-to-plane
-        scatter about the map, the check's sigma); the points already in the map are kept as
+        map lacks (:func:`perception.map_growth.unmapped_surface`); the points already in the map are kept as
         they are. Returns the number of points added (each growth recorded in ``map_growth``)."""
         points, normals = unmapped_surface(points_body, self._model_points, self._tree, self.voxel,
-                                           self.max_correspondence, scatter)
+                                           self.max_correspondence)
         if not len(points):
             return 0
         self._set_model(np.vstack([self._model_points, points]), np.vstack([self._model_normals, normals]))
