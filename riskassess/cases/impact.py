@@ -483,6 +483,11 @@ class Registration(Strict):
         0, description="Consecutive frames a candidate pose chain after a lost debris track may fail and still go "
                        "on, predicted across the gap (-); the failed frames stay failed (issue 26). 0: a chain "
                        "ends at its first failed frame.")
+    reacquire_grow_map: bool = Field(
+        False, description="After a lost debris track's re-acquisition is confirmed, the confirmed frames and every "
+                           "later frame tracked from the motion prediction that passes its checks add the surface "
+                           "the map lacks (model-free tracking; issue 26). False: the map stays as built in the "
+                           "observation.")
 
     @model_validator(mode="after")
     def _budget(self):
