@@ -122,6 +122,8 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
                 thread_contact_drift=summary.get("checks", {}).get("energy_balance_relative_drift"),
                 thread_segments=case.contact.thread_segments,
                 capture=recorded_capture_window(case, locations, simulation.assembly, recorder) if capture else None)
+            if not capture:         # the case states that nothing after its end time loads the target
+                verdict["judged_window"] = {"window": "fixed", "end_time_s": float(recorder.series["time"][-1])}
             if case.structures.twin:
                 verdict = _with_twin(verdict, locations, recorder.series, case, case_path)
             results.atomic_write_npz(folder.path / "structures.npz", demand_series(locations, recorder.series))

@@ -209,6 +209,7 @@ def test_a_run_judges_and_reports_the_modal_reading(tmp_path):
     case_path = tmp_path / "case" / "case.toml"
     case_path.write_text(text)
     verdict = run_case(case_path, tmp_path / "run").structures
+    assert verdict["judged_window"] == {"window": "fixed", "end_time_s": pytest.approx(0.3, abs=1e-9)}
     array = verdict["locations"][0]
     assert array["reading"].startswith("through the structure's first mode: every first mode in 0.2-2 Hz")
     moment = array["criteria"]["moment"]

@@ -76,10 +76,21 @@ def verdict_section(run: RunFolder) -> Section:
     if verdict.get("capture_window"):
         blocks.append(Note(capture_window_text(verdict["capture_window"]),
                            "info" if verdict["capture_window"]["settled"] else "warning"))
+    elif verdict.get("judged_window"):
+        blocks.append(Note(fixed_window_text(verdict["judged_window"]), "warning"))
     blocks.append(Note("Likelihood: probability of failure with the allowable uniformly distributed over its "
                        "range. For a released location it is a lower bound ('>='), because the joint carries "
                        "nothing after its release."))
     return Section("verdict", "Verdict: secondary debris", blocks)
+
+
+def fixed_window_text(window: dict) -> str:
+    """One sentence on the judged window of a run with ``structures.window = "fixed"``: what its answer is
+    conditional on (``window`` is the verdict's ``judged_window``)."""
+    return (f"Judged window: fixed, 0 to {window['end_time_s']:.2f} s (structures.window = 'fixed'): the case states "
+            f"that nothing after its end time loads the target (for example the net closed or in tow by then). "
+            f"Loads after it are not judged and the capture was not checked to be over; with the default window "
+            f"('capture') a location that held would need the capture over to say so.")
 
 
 def capture_window_text(window: dict) -> str:
