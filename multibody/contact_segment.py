@@ -428,8 +428,9 @@ def _thread_start(r, j, s, b, x, cw, shapes, bodies, rot, com_lvlh, law, step, n
     lo = (shapes.box_min_body[s, 0], shapes.box_min_body[s, 1], shapes.box_min_body[s, 2])
     hi = (shapes.box_max_body[s, 0], shapes.box_max_body[s, 1], shapes.box_max_body[s, 2])
     d = (pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2])
-    nbx, nby, nbz = segment_box_normal(pa[0] + t_deepest * d[0], pa[1] + t_deepest * d[1], pa[2] + t_deepest * d[2],
-                                       d[0], d[1], d[2], lo, hi, w[0], w[1], w[2])
+    # the unit normal; its slope (below 1 inside the box) only softens the contact, so the sub-steps sized for 1 hold
+    nbx, nby, nbz, _ = segment_box_normal(pa[0] + t_deepest * d[0], pa[1] + t_deepest * d[1],
+                                          pa[2] + t_deepest * d[2], d[0], d[1], d[2], lo, hi, w[0], w[1], w[2])
     a, c = cw.node[ka], cw.node[kc]
     arm_x = wa * x[0, a] + wc * x[0, c] - com_lvlh[b, 0]
     arm_y = wa * x[1, a] + wc * x[1, c] - com_lvlh[b, 1]
