@@ -348,35 +348,26 @@ def test_thread_contact_force_is_the_gradient_of_its_energy_at_an_edge(seed):
     assert force == pytest.approx(-gradient, abs=1e-5 * np.abs(gradient).max())
 
 
-def _bullet_at_an_edge(alpha, mu, step=1e-4):
-    """The reference case's 3.22 s event rebuilt (key on): a bullet (1.786 kg, 1 cm) striking the main body's -x
-    face at 20.9 m/s beside its bottom edge (x = -1.6875, z = -3.9375 m; the box 3.375 x 3.75 x 7.875 m, fixed:
-    1e12 kg), its tether (0.8824 m) to a net node (7.76 g, 1 mm) wrapped round that edge; the states are the run's,
-    body frame, 0.25 ms before the bullet touches. The tether's spring is off, so the contact is the only force."""
-    bullet, node = np.array([-1.699, 1.5684, -3.9379]), np.array([-1.5304, 0.7025, -4.0166])
-    v_bullet, v_node = np.array([20.9, 3.73, 12.53]), np.array([20.56, 5.03, 10.7])
-    net = NetTopology(positions=np.array([bullet - 2.5 * step * v_bullet, node - 2.5 * step * v_node]),
-                      masses=np.array([1.786, 0.00776]), radii=np.array([0.01, 0.001]), threads=np.array([[0, 1]]),
-                      rest_lengths=np.array([0.8824]), stiffness=np.array([0.0]), damping=np.array([0.0]),
-                      bending_triples=np.zeros((0, 3), np.int64), bending_stiffness=np.zeros(0), nodes_per_side=0,
-                      n_bullets=0)
-    assembly = ImpactAssembly(
-        net=net, net_velocity=np.array([v_bullet, v_node]), bodies=[_plate([3.375, 3.75, 7.875], 1e12)], joints=[],
-        contact=ContactLaw(stiffness=PAPER_CONTACT_STIFFNESS, hunt_crossley_alpha=alpha, mu_static=mu,
-                           mu_kinetic=0.8 * mu, thread_segments=True),
-        solver=SolverSpec(end_time=3e-3, step=step, output_rate=1.0 / step, net_output_rate=1.0 / step,
-                          implicit_contact_speed=0.15))
-    simulation = ImpactSimulation(assembly)
-    simulation.health.reference_energy = None       # measure the balance, do not refuse it
-    return simulation.run().series
+def _bullet_edge_strike():
+    """bench/bench_bullet_edge_strike.py's scene (the reference case's key-on 3.22 s event rebuilt), loaded as
+    tests/test_bench_scripts.py loads the bench scripts."""
+    import importlib.util
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[2] / "bench" / "bench_bullet_edge_strike.py"
+    spec = importlib.util.spec_from_file_location("bench_bullet_edge_strike", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.strike
 
 
 def test_a_bullet_striking_beside_the_edge_its_tether_wraps_conserves_energy():
-    """Without damping or friction the strike conserves energy: the balance (kinetic + contact elastic) at the end
-    (the contact over) within 1 % of the launch energy (545 J). Measured -0.23 % at the shipped step (1e-4 s) and
-    +0.03 % at 1e-5 s (Verlet's step error on the stiff strike; node contact alone +0.50 %); +21.4 % (+116.7 J)
-    before the thread contact's force took its slope at an interior edge (segment_box_normal)."""
-    series = _bullet_at_an_edge(alpha=0.0, mu=0.0)
+    """A bullet (1.786 kg, 1 cm) striking a fixed box's face at 20.9 m/s beside the edge its tether wraps, the tether's
+    line inside the box's corner (bench/bench_bullet_edge_strike.py; the tether's spring off, so the contact is the
+    only force). Without damping or friction the strike conserves energy: the balance (kinetic + contact elastic) at
+    the end (the contact over) within 1 % of the launch energy (545 J). Measured +0.48 % at the shipped step (1e-4 s)
+    and -0.32 % at 1e-5 s (the sub-cycled strike's step and sub-step error; node contact alone +0.50 % and +0.04 %);
+    +21.5 % (+116.9 J) before the thread contact's force took its slope at an interior edge (segment_box_normal)."""
+    series = _bullet_edge_strike()(True, 1e-4, alpha=0.0, mu=0.0)
     launch = series["energy_total"][0]
     assert series["energy_contact_elastic"][-1] == 0.0                  # the contact is over
     assert series["energy_net_kinetic"][-1] > 0.9 * launch              # and the bullet rebounded
