@@ -36,8 +36,8 @@ it touches a box shape under the same law as the nodes:
   clusters only predict it (it moves their nodes, its impulse is not applied twice). Until 2026-11-27 each thread
   had its own sub-cycle and owned a node's contact only when it was the node's one thread in contact. Measured
   (one thread striking over a plate's edge at 20 m/s, bench/bench_thread_strike_energy.py): the balance closes to
-  +0.63 % with the node's contact owned, +1.7 % with it only predicted, +15.6 % with the node in free flight in
-  the sub-cycle.
+  +0.63 % with the node's contact owned (+0.52 % since the force follows the energy's slope at an edge, helper
+  keyon19), +1.7 % with it only predicted, +15.6 % with the node in free flight in the sub-cycle.
 * **who carries it**: a force F at :math:`p = (1 - s) x_a + s x_b` is split (1 - s) F on node a and s F on
   node b, so the point's acceleration is F / m_p with the effective mass
 
