@@ -28,6 +28,7 @@ from riskassess.cases.inputs import (JSON_FILE_LIMIT, KIND_NOTE, MESH_FILE_LIMIT
                                     unique_names)
 from riskassess.cases.target_geometry import target_points_lvlh, target_vertices_lvlh
 from riskassess.cases.uncertain import parse_uncertain
+from structures.capture_window import CAPTURE_ENERGY_J, CAPTURE_HOLD_S
 from structures.modal_load import SAMPLES_PER_MODE_PERIOD
 from structures.section_shapes import SHAPES
 
@@ -610,6 +611,22 @@ class Structures(Strict):
                            "deterministic (both runs' peaks so far agree within 5 % up to it) or chaotic (one draw of "
                            "the capture's late strikes); a location that holds on a chaotic peak is indeterminate "
                            "(docs/structures.md). Doubles the run time unless the run already shows debris.")
+    window: Literal["fixed", "capture"] = Field(
+        "fixed", description="The judged window: 'fixed' judges 0..simulation.end_time; 'capture' judges the capture "
+                             "until it is over (the net's kinetic energy relative to the debris' main body, its "
+                             "rigid motion with that body removed, below capture_energy_J and no judged running peak "
+                             "rising, both for capture_hold_s) and stops the run there; simulation.end_time is then "
+                             "the cap, and a run that reaches it before the capture is over cannot say a location "
+                             "holds (indeterminate, rule capture_not_over; docs/structures.md, 'The whole capture as "
+                             "the judged window'). Coupled runs only.")
+    capture_energy_J: Positive = Field(
+        CAPTURE_ENERGY_J, description="With window = 'capture': the net's kinetic energy relative to the debris (J) "
+                                      "below which its relative motion counts as died out; the default is "
+                                      "justified from measured envisat_small runs in docs/structures.md.")
+    capture_hold_s: Positive = Field(
+        CAPTURE_HOLD_S, description="With window = 'capture': how long (s) the relative energy must stay below "
+                                    "capture_energy_J with no judged running peak rising; the default covers one "
+                                    "pass of the wrapped net past the body (6.2 s apart at 4.5 m/s on envisat_small).")
 
     @field_validator("weak_locations")
     @classmethod
@@ -716,6 +733,14 @@ class Case(Strict):
         if self.structures is not None and self.structures.twin and self.simulation.coupling == "sequential":
             raise ValueError("structures.twin checks the peaks of a coupled run; a sequential run (the seed paper's "
                              "method) drives the debris with recorded loads: use coupling = 'coupled' or twin = false")
+        return self
+
+    @model_validator(mode="after")
+    def _capture_window_coupled(self):
+        if self.structures is not None and self.structures.window == "capture" and self.simulation.coupling == "sequential":
+            raise ValueError("structures.window = 'capture' follows the net's motion relative to the debris; a "
+                             "sequential run (the seed paper's method) has the net against a fixed wall: use "
+                             "coupling = 'coupled' or window = 'fixed'")
         return self
 
     @model_validator(mode="after")
