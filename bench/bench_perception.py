@@ -295,8 +295,13 @@ def _report(a, observation, seed):
           f"(observation), first frame {a['first_frame_search_s']:.2f} s, collision frames "
           f"{a['collision_registration_ms_per_frame']:.0f} ms/frame mean; ray casting {a['ray_casting_ms_per_frame']:.1f} ms/frame")
     for phase, t in track.items():
+        if not isinstance(t, dict):   # percep19's first answers kept the map's growth here (a list)
+            continue
         print(f"  {phase}: {t['registered']}/{t['frames']} frames registered, rotation error mean "
               f"{t['rotation_error_mean_deg'] or float('nan'):.2f} deg, p95 {t['rotation_error_p95_deg'] or float('nan'):.2f} deg")
+    if a.get("map_growth"):
+        print(f"map grown {len(a['map_growth'])} times after re-acquisitions: "
+              f"{sum(g['points_added'] for g in a['map_growth'])} points added")
     if "center_of_mass_error_m" in a:
         print(f"CoM error {a['center_of_mass_error_m'] * 1e3:.2f} mm; inertia ratio error "
               f"{_fmt(a['inertia_ratio_error_percent'])} %; D error {a['normalized_kinetic_energy_error_percent']:+.3f} %, "

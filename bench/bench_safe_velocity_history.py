@@ -20,6 +20,14 @@ temporary folder (or ``--keep DIR``; ``--kept DIR`` reads a folder kept so and r
   then the peak over (T, end] the same way;
 - the wrapping: the bullets' along-track position beyond the main body's centre and the net's kinetic energy relative
   to the debris' centre of mass, at 16 times;
+- the capture (:mod:`structures.capture_window`): every 5 s, the net's kinetic energy relative to the debris' main
+  body with its rigid motion removed and the hinge's demand so far; then, per pair of ``--capture-energy`` (J) and
+  ``--capture-hold`` (s) (defaults: the case's threshold, ``structures.capture_energy_J`` or else
+  ``capture_energy_fraction`` of the launch's relative energy, and its hold), the time
+  t_s the capture is over (None: not over by the run's end) and the largest demand over the judged part of
+  [0, t_s] and after it; the smallest relative energy at which the demand reached 0.25, 0.5 and 1 of its allowable;
+  and per 1 s window the largest demand against the smallest relative energy in it (the demand a given relative
+  energy has been seen to bring);
 - the run's answer, each location's state and the energy balance's largest drift.
 """
 from __future__ import annotations
@@ -37,7 +45,10 @@ import numpy as np
 
 from riskassess.cases.impact import validate_case
 from riskassess.stages.run import run_case
+from riskassess.models.impact import model_inputs, weak_locations
 from riskassess.sweep.spec import case_with
+from structures.capture_window import (energy_threshold, hold_time, judged_rise_times, reference_body,
+                                      relative_energy_history, settle_time)
 
 WINDOW_S = 0.5   # s, the load-history table's window
 HALF_SPAN = 12   # samples either side of the peak printed (1 ms each at the case's 1 kHz output)
@@ -138,6 +149,10 @@ def main() -> None:
     parser.add_argument("--kept", default=None, help="a folder kept by --keep: print its history, run nothing")
     parser.add_argument("--judge-until", type=float, action="append", default=[],
                         help="also print the peak demand up to this time (s); repeatable")
+    parser.add_argument("--capture-energy", type=float, action="append", default=[],
+                        help="settle threshold (J) of the capture window to evaluate; repeatable")
+    parser.add_argument("--capture-hold", type=float, action="append", default=[],
+                        help="settle hold (s) of the capture window to evaluate; repeatable")
     args = parser.parse_args()
     overrides = sample_overrides(Path(args.store), args.sample) | {"structures.release": args.release}
     if args.velocity is not None:
@@ -155,6 +170,54 @@ def main() -> None:
         else:
             print(f"read from {out} (kept by an earlier run of the same command with --keep); nothing run")
         print_history(out, next(j for j in case.target.joints if j.name == args.joint), args.judge_until)
+        energies = args.capture_energy or [case.structures.capture_energy_J]      # None: the case's energy fraction
+        holds = args.capture_hold or [hold_time(case.structures.capture_hold_s, case.launch.velocity)]
+        print_capture(out, case, args.case, next(j for j in case.target.joints if j.name == args.joint), energies, holds)
+
+
+def print_capture(out: Path, case, case_path: str, joint, energies: list, holds: list) -> None:
+    """The capture window of the run in ``out`` (module docstring)."""
+    series, net = dict(np.load(out / "timeseries.npz")), dict(np.load(out / "net.npz"))
+    structures = json.loads((out / "structures.json").read_text())
+    assembly = model_inputs(case, Path(case_path).parent).assembly
+    locations = weak_locations(case, assembly)
+    body = reference_body(assembly.bodies, assembly.joints, assembly.debris_indices)
+    t_energy, energy = relative_energy_history(net, net["masses"], series, body)
+    skip = structures["skip_initial_s"]
+    rises, _ = judged_rise_times(locations, series, skip)
+    t, demand = series["time"], hinge_demand(series, joint.name)
+    allowable = decisive_allowable(structures, joint.name)
+    print(f"capture: net kinetic energy relative to {assembly.bodies[body].name} (its rigid motion removed), "
+          f"and {joint.name}'s largest demand so far:")
+    for k in np.flatnonzero(np.isclose(np.mod(t_energy + 1e-9, 5.0), 0.0, atol=1e-6)):
+        so_far = demand[(t >= skip) & (t <= t_energy[k])]
+        print(f"  {t_energy[k]:6.2f} s: {energy[k]:8.2f} J; demand so far {so_far.max() if so_far.size else 0.0:7.1f} N m")
+    print(f"  last judged running-peak rise (any location) at {rises[-1] if rises.size else float('nan'):.3f} s")
+    for threshold in energies:
+        threshold = energy_threshold(energy[0], case.structures.capture_energy_fraction, threshold)
+        for hold in holds:
+            t_s = settle_time(t_energy, energy, rises, threshold, hold, skip)
+            if t_s is None:
+                print(f"  threshold {threshold:g} J, hold {hold:g} s: not over by {t[-1]:.2f} s "
+                      f"(relative energy {energy[-1]:.1f} J)")
+                continue
+            before, after = (t >= skip) & (t <= t_s), t > t_s
+            late = f"{demand[after].max():.1f} N m" if after.any() else "-"
+            print(f"  threshold {threshold:g} J, hold {hold:g} s: t_s = {t_s:.2f} s; peak up to t_s "
+                  f"{demand[before].max():.1f} N m ({demand[before].max() / allowable:.3f}), after it {late}")
+    energy_at = np.interp(t, t_energy, energy)
+    for fraction in (0.25, 0.5, 1.0):
+        hit = np.flatnonzero((t >= skip) & (demand >= fraction * allowable))
+        if hit.size:
+            k = hit[np.argmin(energy_at[hit])]
+            print(f"  smallest relative energy with the demand at {fraction:g} of the allowable: {energy_at[k]:.1f} J at "
+                  f"{t[k]:.2f} s ({demand[k]:.0f} N m)")
+    print("  per 1 s window: smallest relative energy (J) and largest demand (N m):")
+    for start in np.arange(0.0, t[-1], 1.0):
+        inside_e = (t_energy >= start) & (t_energy < start + 1.0)
+        inside_d = (t >= max(start, skip)) & (t < start + 1.0)
+        if inside_e.any() and inside_d.any():
+            print(f"    {start:5.1f} s: {energy[inside_e].min():8.2f} J  {demand[inside_d].max():7.1f} N m")
 
 
 def print_history(out: Path, joint, judge_until: list) -> None:

@@ -1,6 +1,7 @@
 """Where a run's energy balance gains: the work of the node contact and of every other force on the net, step by step.
 
     python3 bench/net_energy_flows.py [CASE] [--key off] [--end-time T] [--set SECTION.KEY=VALUE ...] [--save NPZ]
+                                      [--events T0:T1]
 
 The run's simulation alone (as ``bench/thread_contact_drift.py``: no pipeline products, the health check's energy
 limit lifted) with the kernel's net step wrapped (a Python wrapper around ``multibody.kernel_net.kernel_net_step``,
@@ -24,6 +25,10 @@ From these and the recorded energy terms, at the output samples (% of the health
 * net made = ``d(net_kinetic) - all_on_nodes`` (the synchronized kinetic energy against the half-step one: bounded,
   not cumulative); bodies made = the rest of the balance's drift.
 
+With ``--events T0:T1`` the contact made is also split per step inside that window (:class:`EventMeter`) and printed
+by 5 ms: the nodes whose contact did the most work (bullets marked), the threads' contacts' share of the dissipation,
+the bodies' largest contact force (helper keyon19: the key-on gains at 3.22 s and 4.74-4.86 s located this way).
+
 Helper gain18 (docs/model.md, "The gain the joints' dampers unmasked").
 """
 from __future__ import annotations
@@ -42,6 +47,7 @@ from bench_thread_segments import case_text  # noqa: E402
 from thread_contact_drift import with_overrides  # noqa: E402
 
 import multibody.kernel_net as kernel_net_module  # noqa: E402
+from multibody.kernel import CONTACT_DISSIPATED, CONTACT_ELASTIC  # noqa: E402
 from multibody.impact import ImpactSimulation  # noqa: E402
 from riskassess.cases.impact import load_case  # noqa: E402
 from riskassess.models.impact import model_inputs  # noqa: E402
@@ -141,6 +147,58 @@ class FlowMeter:
         return self.step * float(np.sum(non_elastic * (rate_mid - rate_end)))
 
 
+class EventMeter(FlowMeter):
+    """:class:`FlowMeter` that also keeps, for each step inside ``window`` (s), each node's contact work in Verlet's
+    terms (its contact impulse of the step times ``v(n+1)``, J), the contact's elastic energy (J) and booked
+    dissipation (J, running), the threads' contacts' booked dissipation (J, running) and the bodies' work total."""
+
+    def __init__(self, simulation: ImpactSimulation, n_steps: int, thread_split: bool, window: tuple):
+        super().__init__(simulation, n_steps, thread_split)
+        self.window = window
+        self.steps = []
+        self._scalars = self.kernel.buffers.scalars
+        self._segments = self.kernel.buffers.segments
+
+    def __call__(self, m, q_bodies, qt_bodies, qtt_bodies, t, q_next_bodies, force_bodies):
+        inside = self.window[0] <= t <= self.window[1]
+        before = self.node_impulse.copy() if inside else None
+        super().__call__(m, q_bodies, qt_bodies, qtt_bodies, t, q_next_bodies, force_bodies)
+        if inside:
+            impulse = self.node_impulse - before
+            nodes = np.nonzero(np.abs(impulse).sum(axis=1))[0]
+            work = np.einsum("ni,in->n", impulse[nodes], self.net_velocity.reshape(3, -1)[:, nodes])
+            thread_lost = float(self._segments.dissipated.sum()) if self._segments.enabled else 0.0
+            self.steps.append((t, nodes, work, float(self._scalars[CONTACT_ELASTIC]),
+                               float(self._scalars[CONTACT_DISSIPATED]), thread_lost, self.totals[3]))
+
+
+def print_events(meter: EventMeter, series: dict, reference: float, node_mass: np.ndarray, span: float = 5e-3) -> None:
+    """The contact made inside the meter's window, by ``span`` (s): per step the nodes' contact work, the bodies' (booked
+    at the next step), the change of the contact's elastic energy and its booked dissipation."""
+    steps = meter.steps
+    heavy = node_mass > 10.0 * np.median(node_mass)
+    print(f"   contact made by {1e3 * span:.0f} ms (% of the reference energy; B: a bullet):")
+    groups = {}
+    for k in range(1, len(steps) - 1):
+        t, nodes, work, elastic, lost, thread_lost, _ = steps[k]
+        made = (work.sum() + steps[k + 1][6] - steps[k][6] + elastic - steps[k - 1][3] + lost - steps[k - 1][4])
+        g = groups.setdefault(int(np.floor(t / span + 1e-9)), [0.0, 0.0, 0.0, {}])
+        g[0] += made
+        g[1] += lost - steps[k - 1][4]
+        g[2] += thread_lost - steps[k - 1][5]
+        for i, w in zip(nodes.tolist(), work.tolist()):
+            g[3][i] = g[3].get(i, 0.0) + w
+    t_series = series["time"]
+    for key in sorted(groups):
+        made, lost, thread_lost, works = groups[key]
+        rows = (t_series >= key * span) & (t_series < (key + 1) * span)
+        force = np.abs(series["contact_force_lvlh"][rows]).max(axis=(0, 2)) if rows.any() else []
+        top = sorted(works.items(), key=lambda kv: -abs(kv[1]))[:4]
+        print(f"   {key * span:.3f} s {100 * made / reference:+.4f} %  dissipated {lost:.2f} J (threads' contacts "
+              f"{thread_lost:.2f} J); largest |F| per body {np.round(force).astype(int).tolist()} N; nodes' work: "
+              + ", ".join(f"{i}{'B' if heavy[i] else ''} {w:+.2f} J" for i, w in top))
+
+
 def at_samples(record: np.ndarray, t_samples: np.ndarray, step: float) -> np.ndarray:
     """The per-step running totals at the output samples' times (the step whose evaluation time is the sample's);
     ``on_bodies`` is booked one step later, so it is read one step on."""
@@ -188,6 +246,8 @@ def main(argv=None) -> None:
     parser.add_argument("--thread-split", action="store_true",
                         help="also measure the threads' dampers' booking against their work (FlowMeter.thread_split)")
     parser.add_argument("--save", default=None, metavar="NPZ", help="write the series and the flows to this file")
+    parser.add_argument("--events", default=None, metavar="T0:T1",
+                        help="also split the contact made per step in this window (s), printed by 5 ms (EventMeter)")
     args = parser.parse_args(argv)
     case_path = Path(args.case)
     with tempfile.TemporaryDirectory() as folder:
@@ -200,13 +260,18 @@ def main(argv=None) -> None:
     simulation.health.reference_energy = None       # measure the drift, do not refuse it
     n_steps = int(round(assembly.solver.end_time / assembly.solver.step))
     start = time.process_time()
-    with FlowMeter(simulation, n_steps, args.thread_split) as meter:
+    window = tuple(float(v) for v in args.events.split(":")) if args.events else None
+    meter = (EventMeter(simulation, n_steps, args.thread_split, window) if window
+             else FlowMeter(simulation, n_steps, args.thread_split))
+    with meter:
         series = simulation.run().series
     cpu = time.process_time() - start
     flows = at_samples(meter.record[:meter.count], series["time"], meter.step)
     print(f"{case_path.name} thread_segments {args.key} {' '.join(args.set)}, end {series['time'][-1]:.3f} s: CPU "
           f"{cpu:.1f} s, load {os.getloadavg()[0]:.1f}; reference energy {reference:.0f} J", flush=True)
     parts = print_flows(series, flows, reference)
+    if window:
+        print_events(meter, series, reference, np.asarray(simulation.system.kernel.net.mass, float))
     if args.save:
         np.savez_compressed(args.save, reference_energy=reference, flows=flows, step_record=meter.record[:meter.count],
                             **{f"made_{name}": part for name, part in parts.items()}, **series)

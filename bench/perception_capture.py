@@ -78,7 +78,8 @@ def keep_collision_inputs(store: dict, tracker) -> None:
                      "model_frames": tracker.model_frames, "seed": tracker.seed,
                      "free_space_lateral_bins": tracker.free_space_lateral_bins,
                      "search_cpu_per_frame": tracker.search_cpu_per_frame,
-                     "search_cpu_per_run": tracker.search_cpu_per_run, "continuity_turn": tracker.continuity_turn},
+                     "search_cpu_per_run": tracker.search_cpu_per_run, "continuity_turn": tracker.continuity_turn,
+                     "chain_missed_frames": tracker.chain_missed_frames, "grow_map": tracker.grow_map},
         "map_points_body": np.array(tracker.model_points_body), "map_normals_body": np.array(tracker._model_normals),
         "alignments": list(tracker.alignments), "search_cpu_spent": tracker.search_cpu_spent}
     updates = store["collision_updates"] = []

@@ -36,14 +36,14 @@ def true_body_to_world(capture, time_s) -> np.ndarray:
     return np.asarray(frames["true_target_to_world"][index]) @ capture["target_to_body"][:3, :3].T
 
 
-def replayed_log(capture, continuity_turn="recorded", until=np.inf, chain_missed_frames=0):
+def replayed_log(capture, continuity_turn="recorded", until=np.inf, chain_missed_frames=0, grow_map=False):
     """The collision phase's registration run again from ``capture``'s inputs up to ``until`` (s), with
     the candidate log on; ``continuity_turn`` (rad or None) replaces the recorded tracker's, and a chain may
-    miss ``chain_missed_frames`` frames. The search budgets are lifted (the recorded run's CPU cuts depend
-    on the load). Returns the log and the tracker's alignments."""
+    miss ``chain_missed_frames`` frames and, with ``grow_map``, confirmed frames grow the map. The search
+    budgets are lifted (the recorded run's CPU cuts depend on the load). Returns the log, the tracker's alignments and its map growth (``DebrisTracker.map_growth``)."""
     start = capture["collision_tracker"]
     settings = dict(start["settings"], search_cpu_per_frame=np.inf, search_cpu_per_run=np.inf,
-                    chain_missed_frames=chain_missed_frames)
+                    chain_missed_frames=chain_missed_frames, grow_map=grow_map)
     if continuity_turn != "recorded":
         settings["continuity_turn"] = continuity_turn
     tracker = DebrisTracker(settings.pop("voxel"), settings.pop("max_correspondence"), settings.pop("model_frames"),
@@ -56,7 +56,7 @@ def replayed_log(capture, continuity_turn="recorded", until=np.inf, chain_missed
         tracker.field_of_view, tracker.ray_spacing = update["field_of_view"], update["ray_spacing"]
         tracker.update(update["time"], update["points_world"], update["sensor_world"],
                        all_returns_world=update.get("all_returns_world"), sensor_to_world=update.get("sensor_to_world"))
-    return tracker.candidate_log, tracker.alignments
+    return tracker.candidate_log, tracker.alignments, tracker.map_growth
 
 
 def describe(capture, log, until=np.inf) -> list[str]:
@@ -86,14 +86,21 @@ def main(argv=None):
     parser.add_argument("--continuity-deg", type=float, default=None,
                         help="with --replay: continuity limit (deg; 0: off); default the recorded run's")
     parser.add_argument("--chain-missed-frames", type=int, default=0, help="with --replay: frames a chain may miss")
+    parser.add_argument("--grow-map", action="store_true",
+                        help="with --replay: confirmed frames after a re-acquisition grow the map")
     parser.add_argument("--until", type=float, default=np.inf, help="last time shown or replayed (s)")
     args = parser.parse_args(argv)
     capture = pickle.load(open(args.capture, "rb"))
     if args.replay:
         turn = "recorded" if args.continuity_deg is None else (np.radians(args.continuity_deg) or None)
-        log, alignments = replayed_log(capture, turn, args.until, args.chain_missed_frames)
-        registered = [a.time for a in alignments[len(capture["collision_tracker"]["alignments"]):] if a.ok]
-        print("registered collision frames (s):", " ".join(f"{t:.1f}" for t in registered))
+        log, alignments, map_growth = replayed_log(capture, turn, args.until, args.chain_missed_frames, args.grow_map)
+        registered = [a for a in alignments[len(capture["collision_tracker"]["alignments"]):] if a.ok]
+        print("registered collision frames (s), angle to the truth (deg):", " ".join(
+            "%.1f (%.1f)" % (a.time, _angle_deg(a.body_to_world[:3, :3], true_body_to_world(capture, a.time)))
+            for a in registered))
+        for growth in map_growth:
+            print("map grown at %.1f s: %d points added, %d in the map" % (
+                growth["time"], growth["points_added"], growth["map_points"]))
     else:
         log = capture["candidate_log"]
     print("\n".join(describe(capture, log, args.until)))

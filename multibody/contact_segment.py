@@ -36,8 +36,8 @@ it touches a box shape under the same law as the nodes:
   clusters only predict it (it moves their nodes, its impulse is not applied twice). Until 2026-11-27 each thread
   had its own sub-cycle and owned a node's contact only when it was the node's one thread in contact. Measured
   (one thread striking over a plate's edge at 20 m/s, bench/bench_thread_strike_energy.py): the balance closes to
-  +0.63 % with the node's contact owned, +1.7 % with it only predicted, +15.6 % with the node in free flight in
-  the sub-cycle.
+  +0.63 % with the node's contact owned (+0.52 % since the force follows the energy's slope at an edge, helper
+  keyon19), +1.7 % with it only predicted, +15.6 % with the node in free flight in the sub-cycle.
 * **who carries it**: a force F at :math:`p = (1 - s) x_a + s x_b` is split (1 - s) F on node a and s F on
   node b, so the point's acceleration is F / m_p with the effective mass
 
@@ -428,8 +428,9 @@ def _thread_start(r, j, s, b, x, cw, shapes, bodies, rot, com_lvlh, law, step, n
     lo = (shapes.box_min_body[s, 0], shapes.box_min_body[s, 1], shapes.box_min_body[s, 2])
     hi = (shapes.box_max_body[s, 0], shapes.box_max_body[s, 1], shapes.box_max_body[s, 2])
     d = (pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2])
-    nbx, nby, nbz = segment_box_normal(pa[0] + t_deepest * d[0], pa[1] + t_deepest * d[1], pa[2] + t_deepest * d[2],
-                                       d[0], d[1], d[2], lo, hi, w[0], w[1], w[2])
+    # the unit normal; its slope (below 1 inside the box) only softens the contact, so the sub-steps sized for 1 hold
+    nbx, nby, nbz, _ = segment_box_normal(pa[0] + t_deepest * d[0], pa[1] + t_deepest * d[1],
+                                          pa[2] + t_deepest * d[2], d[0], d[1], d[2], lo, hi, w[0], w[1], w[2])
     a, c = cw.node[ka], cw.node[kc]
     arm_x = wa * x[0, a] + wc * x[0, c] - com_lvlh[b, 0]
     arm_y = wa * x[1, a] + wc * x[1, c] - com_lvlh[b, 1]

@@ -539,7 +539,7 @@ def checked_post_step(watch: HealthWatch, post_step=None, every: int = 1):
     return hook
 
 
-def solve_checked(mbs, settings, solver_type, watch: HealthWatch) -> None:
+def solve_checked(mbs, settings, solver_type, watch: HealthWatch, stopped_early=None) -> None:
     """``exudyn.SolveDynamic`` with the health checks: raise :class:`SimulationFailed` when a hook
     stopped the run (``watch.failure``), when the solver reports failure, or when it raised.
 
@@ -553,6 +553,9 @@ def solve_checked(mbs, settings, solver_type, watch: HealthWatch) -> None:
         The explicit integrator.
     watch : HealthWatch
         The run's health record (the hooks' failures, the likely cause).
+    stopped_early : callable ``() -> bool``, optional
+        True when a hook stopped the run on purpose before the end time (the capture was over,
+        :mod:`structures.capture_window`): then reaching less than the end time is not a failure.
     """
     end_time = settings.timeIntegration.endTime
     try:
@@ -565,6 +568,8 @@ def solve_checked(mbs, settings, solver_type, watch: HealthWatch) -> None:
                                f"{str(exc).strip().splitlines()[0] if str(exc).strip() else ''}", watch.cause) from exc
     if watch.failure is not None:
         raise watch.failure
+    if stopped_early is not None and stopped_early():
+        return
     reached = mbs.systemData.GetTime()
     half_step = 0.5 * end_time / max(settings.timeIntegration.numberOfSteps, 1)
     # a solver that reports success but stopped short failed all the same
@@ -581,7 +586,7 @@ class ImpactSimulation:
         self.health = HealthWatch(likely_failure_cause(assembly),
                                   max(initial_kinetic_energy(assembly), MIN_REFERENCE_ENERGY_J))
 
-    def run(self, progress=None, monitor=None) -> Recorder:
+    def run(self, progress=None, monitor=None, capture=None) -> Recorder:
         """Integrate to the end time.
 
         Raises :class:`~multibody.health.SimulationFailed` at the first failed health check
@@ -594,13 +599,17 @@ class ImpactSimulation:
             Called at every output sample with the time (s).
         monitor : object with ``check(...)``, optional
             Called after ``progress`` (see :class:`~multibody.recorder.Recorder`).
+        capture : structures.capture_window.CaptureMonitor, optional
+            The capture's settle test; the run stops (before the end time) once the capture is over
+            (``recorder.stopped_early``).
 
         Returns
         -------
         Recorder
             All time series of the run.
         """
-        recorder = Recorder(self.assembly, self.system, progress=progress, monitor=monitor, health=self.health)
+        recorder = Recorder(self.assembly, self.system, progress=progress, monitor=monitor, health=self.health,
+                            capture=capture)
         self.recorder = recorder
         mbs = self.system.mbs
         post_step = recorder.post_step
@@ -621,8 +630,10 @@ class ImpactSimulation:
         try:
             if not self.health.ok:
                 raise self.health.failure
-            solve_checked(mbs, settings, INTEGRATORS[self.assembly.solver.integrator][0], self.health)
-            if kernel_net is not None and not kernel_net.finish_steps(mbs):
+            solve_checked(mbs, settings, INTEGRATORS[self.assembly.solver.integrator][0], self.health,
+                          stopped_early=lambda: recorder.stopped_early)
+            # a run stopped early has done its last step's work already (the hook that stopped it)
+            if kernel_net is not None and not recorder.stopped_early and not kernel_net.finish_steps(mbs):
                 raise self.health.failure
             if not self.health.finish():
                 raise self.health.failure

@@ -113,13 +113,17 @@ class Recorder:
     """Samples the running system from Exudyn's post-step hook (when the kernel integrates the net, from its
     pre-step hook for the step before: :meth:`multibody.kernel_net.KernelNet.set_after_step`)."""
 
-    def __init__(self, assembly, system, progress=None, monitor=None, health=None):
+    def __init__(self, assembly, system, progress=None, monitor=None, health=None, capture=None):
         self.assembly = assembly
         self.system = system
         self.progress = progress
         #: optional ``check(t, force_joint, moment_joint, joint_energies)`` called after each
         #: sample (structures.release.ReleaseMonitor switches failed joints off there)
         self.monitor = monitor
+        #: optional settle test of the capture (structures.capture_window.CaptureMonitor): ``sample(t, force_joint,
+        #: moment_joint)`` after each sample, ``snapshot(t, positions_lvlh, velocities_lvlh, com_lvlh, velocity_lvlh,
+        #: body_to_lvlh, omega_body) -> bool`` at each net snapshot; True stops the run (:attr:`stopped_early`)
+        self.capture = capture
         #: :class:`~multibody.health.HealthWatch`: finite state at every sample and at least every
         #: HEALTH_INTERVAL_S, energy balance at every sample; a failed check stops the solver
         self.health = health or HealthWatch(cause="")
@@ -268,7 +272,7 @@ class Recorder:
         elif self._steps_unchecked >= self._health_every:
             self._steps_unchecked = 0
             self.health.state(t, *self.system.state_arrays())
-        return self.health.ok
+        return self.health.ok and not self.stopped_early
 
     def _book_joint_dampers(self):
         """The joints' dampers' work over the step that just ended, into the balance's ``dissipated_joints``
@@ -343,6 +347,8 @@ class Recorder:
         self._store()
         if self.monitor is not None:
             self._check_monitor(t, forces_joint.copy(), moments_joint.copy())
+        if self.capture is not None:
+            self.capture.sample(t, forces_joint, moments_joint)
         if t == 0.0 or t >= self._next_net - 0.5 * self.step:
             x_lvlh, v_lvlh = self.system.net_state(q, qt)
             k = self._n_net
@@ -353,6 +359,8 @@ class Recorder:
             self._n_net += 1
             if t > 0.0:
                 self._next_net += self.net_interval
+            if self.capture is not None:
+                self._check_capture(t, k)
         if self.progress is not None:
             self.progress(t)
 
@@ -364,6 +372,14 @@ class Recorder:
         impulse_lvlh[:] = 0.0
         self._last_net_time = t
         return force_lvlh
+
+    def _check_capture(self, t, k):
+        """The capture's settle test at net snapshot ``k`` (the velocities as stored, float32, so that the verdict's
+        recomputation from the snapshots reads the same values); a capture that is over stops the run."""
+        w = self._body_out
+        if self.capture.snapshot(t, self._net_positions[k], self._net_velocities[k], w.com_lvlh, w.velocity_lvlh,
+                                 w.body_to_lvlh, w.omega_body):
+            self.stopped_early = True
 
     def _check_monitor(self, t, force_joint, moment_joint):
         before = len(self.monitor.events)

@@ -222,9 +222,11 @@ def _thread_contact_force(ka, kc, x, w, mass, box_min, box_max, s, radius, law, 
     d = (pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2])
     lo = (box_min[s, 0], box_min[s, 1], box_min[s, 2])
     hi = (box_max[s, 0], box_max[s, 1], box_max[s, 2])
-    nx, ny, nz = segment_box_normal(pa[0] + t_deepest * d[0], pa[1] + t_deepest * d[1], pa[2] + t_deepest * d[2],
-                                    d[0], d[1], d[2], lo, hi, v[0], v[1], v[2])
-    rate = -(v[0] * nx + v[1] * ny + v[2] * nz)          # q's rate: the point's closing speed ...
+    nx, ny, nz, slope = segment_box_normal(pa[0] + t_deepest * d[0], pa[1] + t_deepest * d[1],
+                                           pa[2] + t_deepest * d[2], d[0], d[1], d[2], lo, hi, v[0], v[1], v[2])
+    # q's rate: the point's closing speed times the depth's slope along the normal (below 1 where the point lies
+    # inside the box, between two faces: segment_box_normal) ...
+    rate = -slope * (v[0] * nx + v[1] * ny + v[2] * nz)
     me = (0.0, 0.0, 0.0)
     if end == 0:
         me = n_a
@@ -238,12 +240,15 @@ def _thread_contact_force(ka, kc, x, w, mass, box_min, box_max, s, radius, law, 
     dissipated = (fn - elastic) * rate * dt
     normal_speed = v[0] * nx + v[1] * ny + v[2] * nz
     gx, gy, gz = v[0] - normal_speed * nx, v[1] - normal_speed * ny, v[2] - normal_speed * nz
-    fx, fy, fz = fn * nx, fn * ny, fn * nz
+    # the point's normal force: the gradient of k q^(n+1)/(n+1), fn times the slope (fn alone made energy where the
+    # point lies inside the box: segment_box_normal)
+    pressure = fn * slope
+    fx, fy, fz = pressure * nx, pressure * ny, pressure * nz
     slip = math.sqrt(gx * gx + gy * gy + gz * gz)
     if fn > 0.0 and slip > 0.0:
         mu = hollar_friction_coefficient_inverse(slip, law.mu_static, law.mu_kinetic, 1.0 / law.transition_speed)
         reduced = 1.0 / (wp * wp / mass[ka] + wq * wq / mass[kc] + inverse_body_mass)
-        magnitude = min(mu * fn, reduced * slip / dt)   # may stop the slip within a sub-step, not reverse it
+        magnitude = min(mu * pressure, reduced * slip / dt)   # may stop the slip within a sub-step, not reverse it
         along = magnitude / slip
         fx -= along * gx
         fy -= along * gy

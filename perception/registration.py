@@ -72,6 +72,7 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from perception.nearest_grid import NearestPointGrid
+from perception.map_growth import unmapped_surface
 from perception.point_to_plane import point_to_plane_information, tukey_normal_equations
 from perception.pose_motion import predict_pose, propagate_pose
 from perception.visibility import free_space_violation, unseen_model_share, visible_side_centroid
@@ -390,13 +391,24 @@ class DebrisTracker:
                                 frames, so with a motion) may fail and still go on, its next frame predicted
                                 across the gap; the failed frames stay failed. 0 (default): a chain is
                                 dropped at its first failed frame.
+    grow_map : bool             After a lost track's re-acquisition is confirmed (a single chain that passed
+                                every check of each of its frames and turned its view by CONFIRMING_VIEW_TURN),
+                                the chain's frames and every later frame registered from the motion prediction
+                                that passes every check add the surface their scans show and the map lacks
+                                (:meth:`_grow_map`). Pending chains' frames, failed frames, searched frames
+                                without a motion and all frames before the first confirmed re-acquisition add
+                                nothing. False (default): the model stays as given.
     """
 
     def __init__(self, voxel=0.03, max_correspondence=0.1, model_frames=30, model_points_body=None,
                  model_normals_body=None, symmetries_body=None, seed=0, field_of_view=None, ray_spacing=0.0,
                  search_cpu_per_frame=np.inf, search_cpu_per_run=np.inf, free_space_lateral_bins=0,
-                 continuity_turn=None, chain_missed_frames=0):
+                 continuity_turn=None, chain_missed_frames=0, grow_map=False):
         self.voxel = voxel
+        self.grow_map = bool(grow_map)
+        self._reacquired = False             # a re-acquisition has been confirmed (the map may grow from then on)
+        self._chain_scans = {}               # time (s) -> thinned scan (m, world) of frames of pending chains
+        self.map_growth = []                 # one dict per map growth: time (s), frames, points added
         self.continuity_turn = continuity_turn
         self.chain_missed_frames = int(chain_missed_frames)
         # None: off; a list: every candidate pose a lost track's search or chain produced, one dict each
@@ -495,6 +507,39 @@ class DebrisTracker:
         (:mod:`perception.nearest_grid`, ~10x faster than the KD-tree) of a third of a voxel."""
         self._nearest = NearestPointGrid(self._model_points, self.voxel / 3, self.max_correspondence)
 
+    def _grow_after_reacquisition(self, alignment, points_world, tracked_with_motion) -> None:
+        """The map growth rule (``grow_map``): the scans of pending chains' frames are kept; when a chain is
+        confirmed (``revised``), its frames and the confirming one grow the map, in time order; afterwards a
+        frame does when it passed every check from the motion prediction (``tracked_with_motion``)."""
+        if self._chains:
+            self._chain_scans[alignment.time] = points_world
+        if self.revised:
+            self._reacquired = True
+            frames = [(self.alignments[i], self._chain_scans.get(self.alignments[i].time)) for i in self.revised]
+            frames = sorted(frames + [(alignment, points_world)], key=lambda frame: frame[0].time)
+        elif self._reacquired and alignment.ok and tracked_with_motion:
+            frames = [(alignment, points_world)]
+        else:
+            frames = []
+        if not self._chains:
+            self._chain_scans = {}
+        for confirmed, points in frames:
+            if points is not None and confirmed.ok:
+                self._grow_map(confirmed.time, _transform(points, confirmed.world_to_body))
+
+    def _grow_map(self, time_s, points_body) -> int:
+        """Adds to the map (the model, frame B) the surface a registered scan (n, 3) (m, frame B) shows and the
+        map lacks (:func:`perception.map_growth.unmapped_surface`); the points already in the map are kept as
+        they are. Returns the number of points added (each growth recorded in ``map_growth``)."""
+        points, normals = unmapped_surface(points_body, self._model_points, self._tree, self.voxel,
+                                           self.max_correspondence)
+        if not len(points):
+            return 0
+        self._set_model(np.vstack([self._model_points, points]), np.vstack([self._model_normals, normals]))
+        self._freeze_model()
+        self.map_growth.append({"time": float(time_s), "points_added": len(points), "map_points": len(self._model_points)})
+        return len(points)
+
     # -- one frame -------------------------------------------------------------------
     def update(self, time_s, points_world, sensor_world, gate=None, all_returns_world=None,
                sensor_to_world=None) -> Alignment:
@@ -538,6 +583,7 @@ class DebrisTracker:
         self._frame_returns = None if all_returns_world is None else np.asarray(all_returns_world, float)
         self._frame_sensor_to_world = None if sensor_to_world is None else np.asarray(sensor_to_world, float)
         scan = _cloud(points_world).voxel_down_sample(self.voxel)
+        tracked_with_motion = False
         if self._model is None:   # the first scan starts the model and defines the frame B
             alignment = self._start_model(time_s, np.asarray(scan.points))
         else:
@@ -546,6 +592,7 @@ class DebrisTracker:
                 scan = self._gated(scan, predicted, gate)
             alignment = self._track_within_budget(time_s, scan, predicted, has_motion, sensor_world)
             self._frame_spacing = None
+            tracked_with_motion = has_motion
         self._frame_returns = self._frame_sensor_to_world = None
         alignment.seconds = time.perf_counter() - start
         alignment.cpu_seconds = time.process_time() - cpu_start
@@ -553,6 +600,8 @@ class DebrisTracker:
             self.search_cpu_spent += alignment.cpu_seconds
         self.alignments.append(alignment)
         self._grow_model(alignment, np.asarray(scan.points))
+        if self.grow_map and len(self.alignments) > 1:
+            self._grow_after_reacquisition(alignment, np.asarray(scan.points), tracked_with_motion)
         return alignment
 
     def _gated(self, scan, predicted, gate) -> o3d.geometry.PointCloud:

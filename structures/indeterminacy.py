@@ -17,9 +17,10 @@ from typing import NamedTuple
 #: the run); loads that are not finite; net threads through the part that could take it past its allowable
 #: (structures.thread_gaps); the threads' own contact on with an energy error past its limit (structures.verdict.
 #: thread_contact_energy_gap); the twin run exceeding the allowable, the peak one draw of a chaotic capture,
-#: the twin not run (structures.twin).
+#: the twin not run (structures.twin); the run reaching its end time before the capture was over
+#: (structures.capture_window, ``structures.window = "capture"``).
 RULES = ("too_few_judged_samples", "coarse_sampling", "no_capture_load", "non_finite_loads", "thread_pass_through",
-         "thread_contact_energy", "twin_exceeds", "chaotic_peak", "twin_not_run")
+         "thread_contact_energy", "twin_exceeds", "chaotic_peak", "twin_not_run", "capture_not_over")
 
 
 class Indeterminacy(NamedTuple):

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from structures.capture_window import capture_gap
 from structures.indeterminacy import Indeterminacy, mark
 from structures.release import ReleaseEvent, released_pieces
 from structures.reproducibility import TWIN_OFFSET, twin_label
@@ -128,7 +129,7 @@ def location_state(result: dict, gaps: list[Indeterminacy]) -> tuple[str, list[I
 def structures_verdict(locations: list[WeakLocation], series: dict, assembly, events: list[ReleaseEvent],
                        net_positions_final, skip_until: float, policy: str, pass_throughs=None,
                        judge_pass_throughs: bool = True, thread_contact_drift: float | None = None,
-                       thread_segments: bool = False) -> dict:
+                       thread_segments: bool = False, capture: dict | None = None) -> dict:
     """JSON-ready verdict: per location the criteria, margins, likelihood and any release, and the
     answer ``debris_state`` (:data:`DEBRIS_STATES`) with the reasons when it is indeterminate.
 
@@ -163,6 +164,10 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
         The run had the threads' own contact on (``contact.thread_segments``): a location that holds is
         indeterminate when ``thread_contact_drift`` is past :data:`THREAD_CONTACT_DRIFT_LIMIT`
         (:func:`thread_contact_energy_gap`).
+    capture : dict, optional
+        With ``structures.window = "capture"``: :func:`structures.capture_window.capture_window` of the run. A
+        location that has not failed is indeterminate (rule ``capture_not_over``) when the run reached its end time
+        before the capture was over; the dict goes to ``capture_window``.
 
     Returns
     -------
@@ -176,6 +181,7 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
     released_at = {e.location: e for e in events}
     gaps = evidence_gaps(time, series["contact_force_lvlh"][:, list(assembly.debris_indices)], skip_until)
     energy_gap = thread_contact_energy_gap(thread_contact_drift) if thread_segments else None
+    unsettled = capture_gap(capture) if capture is not None else None
     rows = []
     judged_at = policy if policy != "never" else "low"     # without release, range allowables judge low
     for loc in locations:
@@ -194,6 +200,8 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
             state, found = "indeterminate", [pass_through_reason(check)]
         if energy_gap is not None and state != "fails":
             state, found = "indeterminate", found + [energy_gap]
+        if unsettled is not None and state != "fails":       # a hold seen over part of the capture is not a hold
+            state, found = "indeterminate", found + [unsettled]
         mark(result, state, found)
         result["peak_window"] = "unchecked"        # deterministic or chaotic once a twin run checks it (apply_twin)
         result["condition"] = condition_sentence(result, judged_at)
@@ -206,10 +214,13 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
         answer = INDETERMINATE
     else:
         answer = NO_DEBRIS
-    return {"skip_initial_s": skip_until, "release_policy": policy,
-            "thread_pass_through": "bound" if judge_pass_throughs else "ignore", "locations": rows, "released_pieces": pieces,
-            "debris_state": answer, "secondary_debris": {DEBRIS: True, NO_DEBRIS: False}.get(answer),
-            "indeterminate_reasons": sorted({r["indeterminate_reason"] for r in rows if r["indeterminate_reason"]})}
+    out = {"skip_initial_s": skip_until, "release_policy": policy,
+           "thread_pass_through": "bound" if judge_pass_throughs else "ignore", "locations": rows, "released_pieces": pieces,
+           "debris_state": answer, "secondary_debris": {DEBRIS: True, NO_DEBRIS: False}.get(answer),
+           "indeterminate_reasons": sorted({r["indeterminate_reason"] for r in rows if r["indeterminate_reason"]})}
+    if capture is not None:
+        out["capture_window"] = capture
+    return out
 
 
 def apply_twin(verdict: dict, locations: list[WeakLocation], series: dict, twin_series: dict | None,

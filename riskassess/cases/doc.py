@@ -85,7 +85,7 @@ SECTIONS = [
 
 
 #: Symbols a unit in a field description may be built from (SI only, see the header).
-UNIT_SYMBOLS = {"m", "kg", "s", "N", "Pa", "rad", "Hz", "-"}
+UNIT_SYMBOLS = {"m", "kg", "s", "N", "J", "Pa", "rad", "Hz", "-"}
 
 
 def _is_unit(text: str) -> bool:

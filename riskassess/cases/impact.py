@@ -29,6 +29,7 @@ from riskassess.cases.inputs import (JSON_FILE_LIMIT, KIND_NOTE, MESH_FILE_LIMIT
                                     unique_names)
 from riskassess.cases.target_geometry import target_points_lvlh, target_vertices_lvlh
 from riskassess.cases.uncertain import parse_uncertain
+from structures.capture_window import CAPTURE_ENERGY_FRACTION, CAPTURE_HOLD_TRAVEL_M
 from structures.modal_load import SAMPLES_PER_MODE_PERIOD
 from structures.section_shapes import SHAPES
 
@@ -487,6 +488,11 @@ class Registration(Strict):
         0, description="Consecutive frames a candidate pose chain after a lost debris track may fail and still go "
                        "on, predicted across the gap (-); the failed frames stay failed (issue 26). 0: a chain "
                        "ends at its first failed frame.")
+    reacquire_grow_map: bool = Field(
+        False, description="After a lost debris track's re-acquisition is confirmed, the confirmed frames and every "
+                           "later frame tracked from the motion prediction that passes its checks add the surface "
+                           "the map lacks (model-free tracking; issue 26). False: the map stays as built in the "
+                           "observation.")
 
     @model_validator(mode="after")
     def _budget(self):
@@ -625,6 +631,31 @@ class Structures(Strict):
                            "deterministic (both runs' peaks so far agree within 5 % up to it) or chaotic (one draw of "
                            "the capture's late strikes); a location that holds on a chaotic peak is indeterminate "
                            "(docs/structures.md). Doubles the run time unless the run already shows debris.")
+    window: Literal["fixed", "capture"] = Field(
+        "capture", description="The judged window (default 'capture' for coupled runs, 'fixed' for sequential ones): "
+                             "'fixed' judges 0..simulation.end_time, a statement that nothing after it can load the "
+                             "target (for example the net closed or in tow by then; the report names the window); "
+                             "'capture' judges the capture "
+                             "until it is over (the net's kinetic energy relative to the debris' main body, its "
+                             "rigid motion with that body removed, below capture_energy_J and no judged running peak "
+                             "rising, both for capture_hold_s) and stops the run there; simulation.end_time is then "
+                             "the cap, and a run that reaches it before the capture is over cannot say a location "
+                             "holds (indeterminate, rule capture_not_over; docs/structures.md, 'The whole capture as "
+                             "the judged window'). Coupled runs only.")
+    capture_energy_J: Positive | None = Field(
+        None, description="With window = 'capture': the net's kinetic energy relative to the debris (J) below which "
+                          "its relative motion counts as died out; default capture_energy_fraction of that energy at "
+                          "launch.")
+    capture_energy_fraction: Annotated[float, Field(gt=0, le=1)] = Field(
+        CAPTURE_ENERGY_FRACTION, description="With window = 'capture' and no capture_energy_J: the share (-) of the "
+                                             "net's kinetic energy relative to the debris at launch below which its "
+                                             "relative motion counts as died out; the default is argued from "
+                                             "measured envisat_small runs in docs/structures.md.")
+    capture_hold_s: Positive | None = Field(
+        None, description="With window = 'capture': how long (s) the relative energy must stay below its threshold "
+                          f"with no judged running peak rising; default {CAPTURE_HOLD_TRAVEL_M:g} m of net travel at "
+                          "launch.velocity (one pass of the wrapped net past the body at every speed run on "
+                          "envisat_small).")
 
     @field_validator("weak_locations")
     @classmethod
@@ -751,6 +782,27 @@ class Case(Strict):
         if self.structures is not None and self.structures.twin and self.simulation.coupling == "sequential":
             raise ValueError("structures.twin checks the peaks of a coupled run; a sequential run (the seed paper's "
                              "method) drives the debris with recorded loads: use coupling = 'coupled' or twin = false")
+        return self
+
+    @model_validator(mode="before")
+    @classmethod
+    def _default_window_by_coupling(cls, data):
+        # A hold seen over part of a coupled capture is not a hold (docs/structures.md, "The whole capture as the
+        # judged window"), so coupled runs judge the capture unless the case says otherwise; the sequential method
+        # (the seed paper's) judges its recorded history, which 'capture' cannot follow.
+        if isinstance(data, dict) and isinstance(data.get("structures"), dict) and "window" not in data["structures"]:
+            simulation = data.get("simulation")
+            coupling = simulation.get("coupling", "coupled") if isinstance(simulation, dict) else "coupled"
+            data = {**data, "structures": {**data["structures"],
+                                           "window": "fixed" if coupling == "sequential" else "capture"}}
+        return data
+
+    @model_validator(mode="after")
+    def _capture_window_coupled(self):
+        if self.structures is not None and self.structures.window == "capture" and self.simulation.coupling == "sequential":
+            raise ValueError("structures.window = 'capture' follows the net's motion relative to the debris; a "
+                             "sequential run (the seed paper's method) has the net against a fixed wall: use "
+                             "coupling = 'coupled' or window = 'fixed'")
         return self
 
     @model_validator(mode="after")

@@ -426,12 +426,14 @@ def _search_budget(registration) -> dict:
     """The tracker's CPU limits of the search for a lost track (``perception.registration``'s
     ``search_cpu_per_frame`` and ``search_cpu_per_run``, s) and its continuity limit of a
     re-acquisition (``reacquire_continuity_turn``, rad) and the frames a candidate chain may miss
-    (``reacquire_chain_missed_frames``), as keyword arguments of
+    (``reacquire_chain_missed_frames``) and whether confirmed frames grow the map after a re-acquisition
+    (``reacquire_grow_map``), as keyword arguments of
     :class:`perception.registration.DebrisTracker`."""
     return {"search_cpu_per_frame": registration.search_cpu_per_frame,
             "search_cpu_per_run": registration.search_cpu_per_run,
             "continuity_turn": registration.reacquire_continuity_turn,
-            "chain_missed_frames": registration.reacquire_chain_missed_frames}
+            "chain_missed_frames": registration.reacquire_chain_missed_frames,
+            "grow_map": registration.reacquire_grow_map}
 
 
 def _search_budget_figures(tracker: DebrisTracker, frames: Frames) -> dict:
@@ -1128,6 +1130,8 @@ def _conclude(folder, answer, tracker, frames, track: NetTrack, assembly, wall, 
     answer.update(_timing(tracker, frames))
     answer["tracking"] = _tracking_figures(tracker, frames)
     answer["search_budget"] = _search_budget_figures(tracker, frames)
+    if tracker.grow_map:   # the map's growth after re-acquisitions (perception.registration.reacquire_grow_map)
+        answer["map_growth"] = tracker.map_growth
     if assembly is not None:
         answer["net"] = _net_figures(track, assembly)
         _name_budget_cuts(answer)

@@ -20,6 +20,7 @@ from riskassess.models.impact_sequential import applied_contact_series, driven_i
 from riskassess.cases.impact import Case, load_case
 from riskassess.products.outfolder import OutputFolder, claim
 from riskassess.products.summary import run_summary, sequential_summary
+from structures.capture_window import CaptureMonitor, capture_window, hold_time, reference_body
 from structures.release import ReleaseMonitor
 from structures.reproducibility import TWIN_OFFSET
 from structures.verdict import DEBRIS, INDETERMINATE, apply_twin, demand_series, structures_verdict
@@ -96,7 +97,8 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
             monitor = ReleaseMonitor(locations, simulation.system, case.structures.skip_initial,
                                      case.structures.release, interval_s=1.0 / case.simulation.output_rate)
         driven_progress = _scaled(progress, 0.5 * case.simulation.end_time) if sequential else progress
-        recorder = run_recorded(simulation, folder, progress=driven_progress, monitor=monitor)
+        capture = capture_monitor(case, locations, simulation.assembly)
+        recorder = run_recorded(simulation, folder, progress=driven_progress, monitor=monitor, capture=capture)
         if sequential:
             recorder.series = applied_contact_series(recorder.series, loads)
             summary = write_sequential(folder, wall_recorder, wall, recorder, simulation, inputs.assembly, case)
@@ -118,7 +120,10 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
                 net_positions_final, case.structures.skip_initial, case.structures.release, pass_throughs,
                 judge_pass_throughs=case.structures.thread_pass_through == "bound",
                 thread_contact_drift=summary.get("checks", {}).get("energy_balance_relative_drift"),
-                thread_segments=case.contact.thread_segments)
+                thread_segments=case.contact.thread_segments,
+                capture=recorded_capture_window(case, locations, simulation.assembly, recorder) if capture else None)
+            if not capture:         # the case states that nothing after its end time loads the target
+                verdict["judged_window"] = {"window": "fixed", "end_time_s": float(recorder.series["time"][-1])}
             if case.structures.twin:
                 verdict = _with_twin(verdict, locations, recorder.series, case, case_path)
             results.atomic_write_npz(folder.path / "structures.npz", demand_series(locations, recorder.series))
@@ -131,6 +136,31 @@ def run_case(case_path: str | Path, out_dir: str | Path, progress=None, case: Ca
     return RunOutput(folder.path, summary, verdict)
 
 
+def capture_monitor(case: Case, locations, assembly) -> CaptureMonitor | None:
+    """The capture's settle test for the run (``structures.window = "capture"``; None otherwise): it stops the
+    simulation once the capture is over (:mod:`structures.capture_window`)."""
+    if not locations or case.structures.window != "capture":
+        return None
+    s = case.structures
+    body = reference_body(assembly.bodies, assembly.joints, assembly.debris_indices)
+    return CaptureMonitor(locations, assembly.net.masses, body, s.skip_initial, s.capture_energy_J,
+                          hold_time(s.capture_hold_s, case.launch.velocity), interval_s=1.0 / case.simulation.output_rate,
+                          energy_fraction=s.capture_energy_fraction)
+
+
+def recorded_capture_window(case: Case, locations, assembly, recorder) -> dict:
+    """Whether and when the recorded run's capture was over (:func:`structures.capture_window.capture_window`),
+    read from its series and net snapshots."""
+    s = case.structures
+    body = reference_body(assembly.bodies, assembly.joints, assembly.debris_indices)
+    window = capture_window(locations, recorder.series, recorder.net, assembly.net.masses, body,
+                            assembly.bodies[body].name, s.skip_initial, s.capture_energy_J,
+                            hold_time(s.capture_hold_s, case.launch.velocity), s.capture_energy_fraction)
+    window["end_time_cap_s"] = case.simulation.end_time
+    window["stopped_early"] = bool(recorder.stopped_early)
+    return window
+
+
 def _with_twin(verdict: dict, locations, series: dict, case: Case, case_path: Path) -> dict:
     """The verdict with every judged peak labelled against a twin run (launch speed x (1 + TWIN_OFFSET), no
     release, no products: :func:`structures.verdict.apply_twin`); the twin is not run when the run already
@@ -141,11 +171,20 @@ def _with_twin(verdict: dict, locations, series: dict, case: Case, case_path: Pa
                            "note": "not run: the run shows debris"}
         return verdict
     launch = case.launch.model_copy(update={"velocity": case.launch.velocity * (1.0 + TWIN_OFFSET)})
-    twin = _simulation(model_inputs(case.model_copy(update={"launch": launch}), case_path.parent))
+    # the twin covers the run's own window: a capture window may have stopped the run before its end time (the cap)
+    end = float(series["time"][-1])
+    simulation = case.simulation
+    if end < simulation.end_time - 0.5 * simulation.step:
+        simulation = simulation.model_copy(update={"end_time": end})
+    twin_case = case.model_copy(update={"launch": launch, "simulation": simulation})
+    twin = _simulation(model_inputs(twin_case, case_path.parent))
     try:
         twin_series = twin.run().series
     except SimulationFailed as exc:
         return apply_twin(verdict, locations, series, None, skip, policy, f"the twin run failed: {exc}")
+    if twin_series["time"].shape != series["time"].shape:
+        return apply_twin(verdict, locations, series, None, skip, policy,
+                          f"the twin run's {twin_series['time'].size} samples do not match the run's {series['time'].size}")
     return apply_twin(verdict, locations, series, twin_series, skip, policy)
 
 
@@ -167,7 +206,7 @@ def run_recorded(simulation: ImpactSimulation, folder: OutputFolder, **run_optio
     folder : OutputFolder
         The claimed run folder.
     **run_options
-        ``progress`` and ``monitor`` of :meth:`multibody.impact.ImpactSimulation.run`.
+        ``progress``, ``monitor`` and ``capture`` of :meth:`multibody.impact.ImpactSimulation.run`.
 
     Returns
     -------

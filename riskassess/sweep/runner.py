@@ -108,7 +108,9 @@ def run_record(summary: dict, verdict: dict | None, overrides: dict) -> dict:
         ``peak_contact_moment_Nm`` (about the debris CoM), ``joint_peak_moment_after_transient_Nm``,
         ``energy_balance_relative_drift``, ``wall_time_s``, ``steps_per_second``, ``locations``
         (per location ``utilization`` (-), ``likelihood``, ``peaks`` in their ``units``, ...),
-        ``released_pieces`` and ``breakup_likelihood``.
+        ``released_pieces`` and ``breakup_likelihood``; with ``structures.window = "capture"`` also
+        ``capture_window`` (``settled``, ``settled_at_s``, ``end_time_s``, ``net_energy_relative_end_J``,
+        ``last_rise_s``).
     """
     record = {
         "inputs": overrides,
@@ -142,6 +144,10 @@ def run_record(summary: dict, verdict: dict | None, overrides: dict) -> dict:
     if record["debris_state"] == INDETERMINATE:
         record["secondary_debris"] = None
     record["indeterminate_reasons"] = indeterminate_reasons_of(record)
+    if verdict.get("capture_window"):      # structures.window = "capture": when the capture was over, and its energy
+        window = verdict["capture_window"]
+        record["capture_window"] = {k: window.get(k) for k in ("settled", "settled_at_s", "end_time_s",
+                                                               "net_energy_relative_end_J", "last_rise_s")}
     return record
 
 

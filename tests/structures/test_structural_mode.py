@@ -203,10 +203,13 @@ def test_a_run_judges_and_reports_the_modal_reading(tmp_path):
     # is about the reading, so it judges the node-contact loads alone
     text = text.replace('release = "low"', 'release = "low"\nthread_pass_through = "ignore"', 1)
     assert 'thread_pass_through = "ignore"' in text
+    # and over its 0.3 s alone (the default "capture" window would call a 0.3 s hold indeterminate)
+    text = text.replace('release = "low"', 'release = "low"\nwindow = "fixed"', 1)
     (tmp_path / "case").mkdir()
     case_path = tmp_path / "case" / "case.toml"
     case_path.write_text(text)
     verdict = run_case(case_path, tmp_path / "run").structures
+    assert verdict["judged_window"] == {"window": "fixed", "end_time_s": pytest.approx(0.3, abs=1e-9)}
     array = verdict["locations"][0]
     assert array["reading"].startswith("through the structure's first mode: every first mode in 0.2-2 Hz")
     moment = array["criteria"]["moment"]

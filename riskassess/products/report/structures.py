@@ -73,10 +73,50 @@ def verdict_section(run: RunFolder) -> Section:
                            "whose nodes lie either side of a thin part passes through it without a force; bound: "
                            "twice each such thread's tension at its crossing, at the 'net_output_rate' snapshots): "
                            + " ".join(passed), "warning"))
+    if verdict.get("capture_window"):
+        blocks.append(Note(capture_window_text(verdict["capture_window"]),
+                           "info" if verdict["capture_window"]["settled"] else "warning"))
+    elif verdict.get("judged_window"):
+        blocks.append(Note(fixed_window_text(verdict["judged_window"]), "warning"))
     blocks.append(Note("Likelihood: probability of failure with the allowable uniformly distributed over its "
                        "range. For a released location it is a lower bound ('>='), because the joint carries "
                        "nothing after its release."))
     return Section("verdict", "Verdict: secondary debris", blocks)
+
+
+def fixed_window_text(window: dict) -> str:
+    """One sentence on the judged window of a run with ``structures.window = "fixed"``: what its answer is
+    conditional on (``window`` is the verdict's ``judged_window``)."""
+    return (f"Judged window: fixed, 0 to {window['end_time_s']:.2f} s (structures.window = 'fixed'): the case states "
+            f"that nothing after its end time loads the target (for example the net closed or in tow by then). "
+            f"Loads after it are not judged and the capture was not checked to be over; with the default window "
+            f"('capture') a location that held would need the capture over to say so.")
+
+
+def capture_window_text(window: dict) -> str:
+    """One sentence on the judged window of a run with ``structures.window = "capture"``: when the capture was over
+    (or that it was not by the end time), the net's relative energy and the keys.
+
+    Parameters
+    ----------
+    window : dict
+        The verdict's ``capture_window`` (:func:`structures.capture_window.capture_window`).
+
+    Returns
+    -------
+    str
+    """
+    keys = (f"(the net's kinetic energy relative to {window['reference_body']}, its rigid motion removed, below "
+            f"{window['energy_threshold_J']:g} J and no judged running peak rising, both for {window['hold_s']:g} s)")
+    energy = "unknown" if window["net_energy_relative_end_J"] is None else f"{window['net_energy_relative_end_J']:.3g} J"
+    if window["settled"]:
+        return (f"Judged window: the whole capture, over at t_s = {window['settled_at_s']:.2f} s {keys}; the run "
+                f"{'stopped' if window.get('stopped_early') else 'ended'} at {window['end_time_s']:.2f} s with "
+                f"{energy} relative energy.")
+    return (f"Judged window: the capture was NOT over when the run reached its end time {window['end_time_s']:.2f} s "
+            f"{keys}: relative energy {energy}, the last rise of a judged peak at "
+            f"{window['last_rise_s'] if window['last_rise_s'] is not None else float('nan'):.2f} s; no location that "
+            f"held can say so (indeterminate).")
 
 
 def pass_through_text(loc: dict) -> str:

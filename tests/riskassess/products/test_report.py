@@ -151,3 +151,17 @@ def test_run_writes_report_and_vtk_when_asked(tmp_path):
     assert len(list((out / "vtk").glob("net_*.vtu"))) == 6
     html = (out / "report.html").read_text()
     assert "Not assessed: the case declares no weak locations" in _html_section(html, "verdict")
+
+
+def test_the_report_states_what_a_fixed_and_an_open_capture_window_rest_on():
+    # a fixed window is the case's statement that nothing later loads the target; a capture not over by the end
+    # time cannot let a location hold (structures/capture_window.py)
+    from riskassess.products.report.structures import capture_window_text, fixed_window_text
+    fixed = fixed_window_text({"window": "fixed", "end_time_s": 7.5})
+    assert "0 to 7.50 s" in fixed and "structures.window = 'fixed'" in fixed and "not judged" in fixed
+    open_capture = capture_window_text({"window": "capture", "settled": False, "settled_at_s": None,
+                                        "end_time_s": 45.0, "energy_threshold_J": 0.37, "hold_s": 10.5,
+                                        "reference_body": "main_body", "net_energy_relative_end_J": 6.92,
+                                        "last_rise_s": 30.228})
+    assert "NOT over" in open_capture and "45.00 s" in open_capture and "0.37 J" in open_capture
+    assert "6.92 J" in open_capture and "30.23 s" in open_capture and "indeterminate" in open_capture
