@@ -7,6 +7,7 @@ and through the structure's first mode.
                                             [--workers N] [--markdown]
                                             [--store STORE --sample N [--velocity V]] [--peak-times LOCATION]
                                             [--quantile Q ...] [--variants V1,V2,...]
+                                            [--load-filter HZ] [--joint-filter JOINT:HZ ...]
 
 Runs the case (default ``cases/envisat_small.toml``) with joint release off (every peak is then the
 demand the intact joint carries, not cut at a release) at a baseline and one change at a time:
@@ -49,6 +50,11 @@ peak over the replicas the same way (for a chaotic capture the distribution of t
 and a verdict's probability rests on its upper tail, not on one run). Prints the CPU time per run and the load.
 ``--variants`` runs only some configurations, replica by replica over them (a study stopped early stays
 balanced), and reports the others missing.
+
+``--load-filter HZ`` (``structures.load_filter_hz``) and ``--joint-filter JOINT:HZ`` (a joint's ``load_filter_hz``)
+run the joints' load filter (:mod:`multibody.load_filter`: a 2nd-order Butterworth on every step's load, before the
+output's decimation) and add the reading "through the step filter": the filtered loads the verdict then judges
+(a joint without a cut-off reads raw there). The raw loads of the same runs stay the "as recorded" reading.
 """
 from __future__ import annotations
 
@@ -138,6 +144,18 @@ def with_members(text: str, specs: list[str], modulus: float, shear_modulus: flo
     return text
 
 
+def with_load_filters(text: str, cutoff_hz: float | None, joint_specs: list[str]) -> str:
+    """The case text with ``structures.load_filter_hz = cutoff_hz`` (when given) and each ``JOINT:HZ`` joint's own
+    ``load_filter_hz`` (:mod:`multibody.load_filter`)."""
+    if cutoff_hz:
+        text = _sub(r'^release = "never".*$', lambda m: m.group(0) + f"\nload_filter_hz = {cutoff_hz!r}", text)
+    for spec in joint_specs:
+        joint, hz = spec.split(":")
+        text = _sub(rf'^name = "{re.escape(joint)}".*$', lambda m: m.group(0) + f"\nload_filter_hz = {float(hz)!r}",
+                    text)
+    return text
+
+
 def replica_overrides(overrides: dict, replica: int, velocity: float | None) -> dict:
     """A store sample's overrides (dotted key -> SI value) for one replica: its launch velocity (m/s; or
     ``velocity``) times 1 + replica x REPLICA_OFFSET, as :func:`case_text` offsets the case's own."""
@@ -166,17 +184,23 @@ def simulate(text: str, base_dir: str, stiffness_scale: float, out: str, overrid
         except SimulationFailed as exc:     # a variant the model cannot run is a finding, not a crash
             return f"failed: {exc}"
         with np.load(Path(tmp) / "run" / "timeseries.npz") as data:
+            filtered = ({"force_filtered": data["joint_force_filtered_joint"],
+                         "moment_filtered": data["joint_moment_filtered_joint"]}
+                        if "joint_force_filtered_joint" in data else {})
             np.savez(out + ".tmp.npz", time=data["time"], force=data["joint_force_joint"],
-                     moment=data["joint_moment_joint"], cpu=time.process_time() - start)
+                     moment=data["joint_moment_joint"], cpu=time.process_time() - start, **filtered)
     os.replace(out + ".tmp.npz", out)
     return out
 
 
-def histories(locations, run, modes, damping: float, in_dynamics: set) -> dict:
-    """{"location / criterion": demand history} of one run's joint reactions, read through ``modes`` (Hz;
-    empty: as recorded); a location whose joint carries its member (``in_dynamics``, joint indices) is
-    always read as recorded (its compliance is already in the run)."""
+def histories(locations, run, modes, damping: float, in_dynamics: set, filtered: bool = False) -> dict:
+    """{"location / criterion": demand history} of one run's joint reactions (``filtered``: through the step
+    filter, :mod:`multibody.load_filter`), read through ``modes`` (Hz; empty: as recorded); a location whose joint
+    carries its member (``in_dynamics``, joint indices) is always read as recorded (its compliance is already in the
+    run)."""
     t, force, moment = run["time"], run["force"], run["moment"]
+    if filtered:
+        force, moment = run["force_filtered"], run["moment_filtered"]
     out = {}
     for loc in locations:
         own = () if loc.joint in in_dynamics else tuple(modes)
@@ -249,10 +273,11 @@ MARKS = {"ok": "", "within statistical error": " ~", "unresolved": " ?", "NOT CO
 
 
 def reading_table(results: dict, replicas: int, locations, modes, damping, skip: float, in_dynamics: set,
-                  margin: float = 0.0) -> dict:
+                  margin: float = 0.0, filtered: bool = False) -> dict:
     """{key: {"parting": s, "peaks": {variant: [{window: peak} per replica]}}} for one reading."""
     ran = {v: [results[(v, r)] for r in range(replicas) if not isinstance(results[(v, r)], str)] for v in VARIANTS}
-    runs = {v: [histories(locations, run, modes, damping, in_dynamics) for run in ran[v]] for v in VARIANTS if ran[v]}
+    runs = {v: [histories(locations, run, modes, damping, in_dynamics, filtered) for run in ran[v]]
+            for v in VARIANTS if ran[v]}
     base_time = ran["baseline"][0]["time"]
     table = {}
     for key in runs["baseline"][0]:
@@ -278,8 +303,8 @@ def report(results: dict, replicas: int, locations, readings: dict, skip: float,
               f"spread | {'median' if only_median else 'value'} known to | " + " | ".join(names) + " |")
         print("|" + "---|" * (6 + len(names)))
     members = {f"{loc.name} / " for loc in locations if loc.joint in in_dynamics}
-    for index, (reading, (modes, damping)) in enumerate(readings.items()):
-        table = reading_table(results, replicas, locations, modes, damping, skip, in_dynamics, margin)
+    for index, (reading, (modes, damping, filtered)) in enumerate(readings.items()):
+        table = reading_table(results, replicas, locations, modes, damping, skip, in_dynamics, margin, filtered)
         counts = dict.fromkeys(MARKS, 0)
         if not markdown:
             print(f"\n=== reading: {reading} (locations whose joint carries its member: as recorded)")
@@ -328,16 +353,16 @@ def peak_times(results: dict, replicas: int, locations, readings: dict, skip: fl
     if location is None:
         raise SystemExit(f"--peak-times: no weak location '{name}' (known: {', '.join(l.name for l in locations)})")
     print(f"\n{name}: judged peak (t >= {skip:g} s), its time and utilization (peak / allowable low end)")
-    for reading, (modes, damping) in readings.items():
+    for reading, (modes, damping, filtered) in readings.items():
         for (variant, replica), run in results.items():
             if isinstance(run, str):
                 continue
-            for key, series in histories([location], run, modes, damping, in_dynamics).items():
+            for key, series in histories([location], run, modes, damping, in_dynamics, filtered).items():
                 criterion = key.split(" / ")[1]
                 judged = np.where(run["time"] >= skip, series, -np.inf)
                 k = int(np.argmax(judged))
                 low = location.criteria()[criterion].low
-                moment_joint = run["moment"][k, location.joint]
+                moment_joint = run["moment_filtered" if filtered else "moment"][k, location.joint]
                 print(f"  {reading:34s} {variant:12s} r{replica}  {criterion}: {series[k]:8.1f} at {run['time'][k]:.3f} s, "
                       f"utilization {series[k] / low:.3f}; moment h1 h2 h3 {moment_joint[0]:+.0f} "
                       f"{moment_joint[1]:+.0f} {moment_joint[2]:+.0f} N m")
@@ -387,6 +412,11 @@ def main() -> None:
     parser.add_argument("--quantile", type=float, action="append", default=[], metavar="Q",
                         help="also compare this quantile (0 < Q < 1) of the peak over the replicas, e.g. 0.9 (what a "
                              "verdict's probability uses: the upper tail, not one run)")
+    parser.add_argument("--load-filter", type=float, default=None, metavar="HZ",
+                        help="structures.load_filter_hz: every joint's loads through a 2nd-order Butterworth at HZ, "
+                             "run every step (adds the reading 'through the step filter')")
+    parser.add_argument("--joint-filter", action="append", default=[], metavar="JOINT:HZ",
+                        help="this joint's own load_filter_hz (overrides --load-filter for it)")
     parser.add_argument("--variants", default=",".join(VARIANTS),
                         help="comma list of the configurations to run (default: all); the others are reported missing")
     args = parser.parse_args()
@@ -402,6 +432,7 @@ def main() -> None:
         text = _sub(r"^output_rate = [0-9.e]+", f"output_rate = {args.output_rate:g}", text)
     if args.end_time:
         text = _sub(r"^end_time = [0-9.e]+", f"end_time = {args.end_time:g}", text)
+    text = with_load_filters(text, args.load_filter, args.joint_filter)
     overrides = sample_overrides(Path(args.store), args.sample) if args.store else {}
     if args.velocity is not None and not overrides:
         raise SystemExit("--velocity: with --store only (the case's own velocity is its [launch] velocity)")
@@ -459,8 +490,12 @@ def main() -> None:
     case = validate_case(tomllib.loads(text), case_path)      # the case as run (with any --member)
     locations = weak_locations(case, model_inputs(case, case_path.parent).assembly)
     skip = case.structures.skip_initial if args.skip is None else args.skip
-    readings = {"as recorded": ((), 0.0)}
-    readings.update({label: (tuple(grid), args.mode_damping) for label, grid in map(parse_mode, args.mode)})
+    readings = {"as recorded": ((), 0.0, False)}
+    if args.load_filter or args.joint_filter:
+        cutoffs = ", ".join([f"{args.load_filter:g} Hz" if args.load_filter else "raw"]
+                            + [f"{spec.split(':')[0]} {float(spec.split(':')[1]):g} Hz" for spec in args.joint_filter])
+        readings[f"through the step filter ({cutoffs})"] = ((), 0.0, True)
+    readings.update({label: (tuple(grid), args.mode_damping, False) for label, grid in map(parse_mode, args.mode)})
     in_dynamics = {i for i, j in enumerate(case.target.joints) if j.member is not None}
     if any(not 0.0 < q < 1.0 for q in args.quantile):
         raise SystemExit(f"--quantile: a fraction between 0 and 1, got {args.quantile}")

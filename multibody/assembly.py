@@ -75,6 +75,10 @@ class JointSpec:
                                       [rot h1, rot h2, rot h3] (N m/rad), joint frame, e.g. a member's
                                       compliance lumped at its root (structures.member); replaces
                                       every penalty spring of the joint.
+    load_filter_hz : float            Cut-off (Hz) of the Butterworth low-pass its recorded loads are
+                                      also read through, every step (multibody.load_filter); 0: none.
+                                      Recording only: the dynamics do not see it.
+    load_filter_order : int           That filter's order, 2 or 4.
     """
 
     name: str
@@ -92,6 +96,8 @@ class JointSpec:
     rotation_modes_hz: np.ndarray | None = None
     rotation_modes_damping_ratio: float = 0.0
     structural_stiffness: np.ndarray | None = None
+    load_filter_hz: float = 0.0
+    load_filter_order: int = 4
 
 
 def subtree_bodies(joints: list[JointSpec], root: int, cut_joints=()) -> list[int]:

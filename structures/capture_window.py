@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from structures.indeterminacy import Indeterminacy
-from structures.weak_location import WeakLocation, demands, judged_demands, online_modal_loads
+from structures.weak_location import WeakLocation, demands, joint_loads, judged_demands, online_modal_loads
 
 #: Share of the net's kinetic energy relative to the debris at launch below which the net's motion relative to
 #: the debris counts as died out (``structures.capture_energy_fraction``'s default). From measured runs,
@@ -244,7 +244,7 @@ def judged_rise_times(locations: list[WeakLocation], series: dict, judged_from_s
     t = np.asarray(series["time"], float)
     columns, names = [], []
     for loc in locations:
-        judged = judged_demands(loc, t, series["joint_force_joint"][:, loc.joint], series["joint_moment_joint"][:, loc.joint])
+        judged = judged_demands(loc, t, *joint_loads(loc, series))
         for criterion in loc.criteria():
             columns.append(np.asarray(judged[criterion], float))
             names.append(f"{loc.name} {criterion.replace('_', ' ')}")
@@ -307,7 +307,7 @@ def _last_rise_demand(locations, series, judged_from_s, last_rise):
         return None
     t = np.asarray(series["time"], float)
     for loc in locations:
-        judged = judged_demands(loc, t, series["joint_force_joint"][:, loc.joint], series["joint_moment_joint"][:, loc.joint])
+        judged = judged_demands(loc, t, *joint_loads(loc, series))
         for criterion in loc.criteria():
             if np.any(np.isclose(rise_times(t, judged[criterion][:, None], judged_from_s), last_rise, rtol=0, atol=1e-12)):
                 return f"{loc.name} {criterion.replace('_', ' ')}"

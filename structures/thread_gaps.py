@@ -19,7 +19,7 @@ import numpy as np
 from multibody.assembly import subtree_bodies
 from multibody.thread_crossing import PassThroughSnapshot, missed_load_bounds
 from structures.indeterminacy import Indeterminacy
-from structures.weak_location import WeakLocation, demands, judged_demands
+from structures.weak_location import WeakLocation, demands, joint_loads, judged_demands
 
 
 def demand_per_unit_load(location: WeakLocation) -> dict[str, tuple[float, float]]:
@@ -95,8 +95,7 @@ def pass_through_check(location: WeakLocation, result: dict, history: list[PassT
     """
     carried = set(subtree_bodies(assembly.joints, assembly.joints[location.joint].child))
     time = np.asarray(series["time"], float)
-    demand = judged_demands(location, time, series["joint_force_joint"][:, location.joint],
-                            series["joint_moment_joint"][:, location.joint])
+    demand = judged_demands(location, time, *joint_loads(location, series))
     per_unit = demand_per_unit_load(location)
     rows = []
     for snap in history:

@@ -8,7 +8,7 @@ from structures.indeterminacy import Indeterminacy, mark
 from structures.release import ReleaseEvent, released_pieces
 from structures.reproducibility import TWIN_OFFSET, twin_label
 from structures.thread_gaps import pass_through_check, pass_through_reason
-from structures.weak_location import WeakLocation, assess, judged_demands
+from structures.weak_location import WeakLocation, assess, joint_loads, judged_demands
 
 #: The three answers to "does this capture create secondary debris?" (``debris_state`` in
 #: structures.json, the CLI, the report and the sweep store). ``secondary_debris`` carries the
@@ -185,8 +185,7 @@ def structures_verdict(locations: list[WeakLocation], series: dict, assembly, ev
     rows = []
     judged_at = policy if policy != "never" else "low"     # without release, range allowables judge low
     for loc in locations:
-        result = assess(loc, time, series["joint_force_joint"][:, loc.joint], series["joint_moment_joint"][:, loc.joint],
-                        skip_until, judged_at)
+        result = assess(loc, time, *joint_loads(loc, series), skip_until, judged_at)
         result["joint"] = assembly.joints[loc.joint].name
         event = released_at.get(loc.name)
         result["released_at_s"] = event.time if event else None
@@ -259,10 +258,8 @@ def apply_twin(verdict: dict, locations: list[WeakLocation], series: dict, twin_
     for loc, row in zip(locations, verdict["locations"]):
         reasons, windows = [], []
         if twin_series is not None:
-            mine = judged_demands(loc, series["time"], series["joint_force_joint"][:, loc.joint],
-                                  series["joint_moment_joint"][:, loc.joint])
-            theirs = judged_demands(loc, twin_series["time"], twin_series["joint_force_joint"][:, loc.joint],
-                                    twin_series["joint_moment_joint"][:, loc.joint])
+            mine = judged_demands(loc, series["time"], *joint_loads(loc, series))
+            theirs = judged_demands(loc, twin_series["time"], *joint_loads(loc, twin_series))
         for name, criterion in row["criteria"].items():
             if criterion["peak"] is None:
                 continue
@@ -396,7 +393,6 @@ def demand_series(locations: list[WeakLocation], series: dict) -> dict:
     """
     out = {"time": series["time"]}
     for loc in locations:
-        for name, values in judged_demands(loc, series["time"], series["joint_force_joint"][:, loc.joint],
-                                           series["joint_moment_joint"][:, loc.joint]).items():
+        for name, values in judged_demands(loc, series["time"], *joint_loads(loc, series)).items():
             out[f"{loc.name}/{name}"] = np.asarray(values)
     return out

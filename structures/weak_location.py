@@ -51,6 +51,8 @@ class WeakLocation:
     moment_axes: tuple = (0, 1, 2)       # joint-frame components judged by allowable_moment
     structural_modes_hz: tuple = ()      # modes (Hz) the loads are read through; empty: as recorded
     structural_damping_ratio: float = 0.02   # their damping, fraction of critical (-)
+    load_filter_hz: float = 0.0          # cut-off (Hz) of the joint's load filter (multibody.load_filter); 0: none
+    load_filter_order: int = 4           # its order (2 or 4)
 
     def criteria(self) -> dict:
         """Criterion name -> allowable, for the criteria this location has."""
@@ -117,6 +119,31 @@ def demands(location: WeakLocation, force_joint, moment_joint) -> dict:
     out["moment"] = np.linalg.norm(m[:, list(location.moment_axes)], axis=1)
     out["force"] = np.linalg.norm(f, axis=1)
     return out
+
+
+def joint_loads(location: WeakLocation, series: dict) -> tuple:
+    """The joint loads the location is judged on: its joint's filtered loads (``joint_force_filtered_joint``,
+    ``joint_moment_filtered_joint``, :mod:`multibody.load_filter`) when it has ``load_filter_hz``, else the raw
+    reaction (``joint_force_joint``, ``joint_moment_joint``).
+
+    Parameters
+    ----------
+    location : WeakLocation
+    series : dict
+        Recorded series (:mod:`multibody.recorder`).
+
+    Returns
+    -------
+    force_joint, moment_joint : (k, 3) float
+        (N, N m), joint frame.
+    """
+    if location.load_filter_hz:
+        if "joint_force_filtered_joint" not in series:
+            raise KeyError(f"weak location '{location.name}' is judged on its joint's loads through a "
+                           f"{location.load_filter_hz:g} Hz filter, but the run recorded no filtered loads")
+        return (series["joint_force_filtered_joint"][:, location.joint],
+                series["joint_moment_filtered_joint"][:, location.joint])
+    return series["joint_force_joint"][:, location.joint], series["joint_moment_joint"][:, location.joint]
 
 
 def judged_demands(location: WeakLocation, time, force_joint, moment_joint) -> dict:
@@ -213,10 +240,14 @@ def assess(location: WeakLocation, time, force_joint, moment_joint, skip_until=0
 def reading(location: WeakLocation) -> str:
     """How the location's loads are read, in words (``reading`` in structures.json)."""
     modes = location.structural_modes_hz
+    order = {2: "2nd", 4: "4th"}.get(location.load_filter_order, f"order-{location.load_filter_order}")
+    filtered = (f"through a {order}-order Butterworth low-pass at {location.load_filter_hz:g} Hz run every step on "
+                f"the joint's load (the penalty joint's own modes removed)") if location.load_filter_hz else ""
     if not modes:
-        return "as recorded (the stiff joint's reaction)"
+        return filtered or "as recorded (the stiff joint's reaction)"
     span = f"{modes[0]:.3g} Hz" if len(modes) == 1 else f"every first mode in {modes[0]:.3g}-{modes[-1]:.3g} Hz (envelope)"
-    return f"through the structure's first mode: {span}, damping {location.structural_damping_ratio:.3g} of critical"
+    return ((filtered + ", then " if filtered else "")
+            + f"through the structure's first mode: {span}, damping {location.structural_damping_ratio:.3g} of critical")
 
 
 def _criterion_verdict(name, allowable, time, demand, judged, skip_until, policy) -> dict:

@@ -23,6 +23,7 @@ import numpy as np
 from pydantic import BaseModel, Field, ValidationError, create_model, field_validator, model_validator
 
 from multibody.shapes import SHAPES as CONTACT_SHAPES
+from multibody.load_filter import NYQUIST_FRACTION
 from riskassess.cases.inputs import (JSON_FILE_LIMIT, KIND_NOTE, MESH_FILE_LIMIT, CaseError, CaseName, ItemName,
                                     RelativeFile, Strict, Text, decode_utf8, read_limited, read_toml, resolve_reference,
                                     unique_names)
@@ -361,6 +362,10 @@ class Joint(Strict):
                           "torsion and bending compliance, lumped at the root, become the joint's six springs, so its "
                           "loads no longer rest on a penalty stiffness (docs/structures.md); penalty_damping_ratio is "
                           "then the member's damping. Not with first_mode_hz or the penalty keys.")
+    load_filter_hz: Positive | None = Field(
+        None, description="Cut-off (Hz) of the Butterworth low-pass this joint's loads are read through, "
+                          "run every simulation step (structures.load_filter_order; overrides structures.load_filter_hz for this joint; "
+                          "docs/structures.md, 'Loads through a stated low-pass filter').")
     rotation_modes: RotationModes | None = Field(
         None, description="The structure's own modes about the joint's locked rotation axes (Hz, each axis alone), "
                           "with their damping and source: those axes carry the structure's compliance (needs at least "
@@ -611,6 +616,16 @@ class Structures(Strict):
                              "node-contact loads alone, as the seed paper's model, and reports the threads without "
                              "judging them.")
     weak_locations: Annotated[list[WeakLocationSpec], Field(min_length=1)]
+    load_filter_order: Literal[2, 4] = Field(
+        4, description="Order of the joints' Butterworth load filters (load_filter_hz): 4 takes a penalty mode 4x "
+                       "above the cut-off down by 256, 2 by 16 (docs/structures.md).")
+    load_filter_hz: Positive | None = Field(
+        None, description="Cut-off (Hz) of a Butterworth low-pass (load_filter_order) run on every joint's loads at every "
+                          "simulation step (before the output's decimation): the verdict and the release judge the "
+                          "filtered loads, recorded beside the raw ones. A penalty joint's own spring modes "
+                          "(15-1500 Hz) are numerical; give a cut-off above the structure's physical content and well "
+                          "below them (docs/structures.md, 'Loads through a stated low-pass filter'); a joint's own "
+                          "load_filter_hz overrides it. Omitted: the raw penalty loads are judged.")
     twin: bool = Field(
         False, description="Run the case a second time with the launch speed x (1 + 1e-7) and label each judged peak "
                            "deterministic (both runs' peaks so far agree within 5 % up to it) or chaotic (one draw of "
@@ -740,6 +755,26 @@ class Case(Strict):
                              "both missing and bent")
         if len(set(bent)) != len(bent):
             raise ValueError("perception.truth_damage.bends: a shape is bent at most once")
+        return self
+
+    @model_validator(mode="after")
+    def _load_filters(self):
+        """Every load filter's cut-off within 1/10 of the step's Nyquist frequency (the discrete filter follows the
+        analogue one there) and sampled SAMPLES_PER_MODE_PERIOD (20) times per period by the output, as a modal reading."""
+        default = self.structures.load_filter_hz if self.structures is not None else None
+        for joint in self.target.joints:
+            cutoff = joint.load_filter_hz or default
+            if cutoff is None:
+                continue
+            highest = NYQUIST_FRACTION * 0.5 / self.simulation.step
+            if cutoff > highest:
+                raise ValueError(f"joint '{joint.name}': a load filter at {cutoff:g} Hz needs simulation.step <= "
+                                 f"{NYQUIST_FRACTION * 0.5 / cutoff:g} s (cut-off within 1/10 of the step's Nyquist "
+                                 f"frequency); got {self.simulation.step:g} s")
+            if self.simulation.output_rate < SAMPLES_PER_MODE_PERIOD * cutoff:
+                raise ValueError(f"joint '{joint.name}': a load filter at {cutoff:g} Hz needs simulation.output_rate "
+                                 f">= {SAMPLES_PER_MODE_PERIOD * cutoff:g} Hz ({SAMPLES_PER_MODE_PERIOD} samples per "
+                                 f"period); got {self.simulation.output_rate:g} Hz")
         return self
 
     @model_validator(mode="after")

@@ -197,10 +197,21 @@ def build_bodies_and_joints(case: Case, base: Path):
             penalty_damping_ratio=j.penalty_damping_ratio, first_mode_hz=j.first_mode_hz,
             rotation_modes_hz=None if j.rotation_modes is None else j.rotation_modes.frequencies_hz(),
             rotation_modes_damping_ratio=0.0 if j.rotation_modes is None else j.rotation_modes.damping_ratio,
-            structural_stiffness=_member_springs(j, frame, target_to_lvlh)))
+            structural_stiffness=_member_springs(j, frame, target_to_lvlh),
+            load_filter_hz=load_filter_hz(case, j),
+            load_filter_order=case.structures.load_filter_order if case.structures is not None else 4))
         if j.initial_angle or j.initial_rate:
             _apply_initial_hinge_state(bodies, joints, len(joints) - 1, j.initial_angle, j.initial_rate)
     return bodies, joints, rest_attitudes, rest_coms
+
+
+def load_filter_hz(case: Case, joint) -> float:
+    """The cut-off (Hz) of joint ``joint``'s load filter (multibody.load_filter): its own ``load_filter_hz``, else
+    the case's ``structures.load_filter_hz``, else 0 (none)."""
+    if joint.load_filter_hz is not None:
+        return float(joint.load_filter_hz)
+    structures = case.structures
+    return float(structures.load_filter_hz) if structures is not None and structures.load_filter_hz else 0.0
 
 
 #: Fewest output samples per period of the fastest mode a member's springs make: the recorded reaction of a
@@ -388,7 +399,8 @@ def weak_locations(case: Case, assembly) -> list:
             ultimate_shear=Allowable.of(material.ultimate_shear) if material else None,
             allowable_moment=Allowable.of(spec.allowable_moment) if spec.allowable_moment is not None else None,
             allowable_force=Allowable.of(spec.allowable_force) if spec.allowable_force is not None else None,
-            moment_axes=axes, **_structural_modes(spec)))
+            moment_axes=axes, load_filter_hz=joint.load_filter_hz, load_filter_order=joint.load_filter_order,
+            **_structural_modes(spec)))
     return out
 
 

@@ -97,6 +97,17 @@ def test_bad_weak_locations_are_named(tmp_path, old, new, expected):
     assert expected in message
 
 
+@pytest.mark.parametrize("cutoff, expected", [
+    # the step is 1e-4 s: a cut-off within 1/10 of its 5 kHz Nyquist frequency (multibody.load_filter.NYQUIST_FRACTION)
+    (600.0, "a load filter at 600 Hz needs simulation.step <= 8.33333e-05 s"),
+    # the output samples the filtered load 20 times per period of the cut-off, as a modal reading
+    # (structures.modal_load.SAMPLES_PER_MODE_PERIOD)
+    (150.0, "a load filter at 150 Hz needs simulation.output_rate >= 3000 Hz"),
+])
+def test_a_load_filter_the_step_or_output_cannot_carry_is_refused(tmp_path, cutoff, expected):
+    assert expected in _load_modified(tmp_path, 'release = "low"', f'release = "low"\nload_filter_hz = {cutoff}')
+
+
 def test_case_format_doc_is_current():
     """docs/case-format.md is generated from the models; regenerate with python -m riskassess.cases.doc."""
     from riskassess.cases.doc import render
