@@ -25,8 +25,11 @@ TIMING_KEYS = {"wall_time_s", "steps_per_second"}
 def short_case(tmp_path_factory):
     path = tmp_path_factory.mktemp("sweep_case") / "small_short.toml"
     # the sweep's mechanics need decided runs: judge the node-contact loads alone (threads pass through the
-    # array and ASAR; under the default "bound" a holding location can turn indeterminate, exit code 5)
-    path.write_text(shortened_case(END_TIME).replace('release = "low"', 'release = "low"\nthread_pass_through = "ignore"', 1))
+    # array and ASAR; under the default "bound" a holding location can turn indeterminate, exit code 5), over
+    # the short run's own window (under the default "capture" window a hold before the capture is over is
+    # indeterminate too)
+    path.write_text(shortened_case(END_TIME).replace(
+        'release = "low"', 'release = "low"\nthread_pass_through = "ignore"\nwindow = "fixed"', 1))
     return path
 
 
@@ -207,7 +210,8 @@ def test_assess_monte_carlo_probability_has_the_known_answer(tmp_path, capsys):
     assert 'release = "low"' in text
     # node-contact loads alone: threads pass through the array, and under the default "bound" their load
     # would make its holding runs indeterminate (tests/structures/test_thread_gaps.py), not the known answer
-    case.write_text(text.replace('release = "low"', 'release = "never"\nthread_pass_through = "ignore"', 1))
+    # and over the 0.6 s run's own window ("fixed"): the default "capture" window makes a hold there indeterminate
+    case.write_text(text.replace('release = "low"', 'release = "never"\nthread_pass_through = "ignore"\nwindow = "fixed"', 1))
     assert main(["assess", str(case), "--out", str(tmp_path / "one"), "--json"]) in (0, 1)
     capsys.readouterr()
     verdict = json.loads((tmp_path / "one" / "structures.json").read_text())
