@@ -516,6 +516,21 @@ def sample_row(m, q, qt, net_q, net_qt, t, interval):
 
 
 @njit(cache=True)
+def _mid_step_body_states_into(m, q, qt, qtt, half_kick):
+    """Every body's state with VelocityVerlet's half-step velocity v(n+1/2) = v(n+1) - h/2 a(n+1) (the velocity the
+    forces of the step acted with; half_kick 0 gives v(n+1)) into ``m.damper_work`` (com, velocity, attitude and
+    angular velocity, LVLH / body frame)."""
+    bodies, work = m.bodies, m.damper_work
+    velocity = work.velocity
+    for b in range(bodies.mass.shape[0]):
+        i = bodies.index[b]
+        for k in range(6):
+            velocity[i + k] = qt[i + k] - half_kick * qtt[i + k]
+        body_state_into(q, velocity, i, b, bodies.reference_com_lvlh, bodies.node_to_body, work.com_lvlh,
+                        work.velocity_lvlh, work.node_to_lvlh, work.body_to_lvlh, work.omega_lvlh, work.omega_body)
+
+
+@njit(cache=True)
 def book_joint_dampers(m, q, qt, qtt, half_kick, step):
     """Add the energy the joints' dampers dissipated over the step that just ended to
     ``m.extras[EXTRA_JOINTS_DISSIPATED]`` (J) and return it.
@@ -543,14 +558,8 @@ def book_joint_dampers(m, q, qt, qtt, half_kick, step):
     float
         The step's dissipated energy (J).
     """
-    bodies, joints, work = m.bodies, m.joints, m.damper_work
-    velocity = work.velocity
-    for b in range(bodies.mass.shape[0]):
-        i = bodies.index[b]
-        for k in range(6):
-            velocity[i + k] = qt[i + k] - half_kick * qtt[i + k]
-        body_state_into(q, velocity, i, b, bodies.reference_com_lvlh, bodies.node_to_body, work.com_lvlh,
-                        work.velocity_lvlh, work.node_to_lvlh, work.body_to_lvlh, work.omega_lvlh, work.omega_body)
+    joints, work = m.joints, m.damper_work
+    _mid_step_body_states_into(m, q, qt, qtt, half_kick)
     power = 0.0
     for j in range(joints.parent.shape[0]):
         if m.active[j] != 0.0:
@@ -640,14 +649,8 @@ def filter_joint_loads(m, bank, scratch, q, qt, qtt, half_kick, first):
     first : bool
         The first step: each filter starts at rest under its first load (no start-up transient).
     """
-    bodies, joints, work = m.bodies, m.joints, m.damper_work
-    velocity = work.velocity
-    for b in range(bodies.mass.shape[0]):
-        i = bodies.index[b]
-        for k in range(6):
-            velocity[i + k] = qt[i + k] - half_kick * qtt[i + k]
-        body_state_into(q, velocity, i, b, bodies.reference_com_lvlh, bodies.node_to_body, work.com_lvlh,
-                        work.velocity_lvlh, work.node_to_lvlh, work.body_to_lvlh, work.omega_lvlh, work.omega_body)
+    joints, work = m.joints, m.damper_work
+    _mid_step_body_states_into(m, q, qt, qtt, half_kick)
     load = scratch[:2]    # the joint's force and moment
     for j in range(joints.parent.shape[0]):
         if m.active[j] != 0.0:
