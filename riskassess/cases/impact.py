@@ -637,8 +637,9 @@ class Structures(Strict):
                              "target (for example the net closed or in tow by then; the report names the window); "
                              "'capture' judges the capture "
                              "until it is over (the net's kinetic energy relative to the debris' main body, its "
-                             "rigid motion with that body removed, below capture_energy_J and no judged running peak "
-                             "rising, both for capture_hold_s) and stops the run there; simulation.end_time is then "
+                             "rigid motion with that body removed, below its threshold (capture_energy_J, else "
+                             "capture_energy_fraction of it at launch) and no judged running peak rising, both for "
+                             "capture_hold_s) and stops the run there; simulation.end_time is then "
                              "the cap, and a run that reaches it before the capture is over cannot say a location "
                              "holds (indeterminate, rule capture_not_over; docs/structures.md, 'The whole capture as "
                              "the judged window'). Coupled runs only.")
