@@ -68,6 +68,7 @@ class ClosingWinch:
     ----------
     work : float              The winch's work on the net so far (J); positive while it reels in against tension.
     activated_at : float or None  Activation time (s), once known.
+    rest_start, rest_end : (12,) float or None  Natural lengths (m) at the start and the end of the reel-in.
     first_contact : float or None Time of the net's first contact (s), once seen.
     """
 
@@ -90,13 +91,27 @@ class ClosingWinch:
         self.activated_at = spec.start
         self.closed = False
         self._pending = None   # (before, after) natural lengths of the last update, half its work still to book
+        #: the loop's natural lengths (m) when the reel-in starts (the slack taken up) and when it ends; None before
+        self.rest_start = self.rest_end = None
 
     def natural_lengths(self, t: float) -> np.ndarray:
-        """The loop's natural lengths (m) at time ``t`` (s) by the schedule (open before the activation)."""
-        if self.activated_at is None:
+        """The loop's natural lengths (m) at time ``t`` (s) by the schedule: open before the activation, then
+        linear from :attr:`rest_start` to :attr:`rest_end` over the duration."""
+        if self.rest_start is None:
             return self.spec.rest_open.copy()
-        return reeled_rest_lengths(self.spec.rest_open, self.spec.rest_closed,
-                                   reel_fraction(t, self.activated_at, self.spec.duration))
+        return reeled_rest_lengths(self.rest_start, self.rest_end, reel_fraction(t, self.activated_at, self.spec.duration))
+
+    def _take_up_slack(self) -> None:
+        """At the activation: the winch first takes in the slack, without load (each thread's natural length becomes
+        the smaller of its open length and its length now, :attr:`rest_start`), then reels in at a constant rate to
+        :attr:`rest_end`, the closed lengths (or the start's where already shorter: the winch never pays out). A slack
+        thread holds no energy, so taking up its slack does no work. Without this, a wrapped net's loop, much shorter
+        than the flat net's perimeter, would be reeled in from slack over most of the duration and then at the full
+        rate in its last part."""
+        x_lvlh = self._loop_positions()
+        length = np.linalg.norm(x_lvlh[self.threads[:, 1]] - x_lvlh[self.threads[:, 0]], axis=1)
+        self.rest_start = np.minimum(self.spec.rest_open, length)
+        self.rest_end = np.minimum(self.spec.rest_closed, self.rest_start)
 
     def _loop_positions(self) -> np.ndarray:
         """(n, 3) positions (m, LVLH) of the nodes (only the loop's are filled; the rest are zero)."""
@@ -136,6 +151,8 @@ class ClosingWinch:
         t_next = t + self.step
         if t_next < self.activated_at:
             return
+        if self.rest_start is None:
+            self._take_up_slack()
         rest_before = self.rest[self.index].copy()
         rest = self.natural_lengths(t_next)
         self.work += 0.5 * self._energy_change(rest_before, rest)
@@ -150,4 +167,5 @@ class ClosingWinch:
         return {"first_contact_s": self.first_contact, "activated_at_s": self.activated_at, "closed_at_s": end,
                 "closed": bool(self.closed), "winch_work_J": float(self.work),
                 "loop_open_length_m": float(np.sum(self.spec.rest_open)),
-                "loop_closed_length_m": float(np.sum(self.spec.rest_closed))}
+                "loop_start_length_m": None if self.rest_start is None else float(np.sum(self.rest_start)),
+                "loop_closed_length_m": float(np.sum(self.spec.rest_closed if self.rest_end is None else self.rest_end))}

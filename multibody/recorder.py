@@ -172,6 +172,7 @@ class Recorder:
         self._unfiltered = np.array([not c for c in cutoffs_hz], bool)
         #: the net's closing winch (multibody.closing_winch), None for an open net
         self._winch = system.closing
+        self._launch_reference = self.health.reference_energy   # the energy check's reference before any winch work
         self._layout = series_layout(nb, nj, assembly.chaser is not None, assembly.body_loads is not None,
                                      self._load_filter is not None, self._winch is not None)
         self._columns = {}
@@ -378,6 +379,9 @@ class Recorder:
         self._row[total_column - 1] = -self._winch.work
         total_energy = total_energy - self._winch.work
         self._row[total_column] = total_energy
+        if self.health.reference_energy is not None:
+            # the balance's scale is the energy brought in: the launch's and what the winch has put in since
+            self.health.reference_energy = max(self.health.reference_energy, self._launch_reference + self._winch.work)
         return total_energy
 
     def _node_contact_force(self, t):
