@@ -162,10 +162,13 @@ class ClosingWinch:
         self.closed = reel_fraction(t_next, self.activated_at, self.spec.duration) >= 1.0
 
     def summary(self) -> dict:
-        """JSON-ready: activation and first-contact times (s), the reel-in's end (s), the work booked (J)."""
+        """JSON-ready: activation and first-contact times (s), the reel-in's end (s), the work booked (J), the loop's
+        natural lengths (m): open, at the start of the reel-in, closed (sums, and per thread for the last two)."""
         end = None if self.activated_at is None else self.activated_at + self.spec.duration
         return {"first_contact_s": self.first_contact, "activated_at_s": self.activated_at, "closed_at_s": end,
                 "closed": bool(self.closed), "winch_work_J": float(self.work),
                 "loop_open_length_m": float(np.sum(self.spec.rest_open)),
                 "loop_start_length_m": None if self.rest_start is None else float(np.sum(self.rest_start)),
-                "loop_closed_length_m": float(np.sum(self.spec.rest_closed if self.rest_end is None else self.rest_end))}
+                "loop_closed_length_m": float(np.sum(self.spec.rest_closed if self.rest_end is None else self.rest_end)),
+                "thread_start_lengths_m": None if self.rest_start is None else self.rest_start.tolist(),
+                "thread_closed_lengths_m": (self.spec.rest_closed if self.rest_end is None else self.rest_end).tolist()}
