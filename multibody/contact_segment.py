@@ -85,7 +85,7 @@ from multibody.broad_phase import box_signed_distance
 from multibody.contact import hertz_elastic_energy
 
 from multibody.contact_kernel import _effective_mass_of_body, _substeps_to_resolve_contact, add_body_reaction
-from multibody.jit_cache import WITH_REFCOUNTS
+from multibody.jit_cache import NO_REFCOUNTS
 from multibody.segment_box import MAX_BREAKPOINTS, segment_box_normal
 from multibody.segment_cycle import ClusterWork, cluster_contact_over_step, cluster_work, thread_contact_geometry
 from multibody.segment_pairs import _contact_pairs, _near_shapes, _node_motion, _to_body
@@ -226,7 +226,11 @@ def _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body
         seg.lag_body[j] = -1
 
 
-@njit(cache=True, **WITH_REFCOUNTS)  # allocates; called from a NO_REFCOUNTS kernel (jit_cache)
+# no reference counts (jit_cache.NO_REFCOUNTS), nor in its callees (numba compiles them with its setting): with counts,
+# every call below the step's entry (per candidate pair, cluster and thread) took and dropped a reference to every array
+# of the named tuples it was handed (KernelBuffers, SegmentBuffers, ClusterWork: some 100 arrays a call), and these
+# atomic counts were 52-60 % of a wrapped capture's CPU (perf, helper speed20, docs/model.md "Speed")
+@njit(cache=True, **NO_REFCOUNTS)
 def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers,
                                net_force_lvlh, body_force_lvlh, torque_lvlh):
     """Add the threads' contact forces with the box shapes (module doc) to ``net_force_lvlh`` and their
@@ -276,10 +280,12 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
     _near_shapes(x, v, net_force_lvlh, net_mass, buffers.velocity_lag, seg, states, shapes, step)
     energy, count, dissipated = 0.0, 0, 0.0
     # the per-thread energy record: this step's sub-cycles write their end energies into row 1
-    seg.end_energy[0, :] = seg.end_energy[1, :]
+    # row to row element by element: a slice assignment between arrays allocates (its overlap copy)
+    for j in range(threads.shape[0]):
+        seg.end_energy[0, j] = seg.end_energy[1, j]
+        seg.sharing[0, j] = seg.sharing[1, j]
     seg.end_energy[1, :] = 0.0
     seg.start_energy[:] = 0.0
-    seg.sharing[0, :] = seg.sharing[1, :]
     seg.sharing[1, :] = 0
     seg.owned_shape[:] = -1
     seg.node_threads[:] = 0
@@ -295,7 +301,9 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
         energy += e
         count += count_k
         dissipated += w
-    net_force_lvlh += node_force
+    for d in range(3):      # element by element (an array's += allocates)
+        for i in range(node_force.shape[1]):
+            net_force_lvlh[d, i] += node_force[d, i]
     if n_substeps > 1:
         # the energy each thread's contact starts this step with less what its sub-cycle ended the last with: the
         # energy made between the steps (one force evaluation a step: Verlet)

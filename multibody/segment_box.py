@@ -13,6 +13,8 @@ import math
 
 from numba import njit
 
+from multibody.jit_cache import WITH_REFCOUNTS
+
 #: Distance (m) within which points of a thread count as equally deep: a thread parallel to a face to
 #: round-off (1e-9 m over a 2 m thread is a 5e-10 rad tilt) takes its load at the middle of the overlap,
 #: and its interior counts as deeper than its ends only beyond this (a thread on a face adds nothing).
@@ -205,7 +207,7 @@ def segment_box_sublevel(a, d, lo, hi, level, work):
     return low, high
 
 
-@njit(cache=True)
+@njit(cache=True, **WITH_REFCOUNTS)  # allocates (its lists); called from NO_REFCOUNTS kernels (jit_cache)
 def segment_box_normal(px, py, pz, dx, dy, dz, lo, hi, wx, wy, wz):
     """Unit contact normal (body frame) from the box to a segment's deepest point p (direction d), and the
     slope of the segment's deepest penetration along it.
