@@ -49,9 +49,49 @@ from multibody.recorder import Recorder  # noqa: E402
 from riskassess.cases.impact import validate_case  # noqa: E402
 from riskassess.stages.run import run_case  # noqa: E402
 from riskassess.sweep.spec import case_with  # noqa: E402
+from multibody.segment_box import TIE_DISTANCE, segment_box_separation  # noqa: E402
+from multibody.segment_cycle import thread_contact_geometry  # noqa: E402
 from structures.capture_window import CaptureMonitor  # noqa: E402
 
 PARTS = ("total", "kernel", "post", "capture")
+
+
+def segment_census(kernel) -> dict:
+    """The thread contact's pair search at the last evaluation, counted (not timed) from the kernel's buffers:
+    (thread, box) pairs tested, past the bounding-sphere test, past the slab test (the narrow phase's candidates, each
+    one or two :func:`~multibody.segment_cycle.thread_contact_geometry` calls until speed20), of those penetrating
+    now, those the separating-axis bound keeps apart (:func:`multibody.segment_pairs._contact_can_act`), and the
+    pairs found (:mod:`multibody.segment_pairs`; the same tests, written out in Python on the same buffers)."""
+    buffers, net, shapes = kernel.buffers, kernel.net, kernel.shapes
+    seg, states, x = buffers.segments, buffers.states, buffers.work_soa[0]
+    threads, radius, step = net.threads, net.radius, kernel.step
+    counts = dict(tested=0, sphere=0, slab=0, penetrating_now=0, separated=0)
+    for j in range(threads.shape[0]):
+        a, c = threads[j]
+        length = np.linalg.norm(x[:, c] - x[:, a])
+        motion = step * max(seg.node_speed[a], seg.node_speed[c])
+        for s in np.flatnonzero(shapes.is_box):
+            counts["tested"] += 1
+            reach = 1.001 * (min(radius[a], radius[c]) + motion + step * seg.shape_work[1, s])
+            if 0.5 * (seg.centre_distance[s, a] + seg.centre_distance[s, c] - length) > seg.shape_work[0, s] + reach:
+                continue
+            counts["sphere"] += 1
+            b = shapes.body[s]
+            pa = tuple(states.body_to_lvlh[b].T @ (x[:, a] - states.com_lvlh[b]))
+            pc = tuple(states.body_to_lvlh[b].T @ (x[:, c] - states.com_lvlh[b]))
+            low, high = np.minimum(pa, pc), np.maximum(pa, pc)
+            if (low > shapes.box_max_body[s] + reach).any() or (high < shapes.box_min_body[s] - reach).any():
+                continue
+            counts["slab"] += 1
+            now = thread_contact_geometry(pa, pc, shapes.box_min_body, shapes.box_max_body, s, radius[a], radius[c],
+                                          np.zeros_like(seg.breakpoints))
+            counts["penetrating_now"] += int(now[0] > 0.0 or (now[5] > 0.0) != (now[6] > 0.0))
+            # decided by the separating-axis bound (segment_pairs._contact_can_act), no geometry call
+            lo, hi = tuple(shapes.box_min_body[s]), tuple(shapes.box_max_body[s])
+            counts["separated"] += int(segment_box_separation(pa, tuple(np.subtract(pc, pa)), lo, hi)
+                                       > min(radius[a], radius[c]) + TIE_DISTANCE)
+    counts["pairs"] = int(seg.node_threads.sum() // 2)
+    return counts
 
 
 class PhaseClock:
@@ -72,6 +112,8 @@ class PhaseClock:
         self.window = 0
         self.marks = []          # (window, CLOCK_MONOTONIC s) at each window's first step
         self._last_entry = None  # (window, process time) of the previous step's entry
+        self.census_times = []   # s of simulated time at which to count the thread contact's pair search
+        self.census = []         # (t, counts) (segment_census)
 
     def window_of(self, t: float) -> int:
         return int(min(max(np.searchsorted(self.edges, t, side="right") - 1, 0), len(self.edges) - 2))
@@ -90,6 +132,10 @@ class PhaseClock:
 
     def add(self, part: str, seconds: float) -> None:
         self.cpu[part][self.window] += seconds
+
+    def exclude(self, seconds: float) -> None:
+        """Leave ``seconds`` of CPU spent inside this step (the census) out of its total."""
+        self._last_cpu += seconds
 
 
 def timed(clock: PhaseClock, part: str, function):
@@ -113,6 +159,11 @@ def instrument(clock: PhaseClock) -> None:
         clock.step_entry(t)
         keep = call(self, mbs, t)
         clock.contacts[clock.window] += self.kernel.buffers.scalars[N_CONTACTS]
+        if clock.census_times and t >= clock.census_times[0]:
+            clock.census_times.pop(0)
+            start = time.process_time()
+            clock.census.append((t, segment_census(self.kernel)))
+            clock.exclude(time.process_time() - start)
         return keep
 
     kernel_net_module.KernelNet.__call__ = pre_step
@@ -155,6 +206,8 @@ def print_table(clock: PhaseClock, step: float) -> None:
     print(f"whole run: {n} steps, CPU {total['total']:.1f} s ({total['total'] / (n * step):.2f} s per simulated s): "
           f"kernel {total['kernel']:.1f} s, post-step {total['post']:.1f} s (capture monitor {total['capture']:.2f} s), "
           f"other {total['total'] - total['kernel'] - total['post']:.1f} s")
+    for t, counts in clock.census:
+        print(f"thread-contact pair search at {t:.4f} s: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
 
 
 def main() -> None:
@@ -167,6 +220,8 @@ def main() -> None:
     parser.add_argument("--windows", default="0,0.5,3,10,20,40",
                         help="window edges (s of simulated time); the run's end closes the last")
     parser.add_argument("--perf-marks", action="store_true")
+    parser.add_argument("--census", default="", help="times (s) at which to count the thread contact's pair search "
+                        "(segment_census; its CPU time is left out of the step's)")
     args = parser.parse_args()
     overrides = sample_overrides(Path(args.store), args.sample) | {"structures.release": args.release}
     if args.end_time is not None:
@@ -175,6 +230,7 @@ def main() -> None:
     end_time = case.simulation.end_time
     edges = [e for e in (float(v) for v in args.windows.split(",")) if e < end_time] + [end_time]
     clock = PhaseClock(edges)
+    clock.census_times = sorted(float(v) for v in args.census.split(",") if v)
     instrument(clock)
     print(f"{args.case}, sample {args.sample}: {overrides}")
     with tempfile.TemporaryDirectory() as tmp:
