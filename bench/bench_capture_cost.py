@@ -49,7 +49,11 @@ from multibody.recorder import Recorder  # noqa: E402
 from riskassess.cases.impact import validate_case  # noqa: E402
 from riskassess.stages.run import run_case  # noqa: E402
 from riskassess.sweep.spec import case_with  # noqa: E402
-from multibody.segment_box import TIE_DISTANCE, segment_box_separation  # noqa: E402
+from multibody.segment_box import TIE_DISTANCE  # noqa: E402
+try:   # absent in trees before helper speed20 (their "before" figures)
+    from multibody.segment_box import segment_box_separation  # noqa: E402
+except ImportError:
+    segment_box_separation = None
 from multibody.segment_cycle import thread_contact_geometry  # noqa: E402
 from structures.capture_window import CaptureMonitor  # noqa: E402
 
@@ -87,6 +91,8 @@ def segment_census(kernel) -> dict:
                                           np.zeros_like(seg.breakpoints))
             counts["penetrating_now"] += int(now[0] > 0.0 or (now[5] > 0.0) != (now[6] > 0.0))
             # decided by the separating-axis bound (segment_pairs._contact_can_act), no geometry call
+            if segment_box_separation is None:
+                continue
             lo, hi = tuple(shapes.box_min_body[s]), tuple(shapes.box_max_body[s])
             counts["separated"] += int(segment_box_separation(pa, tuple(np.subtract(pc, pa)), lo, hi)
                                        > min(radius[a], radius[c]) + TIE_DISTANCE)
