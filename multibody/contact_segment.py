@@ -198,7 +198,7 @@ def _apply_at_point(a, b, split, body, fx, fy, fz, arm_x, arm_y, arm_z, weight, 
     out_node_impulse[b, 2] += wb * fz * weight
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body_force_lvlh, torque_lvlh,
                      out_body_impulse, out_node_impulse):
     """Apply every thread's impulses carried from the previous step (its contact's end minus mean velocity
@@ -229,7 +229,9 @@ def _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body
 # no reference counts (jit_cache.NO_REFCOUNTS), nor in its callees (numba compiles them with its setting): with counts,
 # every call below the step's entry (per candidate pair, cluster and thread) took and dropped a reference to every array
 # of the named tuples it was handed (KernelBuffers, SegmentBuffers, ClusterWork: some 100 arrays a call), and these
-# atomic counts were 52-60 % of a wrapped capture's CPU (perf, helper speed20, docs/model.md "Speed")
+# atomic counts were 52-60 % of a wrapped capture's CPU (perf, helper speed20, docs/model.md "Speed"). Its callees state
+# NO_REFCOUNTS themselves: numba keys neither its on-disk cache nor a dispatcher's compiled versions by this setting, so
+# a callee first compiled from Python (a test) kept its counts inside the kernel too (measured: 18 % of the samples)
 @njit(cache=True, **NO_REFCOUNTS)
 def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers,
                                net_force_lvlh, body_force_lvlh, torque_lvlh):
@@ -318,7 +320,7 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
     return energy, count, dissipated
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _cluster_on_box(first, last, x, v, net_force_lvlh, net, states, bodies, shapes, law, step, n_substeps,
                     stage_weight, buffers, body_force_lvlh, torque_lvlh):
     """The cluster of (thread, box) pairs ``seg.pair_order[first:last]`` (one box, threads sharing nodes:
@@ -410,7 +412,7 @@ def _cluster_on_box(first, last, x, v, net_force_lvlh, net, states, bodies, shap
     return energy, count, lost_total
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _thread_start(r, j, s, b, x, cw, shapes, bodies, rot, com_lvlh, law, step, n_substeps, seg):
     """Thread row ``r`` (net thread ``j``) of the cluster at the step's start: books its contact energy
     (``seg.start_energy``) and its nodes' sharing; returns that energy (J), 1 if it penetrates (else 0), and the
@@ -457,7 +459,7 @@ def _thread_start(r, j, s, b, x, cw, shapes, bodies, rot, com_lvlh, law, step, n
     return start_energy, 1 if penetration > 0.0 else 0, n_cycle
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _apply_thread_impulses(j, a, c, b, impulses, x, com_lvlh, step, stage_weight, seg, body_force_lvlh, torque_lvlh,
                            buffers):
     """Each node's mean impulse over the step (``impulses`` rows 0 and 2, N s, LVLH) as a force now, the body's
@@ -483,7 +485,7 @@ def _apply_thread_impulses(j, a, c, b, impulses, x, com_lvlh, step, stage_weight
         seg.lag_body[j] = b
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _substeps_to_resolve(penetration, w, normal, point_mass, body_mass, acc, wa, wc, rel, ka, kc, depth_a, depth_c,
                          normal_a, normal_c, mass_a, mass_c, law, step, n_substeps, seg):
     """Sub-steps for the thread's sub-cycle (:mod:`multibody.segment_cycle`): enough to resolve its point's contact

@@ -13,7 +13,7 @@ import math
 
 from numba import njit
 
-from multibody.jit_cache import WITH_REFCOUNTS
+from multibody.jit_cache import NO_REFCOUNTS, WITH_REFCOUNTS
 
 #: Distance (m) within which points of a thread count as equally deep: a thread parallel to a face to
 #: round-off (1e-9 m over a 2 m thread is a 5e-10 rad tilt) takes its load at the middle of the overlap,
@@ -25,7 +25,7 @@ TIE_DISTANCE = 1e-9
 MAX_BREAKPOINTS = 11
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def segment_box_breakpoints(a, d, lo, hi, out):
     """Sorted parameters t in [0, 1] where the segment a + t d crosses one of the box's six slab planes or
     three mid-planes, with 0 and 1; returns how many (the first entries of ``out``).
@@ -90,7 +90,7 @@ def _inside_distance(alpha, beta, t):
     return max(alpha[0] + beta[0] * t, alpha[1] + beta[1] * t, alpha[2] + beta[2] * t)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def segment_box_separation(a, d, lo, hi):
     """A lower bound (m) of the distance between the segment a + t d, t in [0, 1], and the box [lo, hi]: the largest
     gap between their projections on the separating axes of a segment and a box, the box's three axes e_i and the
@@ -140,7 +140,7 @@ def segment_box_separation(a, d, lo, hi):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def segment_box_deepest(a, d, lo, hi, work):
     """The segment's deepest point against a box: t* minimizing the signed distance, and that distance.
 
@@ -202,7 +202,7 @@ def segment_box_deepest(a, d, lo, hi, work):
     return best_t, best
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def segment_box_sublevel(a, d, lo, hi, level, work):
     """The interval [t_low, t_high] of the segment whose signed distance to the box is at most ``level`` (m),
     exact per breakpoint interval (:func:`segment_box_deepest`); empty (t_low > t_high) if none.

@@ -19,12 +19,14 @@ import math
 
 from numba import njit
 
+from multibody.jit_cache import NO_REFCOUNTS
+
 from multibody.broad_phase import box_signed_distance
 from multibody.segment_box import TIE_DISTANCE, segment_box_separation
 from multibody.segment_cycle import thread_contact_geometry
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _near_shapes(x, v, net_force_lvlh, net_mass, velocity_lag, seg, states, shapes, step):
     """Each node's speed bound over the step (``seg.node_speed``, m/s: L1 norms, an upper bound), each box
     shape's bounding sphere (radius) and surface speed bound (``seg.shape_work``), and each node's distance
@@ -96,7 +98,7 @@ def _node_motion(i, b, x, v, net_force_lvlh, net_mass, node_lag, lag, states, ha
     return rel, acc
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _contact_pairs(x, v, net_force_lvlh, net, states, shapes, step, n_substeps, buffers):
     """This step's (thread, box) contact pairs into ``seg.pair_thread`` / ``seg.pair_shape``: the thread's deepest
     point is interior and penetrates now, or does at the end of the step's free motion (a thread turning over an
@@ -144,7 +146,7 @@ def _contact_pairs(x, v, net_force_lvlh, net, states, shapes, step, n_substeps, 
     return n_pairs
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, radius, states, shapes, step, n_substeps,
                          buffers):
     """Whether thread (a, c)'s contact with box ``s`` can act within the step: it penetrates now, or at the end of
@@ -174,7 +176,7 @@ def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, rad
     return _contact_can_act(qa, qc, box_min, box_max, s, radius[a], radius[c], seg.breakpoints)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _contact_can_act(pa, pc, box_min, box_max, s, radius_a, radius_c, work):
     """Whether thread (``pa``, ``pc``: its nodes, body frame, m) acts on box ``s`` at these positions: its deepest point
     is interior and penetrates (:func:`multibody.segment_cycle.thread_contact_geometry`'s excess > 0), or exactly one

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from numba import njit
 
+from multibody.jit_cache import NO_REFCOUNTS
+
 
 @njit(cache=True, inline="always")
 def _root(parent, key):
@@ -24,7 +26,7 @@ def _root(parent, key):
     return key
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def group_pairs(pair_thread, pair_shape, n_pairs, threads, n_nodes, parent, root_cluster, order, start):
     """Group the first ``n_pairs`` (thread, shape) contact pairs into clusters of pairs on one shape that share
     nodes, transitively.
