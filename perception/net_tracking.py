@@ -11,8 +11,8 @@ re-associated a few times (an ICP on a deformable graph). Nodes the sensor does 
 paper's 30 deg vertical field of view shows a strip of the net) follow the smoothness prior
 between the seen strip and the rim.
 
-Node velocities come from a Savitzky-Golay filter over the frames; the net's momentum from
-the design's node masses (the paper's assumption (b): the thread mass lumped on the nodes).
+Node velocities come from a Savitzky-Golay filter over the frames (order 4 over 7 frames); the net's
+momentum from the design's node masses (the paper's assumption (b): the thread mass lumped on the nodes).
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.signal import savgol_filter
+from scipy.signal import savgol_coeffs, savgol_filter
 from scipy.sparse.linalg import spsolve
 
 
@@ -231,9 +231,39 @@ def carried_by_chaser(positions_world, chaser_from, chaser_to) -> np.ndarray:
     return np.asarray(positions_world) @ relative[:3, :3].T + relative[:3, 3]
 
 
-def node_velocities(times, positions_world, window=7) -> np.ndarray:
+#: Polynomial order of the node velocities' local fits. Order 4 over 7 frames passes a node's motion
+#: within 3 % up to a tenth of the frame rate (gain 0.998 at 0.05, 0.971 at 0.1 of it; 0.68 at 0.2), where
+#: order 2 (a straight-line slope over the 7 frames) keeps only 0.889 and 0.607 of it. The net's motion
+#: relative to its mean after the collision has half its power below 0.2-0.6 Hz at 10 Hz frames
+#: (featured debris), so order 2 under-stated the net's angular momentum by 0.10-0.12 N m s in x
+#: (exact node positions differentiated; docs/perception.md, "The seen net nodes' velocities"). The price
+#: is noise: 0.51 against 0.19 position standard deviations per frame period (the coefficients' norm).
+VELOCITY_FIT_ORDER = 4
+
+
+def velocity_gain(frequency, frame_period, window=7, order=VELOCITY_FIT_ORDER) -> float:
+    """Ratio (-) of :func:`node_velocities`' estimate to the true velocity for a sinusoidal motion of
+    ``frequency`` (Hz) sampled every ``frame_period`` (s), away from the ends of the frames: the
+    frequency response of the Savitzky-Golay derivative, sum_k c_k sin(2 pi f k T) / (2 pi f).
+
+    Parameters
+    ----------
+    frequency : float
+        Frequency of the motion (Hz), > 0.
+    frame_period : float
+        Time between frames (s).
+    window, order : int
+        The local fits' frames and polynomial order.
+    """
+    coefficients = savgol_coeffs(window, order, deriv=1, delta=frame_period, use="dot")
+    lags = frame_period * (np.arange(window) - window // 2)
+    omega = 2.0 * np.pi * frequency
+    return float(np.sum(coefficients * np.sin(omega * lags)) / omega)
+
+
+def node_velocities(times, positions_world, window=7, order=VELOCITY_FIT_ORDER) -> np.ndarray:
     """Node velocities (k, n, 3) (m/s) from positions (k, n, 3) at equally spaced ``times``
-    (k,) (s): local quadratic fits over ``window`` frames (Savitzky-Golay), not raw differences.
+    (k,) (s): local polynomial fits over ``window`` frames (Savitzky-Golay), not raw differences.
 
     Parameters
     ----------
@@ -243,15 +273,23 @@ def node_velocities(times, positions_world, window=7) -> np.ndarray:
         Node positions per frame (m, world frame).
     window : int
         Frames per local fit; shortened to the largest odd number <= k.
+    order : int
+        Polynomial order of the local fits (:data:`VELOCITY_FIT_ORDER`); lowered to window - 1 when
+        the window is shortened below it.
 
     Returns
     -------
     (k, n, 3) float
         Node velocities (m/s, world frame).
+
+    Notes
+    -----
+    A polynomial of degree <= ``order`` is differentiated exactly; a sinusoid of frequency f is scaled by
+    :func:`velocity_gain`. Motion above half the frame rate cannot be recovered by any stencil (aliasing).
     """
     positions = np.asarray(positions_world, float)
     window = min(window, len(times) - (1 - len(times) % 2))
     if window < 3:
         raise ValueError("node velocities need at least 3 frames")
     step = float(np.mean(np.diff(times)))
-    return savgol_filter(positions, window, 2, deriv=1, delta=step, axis=0, mode="interp")
+    return savgol_filter(positions, window, min(order, window - 1), deriv=1, delta=step, axis=0, mode="interp")
