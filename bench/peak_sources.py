@@ -29,23 +29,27 @@ contact impulse (integral of |M_c . beam axis| dt, N m s) in each of ``--windows
 from __future__ import annotations
 
 import argparse
+import sys
 import tomllib
+from itertools import combinations
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import sosfilt
-
-from multibody.load_filter import butterworth_sections
+from scipy.stats import mannwhitneyu
+from multibody.load_filter import butterworth_sections, filter_signal
 from riskassess.cases.impact import validate_case
 from riskassess.models.impact import model_inputs, weak_locations
 from structures.weak_location import demands
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+from bench_peak_convergence import quantile_change  # noqa: E402
+
 
 def lowpass(series: np.ndarray, cutoff_hz: float, dt: float, order: int = 4) -> np.ndarray:
-    """``series`` ((k, ...) float, samples ``dt`` s apart) through the load filter's Butterworth, from rest."""
+    """``series`` ((k,) or (k, 3) float, samples ``dt`` s apart) through the load filter's Butterworth, starting at
+    rest under its first value as the run's filter does."""
     sections = butterworth_sections(cutoff_hz, dt, order)
-    sos = np.column_stack([sections[:, :3], np.ones(len(sections)), sections[:, 3:]])
-    return sosfilt(sos, series, axis=0)
+    return np.apply_along_axis(lambda column: filter_signal(sections, column), 0, series)
 
 
 def rate(series: np.ndarray, dt: float) -> np.ndarray:
@@ -136,9 +140,56 @@ def run_sources(run: dict, location, criterion: str, joint, bodies, skip: float,
     return {"peak": float(demand[criterion][k]), "time": float(t[k]),
             "torsion": float(demand["torsion_stress"][k]), "transverse": float(demand["transverse_shear_stress"][k]),
             "torque": float(moment[k] @ beam_joint), "parts": filtered,
-            "shear_force": float(np.linalg.norm(transverse_lvlh)), "shear_parts": shear_parts, "impulse_before": impulse,
-            "windows": contact_impulses(run, joint.child, axis_lvlh, windows)}
+            "shear_force": float(np.linalg.norm(transverse_lvlh)), "shear_parts": shear_parts,
+            "impulse_before": impulse, "windows": contact_impulses(run, joint.child, axis_lvlh, windows)}
 
+
+
+def print_run(variant: str, replica: str, out: dict, margin: float) -> None:
+    """One run's line: its judged peak, the torque's and the shear force's parts (:func:`run_sources`)."""
+    p, f = out["parts"], out["shear_parts"]
+    print(f"{variant:12s} r{replica:>2s} {out['peak']:7.1f} Pa at {out['time']:6.3f} s (torsion {out['torsion']:6.1f}, "
+          f"transverse {out['transverse']:5.1f}); torque {out['torque']:+6.2f} = {p['transmitted']:+6.2f} "
+          f"{p['relative']:+6.2f} {p['contact']:+6.2f} {p['lever']:+6.2f} "
+          f"(closure {out['torque'] - sum(p.values()):+.2f}); shear force {out['shear_force']:5.1f} N = "
+          + " ".join(f"{v:+6.1f}" for v in f.values())
+          + f" (closure {out['shear_force'] - sum(f.values()):+.1f}); contact impulse in the {margin:g} s "
+          f"before: child {out['impulse_before']['child']:.2f}, parent {out['impulse_before']['parent']:.2f} N s")
+
+
+def compare(name: str, values: dict, rng) -> None:
+    """Print, for each pair of variants (a, b), the change of the median of ``values[b]`` against ``values[a]`` with
+    its 90 % bootstrap interval (both resampled) and the two-sided Mann-Whitney U p-value (the same distribution?)."""
+    cells = []
+    for a, b in combinations(values, 2):
+        x, y = np.asarray(values[a]), np.asarray(values[b])
+        if np.median(x) == 0.0 or len(x) < 2 or len(y) < 2:
+            continue
+        change, low, high = quantile_change(x, y, rng)
+        cells.append(f"{b} vs {a}: {change:+.0%} [{low:+.0%}, {high:+.0%}] p={mannwhitneyu(x, y).pvalue:.3f}")
+    print(f"  {name:34s} " + "; ".join(cells))
+
+
+def summary(rows: dict, windows) -> None:
+    """Medians per variant, and each pair of variants compared (:func:`compare`): the judged peak, its torsion, the
+    contact part of its torque, and the child's contact impulses per window."""
+    rng = np.random.default_rng(0)
+    print("\nmedians per variant: peak (Pa), its time (s); child's contact impulse |F| (N s) / torsional (N m s) "
+          "per window")
+    for variant, outs in rows.items():
+        cells = "  ".join(f"{lo:g}-{hi:g}: {np.median([o['windows'][i][0] for o in outs]):.2f} / "
+                          f"{np.median([o['windows'][i][1] for o in outs]):.3f}" for i, (lo, hi) in enumerate(windows))
+        print(f"{variant:12s} n={len(outs):2d} peak {np.median([o['peak'] for o in outs]):6.1f} at "
+              f"{np.median([o['time'] for o in outs]):5.2f} s;  {cells}")
+    print("\npairs of variants: change of the median [90 % bootstrap interval], Mann-Whitney p")
+    compare("judged peak", {v: [o["peak"] for o in outs] for v, outs in rows.items()}, rng)
+    compare("its torsion", {v: [o["torsion"] for o in outs] for v, outs in rows.items()}, rng)
+    compare("|contact part of its torque|", {v: [abs(o["parts"]["contact"]) for o in outs] for v, outs in rows.items()},
+            rng)
+    for i, (lo, hi) in enumerate(windows):
+        for j, label in ((0, "|F|"), (1, "torsional")):
+            compare(f"contact impulse {label} {lo:g}-{hi:g} s",
+                    {v: [o["windows"][i][j] for o in outs] for v, outs in rows.items()}, rng)
 
 
 def main() -> None:
@@ -169,24 +220,11 @@ def main() -> None:
         if "contact_moment_lvlh" not in run or "force_filtered" not in run:
             print(f"{path.name}: no contact series or filtered loads (an older cache); skipped")
             continue
-        out = run_sources(run, location, args.criterion, joint, assembly.bodies, case.structures.skip_initial, args.cutoff,
-                          args.margin, windows)
+        out = run_sources(run, location, args.criterion, joint, assembly.bodies, case.structures.skip_initial,
+                          args.cutoff, args.margin, windows)
         rows.setdefault(variant, []).append(out)
-        p = out["parts"]
-        print(f"{variant:12s} r{replica:>2s} {out['peak']:7.1f} Pa at {out['time']:6.3f} s (torsion {out['torsion']:6.1f}, "
-              f"transverse {out['transverse']:5.1f}); torque {out['torque']:+6.2f} = {p['transmitted']:+6.2f} "
-              f"{p['relative']:+6.2f} {p['contact']:+6.2f} {p['lever']:+6.2f} (closure "
-              f"{out['torque'] - sum(p.values()):+.2f}); shear force {out['shear_force']:5.1f} N = "
-              + " ".join(f"{v:+6.1f}" for v in out["shear_parts"].values())
-              + f" (closure {out['shear_force'] - sum(out['shear_parts'].values()):+.1f}); contact impulse in the {args.margin:g} s before: child "
-              f"{out['impulse_before']['child']:.2f}, parent {out['impulse_before']['parent']:.2f} N s")
-    print("\nmedians per variant: peak (Pa), its time (s); child's contact impulse |F| (N s) / torsional (N m s) "
-          "per window")
-    for variant, outs in rows.items():
-        cells = "  ".join(f"{lo:g}-{hi:g}: {np.median([o['windows'][i][0] for o in outs]):.2f} / "
-                          f"{np.median([o['windows'][i][1] for o in outs]):.3f}" for i, (lo, hi) in enumerate(windows))
-        print(f"{variant:12s} n={len(outs):2d} peak {np.median([o['peak'] for o in outs]):6.1f} at "
-              f"{np.median([o['time'] for o in outs]):5.2f} s;  {cells}")
+        print_run(variant, replica, out, args.margin)
+    summary(rows, windows)
 
 
 if __name__ == "__main__":
