@@ -141,7 +141,8 @@ def run_sources(run: dict, location, criterion: str, joint, bodies, skip: float,
             "torsion": float(demand["torsion_stress"][k]), "transverse": float(demand["transverse_shear_stress"][k]),
             "torque": float(moment[k] @ beam_joint), "parts": filtered,
             "shear_force": float(np.linalg.norm(transverse_lvlh)), "shear_parts": shear_parts,
-            "impulse_before": impulse, "windows": contact_impulses(run, joint.child, axis_lvlh, windows)}
+            "impulse_before": impulse, "energy_drift": float(run["energy_total"][-1] - run["energy_total"][0]),
+            "net_kinetic_late": float(run["energy_net_kinetic"][t >= t[-1] - 2.0].mean()), "windows": contact_impulses(run, joint.child, axis_lvlh, windows)}
 
 
 
@@ -180,11 +181,16 @@ def summary(rows: dict, windows) -> None:
         cells = "  ".join(f"{lo:g}-{hi:g}: {np.median([o['windows'][i][0] for o in outs]):.2f} / "
                           f"{np.median([o['windows'][i][1] for o in outs]):.3f}" for i, (lo, hi) in enumerate(windows))
         print(f"{variant:12s} n={len(outs):2d} peak {np.median([o['peak'] for o in outs]):6.1f} at "
-              f"{np.median([o['time'] for o in outs]):5.2f} s;  {cells}")
+              f"{np.median([o['time'] for o in outs]):5.2f} s; energy drift "
+              f"{np.median([o['energy_drift'] for o in outs]):+.2f} J, net kinetic last 2 s "
+              f"{np.median([o['net_kinetic_late'] for o in outs]):.2f} J;  {cells}")
     print("\npairs of variants: change of the median [90 % bootstrap interval], Mann-Whitney p")
     compare("judged peak", {v: [o["peak"] for o in outs] for v, outs in rows.items()}, rng)
     compare("its torsion", {v: [o["torsion"] for o in outs] for v, outs in rows.items()}, rng)
     compare("|contact part of its torque|", {v: [abs(o["parts"]["contact"]) for o in outs] for v, outs in rows.items()},
+            rng)
+    compare("energy balance drift (J)", {v: [abs(o["energy_drift"]) for o in outs] for v, outs in rows.items()}, rng)
+    compare("net kinetic energy, last 2 s (J)", {v: [o["net_kinetic_late"] for o in outs] for v, outs in rows.items()},
             rng)
     for i, (lo, hi) in enumerate(windows):
         for j, label in ((0, "|F|"), (1, "torsional")):
