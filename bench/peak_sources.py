@@ -3,6 +3,7 @@ transmitted through the joint, run by run, from a bench_peak_convergence cache.
 
     python3 bench/peak_sources.py CASE CACHE [--location asar_mount] [--criterion shear_stress] [--cutoff 3]
                                   [--windows 0-0.25,0.25-2,2-4,4-6,6-8,8-11] [--margin 1.0]
+    python3 bench/peak_sources.py CASE CACHE --joint-modes 1e-4,5e-5,2.5e-5     (each joint's modes at these steps)
 
 The cache must hold the runs' contact and body series (``bench/bench_peak_convergence.py`` keeps them since
 helper asar20, ``HISTORY_KEYS``) and their filtered joint loads (``--load-filter``).
@@ -36,6 +37,7 @@ from pathlib import Path
 
 import numpy as np
 from scipy.stats import mannwhitneyu
+from multibody.hinge import structural_modes_hz
 from multibody.load_filter import butterworth_sections, filter_signal
 from riskassess.cases.impact import validate_case
 from riskassess.models.impact import model_inputs, weak_locations
@@ -146,6 +148,15 @@ def run_sources(run: dict, location, criterion: str, joint, bodies, skip: float,
 
 
 
+def print_joint_modes(assembly, steps) -> None:
+    """Each joint's modes (Hz; x, y, z, rot h1, h2, h3, each axis alone) with the springs a run at each of ``steps``
+    (s) uses: the automatic penalty follows the step only below its caps (:mod:`multibody.hinge`)."""
+    for step in steps:
+        for joint in assembly.joints:
+            modes = structural_modes_hz(joint, assembly.bodies[joint.parent], assembly.bodies[joint.child], step)
+            print(f"step {step:g} s  {joint.name:20s} " + " ".join(f"{f:7.1f}" for f in modes))
+
+
 def print_run(variant: str, replica: str, out: dict, margin: float) -> None:
     """One run's line: its judged peak, the torque's and the shear force's parts (:func:`run_sources`)."""
     p, f = out["parts"], out["shear_parts"]
@@ -207,11 +218,16 @@ def main() -> None:
     parser.add_argument("--cutoff", type=float, default=3.0, help="the location's load-filter cut-off (Hz)")
     parser.add_argument("--margin", type=float, default=1.0, help="contact impulse window before the peak (s)")
     parser.add_argument("--windows", default="0-0.25,0.25-2,2-4,4-6,6-8,8-11", help="comma list of LOW-HIGH (s)")
+    parser.add_argument("--joint-modes", default=None, metavar="STEP,STEP",
+                        help="only print each joint's modes (Hz) at these steps (s) and stop")
     args = parser.parse_args()
     case_path = Path(args.case).resolve()
     text = case_path.read_text().replace('release = "low"', 'release = "never"', 1)
     case = validate_case(tomllib.loads(text), case_path)
     assembly = model_inputs(case, case_path.parent).assembly
+    if args.joint_modes:
+        print_joint_modes(assembly, [float(v) for v in args.joint_modes.split(",")])
+        return
     location = next(loc for loc in weak_locations(case, assembly) if loc.name == args.location)
     joint = assembly.joints[location.joint]
     windows = [tuple(float(v) for v in w.split("-")) for w in args.windows.split(",")]
