@@ -178,7 +178,7 @@ def compare(name: str, values: dict, rng) -> None:
         if np.median(x) == 0.0 or len(x) < 2 or len(y) < 2:
             continue
         change, low, high = quantile_change(x, y, rng)
-        cells.append(f"{b} vs {a}: {change:+.0%} [{low:+.0%}, {high:+.0%}] p={mannwhitneyu(x, y).pvalue:.3f}")
+        cells.append(f"{b} vs {a}: {change:+.1%} [{low:+.0%}, {high:+.0%}] p={mannwhitneyu(x, y).pvalue:.3f}")
     print(f"  {name:34s} " + "; ".join(cells))
 
 
