@@ -32,15 +32,17 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def captured_state_model():
-    """Patch the structref's constructor so the run's net state arrays can be saved and restored."""
+    """Patch the structref's constructor so the run's net state arrays can be saved and restored (the cached
+    constructor ``_new_net_step_model`` since helper speed20, the proxy class in older trees)."""
     captured = []
-    original = kernel_net_module.NetStepModel
+    name = "_new_net_step_model" if hasattr(kernel_net_module, "_new_net_step_model") else "NetStepModel"
+    original = getattr(kernel_net_module, name)
 
     def capture(*args):
         captured.append(args)
         return original(*args)
 
-    kernel_net_module.NetStepModel = capture
+    setattr(kernel_net_module, name, capture)
     return captured
 
 

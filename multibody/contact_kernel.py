@@ -96,7 +96,7 @@ def _apply_contact_pair(i, b, fx, fy, fz, com_lvlh, weight, x, net_force_lvlh, b
 CONTACT_PHASE_PER_SUBSTEP = 0.02
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _substeps_to_resolve_contact(penetrations, relative_velocities, normals, body_masses, n_contacts,
                                  external_force, node_mass, step, stiffness, exponent, damping):
     """Sub-steps that resolve a node's contacts over one step at CONTACT_PHASE_PER_SUBSTEP.

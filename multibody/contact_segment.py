@@ -85,7 +85,7 @@ from multibody.broad_phase import box_signed_distance
 from multibody.contact import hertz_elastic_energy
 
 from multibody.contact_kernel import _effective_mass_of_body, _substeps_to_resolve_contact, add_body_reaction
-from multibody.jit_cache import WITH_REFCOUNTS
+from multibody.jit_cache import NO_REFCOUNTS
 from multibody.segment_box import MAX_BREAKPOINTS, segment_box_normal
 from multibody.segment_cycle import ClusterWork, cluster_contact_over_step, cluster_work, thread_contact_geometry
 from multibody.segment_pairs import _contact_pairs, _near_shapes, _node_motion, _to_body
@@ -198,7 +198,7 @@ def _apply_at_point(a, b, split, body, fx, fy, fz, arm_x, arm_y, arm_z, weight, 
     out_node_impulse[b, 2] += wb * fz * weight
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body_force_lvlh, torque_lvlh,
                      out_body_impulse, out_node_impulse):
     """Apply every thread's impulses carried from the previous step (its contact's end minus mean velocity
@@ -226,7 +226,13 @@ def _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body
         seg.lag_body[j] = -1
 
 
-@njit(cache=True, **WITH_REFCOUNTS)  # allocates; called from a NO_REFCOUNTS kernel (jit_cache)
+# no reference counts (jit_cache.NO_REFCOUNTS), nor in its callees (numba compiles them with its setting): with counts,
+# every call below the step's entry (per candidate pair, cluster and thread) took and dropped a reference to every array
+# of the named tuples it was handed (KernelBuffers, SegmentBuffers, ClusterWork: some 100 arrays a call), and these
+# atomic counts were 52-60 % of a wrapped capture's CPU (perf, helper speed20, docs/model.md "Speed"). Its callees state
+# NO_REFCOUNTS themselves: numba keys neither its on-disk cache nor a dispatcher's compiled versions by this setting, so
+# a callee first compiled from Python (a test) kept its counts inside the kernel too (measured: 18 % of the samples)
+@njit(cache=True, **NO_REFCOUNTS)
 def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps, stage_weight, buffers,
                                net_force_lvlh, body_force_lvlh, torque_lvlh):
     """Add the threads' contact forces with the box shapes (module doc) to ``net_force_lvlh`` and their
@@ -276,10 +282,12 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
     _near_shapes(x, v, net_force_lvlh, net_mass, buffers.velocity_lag, seg, states, shapes, step)
     energy, count, dissipated = 0.0, 0, 0.0
     # the per-thread energy record: this step's sub-cycles write their end energies into row 1
-    seg.end_energy[0, :] = seg.end_energy[1, :]
+    # row to row element by element: a slice assignment between arrays allocates (its overlap copy)
+    for j in range(threads.shape[0]):
+        seg.end_energy[0, j] = seg.end_energy[1, j]
+        seg.sharing[0, j] = seg.sharing[1, j]
     seg.end_energy[1, :] = 0.0
     seg.start_energy[:] = 0.0
-    seg.sharing[0, :] = seg.sharing[1, :]
     seg.sharing[1, :] = 0
     seg.owned_shape[:] = -1
     seg.node_threads[:] = 0
@@ -295,7 +303,9 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
         energy += e
         count += count_k
         dissipated += w
-    net_force_lvlh += node_force
+    for d in range(3):      # element by element (an array's += allocates)
+        for i in range(node_force.shape[1]):
+            net_force_lvlh[d, i] += node_force[d, i]
     if n_substeps > 1:
         # the energy each thread's contact starts this step with less what its sub-cycle ended the last with: the
         # energy made between the steps (one force evaluation a step: Verlet)
@@ -310,7 +320,7 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
     return energy, count, dissipated
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _cluster_on_box(first, last, x, v, net_force_lvlh, net, states, bodies, shapes, law, step, n_substeps,
                     stage_weight, buffers, body_force_lvlh, torque_lvlh):
     """The cluster of (thread, box) pairs ``seg.pair_order[first:last]`` (one box, threads sharing nodes:
@@ -402,7 +412,7 @@ def _cluster_on_box(first, last, x, v, net_force_lvlh, net, states, bodies, shap
     return energy, count, lost_total
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _thread_start(r, j, s, b, x, cw, shapes, bodies, rot, com_lvlh, law, step, n_substeps, seg):
     """Thread row ``r`` (net thread ``j``) of the cluster at the step's start: books its contact energy
     (``seg.start_energy``) and its nodes' sharing; returns that energy (J), 1 if it penetrates (else 0), and the
@@ -449,7 +459,7 @@ def _thread_start(r, j, s, b, x, cw, shapes, bodies, rot, com_lvlh, law, step, n
     return start_energy, 1 if penetration > 0.0 else 0, n_cycle
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _apply_thread_impulses(j, a, c, b, impulses, x, com_lvlh, step, stage_weight, seg, body_force_lvlh, torque_lvlh,
                            buffers):
     """Each node's mean impulse over the step (``impulses`` rows 0 and 2, N s, LVLH) as a force now, the body's
@@ -475,7 +485,7 @@ def _apply_thread_impulses(j, a, c, b, impulses, x, com_lvlh, step, stage_weight
         seg.lag_body[j] = b
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _substeps_to_resolve(penetration, w, normal, point_mass, body_mass, acc, wa, wc, rel, ka, kc, depth_a, depth_c,
                          normal_a, normal_c, mass_a, mass_c, law, step, n_substeps, seg):
     """Sub-steps for the thread's sub-cycle (:mod:`multibody.segment_cycle`): enough to resolve its point's contact

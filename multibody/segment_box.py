@@ -13,6 +13,8 @@ import math
 
 from numba import njit
 
+from multibody.jit_cache import NO_REFCOUNTS, WITH_REFCOUNTS
+
 #: Distance (m) within which points of a thread count as equally deep: a thread parallel to a face to
 #: round-off (1e-9 m over a 2 m thread is a 5e-10 rad tilt) takes its load at the middle of the overlap,
 #: and its interior counts as deeper than its ends only beyond this (a thread on a face adds nothing).
@@ -23,7 +25,7 @@ TIE_DISTANCE = 1e-9
 MAX_BREAKPOINTS = 11
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def segment_box_breakpoints(a, d, lo, hi, out):
     """Sorted parameters t in [0, 1] where the segment a + t d crosses one of the box's six slab planes or
     three mid-planes, with 0 and 1; returns how many (the first entries of ``out``).
@@ -88,7 +90,57 @@ def _inside_distance(alpha, beta, t):
     return max(alpha[0] + beta[0] * t, alpha[1] + beta[1] * t, alpha[2] + beta[2] * t)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
+def segment_box_separation(a, d, lo, hi):
+    """A lower bound (m) of the distance between the segment a + t d, t in [0, 1], and the box [lo, hi]: the largest
+    gap between their projections on the separating axes of a segment and a box, the box's three axes e_i and the
+    three directions d x e_i across the segment (the set that separates any disjoint pair of them, Gottschalk et al.
+    1996). The distance is at least the gap along any unit axis u, since |x - y| >= u . (x - y); a positive bound
+    proves the two apart, zero or less proves nothing.
+
+    .. math:: g_u = \frac{|u \cdot (a - c)| - \sum_k |u_k| h_k}{|u|}, \qquad u = d \times e_i
+
+    (c the box's centre, h its half sizes; the segment projects to the one value u . a on such an axis). The axes'
+    components are d's own (no round-off), so the bound's round-off is that of the dot products, about 1e-16 of the
+    coordinates (1e-14 m for a body of some 10 m).
+
+    Parameters
+    ----------
+    a, d : tuple of 3 float
+        Segment start and direction (end minus start), body frame (m).
+    lo, hi : tuple of 3 float
+        The box's corners, body frame (m).
+
+    Returns
+    -------
+    float
+        (m).
+
+    References
+    ----------
+    Gottschalk, Lin & Manocha 1996, "OBBTree: a hierarchical structure for rapid interference detection", SIGGRAPH,
+    Sec. 4 (the separating axis theorem for boxes; for a segment the axes are the box's faces and d x e_i).
+    """
+    best = -math.inf
+    for i in range(3):
+        low, high = min(a[i], a[i] + d[i]), max(a[i], a[i] + d[i])
+        best = max(best, lo[i] - high, low - hi[i])
+    r0, r1, r2 = a[0] - 0.5 * (lo[0] + hi[0]), a[1] - 0.5 * (lo[1] + hi[1]), a[2] - 0.5 * (lo[2] + hi[2])
+    h0, h1, h2 = 0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]), 0.5 * (hi[2] - lo[2])
+    # d x e_x = (0, d2, -d1), d x e_y = (-d2, 0, d0), d x e_z = (d1, -d0, 0)
+    norm = math.sqrt(d[1] * d[1] + d[2] * d[2])
+    if norm > 0.0:
+        best = max(best, (abs(d[2] * r1 - d[1] * r2) - abs(d[2]) * h1 - abs(d[1]) * h2) / norm)
+    norm = math.sqrt(d[0] * d[0] + d[2] * d[2])
+    if norm > 0.0:
+        best = max(best, (abs(d[0] * r2 - d[2] * r0) - abs(d[2]) * h0 - abs(d[0]) * h2) / norm)
+    norm = math.sqrt(d[0] * d[0] + d[1] * d[1])
+    if norm > 0.0:
+        best = max(best, (abs(d[1] * r0 - d[0] * r1) - abs(d[1]) * h0 - abs(d[0]) * h1) / norm)
+    return best
+
+
+@njit(cache=True, **NO_REFCOUNTS)
 def segment_box_deepest(a, d, lo, hi, work):
     """The segment's deepest point against a box: t* minimizing the signed distance, and that distance.
 
@@ -150,7 +202,7 @@ def segment_box_deepest(a, d, lo, hi, work):
     return best_t, best
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def segment_box_sublevel(a, d, lo, hi, level, work):
     """The interval [t_low, t_high] of the segment whose signed distance to the box is at most ``level`` (m),
     exact per breakpoint interval (:func:`segment_box_deepest`); empty (t_low > t_high) if none.
@@ -205,7 +257,7 @@ def segment_box_sublevel(a, d, lo, hi, level, work):
     return low, high
 
 
-@njit(cache=True)
+@njit(cache=True, **WITH_REFCOUNTS)  # allocates (its lists); called from NO_REFCOUNTS kernels (jit_cache)
 def segment_box_normal(px, py, pz, dx, dy, dz, lo, hi, wx, wy, wz):
     """Unit contact normal (body frame) from the box to a segment's deepest point p (direction d), and the
     slope of the segment's deepest penetration along it.

@@ -46,6 +46,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from multibody.jit_cache import NO_REFCOUNTS
+
 from multibody.broad_phase import box_signed_distance
 from multibody.contact import _power, hollar_friction_coefficient_inverse
 from multibody.segment_box import TIE_DISTANCE, segment_box_deepest, segment_box_normal, segment_box_sublevel
@@ -92,7 +94,7 @@ def cluster_work(n_nodes: int, n_threads: int) -> ClusterWork:
                        thread_lost=np.zeros(m), node_lost=np.zeros(n))
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def thread_contact_geometry(pa, pc, box_min, box_max, s, radius_a, radius_c, work):
     """The thread's contact coordinate against box ``s`` for body-frame node positions ``pa``, ``pc`` (m).
 
@@ -203,7 +205,7 @@ def _relative_velocity(rel, acc, u, p, x, i, t, bv0, bv1, bv2, bw0, bw1, bw2):
             rel[i, 2] + acc[i, 2] * t + u[i, 2] + p[i, 2] - (bv2 + bw0 * x[i, 1] - bw1 * x[i, 0]))
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def _thread_contact_force(ka, kc, x, w, mass, box_min, box_max, s, radius, law, inverse_body_mass, dt, work, force):
     """The thread (cluster nodes ``ka``, ``kc``) contact's forces on its nodes at a sub-step, added to ``force``
     (body frame, N): F at the deepest point split (1 - s, s), and -(F . n) n_e on the deeper node e, which hands its
@@ -268,7 +270,7 @@ def _thread_contact_force(ka, kc, x, w, mass, box_min, box_max, s, radius, law, 
     return dissipated, 1
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def thread_contact_energy(ka, kc, x, box_min, box_max, s, radius, law, work):
     """The thread's (cluster nodes ``ka``, ``kc``) contact elastic energy k q^(n+1)/(n+1) at positions ``x`` (J)."""
     geometry = thread_contact_geometry((x[ka, 0], x[ka, 1], x[ka, 2]), (x[kc, 0], x[kc, 1], x[kc, 2]), box_min,
@@ -279,7 +281,7 @@ def thread_contact_energy(ka, kc, x, box_min, box_max, s, radius, law, work):
     return law.stiffness * _power(excess, law.exponent) * excess / (law.exponent + 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def cluster_contact_over_step(cluster, box_min, box_max, s, body_mass, inverse_inertia_body, b, law, step,
                               n_substeps, work):
     """A cluster of threads in contact with box ``s`` of body ``b`` (threads that share nodes, and those nodes'

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from numba import njit
 
+from multibody.jit_cache import NO_REFCOUNTS
+
 
 @njit(cache=True, inline="always")
 def _root(parent, key):
@@ -24,7 +26,7 @@ def _root(parent, key):
     return key
 
 
-@njit(cache=True)
+@njit(cache=True, **NO_REFCOUNTS)
 def group_pairs(pair_thread, pair_shape, n_pairs, threads, n_nodes, parent, root_cluster, order, start):
     """Group the first ``n_pairs`` (thread, shape) contact pairs into clusters of pairs on one shape that share
     nodes, transitively.
@@ -70,11 +72,16 @@ def group_pairs(pair_thread, pair_shape, n_pairs, threads, n_nodes, parent, root
         start[root_cluster[r] + 1] += 1
     for k in range(n_clusters):
         start[k + 1] += start[k]
-    fill = start[:n_clusters].copy()
+    # each cluster's pairs placed at start[k], which counts up to its end (the next cluster's start) ...
     for p in range(n_pairs):
         k = root_cluster[_root(parent, threads[pair_thread[p], 0] + n_nodes * pair_shape[p])]
-        order[fill[k]] = p
-        fill[k] += 1
+        order[start[k]] = p
+        start[k] += 1
+    # ... and shifted back by one cluster (no copy of the starts: this kernel allocates nothing, so it runs without
+    # reference counts, jit_cache.NO_REFCOUNTS)
+    for k in range(n_clusters, 0, -1):
+        start[k] = start[k - 1]
+    start[0] = 0
     for p in range(n_pairs):
         root_cluster[_root(parent, threads[pair_thread[p], 0] + n_nodes * pair_shape[p])] = -1
     return n_clusters
