@@ -29,7 +29,7 @@ import numpy as np
 
 from multibody.net_towing import run_exudyn
 from multibody.net_towing_kernel import cylinder_distance
-from multibody.net_wrap import closing_loop
+from multibody.closing import closing_loop
 from riskassess.cases.impact import load_model
 from riskassess.cases.towing import TowingCase
 from riskassess.models.towing_fullnet import debris_geometry, full_net_model

@@ -14,6 +14,7 @@ import trimesh
 from multibody.net import NetTopology
 
 if TYPE_CHECKING:       # annotation only: the loads module needs Exudyn, these descriptions do not
+    from multibody.closing_winch import ClosingSpec
     from multibody.recorded_loads import RecordedBodyLoads
 
 
@@ -207,6 +208,9 @@ class ImpactAssembly:
     #: recorded contact loads applied to the bodies (the sequential method's second step,
     #: :mod:`multibody.recorded_loads`); None in a coupled run
     body_loads: RecordedBodyLoads | None = None
+    #: the net's closing mechanism (:class:`multibody.closing_winch.ClosingSpec`; the loop is the net's last 12
+    #: threads); None: the net stays open
+    closing: ClosingSpec | None = None
 
     @property
     def debris_indices(self) -> list[int]:

@@ -17,6 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from multibody.assembly import ImpactAssembly
 from multibody.broad_phase import box_shape_flags
+from multibody.closing_winch import ClosingWinch
 from multibody.geometry import contact_shapes_body_frame
 from multibody.health import HealthWatch, SimulationFailed, check_solver_flag
 from multibody.hinge import add_penalty_joint
@@ -66,6 +67,7 @@ class BuiltSystem:
     joint_point_child_body: list    # (3,) joint point, child body frame (m)
     kernel_net: KernelNet | None = None  # the net's state when the kernel integrates it
     rotations: ExactRotations | None = None  # VelocityVerlet: the attitudes restored after each step
+    closing: ClosingWinch | None = None  # the net's closing winch (assembly.closing), kernel path only
 
     def net_state(self, q, qt):
         """(n, 3) node positions (m) and velocities (m/s), LVLH, at the end of the last step, from
@@ -307,9 +309,15 @@ def build_impact_system(assembly: ImpactAssembly, rest_body_to_lvlh=None, rest_c
     kernel_net = None
     # Exudyn's explicit Lie-group update loses turns below ~2e-8 rad a step (multibody.rotation_update)
     rotations = ExactRotations(3 * n_exudyn, len(body_nodes), state_index) if verlet else None
+    closing = None
+    if assembly.closing is not None and not in_kernel:
+        raise ValueError("the net's closing mechanism needs the compiled kernel to integrate the net "
+                         "(simulation.net_integration = \"kernel\" with VelocityVerlet)")
     if in_kernel:
         kernel_net = KernelNet(mbs, coupled, kernel, assembly.net_velocity, state_index, rotations)
         mbs.SetPreStepUserFunction(kernel_net)
+        if assembly.closing is not None:
+            closing = ClosingWinch(assembly.closing, kernel, kernel_net.q, assembly.solver.step)
     elif verlet:
         mbs.SetPreStepUserFunction(VerletForces(mbs, coupled, kernel, assembly.solver.step, 3 * n,
                                                 len(body_nodes), state_index, rotations))
@@ -317,7 +325,7 @@ def build_impact_system(assembly: ImpactAssembly, rest_body_to_lvlh=None, rest_c
         layout["index"] = state_index
     return BuiltSystem(sc, mbs, kernel, net_node, body_nodes, body_objects, joint_objects,
                        joints_to_parent, joints_to_child, points_parent_body, points_child_body, kernel_net,
-                       rotations)
+                       rotations, closing)
 
 
 def uses_kernel_net(assembly: ImpactAssembly) -> bool:
@@ -576,6 +584,29 @@ def solve_checked(mbs, settings, solver_type, watch: HealthWatch, stopped_early=
     check_solver_flag(bool(success) and reached >= end_time - half_step, end_time, reached, watch.cause)
 
 
+def with_winch(post_step, winch: ClosingWinch | None):
+    """``post_step`` between the closing winch's booking of its last update (:meth:`ClosingWinch.book_pending`) and
+    its next update (:meth:`ClosingWinch.after_step`), or ``post_step`` itself without a winch (the default path
+    calls exactly what it called before).
+
+    Parameters
+    ----------
+    post_step : callable ``(mbs, t) -> bool``
+        The recorder's post-step work (its sample at ``t`` reads the loop as it was over the step).
+    winch : ClosingWinch or None
+    """
+    if winch is None:
+        return post_step
+
+    def hook(mbs, t):
+        winch.book_pending()    # the last update's work completed at this step's end, before the sample reads it
+        keep = post_step(mbs, t)
+        winch.after_step(t)
+        return keep
+
+    return hook
+
+
 class ImpactSimulation:
     """Build and run one coupled impact; ``run()`` returns the recorder with all time series."""
 
@@ -618,7 +649,7 @@ class ImpactSimulation:
             # the post-step work runs from the kernel's pre-step, for the step before (one Python
             # call from Exudyn a step instead of two; the same work in the same order), after the kernel
             # has restored the step's exact attitudes (multibody.rotation_update)
-            kernel_net.set_after_step(post_step, mbs.systemData.GetTime())
+            kernel_net.set_after_step(with_winch(post_step, self.system.closing), mbs.systemData.GetTime())
         else:
             if self.system.rotations is not None:
                 # Exudyn's attitudes made exact before anything reads them (multibody.rotation_update)

@@ -22,6 +22,7 @@ from numba import njit, types
 from numba.experimental import structref
 from scipy.spatial.transform import Rotation
 
+from multibody.closing import reel_fraction, reeled_rest_lengths
 from multibody.health import HealthWatch
 from multibody.impact import checked_post_step, explicit_settings, solve_checked
 from multibody.control.lateral import L_ON, L_SIZE, lateral_thrust
@@ -287,9 +288,9 @@ class NetTowState:
         Updates ``rest`` and ``stiffness`` of the closing threads in place (the kernel holds views).
         """
         m = self.model
-        ramp = min(1.0, (t - m.closing_time) / m.closing_duration)
+        ramp = reel_fraction(t, m.closing_time, m.closing_duration)
         k = len(self.rest_open)
-        self.rest[-k:] = self.rest_open + ramp * (m.net.closing_rest_closed - self.rest_open)
+        self.rest[-k:] = reeled_rest_lengths(self.rest_open, m.net.closing_rest_closed, ramp)
         self.stiffness[-k:] = m.net.closing_stiffness(self.rest[-k:])
         self.reeling = ramp < 1.0
 

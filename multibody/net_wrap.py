@@ -4,7 +4,8 @@ prepared wrapped state around the Zenit-2 cylinder (Boonrath, Singh & Botta 2024
 Topology from :func:`multibody.net.flat_square_net` (N x N nodes, corner masses on the corners);
 the closing mechanism is a loop of tension-only threads laced through the four corner masses and
 two perimeter nodes per side (twelve lacing points, Sec. 2.1), appended as the last
-:data:`N_CLOSING` threads; shortening their natural length closes the net.
+:data:`~multibody.closing.N_CLOSING` threads (:mod:`multibody.closing`, shared with the impact model);
+shortening their natural length closes the net.
 
 The wrapped state (:func:`drape_and_close`) is made by the model itself, in the debris frame with
 the debris held still: the net starts flat above the cylinder's side facing the chaser,
@@ -20,13 +21,10 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from multibody.closing import N_CLOSING, append_closing_loop, closing_stiffness
 from multibody.net import NetTopology, flat_square_net
 from multibody.net_towing_kernel import (ACC_SIZE, CYL_HALF, CYL_RADIUS, CYL_Z, DebrisBody, DebrisMotion, NetThreads,
                                          TetherEnd, cylinder_distance, net_forces)
-
-#: Threads of the closing loop (four corner masses and eight perimeter nodes, Sec. 2.1).
-N_CLOSING = 12
-
 
 @dataclass(frozen=True)
 class TowingNet:
@@ -55,29 +53,7 @@ class TowingNet:
         rest : (12,) float
             Natural lengths of the closing threads (m).
         """
-        return self.closing_axial_rigidity / np.asarray(rest)
-
-
-def closing_loop(nodes_per_side: int) -> np.ndarray:
-    """The twelve lacing points in order around the perimeter (node indices; the corner masses are
-    :func:`~multibody.net.flat_square_net`'s bullets n^2 .. n^2+3 on grid corners 0, n-1, n(n-1), n^2-1).
-
-    Parameters
-    ----------
-    nodes_per_side : int
-        N of the N x N net.
-
-    Returns
-    -------
-    (12,) int
-        Node indices of the lacing points, in order around the perimeter.
-    """
-    n = nodes_per_side
-    j1 = int(round((n - 1) / 3))
-    j2 = n - 1 - j1
-    cm = n * n + np.arange(4)
-    return np.array([cm[0], j1, j2, cm[1], j1 * n + n - 1, j2 * n + n - 1, cm[3], (n - 1) * n + j2,
-                     (n - 1) * n + j1, cm[2], j2 * n, j1 * n])
+        return closing_stiffness(self.closing_axial_rigidity, rest)
 
 
 def towing_net(side_length, nodes_per_side, net_mass, corner_mass, node_radius, corner_radius, thread_axial_rigidity,
@@ -123,17 +99,8 @@ def towing_net(side_length, nodes_per_side, net_mass, corner_mass, node_radius, 
     mesh = side_length / (n - 1)
     net = flat_square_net(center_body, normal_body, side_length, n, node_mass, node_radius, thread_axial_rigidity,
                           thread_damping, corner_mass, corner_radius, mesh)
-    loop = closing_loop(n)
-    pairs = np.c_[loop, np.roll(loop, -1)]
-    rest_open = np.linalg.norm(net.positions[pairs[:, 1]] - net.positions[pairs[:, 0]], axis=1)
+    topology, rest_open = append_closing_loop(net, closing_axial_rigidity, thread_damping)
     rest_closed = closed_fraction * rest_open
-    topology = NetTopology(
-        positions=net.positions, masses=net.masses, radii=net.radii,
-        threads=np.vstack([net.threads, pairs]).astype(np.int64), rest_lengths=np.r_[net.rest_lengths, rest_open],
-        stiffness=np.r_[net.stiffness, closing_axial_rigidity / rest_open],
-        damping=np.r_[net.damping, np.full(N_CLOSING, float(thread_damping))],
-        bending_triples=net.bending_triples, bending_stiffness=net.bending_stiffness,
-        nodes_per_side=n, n_bullets=4)
     return TowingNet(topology, (n // 2) * n + n // 2, rest_open, rest_closed, float(closing_axial_rigidity))
 
 

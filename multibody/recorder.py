@@ -77,7 +77,7 @@ FILTERED_LOADS = ("joint_force_filtered_joint", "joint_moment_filtered_joint")
 
 
 def series_layout(n_bodies: int, n_joints: int, chaser: bool, applied_loads: bool,
-                  filtered_loads: bool = False) -> list:
+                  filtered_loads: bool = False, winch: bool = False) -> list:
     """The time series' keys and the shape of one sample of each, in the order of :attr:`Recorder.series`.
 
     Parameters
@@ -90,13 +90,16 @@ def series_layout(n_bodies: int, n_joints: int, chaser: bool, applied_loads: boo
     filtered_loads : bool
         The joints' loads are filtered every step (``joint_force_filtered_joint``, ``joint_moment_filtered_joint``,
         after the existing columns, so a run without them records the same row).
+    winch : bool
+        The net has a closing winch (``energy_winch_work``: minus the work it did on the net, J, before the total).
 
     Returns
     -------
     list of (str, tuple)
     """
     nb, nj = n_bodies, n_joints
-    energies = list(ENERGY_TERMS) + ["chaser_kinetic"] * chaser + ["applied_loads_work"] * applied_loads + ["total"]
+    energies = (list(ENERGY_TERMS) + ["chaser_kinetic"] * chaser + ["applied_loads_work"] * applied_loads
+                + ["winch_work"] * winch + ["total"])
     return ([("time", ())]
             + [(key, (nb, 3)) for key in ("contact_force_lvlh", "contact_moment_lvlh", "contact_force_body",
                                           "contact_moment_body", "body_com_lvlh", "body_velocity_lvlh",
@@ -167,8 +170,11 @@ class Recorder:
         self._filter_started = False
         self._filter_scratch = np.zeros((6, 3))
         self._unfiltered = np.array([not c for c in cutoffs_hz], bool)
+        #: the net's closing winch (multibody.closing_winch), None for an open net
+        self._winch = system.closing
+        self._launch_reference = self.health.reference_energy   # the energy check's reference before any winch work
         self._layout = series_layout(nb, nj, assembly.chaser is not None, assembly.body_loads is not None,
-                                     self._load_filter is not None)
+                                     self._load_filter is not None, self._winch is not None)
         self._columns = {}
         width = 0
         for key, shape in self._layout:
@@ -342,6 +348,8 @@ class Recorder:
             self._row[total_column - 1] = work_term
             total_energy = total_energy + work_term  # the sum's last term, in the order ENERGY_TERMS adds them
             self._row[total_column] = total_energy
+        if self._winch is not None:
+            total_energy = self._book_winch(total_energy)
         if not self.health.energy(t, total_energy):
             return
         self._store()
@@ -363,6 +371,18 @@ class Recorder:
                 self._check_capture(t, k)
         if self.progress is not None:
             self.progress(t)
+
+    def _book_winch(self, total_energy: float) -> float:
+        """The closing winch's work into the row (``energy_winch_work``: minus the work it did on the net, so that
+        the total stays closed while the loop pulls) and the total with it (J)."""
+        total_column = self._energy_slice.stop - 1
+        self._row[total_column - 1] = -self._winch.work
+        total_energy = total_energy - self._winch.work
+        self._row[total_column] = total_energy
+        if self.health.reference_energy is not None:
+            # the balance's scale is the energy brought in: the launch's and what the winch has put in since
+            self.health.reference_energy = max(self.health.reference_energy, self._launch_reference + self._winch.work)
+        return total_energy
 
     def _node_contact_force(self, t):
         """Contact force on each net node (N, LVLH), averaged since the previous net snapshot."""

@@ -137,12 +137,49 @@ class Thread(Strict):
         return self
 
 
+class Closing(Strict):
+    """The net's closing mechanism (docs/model.md, "Closing the net"): a loop of tension-only threads laced through
+    the four bullets and two perimeter nodes per side (Boonrath, Singh & Botta 2024, Sec. 2.1), reeled in by a winch
+    from its trigger over ``duration_s`` to ``closed_fraction`` of its open length. Off (no table): the net stays open."""
+
+    start: NonNegative | Literal["first_contact"] = Field(
+        "first_contact", description="When the winch starts: a time (s), or 'first_contact' (the net's first contact "
+                                     "with any body, nodes' or threads', plus the delay): a mission fires the closing on "
+                                     "the net's sensed arrival and waits for the wrap.")
+    delay_s: NonNegative | None = Field(
+        None, description="With start = 'first_contact': the wait after it (s). Give this or delay_travel_m; "
+                          "neither: 0.")
+    delay_travel_m: NonNegative | None = Field(
+        None, description="With start = 'first_contact': the wait after it as net travel (m), delay = this / "
+                          "launch.velocity (the capture keeps its shape in units of travel, docs/structures.md; "
+                          "14 m is the seed's 7 s at 2 m/s, Boonrath et al. 2024 Sec. 4.1).")
+    duration_s: Positive = Field(
+        description="Reel-in time from open to closed (s): the natural lengths shorten linearly over it.")
+    closed_fraction: Annotated[float, Field(gt=0, le=1)] = Field(
+        description="The closed loop's natural length over its open length, the mouth's perimeter in the launch "
+                    "shape (-).")
+    axial_rigidity: Positive = Field(description="EA of the closing thread (N); a thread of natural length l0 "
+                                                 "gets EA / l0 (N/m).")
+    damping: NonNegative | None = Field(
+        None, description="Axial damping of each closing thread (N s/m); default net.thread.damping.")
+
+    @model_validator(mode="after")
+    def _delay(self):
+        if self.delay_s is not None and self.delay_travel_m is not None:
+            raise ValueError("give at most one of 'delay_s' (s) or 'delay_travel_m' (m)")
+        if self.start != "first_contact" and (self.delay_s is not None or self.delay_travel_m is not None):
+            raise ValueError(f"a delay goes with start = 'first_contact'; start = {self.start!r} is already a time")
+        return self
+
+
 class Net(Strict):
     side_length: Positive = Field(description="Side of the square net (m).")
     nodes_per_side: Annotated[int, Field(ge=2, le=200)] = Field(description="Nodes along one side (-).")
     thread: Thread
     node_mass: Positive | None = Field(
         None, description="Mass of one net node (kg); default: thread mass spread evenly over the nodes.")
+    closing: Closing | None = Field(
+        None, description="The closing mechanism ([net.closing]); none: the net stays open (the default).")
 
     @model_validator(mode="after")
     def _mass_source(self):
@@ -804,6 +841,22 @@ class Case(Strict):
             raise ValueError("structures.window = 'capture' follows the net's motion relative to the debris; a "
                              "sequential run (the seed paper's method) has the net against a fixed wall: use "
                              "coupling = 'coupled' or window = 'fixed'")
+        return self
+
+    @model_validator(mode="after")
+    def _closing_coupled_kernel(self):
+        if self.net.closing is None:
+            return self
+        sim = self.simulation
+        if sim.coupling == "sequential":
+            raise ValueError("net.closing closes the net around free debris; a sequential run (the seed paper's "
+                             "method) has the net against a fixed wall: use coupling = 'coupled' or remove [net.closing]")
+        if sim.net_integration != "kernel" or sim.integrator != "VelocityVerlet":
+            raise ValueError("net.closing reels the loop in inside the compiled kernel: it needs "
+                             "simulation.net_integration = 'kernel' and integrator = 'VelocityVerlet'")
+        if self.net.nodes_per_side < 4:
+            raise ValueError(f"net.closing laces two perimeter nodes per side: nodes_per_side must be >= 4. "
+                             f"Got {self.net.nodes_per_side} instead")
         return self
 
     @model_validator(mode="after")

@@ -14,6 +14,8 @@ from scipy.spatial.transform import Rotation
 
 from multibody.assembly import (ContactLaw, ImpactAssembly, JointSpec, NetMount, RigidBodySpec, SolverSpec,
                                 subtree_bodies)
+from multibody.closing import N_CLOSING, append_closing_loop
+from multibody.closing_winch import ClosingSpec
 from multibody.geometry import geometric_center_of_mass, uniform_density_inertia
 from multibody.hinge import hinge_frame_lvlh, structural_modes_hz
 from multibody.net import bowl_net_positions, flat_square_net, thread_node_mass
@@ -141,7 +143,38 @@ def build_net(case: Case):
         except ValueError as exc:
             raise ValueError(f"launch.sag = {launch.sag:g} m: {exc}") from None
     velocity = np.tile(launch.velocity * direction, (topology.n_nodes, 1))
+    if net.closing is not None:
+        topology, _ = append_closing_loop(topology, net.closing.axial_rigidity,
+                                          thread.damping if net.closing.damping is None else net.closing.damping)
     return topology, velocity
+
+
+def closing_spec(case: Case, net) -> ClosingSpec | None:
+    """The case's closing mechanism for the impact model, or None for an open net.
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case (``net.closing``, the launch speed for a delay given as travel).
+    net : multibody.net.NetTopology
+        The built net (:func:`build_net`), the loop its last 12 threads, open.
+
+    Returns
+    -------
+    ClosingSpec or None
+        Open natural lengths = the loop's threads' lengths in the launch shape (m); closed = ``closed_fraction`` of them.
+    """
+    closing = case.net.closing
+    if closing is None:
+        return None
+    rest_open = np.asarray(net.rest_lengths[-N_CLOSING:], float).copy()
+    if closing.delay_travel_m is not None:
+        delay = closing.delay_travel_m / case.launch.velocity
+    else:
+        delay = closing.delay_s or 0.0
+    return ClosingSpec(start=None if closing.start == "first_contact" else float(closing.start), delay=float(delay),
+                       duration=float(closing.duration_s), rest_open=rest_open,
+                       rest_closed=closing.closed_fraction * rest_open, axial_rigidity=float(closing.axial_rigidity))
 
 
 def build_bodies_and_joints(case: Case, base: Path):
@@ -350,7 +383,7 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
                           contact_substep=sim.contact_substep, net_integration=sim.net_integration,
                           implicit_contact_speed=sim.implicit_contact_speed),
         mean_motion=mean_motion(case.orbit.altitude) if isinstance(case.orbit, CircularOrbit) else 0.0,
-        mount=mount, chaser=chaser_index)
+        mount=mount, chaser=chaser_index, closing=closing_spec(case, net))
     return ModelInputs(assembly, rest_att, rest_com)
 
 

@@ -166,7 +166,7 @@ def run_summary(recorder, assembly, case_name: str) -> dict:
     dv = s["debris_velocity_lvlh"][-1] - s["debris_velocity_lvlh"][0]
     estimate = momentum_exchange_velocity(assembly) - s["debris_velocity_lvlh"][0]
     solver = assembly.solver
-    return {
+    summary = {
         "case": case_name,
         "simulated_time_s": float(t[-1]),
         "steps": solver.n_steps,
@@ -188,6 +188,10 @@ def run_summary(recorder, assembly, case_name: str) -> dict:
         "health": recorder.health.summary(),
         "paper_reference": PAPER_REFERENCE,
     }
+    winch = getattr(recorder.system, "closing", None)
+    if winch is not None:   # the net's closing mechanism: trigger, reel-in and the winch's work (J)
+        summary["closing"] = winch.summary()
+    return summary
 
 
 def sequential_summary(wall_recorder, wall_assembly, recorder, assembly, coupled_assembly, case_name: str) -> dict:

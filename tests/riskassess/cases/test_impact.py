@@ -214,3 +214,34 @@ def test_launch_sag_builds_the_bowl_and_keeps_the_launch_momentum(tmp_path):
     path = tmp_path / "sag.toml"
     path.write_text(REFERENCE.replace("velocity = 20.0 ", "sag = 2.0\nvelocity = 20.0 ", 1))
     assert load_case(path).launch.sag == 2.0
+
+
+CLOSING = "\n[net.closing]\nduration_s = 5.0\nclosed_fraction = 0.1\naxial_rigidity = 55000.0\n"
+
+
+@pytest.mark.parametrize("extra, expected", [
+    ("delay_s = 2.0\ndelay_travel_m = 14.0\n", "at most one of 'delay_s' (s) or 'delay_travel_m' (m)"),
+    ("start = 3.0\ndelay_s = 2.0\n", "a delay goes with start = 'first_contact'"),
+    ("start = \"on_wrap\"\n", "net.closing.start"),
+    ("closed_fraction_of = 0.1\n", "closed_fraction_of"),
+    ("duration_s_typo = 1\n", "duration_s_typo"),
+])
+def test_closing_keys_refused_with_a_clear_error(tmp_path, extra, expected):
+    message = _load_modified(tmp_path, "\n[bullets]", CLOSING + extra + "\n[bullets]")
+    assert expected in message and "bad.toml" in message
+
+
+def test_closing_refused_with_the_sequential_method(tmp_path):
+    text = REFERENCE.replace("\n[bullets]", CLOSING + "\n[bullets]", 1).replace(
+        '[simulation]\n', '[simulation]\ncoupling = "sequential"\n', 1)
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(CaseError, match="net.closing closes the net around free debris"):
+        load_case(path)
+
+
+def test_closing_case_loads_with_its_defaults(tmp_path):
+    path = tmp_path / "closing.toml"
+    path.write_text(REFERENCE.replace("\n[bullets]", CLOSING + "\n[bullets]", 1))
+    closing = load_case(path).net.closing
+    assert closing.start == "first_contact" and closing.delay_s is None and closing.damping is None
