@@ -14,7 +14,7 @@ demand the intact joint carries, not cut at a release) at a baseline and one cha
 
 - step halved (the automatic penalty stiffness follows the step: its modes sit at 0.5 / step rad/s,
   so this is also 4x stiffer joints where the stiffness is not capped; with ``--first-mode`` the joints
-  keep the structure's mode);
+  keep the structure's mode), or quartered (``step/4``, only when named in ``--variants``);
 - penalty stiffness / 4 at the same step (``multibody.hinge.PENALTY_STEP_FACTOR`` halved and both
   stiffness caps / 4, in the worker only: every automatic joint axis rings at half its frequency), or,
   with ``--first-mode``, the structure's first mode / 2;
@@ -90,10 +90,15 @@ ROOT = Path(__file__).resolve().parents[1]
 TOLERANCE = REPRODUCIBLE_TOLERANCE
 #: Relative launch-velocity offset between replicas: far below any physical uncertainty.
 REPLICA_OFFSET = TWIN_OFFSET
-VARIANTS = ("baseline", "step/2", "stiffness/4", "damping 0.1", "output 2x")
+VARIANTS = ("baseline", "step/2", "stiffness/4", "damping 0.1", "output 2x", "step/4")
 #: Automatic penalty of the shipped model, restored in each worker before a variant changes it.
 AUTOMATIC_PENALTY = (hinge.PENALTY_STEP_FACTOR, hinge.PENALTY_TRANSLATIONAL_CAP, hinge.PENALTY_ROTATIONAL_CAP)
 BOOTSTRAP_DRAWS = 2000
+#: Series kept beside the joint reactions, to trace where a peak comes from (bench/peak_sources.py): the contact force
+#: and moment on each body, the bodies' motion, the joints' relative motion and the energies.
+HISTORY_KEYS = ("contact_force_lvlh", "contact_moment_lvlh", "body_com_lvlh", "body_velocity_lvlh", "body_omega_body",
+                "body_to_lvlh", "joint_rotation_joint", "joint_rate_joint", "energy_net_kinetic", "energy_total",
+                "energy_dissipated_contact", "energy_dissipated_threads", "energy_dissipated_joints")
 
 
 def _sub(pattern: str, change, text: str) -> str:
@@ -117,8 +122,9 @@ def case_text(text: str, variant: str, replica: int, first_mode: float | None) -
             re.sub(r'^(kind = "(revolute|clamped)".*)$', lambda m: "\n".join([m.group(1)] + joint_extra), b,
                    count=1, flags=re.M)
             for b in blocks[1:]])
-    if variant == "step/2":
-        text = _sub(r"^step = ([0-9.e-]+)", lambda m: f"step = {float(m.group(1)) / 2:g}", text)
+    if variant in ("step/2", "step/4"):
+        divisor = 2 if variant == "step/2" else 4
+        text = _sub(r"^step = ([0-9.e-]+)", lambda m: f"step = {float(m.group(1)) / divisor:g}", text)
     if variant == "output 2x":
         text = _sub(r"^output_rate = ([0-9.e]+)", lambda m: f"output_rate = {2 * float(m.group(1)):g}", text)
     return _sub(r"^velocity = ([0-9.e+-]+)",
@@ -156,6 +162,20 @@ def with_load_filters(text: str, cutoff_hz: float | None, joint_specs: list[str]
     return text
 
 
+def with_rotation_modes(text: str, specs: list[str]) -> str:
+    """The case text with each ``JOINT:H1,H2,H3`` joint's rotations carrying the structure's modes (Hz; ``-`` keeps
+    an axis's automatic penalty): ``rotation_modes`` on the joint (:func:`multibody.hinge.joint_stiffness_joint_frame`),
+    damping 2 % of critical, its ``source`` naming this option (an engineering estimate, docs/structures.md)."""
+    for spec in specs:
+        joint, values = spec.split(":")
+        axes = ", ".join(f"{axis}_hz = {float(v)!r}" for axis, v in zip(("h1", "h2", "h3"), values.split(","))
+                         if v != "-")
+        modes = (f'rotation_modes = {{ {axes}, damping_ratio = 0.02, '
+                 f'source = "bench --rotation-modes {spec}: engineering estimate" }}')
+        text = _sub(rf'^name = "{re.escape(joint)}".*$', lambda m: m.group(0) + "\n" + modes, text)
+    return text
+
+
 def replica_overrides(overrides: dict, replica: int, velocity: float | None) -> dict:
     """A store sample's overrides (dotted key -> SI value) for one replica: its launch velocity (m/s; or
     ``velocity``) times 1 + replica x REPLICA_OFFSET, as :func:`case_text` offsets the case's own."""
@@ -187,8 +207,9 @@ def simulate(text: str, base_dir: str, stiffness_scale: float, out: str, overrid
             filtered = ({"force_filtered": data["joint_force_filtered_joint"],
                          "moment_filtered": data["joint_moment_filtered_joint"]}
                         if "joint_force_filtered_joint" in data else {})
+            history = {key: data[key] for key in HISTORY_KEYS if key in data}
             np.savez(out + ".tmp.npz", time=data["time"], force=data["joint_force_joint"],
-                     moment=data["joint_moment_joint"], cpu=time.process_time() - start, **filtered)
+                     moment=data["joint_moment_joint"], cpu=time.process_time() - start, **filtered, **history)
     os.replace(out + ".tmp.npz", out)
     return out
 
@@ -417,8 +438,12 @@ def main() -> None:
                              "run every step (adds the reading 'through the step filter')")
     parser.add_argument("--joint-filter", action="append", default=[], metavar="JOINT:HZ",
                         help="this joint's own load_filter_hz (overrides --load-filter for it)")
-    parser.add_argument("--variants", default=",".join(VARIANTS),
-                        help="comma list of the configurations to run (default: all); the others are reported missing")
+    parser.add_argument("--rotation-modes", action="append", default=[], metavar="JOINT:H1,H2,H3",
+                        help="give this joint's rotations the structure's modes (Hz; '-' keeps an axis's automatic "
+                             "penalty): rotation_modes on the joint, 2 %% damping")
+    parser.add_argument("--variants", default=",".join(v for v in VARIANTS if v != "step/4"),
+                        help="comma list of the configurations to run (default: all but step/4, which costs about four "
+                             "baseline runs); the others are reported missing")
     args = parser.parse_args()
     case_path = Path(args.case).resolve()
     text = case_path.read_text()
@@ -433,6 +458,7 @@ def main() -> None:
     if args.end_time:
         text = _sub(r"^end_time = [0-9.e]+", f"end_time = {args.end_time:g}", text)
     text = with_load_filters(text, args.load_filter, args.joint_filter)
+    text = with_rotation_modes(text, args.rotation_modes)
     overrides = sample_overrides(Path(args.store), args.sample) if args.store else {}
     if args.velocity is not None and not overrides:
         raise SystemExit("--velocity: with --store only (the case's own velocity is its [launch] velocity)")
@@ -454,9 +480,12 @@ def main() -> None:
     if args.report_only or chosen != set(VARIANTS):   # what the cache holds (a partial table while runs go on)
         if not args.report_only:
             with ProcessPoolExecutor(args.workers) as pool:
-                # replica by replica over the variants: a study stopped early keeps the variants' counts even
-                for key in sorted((k for k in jobs if k[0] in chosen), key=lambda k: (k[1], VARIANTS.index(k[0]))):
-                    print(f"{key} {pool.submit(simulate, *jobs[key]).result()}", flush=True)
+                # replica by replica over the variants (the pool takes them in this order): a study stopped early
+                # keeps the variants' counts even
+                order = sorted((k for k in jobs if k[0] in chosen), key=lambda k: (k[1], VARIANTS.index(k[0])))
+                futures = {pool.submit(simulate, *jobs[key]): key for key in order}
+                for future in as_completed(futures):
+                    print(f"{futures[future]} {future.result()}", flush=True)
         results = {key: job[3] if Path(job[3]).exists() else "missing: not run yet" for key, job in jobs.items()}
     else:
         with ProcessPoolExecutor(args.workers) as pool:

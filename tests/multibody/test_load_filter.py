@@ -170,3 +170,94 @@ def test_filtered_peak_converges_in_penalty_stiffness_where_the_raw_one_does_not
     # undamped amplification of a 5 ms ramp, 1 + |2 sin(w tau / 2) / (w tau)|: 1.14 at 236 Hz, 1.52 at 118 Hz
     assert abs(filtered_change) < 0.05
     assert abs(raw_change) > 0.2
+
+
+# -- a rigid appendage's torsion under a known torque: the ASAR mount of envisat_small (helper asar20) -------------------
+# envisat_small's main body and ASAR plate (cases/envisat_small.toml): masses (kg), inertias about the CoMs (kg m^2,
+# body frame = LVLH at rest), the ASAR's CoM 1.953 m and its mount 1.875 m from the main body's CoM along -y; the
+# ASAR's beam axis (the section's axis 1) is z. The mount keeps the automatic penalty, capped at 1e9 N/m and
+# 1e8 N m/rad as in the run: its modes (185-203 Hz translations, 20.5 / 126.7 / 20.6 Hz rotations) do not follow the
+# step, as docs/structures.md measures for the ASAR's judged shear.
+MAIN_MASS, MAIN_INERTIA = 6621.0, np.diag([41976.11, 40501.90, 14043.76])
+ASAR_MASS, ASAR_INERTIA = 832.0, np.diag([6935.02, 7089.33, 157.69])
+ASAR_COM_Y, ASAR_MOUNT_Y = -1.953, -1.875          # (m) from the main body's CoM
+ASAR_CUTOFF_HZ, ASAR_ORDER = 3.0, 4                # the study's load filter on the ASAR mount
+TWIST_END = 1.2                                     # (s): the 3 Hz filter's step response settles (10.8 % overshoot)
+
+
+def twisted_mount(step: float, torque_main: float, torque_asar: float):
+    """The main body and the ASAR clamped at their mount, torques about LVLH z (N m) rising over RISE on each (the
+    net's contact moment on the ASAR, a strike's on the main body); returns the run's series and the applied loads."""
+    y0 = 30.0
+    main = RigidBodySpec(name="main_body", mass=MAIN_MASS, inertia_body=MAIN_INERTIA, com_lvlh=np.array([0.0, y0, 0.0]),
+                         meshes_body=[trimesh.creation.box(extents=[3.375, 3.75, 7.875])])
+    asar = RigidBodySpec(name="asar", mass=ASAR_MASS, inertia_body=ASAR_INERTIA,
+                         com_lvlh=np.array([0.0, y0 + ASAR_COM_Y, 0.0]),
+                         meshes_body=[trimesh.creation.box(extents=[1.5, 0.156, 10.0])])
+    point = np.array([0.0, y0 + ASAR_MOUNT_Y, 0.0])
+    joint = JointSpec(name="asar_mount", kind="clamped", parent=0, child=1, point_lvlh=point,
+                      hinge_to_lvlh=hinge_frame_lvlh(np.array([0.0, 0.0, 1.0]), point, asar.com_lvlh),
+                      load_filter_hz=ASAR_CUTOFF_HZ, load_filter_order=ASAR_ORDER)
+    time = np.arange(1, int(round(TWIST_END * RATE)) + 1) / RATE
+    moment_body = np.zeros((time.size, 2, 3))
+    ramp = np.minimum(time / RISE, 1.0)                 # held over each output interval
+    moment_body[:, 0, 2], moment_body[:, 1, 2] = torque_main * ramp, torque_asar * ramp
+    loads = RecordedBodyLoads(time=time, force_lvlh=np.zeros_like(moment_body), moment_body=moment_body,
+                              reference_energy=10.0)
+    assembly = ImpactAssembly(net=single_node([0.0, 0.0, 0.0], [0.0, 0.0, 0.0]), net_velocity=np.zeros((1, 3)),
+                              bodies=[main, asar], joints=[joint], contact=ContactLaw(stiffness=1e8),
+                              solver=SolverSpec(end_time=TWIST_END, step=step, output_rate=RATE), body_loads=loads)
+    series = ImpactSimulation(assembly).run().series
+    return series, loads, joint.hinge_to_lvlh
+
+
+def rigid_mount_loads(torque_main: float, torque_asar: float) -> tuple[float, float]:
+    """The ideal (rigid) mount's torsion about z (N m, about the mount point) and force along x (N) on the ASAR under
+    steady torques about z (a couple on a free pair: its CoM stays, it spins up at alpha = T / I_zz about the pair's
+    CoM; small angles): Newton-Euler on the ASAR,
+
+        F_j = m_a a_C = -m_a alpha d_a x,    M_j,z = I_a,zz alpha - T_asar + [(C - P) x F_j]_z
+
+    with d_a the ASAR's CoM from the pair's CoM along y and C - P = (ASAR_COM_Y - ASAR_MOUNT_Y) y."""
+    total = MAIN_MASS + ASAR_MASS
+    d_main, d_asar = -ASAR_MASS * ASAR_COM_Y / total, MAIN_MASS * ASAR_COM_Y / total      # along y, from the pair's CoM
+    inertia_zz = MAIN_INERTIA[2, 2] + ASAR_INERTIA[2, 2] + MAIN_MASS * d_main**2 + ASAR_MASS * d_asar**2
+    alpha = (torque_main + torque_asar) / inertia_zz
+    force_x = -ASAR_MASS * alpha * d_asar
+    lever_y = ASAR_COM_Y - ASAR_MOUNT_Y
+    return ASAR_INERTIA[2, 2] * alpha - torque_asar - lever_y * force_x, force_x     # [(C - P) x F]_z = -lever_y F_x
+
+
+def held_ramp_filtered(times, step: float) -> np.ndarray:
+    """The torques' unit ramp, held over each output interval, through the mount's load filter at ``step``, at
+    ``times`` (the ideal mount's loads are this times their plateau)."""
+    steps = np.arange(1, int(round(times[-1] / step)) + 1) * step
+    held = np.minimum(np.ceil(steps * RATE - 1e-6) / RATE / RISE, 1.0)      # the output interval holding each step
+    out = filter_signal(butterworth_sections(ASAR_CUTOFF_HZ, step, ASAR_ORDER), np.concatenate([[0.0], held]))
+    return np.interp(times, np.concatenate([[0.0], steps]), out)
+
+
+@pytest.mark.parametrize("torque_main, torque_asar", [(1000.0, 0.0), (0.0, 10.0)], ids=["strike on the main body",
+                                                                                        "contact on the asar"])
+def test_asar_mount_torsion_is_the_rigid_appendages_independent_of_the_step(torque_main, torque_asar):
+    """The ASAR mount's filtered torsion and transverse force under a known torque equal the rigid appendage's
+    (Newton-Euler, :func:`rigid_mount_loads`) through the same filter, at the run's step and at a quarter of it:
+    the joint model and the load extraction do not make the judged ASAR shear follow the step."""
+    torsion_plateau, force_plateau = rigid_mount_loads(torque_main, torque_asar)
+    peaks = {}
+    for step in (1e-4, 2.5e-5):
+        series, _, hinge_to_lvlh = twisted_mount(step, torque_main, torque_asar)
+        t = series["time"]
+        torsion = series["joint_moment_filtered_joint"][:, 0] @ (hinge_to_lvlh.T @ [0.0, 0.0, 1.0])
+        force_x = series["joint_force_filtered_joint"][:, 0] @ (hinge_to_lvlh.T @ [1.0, 0.0, 0.0])
+        ideal = held_ramp_filtered(t, step)
+        # 2e-3 of the plateau: the mount's rotation modes (20.5 Hz and up), excited by the 5 ms rise about as much as
+        # the load itself, pass the 4th-order 3 Hz filter with (3 / 20.5)^4 = 4.6e-4 of their ringing; the spin-up's
+        # centripetal and gyroscopic terms are (alpha t)^2 = 5e-7 of the load at 1.2 s (measured: 1.4e-4 and 2.7e-4
+        # at every step, 2026-11-27)
+        np.testing.assert_allclose(torsion, torsion_plateau * ideal, rtol=0, atol=2e-3 * abs(torsion_plateau))
+        np.testing.assert_allclose(force_x, force_plateau * ideal, rtol=0, atol=2e-3 * abs(force_plateau))
+        peaks[step] = np.abs(torsion).max()
+    # the filtered peak (10.8 % over the plateau: the 4th-order filter's overshoot) does not follow the step: within
+    # the tolerance above, far inside Deliver 1's 5 % (measured: the same to 7 digits at 1e-4, 5e-5 and 2.5e-5 s)
+    assert peaks[2.5e-5] == pytest.approx(peaks[1e-4], rel=2e-3)
