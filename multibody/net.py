@@ -253,6 +253,50 @@ def flat_square_net(center, direction, side_length, nodes_per_side, node_mass, n
     )
 
 
+def net_kinetic_energy_relative_to_body(masses, positions, velocities, body_com, body_velocity, omega):
+    """Kinetic energy of the net's motion relative to a rigid body (J): each node's velocity less the body's
+    velocity field at the node's position, what the net carries beyond moving rigidly with the body.
+
+    .. math::
+
+        T_{rel} = \\tfrac12 \\sum_i m_i \\, \\lVert v_i - v_c - \\omega \\times (x_i - x_c) \\rVert^2
+
+    A net (or a part of it) that moves rigidly with the body contributes nothing, whatever the body's spin: a net
+    wrapped on a spinning stage and turning with it carries kinetic energy about its own CoM that is no flapping
+    (the towing model's switch, :mod:`multibody.tow_switch`), and a net settled on the debris ends the capture
+    (:mod:`structures.capture_window`).
+
+    Parameters
+    ----------
+    masses : (n,) float
+        Node masses (kg).
+    positions : (k, n, 3) or (n, 3) float
+        Node positions (m) at k instants, in one frame (LVLH in the impact model, ECI in the towing model).
+    velocities : (k, n, 3) or (n, 3) float
+        Node velocities (m/s) relative to that frame's axes.
+    body_com, body_velocity : (k, 3) or (3,) float
+        The body's centre of mass (m) and its velocity (m/s), same frame.
+    omega : (k, 3) or (3,) float
+        The body's angular velocity relative to that frame's axes (rad/s), expressed in it.
+
+    Returns
+    -------
+    (k,) float or float
+        The energy at each instant (J).
+    """
+    x = np.asarray(positions, float)
+    single = x.ndim == 2
+    x = x[None] if single else x
+    v = np.asarray(velocities, float).reshape(x.shape)
+    c, vc, w = (np.asarray(a, float).reshape(-1, 1, 3) for a in (body_com, body_velocity, omega))
+    m = np.asarray(masses, float)
+    if m.shape != (x.shape[1],):
+        raise ValueError(f"masses must have shape ({x.shape[1]},) like the nodes. Got {m.shape} instead")
+    relative = v - vc - np.cross(w, x - c)
+    energy = 0.5 * np.einsum("n,kni,kni->k", m, relative, relative)
+    return float(energy[0]) if single else energy
+
+
 @njit(cache=True, inline="always")
 def tension_only_kelvin_voigt(stretch, rate, stiffness, damping):
     """Tension (N) of a thread or tether that pulls only: a Kelvin-Voigt spring-damper while

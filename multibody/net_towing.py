@@ -38,8 +38,8 @@ from multibody.towing import HEALTH_EVERY_STEPS, TowedBodies, tow_failure_cause
 from multibody.net_towing_kernel import D_LATERAL, D_SLIDING, D_THRUST, D_TORQUE
 from multibody.orbit import add_body_gravity
 from multibody.health import SimulationFailed
-from multibody.tow_switch import (QuasiSteadyWatch, SwitchCriterion, net_internal_kinetic_energy,
-                                  net_kinetic_energy_relative_to_body)
+from multibody.net import net_kinetic_energy_relative_to_body
+from multibody.tow_switch import QuasiSteadyWatch, SwitchCriterion, net_internal_kinetic_energy
 
 #: Layout of the run state ``clock``: net time (s), external impulse (3, N s) since the start.
 CLOCK_TIME, CLOCK_IMPULSE, CLOCK_SIZE = 0, 1, 4

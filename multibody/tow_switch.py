@@ -7,7 +7,7 @@ sample t at which, over the whole window [t - window, t], all after ``earliest``
 
 * the main tether stayed taut (tension > 0 at every sample), and
 * the tension and the net's kinetic energy relative to the debris' rigid motion
-  (:func:`net_kinetic_energy_relative_to_body`), each averaged over consecutive blocks of ``averaging``
+  (:func:`multibody.net.net_kinetic_energy_relative_to_body`), each averaged over consecutive blocks of ``averaging``
   seconds ending at t (as many whole blocks as the window holds; ``averaging`` = 0: every sample is a
   block), are stationary: the block means of the tension vary peak-to-peak by at most ``tension_rel_tol``
   of their mean (:func:`multibody.quasi_steady.window_is_steady`, the project's quasi-steady rule), and
@@ -60,38 +60,6 @@ def net_internal_kinetic_energy(masses, velocities) -> float:
     v = np.asarray(velocities, float)
     v_com = m @ v / m.sum()
     return float(0.5 * np.sum(m * np.sum((v - v_com) ** 2, axis=1)))
-
-
-def net_kinetic_energy_relative_to_body(masses, positions, velocities, body_com, body_velocity,
-                                        omega_inertial) -> float:
-    """Kinetic energy of the net's nodes relative to a rigid body's motion (J): what the net carries beyond
-    moving rigidly with the debris.
-
-    A net wrapped on a spinning stage and turning with it carries kinetic energy about its own CoM
-    (:func:`net_internal_kinetic_energy`; at 17.5 deg/s some 2 J for the 15 x 15 net) that is no flapping at
-    all: the lower-order model lumps that net into the debris. Measured against the body's velocity field
-    v_B + omega x (x_i - r_B), a net riding rigidly on the body carries none.
-
-    Parameters
-    ----------
-    masses : (n,) float
-        Node masses (kg).
-    positions, velocities : (n, 3) float
-        Node positions (m) and velocities (m/s), inertial.
-    body_com, body_velocity : (3,) float
-        The body's CoM (m) and its velocity (m/s), inertial.
-    omega_inertial : (3,) float
-        The body's angular velocity in the inertial frame (rad/s).
-
-    Returns
-    -------
-    float
-        sum_i m_i |v_i - v_B - omega x (x_i - r_B)|^2 / 2 (J).
-    """
-    m = np.asarray(masses, float)
-    arm = np.asarray(positions, float) - np.asarray(body_com, float)
-    relative = np.asarray(velocities, float) - np.asarray(body_velocity, float) - np.cross(omega_inertial, arm)
-    return float(0.5 * np.sum(m * np.sum(relative ** 2, axis=1)))
 
 
 @dataclass(frozen=True)

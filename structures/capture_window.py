@@ -6,7 +6,8 @@ around the debris, and a later pass can load a joint more than an earlier one wi
 the net has stopped moving relative to the debris and no judged demand is still rising:
 
 - the net's kinetic energy relative to the debris' reference body, with the part that moves rigidly with that
-  body removed (:func:`net_energy_relative_to_body`), has stayed below a threshold for a hold time, and
+  body removed (:func:`multibody.net.net_kinetic_energy_relative_to_body`), has stayed below a threshold for a
+  hold time, and
 - no judged location's running peak has risen over that hold time (:func:`settle_time`).
 
 :class:`CaptureMonitor` applies the same rule while a run goes on (the recorder calls it at every output sample
@@ -21,6 +22,8 @@ body frame; :func:`omega_lvlh` rotates it).
 from __future__ import annotations
 
 import numpy as np
+
+from multibody.net import net_kinetic_energy_relative_to_body
 
 from structures.indeterminacy import Indeterminacy
 from structures.weak_location import WeakLocation, demands, joint_loads, judged_demands, online_modal_loads
@@ -74,50 +77,6 @@ def omega_lvlh(body_to_lvlh, omega_body):
     return np.einsum("...ij,...j->...i", np.asarray(body_to_lvlh, float), np.asarray(omega_body, float))
 
 
-def net_energy_relative_to_body(masses, positions_lvlh, velocities_lvlh, com_lvlh, velocity_lvlh,
-                                omega_body_lvlh):
-    """Kinetic energy of the net's motion relative to a rigid body (J): each node's velocity less the body's
-    velocity field at the node's position.
-
-    .. math::
-
-        T_{rel} = \\tfrac12 \\sum_i m_i \\, \\lVert v_i - v_c - \\omega \\times (x_i - x_c) \\rVert^2
-
-    A net (or a part of it) that moves rigidly with the body contributes nothing, whatever the body's spin.
-
-    Parameters
-    ----------
-    masses : (n,) float
-        Node masses (kg).
-    positions_lvlh : (k, n, 3) or (n, 3) float
-        Node positions (m), LVLH, at k instants.
-    velocities_lvlh : (k, n, 3) or (n, 3) float
-        Node velocities (m/s), LVLH.
-    com_lvlh : (k, 3) or (3,) float
-        The body's centre of mass (m), LVLH.
-    velocity_lvlh : (k, 3) or (3,) float
-        The body's centre-of-mass velocity (m/s), LVLH.
-    omega_body_lvlh : (k, 3) or (3,) float
-        The body's angular velocity relative to the LVLH axes (rad/s), expressed in LVLH.
-
-    Returns
-    -------
-    (k,) float or float
-        The energy at each instant (J).
-    """
-    x = np.asarray(positions_lvlh, float)
-    single = x.ndim == 2
-    x = x[None] if single else x
-    v = np.asarray(velocities_lvlh, float).reshape(x.shape)
-    c, vc, w = (np.asarray(a, float).reshape(-1, 1, 3) for a in (com_lvlh, velocity_lvlh, omega_body_lvlh))
-    m = np.asarray(masses, float)
-    if m.shape != (x.shape[1],):
-        raise ValueError(f"masses must have shape ({x.shape[1]},) like the nodes. Got {m.shape} instead")
-    relative = v - vc - np.cross(w, x - c)
-    energy = 0.5 * np.einsum("n,kni,kni->k", m, relative, relative)
-    return float(energy[0]) if single else energy
-
-
 def rise_times(time, demands_judged, judged_from_s: float = 0.0):
     """Times at which a judged running peak rose: a sample after ``judged_from_s`` whose demand exceeds every
     earlier judged sample of the same demand (the first judged sample counts as a rise).
@@ -157,8 +116,9 @@ def settle_time(energy_time, energy_J, rise_time, energy_threshold_J: float, hol
     energy_time : (k,) float
         Times of the relative-energy values (s), increasing: the check instants.
     energy_J : (k,) float
-        The net's kinetic energy relative to the debris (J, :func:`net_energy_relative_to_body`); a value that is
-        not finite counts as above the threshold.
+        The net's kinetic energy relative to the debris (J,
+        :func:`multibody.net.net_kinetic_energy_relative_to_body`); a value that is not finite counts as above the
+        threshold.
     rise_time : (r,) float
         Times at which a judged running peak rose (s, :func:`rise_times`).
     energy_threshold_J : float
@@ -233,9 +193,9 @@ def relative_energy_history(net: dict, masses, series: dict, body: int):
     if t_net.size and np.max(np.abs(t[rows] - t_net)) > 1e-9 * max(1.0, t[-1]):
         raise ValueError("net snapshots must be taken at series samples (the recorder takes them so)")
     omega = omega_lvlh(series["body_to_lvlh"][rows, body], series["body_omega_body"][rows, body])
-    energy = net_energy_relative_to_body(masses, net["positions_lvlh"], net["velocities_lvlh"],
-                                         series["body_com_lvlh"][rows, body], series["body_velocity_lvlh"][rows, body],
-                                         omega)
+    energy = net_kinetic_energy_relative_to_body(masses, net["positions_lvlh"], net["velocities_lvlh"],
+                                                 series["body_com_lvlh"][rows, body],
+                                                 series["body_velocity_lvlh"][rows, body], omega)
     return t_net, np.atleast_1d(energy)
 
 
@@ -426,8 +386,8 @@ class CaptureMonitor:
         """One net snapshot (the nodes' positions (m) and velocities (m/s), LVLH; every body's com (m), velocity
         (m/s), attitude and body-frame angular velocity (rad/s)); True once the capture is over."""
         b = self.body
-        energy = net_energy_relative_to_body(self.masses, positions_lvlh, velocities_lvlh, com_lvlh[b],
-                                             velocity_lvlh[b], omega_lvlh(body_to_lvlh[b], omega_body[b]))
+        energy = net_kinetic_energy_relative_to_body(self.masses, positions_lvlh, velocities_lvlh, com_lvlh[b],
+                                                     velocity_lvlh[b], omega_lvlh(body_to_lvlh[b], omega_body[b]))
         if self.energy_threshold_J is None:          # the first snapshot: the launch's relative energy
             self.energy_threshold_J = energy_threshold(energy, self.energy_fraction)
         self.energy_time.append(float(t))

@@ -11,8 +11,9 @@ from scipy.spatial.transform import Rotation
 
 from riskassess.cases.impact import CaseError, load_case
 from riskassess.stages.run import run_case
+from multibody.net import net_kinetic_energy_relative_to_body
 from structures.capture_window import (CAPTURE_ENERGY_FRACTION, CAPTURE_HOLD_TRAVEL_M, capture_gap, energy_threshold,
-                                       hold_time, net_energy_relative_to_body, omega_lvlh, rise_times, settle_time)
+                                       hold_time, omega_lvlh, rise_times, settle_time)
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 SNAPSHOT_S = 0.02   # s, the shipped cases' net snapshots (50 Hz): the settle test's time resolution
@@ -32,7 +33,7 @@ def test_a_net_moving_rigidly_with_a_spinning_body_has_no_relative_energy(seed):
     rng = np.random.default_rng(seed)
     masses, x, c, vc, w = _net_and_body(rng)
     v = vc + np.cross(w, x - c)             # every node on the body's velocity field
-    energy = net_energy_relative_to_body(masses, x, v, c, vc, w)
+    energy = net_kinetic_energy_relative_to_body(masses, x, v, c, vc, w)
     absolute = 0.5 * np.sum(masses * np.sum(v ** 2, axis=1))
     # round-off of the subtraction: a few ulp of the nodes' own kinetic energy
     assert abs(energy) <= 1e-13 * absolute
@@ -45,10 +46,10 @@ def test_a_known_relative_motion_has_half_m_v_squared(seed):
     u = rng.normal(0.0, 1.0, 3)             # the same drift of every node past the spinning body
     v = vc + np.cross(w, x - c) + u
     expected = 0.5 * masses.sum() * u @ u   # 1/2 m v^2 of the drift alone
-    assert net_energy_relative_to_body(masses, x, v, c, vc, w) == pytest.approx(expected, rel=1e-12)
+    assert net_kinetic_energy_relative_to_body(masses, x, v, c, vc, w) == pytest.approx(expected, rel=1e-12)
     # over several instants at once (k, n, 3), the same per instant
-    energies = net_energy_relative_to_body(masses, np.stack([x, x]), np.stack([v, vc + np.cross(w, x - c)]),
-                                           np.stack([c, c]), np.stack([vc, vc]), np.stack([w, w]))
+    energies = net_kinetic_energy_relative_to_body(masses, np.stack([x, x]), np.stack([v, vc + np.cross(w, x - c)]),
+                                                   np.stack([c, c]), np.stack([vc, vc]), np.stack([w, w]))
     np.testing.assert_allclose(energies, [expected, 0.0], rtol=1e-12, atol=1e-12 * expected)
 
 
@@ -61,8 +62,8 @@ def test_the_body_rate_is_rotated_into_lvlh():
 
 def test_mismatched_masses_are_refused():
     with pytest.raises(ValueError, match=r"masses must have shape \(3,\)"):
-        net_energy_relative_to_body(np.ones(2), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3), np.zeros(3),
-                                    np.zeros(3))
+        net_kinetic_energy_relative_to_body(np.ones(2), np.zeros((3, 3)), np.zeros((3, 3)), np.zeros(3),
+                                            np.zeros(3), np.zeros(3))
 
 
 def test_a_running_peak_rises_only_above_every_earlier_judged_value():

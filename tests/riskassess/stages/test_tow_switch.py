@@ -6,8 +6,8 @@ import pytest
 
 from multibody.net_towing import run_exudyn
 from multibody.towing import run_exudyn as run_lower_order
-from multibody.tow_switch import (SwitchCriterion, net_internal_kinetic_energy, net_kinetic_energy_relative_to_body,
-                                  switch_time)
+from multibody.net import net_kinetic_energy_relative_to_body
+from multibody.tow_switch import SwitchCriterion, net_internal_kinetic_energy, switch_time
 from riskassess.cases.impact import load_model
 from riskassess.cases.inputs import CaseError
 from riskassess.cases.towing import TowingCase
