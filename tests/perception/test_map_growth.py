@@ -9,11 +9,9 @@ import perception.map_growth as map_growth
 import perception.registration as registration
 import perception.scan_to_map as scan_to_map
 from multibody.geometry import shape_mesh
-from perception.lidar import cast, sensor_to_platform
 from perception.registration import Alignment, DebrisTracker, known_shape_model
+from tests.perception.conftest import SENSOR, scan_of_body
 
-SENSOR = np.zeros(3)
-UP = np.array([0.0, 0.0, 1.0])
 POSITION = np.array([4.0, 0.0, 0.3])   # m, world: the bus at 4 m, as in test_reacquisition.py
 HALF_X = 0.6                            # m: the bus' half length along x (1.2 x 1.0 x 1.6 m box)
 
@@ -35,12 +33,7 @@ def _one_sided_map(bus):
 def _scan(bus, lidar, rotation, seed):
     """Returns (m, world) of the bus (body -> world ``rotation``, centre at POSITION), the sensor attitude
     and the true world -> B."""
-    sensor_to_world = sensor_to_platform(POSITION - SENSOR, UP)
-    vertices = np.asarray(bus.vertices) @ rotation.T + POSITION
-    scan = cast(lidar, [((vertices - SENSOR) @ sensor_to_world, bus.faces)], 0.0, np.random.default_rng(seed))
-    truth = np.eye(4)
-    truth[:3, :3], truth[:3, 3] = rotation.T, -rotation.T @ POSITION
-    return scan.points_sensor @ sensor_to_world.T + SENSOR, sensor_to_world, truth
+    return scan_of_body(bus, lidar, rotation, POSITION, seed)
 
 
 def _rotation(t):

@@ -8,12 +8,10 @@ from scipy.spatial.transform import Rotation
 import perception.registration as registration
 import perception.pose_motion as pose_motion
 from multibody.geometry import shape_mesh
-from perception.lidar import cast, sensor_to_platform
 from perception.registration import MAX_UNSEEN, Alignment, DebrisTracker, _cloud, known_shape_model
 from perception.shape import half_turn_symmetry_transforms, rotation_error
+from tests.perception.conftest import SENSOR, scan_of_body
 
-SENSOR = np.zeros(3)
-UP = np.array([0.0, 0.0, 1.0])
 BUS_CENTRE = np.zeros(3)
 
 
@@ -23,17 +21,6 @@ def featured_body():
     1.6 m bus and a 2 x 0.8 m array on its +y side."""
     return trimesh.util.concatenate([shape_mesh("box", size=[1.2, 1.0, 1.6]),
                                      shape_mesh("box", size=[0.05, 2.0, 0.8], center=(0.0, 1.5, 0.2))])
-
-
-def _scene(mesh, lidar, rotation, position, seed=0):
-    """Scan of the body (body -> world ``rotation``, origin at ``position``, m) from the sensor at the
-    origin, boresight on the body: returns (m, world), the sensor attitude and the true world -> B."""
-    sensor_to_world = sensor_to_platform(position - SENSOR, UP)
-    vertices = np.asarray(mesh.vertices) @ rotation.T + position
-    scan = cast(lidar, [((vertices - SENSOR) @ sensor_to_world, mesh.faces)], 0.0, np.random.default_rng(seed))
-    truth = np.eye(4)
-    truth[:3, :3], truth[:3, 3] = rotation.T, -rotation.T @ position
-    return scan.points_sensor @ sensor_to_world.T + SENSOR, sensor_to_world, truth
 
 
 def _tracker(mesh, lidar, **options):
@@ -60,7 +47,7 @@ def test_half_turns_of_the_bus_are_rejected_by_the_unseen_model(featured_body, c
     # array on its side, shifted 0.4 m: it passes the surface checks (tight fitness 0.89, free-space
     # violation 0.042) and only the unseen model rejects it; the other two also fail on the fit (0.65).
     rotation = Rotation.from_rotvec([0.3, -0.2, 0.9]).as_matrix()
-    points, sensor_to_world, truth = _scene(featured_body, c_fans_lidar, rotation, np.array([4.0, 0.0, 0.3]))
+    points, sensor_to_world, truth = scan_of_body(featured_body, c_fans_lidar, rotation, np.array([4.0, 0.0, 0.3]))
     tracker = _tracker(featured_body, c_fans_lidar)
     right = _judged(tracker, points, sensor_to_world, truth)
     assert right.ok and right.unseen < MAX_UNSEEN / 4
@@ -88,7 +75,7 @@ def _turning_frames(mesh, lidar, position, times):
     constant-rate prediction follows exactly) and its true body -> world rotations."""
     rotations = [Rotation.from_rotvec(np.array([0.7, 0.2, -0.6]) * t).as_matrix()
                  @ Rotation.from_rotvec([0.4, 1.1, -0.3]).as_matrix() for t in times]
-    return [(_scene(mesh, lidar, rotation, position, seed=k), rotation) for k, rotation in enumerate(rotations)]
+    return [(scan_of_body(mesh, lidar, rotation, position, seed=k), rotation) for k, rotation in enumerate(rotations)]
 
 
 @pytest.mark.parametrize("told", [True, False])
@@ -152,7 +139,7 @@ def test_the_branch_nearer_the_propagated_attitude_is_kept_when_its_half_turn_fi
     # the bound's margin is 90 deg): the kept pose is within 3 deg of the truth (one searched frame of
     # the mesh at 4 m is good to ~1 deg), the half turn is dropped.
     rotation = Rotation.from_rotvec([0.3, -0.2, 0.9]).as_matrix()
-    points, sensor_to_world, truth = _scene(featured_body, c_fans_lidar, rotation, np.array([4.0, 0.0, 0.3]))
+    points, sensor_to_world, truth = scan_of_body(featured_body, c_fans_lidar, rotation, np.array([4.0, 0.0, 0.3]))
     tracker = _tracker(featured_body, c_fans_lidar, continuity_turn=np.radians(90.0))
     tracker.field_of_view = None
     half = np.eye(4)
