@@ -15,14 +15,18 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
-import trimesh
 
-from multibody.assembly import ContactLaw, ImpactAssembly, RigidBodySpec, SolverSpec
+from multibody.assembly import ContactLaw, ImpactAssembly, SolverSpec
 from multibody.impact import ImpactSimulation
 from multibody.net import NetTopology
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # the sibling bench script, also when imported
+from bench_thread_strike_energy import fixed_plate  # noqa: E402
 
 #: The seed paper's contact stiffness (N/m^1.5) [paper T2]; the reference net's node mass (kg) and thread (N/m).
 CONTACT_STIFFNESS, NODE_MASS, THREAD_STIFFNESS = 1.622e8, 0.00776, 62308.25
@@ -39,13 +43,8 @@ def pressed_node(depth: float, step: float, implicit_speed: float = 0.15, end_ti
                       stiffness=np.array([THREAD_STIFFNESS]), damping=np.array([1.58]),
                       bending_triples=np.zeros((0, 3), np.int64), bending_stiffness=np.zeros(0), nodes_per_side=0,
                       n_bullets=0)
-    extents, mass = np.array([0.4, 0.05, 0.4]), 1e12
-    inertia = mass / 12.0 * np.diag([extents[1] ** 2 + extents[2] ** 2, extents[0] ** 2 + extents[2] ** 2,
-                                     extents[0] ** 2 + extents[1] ** 2])
-    plate = RigidBodySpec(name="plate", mass=mass, inertia_body=inertia, com_lvlh=np.zeros(3),
-                          meshes_body=[trimesh.creation.box(extents=extents)])
     assembly = ImpactAssembly(
-        net=net, net_velocity=np.zeros((2, 3)), bodies=[plate], joints=[],
+        net=net, net_velocity=np.zeros((2, 3)), bodies=[fixed_plate()], joints=[],
         contact=ContactLaw(stiffness=CONTACT_STIFFNESS, hunt_crossley_alpha=0.0, mu_static=0.0, mu_kinetic=0.0),
         solver=SolverSpec(end_time=end_time, step=step, output_rate=1000.0, net_output_rate=100.0,
                           implicit_contact_speed=implicit_speed))

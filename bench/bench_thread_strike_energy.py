@@ -32,6 +32,16 @@ SETUPS = {"flat, s = 0.5": (-0.5, 0.5), "flat, s = 0.625": (-0.5, 0.3), "edge, 0
           "edge, 0.85 m beyond": (-0.15, 1.0)}
 
 
+def fixed_plate() -> RigidBodySpec:
+    """A 0.4 x 0.05 x 0.4 m plate of 1e12 kg centred at the LVLH origin (its face at y = -0.025 m): it does not move
+    under a thread's strike."""
+    extents, mass = np.array([0.4, 0.05, 0.4]), 1e12
+    inertia = mass / 12.0 * np.diag([extents[1] ** 2 + extents[2] ** 2, extents[0] ** 2 + extents[2] ** 2,
+                                     extents[0] ** 2 + extents[1] ** 2])
+    return RigidBodySpec(name="plate", mass=mass, inertia_body=inertia, com_lvlh=np.zeros(3),
+                         meshes_body=[trimesh.creation.box(extents=extents)])
+
+
 def strike(x_a: float, x_b: float, speed: float, step: float, thread_segments: bool, end_time: float = 4e-3):
     """The recorded series of one thread (nodes at x_a, x_b, m) falling flat at ``speed`` (m/s) onto the plate,
     its surface 2.5 steps of flight from the face at the start, and the thread contact's buffers
@@ -43,13 +53,8 @@ def strike(x_a: float, x_b: float, speed: float, step: float, thread_segments: b
                       stiffness=np.array([62308.25]), damping=np.array([1.58]),
                       bending_triples=np.zeros((0, 3), np.int64), bending_stiffness=np.zeros(0), nodes_per_side=0,
                       n_bullets=0)
-    extents, mass = np.array([0.4, 0.05, 0.4]), 1e12
-    inertia = mass / 12.0 * np.diag([extents[1] ** 2 + extents[2] ** 2, extents[0] ** 2 + extents[2] ** 2,
-                                     extents[0] ** 2 + extents[1] ** 2])
-    plate = RigidBodySpec(name="plate", mass=mass, inertia_body=inertia, com_lvlh=np.zeros(3),
-                          meshes_body=[trimesh.creation.box(extents=extents)])
     assembly = ImpactAssembly(
-        net=net, net_velocity=np.array([[0.0, speed, 0.0]] * 2), bodies=[plate], joints=[],
+        net=net, net_velocity=np.array([[0.0, speed, 0.0]] * 2), bodies=[fixed_plate()], joints=[],
         contact=ContactLaw(stiffness=STIFFNESS, hunt_crossley_alpha=0.05, mu_static=0.19, mu_kinetic=0.152,
                            thread_segments=thread_segments),
         solver=SolverSpec(end_time=end_time, step=step, output_rate=1.0 / step, net_output_rate=1000.0,

@@ -26,7 +26,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 import perception_substitution as substitution  # noqa: E402
-from perception_net_unseen import seen_nodes  # noqa: E402
+from perception_net_unseen import _vec, seen_nodes  # noqa: E402
 from perception.net_tracking import NetPrior, nearest_segments, node_velocities  # noqa: E402
 
 #: A return this close to a true thread (m) is taken as that thread's (the threads' radius is 2 mm, the
@@ -114,10 +114,6 @@ def association(cap) -> dict:
     return {"right_thread": np.nanmean(right), "right_thread_range": (np.nanmin(right), np.nanmax(right)),
             "seen_position_rms": np.mean(position_rms), "seen_normal_rms": np.mean(normal_rms),
             "L_seen_velocity_in_plane": np.mean(in_plane, axis=0), "L_seen_velocity_normal": np.mean(along_normal, axis=0)}
-
-
-def _vec(v) -> str:
-    return "(" + ", ".join(f"{x:+.2f}" for x in v) + ")"
 
 
 def main(argv=None):
