@@ -26,6 +26,7 @@ from multibody.net import NetTopology, flat_square_net
 from multibody.net_towing_kernel import (ACC_SIZE, CYL_HALF, CYL_RADIUS, CYL_Z, DebrisBody, DebrisMotion, NetThreads,
                                          TetherEnd, cylinder_distance, net_forces)
 
+
 @dataclass(frozen=True)
 class TowingNet:
     """Net topology with its closing loop (SI; positions in the frame they were built in).

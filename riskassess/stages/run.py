@@ -142,23 +142,28 @@ def capture_monitor(case: Case, locations, assembly) -> CaptureMonitor | None:
     if not locations or case.structures.window != "capture":
         return None
     s = case.structures
-    body = reference_body(assembly.bodies, assembly.joints, assembly.debris_indices)
-    return CaptureMonitor(locations, assembly.net.masses, body, s.skip_initial, s.capture_energy_J,
-                          hold_time(s.capture_hold_s, case.launch.velocity), interval_s=1.0 / case.simulation.output_rate,
-                          energy_fraction=s.capture_energy_fraction)
+    body, hold_s = _capture_body_and_hold(case, assembly)
+    return CaptureMonitor(locations, assembly.net.masses, body, s.skip_initial, s.capture_energy_J, hold_s,
+                          interval_s=1.0 / case.simulation.output_rate, energy_fraction=s.capture_energy_fraction)
 
 
 def recorded_capture_window(case: Case, locations, assembly, recorder) -> dict:
     """Whether and when the recorded run's capture was over (:func:`structures.capture_window.capture_window`),
     read from its series and net snapshots."""
     s = case.structures
-    body = reference_body(assembly.bodies, assembly.joints, assembly.debris_indices)
+    body, hold_s = _capture_body_and_hold(case, assembly)
     window = capture_window(locations, recorder.series, recorder.net, assembly.net.masses, body,
-                            assembly.bodies[body].name, s.skip_initial, s.capture_energy_J,
-                            hold_time(s.capture_hold_s, case.launch.velocity), s.capture_energy_fraction)
+                            assembly.bodies[body].name, s.skip_initial, s.capture_energy_J, hold_s,
+                            s.capture_energy_fraction)
     window["end_time_cap_s"] = case.simulation.end_time
     window["stopped_early"] = bool(recorder.stopped_early)
     return window
+
+
+def _capture_body_and_hold(case: Case, assembly) -> tuple[int, float]:
+    """The capture's reference body (index) and hold (s): the same for the online test and the recorded one."""
+    body = reference_body(assembly.bodies, assembly.joints, assembly.debris_indices)
+    return body, hold_time(case.structures.capture_hold_s, case.launch.velocity)
 
 
 def _with_twin(verdict: dict, locations, series: dict, case: Case, case_path: Path) -> dict:
