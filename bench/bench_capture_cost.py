@@ -77,7 +77,8 @@ def segment_census(kernel) -> dict:
         for s in np.flatnonzero(shapes.is_box):
             counts["tested"] += 1
             reach = 1.001 * (min(radius[a], radius[c]) + motion + step * seg.shape_work[1, s])
-            if 0.5 * (seg.centre_distance[s, a] + seg.centre_distance[s, c] - length) > seg.shape_work[0, s] + reach:
+            centre_distance = np.linalg.norm(x[:, [a, c]] - seg.shape_work[2:5, [s]], axis=0)
+            if 0.5 * (centre_distance.sum() - length) > seg.shape_work[0, s] + reach:
                 continue
             counts["sphere"] += 1
             b = shapes.body[s]
@@ -97,6 +98,9 @@ def segment_census(kernel) -> dict:
             counts["separated"] += int(segment_box_separation(pa, tuple(np.subtract(pc, pa)), lo, hi)
                                        > min(radius[a], radius[c]) + TIE_DISTANCE)
     counts["pairs"] = int(seg.node_threads.sum() // 2)
+    # the candidate pairs kept with a skin (multibody.segment_candidates; absent before helper speed21) and their builds
+    if hasattr(seg, "candidate_count"):
+        counts["listed"], counts["builds"] = int(seg.candidate_count[0]), int(seg.candidate_count[1])
     return counts
 
 
