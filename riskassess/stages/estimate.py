@@ -5,15 +5,17 @@ the 2-core machine CI uses, quiet (load < 1), and a run on a loaded or slower ma
 longer. They only need to be right within a factor of a few: their job is to stop a mistyped
 ``end_time = 1e6`` (1e10 steps, years of wall time) before it starts, not to schedule work.
 
-* impact (``run``, ``assess``, ``perceive``, sweeps): a fixed 2.5 s (building the model, loading the compiled
-  kernels, writing the products), then per step 15.5 us (Exudyn's bodies and joints, the hooks, the recorder)
-  plus 0.0285 us per net node (the compiled kernel integrating the net) plus 19 us with the thread contact on
-  (``contact.thread_segments``: its pair search, geometry and sub-cycles, a run's mean over flight and wrapping).
-  Fitted (helper speed21, 2026-11-28, docs/model.md "Speed") to CPU times of the solve: the reference case's 35 x 35
-  net (1229 nodes) 50.5 us a step (3.79 s for 7.5 s, load 1.2), the same case with a 15 x 15 net (229 nodes) 22 us
-  a step, the 2.0 m/s whole-capture case copy with the thread contact (229 nodes) 41 us a step over 15 s, and the
-  run's fixed part (the pipeline's CPU less the solve's, 2.3-2.4 s). The earlier model (60 us a step plus 0.33 us per
-  node-step, from 2026-11-26's 143 and 481 us a step) read 2-3x the cost of today's code;
+* impact (``run``, ``assess``, ``perceive``, sweeps): a fixed 2.4 s (building the model, loading the compiled
+  kernels, writing the products), then per step 17 us (Exudyn's bodies and joints, the hooks, the recorder) plus
+  0.0273 us per net node (the compiled kernel integrating the net) plus 22 us with the thread contact on
+  (``contact.thread_segments``: its pair search, geometry and sub-cycles, a whole capture's mean over flight and
+  wrapping). Fitted by helper speed21 (2026-11-28, docs/model.md "Speed", CPU times at load 3-9, nice 10) to: the
+  reference case's solve with the 15 x 15 and 35 x 35 nets (``bench/bench_impact.py --sizes 15 35``: 23.3 and
+  50.6 us a step, 229 and 1229 nodes: the line through them gives the first two terms), the 2.0 m/s whole-capture
+  case copy to 15 s (41 us a step for the solve; the pipeline's CPU less the solve's, 2.3-2.5 s, the fixed part) and
+  the 1.0 m/s copy over 135 s (71.1 s CPU for the whole run): the thread contact's term sits between their 18 and
+  28 us. The earlier model (60 us a step plus 0.33 us per node-step, from the 143 and 481 us a step of 2026-11-26)
+  read 2-3x the cost of today's code (183 s for that 135 s run);
 * lower-order tow: 15 us per step (0.97 s for 71 100 steps, docs/towing.md);
 * full-net tow: 0.11 us per net node and net sub-step (300 s of the 15 x 15 net, 229 nodes, with
   20 sub-steps of each 2 ms step: 6.9e8 node sub-steps in 75.7 s, docs/towing.md).
@@ -25,15 +27,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-IMPACT_SETUP_S = 2.5
-IMPACT_US_PER_STEP = 15.5
-IMPACT_US_PER_NODE_STEP = 0.0285
-THREAD_CONTACT_US_PER_STEP = 19.0
+IMPACT_SETUP_S = 2.4
+IMPACT_US_PER_STEP = 17.0
+IMPACT_US_PER_NODE_STEP = 0.0273
+THREAD_CONTACT_US_PER_STEP = 22.0
 TOW_US_PER_STEP = 15.0
 FULL_NET_US_PER_NODE_SUBSTEP = 0.11
 
-#: Work refused without ``--force``: one hour of estimated wall time (a full reference impact of 7.5 s is about
-#: 6 s; a 60 s impact of the full net about 45 s) or 8 GB of recorded data.
+#: Work refused without ``--force``: one hour of estimated wall time (a reference impact of 7.5 s is about 6 s; a
+#: 60 s impact of the full net about 33 s; 1000 s of a 15 x 15 capture with the thread contact about 7.5 min) or
+#: 8 GB of recorded data.
 LIMIT_WALL_S = 3600.0
 LIMIT_MEMORY_BYTES = 8e9
 #: Never started, even with ``--force``: beyond this the estimate itself says the run cannot finish.
