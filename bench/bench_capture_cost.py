@@ -18,7 +18,8 @@ CPU time (``time.process_time``) by wrappers around them:
   the force vector handed to Exudyn).
 
 Prints per window: steps, CPU per simulated second and us per step of each part, the mean penetrating contacts
-(node and thread) per step, then the totals, the load average before and after, and a hash of the run's time series
+(node and thread) per step, the builds of the thread contact's candidate pairs (:mod:`multibody.segment_candidates`;
+``--skin D`` sets their skin, in m: the cost changes, the run does not), then the totals, the load average before and after, and a hash of the run's time series
 and net snapshots (two code versions that print the same hash computed the same trajectory to the last bit).
 The wrappers cost about 1-2 us a step (four CPU-clock reads), included in ``other``.
 
