@@ -1,8 +1,9 @@
 """What a simulation will cost, said before it starts, and refused above a limit unless forced.
 
 A stated cost model (not a calibration run): the figures are the project's own measurements on
-the 2-core machine CI uses, quiet (load < 1), and a run on a loaded or slower machine takes
-longer. They only need to be right within a factor of a few: their job is to stop a mistyped
+the 2-core machine CI uses (the impact's: CPU times at load 3-9, which a quiet machine matches or
+beats by up to some 10 %; the tows': quiet, load < 1), and a run on a loaded or slower machine takes
+longer in wall time. They only need to be right within a factor of a few: their job is to stop a mistyped
 ``end_time = 1e6`` (1e10 steps, years of wall time) before it starts, not to schedule work.
 
 * impact (``run``, ``assess``, ``perceive``, sweeps): a fixed 2.4 s (building the model, loading the compiled
