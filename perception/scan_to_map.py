@@ -602,8 +602,8 @@ def registered_again(track: MapTrack, thin, max_correspondence, prior_sigma=PRIO
     built at the earlier frames' poses), and the finished map is built from those poses; on the featured
     debris the second pass moves the frames by 0.23-0.25 deg (median). Measured (docs/perception.md,
     percep21): it raises the model-free C by 0.17-0.40 % on five seeds (all five then within 0.2 %), but by
-    turning the spin momentum before the collision the other way (C's share of h0 from -0.18..+0.04 % to
-    +0.16..+0.20 %), i.e. by compensating the other terms' bias, not removing it; on a synthetic tumble with a
+    turning the spin momentum before the collision the other way (C's share of h0 from -0.24..+0.04 % to
+    +0.07..+0.25 %), i.e. by compensating the other terms' bias, not removing it; on a synthetic tumble with a
     known answer it takes h further from the truth (0.066-0.101 -> 0.076-0.130 deg, rng seeds 0-4).
 
     Parameters
