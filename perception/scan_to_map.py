@@ -596,7 +596,8 @@ def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA,
 def registered_again(track: MapTrack, thin, max_correspondence, prior_sigma=PRIOR_SIGMA) -> MapTrack:
     """The track with every registered frame registered again to the finished map, from its own pose (the
     motion prior centred there, so a direction the scan does not fix stays put), and its information at
-    the new pose; the map is kept. The stage's ``perception.registration.map_second_pass`` (off: measured, not adopted).
+    the new pose; the map is kept. The stage's ``perception.registration.map_second_pass`` (off: measured,
+    not adopted).
 
     Why it was tried: the online pass registers frame i to the map of the frames before it (a partial map,
     built at the earlier frames' poses), and the finished map is built from those poses; on the featured
