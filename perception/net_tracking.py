@@ -126,6 +126,10 @@ class NetPrior:
     smoothness : how differently two joined nodes may move in one frame.
     anchor : how far a rim node may sit from its rod tip (the mount's compliance).
     gate : returns farther than this from every predicted thread are not net returns.
+    stretch : how far a thread may be longer than its rest length (used when :func:`fit_net_nodes` is given
+        the rest lengths): a thread is inextensible in tension and free in slack, so the meshes between the
+        rim held at the rod tips and a seen node are counted by the threads' lengths and a grid slid by a
+        mesh costs a stretched thread (it cannot slip as the association alone can; docs/perception.md, percep21).
     """
 
     point: float = 0.02
@@ -133,10 +137,11 @@ class NetPrior:
     smoothness: float = 0.02
     anchor: float = 0.01
     gate: float = 0.15
+    stretch: float = 0.01
 
 
 def fit_net_nodes(points_world, predicted_world, threads, prior: NetPrior = NetPrior(), anchors=None,
-                  iterations=4) -> NetFit:
+                  iterations=4, rest_lengths=None) -> NetFit:
     """Node positions of a net of known topology from its LiDAR returns (see module docstring).
 
     Parameters
@@ -148,6 +153,9 @@ def fit_net_nodes(points_world, predicted_world, threads, prior: NetPrior = NetP
     anchors : (node indices (a,), positions (a, 3)) or None: nodes held near known points
                                 (m, world frame; the chaser's rod tips).
     iterations : int            Re-associations of the returns to the threads.
+    rest_lengths : (m,) float or None   Rest length of each thread (m): a thread longer than it at the current
+                                iterate adds the residual (length - rest) / ``prior.stretch``, linearized
+                                (:func:`_stretch_terms`). None: no length term (the stage's fit).
     """
     predicted = np.asarray(predicted_world, float)
     points = np.asarray(points_world, float).reshape(-1, 3)
@@ -203,12 +211,38 @@ def fit_net_nodes(points_world, predicted_world, threads, prior: NetPrior = NetP
             pulled = np.einsum("qij,qj->qi", across, offset)
             for a in range(2):
                 np.add.at(rhs, (3 * nodes[:, a])[:, None] + np.arange(3), weights[:, [a]] * pulled)
+        if rest_lengths is not None:
+            extra_normal, extra_rhs = _stretch_terms(positions, predicted, threads, np.asarray(rest_lengths, float),
+                                                     prior.stretch)
+            normal, rhs = normal + extra_normal, rhs + extra_rhs
         positions = predicted + spsolve(normal.tocsc(), rhs).reshape(n, 3)
     observed = np.zeros(n, bool)
     if use.any():
         observed[threads[index[use]].ravel()] = True
     rms = float(np.sqrt(np.mean(distance[use] ** 2))) if use.any() else float("nan")
     return NetFit(positions, observed, int(use.sum()), rms)
+
+
+def _stretch_terms(positions, predicted, threads, rest_lengths, sigma):
+    """Normal-equation terms (3n, 3n) sparse and (3n,) of the stretched threads' residuals
+    r = (|x_j - x_i| - L0) / sigma, linearized at ``positions`` in the displacements d = x - ``predicted``
+    (m): with u the thread's unit vector, J = u^T on j and -u^T on i, J d_now the length change so far;
+    minimizing (|x_j - x_i| - L0 + J (d - d_now))^2 / sigma^2 adds J^T J / sigma^2 and
+    J^T (J d_now - (|x_j - x_i| - L0)) / sigma^2. Slack threads (shorter than L0) add nothing."""
+    n = len(positions)
+    vector = positions[threads[:, 1]] - positions[threads[:, 0]]
+    length = np.linalg.norm(vector, axis=1)
+    taut = length > rest_lengths
+    if not taut.any():
+        return sp.csr_matrix((3 * n, 3 * n)), np.zeros(3 * n)
+    pairs, u = threads[taut], vector[taut] / length[taut, None]
+    k = len(pairs)
+    rows = np.repeat(np.arange(k), 6)
+    cols = (3 * pairs[:, [0, 0, 0, 1, 1, 1]] + np.tile(np.arange(3), 2)).ravel()
+    jacobian = sp.csr_matrix((np.c_[-u, u].ravel(), (rows, cols)), shape=(k, 3 * n))
+    displacement = (positions - predicted).ravel()
+    target = jacobian @ displacement - (length[taut] - rest_lengths[taut])
+    return (jacobian.T @ jacobian) / sigma**2, jacobian.T @ target / sigma**2
 
 
 def carried_by_chaser(positions_world, chaser_from, chaser_to) -> np.ndarray:

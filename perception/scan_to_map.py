@@ -593,6 +593,48 @@ def track_scans(scans_world, voxel, max_correspondence, prior_sigma=PRIOR_SIGMA,
                      None if sensors_world is None else views)
 
 
+def registered_again(track: MapTrack, thin, max_correspondence, prior_sigma=PRIOR_SIGMA) -> MapTrack:
+    """The track with every registered frame registered again to the finished map, from its own pose (the
+    motion prior centred there, so a direction the scan does not fix stays put), and its information at
+    the new pose; the map is kept. The stage's ``perception.registration.map_second_pass`` (off: measured,
+    not adopted).
+
+    Why it was tried: the online pass registers frame i to the map of the frames before it (a partial map,
+    built at the earlier frames' poses), and the finished map is built from those poses; on the featured
+    debris the second pass moves the frames by 0.23-0.25 deg (median). Measured (docs/perception.md,
+    percep21): it raises the model-free C by 0.17-0.40 % on five seeds (all five then within 0.2 %), but by
+    turning the spin momentum before the collision the other way (C's share of h0 from -0.24..+0.04 % to
+    +0.07..+0.25 %), i.e. by compensating the other terms' bias, not removing it; on a synthetic tumble with a
+    known answer it takes h further from the truth (0.066-0.101 -> 0.076-0.130 deg, rng seeds 0-4).
+
+    Parameters
+    ----------
+    track : MapTrack                   Result of the online pass (:func:`track_scans`).
+    thin : list of (n_k, 3) float      The frames' thinned scans, world frame (m).
+    max_correspondence : float         ICP correspondence distance, coarse level (m).
+    prior_sigma : (6,) float           1-sigma of the prior about the frame's own pose (rad, m).
+
+    Returns
+    -------
+    MapTrack                           Poses, fitness, RMS distance, information and CPU time of the
+                                       frames registered again (CPU added); the map, ``ok`` and the
+                                       online seconds as in ``track``.
+    """
+    index = map_index(track.map_points, max_correspondence)
+    normals = LazyNormals.given(track.map_normals, index)
+    poses, fitness, rmse = track.world_to_body.copy(), track.fitness.copy(), track.rmse.copy()
+    information = track.information.copy()
+    cpu = np.zeros(len(poses)) if track.cpu_seconds is None else track.cpu_seconds.copy()
+    for i in np.flatnonzero(track.ok):
+        cpu_tic = time.process_time()
+        poses[i], fitness[i], rmse[i] = _register(thin[i], track.map_points, normals, poses[i], max_correspondence,
+                                                  prior_sigma, index)
+        information[i] = map_information(thin[i], poses[i], track.map_points, track.map_normals, max_correspondence,
+                                         index)
+        cpu[i] += time.process_time() - cpu_tic
+    return MapTrack(poses, track.ok, fitness, rmse, information, track.seconds, track.map_points, track.map_normals, cpu)
+
+
 def _built_map(points_body, voxel, max_correspondence, views_body=None):
     """Map points (n, 3) (frame B, m) of registered surface points, their normals (:class:`LazyNormals`,
     as :func:`surface_map`'s), their index and their mean views towards the sensor (frame B; zeros

@@ -576,6 +576,11 @@ class Registration(Strict):
                            "later frame tracked from the motion prediction that passes its checks add the surface "
                            "the map lacks (model-free tracking; issue 26). False: the map stays as built in the "
                            "observation.")
+    map_second_pass: bool = Field(
+        False, description="Model-free tracking: once the observation's map is built, every observation frame is "
+                           "registered again to it from its own pose, the map kept as built "
+                           "(perception.scan_to_map.registered_again; issue 26, percep21: not adopted). False: "
+                           "the online pass's poses.")
 
     @model_validator(mode="after")
     def _budget(self):

@@ -50,7 +50,7 @@ from perception.motion import NotObservable
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
 from perception.pointing import Pointing, debris_blob
 from perception.registration import MAP_LATERAL_BINS, MIN_POINTS, DebrisTracker, known_shape_model
-from perception.scan_to_map import alignments as map_alignments, track_scans
+from perception.scan_to_map import alignments as map_alignments, registered_again, thinned_scan, track_scans
 from perception.shape import half_turn_symmetry_transforms, rotation_error
 from riskassess.products import results
 from riskassess.models.impact import model_inputs
@@ -407,6 +407,9 @@ def track_model_free(scene: Scene, frames: Frames):
     origins = [com - rot @ com_target for rot, com in zip(frames.true_target_to_world, frames.true_com_world)]
     reg = p.registration
     track = track_scans(frames.scans, reg.voxel, reg.max_correspondence)
+    if reg.map_second_pass:
+        thin = [thinned_scan(scan, reg.voxel) if len(scan) else np.zeros((0, 3)) for scan in frames.scans]
+        track = registered_again(track, thin, reg.max_correspondence)
     # No registered frame (e.g. empty scans): no map; the fits below answer "not observable".
     tracker = DebrisTracker(reg.voxel, reg.max_correspondence, reg.model_frames,
                             *((track.map_points, track.map_normals) if track.ok.any() else ()), seed=p.seed,
