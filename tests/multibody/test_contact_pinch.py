@@ -32,8 +32,9 @@ def test_a_pinched_node_pushes_both_plates_and_conserves_momentum(alpha, mu):
     # node's net kick, zero when pinched, and they crushed it: +740 J on 2.5 J). Linear momentum to round-off: the
     # plates' momenta are 5 and 4.5 N s, so 1e-12 N s is some 2e-13 of them. The angular momentum about the LVLH
     # origin: every reaction acts at the node, so a step's torques cancel, but Verlet's staggered kicks and drifts
-    # change sum x(n) x p(n) by O(h^2 |v| |f|) a step (measured 8.5e-7 N m s at 1e-4 s); 1e-5 of its scale
-    # sum |r| m |v| (0.3 N m s), as tests/multibody/test_conservation.py's 1e-6 for a 300 times gentler strike.
+    # change sum x(n) x p(n) by O(h^2 |v| |f|) a step (measured 8.5e-7 N m s at 1e-4 s with friction, halving with
+    # the step); 1e-5 of its scale sum |r| m |v| (0.3 N m s), as tests/multibody/test_conservation.py's 1e-6 for a
+    # gentler strike.
     series = node_pinch(1e-4, alpha, mu)
     velocity = series["body_velocity_lvlh"][-1, :, 1]
     assert velocity[0] < 0.0 < velocity[1]
@@ -48,9 +49,9 @@ def test_a_pinched_node_conserves_energy_to_first_order_in_the_step():
     # Without damping or friction the collision is elastic: kinetic + elastic energy constant up to the integration
     # error. Each body takes its contact's whole impulse over the step as a force held over the step while the
     # sub-cycle let it recoil gradually, an error of about F^2 h^2 / (2 m_body) a step over the contact's steps:
-    # first order in h (at 1e-4 s, 3.7 kN peaks: about 0.27 J on 2.5 J, measured 0.27 J at 1e-4 s, halving with
-    # the step). The tolerances: 15 % of the 2.5 J at 1e-4 s, the ratio of the errors at h and h/2 within
-    # [0.35, 0.65] (first order: 0.5).
+    # first order in h (measured 0.127 J on the scene's 1.75 J at 1e-4 s, 0.058 J at 5e-5 s; main: +61 J). The
+    # tolerances: 15 % of the 1.75 J at 1e-4 s, the ratio of the errors at h and h/2 within [0.35, 0.65] (first
+    # order: 0.5).
     errors = [balance_error(node_pinch(step)) for step in (1e-4, 5e-5)]
     start = node_pinch(1e-4)["energy_total"][0]
     assert errors[0] < 0.15 * start
