@@ -293,7 +293,9 @@ def _foreign_contact_kick(cluster, f, x, w, mass, radius, box_min, box_max, law,
     """Entry ``f`` of the cluster's other-box contacts over a sub-step at time ``t``: the thread's contact with the
     other box (held in its start pose relative to this body, moving with its start relative velocity and spin) from
     the nodes' current positions ``x`` and velocities ``w`` (relative to this body, this box's frame), into their
-    predicted velocity changes ``p`` (m/s); the other body's recoil within the step is not followed."""
+    predicted velocity changes ``p`` (m/s). The other body is carried along by this body's recoil within the step (the
+    sub-cycle's frame), its own recoil is not followed: both are below 1e-7 m/s a step for a 500 N squeeze of the
+    832-6621 kg Envisat bodies."""
     r = cluster.foreign_row[f]
     s2 = cluster.foreign_shape[f]
     rot, origin = cluster.foreign_rotation[f], cluster.foreign_origin[f]
