@@ -2,7 +2,7 @@
 part of the step (the compiled net step, the recorder's post-step work, the capture monitor, Exudyn and the glue).
 
     python3 bench/bench_capture_cost.py CASE --store STORE --sample N [--end-time T] [--windows 0,0.5,3,10,20]
-                                        [--release never] [--perf-marks]
+                                        [--release never] [--perf-marks] [--census T,...] [--skin D]
 
 Runs Monte Carlo sample ``N`` of a store written by ``bench/bench_safe_velocity.py`` (as
 ``bench/bench_safe_velocity_history.py`` does: its uncertain inputs, ``structures.release`` = ``--release``) through
@@ -18,7 +18,8 @@ CPU time (``time.process_time``) by wrappers around them:
   the force vector handed to Exudyn).
 
 Prints per window: steps, CPU per simulated second and us per step of each part, the mean penetrating contacts
-(node and thread) per step, then the totals, the load average before and after, and a hash of the run's time series
+(node and thread) per step, the builds of the thread contact's candidate pairs (:mod:`multibody.segment_candidates`;
+``--skin D`` sets their skin, in m: the cost changes, the run does not), then the totals, the load average before and after, and a hash of the run's time series
 and net snapshots (two code versions that print the same hash computed the same trajectory to the last bit).
 The wrappers cost about 1-2 us a step (four CPU-clock reads), included in ``other``.
 
@@ -77,7 +78,8 @@ def segment_census(kernel) -> dict:
         for s in np.flatnonzero(shapes.is_box):
             counts["tested"] += 1
             reach = 1.001 * (min(radius[a], radius[c]) + motion + step * seg.shape_work[1, s])
-            if 0.5 * (seg.centre_distance[s, a] + seg.centre_distance[s, c] - length) > seg.shape_work[0, s] + reach:
+            centre_distance = np.linalg.norm(x[:, [a, c]] - seg.shape_work[2:5, [s]], axis=0)
+            if 0.5 * (centre_distance.sum() - length) > seg.shape_work[0, s] + reach:
                 continue
             counts["sphere"] += 1
             b = shapes.body[s]
@@ -97,6 +99,9 @@ def segment_census(kernel) -> dict:
             counts["separated"] += int(segment_box_separation(pa, tuple(np.subtract(pc, pa)), lo, hi)
                                        > min(radius[a], radius[c]) + TIE_DISTANCE)
     counts["pairs"] = int(seg.node_threads.sum() // 2)
+    # the candidate pairs kept with a skin (multibody.segment_candidates; absent before helper speed21) and their builds
+    if hasattr(seg, "candidate_count"):
+        counts["listed"], counts["builds"] = int(seg.candidate_count[0]), int(seg.candidate_count[1])
     return counts
 
 
@@ -120,6 +125,9 @@ class PhaseClock:
         self._last_entry = None  # (window, process time) of the previous step's entry
         self.census_times = []   # s of simulated time at which to count the thread contact's pair search
         self.census = []         # (t, counts) (segment_census)
+        self.skin = None         # the thread contact's candidate skin (m) set before the first step; None: default
+        self.builds = np.zeros(n, np.int64)   # builds of the candidate pairs (multibody.segment_candidates) per window
+        self._builds_seen = 0
 
     def window_of(self, t: float) -> int:
         return int(min(max(np.searchsorted(self.edges, t, side="right") - 1, 0), len(self.edges) - 2))
@@ -163,8 +171,15 @@ def instrument(clock: PhaseClock) -> None:
 
     def pre_step(self, mbs, t):
         clock.step_entry(t)
+        seg = self.kernel.buffers.segments
+        listed = getattr(seg, "candidate_count", np.zeros(0))     # absent before helper speed21
+        if clock.skin is not None and listed.size and clock._builds_seen == 0:
+            seg.candidate_scalar[0] = clock.skin
         keep = call(self, mbs, t)
         clock.contacts[clock.window] += self.kernel.buffers.scalars[N_CONTACTS]
+        if listed.size:
+            clock.builds[clock.window] += listed[1] - clock._builds_seen
+            clock._builds_seen = listed[1]
         if clock.census_times and t >= clock.census_times[0]:
             clock.census_times.pop(0)
             start = time.process_time()
@@ -197,7 +212,8 @@ def run_digest(folder: Path) -> str:
 def print_table(clock: PhaseClock, step: float) -> None:
     """Per window: steps, CPU per simulated second (s/s), us per step of each part, contacts per step."""
     print(f"{'window (s)':>14} {'steps':>7} {'CPU/sim-s':>9} {'total':>7} {'kernel':>7} {'post':>6} {'capture':>7} "
-          f"{'other':>6} {'contacts':>8}   (us a step; CPU/sim-s in s per simulated s)")
+          f"{'other':>6} {'contacts':>8} {'builds':>7}   (us a step; CPU/sim-s in s per simulated s; builds of the "
+          f"thread contact's candidate pairs)")
     for k in range(len(clock.steps)):
         n = clock.steps[k]
         if n == 0:
@@ -206,7 +222,7 @@ def print_table(clock: PhaseClock, step: float) -> None:
         other = us["total"] - us["kernel"] - us["post"]
         print(f"{clock.edges[k]:6.2f}-{clock.edges[k + 1]:6.2f} {n:7d} {clock.cpu['total'][k] / (n * step):9.2f} "
               f"{us['total']:7.1f} {us['kernel']:7.1f} {us['post']:6.1f} {us['capture']:7.2f} {other:6.1f} "
-              f"{clock.contacts[k] / n:8.1f}")
+              f"{clock.contacts[k] / n:8.1f} {clock.builds[k]:7d}")
     n = clock.steps.sum()
     total = {part: clock.cpu[part].sum() for part in PARTS}
     print(f"whole run: {n} steps, CPU {total['total']:.1f} s ({total['total'] / (n * step):.2f} s per simulated s): "
@@ -226,6 +242,8 @@ def main() -> None:
     parser.add_argument("--windows", default="0,0.5,3,10,20,40",
                         help="window edges (s of simulated time); the run's end closes the last")
     parser.add_argument("--perf-marks", action="store_true")
+    parser.add_argument("--skin", type=float, default=None, help="the thread contact's candidate skin (m; "
+                        "multibody.segment_candidates.CANDIDATE_SKIN unless given): changes the cost, not the run")
     parser.add_argument("--census", default="", help="times (s) at which to count the thread contact's pair search "
                         "(segment_census; its CPU time is left out of the step's)")
     args = parser.parse_args()
@@ -237,6 +255,7 @@ def main() -> None:
     edges = [e for e in (float(v) for v in args.windows.split(",")) if e < end_time] + [end_time]
     clock = PhaseClock(edges)
     clock.census_times = sorted(float(v) for v in args.census.split(",") if v)
+    clock.skin = args.skin
     instrument(clock)
     print(f"{args.case}, sample {args.sample}: {overrides}")
     with tempfile.TemporaryDirectory() as tmp:

@@ -16,6 +16,7 @@ from multibody.net import NetTopology
 if TYPE_CHECKING:       # annotation only: the loads module needs Exudyn, these descriptions do not
     from multibody.closing_winch import ClosingSpec
     from multibody.recorded_loads import RecordedBodyLoads
+    from multibody.tether_spool import TetherSpec
 
 
 @dataclass
@@ -211,6 +212,9 @@ class ImpactAssembly:
     #: the net's closing mechanism (:class:`multibody.closing_winch.ClosingSpec`; the loop is the net's last 12
     #: threads); None: the net stays open
     closing: ClosingSpec | None = None
+    #: the main tether from a net node to a station-keeping chaser (:class:`multibody.tether_spool.TetherSpec`,
+    #: :mod:`multibody.net_tether`); None: the net flies free of the chaser
+    tether: TetherSpec | None = None
 
     @property
     def debris_indices(self) -> list[int]:

@@ -28,6 +28,37 @@ from multibody.kernel import N_CONTACTS, KernelData
 from multibody.net import PADDING_REST_LENGTH
 
 
+class ContactTrigger:
+    """When a mechanism fires (the closing's winch, the main tether's spool brake): at a time, or at the net's first
+    contact with any body (the kernel's contact count, nodes' and threads') plus a delay.
+
+    Parameters
+    ----------
+    start : float or None
+        Activation time (s); None: at the first contact plus ``delay``.
+    delay : float
+        Time after the first contact (s) when ``start`` is None.
+    scalars : (N_SCALARS,) float
+        The kernel's scalars (:class:`multibody.kernel.KernelBuffers`), read for the contact count.
+
+    Attributes
+    ----------
+    activated_at : float or None  Activation time (s), once known.
+    first_contact : float or None Time of the net's first contact (s), once seen.
+    """
+
+    def __init__(self, start: float | None, delay: float, scalars):
+        self.activated_at, self.delay, self.scalars = start, float(delay), scalars
+        self.first_contact = None
+
+    def activation(self, t: float) -> float | None:
+        """After the step that ended at ``t`` (s): the activation time (s), or None while it is not known."""
+        if self.activated_at is None and self.first_contact is None and self.scalars[N_CONTACTS] > 0:
+            self.first_contact = t
+            self.activated_at = t + self.delay
+        return self.activated_at
+
+
 @dataclass(frozen=True)
 class ClosingSpec:
     """The closing mechanism of an impact run (SI).
@@ -87,12 +118,21 @@ class ClosingWinch:
         self.net_q = net_q
         self.n_nodes = kernel.n_nodes
         self.work = 0.0
-        self.first_contact = None
-        self.activated_at = spec.start
+        self.trigger = ContactTrigger(spec.start, spec.delay, self.scalars)
         self.closed = False
         self._pending = None   # (before, after) natural lengths of the last update, half its work still to book
         #: the loop's natural lengths (m) when the reel-in starts (the slack taken up) and when it ends; None before
         self.rest_start = self.rest_end = None
+
+    @property
+    def activated_at(self) -> float | None:
+        """Activation time (s), once known (:class:`ContactTrigger`)."""
+        return self.trigger.activated_at
+
+    @property
+    def first_contact(self) -> float | None:
+        """Time of the net's first contact (s), once seen (:class:`ContactTrigger`)."""
+        return self.trigger.first_contact
 
     def natural_lengths(self, t: float) -> np.ndarray:
         """The loop's natural lengths (m) at time ``t`` (s) by the schedule: open before the activation, then
@@ -140,14 +180,8 @@ class ClosingWinch:
         """After the step that ended at ``t`` (s): watch for the trigger, then set the loop's natural lengths and
         stiffnesses for the next step's evaluation (at ``t + step``) and book half the work of the change at the
         current positions (:meth:`book_pending` books the other half after the step)."""
-        if self.closed:
+        if self.closed or self.trigger.activation(t) is None:
             return
-        if self.activated_at is None:
-            if self.first_contact is None and self.scalars[N_CONTACTS] > 0:
-                self.first_contact = t
-                self.activated_at = t + self.spec.delay
-            if self.activated_at is None:
-                return
         t_next = t + self.step
         if t_next < self.activated_at:
             return

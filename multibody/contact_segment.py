@@ -88,6 +88,7 @@ from multibody.contact_kernel import _effective_mass_of_body, _substeps_to_resol
 from multibody.jit_cache import NO_REFCOUNTS
 from multibody.segment_box import MAX_BREAKPOINTS, segment_box_normal
 from multibody.segment_cycle import ClusterWork, cluster_contact_over_step, cluster_work, thread_contact_geometry
+from multibody.segment_candidates import CANDIDATE_SKIN, refresh_candidates
 from multibody.segment_pairs import _contact_pairs, _near_shapes, _node_motion, _to_body
 from multibody.thread_cluster import group_pairs
 
@@ -109,9 +110,18 @@ class SegmentBuffers(NamedTuple):
     dissipated: np.ndarray          # (m,) per thread, the energy its contact dissipated (J)
     node_force_lvlh: np.ndarray     # (3, n) this pass's forces on the nodes (N), LVLH, coordinate-major
     lag_velocity_lvlh: np.ndarray   # (3, n) the carried impulses' velocity change of each node (m/s), LVLH
-    centre_distance: np.ndarray     # (ns, n) each node's distance to each shape's bounding-sphere centre (m)
     node_speed: np.ndarray          # (n,) bound of each node's speed over the step (m/s)
-    shape_work: np.ndarray          # (2, ns) each shape's bounding-sphere radius (m) and surface speed bound (m/s)
+    shape_work: np.ndarray          # (5, ns) each shape's bounding-sphere radius (m), surface speed bound (m/s) and
+                                    # bounding-sphere centre (rows 2-4, LVLH, m)
+    candidate_thread: np.ndarray    # (m ns,) int64 the candidate (thread, box) pairs (multibody.segment_candidates):
+                                    # the thread
+    candidate_shape: np.ndarray     # (m ns,) int64 ... and the box
+    candidate_count: np.ndarray     # (2,) int64 the pairs listed; the builds so far
+    candidate_scalar: np.ndarray    # (2,) the skin (m); the step of the last build (s), 0 before the first
+    built_position_body: np.ndarray  # (nb, 3, n) each node's position in each box-carrying body's frame at the last
+                                     # build (m)
+    built_speed: np.ndarray         # (n,) node_speed at the last build (m/s)
+    built_surface_speed: np.ndarray  # (ns,) shape_work[1] at the last build (m/s)
     breakpoints: np.ndarray         # (MAX_BREAKPOINTS,) work: a segment's sorted breakpoints
     contact_scalar: np.ndarray      # (5, 1) work: penetration, body mass (sub-step count)
     contact_vector: np.ndarray      # (6, 1, 3) work: relative velocity, normal (sub-step count)
@@ -137,21 +147,29 @@ class SegmentBuffers(NamedTuple):
                                     # in its own contact with the box at the start, column 5: with one
 
 
-def segment_buffers(n_threads: int, n_nodes: int, n_shapes: int, enabled: bool) -> SegmentBuffers:
+def segment_buffers(n_threads: int, n_nodes: int, n_shapes: int, n_bodies: int, enabled: bool,
+                    skin: float = CANDIDATE_SKIN) -> SegmentBuffers:
     """Zeroed :class:`SegmentBuffers`; with ``enabled`` False every array is empty (nothing to carry).
 
     Parameters
     ----------
-    n_threads, n_nodes, n_shapes : int
+    n_threads, n_nodes, n_shapes, n_bodies : int
     enabled : bool
         The case's ``contact.thread_segments``.
+    skin : float
+        The candidate pairs' skin (m; :mod:`multibody.segment_candidates`): it changes the cost only; 0 rebuilds them
+        at every evaluation.
     """
-    m, n, ns = (n_threads, n_nodes, n_shapes) if enabled else (0, 0, 0)
+    m, n, ns, nb = (n_threads, n_nodes, n_shapes, n_bodies) if enabled else (0, 0, 0, 0)
     return SegmentBuffers(enabled=int(bool(enabled)), lag_impulse_lvlh=np.zeros((2, m, 2, 3)),
                           lag_body=np.full((2, m), -1, np.int64), end_energy=np.zeros((2, m)), start_energy=np.zeros(m),
                           energy_jump=np.zeros(m), dissipated=np.zeros(m),
                           node_force_lvlh=np.zeros((3, n)), lag_velocity_lvlh=np.zeros((3, n)),
-                          centre_distance=np.zeros((ns, n)), node_speed=np.zeros(n), shape_work=np.zeros((2, ns)),
+                          node_speed=np.zeros(n), shape_work=np.zeros((5, ns)),
+                          candidate_thread=np.zeros(m * ns, np.int64), candidate_shape=np.zeros(m * ns, np.int64),
+                          candidate_count=np.zeros(2, np.int64), candidate_scalar=np.array([float(skin), 0.0]),
+                          built_position_body=np.zeros((nb, 3, n)), built_speed=np.zeros(n),
+                          built_surface_speed=np.zeros(ns),
                           breakpoints=np.zeros(MAX_BREAKPOINTS), contact_scalar=np.zeros((5, 1)),
                           contact_vector=np.zeros((6, 1, 3)), external_force=np.zeros(3), cycle_out=np.zeros((4, 3)),
                           owned_shape=np.full(n, -1, np.int64), node_threads=np.zeros(n, np.int64),
@@ -283,6 +301,7 @@ def add_segment_contact_forces(x, v, net, states, bodies, shapes, law, step, n_s
     _release_carried(x, seg, threads, net_mass, states, step, stage_weight, body_force_lvlh, torque_lvlh,
                                out_body_impulse, out_node_impulse)
     _near_shapes(x, v, net_force_lvlh, net_mass, buffers.velocity_lag, seg, states, shapes, step)
+    refresh_candidates(x, threads, net.radius, seg, states, shapes, step)
     energy, count, dissipated = 0.0, 0, 0.0
     # the per-thread energy record: this step's sub-cycles write their end energies into row 1
     # row to row element by element: a slice assignment between arrays allocates (its overlap copy)

@@ -39,6 +39,7 @@ from multibody.net import thread_runs
 from multibody.node_frame import inertia_node, node_to_body_rotations, vector_node
 from multibody.recorder import Recorder
 from multibody.recorder_kernel import sample_row
+from multibody.tether_spool import TetherSpool
 from multibody.rotation_update import ExactRotations
 from multibody.solver_output import solver_chatter_captured
 
@@ -68,6 +69,7 @@ class BuiltSystem:
     kernel_net: KernelNet | None = None  # the net's state when the kernel integrates it
     rotations: ExactRotations | None = None  # VelocityVerlet: the attitudes restored after each step
     closing: ClosingWinch | None = None  # the net's closing winch (assembly.closing), kernel path only
+    tether: TetherSpool | None = None    # the main tether's spool (assembly.tether), kernel path only
 
     def net_state(self, q, qt):
         """(n, 3) node positions (m) and velocities (m/s), LVLH, at the end of the last step, from
@@ -309,15 +311,20 @@ def build_impact_system(assembly: ImpactAssembly, rest_body_to_lvlh=None, rest_c
     kernel_net = None
     # Exudyn's explicit Lie-group update loses turns below ~2e-8 rad a step (multibody.rotation_update)
     rotations = ExactRotations(3 * n_exudyn, len(body_nodes), state_index) if verlet else None
-    closing = None
-    if assembly.closing is not None and not in_kernel:
-        raise ValueError("the net's closing mechanism needs the compiled kernel to integrate the net "
-                         "(simulation.net_integration = \"kernel\" with VelocityVerlet)")
+    closing = spool = None
+    for name, mechanism in (("closing mechanism", assembly.closing), ("main tether", assembly.tether)):
+        if mechanism is not None and not in_kernel:
+            raise ValueError(f"the net's {name} needs the compiled kernel to integrate the net "
+                             "(simulation.net_integration = \"kernel\" with VelocityVerlet)")
     if in_kernel:
-        kernel_net = KernelNet(mbs, coupled, kernel, assembly.net_velocity, state_index, rotations)
+        tether = None if assembly.tether is None else assembly.tether.kernel_tether()
+        kernel_net = KernelNet(mbs, coupled, kernel, assembly.net_velocity, state_index, rotations, tether)
         mbs.SetPreStepUserFunction(kernel_net)
         if assembly.closing is not None:
             closing = ClosingWinch(assembly.closing, kernel, kernel_net.q, assembly.solver.step)
+        if tether is not None:
+            spool = TetherSpool(assembly.tether, tether, kernel.buffers.scalars, kernel.net.reference_lvlh,
+                                kernel_net.q, assembly.solver.step)
     elif verlet:
         mbs.SetPreStepUserFunction(VerletForces(mbs, coupled, kernel, assembly.solver.step, 3 * n,
                                                 len(body_nodes), state_index, rotations))
@@ -325,7 +332,7 @@ def build_impact_system(assembly: ImpactAssembly, rest_body_to_lvlh=None, rest_c
         layout["index"] = state_index
     return BuiltSystem(sc, mbs, kernel, net_node, body_nodes, body_objects, joint_objects,
                        joints_to_parent, joints_to_child, points_parent_body, points_child_body, kernel_net,
-                       rotations, closing)
+                       rotations, closing, spool)
 
 
 def uses_kernel_net(assembly: ImpactAssembly) -> bool:
@@ -584,24 +591,28 @@ def solve_checked(mbs, settings, solver_type, watch: HealthWatch, stopped_early=
     check_solver_flag(bool(success) and reached >= end_time - half_step, end_time, reached, watch.cause)
 
 
-def with_winch(post_step, winch: ClosingWinch | None):
-    """``post_step`` between the closing winch's booking of its last update (:meth:`ClosingWinch.book_pending`) and
-    its next update (:meth:`ClosingWinch.after_step`), or ``post_step`` itself without a winch (the default path
-    calls exactly what it called before).
+def with_winch(post_step, *winches):
+    """``post_step`` between the winches' booking of their last update (:meth:`ClosingWinch.book_pending`,
+    :meth:`TetherSpool.book_pending`) and their next update (``after_step``), or ``post_step`` itself without a
+    winch (the default path calls exactly what it called before).
 
     Parameters
     ----------
     post_step : callable ``(mbs, t) -> bool``
-        The recorder's post-step work (its sample at ``t`` reads the loop as it was over the step).
-    winch : ClosingWinch or None
+        The recorder's post-step work (its sample at ``t`` reads the loop and the tether as they were over the step).
+    *winches : ClosingWinch, TetherSpool or None
+        The closing winch and the tether's spool; None entries are left out.
     """
-    if winch is None:
+    winches = [w for w in winches if w is not None]
+    if not winches:
         return post_step
 
     def hook(mbs, t):
-        winch.book_pending()    # the last update's work completed at this step's end, before the sample reads it
+        for winch in winches:
+            winch.book_pending()    # the last update's work completed at this step's end, before the sample reads it
         keep = post_step(mbs, t)
-        winch.after_step(t)
+        for winch in winches:
+            winch.after_step(t)
         return keep
 
     return hook
@@ -649,7 +660,7 @@ class ImpactSimulation:
             # the post-step work runs from the kernel's pre-step, for the step before (one Python
             # call from Exudyn a step instead of two; the same work in the same order), after the kernel
             # has restored the step's exact attitudes (multibody.rotation_update)
-            kernel_net.set_after_step(with_winch(post_step, self.system.closing), mbs.systemData.GetTime())
+            kernel_net.set_after_step(with_winch(post_step, self.system.closing, self.system.tether), mbs.systemData.GetTime())
         else:
             if self.system.rotations is not None:
                 # Exudyn's attitudes made exact before anything reads them (multibody.rotation_update)

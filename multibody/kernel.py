@@ -211,7 +211,7 @@ def kernel_buffers(net: NetArrays, n_bodies: int, n_shapes: int, thread_segments
                          states=BodyStates(np.zeros((n_bodies, 3, 3)), np.zeros((n_bodies, 3)),
                                            np.zeros((n_bodies, 3)), np.zeros((n_bodies, 3)),
                                            np.zeros((n_bodies, 3, 3)), np.zeros((n_bodies, 3))),
-                         segments=segment_buffers(len(net.threads), n, n_shapes, thread_segments))
+                         segments=segment_buffers(len(net.threads), n, n_shapes, n_bodies, thread_segments))
 
 
 class BodyStates(NamedTuple):

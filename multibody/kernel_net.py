@@ -40,6 +40,7 @@ from multibody.kernel import (
     coupled_forces_soa,
     verlet_evaluation_state_into,
 )
+from multibody.net_tether import NetTether, add_tether_force, no_tether
 
 
 @structref.register
@@ -51,7 +52,7 @@ class NetStepModelType(UnliteralStructRef):
 #: (same names, same buffers: what the kernel accumulates there, the recorder reads there), then the
 #: net's state and the work vectors of this module.
 KERNEL_FIELDS = ("net", "bodies", "shapes", "law", "mounts", "mean_motion", "step", "stage_weight", "buffers")
-STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "qt_eval", "inverse_mass", "reference_soa")
+STATE_FIELDS = ("n_substeps", "q", "qt", "qtt", "qt_eval", "inverse_mass", "reference_soa", "tether")
 
 
 class NetStepModel(structref.StructRefProxy):
@@ -62,14 +63,15 @@ class NetStepModel(structref.StructRefProxy):
     state, coordinate-major, module doc; inside a step ``q`` holds the step's end, the evaluation state's
     positions), ``qt_eval`` ((3 n + 6 nb,) work space: the net's mid-step velocities (first 3 n), the bodies'
     (last 6 nb)), ``inverse_mass`` ((3 n,) 1 / node mass per coordinate (1/kg)), ``reference_soa`` ((3 n,)
-    the nodes' reference positions (m), LVLH), both coordinate-major.
+    the nodes' reference positions (m), LVLH), both coordinate-major, and ``tether``
+    (:class:`multibody.net_tether.NetTether`, the main tether to the chaser; node -1: none).
     """
 
 
 structref.define_proxy(NetStepModel, NetStepModelType, KERNEL_FIELDS + STATE_FIELDS)
 
 
-def net_step_model(kernel: KernelData, net_velocity) -> tuple:
+def net_step_model(kernel: KernelData, net_velocity, tether: NetTether | None = None) -> tuple:
     """The structref for ``kernel`` with the net in its reference position; returns it and its ``q``,
     ``qt`` arrays (a structref proxy has no Python attributes: its fields are read in compiled code).
 
@@ -78,6 +80,8 @@ def net_step_model(kernel: KernelData, net_velocity) -> tuple:
     kernel : KernelData
     net_velocity : (n, 3) float
         Initial node velocities (m/s), LVLH.
+    tether : NetTether or None
+        The main tether (:mod:`multibody.net_tether`); None: none.
     """
     n, nb = kernel.n_nodes, kernel.n_bodies
     n_substeps = max(1, int(np.ceil(kernel.step / kernel.contact_substep - 1e-9))) if np.isfinite(
@@ -87,18 +91,19 @@ def net_step_model(kernel: KernelData, net_velocity) -> tuple:
     coordinate_major = np.ascontiguousarray(np.asarray(net_velocity, float).reshape(n, 3).T).reshape(3 * n)
     state = [n_substeps, np.zeros(3 * n), coordinate_major, np.zeros(3 * n), np.zeros(3 * n + 6 * nb),
              np.tile(1.0 / np.asarray(kernel.net.mass, float), 3),
-             np.ascontiguousarray(np.asarray(kernel.net.reference_lvlh, float).T).reshape(3 * n)]
+             np.ascontiguousarray(np.asarray(kernel.net.reference_lvlh, float).T).reshape(3 * n),
+             no_tether() if tether is None else tether]
     return _new_net_step_model(*values, *state), state[1], state[2]
 
 
 @njit(cache=True)
 def _new_net_step_model(net, bodies, shapes, law, mounts, mean_motion, step, stage_weight, buffers, n_substeps, q, qt,
-                        qtt, qt_eval, inverse_mass, reference_soa):
+                        qtt, qt_eval, inverse_mass, reference_soa, tether):
     """``NetStepModel(...)`` (the fields of :data:`KERNEL_FIELDS` and :data:`STATE_FIELDS`, in order), compiled once
     into numba's on-disk cache: the proxy class's own constructor is compiled afresh in every process, 2.3-2.6 s CPU
     before a run's first step (helper speed20: 0.17 s through this function from the cache)."""
     return NetStepModel(net, bodies, shapes, law, mounts, mean_motion, step, stage_weight, buffers, n_substeps, q, qt,
-                        qtt, qt_eval, inverse_mass, reference_soa)
+                        qtt, qt_eval, inverse_mass, reference_soa, tether)
 
 
 # inlined (numba IR), with the buffers its caller already read: each read of the structref's buffers counts their
@@ -145,6 +150,8 @@ def kernel_net_start(m, q_bodies, qt_bodies):
     m.qt_eval[:n3] = m.qt
     buffers = m.buffers
     _forces(m, buffers, q_bodies, qt_bodies, 1)
+    if m.tether.node[0] >= 0:   # the main tether (multibody.net_tether); nothing booked at the initial state
+        add_tether_force(buffers.work_soa[0], m.qt_eval[:n3].reshape(3, n), m.tether, buffers.work_soa[2], 0.0)
     force = buffers.work_soa[2].reshape(n3)
     for k in range(n3):
         m.qtt[k] = force[k] / m.net.mass[k % n]
@@ -196,6 +203,9 @@ def kernel_net_step(m, q_bodies, qt_bodies, qtt_bodies, time, q_next_bodies, for
     v_half_bodies = qt_eval[n3:]
     verlet_evaluation_state_into(q_bodies, qt_bodies, qtt_bodies, step, 0, nb, q_next_bodies, v_half_bodies)
     _forces(m, buffers, q_next_bodies, v_half_bodies, m.n_substeps if time > 0.0 else 1)
+    tether = m.tether
+    if tether.node[0] >= 0:   # the main tether to the chaser (multibody.net_tether), at the same evaluation state
+        add_tether_force(work_soa[0], qt_eval[:n3].reshape(3, n3 // 3), tether, work_soa[2], step)
     force = work_soa[2].reshape(n3)
     # flat loops over the coordinates with few arrays each: the compiler vectorizes them (with more
     # arrays in one loop its run-time overlap checks give up and the loop stays scalar)
@@ -224,15 +234,18 @@ class KernelNet:
     rotations : multibody.rotation_update.ExactRotations or None
         Keeps each step's exact end attitudes; they are written over Exudyn's at the start of the next
         pre-step, before :attr:`after_step` reads the state (and by :meth:`finish_steps` after the last step).
+    tether : NetTether or None
+        The main tether to the chaser (:mod:`multibody.net_tether`); None: none.
     """
 
-    def __init__(self, mbs, coupled_object, kernel: KernelData, net_velocity, state_index, rotations=None):
+    def __init__(self, mbs, coupled_object, kernel: KernelData, net_velocity, state_index, rotations=None,
+                 tether: NetTether | None = None):
         self.mbs = mbs
         self.rotations = rotations
         self.coupled_object = coupled_object
         self.kernel = kernel
         self.state_index = state_index
-        self.model, self.q, self.qt = net_step_model(kernel, net_velocity)
+        self.model, self.q, self.qt = net_step_model(kernel, net_velocity, tether)
         self._q_next_bodies = np.zeros(6 * kernel.n_bodies)  # the step's end coordinates of the bodies (m, rad)
         self._force_bodies = np.zeros(6 * kernel.n_bodies)   # the bodies' generalized forces of the step
         self._views = None

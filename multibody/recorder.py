@@ -31,6 +31,11 @@ energy_*                                (k,) J: net_kinetic, net_elastic (thread
                                         total (mechanical + dissipated + released)
 momentum_linear_lvlh                    (k, 3) total of net and debris (kg m/s)
 momentum_angular_lvlh                   (k, 3) about the LVLH origin (kg m^2/s)
+energy_tether_elastic,                  (k,) J, with the main tether (multibody.net_tether): its spring's
+energy_dissipated_tether,               energy, its damper's dissipation so far, minus its reel's work
+energy_tether_winch_work                (in the total)
+tether_tension, tether_length           (k,) N, m (the length from the anchor to the tethered node)
+tether_force_on_chaser_lvlh             (k, 3) N: the pull the chaser's thrusters hold
 ======================================  =========================================================
 
 Net snapshots (``Recorder.net``): ``time`` (s), ``positions_lvlh`` (k, n, 3) float64,
@@ -60,6 +65,7 @@ from multibody.recorder_kernel import (
     sample_row,
 )
 from multibody.load_filter import OUTPUT, filter_bank
+from multibody.net_tether import DISSIPATED, ELASTIC, FORCE_ON_CHASER, LENGTH, TENSION
 
 #: Longest simulated time between two finite-state checks when the output rate is lower (s):
 #: a NaN spreads through the coupled state within a few steps and stays, so 1 ms loses nothing.
@@ -75,9 +81,13 @@ ENERGY_TERMS = ("net_kinetic", "net_elastic", "net_bending", "contact_elastic", 
 #: The series of the joints' filtered loads (:mod:`multibody.load_filter`): force (N), moment (N m), joint frame.
 FILTERED_LOADS = ("joint_force_filtered_joint", "joint_moment_filtered_joint")
 
+#: The main tether's energy terms (:mod:`multibody.net_tether`), before the total: elastic, dissipated by its damper,
+#: minus its reel's work (J).
+TETHER_ENERGIES = ("tether_elastic", "dissipated_tether", "tether_winch_work")
+
 
 def series_layout(n_bodies: int, n_joints: int, chaser: bool, applied_loads: bool,
-                  filtered_loads: bool = False, winch: bool = False) -> list:
+                  filtered_loads: bool = False, winch: bool = False, tether: bool = False) -> list:
     """The time series' keys and the shape of one sample of each, in the order of :attr:`Recorder.series`.
 
     Parameters
@@ -92,6 +102,10 @@ def series_layout(n_bodies: int, n_joints: int, chaser: bool, applied_loads: boo
         after the existing columns, so a run without them records the same row).
     winch : bool
         The net has a closing winch (``energy_winch_work``: minus the work it did on the net, J, before the total).
+    tether : bool
+        The net has the main tether (:mod:`multibody.net_tether`): ``energy_tether_elastic``,
+        ``energy_dissipated_tether``, ``energy_tether_winch_work`` (minus its reel's work, J) before the total, and
+        ``tether_tension`` (N), ``tether_length`` (m), ``tether_force_on_chaser_lvlh`` ((3,) N) last.
 
     Returns
     -------
@@ -99,7 +113,7 @@ def series_layout(n_bodies: int, n_joints: int, chaser: bool, applied_loads: boo
     """
     nb, nj = n_bodies, n_joints
     energies = (list(ENERGY_TERMS) + ["chaser_kinetic"] * chaser + ["applied_loads_work"] * applied_loads
-                + ["winch_work"] * winch + ["total"])
+                + ["winch_work"] * winch + list(TETHER_ENERGIES) * tether + ["total"])
     return ([("time", ())]
             + [(key, (nb, 3)) for key in ("contact_force_lvlh", "contact_moment_lvlh", "contact_force_body",
                                           "contact_moment_body", "body_com_lvlh", "body_velocity_lvlh",
@@ -109,7 +123,8 @@ def series_layout(n_bodies: int, n_joints: int, chaser: bool, applied_loads: boo
                                           "joint_moment_joint")]
             + [("energy_" + key, ()) for key in energies]
             + [("momentum_linear_lvlh", (3,)), ("momentum_angular_lvlh", (3,))]
-            + [(key, (nj, 3)) for key in FILTERED_LOADS] * filtered_loads)
+            + [(key, (nj, 3)) for key in FILTERED_LOADS] * filtered_loads
+            + [("tether_tension", ()), ("tether_length", ()), ("tether_force_on_chaser_lvlh", (3,))] * tether)
 
 
 class Recorder:
@@ -172,9 +187,11 @@ class Recorder:
         self._unfiltered = np.array([not c for c in cutoffs_hz], bool)
         #: the net's closing winch (multibody.closing_winch), None for an open net
         self._winch = system.closing
+        #: the main tether's spool (multibody.tether_spool), None without a tether
+        self._spool = getattr(system, "tether", None)
         self._launch_reference = self.health.reference_energy   # the energy check's reference before any winch work
         self._layout = series_layout(nb, nj, assembly.chaser is not None, assembly.body_loads is not None,
-                                     self._load_filter is not None, self._winch is not None)
+                                     self._load_filter is not None, self._winch is not None, self._spool is not None)
         self._columns = {}
         width = 0
         for key, shape in self._layout:
@@ -350,6 +367,8 @@ class Recorder:
             self._row[total_column] = total_energy
         if self._winch is not None:
             total_energy = self._book_winch(total_energy)
+        if self._spool is not None:
+            total_energy = self._book_tether(total_energy)
         if not self.health.energy(t, total_energy):
             return
         self._store()
@@ -375,14 +394,34 @@ class Recorder:
     def _book_winch(self, total_energy: float) -> float:
         """The closing winch's work into the row (``energy_winch_work``: minus the work it did on the net, so that
         the total stays closed while the loop pulls) and the total with it (J)."""
-        total_column = self._energy_slice.stop - 1
-        self._row[total_column - 1] = -self._winch.work
+        self._row[self._columns["energy_winch_work"][0]] = -self._winch.work
         total_energy = total_energy - self._winch.work
-        self._row[total_column] = total_energy
-        if self.health.reference_energy is not None:
-            # the balance's scale is the energy brought in: the launch's and what the winch has put in since
-            self.health.reference_energy = max(self.health.reference_energy, self._launch_reference + self._winch.work)
+        self._row[self._energy_slice.stop - 1] = total_energy
+        self._raise_reference()
         return total_energy
+
+    def _book_tether(self, total_energy: float) -> float:
+        """The main tether into the row: its elastic energy, its damper's dissipation and minus its reel's work
+        (J), the total with them; its tension (N), length (m) and force on the chaser (N, LVLH)."""
+        state, column = self._spool.state, self._columns
+        terms = (state[ELASTIC], state[DISSIPATED], -self._spool.work)
+        for key, value in zip(TETHER_ENERGIES, terms):
+            self._row[column["energy_" + key][0]] = value
+            total_energy = total_energy + value
+        self._row[self._energy_slice.stop - 1] = total_energy
+        self._row[column["tether_tension"][0]] = state[TENSION]
+        self._row[column["tether_length"][0]] = state[LENGTH]
+        first = column["tether_force_on_chaser_lvlh"][0]
+        self._row[first:first + 3] = state[FORCE_ON_CHASER:FORCE_ON_CHASER + 3]
+        self._raise_reference()
+        return total_energy
+
+    def _raise_reference(self) -> None:
+        """The energy balance's scale is the energy brought in: the launch's and what the closing winch and the
+        tether's reel have put in since."""
+        if self.health.reference_energy is not None:
+            work = sum(w.work for w in (self._winch, self._spool) if w is not None)
+            self.health.reference_energy = max(self.health.reference_energy, self._launch_reference + work)
 
     def _node_contact_force(self, t):
         """Contact force on each net node (N, LVLH), averaged since the previous net snapshot."""

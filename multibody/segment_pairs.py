@@ -2,8 +2,9 @@
 contact, :mod:`multibody.contact_segment`.
 
 * **broad phase** (:func:`_near_shapes`): a speed bound for every node over the step, a bounding sphere and a
-  surface-speed bound for every box, and every node's distance to every box's centre; a thread whose every point
-  stays farther from a box's centre than the box's sphere plus what thread and surface can close within the step
+  surface-speed bound for every box; of the candidate pairs (:mod:`multibody.segment_candidates`: a list kept from
+  step to step with a skin, a superset of the pairs the slab test below passes), a thread whose every point stays
+  farther from a box's centre than the box's sphere plus what thread and surface can close within the step
   (``reach``) is skipped, then one that misses the box's slabs widened by ``reach``.
 * **narrow phase** (:func:`_touches_within_step`): the thread's deepest point penetrates now or at the end of the
   step's free motion (:func:`_node_motion`: each node's velocity relative to the body and its non-contact
@@ -28,9 +29,9 @@ from multibody.segment_cycle import thread_contact_geometry
 
 @njit(cache=True, **NO_REFCOUNTS)
 def _near_shapes(x, v, net_force_lvlh, net_mass, velocity_lag, seg, states, shapes, step):
-    """Each node's speed bound over the step (``seg.node_speed``, m/s: L1 norms, an upper bound), each box
-    shape's bounding sphere (radius) and surface speed bound (``seg.shape_work``), and each node's distance
-    to each box's centre (``seg.centre_distance``, m), for the thread broad phase."""
+    """Each node's speed bound over the step (``seg.node_speed``, m/s: L1 norms, an upper bound), and each box
+    shape's bounding sphere (``seg.shape_work``: radius (m), surface speed bound (m/s), centre in LVLH (m)), for the
+    thread broad phase."""
     n = x.shape[1]
     speed = seg.node_speed
     lag = seg.lag_velocity_lvlh
@@ -48,9 +49,12 @@ def _near_shapes(x, v, net_force_lvlh, net_mass, velocity_lag, seg, states, shap
         b = shapes.body[s]
         mx, my, mz = (0.5 * (box_min[s, 0] + box_max[s, 0]), 0.5 * (box_min[s, 1] + box_max[s, 1]),
                       0.5 * (box_min[s, 2] + box_max[s, 2]))
-        cx = com_lvlh[b, 0] + body_to_lvlh[b, 0, 0] * mx + body_to_lvlh[b, 0, 1] * my + body_to_lvlh[b, 0, 2] * mz
-        cy = com_lvlh[b, 1] + body_to_lvlh[b, 1, 0] * mx + body_to_lvlh[b, 1, 1] * my + body_to_lvlh[b, 1, 2] * mz
-        cz = com_lvlh[b, 2] + body_to_lvlh[b, 2, 0] * mx + body_to_lvlh[b, 2, 1] * my + body_to_lvlh[b, 2, 2] * mz
+        seg.shape_work[2, s] = (com_lvlh[b, 0] + body_to_lvlh[b, 0, 0] * mx + body_to_lvlh[b, 0, 1] * my
+                                + body_to_lvlh[b, 0, 2] * mz)
+        seg.shape_work[3, s] = (com_lvlh[b, 1] + body_to_lvlh[b, 1, 0] * mx + body_to_lvlh[b, 1, 1] * my
+                                + body_to_lvlh[b, 1, 2] * mz)
+        seg.shape_work[4, s] = (com_lvlh[b, 2] + body_to_lvlh[b, 2, 0] * mx + body_to_lvlh[b, 2, 1] * my
+                                + body_to_lvlh[b, 2, 2] * mz)
         seg.shape_work[0, s] = 0.5 * math.sqrt((box_max[s, 0] - box_min[s, 0]) ** 2
                                                + (box_max[s, 1] - box_min[s, 1]) ** 2
                                                + (box_max[s, 2] - box_min[s, 2]) ** 2)
@@ -59,10 +63,13 @@ def _near_shapes(x, v, net_force_lvlh, net_mass, velocity_lag, seg, states, shap
         speed_b = math.sqrt(velocity_lvlh[b, 0] ** 2 + velocity_lvlh[b, 1] ** 2 + velocity_lvlh[b, 2] ** 2)
         spin_b = math.sqrt(omega_lvlh[b, 0] ** 2 + omega_lvlh[b, 1] ** 2 + omega_lvlh[b, 2] ** 2)
         seg.shape_work[1, s] = speed_b + spin_b * extent
-        row = seg.centre_distance[s]
-        x0, x1, x2 = x[0], x[1], x[2]
-        for i in range(n):
-            row[i] = math.sqrt((x0[i] - cx) ** 2 + (x1[i] - cy) ** 2 + (x2[i] - cz) ** 2)
+
+
+@njit(cache=True, inline="always")
+def _centre_distance(x, i, shape_work, s):
+    """Node ``i``'s distance (m) to box ``s``'s bounding-sphere centre (``shape_work[2:5, s]``, LVLH)."""
+    return math.sqrt((x[0, i] - shape_work[2, s]) ** 2 + (x[1, i] - shape_work[3, s]) ** 2
+                     + (x[2, i] - shape_work[4, s]) ** 2)
 
 
 @njit(cache=True, inline="always")
@@ -100,49 +107,49 @@ def _node_motion(i, b, x, v, net_force_lvlh, net_mass, node_lag, lag, states, ha
 
 @njit(cache=True, **NO_REFCOUNTS)
 def _contact_pairs(x, v, net_force_lvlh, net, states, shapes, step, n_substeps, buffers):
-    """This step's (thread, box) contact pairs into ``seg.pair_thread`` / ``seg.pair_shape``: the thread's deepest
-    point is interior and penetrates now, or does at the end of the step's free motion (a thread turning over an
-    edge). Counts each node's threads in contact (``seg.node_threads``) and notes the box they touch
-    (``seg.node_shape``). Returns the number of pairs."""
+    """This step's (thread, box) contact pairs into ``seg.pair_thread`` / ``seg.pair_shape``, from the candidate pairs
+    ``seg.candidate_thread[:k]`` / ``candidate_shape[:k]`` (k = ``seg.candidate_count[0]``, in (thread, box) order: a
+    superset of those the slab test passes, :mod:`multibody.segment_candidates`): the thread's deepest point is interior
+    and penetrates now, or does at the end of the step's free motion (a thread turning over an edge). Counts each
+    node's threads in contact (``seg.node_threads``) and notes the box they touch (``seg.node_shape``). Returns the
+    number of pairs."""
     seg = buffers.segments
     threads, net_mass, radius = net.threads, net.mass, net.radius
-    centre_distance, node_speed = seg.centre_distance, seg.node_speed
-    sphere_radius, surface_speed = seg.shape_work[0], seg.shape_work[1]
+    node_speed, shape_work = seg.node_speed, seg.shape_work
     body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
-    box_min, box_max, shape_body, is_box = shapes.box_min_body, shapes.box_max_body, shapes.body, shapes.is_box
+    box_min, box_max, shape_body = shapes.box_min_body, shapes.box_max_body, shapes.body
     n_pairs = 0
-    for j in range(threads.shape[0]):
+    for k in range(seg.candidate_count[0]):
+        j, s = seg.candidate_thread[k], seg.candidate_shape[k]
         a, c = threads[j, 0], threads[j, 1]
         length = math.sqrt((x[0, c] - x[0, a]) ** 2 + (x[1, c] - x[1, a]) ** 2 + (x[2, c] - x[2, a]) ** 2)
         motion = step * max(node_speed[a], node_speed[c])
         thread_radius = min(radius[a], radius[c])
-        for s in range(shape_body.shape[0]):
-            if is_box[s] == 0:
-                continue
-            # what the thread and the surface can close within the step, plus the thread's radius
-            reach = 1.001 * (thread_radius + motion + step * surface_speed[s])
-            # every point of the segment is at least (|a - o| + |b - o| - L) / 2 from the box's centre o
-            if 0.5 * (centre_distance[s, a] + centre_distance[s, c] - length) > sphere_radius[s] + reach:
-                continue
-            b = shape_body[s]
-            pa = _to_body(x, a, body_to_lvlh, com_lvlh, b)
-            pc = _to_body(x, c, body_to_lvlh, com_lvlh, b)
-            if (min(pa[0], pc[0]) > box_max[s, 0] + reach or max(pa[0], pc[0]) < box_min[s, 0] - reach
-                    or min(pa[1], pc[1]) > box_max[s, 1] + reach or max(pa[1], pc[1]) < box_min[s, 1] - reach
-                    or min(pa[2], pc[2]) > box_max[s, 2] + reach or max(pa[2], pc[2]) < box_min[s, 2] - reach):
-                continue
-            if not _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, radius, states, shapes,
-                                        step, n_substeps, buffers):
-                continue
-            seg.pair_thread[n_pairs] = j
-            seg.pair_shape[n_pairs] = s
-            n_pairs += 1
-            for i in (a, c):
-                seg.node_threads[i] += 1
-                if seg.node_shape[i] == -1:
-                    seg.node_shape[i] = s
-                elif seg.node_shape[i] != s:
-                    seg.node_shape[i] = -2
+        # what the thread and the surface can close within the step, plus the thread's radius
+        reach = 1.001 * (thread_radius + motion + step * shape_work[1, s])
+        # every point of the segment is at least (|a - o| + |b - o| - L) / 2 from the box's centre o
+        if (0.5 * (_centre_distance(x, a, shape_work, s) + _centre_distance(x, c, shape_work, s) - length)
+                > shape_work[0, s] + reach):
+            continue
+        b = shape_body[s]
+        pa = _to_body(x, a, body_to_lvlh, com_lvlh, b)
+        pc = _to_body(x, c, body_to_lvlh, com_lvlh, b)
+        if (min(pa[0], pc[0]) > box_max[s, 0] + reach or max(pa[0], pc[0]) < box_min[s, 0] - reach
+                or min(pa[1], pc[1]) > box_max[s, 1] + reach or max(pa[1], pc[1]) < box_min[s, 1] - reach
+                or min(pa[2], pc[2]) > box_max[s, 2] + reach or max(pa[2], pc[2]) < box_min[s, 2] - reach):
+            continue
+        if not _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, radius, states, shapes,
+                                    step, n_substeps, buffers):
+            continue
+        seg.pair_thread[n_pairs] = j
+        seg.pair_shape[n_pairs] = s
+        n_pairs += 1
+        for i in (a, c):
+            seg.node_threads[i] += 1
+            if seg.node_shape[i] == -1:
+                seg.node_shape[i] = s
+            elif seg.node_shape[i] != s:
+                seg.node_shape[i] = -2
     return n_pairs
 
 

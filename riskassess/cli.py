@@ -90,7 +90,7 @@ def impact_estimate_of(case: Case):
 
     sim = case.simulation
     return impact_estimate(sim.end_time, sim.step, case.net.nodes_per_side ** 2 + 4, len(case.target.bodies) + 1,
-                           sim.output_rate, sim.net_output_rate)
+                           sim.output_rate, sim.net_output_rate, case.contact.thread_segments)
 
 
 def _check_work(estimate, args) -> None:

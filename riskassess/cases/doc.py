@@ -69,7 +69,7 @@ on load, before any work; each error names the file, the key and what is allowed
 
 SECTIONS = [
     ("[simulation]", c.Simulation), ('[orbit] kind = "circular"', c.CircularOrbit), ('[orbit] kind = "none"', c.NoOrbit),
-    ("[net]", c.Net), ("[net.thread]", c.Thread), ("[net.closing] (optional)", c.Closing), ("[bullets]", c.Bullets),
+    ("[net]", c.Net), ("[net.thread]", c.Thread), ("[net.closing] (optional)", c.Closing), ("[net.tether] (optional)", c.Tether), ("[bullets]", c.Bullets),
     ("[launch]", c.Launch),
     ("[contact]", c.Contact), ("[target]", c.Target), ("[[target.bodies]]", c.Body),
     *((f'shapes: kind = "{name}"', model) for name, model in c.SHAPE_MODELS.items()),

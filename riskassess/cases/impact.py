@@ -137,13 +137,12 @@ class Thread(Strict):
         return self
 
 
-class Closing(Strict):
-    """The net's closing mechanism (docs/model.md, "Closing the net"): a loop of tension-only threads laced through
-    the four bullets and two perimeter nodes per side (Boonrath, Singh & Botta 2024, Sec. 2.1), reeled in by a winch
-    from its trigger over ``duration_s`` to ``closed_fraction`` of its open length. Off (no table): the net stays open."""
+class Trigger(Strict):
+    """When a net mechanism fires (the closing's winch starts, the main tether's spool brakes): a time, or the net's
+    first contact plus a delay (:class:`multibody.closing_winch.ContactTrigger`)."""
 
     start: NonNegative | Literal["first_contact"] = Field(
-        "first_contact", description="When the winch starts: a time (s), or 'first_contact' (the net's first contact "
+        "first_contact", description="When it fires: a time (s), or 'first_contact' (the net's first contact "
                                      "with any body, nodes' or threads', plus the delay): a mission fires the closing on "
                                      "the net's sensed arrival and waits for the wrap.")
     delay_s: NonNegative | None = Field(
@@ -153,6 +152,21 @@ class Closing(Strict):
         None, description="With start = 'first_contact': the wait after it as net travel (m), delay = this / "
                           "launch.velocity (the capture keeps its shape in units of travel, docs/structures.md; "
                           "14 m is the seed's 7 s at 2 m/s, Boonrath et al. 2024 Sec. 4.1).")
+
+    @model_validator(mode="after")
+    def _delay(self):
+        if self.delay_s is not None and self.delay_travel_m is not None:
+            raise ValueError("give at most one of 'delay_s' (s) or 'delay_travel_m' (m)")
+        if self.start != "first_contact" and (self.delay_s is not None or self.delay_travel_m is not None):
+            raise ValueError(f"a delay goes with start = 'first_contact'; start = {self.start!r} is already a time")
+        return self
+
+
+class Closing(Trigger):
+    """The net's closing mechanism (docs/model.md, "Closing the net"): a loop of tension-only threads laced through
+    the four bullets and two perimeter nodes per side (Boonrath, Singh & Botta 2024, Sec. 2.1), reeled in by a winch
+    from its trigger over ``duration_s`` to ``closed_fraction`` of its open length. Off (no table): the net stays open."""
+
     duration_s: Positive = Field(
         description="Reel-in time from open to closed (s): the natural lengths shorten linearly over it.")
     closed_fraction: Annotated[float, Field(gt=0, le=1)] = Field(
@@ -163,12 +177,41 @@ class Closing(Strict):
     damping: NonNegative | None = Field(
         None, description="Axial damping of each closing thread (N s/m); default net.thread.damping.")
 
+
+class Tether(Trigger):
+    """The main tether (docs/model.md, "The main tether"): a tension-only Kelvin-Voigt line (the towing model's main
+    tether law, Boonrath, Singh & Botta 2024 eq. (5a)) from the net's central node (the grid's middle node; for an
+    even nodes_per_side the node (n/2, n/2), half a mesh off the centre) to a chaser holding station at a fixed
+    anchor (its thrusters hold it: a kinematic chaser, as the towing seed's pre-tow phase). The spool pays out freely
+    while the net flies (no tension), brakes at its trigger (the natural length frozen at the node's distance plus
+    ``slack_m``), then optionally reels in. Off (no table): the net flies free of the chaser (the default)."""
+
+    stiffness: Positive | None = Field(
+        None, description="k (N/m) of the whole line, e.g. Boonrath et al. Table 1's k_MT = 3000 N/m. Give this "
+                          "or axial_rigidity.")
+    axial_rigidity: Positive | None = Field(
+        None, description="EA of the line (N): k = EA / l0 with l0 the natural length at the brake (and as the "
+                          "reel shortens it).")
+    damping: NonNegative = Field(description="c (N s/m) of the line, e.g. Boonrath et al. Table 1's c_MT = 300.")
+    standoff_m: Positive = Field(
+        15.0, description="The chaser's anchor lies this far (m) back along launch.direction from the net's centre "
+                          "at launch (launch.distance + this from the aim point). Default 15 m: Boonrath et al. "
+                          "Table 1's main tether length l_MT,0 [assumed: the seed gives no launch range].")
+    anchor_lvlh: Vector3 | None = Field(
+        None, description="The anchor (m), LVLH, instead of standoff_m.")
+    slack_m: NonNegative = Field(0.0, description="Added to the node's distance when the spool brakes (m).")
+    reel_rate_m_s: NonNegative = Field(
+        0.0, description="After the brake the spool reels in at this rate (m/s); 0: it holds (the brake only).")
+    reel_in_m: NonNegative = Field(
+        0.0, description="Length (m) the spool reels in after the brake, then it holds; needs reel_rate_m_s > 0.")
+
     @model_validator(mode="after")
-    def _delay(self):
-        if self.delay_s is not None and self.delay_travel_m is not None:
-            raise ValueError("give at most one of 'delay_s' (s) or 'delay_travel_m' (m)")
-        if self.start != "first_contact" and (self.delay_s is not None or self.delay_travel_m is not None):
-            raise ValueError(f"a delay goes with start = 'first_contact'; start = {self.start!r} is already a time")
+    def _line(self):
+        if (self.stiffness is None) == (self.axial_rigidity is None):
+            raise ValueError("give exactly one of 'stiffness' (N/m) or 'axial_rigidity' (N)")
+        if (self.reel_rate_m_s > 0.0) != (self.reel_in_m > 0.0):
+            raise ValueError("a reel-in needs both 'reel_rate_m_s' (m/s) and 'reel_in_m' (m) > 0, or neither. "
+                             f"Got {self.reel_rate_m_s} and {self.reel_in_m} instead")
         return self
 
 
@@ -180,6 +223,9 @@ class Net(Strict):
         None, description="Mass of one net node (kg); default: thread mass spread evenly over the nodes.")
     closing: Closing | None = Field(
         None, description="The closing mechanism ([net.closing]); none: the net stays open (the default).")
+    tether: Tether | None = Field(
+        None, description="The main tether to a station-keeping chaser ([net.tether]); none: the net flies free "
+                          "(the default).")
 
     @model_validator(mode="after")
     def _mass_source(self):
@@ -857,6 +903,23 @@ class Case(Strict):
         if self.net.nodes_per_side < 4:
             raise ValueError(f"net.closing laces two perimeter nodes per side: nodes_per_side must be >= 4. "
                              f"Got {self.net.nodes_per_side} instead")
+        return self
+
+    @model_validator(mode="after")
+    def _tether_coupled_kernel(self):
+        if self.net.tether is None:
+            return self
+        sim = self.simulation
+        if sim.coupling == "sequential":
+            raise ValueError("net.tether ties the net to the chaser while it wraps free debris; a sequential run (the "
+                             "seed paper's method) has the net against a fixed wall: use coupling = 'coupled' or "
+                             "remove [net.tether]")
+        if sim.net_integration != "kernel" or sim.integrator != "VelocityVerlet":
+            raise ValueError("net.tether's force is evaluated inside the compiled kernel's net step: it needs "
+                             "simulation.net_integration = 'kernel' and integrator = 'VelocityVerlet'")
+        if self.chaser is not None:
+            raise ValueError("net.tether's chaser holds station at a fixed anchor; [chaser] (a free chaser body "
+                             "holding the net's rim) is not combined with it: remove one")
         return self
 
     @model_validator(mode="after")

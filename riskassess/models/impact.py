@@ -16,6 +16,8 @@ from multibody.assembly import (ContactLaw, ImpactAssembly, JointSpec, NetMount,
                                 subtree_bodies)
 from multibody.closing import N_CLOSING, append_closing_loop
 from multibody.closing_winch import ClosingSpec
+from multibody.net_tether import anchor_point, central_node
+from multibody.tether_spool import TetherSpec
 from multibody.geometry import geometric_center_of_mass, uniform_density_inertia
 from multibody.hinge import hinge_frame_lvlh, structural_modes_hz
 from multibody.net import bowl_net_positions, flat_square_net, thread_node_mass
@@ -168,13 +170,50 @@ def closing_spec(case: Case, net) -> ClosingSpec | None:
     if closing is None:
         return None
     rest_open = np.asarray(net.rest_lengths[-N_CLOSING:], float).copy()
-    if closing.delay_travel_m is not None:
-        delay = closing.delay_travel_m / case.launch.velocity
-    else:
-        delay = closing.delay_s or 0.0
-    return ClosingSpec(start=None if closing.start == "first_contact" else float(closing.start), delay=float(delay),
+    start, delay = trigger_delay(closing, case.launch.velocity)
+    return ClosingSpec(start=start, delay=delay,
                        duration=float(closing.duration_s), rest_open=rest_open,
                        rest_closed=closing.closed_fraction * rest_open, axial_rigidity=float(closing.axial_rigidity))
+
+
+def trigger_delay(trigger, launch_velocity: float) -> tuple[float | None, float]:
+    """A net mechanism's trigger (:class:`riskassess.cases.impact.Trigger`) as (start (s) or None for the first
+    contact, delay (s)); a delay given as travel (m) is divided by ``launch_velocity`` (m/s)."""
+    if trigger.delay_travel_m is not None:
+        delay = trigger.delay_travel_m / launch_velocity
+    else:
+        delay = trigger.delay_s or 0.0
+    return (None if trigger.start == "first_contact" else float(trigger.start)), float(delay)
+
+
+def tether_spec(case: Case, net) -> TetherSpec | None:
+    """The case's main tether for the impact model, or None without one.
+
+    Parameters
+    ----------
+    case : Case
+        A net-impact case (``net.tether``; the launch's direction and speed).
+    net : multibody.net.NetTopology
+        The built net (:func:`build_net`), positions at launch (m, LVLH).
+
+    Returns
+    -------
+    TetherSpec or None
+        From the net's central node (:func:`multibody.net_tether.central_node`) to the anchor: ``anchor_lvlh``, or
+        ``standoff_m`` back along the launch direction from the centre of the net's grid at launch.
+    """
+    tether = case.net.tether
+    if tether is None:
+        return None
+    n = case.net.nodes_per_side
+    if tether.anchor_lvlh is not None:
+        anchor_lvlh = np.asarray(tether.anchor_lvlh, float)
+    else:
+        anchor_lvlh = anchor_point(net.positions[: n * n].mean(axis=0), case.launch.direction, tether.standoff_m)
+    start, delay = trigger_delay(tether, case.launch.velocity)
+    return TetherSpec(node=central_node(n), anchor_lvlh=anchor_lvlh, stiffness=tether.stiffness,
+                      axial_rigidity=tether.axial_rigidity, damping=float(tether.damping), start=start, delay=delay,
+                      slack=float(tether.slack_m), reel_rate=float(tether.reel_rate_m_s), reel_in=float(tether.reel_in_m))
 
 
 def build_bodies_and_joints(case: Case, base: Path):
@@ -383,7 +422,8 @@ def model_inputs(case: Case, base: Path = Path(".")) -> ModelInputs:
                           contact_substep=sim.contact_substep, net_integration=sim.net_integration,
                           implicit_contact_speed=sim.implicit_contact_speed),
         mean_motion=mean_motion(case.orbit.altitude) if isinstance(case.orbit, CircularOrbit) else 0.0,
-        mount=mount, chaser=chaser_index, closing=closing_spec(case, net))
+        mount=mount, chaser=chaser_index, closing=closing_spec(case, net),
+        tether=tether_spec(case, net))
     return ModelInputs(assembly, rest_att, rest_com)
 
 

@@ -191,6 +191,9 @@ def run_summary(recorder, assembly, case_name: str) -> dict:
     winch = getattr(recorder.system, "closing", None)
     if winch is not None:   # the net's closing mechanism: trigger, reel-in and the winch's work (J)
         summary["closing"] = winch.summary()
+    spool = getattr(recorder.system, "tether", None)
+    if spool is not None:   # the main tether: brake, reel, peak tension (N) and what the chaser's thrusters held
+        summary["tether"] = spool.summary()
     return summary
 
 

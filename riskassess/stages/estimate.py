@@ -1,14 +1,22 @@
 """What a simulation will cost, said before it starts, and refused above a limit unless forced.
 
 A stated cost model (not a calibration run): the figures are the project's own measurements on
-the 2-core machine CI uses, quiet (load < 1), and a run on a loaded or slower machine takes
-longer. They only need to be right within a factor of a few: their job is to stop a mistyped
+the 2-core machine CI uses (the impact's: CPU times at load 3-9, which a quiet machine matches or
+beats by up to some 10 %; the tows': quiet, load < 1), and a run on a loaded or slower machine takes
+longer in wall time. They only need to be right within a factor of a few: their job is to stop a mistyped
 ``end_time = 1e6`` (1e10 steps, years of wall time) before it starts, not to schedule work.
 
-* impact (``run``, ``assess``, ``perceive``, sweeps): 60 us per step for Exudyn's bodies, joints,
-  the hooks and the recorder plus 0.33 us per net node and step (the compiled kernel integrating
-  the net): about the line through bench/bench_impact.py's 143 us per step for 15 x 15 (229 nodes)
-  and 481 us for the 35 x 35 reference case (1229 nodes), at load 1.3-1.6 (docs/model.md, "Speed");
+* impact (``run``, ``assess``, ``perceive``, sweeps): a fixed 2.4 s (building the model, loading the compiled
+  kernels, writing the products), then per step 17 us (Exudyn's bodies and joints, the hooks, the recorder) plus
+  0.0273 us per net node (the compiled kernel integrating the net) plus 22 us with the thread contact on
+  (``contact.thread_segments``: its pair search, geometry and sub-cycles, a whole capture's mean over flight and
+  wrapping). Fitted by helper speed21 (2026-11-28, docs/model.md "Speed", CPU times at load 3-9, nice 10) to: the
+  reference case's solve with the 15 x 15 and 35 x 35 nets (``bench/bench_impact.py --sizes 15 35``: 23.3 and
+  50.6 us a step, 229 and 1229 nodes: the line through them gives the first two terms), the 2.0 m/s whole-capture
+  case copy to 15 s (41 us a step for the solve; the pipeline's CPU less the solve's, 2.3-2.5 s, the fixed part) and
+  the 1.0 m/s copy over 135 s (71.1 s CPU for the whole run): the thread contact's term sits between their 18 and
+  28 us. The earlier model (60 us a step plus 0.33 us per node-step, from the 143 and 481 us a step of 2026-11-26)
+  read 2-3x the cost of today's code (183 s for that 135 s run);
 * lower-order tow: 15 us per step (0.97 s for 71 100 steps, docs/towing.md);
 * full-net tow: 0.11 us per net node and net sub-step (300 s of the 15 x 15 net, 229 nodes, with
   20 sub-steps of each 2 ms step: 6.9e8 node sub-steps in 75.7 s, docs/towing.md).
@@ -20,13 +28,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-IMPACT_US_PER_STEP = 60.0
-IMPACT_US_PER_NODE_STEP = 0.33
+IMPACT_SETUP_S = 2.4
+IMPACT_US_PER_STEP = 17.0
+IMPACT_US_PER_NODE_STEP = 0.0273
+THREAD_CONTACT_US_PER_STEP = 22.0
 TOW_US_PER_STEP = 15.0
 FULL_NET_US_PER_NODE_SUBSTEP = 0.11
 
-#: Work refused without ``--force``: one hour of estimated wall time (a full reference impact is
-#: about 36 s; a 60 s impact of the full net about 5 min) or 8 GB of recorded data.
+#: Work refused without ``--force``: one hour of estimated wall time (a reference impact of 7.5 s is about 6 s; a
+#: 60 s impact of the full net about 33 s; 1000 s of a 15 x 15 capture with the thread contact about 7.5 min) or
+#: 8 GB of recorded data.
 LIMIT_WALL_S = 3600.0
 LIMIT_MEMORY_BYTES = 8e9
 #: Never started, even with ``--force``: beyond this the estimate itself says the run cannot finish.
@@ -59,7 +70,7 @@ def _duration(seconds: float) -> str:
 
 
 def impact_estimate(end_time: float, step: float, n_nodes: int, n_bodies: int, output_rate: float,
-                    net_output_rate: float) -> Estimate:
+                    net_output_rate: float, thread_segments: bool = False) -> Estimate:
     """Cost of an impact run of ``end_time`` (s) at ``step`` (s) with ``n_nodes`` net nodes.
 
     Parameters
@@ -76,6 +87,8 @@ def impact_estimate(end_time: float, step: float, n_nodes: int, n_bodies: int, o
         Time-series samples per second (Hz).
     net_output_rate : float
         Net snapshots per second (Hz).
+    thread_segments : bool
+        The threads take contact too (the case's ``contact.thread_segments``).
 
     Returns
     -------
@@ -83,7 +96,9 @@ def impact_estimate(end_time: float, step: float, n_nodes: int, n_bodies: int, o
         Steps, wall time (s) and recorded data (bytes).
     """
     steps = end_time / step
-    wall = steps * (IMPACT_US_PER_STEP + IMPACT_US_PER_NODE_STEP * n_nodes) * 1e-6
+    per_step_us = (IMPACT_US_PER_STEP + IMPACT_US_PER_NODE_STEP * n_nodes
+                   + (THREAD_CONTACT_US_PER_STEP if thread_segments else 0.0))
+    wall = IMPACT_SETUP_S + steps * per_step_us * 1e-6
     samples = min(end_time * output_rate, steps) + 2
     snapshots = min(end_time * net_output_rate, steps) + 2
     memory = samples * 1e3 * max(n_bodies, 1) + snapshots * 36.0 * n_nodes

@@ -158,7 +158,8 @@ ENERGY_TERMS = (("energy_net_kinetic", "net kinetic"), ("energy_net_elastic", "n
                 ("energy_debris_rotational", "debris rotational"), ("energy_joint_elastic", "joint elastic"),
                 ("energy_dissipated_threads", "dissipated, threads"),
                 ("energy_dissipated_contact", "dissipated, contact"),
-                ("energy_dissipated_joints", "dissipated, joints' dampers"))
+                ("energy_dissipated_joints", "dissipated, joints' dampers"),
+                ("energy_tether_elastic", "main tether elastic"), ("energy_dissipated_tether", "dissipated, main tether"))
 
 
 def energy_section(run: RunFolder) -> Section:

@@ -1,6 +1,7 @@
 """Case files are rejected with a message naming the file, the key and what is allowed."""
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from riskassess.stages.kinds import load_any_case
@@ -245,3 +246,50 @@ def test_closing_case_loads_with_its_defaults(tmp_path):
     path.write_text(REFERENCE.replace("\n[bullets]", CLOSING + "\n[bullets]", 1))
     closing = load_case(path).net.closing
     assert closing.start == "first_contact" and closing.delay_s is None and closing.damping is None
+
+
+TETHER = "\n[net.tether]\nstiffness = 3000.0\ndamping = 300.0\n"
+
+
+@pytest.mark.parametrize("extra, expected", [
+    ("axial_rigidity = 55000.0\n", "exactly one of 'stiffness' (N/m) or 'axial_rigidity' (N)"),
+    ("reel_rate_m_s = 0.1\n", "a reel-in needs both 'reel_rate_m_s' (m/s) and 'reel_in_m' (m) > 0"),
+    ("reel_in_m = 2.0\n", "a reel-in needs both"),
+    ("start = 3.0\ndelay_travel_m = 2.0\n", "a delay goes with start = 'first_contact'"),
+    ("standoff = 20.0\n", "standoff"),
+])
+def test_tether_keys_refused_with_a_clear_error(tmp_path, extra, expected):
+    message = _load_modified(tmp_path, "\n[bullets]", TETHER + extra + "\n[bullets]")
+    assert expected in message and "bad.toml" in message
+
+
+@pytest.mark.parametrize("simulation, expected", [
+    ('coupling = "sequential"\n', "net.tether ties the net to the chaser while it wraps free debris"),
+    ('net_integration = "exudyn"\n', "net.tether's force is evaluated inside the compiled kernel"),
+])
+def test_tether_refused_without_free_debris_or_the_kernel(tmp_path, simulation, expected):
+    text = REFERENCE.replace("\n[bullets]", TETHER + "\n[bullets]", 1).replace(
+        '[simulation]\n', '[simulation]\n' + simulation, 1)
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(CaseError, match=expected):
+        load_case(path)
+
+
+def test_tether_case_ties_the_middle_node_to_an_anchor_behind_the_net(tmp_path):
+    from multibody.net_tether import central_node
+    from riskassess.models.impact import build_net, tether_spec
+    path = tmp_path / "tether.toml"
+    path.write_text(REFERENCE.replace("\n[bullets]", TETHER + "\n[bullets]", 1))
+    case = load_case(path)
+    tether = case.net.tether
+    assert tether.start == "first_contact" and tether.slack_m == 0.0 and tether.reel_rate_m_s == 0.0
+    net, _ = build_net(case)
+    spec = tether_spec(case, net)
+    n = case.net.nodes_per_side
+    assert spec.node == central_node(n) and n % 2 == 1
+    # the middle node of an odd grid is the grid's centre; the anchor 15 m (the default standoff) behind it
+    direction = np.asarray(case.launch.direction) / np.linalg.norm(case.launch.direction)
+    np.testing.assert_allclose(net.positions[spec.node], net.positions[: n * n].mean(axis=0), atol=1e-12)
+    np.testing.assert_allclose(spec.anchor_lvlh, net.positions[spec.node] - 15.0 * direction, atol=1e-12)
+    assert spec.stiffness == 3000.0 and spec.axial_rigidity is None and spec.start is None and spec.delay == 0.0
