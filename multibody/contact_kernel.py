@@ -90,6 +90,32 @@ def _apply_contact_pair(i, b, fx, fy, fz, com_lvlh, weight, x, net_force_lvlh, b
     out_node_impulse[i, 2] += fz * weight
 
 
+@njit(cache=True, inline="always")
+def _apply_each_contact(i, k, strongest, fx, fy, fz, impulses, c_body, step, stage_weight, com_lvlh, x, net_force_lvlh,
+                        body_force_lvlh, torque_lvlh, out_body_impulse, out_node_impulse):
+    """Node ``i``'s ``k`` >= 2 contacts of one sub-cycle: the node takes its mean kick f = (fx, fy, fz) (N, LVLH) and
+    each body the reaction of its own contact's impulse over the step (``impulses`` (>= k, 3), N s, on the node).
+
+    Contact c other than the ``strongest`` acts as the mean force J_c / h on the pair; the strongest takes the rest
+    of f, f - sum_(c != s) J_c / h, and the node's carried remainder m (v_end - v_mean) at the next evaluation
+    (``lag_body``), so over the two evaluations every body gets -J_c, to round-off, and the node sum J_c. Until
+    2026-11-28 every body got a share of the node's net kick in proportion to |J_c|: a node squeezed between two
+    bodies (J_1 = -J_2, net kick 0) pushed on neither, the bodies closed on it unresisted and its contact's
+    energy grew without bound (the pinch scene of ``tests/multibody/test_contact_pinch.py``: +740 J on 2.5 J)."""
+    weight = step * stage_weight
+    inverse_step = 1.0 / step
+    rest_x, rest_y, rest_z = fx, fy, fz
+    for c in range(k):
+        if c == strongest:
+            continue
+        gx, gy, gz = impulses[c, 0] * inverse_step, impulses[c, 1] * inverse_step, impulses[c, 2] * inverse_step
+        rest_x, rest_y, rest_z = rest_x - gx, rest_y - gy, rest_z - gz
+        _apply_contact_pair(i, c_body[c], gx, gy, gz, com_lvlh, weight, x, net_force_lvlh, body_force_lvlh,
+                            torque_lvlh, out_body_impulse, out_node_impulse)
+    _apply_contact_pair(i, c_body[strongest], rest_x, rest_y, rest_z, com_lvlh, weight, x, net_force_lvlh,
+                        body_force_lvlh, torque_lvlh, out_body_impulse, out_node_impulse)
+
+
 #: Phase of a contact's linearized oscillation (rad) per contact sub-step. 0.06 is the
 #: 2 us sub-step of the seed paper's 7.7 g node striking at 20 m/s, which reproduces the
 #: analytic Hunt-Crossley rebound within 0.5 % (tests/multibody/test_contact.py).
@@ -342,22 +368,20 @@ def add_contact_forces(x, v, net, states, bodies, shapes, law, step, n_substeps,
                     k_contact, exponent, d_contact, mu_s, mu_k, v_transition,
                     impulses, work_delta, work_recoil, work_forces)
             scale = net_mass[i] / step
-            # The reaction goes to the bodies in proportion to their impulses (weights sum to 1,
-            # so momentum exchange stays exact).
             # in scalars: a slice here (a view) costs a reference count per contact node and step
-            total = 0.0
             strongest = 0
             for c in range(k):
                 impulse_norm[c] = math.sqrt(impulses[c, 0] ** 2 + impulses[c, 1] ** 2 + impulses[c, 2] ** 2)
-                total += impulse_norm[c]
                 if impulse_norm[c] > impulse_norm[strongest]:
                     strongest = c
-            for c in range(k):
-                weight = impulse_norm[c] / total if total > 0.0 else 1.0 / k
-                _apply_contact_pair(i, c_body[c], weight * scale * mx, weight * scale * my, weight * scale * mz,
-                                    com_lvlh, step * stage_weight, x, net_force_lvlh, body_force_lvlh, torque_lvlh,
-                                    out_body_impulse,
+            if k == 1:
+                _apply_contact_pair(i, c_body[0], scale * mx, scale * my, scale * mz, com_lvlh, step * stage_weight,
+                                    x, net_force_lvlh, body_force_lvlh, torque_lvlh, out_body_impulse,
                                     out_node_impulse)
+            else:
+                _apply_each_contact(i, k, strongest, scale * mx, scale * my, scale * mz, impulses, c_body, step,
+                                    stage_weight, com_lvlh, x, net_force_lvlh, body_force_lvlh, torque_lvlh,
+                                    out_body_impulse, out_node_impulse)
             lag_x, lag_y, lag_z = ex - mx, ey - my, ez - mz
             dissipated_total += dissipated * stage_weight
         # Release the lag carried from the previous step (zero without sub-cycling).

@@ -79,6 +79,19 @@ class ClusterWork(NamedTuple):
     thread_energy: np.ndarray   # (m,) out: each thread's contact energy at the end of the sub-cycle (J)
     thread_lost: np.ndarray     # (m,) out: energy each thread's contact dissipated (J)
     node_lost: np.ndarray       # (n,) out: energy each owned node contact dissipated (J)
+    # a thread of the cluster also in contact with another box this step (a thread pinched between two bodies): that
+    # box's contact with it, predicted here (it moves the thread's nodes, its impulse is that box's cluster's)
+    n_foreign: np.ndarray       # (1,) int64 such (thread row, other box) entries
+    foreign_row: np.ndarray     # (m,) int64 the entry's thread row
+    foreign_shape: np.ndarray   # (m,) int64 the other box
+    foreign_rotation: np.ndarray  # (m, 3, 3) the other box's frame to this box's frame
+    foreign_origin: np.ndarray  # (m, 3) the other body's CoM in this box's frame, relative to this body's (m)
+    foreign_velocity: np.ndarray  # (m, 3) its velocity less this body's material point's there (m/s), this box's frame
+    foreign_spin: np.ndarray    # (m, 3) its angular velocity less this body's (rad/s), this box's frame
+    foreign_inverse_mass: np.ndarray  # (m,) 1 / the other body's mass (1/kg)
+    foreign_work: np.ndarray    # (3, 2, 3) work: the thread's nodes' positions, velocities and forces in the other
+                                # box's frame
+    foreign_node: np.ndarray    # (2, 2) work: the thread's nodes' masses (kg) and radii (m)
 
 
 def cluster_work(n_nodes: int, n_threads: int) -> ClusterWork:
@@ -91,7 +104,12 @@ def cluster_work(n_nodes: int, n_threads: int) -> ClusterWork:
                        mean_change=np.zeros((n, 3)),
                        end_change=np.zeros((n, 3)), predicted=np.zeros((n, 3)), relative=np.zeros((n, 3)),
                        force=np.zeros((n, 3)), own_force=np.zeros((n, 3)), thread_energy=np.zeros(m),
-                       thread_lost=np.zeros(m), node_lost=np.zeros(n))
+                       thread_lost=np.zeros(m), node_lost=np.zeros(n), n_foreign=np.zeros(1, np.int64),
+                       foreign_row=np.zeros(m, np.int64), foreign_shape=np.zeros(m, np.int64),
+                       foreign_rotation=np.zeros((m, 3, 3)), foreign_origin=np.zeros((m, 3)),
+                       foreign_velocity=np.zeros((m, 3)), foreign_spin=np.zeros((m, 3)),
+                       foreign_inverse_mass=np.zeros(m), foreign_work=np.zeros((3, 2, 3)),
+                       foreign_node=np.ones((2, 2)))
 
 
 @njit(cache=True, **NO_REFCOUNTS)
@@ -271,6 +289,44 @@ def _thread_contact_force(ka, kc, x, w, mass, box_min, box_max, s, radius, law, 
 
 
 @njit(cache=True, **NO_REFCOUNTS)
+def _foreign_contact_kick(cluster, f, x, w, mass, radius, box_min, box_max, law, t, dt, work, p):
+    """Entry ``f`` of the cluster's other-box contacts over a sub-step at time ``t``: the thread's contact with the
+    other box (held in its start pose relative to this body, moving with its start relative velocity and spin) from
+    the nodes' current positions ``x`` and velocities ``w`` (relative to this body, this box's frame), into their
+    predicted velocity changes ``p`` (m/s). The other body is carried along by this body's recoil within the step (the
+    sub-cycle's frame), its own recoil is not followed: a recoil moves a body by about F h^2 / (2 m) within a step,
+    3e-9 m for a 500 N squeeze of the 832 kg ASAR at 1e-4 s, against a 0.2 mm squeeze."""
+    r = cluster.foreign_row[f]
+    s2 = cluster.foreign_shape[f]
+    rot, origin = cluster.foreign_rotation[f], cluster.foreign_origin[f]
+    velocity, spin = cluster.foreign_velocity[f], cluster.foreign_spin[f]
+    position2, velocity2, force2 = cluster.foreign_work[0], cluster.foreign_work[1], cluster.foreign_work[2]
+    rows = (cluster.threads[r, 0], cluster.threads[r, 1])
+    for k in range(2):
+        i = rows[k]
+        # the node relative to the other body's CoM, and to its material point there, this box's frame
+        dx = x[i, 0] - origin[0] - velocity[0] * t
+        dy = x[i, 1] - origin[1] - velocity[1] * t
+        dz = x[i, 2] - origin[2] - velocity[2] * t
+        vx = w[i, 0] - velocity[0] - (spin[1] * dz - spin[2] * dy)
+        vy = w[i, 1] - velocity[1] - (spin[2] * dx - spin[0] * dz)
+        vz = w[i, 2] - velocity[2] - (spin[0] * dy - spin[1] * dx)
+        for d in range(3):      # into the other box's frame (the transpose of its rotation to this frame)
+            position2[k, d] = rot[0, d] * dx + rot[1, d] * dy + rot[2, d] * dz
+            velocity2[k, d] = rot[0, d] * vx + rot[1, d] * vy + rot[2, d] * vz
+        force2[k, 0] = force2[k, 1] = force2[k, 2] = 0.0
+    pair = cluster.foreign_node     # the two nodes' masses (row 0) and radii (row 1)
+    for k in range(2):
+        pair[0, k], pair[1, k] = mass[rows[k]], radius[rows[k]]
+    _thread_contact_force(0, 1, position2, velocity2, pair[0], box_min, box_max, s2, pair[1], law,
+                          cluster.foreign_inverse_mass[f], dt, work, force2)
+    for k in range(2):
+        i = rows[k]
+        for d in range(3):
+            p[i, d] += dt * (rot[d, 0] * force2[k, 0] + rot[d, 1] * force2[k, 1] + rot[d, 2] * force2[k, 2]) / mass[i]
+
+
+@njit(cache=True, **NO_REFCOUNTS)
 def thread_contact_energy(ka, kc, x, box_min, box_max, s, radius, law, work):
     """The thread's (cluster nodes ``ka``, ``kc``) contact elastic energy k q^(n+1)/(n+1) at positions ``x`` (J)."""
     geometry = thread_contact_geometry((x[ka, 0], x[ka, 1], x[ka, 2]), (x[kc, 0], x[kc, 1], x[kc, 2]), box_min,
@@ -358,6 +414,9 @@ def cluster_contact_over_step(cluster, box_min, box_max, s, body_mass, inverse_i
                                                    inverse_transition_speed, dt, own[i] != 0)
             own_force[i, 0], own_force[i, 1], own_force[i, 2] = gx, gy, gz
             cluster.node_lost[i] += lost
+        # the other boxes' contacts with the cluster's threads: predicted (they move the nodes, not applied here)
+        for f in range(cluster.n_foreign[0]):
+            _foreign_contact_kick(cluster, f, x, w, mass, radius, box_min, box_max, law, t, dt, work, p)
         # velocity updates (symplectic Euler, as the node contact's sub-cycle) and the body's recoil: every reaction
         # acts at the node it came from
         f0 = f1 = f2 = l0 = l1 = l2 = 0.0
