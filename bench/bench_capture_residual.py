@@ -109,10 +109,13 @@ def print_late(run: dict, parts: dict, late_s: float, window_s: float) -> None:
     total = parts["main"].sum(axis=1)
     mean = {name: parts[name][late].sum(axis=1).mean() for name in ("main", "near", "carried")}
     bullets = parts["main"][late][:, -n_b:].sum(axis=1).mean()
+    largest_bullet = parts["main"][late][:, -n_b:].max() if n_b else 0.0
+    bullet_mass = run["masses"][-1] if n_b else np.nan
     free = (parts["main"] * parts["free"])[late].sum(axis=1).mean()
     touching = (parts["main"] * run["touching"])[late].sum(axis=1).mean()
     print(f"  last {late_s:g} s, means (J): E_main {mean['main']:.3f}, E_near {mean['near']:.3f}, carried {mean['carried']:.4f}; "
-          f"bullets {bullets:.3f} ({bullets / mean['main']:.0%}); nodes > free distance {free:.3f} ({free / mean['main']:.0%}); "
+          f"bullets {bullets:.3f} ({bullets / mean['main']:.0%}; the largest single bullet {largest_bullet:.3f} J, "
+          f"{np.sqrt(2.0 * largest_bullet / bullet_mass):.2f} m/s); nodes > free distance {free:.3f} ({free / mean['main']:.0%}); "
           f"touching {touching:.3f} ({touching / mean['main']:.1%}); centre {parts['centre'][late].mean():.3f}, rotation "
           f"{parts['rotation'][late].mean():.3f}, deformation {parts['deformation'][late].mean():.3f}; appendages "
           + " ".join(f"{a:.4f}" for a in parts["appendages"][late].mean(axis=0)))
