@@ -15,10 +15,10 @@ from multibody.assembly import ContactLaw, ImpactAssembly, RigidBodySpec, Solver
 from multibody.closing import (N_CLOSING, append_closing_loop, closing_loop, closing_threads, loop_elastic_energy,
                                reel_fraction, reeled_rest_lengths)
 from multibody.closing_winch import ClosingSpec
-from multibody.health import HealthWatch
 from multibody.impact import ImpactSimulation
 from multibody.net import flat_square_net
 from multibody.net_wrap import towing_net
+from tests.conftest import run_unwatched
 
 
 def _reeled_net_assembly(step, end_time=0.3, start=0.05, delay=0.0, seed=0):
@@ -39,9 +39,7 @@ def _reeled_net_assembly(step, end_time=0.3, start=0.05, delay=0.0, seed=0):
 
 
 def _run(assembly):
-    simulation = ImpactSimulation(assembly)
-    simulation.health = HealthWatch("", None)  # the balance is what these tests measure
-    return simulation, simulation.run()
+    return run_unwatched(assembly)  # the balance is what these tests measure
 
 
 @pytest.fixture(scope="module")

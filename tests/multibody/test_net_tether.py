@@ -17,12 +17,11 @@ import pytest
 import trimesh
 
 from multibody.assembly import ContactLaw, ImpactAssembly, RigidBodySpec, SolverSpec
-from multibody.health import HealthWatch
-from multibody.impact import ImpactSimulation
 from multibody.net import NetTopology
 from multibody.net_tether import (DISSIPATED, ELASTIC, FORCE_ON_CHASER, ON, REST, STIFFNESS, TENSION, add_tether_force,
                                   anchor_point, central_node, net_tether, reeled_rest_length)
 from multibody.tether_spool import TetherSpec
+from tests.conftest import run_unwatched
 
 STIFFNESS_N_M, DRIFT_M_S, ANCHOR_DISTANCE_M = 10.0, 0.1, 5.0
 
@@ -51,9 +50,7 @@ def _tethered_net_assembly(damping=0.0, end_time=1.5, reel_rate=0.0, reel_in=0.0
 
 
 def _run(assembly):
-    simulation = ImpactSimulation(assembly)
-    simulation.health = HealthWatch("", None)  # the balance is what these tests measure
-    return simulation, simulation.run()
+    return run_unwatched(assembly)  # the balance is what these tests measure
 
 
 @pytest.fixture(scope="module")
