@@ -10,7 +10,10 @@ integration error):
   -0.2 m/s), printed: the balance's largest change, the plates' end velocities along y, the momentum's changes;
 - the thread pinch (:func:`thread_pinch`): a 0.4 m thread across two 1000 kg bars closing on its middle at 0.01 m/s
   each (Envisat sample 9's pinch: about 500 N on a thread point), bars face to face or 2 cm apart along the thread,
-  with and without Hunt-Crossley damping, printed: the booked contact dissipation and the balance's change.
+  with and without Hunt-Crossley damping, printed: the booked contact dissipation and the balance's change;
+- the shared-node pinch (:func:`shared_node_pinch`, helper cluster22): the thread pinch with a tether from its node to
+  a bullet, on bar b only (sample 9's tether 423), the companion threads off (main before cluster22) and on, printed:
+  the booked contact dissipation, the balance's change and the momentum's.
 
 Prints the CPU time of each run and the load.
 """

@@ -11,7 +11,7 @@ def run(self, *a, **k):
 ImpactSimulation.run = run
 orig_spec = bp.SolverSpec
 bp.SolverSpec = lambda **kw: orig_spec(**(kw | {"net_output_rate": 1.0 / kw["step"]}))
-s = bp.shared_node_pinch(float(sys.argv[1]), float(sys.argv[2]), sys.argv[3] == "1")
+s = bp.shared_node_pinch(float(sys.argv[1]), float(sys.argv[2]), sys.argv[3] == "1")   # step, alpha, companions
 sim, r = results[-1]
 print({k: np.shape(v) for k, v in r.net.items()})
 shapes = sim.system.kernel.shapes
