@@ -360,7 +360,9 @@ def _cluster_on_box(first, last, n_pairs, x, v, net_force_lvlh, net, states, bod
     this step) when all the node's threads in contact touch this box; otherwise (threads on several boxes) the
     node contact integrates it with all the threads' pushes and the cluster only predicts it. Each node's impulse
     goes through the first of its threads in the cluster (its carried remainder too); the body takes every
-    reaction at the nodes."""
+    reaction at the nodes. The threads of the cluster also in contact with other boxes, and the threads on other
+    boxes only that share its nodes (:func:`_companion_threads`), feel those boxes' contacts in the sub-cycle as
+    predictions (:func:`_foreign_boxes`)."""
     seg = buffers.segments
     cw = seg.cluster
     threads, radius = net.threads, net.radius
