@@ -139,6 +139,9 @@ class SegmentBuffers(NamedTuple):
     cluster_parent: np.ndarray      # (ns n,) int64 work: union-find over (node, box)
     root_cluster: np.ndarray        # (ns n,) int64 work: each root's cluster, -1 between uses
     cluster: ClusterWork            # one cluster's nodes and threads for its sub-cycle (multibody.segment_cycle)
+    companions: np.ndarray          # (1,) int64 1: a cluster also follows the threads on other boxes only that share
+                                    # its nodes (_companion_threads; the default), 0: not (main before helper cluster22,
+                                    # for A/B runs switched from outside the kernel)
     sharing: np.ndarray             # (2, m) int64 the most threads in contact at either node of the thread, the last
                                     # step and this one (0: the thread not in contact)
     jump_by_sharing: np.ndarray     # (2, 6) the energy made between steps (J, row 0) and the thread-steps it sums (row
@@ -177,6 +180,7 @@ def segment_buffers(n_threads: int, n_nodes: int, n_shapes: int, n_bodies: int, 
                           pair_shape=np.zeros(m * ns, np.int64), pair_order=np.zeros(m * ns, np.int64),
                           cluster_start=np.zeros(m * ns + 1, np.int64), cluster_parent=np.zeros(ns * n, np.int64),
                           root_cluster=np.full(ns * n, -1, np.int64), cluster=cluster_work(n, m),
+                          companions=np.ones(1, np.int64),
                           sharing=np.zeros((2, m), np.int64), jump_by_sharing=np.zeros((2, 6)))
 
 
@@ -356,10 +360,12 @@ def _cluster_on_box(first, last, n_pairs, x, v, net_force_lvlh, net, states, bod
     this step) when all the node's threads in contact touch this box; otherwise (threads on several boxes) the
     node contact integrates it with all the threads' pushes and the cluster only predicts it. Each node's impulse
     goes through the first of its threads in the cluster (its carried remainder too); the body takes every
-    reaction at the nodes."""
+    reaction at the nodes. The threads of the cluster also in contact with other boxes, and the threads on other
+    boxes only that share its nodes (:func:`_companion_threads`), feel those boxes' contacts in the sub-cycle as
+    predictions (:func:`_foreign_boxes`)."""
     seg = buffers.segments
     cw = seg.cluster
-    threads, net_mass, radius = net.threads, net.mass, net.radius
+    threads, radius = net.threads, net.radius
     rot, com_lvlh = states.body_to_lvlh, states.com_lvlh
     s = seg.pair_shape[seg.pair_order[first]]
     b = shapes.body[s]
@@ -373,20 +379,12 @@ def _cluster_on_box(first, last, n_pairs, x, v, net_force_lvlh, net, states, bod
         for e in range(2):
             i = threads[j, e]
             if cw.row[i] < 0:
-                cw.row[i] = k
-                cw.node[k] = i
-                cw.carrier[k] = r
-                position = _to_body(x, i, rot, com_lvlh, b)
-                rel, acc = _node_motion(i, b, x, v, net_force_lvlh, net_mass, buffers.velocity_lag,
-                                        seg.lag_velocity_lvlh, states, half_kick)
-                for d in range(3):
-                    cw.position[k, d], cw.velocity[k, d], cw.acceleration[k, d] = position[d], rel[d], acc[d]
-                cw.mass[k], cw.radius[k] = net_mass[i], radius[i]
                 cw.own[k] = 1 if seg.node_shape[i] == s else 0
+                _node_row(i, k, r, b, x, v, net_force_lvlh, net, states, half_kick, buffers)
                 if cw.own[k] == 1:
                     seg.owned_shape[i] = s
-                    depth = radius[i] - box_signed_distance(position[0], position[1], position[2], box_min, box_max,
-                                                            s)[0]
+                    depth = radius[i] - box_signed_distance(cw.position[k, 0], cw.position[k, 1], cw.position[k, 2],
+                                                            box_min, box_max, s)[0]
                     if depth > 0.0:
                         energy += hertz_elastic_energy(depth, law.stiffness, law.exponent)
                         count += 1
@@ -399,6 +397,9 @@ def _cluster_on_box(first, last, n_pairs, x, v, net_force_lvlh, net, states, bod
         if (p > 0 and seg.pair_thread[p - 1] == cw.thread[r]) or (p + 1 < n_pairs
                                                                    and seg.pair_thread[p + 1] == cw.thread[r]):
             _foreign_boxes(r, p, n_pairs, s, b, states, bodies, shapes, seg, cw)
+    if seg.companions[0] != 0:
+        k = _companion_threads(k, m, n_pairs, s, b, x, v, net_force_lvlh, net, states, bodies, shapes, half_kick,
+                               buffers)
     cw.n_nodes[0], cw.n_threads[0] = k, m
     n_cycle = 1
     for r in range(m):
@@ -445,6 +446,70 @@ def _cluster_on_box(first, last, n_pairs, x, v, net_force_lvlh, net, states, bod
 
 
 @njit(cache=True, **NO_REFCOUNTS)
+def _node_row(i, k, r, b, x, v, net_force_lvlh, net, states, half_kick, buffers):
+    """Net node ``i`` as row ``k`` of the cluster on body ``b``, carried by thread row ``r``: its position in the
+    body's frame (m), its velocity relative to the body's material point (m/s) and its non-contact acceleration held
+    over the step (m/s^2), its mass (kg) and contact radius (m). ``cw.own[k]`` is the caller's."""
+    seg = buffers.segments
+    cw = seg.cluster
+    cw.row[i] = k
+    cw.node[k] = i
+    cw.carrier[k] = r
+    position = _to_body(x, i, states.body_to_lvlh, states.com_lvlh, b)
+    rel, acc = _node_motion(i, b, x, v, net_force_lvlh, net.mass, buffers.velocity_lag, seg.lag_velocity_lvlh,
+                            states, half_kick)
+    for d in range(3):
+        cw.position[k, d], cw.velocity[k, d], cw.acceleration[k, d] = position[d], rel[d], acc[d]
+    cw.mass[k], cw.radius[k] = net.mass[i], net.radius[i]
+
+
+@njit(cache=True, **NO_REFCOUNTS)
+def _companion_threads(k, m, n_pairs, s, b, x, v, net_force_lvlh, net, states, bodies, shapes, half_kick, buffers):
+    """The threads in contact with other boxes only that share a node with the cluster on box ``s`` (transitively,
+    through their own nodes), as rows ``m``, ``m + 1``, ... of the cluster after its ``m`` own threads, their new
+    nodes as rows ``k``, ``k + 1``, ...; each of their boxes an entry of the cluster's other-box contacts
+    (:func:`_foreign_boxes`): the sub-cycle moves the shared nodes under those contacts too (predicted; they are
+    applied and booked by the other boxes' clusters). Returns the cluster's nodes.
+
+    Sample 9 of the 1.0 m/s row (docs/model.md, "A net pinched between two bodies"): thread 419 pinched between the
+    main body and the ASAR, thread 423 (node 224 to bullet 228) on the ASAR alone. The main body's cluster moved node
+    224 without thread 423's contact, the ASAR's with it: the two clusters followed two paths of the shared node."""
+    seg = buffers.segments
+    cw = seg.cluster
+    threads = net.threads
+    rows = m
+    added = True
+    while added:
+        added = False
+        p = 0
+        while p < n_pairs:
+            j, first = seg.pair_thread[p], p
+            on_box = False
+            while p < n_pairs and seg.pair_thread[p] == j:      # a thread's pairs lie next to each other
+                on_box = on_box or seg.pair_shape[p] == s
+                p += 1
+            if on_box or (cw.row[threads[j, 0]] < 0 and cw.row[threads[j, 1]] < 0):
+                continue
+            known = False
+            for r in range(m, rows):
+                known = known or cw.thread[r] == j
+            if known:
+                continue
+            cw.thread[rows] = j
+            for e in range(2):
+                i = threads[j, e]
+                if cw.row[i] < 0:
+                    cw.own[k] = 0
+                    _node_row(i, k, rows, b, x, v, net_force_lvlh, net, states, half_kick, buffers)
+                    k += 1
+                cw.threads[rows, e] = cw.row[i]
+            _foreign_boxes(rows, first, n_pairs, s, b, states, bodies, shapes, seg, cw)
+            rows += 1
+            added = True
+    return k
+
+
+@njit(cache=True, **NO_REFCOUNTS)
 def _foreign_boxes(r, p, n_pairs, s, b, states, bodies, shapes, seg, cw):
     """Thread row ``r`` of the cluster on box ``s`` (body ``b``), whose thread also has contact pairs on other boxes
     this step (``seg.pair_thread`` holds a thread's pairs next to each other, around pair ``p``): each other box as an
@@ -470,6 +535,8 @@ def _foreign_boxes(r, p, n_pairs, s, b, states, bodies, shapes, seg, cw):
             continue
         b2 = shapes.body[s2]
         f = cw.n_foreign[0]
+        if f == cw.foreign_row.shape[0]:
+            return      # more other-box contacts than the net has threads: the rest not predicted
         cw.n_foreign[0] = f + 1
         cw.foreign_row[f], cw.foreign_shape[f] = r, s2
         cw.foreign_inverse_mass[f] = 1.0 / bodies.mass[b2]

@@ -60,7 +60,9 @@ class ClusterWork(NamedTuple):
     n_nodes: np.ndarray         # (1,) int64 nodes in the cluster
     n_threads: np.ndarray       # (1,) int64 threads in the cluster
     node: np.ndarray            # (n,) int64 each row's net node
-    thread: np.ndarray          # (m,) int64 each thread row's net thread
+    thread: np.ndarray          # (m,) int64 each thread row's net thread; rows from n_threads on: threads on other boxes
+                                # only that share the cluster's nodes (contact_segment._companion_threads), whose
+                                # contacts are only predicted (foreign entries)
     threads: np.ndarray         # (m, 2) int64 each thread's two nodes as cluster rows
     row: np.ndarray             # (n,) int64 each net node's cluster row, -1 when not in the cluster being built
     carrier: np.ndarray         # (n,) int64 each node row's first thread row: the thread that carries its impulse
