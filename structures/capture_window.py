@@ -15,6 +15,12 @@ and net snapshot) so that the simulation stops once the capture is over; the ver
 recorded series (:func:`capture_window`) and judges a location that held as indeterminate when the run reached its
 end time before the capture was over (:func:`capture_gap`).
 
+The reference is the main body, not each node's nearest body: on the kept whole-capture runs at 1-3 m/s the
+part of it an appendage's swing carries (nodes riding on the array) is at most 0.2 mJ of the 0.2-6 J left over the
+last 10 s before the cap, the array's own energy relative to the main body at most 4.9 mJ; the rest is the net's and
+the bullets' own motion, 80-99 % of it more than 0.5 m from every body (docs/structures.md, "What the
+energy left at the cap is", :mod:`multibody.relative_motion`).
+
 All quantities SI; positions and velocities in LVLH (velocities relative to the LVLH axes, as the model integrates
 them), the body's angular velocity relative to the LVLH axes (what ``body_omega_body`` holds, expressed in the
 body frame; :func:`omega_lvlh` rotates it).
