@@ -81,7 +81,26 @@ class ClosingSpec:
     axial_rigidity: float
 
 
-class ClosingWinch:
+class TrapezoidWork:
+    """The work a reel does on the net by changing natural lengths, booked by the trapezoid rule: half of each
+    update's elastic-energy change at the positions before the step that uses it (:meth:`book_update`), half at
+    the positions that step ended in (:meth:`book_pending`); second order in the step (either end alone is first
+    order, measured in tests/multibody/test_closing.py). Subclasses give ``_energy_change(rest_from, rest_to)``
+    (J, at the current positions) and start with ``work = 0.0`` and ``_pending = None``."""
+
+    def book_update(self, rest_before, rest_after) -> None:
+        """Book the first half of the work of the update ``rest_before`` -> ``rest_after`` (m) now."""
+        self.work += 0.5 * self._energy_change(rest_before, rest_after)
+        self._pending = (rest_before, rest_after)
+
+    def book_pending(self) -> None:
+        """Book the second half of the last update's work, at the positions the step that used it ended in."""
+        if self._pending is not None:
+            self.work += 0.5 * self._energy_change(*self._pending)
+            self._pending = None
+
+
+class ClosingWinch(TrapezoidWork):
     """Reels the closing loop in inside a running impact (module doc).
 
     Parameters
@@ -168,14 +187,6 @@ class ClosingWinch:
         return (loop_elastic_energy(x_lvlh, self.threads, rest_to, a)
                 - loop_elastic_energy(x_lvlh, self.threads, rest_from, a))
 
-    def book_pending(self) -> None:
-        """Book the second half of the last update's work, at the positions the step that used it ended in (the
-        first half was booked at the positions before it: the trapezoid rule over the step, second order in the
-        step; either end alone is first order, measured in tests/multibody/test_closing.py)."""
-        if self._pending is not None:
-            self.work += 0.5 * self._energy_change(*self._pending)
-            self._pending = None
-
     def after_step(self, t: float) -> None:
         """After the step that ended at ``t`` (s): watch for the trigger, then set the loop's natural lengths and
         stiffnesses for the next step's evaluation (at ``t + step``) and book half the work of the change at the
@@ -189,8 +200,7 @@ class ClosingWinch:
             self._take_up_slack()
         rest_before = self.rest[self.index].copy()
         rest = self.natural_lengths(t_next)
-        self.work += 0.5 * self._energy_change(rest_before, rest)
-        self._pending = (rest_before, rest)
+        self.book_update(rest_before, rest)
         self.rest[self.index] = rest
         self.stiffness[self.index] = closing_stiffness(self.spec.axial_rigidity, rest)
         self.closed = reel_fraction(t_next, self.activated_at, self.spec.duration) >= 1.0

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multibody.closing_winch import ContactTrigger
+from multibody.closing_winch import ContactTrigger, TrapezoidWork
 from multibody.net_tether import (
     DISSIPATED,
     FORCE_ON_CHASER,
@@ -71,7 +71,7 @@ class TetherSpec:
         return net_tether(self.node, self.anchor_lvlh, self.damping)
 
 
-class TetherSpool:
+class TetherSpool(TrapezoidWork):
     """Brakes and reels the main tether inside a running impact (module doc).
 
     Parameters
@@ -129,13 +129,6 @@ class TetherSpool:
         return (tether_elastic_energy(length, rest_to, self.stiffness(rest_to))
                 - tether_elastic_energy(length, rest_from, self.stiffness(rest_from)))
 
-    def book_pending(self) -> None:
-        """Book the second half of the last reel update's work at the position the step that used it ended in
-        (the trapezoid rule, :meth:`multibody.closing_winch.ClosingWinch.book_pending`)."""
-        if self._pending is not None:
-            self.work += 0.5 * self._energy_change(*self._pending)
-            self._pending = None
-
     def _watch(self, t: float) -> None:
         """The step that ended at ``t`` (s): its tension's peak and the first taut step."""
         tension = self.state[TENSION]
@@ -171,8 +164,7 @@ class TetherSpool:
         rest = reeled_rest_length(self.rest_braked, self.spec.reel_rate, t_next - self.braked_at, self.spec.reel_in)
         if rest == rest_before:
             return
-        self.work += 0.5 * self._energy_change(rest_before, rest)
-        self._pending = (rest_before, rest)
+        self.book_update(rest_before, rest)
         self.state[REST] = rest
         self.state[STIFFNESS] = self.stiffness(rest)
 
