@@ -6,8 +6,8 @@ from scipy.spatial.transform import Rotation
 
 from perception.pose_graph import jointly_optimized, optimized_poses
 from perception.scan_to_map import alignments, thinned_scan
-from tests.perception.test_scan_to_map import (COM0, CORRESPONDENCE, VELOCITY, VOXEL, _spin_angle_deg,  # noqa: F401
-                                               tumble)
+from tests.perception.conftest import COM0, CORRESPONDENCE, VELOCITY, VOXEL
+from tests.perception.test_scan_to_map import _spin_angle_deg
 
 
 def _true_world_to_body(tumble):
