@@ -1153,9 +1153,10 @@ def _posed_scan_to_scan(tracker, frames, indices, observation, registration, tar
     (:func:`perception.pose_graph.scan_to_scan_poses`, from their registered poses), keeping each frame's
     information; their attitude errors scored again. Returns the answer's figures of it (CPU in ms a frame)."""
     tic = time.process_time()
+    observation_poses, observation_clouds, observation_ok = observation
     starts = {int(k): tracker.alignments[k].world_to_body for k in indices}
-    poses = scan_to_scan_poses({k: frames.debris_returns[k] for k in starts}, starts, *observation[:2],
-                               observation[2], registration.voxel, registration.max_correspondence)
+    poses = scan_to_scan_poses({k: frames.debris_returns[k] for k in starts}, starts, observation_poses,
+                               observation_clouds, observation_ok, registration.voxel, registration.max_correspondence)
     for k, pose in poses.items():
         tracker.alignments[k] = dataclasses.replace(tracker.alignments[k], world_to_body=pose)
         frames.rotation_error[k] = rotation_error(tracker.alignments[k].body_to_world[:3, :3],
