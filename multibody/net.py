@@ -15,6 +15,7 @@ import numpy as np
 from numba import njit, uint64
 
 from multibody.jit_cache import NO_REFCOUNTS
+from multibody.relative_motion import velocity_field
 
 
 @dataclass(frozen=True)
@@ -288,11 +289,11 @@ def net_kinetic_energy_relative_to_body(masses, positions, velocities, body_com,
     single = x.ndim == 2
     x = x[None] if single else x
     v = np.asarray(velocities, float).reshape(x.shape)
-    c, vc, w = (np.asarray(a, float).reshape(-1, 1, 3) for a in (body_com, body_velocity, omega))
+    c, vc, w = (np.asarray(a, float).reshape(-1, 3) for a in (body_com, body_velocity, omega))
     m = np.asarray(masses, float)
     if m.shape != (x.shape[1],):
         raise ValueError(f"masses must have shape ({x.shape[1]},) like the nodes. Got {m.shape} instead")
-    relative = v - vc - np.cross(w, x - c)
+    relative = v - velocity_field(x, c, vc, w)
     energy = 0.5 * np.einsum("n,kni,kni->k", m, relative, relative)
     return float(energy[0]) if single else energy
 
