@@ -55,13 +55,13 @@ from multibody.recorder_kernel import (
     EXTRA_MEAN_MOTION,
     EXTRA_RELEASED_ENERGY,
     N_EXTRAS,
-    RecorderModel,
     SampledBodies,
     SampledJoints,
     body_sample_buffers,
     book_joint_dampers,
     damper_work_buffers,
     filter_joint_loads,
+    new_recorder_model,
     sample_row,
 )
 from multibody.load_filter import OUTPUT, filter_bank
@@ -254,12 +254,12 @@ class Recorder:
         self._book_dampers = bool(nj) and bool(np.any(self._joints.damping != 0.0))
         self._half_kick = 0.5 * assembly.solver.step if assembly.solver.integrator == "VelocityVerlet" else 0.0
         n_coordinates = len(data.GetODE2Coordinates_t(copy=False))
-        self._model = RecorderModel(self._bodies, self._joints, self._joint_active_float,
-                                    system.kernel.buffers.body_impulse_lvlh, self._body_out, self._net_masses,
-                                    np.ascontiguousarray(system.kernel.net.reference_lvlh, float),
-                                    np.array(net_layout, np.int64), self._net_totals, system.kernel.buffers.scalars,
-                                    self._row, np.array(columns, np.int64), self._extras,
-                                    damper_work_buffers(n_coordinates, nb))
+        self._model = new_recorder_model(self._bodies, self._joints, self._joint_active_float,
+                                         system.kernel.buffers.body_impulse_lvlh, self._body_out, self._net_masses,
+                                         np.ascontiguousarray(system.kernel.net.reference_lvlh, float),
+                                         np.array(net_layout, np.int64), self._net_totals, system.kernel.buffers.scalars,
+                                         self._row, np.array(columns, np.int64), self._extras,
+                                         damper_work_buffers(n_coordinates, nb))
         self._net_in_kernel = system.kernel_net is not None
 
     # -- Exudyn hook -----------------------------------------------------------------

@@ -437,6 +437,16 @@ structref.define_proxy(RecorderModel, RecorderModelType,
 
 
 @njit(cache=True)
+def new_recorder_model(bodies, joints, active, impulse, out, net_mass, net_reference, net_layout, net_totals, scalars,
+                       row, columns, extras, damper_work):
+    """``RecorderModel(...)`` (its fields in order), compiled once into numba's on-disk cache: the proxy class's own
+    constructor is compiled afresh in every process, 1.0 s CPU before a run's first step (measured by helper speed22,
+    2026-11-28, load 13; the net's structref had the same, :func:`multibody.kernel_net._new_net_step_model`)."""
+    return RecorderModel(bodies, joints, active, impulse, out, net_mass, net_reference, net_layout, net_totals,
+                         scalars, row, columns, extras, damper_work)
+
+
+@njit(cache=True)
 def _all_finite(values) -> bool:
     for k in range(values.shape[0]):
         if not math.isfinite(values[k]):

@@ -140,16 +140,34 @@ def settle_time(energy_time, energy_J, rise_time, energy_threshold_J: float, hol
         t_s (s).
     """
     t = np.asarray(energy_time, float)
+    start = max(judged_from_s, t[0]) if t.size else judged_from_s
+    t_s, _ = first_settled(t, np.asarray(energy_J, float), rise_time, energy_threshold_J, hold_s, start)
+    return t_s
+
+
+def first_settled(t, energy_J, rise_time, energy_threshold_J: float, hold_s: float, start: float,
+                  last_above_before: float = -np.inf) -> tuple:
+    """:func:`settle_time`'s rule on the check instants ``t`` ((k,) s, increasing) that follow earlier ones whose
+    latest time with the energy at or above the threshold was ``last_above_before`` (s; -inf: none, or no earlier
+    instants); ``start`` is the judged window's start or the first instant ever, whichever is later (s).
+
+    Returns the first of ``t`` at which the capture is over (s; None when none is) and the latest time at or above
+    the threshold up to the last of ``t`` (s), for the next call. Evaluated on a history in pieces, it answers what
+    one call on the whole history answers, to the bit: the running maximum is exact, and an instant of an earlier
+    piece that did not qualify cannot qualify later (a later rise or energy only adds conditions on later times).
+    """
+    t = np.asarray(t, float)
     e = np.asarray(energy_J, float)
     above = ~(e < energy_threshold_J)
     # the latest time at or before each t_j with the energy at or above the threshold (-inf if none)
-    last_above = np.maximum.accumulate(np.where(above, t, -np.inf)) if t.size else t
+    last_above = (np.maximum(np.maximum.accumulate(np.where(above, t, -np.inf)), last_above_before) if t.size
+                  else t)
     rises = np.sort(np.asarray(rise_time, float))
     count = np.searchsorted(rises, t, side="right")
     last_rise = np.where(count > 0, rises[np.maximum(count - 1, 0)] if rises.size else -np.inf, -np.inf)
-    start = max(judged_from_s, t[0]) if t.size else judged_from_s
     ok = (t - hold_s >= start) & (last_above < t - hold_s) & (last_rise <= t - hold_s)
-    return float(t[np.argmax(ok)]) if ok.any() else None
+    t_s = float(t[np.argmax(ok)]) if ok.any() else None
+    return t_s, (float(last_above[-1]) if t.size else last_above_before)
 
 
 def reference_body(bodies, joints, debris_indices) -> int:
@@ -337,21 +355,30 @@ class CaptureMonitor:
         self.check_interval_s = check_interval_s
         self.energy_fraction = energy_fraction
         self._modal = {loc.name: online_modal_loads(loc, interval_s) for loc in locations}
-        self._loads, self._times = [], []       # joint loads since the last check
+        # joint loads since the last check, as [force, moment] (nj, 2, 3) rows of a table that grows when full (a
+        # new stacked array a sample and a list of them cost some 10 us a sample, about 1 us of every step)
+        self._loads = np.zeros((int(np.ceil(check_interval_s / interval_s)) + 2, 0, 2, 3))
+        self._times = []
         self._modal_loads = {loc.name: [] for loc in locations}
         self._peaks = None                       # running peak of every judged demand
         self.rises: list[float] = []
         self.energy_time: list[float] = []
         self.energy_J: list[float] = []
         self._next_check = 0.0
+        self._checked = 0                        # snapshots whose instants a settle check has ruled out
+        self._last_above = -np.inf               # the latest of them with the energy at or above the threshold (s)
         self.settled_at_s: float | None = None
 
     def sample(self, t: float, force_joint, moment_joint) -> None:
         """One output sample's joint loads ((nj, 3) each: N, N m, joint frame); the demands are computed in batches
         at the settle checks (one array copy a sample; the modal filters of locations read through structural
         modes are fed here, as they must see every sample)."""
+        k = len(self._times)
+        if k == self._loads.shape[0] or self._loads.shape[1] != force_joint.shape[0]:
+            self._loads = _grown(self._loads, k, force_joint.shape[0])
+        self._loads[k, :, 0] = force_joint
+        self._loads[k, :, 1] = moment_joint
         self._times.append(t)
-        self._loads.append(np.stack([force_joint, moment_joint], axis=1))      # (nj, 2, 3)
         for loc in self.locations:
             modal = self._modal[loc.name]
             if modal is not None:
@@ -362,7 +389,7 @@ class CaptureMonitor:
         """Fold the buffered samples' demands into the running peaks (the rises after ``judged_from_s``)."""
         if not self._times:
             return
-        loads_all = np.asarray(self._loads, float)                               # (k, nj, 2, 3)
+        loads_all = self._loads[:len(self._times)]                               # (k, nj, 2, 3)
         columns = []
         for loc in self.locations:
             if self._modal[loc.name] is not None:
@@ -376,7 +403,7 @@ class CaptureMonitor:
             for criterion in loc.criteria():
                 columns.append(np.asarray(values[criterion], float).reshape(-1, n_modes).max(axis=1))
         t = np.asarray(self._times)
-        self._loads, self._times = [], []
+        self._times = []
         if not columns:
             return
         d = np.stack(columns, axis=1)
@@ -402,6 +429,21 @@ class CaptureMonitor:
             return self.settled_at_s is not None
         self._next_check = t + self.check_interval_s
         self._update_rises()
-        self.settled_at_s = settle_time(self.energy_time, self.energy_J, self.rises, self.energy_threshold_J,
-                                        self.hold_s, self.judged_from_s)
+        # settle_time's rule on the instants since the last check only (first_settled: the same answer as on the
+        # whole history; over the whole history every 0.1 s, a check cost in proportion to the simulated time)
+        start = max(self.judged_from_s, self.energy_time[0])
+        self.settled_at_s, self._last_above = first_settled(
+            self.energy_time[self._checked:], self.energy_J[self._checked:], self.rises, self.energy_threshold_J,
+            self.hold_s, start, self._last_above)
+        self._checked = len(self.energy_time)
         return self.settled_at_s is not None
+
+
+def _grown(loads, k: int, n_joints: int):
+    """The monitor's load table ``loads`` ((rows, nj, 2, 3)) with its first ``k`` rows kept and twice the rows
+    (the first sample's joint count when it had none)."""
+    if loads.shape[1] != n_joints:
+        return np.zeros((loads.shape[0], n_joints, 2, 3))
+    grown = np.zeros((2 * loads.shape[0], n_joints, 2, 3))
+    grown[:k] = loads[:k]
+    return grown

@@ -4,50 +4,13 @@ line, and the inertia ratios of the Euler-Poinsot fit."""
 from types import SimpleNamespace
 
 import numpy as np
-import pytest
-import trimesh
 from scipy.spatial.transform import Rotation
 
-from multibody.geometry import shape_mesh
-from perception.euler_poinsot import propagate_torque_free, rotations_from_wxyz
 from perception.free_flight import fit_free_motion
-from perception.lidar import cast
 from perception.registration import DebrisTracker, _cloud, known_shape_model
-from perception.scan_to_map import alignments, thinned_scan, track_scans
-from tests.perception.conftest import PAPER_MOMENTS
-
-VOXEL = 0.03             # m, the case's scan thinning
-CORRESPONDENCE = 0.1     # m, the case's ICP distance
-OMEGA0 = np.array([2.0, 0.5, 1.0])         # rad/s, Tang et al. 2023 Table 1
-COM0 = np.array([10.0, 0.0, 0.0])          # m, the case's 10 m hold distance
-VELOCITY = np.array([0.01, 0.0, -0.01])    # m/s, Tang et al. 2023 Table 1
-
-
-def _featured_debris():
-    """A satellite-like body (1.2 x 1.0 x 1.6 m bus, a 2 x 0.8 m array on one side): flat faces
-    and edges, the surface features a scan-to-map registration needs (the paper's smooth
-    ellipsoid has none about its near-symmetry axis: docs/perception.md, Known limits). Its
-    origin (the point the tumble turns about) is the bus centre."""
-    return trimesh.util.concatenate([shape_mesh("box", size=[1.2, 1.0, 1.6]),
-                                     shape_mesh("box", size=[0.05, 2.0, 0.8], center=(0.0, 1.5, 0.2))])
-
-
-@pytest.fixture(scope="module")
-def tumble(c_fans_lidar):
-    """10 s of 10 Hz scans of the featured body tumbling torque-free with the paper's normalized
-    moments and initial rates, its origin on a straight line; tracked without the mesh."""
-    times = np.arange(101) / 10.0
-    qs, _ = propagate_torque_free(np.array([1.0, 0, 0, 0]), OMEGA0, PAPER_MOMENTS / PAPER_MOMENTS[2], times, 0.005)
-    body_to_world = rotations_from_wxyz(qs).as_matrix()
-    mesh = _featured_debris()
-    rng = np.random.default_rng(3)
-    scans = [cast(c_fans_lidar, [(mesh.vertices @ r.T + COM0 + VELOCITY * t, mesh.faces)], t, rng).points_sensor
-             for t, r in zip(times, body_to_world)]
-    track = track_scans(scans, VOXEL, CORRESPONDENCE)
-    # Frame B: world axes at the first scan (the body's attitude there is the identity), origin at
-    # the first thinned scan's centroid; the true CoM sits at COM0 - centroid in B.
-    centroid = thinned_scan(scans[0], VOXEL).mean(axis=0)
-    return SimpleNamespace(times=times, body_to_world=body_to_world, track=track, com_body=COM0 - centroid, scans=scans)
+from perception.scan_to_map import alignments, track_scans
+from tests.perception.conftest import (COM0, CORRESPONDENCE, OMEGA0, PAPER_MOMENTS, VELOCITY, VOXEL,  # noqa: F401
+                                      featured_debris as _featured_debris)
 
 
 def test_first_scan_defines_the_body_frame(tumble):

@@ -13,7 +13,7 @@ from riskassess.cases.impact import CaseError, load_case
 from riskassess.stages.run import run_case
 from multibody.net import net_kinetic_energy_relative_to_body
 from structures.capture_window import (CAPTURE_ENERGY_FRACTION, CAPTURE_HOLD_TRAVEL_M, capture_gap, energy_threshold,
-                                       hold_time, omega_lvlh, rise_times, settle_time)
+                                       first_settled, hold_time, omega_lvlh, rise_times, settle_time)
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 SNAPSHOT_S = 0.02   # s, the shipped cases' net snapshots (50 Hz): the settle test's time resolution
@@ -125,6 +125,36 @@ def test_a_capture_that_never_settles_has_no_settle_time_and_a_reason():
     assert gap.reason.startswith("capture not over at end_time = 16.250 s (relative energy 57.2 J")
     assert "demand rising at 13.931 s (solar_array_hinge_panel moment)" in gap.reason
     assert capture_gap(window | {"settled": True}) is None
+
+
+def _swinging_history(rng, duration=60.0):
+    """Snapshot times (s), a decaying relative energy with lobes and noise (J) and rising running peaks (s): a
+    capture that settles at a time the seed decides, or not at all."""
+    t = np.arange(0.0, duration, SNAPSHOT_S)
+    e0, tau, period = rng.uniform(20.0, 400.0), rng.uniform(3.0, 20.0), rng.uniform(2.0, 9.0)
+    energy = e0 * np.exp(-t / tau) * np.cos(np.pi * t / period) ** 2 * rng.uniform(0.5, 1.5, t.size)
+    demand = np.maximum.accumulate(rng.gamma(0.3, 1.0, t.size) * np.exp(-t / rng.uniform(5.0, 40.0)))
+    return t, energy, rise_times(t, demand[:, None], rng.uniform(0.0, 2.0))
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_the_settle_rule_checked_in_pieces_answers_as_on_the_whole_history(seed):
+    # the running monitor applies settle_time's rule to the instants since its last check only (first_settled,
+    # carrying the latest time at or above the threshold): the answer must be the whole history's, to the bit, with
+    # the rises known at each check (those up to its time: a later rise cannot change an earlier instant's answer)
+    rng = np.random.default_rng(seed)
+    t, energy, rises = _swinging_history(rng)
+    threshold, hold, judged_from = rng.uniform(0.5, 10.0), rng.uniform(0.5, 8.0), rng.uniform(0.0, 2.0)
+    whole = settle_time(t, energy, rises, threshold, hold, judged_from)
+    cuts = np.sort(rng.choice(np.arange(1, t.size), size=rng.integers(1, 40), replace=False))
+    start, last_above, found = max(judged_from, t[0]), -np.inf, None
+    for first, last in zip(np.r_[0, cuts], np.r_[cuts, t.size]):
+        known = rises[rises <= t[last - 1]]
+        found, last_above = first_settled(t[first:last], energy[first:last], known, threshold, hold, start,
+                                          last_above)
+        if found is not None:
+            break
+    assert found == whole
 
 
 def _capture_case(tmp_path, end_time, extra=""):
