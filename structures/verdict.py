@@ -92,9 +92,10 @@ def thread_contact_energy_gap(energy_drift: float | None) -> Indeterminacy | Non
     drift = "not recorded" if energy_drift is None else f"{100 * energy_drift:.3g} %"
     return Indeterminacy("thread_contact_energy",
                          f"the threads' own contact (contact.thread_segments) is on and the energy balance drifted "
-                         f"{drift} (a verdict with it needs at most {100 * THREAD_CONTACT_DRIFT_LIMIT:g} %): its "
-                         f"strikes are not yet energy-consistent (docs/model.md, 'Contact'), so the loads carry an "
-                         f"error node contact would not have")
+                         f"{drift} (a verdict with it needs at most {100 * THREAD_CONTACT_DRIFT_LIMIT:g} %): energy "
+                         f"the integration made or lost may be in the loads; where it came from is not told by the "
+                         f"drift alone (the threads' strikes, docs/model.md 'Contact', or a closing loop's reel-in, "
+                         f"'The closing's energy dip'); a re-run at half simulation.step tells whether the step made it")
 
 
 def location_state(result: dict, gaps: list[Indeterminacy]) -> tuple[str, list[Indeterminacy]]:
