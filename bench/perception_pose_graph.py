@@ -7,7 +7,7 @@ rows (percep21's, ``perception_map_bias.py``): every fit frame, before and after
 stage's map and to the exact model. The
 last rows: every after-fit frame posed by scan-to-scan alignments to the 4 observation frames that share most of
 its coarse cells (at the online or the graph's poses), started from the stage's pose, the partners' poses averaged
-with their information (``scan_to_scan_poses``). The stage's momentum step is redone for each (``perception_substitution.replay``). Printed per capture: C's error, its
+with their information (``perception.pose_graph.scan_to_scan_poses``). The stage's momentum step is redone for each (``perception_substitution.replay``). Printed per capture: C's error, its
 stated 1-sigma, error / 1-sigma, mass, h0 and h1 from the truth, the pose graph's CPU and edges.
 
     python bench/perception_pose_graph.py CASE /tmp/percep17/capchain/none_obs20_seed{0,1,2,3,4}.pkl
@@ -22,14 +22,13 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 import perception_substitution as S
 from perception_map_bias import angle_deg, observation_scans, registered_from_truth, trackers
 from perception.net_tracking import node_velocities
-from perception.pose_graph import coarse_cells, jointly_optimized, overlap_share, pair_alignment, scan_clouds
+from perception.pose_graph import jointly_optimized, scan_clouds, scan_to_scan_poses
 from perception.registration import _cloud, known_shape_model
-from perception.scan_to_map import _transform, alignments as map_alignments, thinned_scan, track_scans
+from perception.scan_to_map import alignments as map_alignments, thinned_scan, track_scans
 
 
 def pose_graph_track(case_path, capture):
@@ -52,48 +51,6 @@ def registered_from(tracker, capture, scans_by_frame, starts) -> list:
     for k, scan in scans_by_frame.items():
         alignments[k].world_to_body = tracker._icp(_cloud(scan).voxel_down_sample(tracker.voxel), starts[k])
     return alignments
-
-
-def scan_to_scan_poses(scans_by_frame, starts, observation_poses, observation_clouds, ok, voxel, max_correspondence,
-                       partners=4) -> dict:
-    """World -> B of frames ``scans_by_frame`` (index -> scan, m, world) from scan-to-scan alignments to the
-    ``partners`` observation frames of largest coarse overlap at the start pose (``starts``: index -> world -> B),
-    each observation frame at its ``observation_poses`` (world -> B); the partners' poses averaged with their
-    information (rotation vector and translation about the start, left perturbation in B)."""
-    observation = np.flatnonzero(ok)
-    cells = {j: coarse_cells(_transform(np.asarray(observation_clouds[j].points), observation_poses[j]))
-             for j in observation}
-    poses = {}
-    for k, scan in scans_by_frame.items():
-        source = _cloud(scan).voxel_down_sample(voxel)
-        mine = coarse_cells(_transform(np.asarray(source.points), starts[k]))
-        chosen = sorted(observation, key=lambda j: -overlap_share(mine, cells[j]))[:partners]
-        information_sum, weighted = np.zeros((6, 6)), np.zeros(6)
-        for j in chosen:
-            start = np.linalg.inv(observation_poses[j]) @ starts[k]
-            transformation, information, fitness = pair_alignment(source, observation_clouds[j], start, max_correspondence)
-            if fitness < 0.5:
-                continue
-            pose = observation_poses[j] @ transformation
-            delta = pose @ np.linalg.inv(starts[k])
-            twist = np.r_[Rotation.from_matrix(delta[:3, :3]).as_rotvec(), delta[:3, 3]]
-            # the edge's information is of a left perturbation in frame j's world coordinates; in B it is the
-            # perturbation moved by pose j's adjoint [[R, 0], [t^ R, R]] (rotation first)
-            rotation, shift = observation_poses[j][:3, :3], observation_poses[j][:3, 3]
-            adjoint = np.block([[rotation, np.zeros((3, 3))],
-                                [np.cross(np.eye(3), shift) @ rotation, rotation]])
-            to_b = np.linalg.inv(adjoint)
-            information_b = to_b.T @ information @ to_b
-            information_sum += information_b
-            weighted += information_b @ twist
-        if not information_sum.any():
-            poses[k] = starts[k]
-            continue
-        twist = np.linalg.solve(information_sum, weighted)
-        delta = np.eye(4)
-        delta[:3, :3], delta[:3, 3] = Rotation.from_rotvec(twist[:3]).as_matrix(), twist[3:]
-        poses[k] = delta @ starts[k]
-    return poses
 
 
 def c_row(capture, net, alignments, c_true) -> str:

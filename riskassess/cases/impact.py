@@ -581,6 +581,14 @@ class Registration(Strict):
                            "registered again to it from its own pose, the map kept as built "
                            "(perception.scan_to_map.registered_again; issue 26, percep21: not adopted). False: "
                            "the online pass's poses.")
+    after_frames_scan_to_scan: bool = Field(
+        False, description="Model-free tracking: the frames of the free flight after the collision are posed again, "
+                           "each by point-to-plane ICP to the 4 observation scans that share most of its surface "
+                           "(each at its online pose), the 4 poses averaged with their information, instead of "
+                           "registered to the map fused from the observation, whose view-dependent bias they "
+                           "otherwise carry (perception.pose_graph.scan_to_scan_poses; issue 26, percep22-23). "
+                           "Their information (the momentum step's 1-sigma) stays the map registration's. "
+                           "False: the poses registered to the map.")
 
     @model_validator(mode="after")
     def _budget(self):

@@ -49,6 +49,7 @@ from perception.model_mismatch import CHECK_EVERY, ModelCheck, SurfaceDistance, 
 from perception.motion import NotObservable
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
 from perception.pointing import Pointing, debris_blob
+from perception.pose_graph import scan_clouds, scan_to_scan_poses
 from perception.registration import MAP_LATERAL_BINS, MIN_POINTS, DebrisTracker, known_shape_model
 from perception.scan_to_map import alignments as map_alignments, registered_again, thinned_scan, track_scans
 from perception.shape import half_turn_symmetry_transforms, rotation_error
@@ -218,6 +219,9 @@ class Frames:
     # and a model-free fall back
     scans: list = field(default_factory=list)
     sensor_poses: list = field(default_factory=list)
+    # collision frames' debris returns (n, 3) (m, world) by frame index, kept only when the free flight's frames
+    # are posed scan to scan (perception.registration.after_frames_scan_to_scan)
+    debris_returns: dict = field(default_factory=dict)
 
 
 def _scan_world(scene, meshes_world, sensor_world, sensor_to_world, t, rng):
@@ -633,6 +637,7 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
     estimate = net.positions.copy()
     times = net_snapshots["time"]
     pointing = _pointing(tracker, frames, com_body)
+    keep_returns = scene.case.perception.registration.after_frames_scan_to_scan
     # The mount turns through the run: a lost track is searched over all attitudes, and a box-like
     # debris' half turns pass the surface checks; the directions where the rays met nothing tell them
     # apart (perception.visibility.unseen_model_share).
@@ -662,6 +667,8 @@ def observe_collision(scene, tracker, frames, symmetries, rng, recorder, assembl
         predicted = carried_by_chaser(estimate, start_pose, chaser_pose)
         on_net = nearest_segments(points, predicted, net.threads)[2] < NET_GATE if len(points) else np.zeros(0, bool)
         debris_points, blob = _debris_returns(tracker, pointing, t, points[~on_net], radius_body)
+        if keep_returns:
+            frames.debris_returns[len(frames.time)] = debris_points
         _register(tracker, frames, t, 1, debris_points, sensor_world, rot, com,
                   symmetries, target_to_body[:3, :3], all_returns=points, sensor_to_world=sensor_to_world)
         alignment = tracker.alignments[-1]
@@ -1096,6 +1103,8 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
         # Nothing to scale by the collision: stop before simulating it.
         answer["not_observable"] = f"before the collision: {exc}"
         return _conclude(folder, answer, tracker, frames, NetTrack(), None, wall, pending)
+    observation = (_observation_partners(tracker, frames, p.registration)
+                   if model_free and p.registration.after_frames_scan_to_scan else None)
     frames.scans, frames.sensor_poses = [], []   # not needed beyond the observation
 
     collision = collision_case(scene.real_case, scene.truth["com_target"], *state_at_zero, scene.spec.rate)
@@ -1111,7 +1120,11 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
     times = np.array(frames.time)
     try:
         start_time = track.times[free_flight_start(track)]
-        after = fit_free_motion(tracker, _good(tracker, times >= start_time - 1e-9), times,
+        free_flight = _good(tracker, times >= start_time - 1e-9)
+        if observation is not None:
+            answer.update(_posed_scan_to_scan(tracker, frames, free_flight, observation, p.registration,
+                                              target_to_body, symmetries))
+        after = fit_free_motion(tracker, free_flight, times,
                                 before.line.com_body, before.fit.moments_, before.fit.principal_to_body_)
         answer["attitude_fit_residual_after_deg"] = after.attitude_residual_deg
         _check_fit_explains_track(after)
@@ -1124,6 +1137,32 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
         answer["not_observable"] = f"after the collision: {exc}"
     answer.update(estimates(scene, before, after, step, state_at_zero, target_to_body, answer["body_frame"]))
     return _conclude(folder, answer, tracker, frames, track, assembly, wall, pending)
+
+
+def _observation_partners(tracker: DebrisTracker, frames: Frames, registration):
+    """The observation's frames as partners of :func:`perception.pose_graph.scan_to_scan_poses`: poses world -> B
+    (k, 4, 4) as tracked, their thinned scans with normals (m, world), and which registered."""
+    observed = tracker.alignments[:len(frames.scans)]
+    thin = [thinned_scan(scan, registration.voxel) if len(scan) else np.zeros((0, 3)) for scan in frames.scans]
+    return (np.array([a.world_to_body for a in observed]), scan_clouds(thin, registration.voxel),
+            np.array([a.ok for a in observed]))
+
+
+def _posed_scan_to_scan(tracker, frames, indices, observation, registration, target_to_body, symmetries) -> dict:
+    """Pose the free-flight frames ``indices`` again scan to scan to the observation's scans
+    (:func:`perception.pose_graph.scan_to_scan_poses`, from their registered poses), keeping each frame's
+    information; their attitude errors scored again. Returns the answer's figures of it (CPU in ms a frame)."""
+    tic = time.process_time()
+    observation_poses, observation_clouds, observation_ok = observation
+    starts = {int(k): tracker.alignments[k].world_to_body for k in indices}
+    poses = scan_to_scan_poses({k: frames.debris_returns[k] for k in starts}, starts, observation_poses,
+                               observation_clouds, observation_ok, registration.voxel, registration.max_correspondence)
+    for k, pose in poses.items():
+        tracker.alignments[k] = dataclasses.replace(tracker.alignments[k], world_to_body=pose)
+        frames.rotation_error[k] = rotation_error(tracker.alignments[k].body_to_world[:3, :3],
+                                                  frames.true_target_to_world[k] @ target_to_body[:3, :3].T, symmetries)
+    return {"after_frames_scan_to_scan": len(poses),
+            "after_frames_scan_to_scan_ms_per_frame": 1e3 * (time.process_time() - tic) / max(len(poses), 1)}
 
 
 def _conclude(folder, answer, tracker, frames, track: NetTrack, assembly, wall, pending) -> dict:
