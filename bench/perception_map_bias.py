@@ -42,6 +42,19 @@ def observation_scans(case_path: Path, seed: int, capture) -> list:
     return frames.scans, scene, case
 
 
+def observation_track(case_path: Path, seed: int, capture):
+    """The observation's scans, scene, case and online scan-to-map track of ``seed``, made again as the stage made
+    them; refused if the map made again differs from the capture's."""
+    from perception.scan_to_map import track_scans
+
+    scans, scene, case = observation_scans(case_path, seed, capture)
+    reg = case.perception.registration
+    track = track_scans(scans, reg.voxel, reg.max_correspondence)
+    if not np.array_equal(track.map_points, capture["collision_tracker"]["map_points_body"]):
+        raise SystemExit("the map made again differs from the capture's")
+    return scans, scene, case, track
+
+
 def registered_from_truth(tracker, capture, scans_by_frame) -> list:
     """The capture's alignments with frames ``scans_by_frame`` (index -> scan, m, world) registered by
     ``tracker``'s ICP from the true pose."""

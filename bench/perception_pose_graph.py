@@ -24,21 +24,18 @@ from pathlib import Path
 import numpy as np
 
 import perception_substitution as S
-from perception_map_bias import angle_deg, observation_scans, registered_from_truth, trackers
+from perception_map_bias import angle_deg, observation_track, registered_from_truth, trackers
 from perception.net_tracking import node_velocities
 from perception.pose_graph import jointly_optimized, scan_clouds, scan_to_scan_poses
 from perception.registration import _cloud, known_shape_model
-from perception.scan_to_map import alignments as map_alignments, thinned_scan, track_scans
+from perception.scan_to_map import alignments as map_alignments, thinned_scan
 
 
 def pose_graph_track(case_path, capture):
     """The online pass made again, the pose graph's track and result, the scene and the case."""
     seed = int(capture["answer"]["bench_seed"])
-    scans, scene, case = observation_scans(case_path, seed, capture)
+    scans, scene, case, track = observation_track(case_path, seed, capture)
     reg = case.perception.registration
-    track = track_scans(scans, reg.voxel, reg.max_correspondence)
-    if not np.array_equal(track.map_points, capture["collision_tracker"]["map_points_body"]):
-        raise SystemExit("the map made again differs from the capture's")
     fused, result = jointly_optimized(track, [thinned_scan(s, reg.voxel) for s in scans], reg.voxel,
                                       reg.max_correspondence)
     return track, fused, result, scene, case, scans

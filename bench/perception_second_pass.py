@@ -20,20 +20,17 @@ from pathlib import Path
 import numpy as np
 
 import perception_substitution as S
-from perception_map_bias import angle_deg, observation_scans
+from perception_map_bias import angle_deg, observation_track
 from perception.net_tracking import node_velocities
-from perception.scan_to_map import alignments as map_alignments, thinned_scan, registered_again, track_scans
+from perception.scan_to_map import alignments as map_alignments, thinned_scan, registered_again
 
 
 def second_pass_alignments(case_path, capture):
     """The capture's alignments with the observation frames from the second pass, the median turn (deg) of
     the second pass and its CPU time a frame (s)."""
     seed = int(capture["answer"]["bench_seed"])
-    scans, _, case = observation_scans(case_path, seed, capture)
+    scans, _, case, track = observation_track(case_path, seed, capture)
     reg = case.perception.registration
-    track = track_scans(scans, reg.voxel, reg.max_correspondence)
-    if not np.array_equal(track.map_points, capture["collision_tracker"]["map_points_body"]):
-        raise SystemExit("the map made again differs from the capture's")
     tic = time.process_time()
     again = registered_again(track, [thinned_scan(s, reg.voxel) for s in scans], reg.max_correspondence)
     cpu = (time.process_time() - tic) / max(int(track.ok.sum()), 1)
