@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from scipy.linalg import block_diag
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
@@ -294,6 +295,37 @@ class TorqueFreeFit:
         # residuals' integrated autocorrelation time.
         self.correlation_time_ = integrated_autocorrelation_time(result.fun.reshape(-1, 3))
         self.covariance_ = np.linalg.pinv(jac.T @ jac) * self.residual_rms_**2 * self.correlation_time_
+        self.jacobian_, self.weights_ = jac, np.asarray(weights, float)
+        return self
+
+    def add_attitude_covariance(self, attitude_covariance) -> TorqueFreeFit:
+        """Add to ``covariance_`` what errors of the measured attitudes correlated from frame to frame give the
+        fitted parameters, through the least squares' linear response (such errors do not show as scatter about
+        the fit, which is all ``covariance_`` knows; e.g. frames posed to shared partner scans,
+        :meth:`perception.scan_to_scan.ReposedFrames.attitude_covariance`).
+
+        A body-side change e_k of measured attitude k changes its weighted residual by W_k e_k, and the
+        parameters by the least-squares response (first order about the optimum):
+
+        .. math:: \\Sigma_p \\mathrel{+}= G \\Sigma_e G^T,\\qquad G = (J^T J)^{+} J^T W
+
+        Parameters
+        ----------
+        attitude_covariance : (3k, 3k) float   Covariance of the fitted frames' attitude errors (rad^2; body-side
+                                               rotation vectors, frame B), in the order of the fit's frames.
+
+        Returns
+        -------
+        TorqueFreeFit
+            ``self``, ``covariance_`` enlarged.
+        """
+        jac = self.jacobian_
+        weights = block_diag(*self.weights_)
+        if np.shape(attitude_covariance) != weights.shape:
+            raise ValueError(f"attitude_covariance must be ({weights.shape[0]}, {weights.shape[0]}) for the fit's "
+                             f"{len(self.weights_)} frames. Got {np.shape(attitude_covariance)} instead.")
+        gain = np.linalg.pinv(jac.T @ jac) @ jac.T @ weights
+        self.covariance_ = self.covariance_ + gain @ np.asarray(attitude_covariance, float) @ gain.T
         return self
 
     def rate_body_at(self, time) -> np.ndarray:
