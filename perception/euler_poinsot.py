@@ -296,6 +296,7 @@ class TorqueFreeFit:
         self.correlation_time_ = integrated_autocorrelation_time(result.fun.reshape(-1, 3))
         self.covariance_ = np.linalg.pinv(jac.T @ jac) * self.residual_rms_**2 * self.correlation_time_
         self.jacobian_, self.weights_ = jac, np.asarray(weights, float)
+        self.attitude_errors_ = np.linalg.solve(self.weights_, result.fun.reshape(-1, 3, 1))[..., 0]
         return self
 
     def add_attitude_covariance(self, attitude_covariance) -> TorqueFreeFit:
@@ -307,7 +308,13 @@ class TorqueFreeFit:
         A body-side change e_k of measured attitude k changes its weighted residual by W_k e_k, and the
         parameters by the least-squares response (first order about the optimum):
 
-        .. math:: \\Sigma_p \\mathrel{+}= G \\Sigma_e G^T,\\qquad G = (J^T J)^{+} J^T W
+        .. math:: \\Sigma_p \\mathrel{+}= s\\, G \\Sigma_e G^T,\\qquad G = (J^T J)^{+} J^T W,\\qquad
+                  s = \\max\\Big(1, \\frac{\\sum_k |e_k|^2 / (3k - p)}{\\sum_k \\operatorname{tr} \\Sigma_{e,kk} / (3k)}\\Big)
+
+        The scale s (``attitude_covariance_scale_``) makes the given covariance account at least for the scatter of
+        the attitudes about the fit (e_k: the residuals, rad), never shrinks it (the Particle Data Group's scale
+        factor, as :data:`perception.momentum.MISFIT_CHI2`): a covariance estimated from too few or mutually
+        correlated samples under-states the frames' errors, and the residuals are a lower bound of them.
 
         Parameters
         ----------
@@ -317,15 +324,19 @@ class TorqueFreeFit:
         Returns
         -------
         TorqueFreeFit
-            ``self``, ``covariance_`` enlarged.
+            ``self``, ``covariance_`` enlarged, ``attitude_covariance_scale_`` set.
         """
         jac = self.jacobian_
         weights = block_diag(*self.weights_)
-        if np.shape(attitude_covariance) != weights.shape:
+        attitude_covariance = np.asarray(attitude_covariance, float)
+        if attitude_covariance.shape != weights.shape:
             raise ValueError(f"attitude_covariance must be ({weights.shape[0]}, {weights.shape[0]}) for the fit's "
-                             f"{len(self.weights_)} frames. Got {np.shape(attitude_covariance)} instead.")
+                             f"{len(self.weights_)} frames. Got {attitude_covariance.shape} instead.")
+        modelled = np.trace(attitude_covariance) / attitude_covariance.shape[0]
+        observed = np.sum(self.attitude_errors_**2) / max(attitude_covariance.shape[0] - jac.shape[1], 1)
+        self.attitude_covariance_scale_ = float(max(1.0, observed / modelled)) if modelled > 0 else 1.0
         gain = np.linalg.pinv(jac.T @ jac) @ jac.T @ weights
-        self.covariance_ = self.covariance_ + gain @ np.asarray(attitude_covariance, float) @ gain.T
+        self.covariance_ = self.covariance_ + self.attitude_covariance_scale_ * gain @ attitude_covariance @ gain.T
         return self
 
     def rate_body_at(self, time) -> np.ndarray:

@@ -11,7 +11,12 @@ their information (percep22-23). Percep24 made it cheap and gave it a covariance
   kept; a frame's alignment to a partner is then the online pass's compiled ICP
   (:func:`perception.scan_to_map.register_to_map`) with the pairwise alignment's Tukey cut-off (the level's whole
   distance, as Open3D's ``TukeyLoss(k=distance)`` of :func:`perception.pose_graph.pair_alignment` had), not
-  Open3D's ICP, which rebuilds a KD-tree of the target on every call.
+  Open3D's ICP, which rebuilds a KD-tree of the target on every call; and its fine level only: a frame starts at
+  its pose registered to the map, within a fraction of a degree and about a centimetre of each partner's optimum
+  (the partners' scatter: 0.15-0.42 deg, 5-10 mm), well inside the fine level's third of the correspondence
+  distance; the coarse level, made for a start centimetres off, with its cut-off at the whole 0.1 m let outliers
+  pull a few alignments by up to a degree (docs/perception.md, percep24: seed 0's frames 0.390 -> 0.329 deg rms
+  from the truth, 30.6 -> 25.7 ms CPU a frame).
 * **A frame's pose inherits its partners' errors.** A partner's online pose error e_j (a left perturbation in B)
   moves every frame aligned to it by e_j; frames that share partners share those errors, so they are correlated
   from frame to frame and do not show as scatter about the torque-free fit, which is all the fit's own covariance
@@ -142,7 +147,8 @@ def aligned_to_partner(scan_world, start, partners: ScanPartners, j):
     measured) and its fitness (share of the scan within the fine distance)."""
     index, normals = partners.index(j)
     pose, fitness, _ = register_to_map(scan_world, partners.points_body[j], normals, start,
-                                       partners.max_correspondence, index=index, cutoff_share=PAIR_CUTOFF)
+                                       partners.max_correspondence, index=index, cutoff_share=PAIR_CUTOFF,
+                                       fine_only=True)
     # on the fine level's points: the partners' informations of a frame only weigh each other (the same points for
     # all), and their scale does not reach the covariance (ReposedFrames.partner_covariance)
     fine = scan_world[::max(1, len(scan_world) // FINE_POINTS)]
