@@ -181,6 +181,10 @@ class TorqueFreeFit:
     covariance_ : (p, p) float      Parameter covariance (J^T J)^-1 scaled by the residual variance
                                     and by the residuals' correlation time.
     correlation_time_ : float       Integrated autocorrelation time of the residuals (frames).
+    jacobian_ : (3k, p) float       Jacobian of the weighted residuals at the optimum.
+    weights_ : (k, 3, 3) float      The weights fitted with (1/rad).
+    weighted_residuals_ : (k, 3)    Weighted attitude residuals W_k e_k (-).
+    attitude_covariance_scale_ : float   After :meth:`add_attitude_covariance`: the scale it applied (-).
     """
 
     def __init__(self, moments=None, principal_to_body=None, max_step=0.01, first_span=5.0):
@@ -296,7 +300,7 @@ class TorqueFreeFit:
         self.correlation_time_ = integrated_autocorrelation_time(result.fun.reshape(-1, 3))
         self.covariance_ = np.linalg.pinv(jac.T @ jac) * self.residual_rms_**2 * self.correlation_time_
         self.jacobian_, self.weights_ = jac, np.asarray(weights, float)
-        self.attitude_errors_ = np.linalg.solve(self.weights_, result.fun.reshape(-1, 3, 1))[..., 0]
+        self.weighted_residuals_ = result.fun.reshape(-1, 3)
         return self
 
     def add_attitude_covariance(self, attitude_covariance) -> TorqueFreeFit:
@@ -332,8 +336,9 @@ class TorqueFreeFit:
         if attitude_covariance.shape != weights.shape:
             raise ValueError(f"attitude_covariance must be ({weights.shape[0]}, {weights.shape[0]}) for the fit's "
                              f"{len(self.weights_)} frames. Got {attitude_covariance.shape} instead.")
+        errors = np.linalg.solve(self.weights_, self.weighted_residuals_[..., None])[..., 0]   # rad, B
         modelled = np.trace(attitude_covariance) / attitude_covariance.shape[0]
-        observed = np.sum(self.attitude_errors_**2) / max(attitude_covariance.shape[0] - jac.shape[1], 1)
+        observed = np.sum(errors**2) / max(attitude_covariance.shape[0] - jac.shape[1], 1)
         self.attitude_covariance_scale_ = float(max(1.0, observed / modelled)) if modelled > 0 else 1.0
         gain = np.linalg.pinv(jac.T @ jac) @ jac.T @ weights
         self.covariance_ = self.covariance_ + self.attitude_covariance_scale_ * gain @ attitude_covariance @ gain.T
