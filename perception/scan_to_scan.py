@@ -16,7 +16,8 @@ their information (percep22-23). Percep24 made it cheap and gave it a covariance
   (the partners' scatter: 0.15-0.42 deg, 5-10 mm), well inside the fine level's third of the correspondence
   distance; the coarse level, made for a start centimetres off, with its cut-off at the whole 0.1 m let outliers
   pull a few alignments by up to a degree (docs/perception.md, percep24: seed 0's frames 0.390 -> 0.329 deg rms
-  from the truth, 30.6 -> 25.7 ms CPU a frame).
+  from the truth, 30.6 -> 25.7 ms CPU a frame). It keeps about a tenth of its start's error (a 0.3 deg start turn
+  left 0.034 deg median, 0.2 deg at most, seed 3): a tighter stop is still to be measured (docs, percep24).
 * **A frame's pose inherits its partners' errors.** A partner's online pose error e_j (a left perturbation in B)
   moves every frame aligned to it by e_j; frames that share partners share those errors, so they are correlated
   from frame to frame and do not show as scatter about the torque-free fit, which is all the fit's own covariance
