@@ -122,9 +122,10 @@ def test_the_damped_loop_closes_the_balance_with_the_winch_holding_the_whole_ten
         work = -s["energy_winch_work"][-1]
         assert s["energy_dissipated_threads"][-1] > 0.05 * work, "the dampers must take a share for this to mean anything"
         errors[step] = np.abs(s["energy_total"] - s["energy_total"][0]).max() / work
-    # measured ERR1 (1e-4 s) and ERR2 (5e-5 s) of the winch's work (WORK J): bound 3x the larger
-    assert errors[1e-4] < BOUND
-    assert errors[1e-4] / errors[5e-5] > RATIO
+    # measured 3.72e-4 (1e-4 s) and 1.86e-4 (5e-5 s) of the winch's work (69.7 J; the dampers took 4.22 J): bound
+    # 1e-3; first order (ratio measured 2.00), as the onsets' error is; the undamped loop's is second order (above)
+    assert errors[1e-4] < 1e-3
+    assert errors[1e-4] / errors[5e-5] > 1.8
 
 
 def test_the_damped_loop_keeps_the_linear_momentum(damped_reeled_runs):

@@ -189,16 +189,17 @@ def test_a_reeled_damped_tether_stretches_as_a_free_damped_oscillator(damped_ree
         return (v0 / w_d * decay * np.sin(w_d * t),
                 v0 * decay * (np.cos(w_d * t) - zeta * w_n / w_d * np.sin(w_d * t)))
 
-    y, y_rate = stretch_and_rate(s["time"])
+    y, y_rate = stretch_and_rate(s["time"][1:])     # from the first sample after the brake (t = 0 is before it)
     expected = k * y + c * y_rate
     assert expected.min() > 0.0 and s["tether_tension"].max() > 1.0
-    # measured 0.0042 N of the 1.50 N peak (0.3 %): the thread's own stretch (k / k_thread = 0.2 % of the
-    # tether's), the reel's start one step after the brake (5e-5 m of stretch: 5e-4 N); bound 1 % of the peak
-    assert np.abs(s["tether_tension"] - expected).max() < 0.01 * expected.max()
+    # measured 0.0175 N of the 1.55 N peak (1.1 %) at 0.011-0.012 s, the same at steps 1e-4 and 5e-5 s: no step error
+    # but the dumbbell's own thread mode (5000 N/m between two 0.5 kg nodes, 141 rad/s) rung by the damper's force
+    # c (v + r) = 1.2 N switched on at the brake; bound 2 % of the peak. The old law's offset c r is 65 % of it.
+    assert np.abs(s["tether_tension"][1:] - expected).max() < 0.02 * expected.max()
     t = np.linspace(0.0, s["time"][-1], 20001)
     dissipated = np.trapezoid(c * stretch_and_rate(t)[1] ** 2, t)
-    # measured 0.3 % (the same causes); bound 1 %
-    assert s["energy_dissipated_tether"][-1] == pytest.approx(dissipated, rel=0.01)
+    # measured -0.058 % at both steps (the same thread mode); bound 0.5 %. The old law would book c (y' - r)^2
+    assert s["energy_dissipated_tether"][-1] == pytest.approx(dissipated, rel=0.005)
 
 
 def test_the_reeled_damped_tether_closes_its_balance_with_the_damper_share_of_the_reel_work(damped_reel):
@@ -214,5 +215,7 @@ def test_the_reeled_damped_tether_closes_its_balance_with_the_damper_share_of_th
         assert work > 50.0 * e0, "the reel must do much work for the test to mean anything"
         onset = 0.5 * 2.0 * (DRIFT_M_S + 0.5) ** 2 * step
         errors[step] = np.abs(s["energy_total"] - e0).max()
+        # measured 3.456e-5 J (1e-4 s) and 1.728e-5 J (5e-5 s) against the onset's 3.6e-5 and 1.8e-5 J, of the
+        # reel's 0.430 J
         assert errors[step] < 1.2 * onset
-    assert errors[1e-4] / errors[5e-5] > 1.8, "first order in the step: halves with it"
+    assert errors[1e-4] / errors[5e-5] > 1.8, "first order in the step: halves with it (measured 2.00)"
