@@ -391,7 +391,7 @@ def reel_damper_power(tension, stretch, stiffness, rest_rate):
 
 
 @njit(cache=True)
-def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
+def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force, rest_rates=None):
     """Add tension-only Kelvin-Voigt thread forces to ``force``; return (elastic J, damping W).
 
     .. math:: T = \\max(0,\\; k (l - l_0) + c \\dot l) \\quad \\text{for } l > l_0
@@ -406,6 +406,10 @@ def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
         Natural length (m), stiffness (N/m) and damping (N s/m) of each thread.
     force : (n, 3) float
         Accumulator (N), frame of ``x``.
+    rest_rates : (m,) float, optional
+        Rate of each natural length (m/s) for threads a reel shortens (the full-net tow's closing loop,
+        :mod:`multibody.net_towing`): the damper reads the stretch's rate l' - l0'
+        (:func:`tension_only_kelvin_voigt`). None: every natural length fixed (the same arithmetic as before).
 
     Returns
     -------
@@ -437,6 +441,8 @@ def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
         ey = dy * inverse_length
         ez = dz * inverse_length
         rate = (v[b, 0] - v[a, 0]) * ex + (v[b, 1] - v[a, 1]) * ey + (v[b, 2] - v[a, 2]) * ez
+        if rest_rates is not None:
+            rate -= rest_rates[t]   # the stretch's rate (numba prunes the branch when None is passed)
         elastic += 0.5 * stiffness[t] * stretch * stretch
         tension = tension_only_kelvin_voigt(stretch, rate, stiffness[t], damping[t])
         power += kelvin_voigt_dissipated_power(tension, stretch, rate, stiffness[t])

@@ -35,6 +35,22 @@ def test_thread_is_tension_only_kelvin_voigt():
     assert np.all(f == 0.0), "a slack thread pushes nothing"
 
 
+def test_a_reeled_thread_damps_its_stretch_rate_not_the_reel():
+    """A thread whose natural length a reel changes (the full-net tow's closing loop, multibody.net_towing): the damper
+    reads s' = l' - l0'. Nodes at rest, the reel hauling in at l0' = -0.2 m/s: T = k s + c s' = 1000 * 0.1 + 2 * 0.2
+    = 100.4 N, the damper's power c s'^2 = 0.08 W. Nodes parting at the reel's rate (l' = l0'): T = k s exactly, no
+    power: a thread reeled at constant stretch is not damped. Exact arithmetic up to round-off."""
+    threads, rest, k, c = np.array([[0, 1]]), np.array([1.0]), np.array([1000.0]), np.array([2.0])
+    x = np.array([[0.0, 0.0, 0.0], [1.1, 0.0, 0.0]])
+    f = np.zeros((2, 3))
+    _, power = add_thread_forces(x, np.zeros((2, 3)), threads, rest, k, c, f, np.array([-0.2]))
+    assert f[0, 0] == pytest.approx(100.4, rel=1e-12) and power == pytest.approx(2.0 * 0.2 ** 2, rel=1e-12)
+    f[:] = 0.0
+    v = np.array([[0.0, 0.0, 0.0], [-0.2, 0.0, 0.0]])
+    _, power = add_thread_forces(x, v, threads, rest, k, c, f, np.array([-0.2]))
+    assert f[0, 0] == pytest.approx(100.0, rel=1e-12) and power == pytest.approx(0.0, abs=1e-12)
+
+
 def test_a_clipped_thread_books_the_spring_energy_it_gives_up():
     """A stretched thread shortening faster than k s / c: the damper would push, the law clips the tension to zero
     (tension-only), and the spring energy the thread gives up is lost: P = T l' - k s l' = -k s l' (module's
