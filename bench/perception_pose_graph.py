@@ -7,7 +7,7 @@ rows (percep21's, ``perception_map_bias.py``): every fit frame, before and after
 stage's map and to the exact model. The
 last rows: every after-fit frame posed by scan-to-scan alignments to the 4 observation frames that share most of
 its coarse cells (at the online or the graph's poses), started from the stage's pose, the partners' poses averaged
-with their information (``perception.pose_graph.scan_to_scan_poses``). The stage's momentum step is redone for each (``perception_substitution.replay``). Printed per capture: C's error, its
+with their information (``perception.scan_to_scan.scan_to_scan_poses``). The stage's momentum step is redone for each (``perception_substitution.replay``). Printed per capture: C's error, its
 stated 1-sigma, error / 1-sigma, mass, h0 and h1 from the truth, the pose graph's CPU and edges.
 
     python bench/perception_pose_graph.py CASE /tmp/percep17/capchain/none_obs20_seed{0,1,2,3,4}.pkl
@@ -26,7 +26,8 @@ import numpy as np
 import perception_substitution as S
 from perception_map_bias import angle_deg, observation_track, registered_from_truth, trackers
 from perception.net_tracking import node_velocities
-from perception.pose_graph import jointly_optimized, scan_clouds, scan_to_scan_poses
+from perception.pose_graph import jointly_optimized, scan_clouds
+from perception.scan_to_scan import scan_partners, scan_to_scan_poses
 from perception.registration import _cloud, known_shape_model
 from perception.scan_to_map import alignments as map_alignments, thinned_scan
 
@@ -104,8 +105,8 @@ def report(case_path: Path, path: str) -> None:
     clouds = scan_clouds([thinned_scan(scan, reg.voxel) for scan in scans], reg.voxel)
     for label, frames_poses, base in (("online", track.world_to_body, capture["alignments"]),
                                       ("pose graph", fused.world_to_body, observed)):
-        poses = scan_to_scan_poses(after_scans, stage_starts, frames_poses, clouds, track.ok, reg.voxel,
-                                   reg.max_correspondence)
+        partners = scan_partners(frames_poses, clouds, track.ok, reg.max_correspondence)
+        poses = scan_to_scan_poses(after_scans, stage_starts, partners, reg.voxel).world_to_body
         alignments = [copy.copy(a) for a in base]
         for k, pose in poses.items():
             alignments[k].world_to_body = pose

@@ -122,8 +122,10 @@ def true_c(cap) -> float:
     return float(np.linalg.eigvalsh(cap["truth"]["inertia_target"])[0])
 
 
-def replay(cap, *, before_tracker=None, after_tracker=None, after_indices=None, com_body=None, net=None):
-    """Redo the stage's fits and momentum step with the inputs given (the captured ones otherwise):
+def replay(cap, *, before_tracker=None, after_tracker=None, after_indices=None, com_body=None, net=None,
+           attitude_covariance=None):
+    """Redo the stage's fits and momentum step with the inputs given (the captured ones otherwise; the after
+    fit's correlated attitude covariance, a callable of the indices, as the stage's re-posed frames give it):
     returns (C, its 1-sigma, mass, before, after, origin, step)."""
     times = np.asarray(cap["frames"]["time"])
     fit_before, fit_after = cap["fits"][0], cap["fits"][-1]
@@ -131,7 +133,8 @@ def replay(cap, *, before_tracker=None, after_tracker=None, after_indices=None, 
     before = fit_free_motion(before_tracker or tracker, fit_before["indices"], times, com_body)
     indices = fit_after["indices"] if after_indices is None else after_indices
     after = fit_free_motion(after_tracker or tracker, indices, times,
-                            before.line.com_body, before.fit.moments_, before.fit.principal_to_body_)
+                            before.line.com_body, before.fit.moments_, before.fit.principal_to_body_,
+                            attitude_covariance)
     origin = before.line.position_world([0.0])[0]
     others = others_after(cap, after.times, origin, *(net or (None, None)))
     parts = cap["assembly"]

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from scipy.linalg import block_diag
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
@@ -180,6 +181,10 @@ class TorqueFreeFit:
     covariance_ : (p, p) float      Parameter covariance (J^T J)^-1 scaled by the residual variance
                                     and by the residuals' correlation time.
     correlation_time_ : float       Integrated autocorrelation time of the residuals (frames).
+    jacobian_ : (3k, p) float       Jacobian of the weighted residuals at the optimum.
+    weights_ : (k, 3, 3) float      The weights fitted with (1/rad).
+    weighted_residuals_ : (k, 3)    Weighted attitude residuals W_k e_k (-).
+    attitude_covariance_scale_ : float   After :meth:`add_attitude_covariance`: the scale it applied (-).
     """
 
     def __init__(self, moments=None, principal_to_body=None, max_step=0.01, first_span=5.0):
@@ -294,6 +299,49 @@ class TorqueFreeFit:
         # residuals' integrated autocorrelation time.
         self.correlation_time_ = integrated_autocorrelation_time(result.fun.reshape(-1, 3))
         self.covariance_ = np.linalg.pinv(jac.T @ jac) * self.residual_rms_**2 * self.correlation_time_
+        self.jacobian_, self.weights_ = jac, np.asarray(weights, float)
+        self.weighted_residuals_ = result.fun.reshape(-1, 3)
+        return self
+
+    def add_attitude_covariance(self, attitude_covariance) -> TorqueFreeFit:
+        """Add to ``covariance_`` what errors of the measured attitudes correlated from frame to frame give the
+        fitted parameters, through the least squares' linear response (such errors do not show as scatter about
+        the fit, which is all ``covariance_`` knows; e.g. frames posed to shared partner scans,
+        :meth:`perception.scan_to_scan.ReposedFrames.attitude_covariance`).
+
+        A body-side change e_k of measured attitude k changes its weighted residual by W_k e_k, and the
+        parameters by the least-squares response (first order about the optimum):
+
+        .. math:: \\Sigma_p \\mathrel{+}= s\\, G \\Sigma_e G^T,\\qquad G = (J^T J)^{+} J^T W,\\qquad
+                  s = \\max\\Big(1, \\frac{\\sum_k |e_k|^2 / (3k - p)}{\\sum_k \\operatorname{tr} \\Sigma_{e,kk} / (3k)}\\Big)
+
+        The scale s (``attitude_covariance_scale_``) makes the given covariance account at least for the scatter of
+        the attitudes about the fit (e_k: the residuals, rad), never shrinks it (the Particle Data Group's scale
+        factor, as :data:`perception.momentum.MISFIT_CHI2`): a covariance estimated from too few or mutually
+        correlated samples under-states the frames' errors, and the residuals are a lower bound of them.
+
+        Parameters
+        ----------
+        attitude_covariance : (3k, 3k) float   Covariance of the fitted frames' attitude errors (rad^2; body-side
+                                               rotation vectors, frame B), in the order of the fit's frames.
+
+        Returns
+        -------
+        TorqueFreeFit
+            ``self``, ``covariance_`` enlarged, ``attitude_covariance_scale_`` set.
+        """
+        jac = self.jacobian_
+        weights = block_diag(*self.weights_)
+        attitude_covariance = np.asarray(attitude_covariance, float)
+        if attitude_covariance.shape != weights.shape:
+            raise ValueError(f"attitude_covariance must be ({weights.shape[0]}, {weights.shape[0]}) for the fit's "
+                             f"{len(self.weights_)} frames. Got {attitude_covariance.shape} instead.")
+        errors = np.linalg.solve(self.weights_, self.weighted_residuals_[..., None])[..., 0]   # rad, B
+        modelled = np.trace(attitude_covariance) / attitude_covariance.shape[0]
+        observed = np.sum(errors**2) / max(attitude_covariance.shape[0] - jac.shape[1], 1)
+        self.attitude_covariance_scale_ = float(max(1.0, observed / modelled)) if modelled > 0 else 1.0
+        gain = np.linalg.pinv(jac.T @ jac) @ jac.T @ weights
+        self.covariance_ = self.covariance_ + self.attitude_covariance_scale_ * gain @ attitude_covariance @ gain.T
         return self
 
     def rate_body_at(self, time) -> np.ndarray:

@@ -44,7 +44,8 @@ class FreeMotion:
 OUTLIER_OVER_MEDIAN = 23.8
 
 
-def fit_free_motion(tracker, indices, times, com_body=None, moments=None, principal_to_body=None) -> FreeMotion:
+def fit_free_motion(tracker, indices, times, com_body=None, moments=None, principal_to_body=None,
+                    attitude_covariance=None) -> FreeMotion:
     """CoM line and torque-free fit through the registered frames ``indices``; inertia shape
     estimated (before the collision) or known (after). Frames the fitted motion does not explain
     (weighted residual above :data:`OUTLIER_OVER_MEDIAN` times the median) are dropped and the fit redone,
@@ -64,6 +65,10 @@ def fit_free_motion(tracker, indices, times, com_body=None, moments=None, princi
     moments, principal_to_body : (3,) and (3, 3) float arrays, optional
         Normalized principal moments (-) and principal -> body rotation when known (after the
         collision); estimated from the rates otherwise.
+    attitude_covariance : callable, optional
+        indices (n,) -> (3n, 3n) covariance (rad^2, body-side, frame B) of the frames' attitude errors that are
+        correlated from frame to frame (e.g. :meth:`perception.scan_to_scan.ReposedFrames.attitude_covariance`),
+        added to the fit's own (:meth:`perception.euler_poinsot.TorqueFreeFit.add_attitude_covariance`).
 
     Returns
     -------
@@ -72,7 +77,8 @@ def fit_free_motion(tracker, indices, times, com_body=None, moments=None, princi
     indices = np.asarray(indices)
     previous = None
     for _ in range(5):
-        motion, chi2 = _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_to_body, previous)
+        motion, chi2 = _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_to_body, previous,
+                                             attitude_covariance)
         keep = chi2 <= OUTLIER_OVER_MEDIAN * np.median(chi2)
         if keep.all():
             break
@@ -85,7 +91,8 @@ def fit_free_motion(tracker, indices, times, com_body=None, moments=None, princi
     return motion
 
 
-def _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_to_body, previous=None):
+def _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_to_body, previous=None,
+                          attitude_covariance=None):
     if len(indices) < MIN_FRAMES_AFTER:
         raise NotObservable(f"only {len(indices)} registered frames of free flight; at least {MIN_FRAMES_AFTER} "
                             "are needed")
@@ -108,6 +115,8 @@ def _fit_free_motion_once(tracker, indices, times, com_body, moments, principal_
         fits = (TorqueFreeFit(moments, principal_to_body).fit(t, attitudes, weights, rate) for rate in rates)
     fit, error = _best_fit(fits, t, attitudes)
     chi2 = np.sum(np.einsum("kij,kj->ki", weights, error) ** 2, axis=1)
+    if attitude_covariance is not None:
+        fit.add_attitude_covariance(attitude_covariance(indices))
     h, h_cov = fit.spin_momentum_per_c()
     return FreeMotion(t, line, fit, h, h_cov, _rms_deg(error)), chi2
 

@@ -171,7 +171,10 @@ class CellList:
         keys = np.ravel_multi_index(np.floor((self.points - self.low) / self.cell).astype(np.int64).T, self.shape)
         self.order = np.argsort(keys, kind="stable")
         self.sorted_points = self.points[self.order]
-        self.starts = np.searchsorted(keys[self.order], np.arange(int(np.prod(self.shape)) + 1))
+        # starts[c]: the points in cells before c (searchsorted of every cell in the sorted keys, the same
+        # array, in a third of the time: percep24)
+        self.starts = np.zeros(int(np.prod(self.shape)) + 1, np.int64)
+        np.cumsum(np.bincount(keys, minlength=len(self.starts) - 1), out=self.starts[1:])
         self.largest_cell = int(np.diff(self.starts).max()) if len(self.points) else 0
 
     def query(self, points, distance_upper_bound=np.inf) -> tuple[np.ndarray, np.ndarray]:

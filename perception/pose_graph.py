@@ -45,9 +45,6 @@ MIN_PAIR_FITNESS = 0.5
 PAIR_ITERATIONS = 30
 #: Scan points a pairwise alignment uses (every k-th point of the thinned source).
 PAIR_POINTS = 3000
-#: Observation scans each later frame is aligned to by :func:`scan_to_scan_poses` (those of most coarse overlap):
-#: as many as a frame's loop closures, the count percep22 measured the after frames with (docs/perception.md).
-PARTNERS = LOOP_EDGES
 #: A pairwise ICP level stops when its fitness and RMS distance change by less than this (relative).
 PAIR_SETTLED = 1e-6
 
@@ -211,11 +208,9 @@ def jointly_optimized(track: MapTrack, thin, voxel, max_correspondence) -> tuple
     return fused, result
 
 
-def adjoint(pose) -> np.ndarray:
-    """Adjoint (6, 6) of a pose (4, 4) acting on (rotation, translation) twists: [[R, 0], [t^ R, R]]; it moves a
-    left perturbation expressed in the pose's source coordinates into its target coordinates."""
-    rotation, shift = pose[:3, :3], pose[:3, 3]
-    return np.block([[rotation, np.zeros((3, 3))], [np.cross(np.eye(3), shift) @ rotation, rotation]])
+def twist_of(pose) -> np.ndarray:
+    """Twist (6,) (rotation vector (rad), translation (m)) of a small pose change (4, 4)."""
+    return np.r_[Rotation.from_matrix(pose[:3, :3]).as_rotvec(), pose[:3, 3]]
 
 
 def information_weighted_pose(start, poses, informations) -> np.ndarray:
@@ -226,10 +221,8 @@ def information_weighted_pose(start, poses, informations) -> np.ndarray:
     """
     information_sum, weighted = np.zeros((6, 6)), np.zeros(6)
     for pose, information in zip(poses, informations):
-        delta = pose @ np.linalg.inv(start)
-        twist = np.r_[Rotation.from_matrix(delta[:3, :3]).as_rotvec(), delta[:3, 3]]
         information_sum += information
-        weighted += information @ twist
+        weighted += information @ twist_of(pose @ np.linalg.inv(start))
     if not information_sum.any():
         return start
     twist = np.linalg.solve(information_sum, weighted)
@@ -241,56 +234,3 @@ def information_weighted_pose(start, poses, informations) -> np.ndarray:
 def most_overlapping(cells, candidate_cells: dict, count) -> list:
     """The ``count`` keys of ``candidate_cells`` (key -> coarse cells) sharing most of ``cells``, largest first."""
     return sorted(candidate_cells, key=lambda j: -overlap_share(cells, candidate_cells[j]))[:count]
-
-
-def scan_to_scan_pose(source, start, observation_poses, observation_clouds, chosen, max_correspondence) -> np.ndarray:
-    """World -> B (4, 4) of one frame's thinned scan ``source`` (Open3D cloud, m, world) from point-to-plane
-    alignments (:func:`pair_alignment`) to the observation frames ``chosen``, each at its ``observation_poses``
-    (world -> B), started from ``start`` (world -> B); partners aligned with a fitness under MIN_PAIR_FITNESS are
-    dropped; the rest averaged with their information moved into B (:func:`information_weighted_pose`)."""
-    poses, informations = [], []
-    for j in chosen:
-        transformation, information, fitness = pair_alignment(source, observation_clouds[j],
-                                                              np.linalg.inv(observation_poses[j]) @ start,
-                                                              max_correspondence)
-        if fitness < MIN_PAIR_FITNESS:
-            continue
-        # the edge's information is of a left perturbation in frame j's world coordinates; in B it is moved by
-        # pose j's adjoint
-        to_body = np.linalg.inv(adjoint(observation_poses[j]))
-        poses.append(observation_poses[j] @ transformation)
-        informations.append(to_body.T @ information @ to_body)
-    return information_weighted_pose(start, poses, informations)
-
-
-def scan_to_scan_poses(scans_by_frame, starts, observation_poses, observation_clouds, ok, voxel, max_correspondence,
-                       partners=PARTNERS) -> dict:
-    """World -> B of frames seen after the observation, each posed scan to scan to the ``partners`` observation
-    scans of largest coarse overlap, not to a map fused from them (whose view-dependent bias the after frames then
-    carry: docs/perception.md, percep21 and percep22).
-
-    Parameters
-    ----------
-    scans_by_frame : dict of int -> (n, 3) float   The frames' scans (m, world at their times).
-    starts : dict of int -> (4, 4) float           Starting pose world -> B of each (the tracker's), also where its
-                                                   overlap with the observation frames is judged.
-    observation_poses : (k, 4, 4) float            Pose world -> B of each observation frame.
-    observation_clouds : list of Open3D clouds     The observation's thinned scans with normals (:func:`scan_clouds`).
-    ok : (k,) bool                                 Observation frames registered (the only partners).
-    voxel : float                                  Scan thinning (m).
-    max_correspondence : float                     Coarse correspondence distance (m); the fine level a third.
-    partners : int                                 Observation frames a frame is aligned to.
-
-    Returns
-    -------
-    dict of int -> (4, 4) float   World -> B of each frame (its start when no partner aligned).
-    """
-    cells = {int(j): coarse_cells(_transform(np.asarray(observation_clouds[j].points), observation_poses[j]))
-             for j in np.flatnonzero(ok)}
-    poses = {}
-    for k, scan in scans_by_frame.items():
-        source = _cloud(scan).voxel_down_sample(voxel)
-        chosen = most_overlapping(coarse_cells(_transform(np.asarray(source.points), starts[k])), cells, partners)
-        poses[k] = scan_to_scan_pose(source, starts[k], observation_poses, observation_clouds, chosen,
-                                     max_correspondence)
-    return poses

@@ -261,7 +261,7 @@ def map_index(map_points, max_correspondence) -> CellList:
 
 
 def register_to_map(scan_world, map_points, map_normals, initial_world_to_body, max_correspondence,
-                    index=None) -> tuple[np.ndarray, float, float]:
+                    index=None, cutoff_share=TUKEY_CUTOFF, fine_only=False) -> tuple[np.ndarray, float, float]:
     """Point-to-plane ICP (Tukey kernel) of a thinned scan to the map, coarse then fine, without a
     motion prior (:func:`register_with_motion_prior` with a zero prior information).
 
@@ -272,6 +272,8 @@ def register_to_map(scan_world, map_points, map_normals, initial_world_to_body, 
     initial_world_to_body : (4, 4)            Starting pose, world -> B.
     max_correspondence : float                Coarse correspondence distance (m); the fine level uses a third.
     index : CellList, optional              :func:`map_index` of the map (built here when not given).
+    cutoff_share : float                      Tukey cut-off as a share of each level's correspondence distance.
+    fine_only : bool                          Only the fine level (a start already within its distance).
 
     Returns
     -------
@@ -279,7 +281,8 @@ def register_to_map(scan_world, map_points, map_normals, initial_world_to_body, 
     within the fine distance of a map point and their RMS distance (m), as Open3D's ICP reports them.
     """
     index = map_index(map_points, max_correspondence) if index is None else index
-    return _register(scan_world, map_points, map_normals, initial_world_to_body, max_correspondence, None, index)
+    return _register(scan_world, map_points, map_normals, initial_world_to_body, max_correspondence, None, index,
+                     cutoff_share, fine_only)
 
 
 def register_with_motion_prior(scan_world, map_points, map_normals, predicted_world_to_body, max_correspondence,
@@ -315,7 +318,8 @@ def register_with_motion_prior(scan_world, map_points, map_normals, predicted_wo
                      index)[0]
 
 
-def _register(scan_world, map_points, map_normals, predicted_world_to_body, max_correspondence, prior_sigma, index):
+def _register(scan_world, map_points, map_normals, predicted_world_to_body, max_correspondence, prior_sigma, index,
+              cutoff_share=TUKEY_CUTOFF, fine_only=False):
     """:func:`register_with_motion_prior`'s pose, and :func:`map_fit`'s fitness and RMS distance at it
     (from the fine level's last look-up when that level used every scan point)."""
     index = map_index(map_points, max_correspondence) if index is None else index
@@ -324,12 +328,12 @@ def _register(scan_world, map_points, map_normals, predicted_world_to_body, max_
     scan_world = np.ascontiguousarray(scan_world, dtype=float)
     if not isinstance(map_normals, LazyNormals):
         map_normals = LazyNormals.given(map_normals, index)
-    for step, distance, iterations in ((max(1, len(scan_world) // COARSE_POINTS), max_correspondence, COARSE_ITERATIONS),
-                                       (max(1, len(scan_world) // FINE_POINTS), max_correspondence / 3,
-                                        FINE_ITERATIONS)):
+    levels = ((max(1, len(scan_world) // COARSE_POINTS), max_correspondence, COARSE_ITERATIONS),
+              (max(1, len(scan_world) // FINE_POINTS), max_correspondence / 3, FINE_ITERATIONS))
+    for step, distance, iterations in levels[1:] if fine_only else levels:
         shells = max(int(np.ceil(distance / index.cell)), 1)
         pose, fitness, rmse = _icp_level(np.ascontiguousarray(scan_world[::step]), pose, _rigid_inverse(predicted_world_to_body),
-                          prior_information, prior_sigma is not None, distance, TUKEY_CUTOFF * distance, iterations,
+                          prior_information, prior_sigma is not None, distance, cutoff_share * distance, iterations,
                           BODY_SIZE, SETTLED, index.low, index.cell, index.shape, index.starts,
                           index.sorted_points, shells, map_normals.sorted_normals, map_normals.sorted_plane_points,
                           map_normals.known, index.largest_cell, map_normals.radius, map_normals.max_nn,

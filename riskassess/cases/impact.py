@@ -586,8 +586,10 @@ class Registration(Strict):
                            "each by point-to-plane ICP to the 4 observation scans that share most of its surface "
                            "(each at its online pose), the 4 poses averaged with their information, instead of "
                            "registered to the map fused from the observation, whose view-dependent bias they "
-                           "otherwise carry (perception.pose_graph.scan_to_scan_poses; issue 26, percep22-23). "
-                           "Their information (the momentum step's 1-sigma) stays the map registration's. "
+                           "otherwise carry (perception.scan_to_scan.scan_to_scan_poses; issue 26, percep22-24). "
+                           "Their attitude errors inherited from shared partner scans (the partners' pose scatter, "
+                           "correlated between frames that share partners) are propagated into the after fit's "
+                           "covariance and so into C's and the principal moments' 1-sigma (percep24). "
                            "False: the poses registered to the map.")
 
     @model_validator(mode="after")

@@ -49,7 +49,8 @@ from perception.model_mismatch import CHECK_EVERY, ModelCheck, SurfaceDistance, 
 from perception.motion import NotObservable
 from perception.net_tracking import NetPrior, carried_by_chaser, fit_net_nodes, nearest_segments, node_velocities, thread_mesh
 from perception.pointing import Pointing, debris_blob
-from perception.pose_graph import scan_clouds, scan_to_scan_poses
+from perception.pose_graph import scan_clouds
+from perception.scan_to_scan import ReposedFrames, ScanPartners, scan_partners, scan_to_scan_poses
 from perception.registration import MAP_LATERAL_BINS, MIN_POINTS, DebrisTracker, known_shape_model
 from perception.scan_to_map import alignments as map_alignments, registered_again, thinned_scan, track_scans
 from perception.shape import half_turn_symmetry_transforms, rotation_error
@@ -1103,8 +1104,11 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
         # Nothing to scale by the collision: stop before simulating it.
         answer["not_observable"] = f"before the collision: {exc}"
         return _conclude(folder, answer, tracker, frames, NetTrack(), None, wall, pending)
+    tic = time.process_time()
     observation = (_observation_partners(tracker, frames, p.registration)
                    if model_free and p.registration.after_frames_scan_to_scan else None)
+    if observation is not None:   # once, before the collision: the partners' normals, cells, poses in B
+        answer["after_frames_partners_cpu_s"] = time.process_time() - tic
     frames.scans, frames.sensor_poses = [], []   # not needed beyond the observation
 
     collision = collision_case(scene.real_case, scene.truth["com_target"], *state_at_zero, scene.spec.rate)
@@ -1121,11 +1125,14 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
     try:
         start_time = track.times[free_flight_start(track)]
         free_flight = _good(tracker, times >= start_time - 1e-9)
+        reposed = None
         if observation is not None:
-            answer.update(_posed_scan_to_scan(tracker, frames, free_flight, observation, p.registration,
-                                              target_to_body, symmetries))
+            reposed = _posed_scan_to_scan(tracker, frames, free_flight, observation, p.registration, target_to_body,
+                                          symmetries)
+            answer.update(_reposed_figures(reposed))
         after = fit_free_motion(tracker, free_flight, times,
-                                before.line.com_body, before.fit.moments_, before.fit.principal_to_body_)
+                                before.line.com_body, before.fit.moments_, before.fit.principal_to_body_,
+                                reposed.attitude_covariance if reposed is not None else None)
         answer["attitude_fit_residual_after_deg"] = after.attitude_residual_deg
         _check_fit_explains_track(after)
         origin = before.line.position_world([0.0])[0]
@@ -1139,30 +1146,37 @@ def _perceive(case: Case, scene: Scene, folder, progress, pending) -> dict:
     return _conclude(folder, answer, tracker, frames, track, assembly, wall, pending)
 
 
-def _observation_partners(tracker: DebrisTracker, frames: Frames, registration):
-    """The observation's frames as partners of :func:`perception.pose_graph.scan_to_scan_poses`: poses world -> B
-    (k, 4, 4) as tracked, their thinned scans with normals (m, world), and which registered."""
+def _observation_partners(tracker: DebrisTracker, frames: Frames, registration) -> ScanPartners:
+    """The observation's frames as partners of :func:`perception.scan_to_scan.scan_to_scan_poses`: their thinned
+    scans with normals, in B at their tracked poses (:func:`perception.scan_to_scan.scan_partners`)."""
     observed = tracker.alignments[:len(frames.scans)]
     thin = [thinned_scan(scan, registration.voxel) if len(scan) else np.zeros((0, 3)) for scan in frames.scans]
-    return (np.array([a.world_to_body for a in observed]), scan_clouds(thin, registration.voxel),
-            np.array([a.ok for a in observed]))
+    return scan_partners(np.array([a.world_to_body for a in observed]), scan_clouds(thin, registration.voxel),
+                         np.array([a.ok for a in observed]), registration.max_correspondence)
 
 
-def _posed_scan_to_scan(tracker, frames, indices, observation, registration, target_to_body, symmetries) -> dict:
+def _posed_scan_to_scan(tracker, frames, indices, partners, registration, target_to_body, symmetries) -> ReposedFrames:
     """Pose the free-flight frames ``indices`` again scan to scan to the observation's scans
-    (:func:`perception.pose_graph.scan_to_scan_poses`, from their registered poses), keeping each frame's
-    information; their attitude errors scored again. Returns the answer's figures of it (CPU in ms a frame)."""
-    tic = time.process_time()
-    observation_poses, observation_clouds, observation_ok = observation
+    (:func:`perception.scan_to_scan.scan_to_scan_poses`, from their registered poses), keeping each frame's
+    information; their attitude errors scored again."""
     starts = {int(k): tracker.alignments[k].world_to_body for k in indices}
-    poses = scan_to_scan_poses({k: frames.debris_returns[k] for k in starts}, starts, observation_poses,
-                               observation_clouds, observation_ok, registration.voxel, registration.max_correspondence)
-    for k, pose in poses.items():
+    reposed = scan_to_scan_poses({k: frames.debris_returns[k] for k in starts}, starts, partners, registration.voxel)
+    for k, pose in reposed.world_to_body.items():
         tracker.alignments[k] = dataclasses.replace(tracker.alignments[k], world_to_body=pose)
         frames.rotation_error[k] = rotation_error(tracker.alignments[k].body_to_world[:3, :3],
                                                   frames.true_target_to_world[k] @ target_to_body[:3, :3].T, symmetries)
-    return {"after_frames_scan_to_scan": len(poses),
-            "after_frames_scan_to_scan_ms_per_frame": 1e3 * (time.process_time() - tic) / max(len(poses), 1)}
+    return reposed
+
+
+def _reposed_figures(reposed: ReposedFrames) -> dict:
+    """The answer's figures of the re-posing: frames, CPU (ms a frame) and the partners' pose scatter, 1-sigma
+    (deg about each axis of B, rms; m along each, rms)."""
+    partner = reposed.partner_covariance()
+    frames = max(len(reposed.world_to_body), 1)
+    return {"after_frames_scan_to_scan": len(reposed.world_to_body),
+            "after_frames_scan_to_scan_ms_per_frame": 1e3 * reposed.cpu_seconds / frames,
+            "after_frames_partner_sigma_deg": float(np.degrees(np.sqrt(np.trace(partner[:3, :3]) / 3))),
+            "after_frames_partner_sigma_m": float(np.sqrt(np.trace(partner[3:, 3:]) / 3))}
 
 
 def _conclude(folder, answer, tracker, frames, track: NetTrack, assembly, wall, pending) -> dict:

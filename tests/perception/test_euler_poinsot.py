@@ -61,3 +61,27 @@ def test_trajectory_fit_recovers_inertia_ratios(seed):
     # principal axes recovered (up to sign) within 1 deg
     alignment = np.abs(np.sum(fit.principal_to_body_ * model_to_principal.inv().as_matrix(), axis=0))
     assert np.all(alignment > np.cos(np.radians(1.0)))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_world_side_turn_of_every_attitude_turns_the_spin_momentum_by_it(seed):
+    # Known answer: attitudes all turned by one world-side rotation q (R -> exp(q) R) are the same torque-free motion
+    # turned by q, so the fit's h = R J w turns by q: dh = q x h, cov(h) = [h]x cov(q) [h]x^T. Measured body-side, the
+    # turn is e_k = R_k^T q on frame k, correlated between all frames: cov(e_k, e_l) = R_k^T cov(q) R_l. Propagated
+    # by add_attitude_covariance through the fit's linear response it must give the same covariance; the fit is on
+    # exact attitudes (its own covariance zero), the moments known; what is left is the finite-difference Jacobian
+    # of h (1e-6 steps) and of the least squares: 1e-4 of the largest entry.
+    rng = np.random.default_rng(seed)
+    times, truth, _ = _tumble(5.0)
+    j = PAPER_MOMENTS / PAPER_MOMENTS[2]
+    weights = np.tile(np.eye(3) / np.radians(0.3), (len(times), 1, 1))
+    fit = TorqueFreeFit(j, np.eye(3)).fit(times, truth, weights, omega0_body=OMEGA0 * 1.02)
+    fit.covariance_ = np.zeros_like(fit.covariance_)   # exact attitudes: only the added part
+    root = rng.normal(0.0, np.radians(0.1), (3, 3))
+    cov_q = root @ root.T
+    rotations = truth.as_matrix()
+    attitude_covariance = np.block([[a.T @ cov_q @ b for b in rotations] for a in rotations])
+    h, cov_h = fit.add_attitude_covariance(attitude_covariance).spin_momentum_per_c()
+    cross = np.cross(np.eye(3), h)   # [h]x: cross @ q = h x q
+    expected = cross @ cov_q @ cross.T
+    np.testing.assert_allclose(cov_h, expected, atol=1e-4 * np.abs(expected).max())
