@@ -165,10 +165,16 @@ def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, rad
     which the free motion does not foresee (the node's rebound raises the edge point's excess over it). Found late,
     such a thread started the next step up to about a millimetre into its contact, energy no force paid for:
     measured, 24 such arrivals made +2.87 % of the reference case's energy at its ASAR strike (0.049 s; helper
-    thread13, bench/thread_contact_drift.py, the record's "arrivals (a node in its own contact)")."""
+    thread13, bench/thread_contact_drift.py, the record's "arrivals (a node in its own contact)").
+
+    The test at the end of the free motion is skipped when the separating-axis bound at the start keeps the thread
+    so far from the box that the motion cannot bring it into reach (:func:`_apart_after_motion`): its answer is then
+    known to be "no", so the pairs found are the same to the bit (helper speed23: late in a whole capture some 100
+    listed pairs a step are apart, each tested at both states before)."""
     seg = buffers.segments
     box_min, box_max = shapes.box_min_body, shapes.box_max_body
-    if _contact_can_act(pa, pc, box_min, box_max, s, radius[a], radius[c], seg.breakpoints):
+    acts, separation = _contact_test(pa, pc, box_min, box_max, s, radius[a], radius[c], seg.breakpoints)
+    if acts:
         return True
     half_kick = 0.5 * step if n_substeps > 1 else 0.0
     rel_a, acc_a = _node_motion(a, b, x, v, net_force_lvlh, net_mass, buffers.velocity_lag, seg.lag_velocity_lvlh,
@@ -176,6 +182,10 @@ def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, rad
     rel_c, acc_c = _node_motion(c, b, x, v, net_force_lvlh, net_mass, buffers.velocity_lag, seg.lag_velocity_lvlh,
                                 states, half_kick)
     h2 = 0.5 * step * step
+    move_a = (step * rel_a[0] + h2 * acc_a[0], step * rel_a[1] + h2 * acc_a[1], step * rel_a[2] + h2 * acc_a[2])
+    move_c = (step * rel_c[0] + h2 * acc_c[0], step * rel_c[1] + h2 * acc_c[1], step * rel_c[2] + h2 * acc_c[2])
+    if _apart_after_motion(separation, move_a, move_c, radius[a], radius[c]):
+        return False
     qa = (pa[0] + step * rel_a[0] + h2 * acc_a[0], pa[1] + step * rel_a[1] + h2 * acc_a[1],
           pa[2] + step * rel_a[2] + h2 * acc_a[2])
     qc = (pc[0] + step * rel_c[0] + h2 * acc_c[0], pc[1] + step * rel_c[1] + h2 * acc_c[1],
@@ -183,25 +193,60 @@ def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, rad
     return _contact_can_act(qa, qc, box_min, box_max, s, radius[a], radius[c], seg.breakpoints)
 
 
+@njit(cache=True, inline="always")
+def _apart_after_motion(separation, move_a, move_c, radius_a, radius_c):
+    """Whether a thread whose separating-axis bound to a box is ``separation`` (m) cannot act on it after its nodes
+    have moved by ``move_a``, ``move_c`` (m, the box's body frame): :func:`_contact_can_act` at the moved nodes is then
+    sure to answer no.
+
+    The distance D from a segment to a convex set is 1-Lipschitz in its two ends together: the moved segment's point
+    at parameter t is the old one's plus (1 - t) m_a + t m_c, at most max(|m_a|, |m_c|) away, and a point's distance to
+    the set changes by at most its own displacement. With the bound S <= D at the start
+    (:func:`multibody.segment_box.segment_box_separation`),
+
+    .. math:: D' \ge S - \max(|m_a|, |m_c|) > \max(r_a, r_c) + \epsilon
+
+    makes every point of the moved thread, its two nodes too, farther from the box than either node's radius: both
+    nodes' own depths are negative (no node contact on one side only) and the thread's deepest depth r - D' too (no
+    excess), so the geometry answers no. The tie distance epsilon (1e-9 m) covers the round-off of S, of the moved
+    positions and of the test's own distances (some 1e-14 m for coordinates of 10 m). Squares, no root: S - r - eps
+    must be positive and its square above both displacements' squares. ``separation`` is -inf when the bound did not
+    decide the start (never apart)."""
+    clearance = separation - max(radius_a, radius_c) - TIE_DISTANCE
+    if not clearance > 0.0:
+        return False
+    limit = clearance * clearance
+    return (move_a[0] * move_a[0] + move_a[1] * move_a[1] + move_a[2] * move_a[2] < limit
+            and move_c[0] * move_c[0] + move_c[1] * move_c[1] + move_c[2] * move_c[2] < limit)
+
+
 @njit(cache=True, **NO_REFCOUNTS)
 def _contact_can_act(pa, pc, box_min, box_max, s, radius_a, radius_c, work):
     """Whether thread (``pa``, ``pc``: its nodes, body frame, m) acts on box ``s`` at these positions: its deepest point
     is interior and penetrates (:func:`multibody.segment_cycle.thread_contact_geometry`'s excess > 0), or exactly one
-    of its nodes is in its own contact with the box: the answer of ``thread_contact_geometry``, which it calls unless
-    cheaper tests decide it. A node contact on one side only says yes (the same distances and test as the geometry's);
-    a segment whose separating-axis bound (:func:`multibody.segment_box.segment_box_separation`) keeps it farther from
-    the box than the thread's radius (by the tie distance, far above the bound's round-off of about 1e-14 m) says no:
-    then the geometry's depth is negative, so its excess is not positive. A wrapped net's candidates past the slab test
-    are mostly threads across a plate's edge or a box's corner region that do not touch it, decided so (helper
-    speed20: 35-38 a step of the 2.0 m/s capture, each two geometry calls before)."""
+    of its nodes is in its own contact with the box: :func:`_contact_test`'s answer."""
+    return _contact_test(pa, pc, box_min, box_max, s, radius_a, radius_c, work)[0]
+
+
+@njit(cache=True, **NO_REFCOUNTS)
+def _contact_test(pa, pc, box_min, box_max, s, radius_a, radius_c, work):
+    """Whether thread (``pa``, ``pc``: its nodes, body frame, m) acts on box ``s`` at these positions, and the
+    separating-axis bound (m) when that bound decided no (else -inf): the answer of ``thread_contact_geometry``, which
+    it calls unless cheaper tests decide it. A node contact on one side only says yes (the same distances and test as
+    the geometry's); a segment whose separating-axis bound (:func:`multibody.segment_box.segment_box_separation`) keeps
+    it farther from the box than the thread's radius (by the tie distance, far above the bound's round-off of about
+    1e-14 m) says no: then the geometry's depth is negative, so its excess is not positive. A wrapped net's candidates
+    past the slab test are mostly threads across a plate's edge or a box's corner region that do not touch it, decided
+    so (helper speed20: 35-38 a step of the 2.0 m/s capture, each two geometry calls before)."""
     gap_a = box_signed_distance(pa[0], pa[1], pa[2], box_min, box_max, s)[0]
     gap_c = box_signed_distance(pc[0], pc[1], pc[2], box_min, box_max, s)[0]
     if (radius_a - gap_a > 0.0) != (radius_c - gap_c > 0.0):
-        return True
+        return True, -math.inf
     lo = (box_min[s, 0], box_min[s, 1], box_min[s, 2])
     hi = (box_max[s, 0], box_max[s, 1], box_max[s, 2])
     d = (pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2])
-    if segment_box_separation(pa, d, lo, hi) > min(radius_a, radius_c) + TIE_DISTANCE:
-        return False
+    separation = segment_box_separation(pa, d, lo, hi)
+    if separation > min(radius_a, radius_c) + TIE_DISTANCE:
+        return False, separation
     geometry = thread_contact_geometry(pa, pc, box_min, box_max, s, radius_a, radius_c, work)
-    return geometry[0] > 0.0 or (geometry[5] > 0.0) != (geometry[6] > 0.0)
+    return geometry[0] > 0.0 or (geometry[5] > 0.0) != (geometry[6] > 0.0), -math.inf
