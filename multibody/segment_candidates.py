@@ -18,12 +18,15 @@ of about 1e-14 m for 10-m coordinates). Why it suffices: a pair left out failed 
 both nodes beyond, say, ``hi_k + reach0 + d``; each node has moved by at most the first term along k, and the pair's
 reach has grown by at most the second (its reach is 1.001 (r + h max(u_a, u_c) + h w_s)), so both nodes are still
 beyond ``hi_k + reach`` and the slab test of :mod:`multibody.segment_pairs` skips the pair now too. The listed pairs
-go through the same tests in the same (thread, box) order as the full scan, so the pairs found, and every force, are
-the full scan's to the last bit; a skin of 0 rebuilds at every evaluation (the full scan's slab test).
+go through the same tests in the same (thread, box) order as the full scan (a pair whose clearance proves it apart
+skips them, :func:`multibody.segment_pairs._still_apart`: their answer is known), so the pairs found, and every
+force, are the full scan's to the last bit; a skin of 0 rebuilds at every evaluation (the full scan's slab test).
 
 Frames: LVLH unless named; the shapes in their body frames (origin at the body's CoM). SI units.
 """
 from __future__ import annotations
+
+import math
 
 from numba import njit
 
@@ -72,6 +75,7 @@ def _candidates_hold(x, seg, states, shapes, step):
         return False
     limit2 = limit * limit
     body_to_lvlh, com_lvlh, built = states.body_to_lvlh, states.com_lvlh, seg.built_position_body
+    moved_body = seg.moved_body
     for b in range(body_to_lvlh.shape[0]):
         if not _carries_box(b, shapes):
             continue
@@ -80,6 +84,9 @@ def _candidates_hold(x, seg, states, shapes, step):
             p = _to_body(x, i, body_to_lvlh, com_lvlh, b)
             d2 = (p[0] - built[b, 0, i]) ** 2 + (p[1] - built[b, 1, i]) ** 2 + (p[2] - built[b, 2, i]) ** 2
             moved |= d2 > limit2
+            # for the pairs' clearances (multibody.segment_pairs._still_apart)
+            moved_body[b, 0, i] = d2
+            moved_body[b, 1, i] = p[0] * p[0] + p[1] * p[1] + p[2] * p[2]
         if moved:
             return False
     return True
@@ -100,6 +107,8 @@ def _build_candidates(x, threads, radius, seg, states, shapes, step):
         for i in range(x.shape[1]):
             p = _to_body(x, i, body_to_lvlh, com_lvlh, b)
             built[b, 0, i], built[b, 1, i], built[b, 2, i] = p[0], p[1], p[2]
+            seg.moved_body[b, 0, i] = 0.0
+            seg.moved_body[b, 1, i] = p[0] * p[0] + p[1] * p[1] + p[2] * p[2]
     for i in range(node_speed.shape[0]):
         seg.built_speed[i] = node_speed[i]
     for s in range(is_box.shape[0]):
@@ -124,6 +133,7 @@ def _build_candidates(x, threads, radius, seg, states, shapes, step):
                 continue
             seg.candidate_thread[count] = j
             seg.candidate_shape[count] = s
+            seg.candidate_clearance[count] = -math.inf     # none proven yet (multibody.segment_pairs)
             count += 1
     seg.candidate_count[0] = count
     seg.candidate_count[1] += 1

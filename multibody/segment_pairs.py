@@ -30,8 +30,8 @@ from multibody.segment_cycle import thread_contact_geometry
 @njit(cache=True, **NO_REFCOUNTS)
 def _near_shapes(x, v, net_force_lvlh, net_mass, velocity_lag, seg, states, shapes, step):
     """Each node's speed bound over the step (``seg.node_speed``, m/s: L1 norms, an upper bound), and each box
-    shape's bounding sphere (``seg.shape_work``: radius (m), surface speed bound (m/s), centre in LVLH (m)), for the
-    thread broad phase."""
+    shape's bounding sphere (``seg.shape_work``: radius (m), surface speed bound (m/s), centre in LVLH (m), its body's
+    speed (m/s) and spin (rad/s)), for the thread broad phase."""
     n = x.shape[1]
     speed = seg.node_speed
     lag = seg.lag_velocity_lvlh
@@ -63,6 +63,7 @@ def _near_shapes(x, v, net_force_lvlh, net_mass, velocity_lag, seg, states, shap
         speed_b = math.sqrt(velocity_lvlh[b, 0] ** 2 + velocity_lvlh[b, 1] ** 2 + velocity_lvlh[b, 2] ** 2)
         spin_b = math.sqrt(omega_lvlh[b, 0] ** 2 + omega_lvlh[b, 1] ** 2 + omega_lvlh[b, 2] ** 2)
         seg.shape_work[1, s] = speed_b + spin_b * extent
+        seg.shape_work[5, s], seg.shape_work[6, s] = speed_b, spin_b
 
 
 @njit(cache=True, inline="always")
@@ -119,9 +120,13 @@ def _contact_pairs(x, v, net_force_lvlh, net, states, shapes, step, n_substeps, 
     body_to_lvlh, com_lvlh = states.body_to_lvlh, states.com_lvlh
     box_min, box_max, shape_body = shapes.box_min_body, shapes.box_max_body, shapes.body
     n_pairs = 0
+    proofs = seg.candidate_scalar[2] != 0.0
     for k in range(seg.candidate_count[0]):
         j, s = seg.candidate_thread[k], seg.candidate_shape[k]
         a, c = threads[j, 0], threads[j, 1]
+        if proofs and _still_apart(seg, k, a, c, shape_body[s], s, radius, step):
+            seg.candidate_count[2] += 1
+            continue
         length = math.sqrt((x[0, c] - x[0, a]) ** 2 + (x[1, c] - x[1, a]) ** 2 + (x[2, c] - x[2, a]) ** 2)
         motion = step * max(node_speed[a], node_speed[c])
         thread_radius = min(radius[a], radius[c])
@@ -138,8 +143,11 @@ def _contact_pairs(x, v, net_force_lvlh, net, states, shapes, step, n_substeps, 
                 or min(pa[1], pc[1]) > box_max[s, 1] + reach or max(pa[1], pc[1]) < box_min[s, 1] - reach
                 or min(pa[2], pc[2]) > box_max[s, 2] + reach or max(pa[2], pc[2]) < box_min[s, 2] - reach):
             continue
-        if not _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, radius, states, shapes,
-                                    step, n_substeps, buffers):
+        touches, separation = _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, radius,
+                                                   states, shapes, step, n_substeps, buffers)
+        if not touches:
+            moved = math.sqrt(max(seg.moved_body[b, 0, a], seg.moved_body[b, 0, c]))
+            seg.candidate_clearance[k] = max(seg.candidate_clearance[k], separation - moved)
             continue
         seg.pair_thread[n_pairs] = j
         seg.pair_shape[n_pairs] = s
@@ -156,7 +164,8 @@ def _contact_pairs(x, v, net_force_lvlh, net, states, shapes, step, n_substeps, 
 @njit(cache=True, **NO_REFCOUNTS)
 def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, radius, states, shapes, step, n_substeps,
                          buffers):
-    """Whether thread (a, c)'s contact with box ``s`` can act within the step: it penetrates now, or at the end of
+    """Whether thread (a, c)'s contact with box ``s`` can act within the step, and the separating-axis bound (m) of its
+    distance to the box at the start when that bound decided no (else -inf): it penetrates now, or at the end of
     the step's free motion (a thread turning over an edge, whose deepest point is not yet interior at the start), or
     exactly one of its nodes is in its own contact with the box now or then.
 
@@ -175,7 +184,7 @@ def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, rad
     box_min, box_max = shapes.box_min_body, shapes.box_max_body
     acts, separation = _contact_test(pa, pc, box_min, box_max, s, radius[a], radius[c], seg.breakpoints)
     if acts:
-        return True
+        return True, -math.inf
     half_kick = 0.5 * step if n_substeps > 1 else 0.0
     rel_a, acc_a = _node_motion(a, b, x, v, net_force_lvlh, net_mass, buffers.velocity_lag, seg.lag_velocity_lvlh,
                                 states, half_kick)
@@ -184,13 +193,43 @@ def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, rad
     h2 = 0.5 * step * step
     move_a = (step * rel_a[0] + h2 * acc_a[0], step * rel_a[1] + h2 * acc_a[1], step * rel_a[2] + h2 * acc_a[2])
     move_c = (step * rel_c[0] + h2 * acc_c[0], step * rel_c[1] + h2 * acc_c[1], step * rel_c[2] + h2 * acc_c[2])
-    if _apart_after_motion(separation, move_a, move_c, radius[a], radius[c]):
-        return False
+    if seg.candidate_scalar[2] != 0.0 and _apart_after_motion(separation, move_a, move_c, radius[a], radius[c]):
+        seg.candidate_count[3] += 1
+        return False, separation
     qa = (pa[0] + step * rel_a[0] + h2 * acc_a[0], pa[1] + step * rel_a[1] + h2 * acc_a[1],
           pa[2] + step * rel_a[2] + h2 * acc_a[2])
     qc = (pc[0] + step * rel_c[0] + h2 * acc_c[0], pc[1] + step * rel_c[1] + h2 * acc_c[1],
           pc[2] + step * rel_c[2] + h2 * acc_c[2])
-    return _contact_can_act(qa, qc, box_min, box_max, s, radius[a], radius[c], seg.breakpoints)
+    if _contact_can_act(qa, qc, box_min, box_max, s, radius[a], radius[c], seg.breakpoints):
+        return True, -math.inf
+    return False, separation
+
+
+@njit(cache=True, inline="always")
+def _still_apart(seg, k, a, c, b, s, radius, step):
+    """Whether candidate pair ``k`` (thread (a, c), box ``s`` on body ``b``) is proven apart for this whole step by
+    its clearance C (``seg.candidate_clearance[k]``, m), so that its tests in :func:`_contact_pairs` would all say no.
+
+    C was set at an earlier step of this build, C = S - max(|p_a - p^0_a|, |p_c - p^0_c|), from the separating-axis
+    bound S <= D of the thread's distance to the box then (:func:`_contact_test`) and its nodes' displacements since
+    the build in the body's frame (p^0: ``seg.built_position_body``). Now, with D 1-Lipschitz in the ends
+    (:func:`_apart_after_motion`) and |p - p_then| <= |p - p^0| + |p_then - p^0| for each node,
+
+    .. math:: D_{now} \\ge C - \\max(|p_a - p^0_a|, |p_c - p^0_c|)
+
+    (``seg.moved_body`` row 0), and over the step's free motion each node moves in the body frame by at most
+    h (u_i + v_b + w_b |r_i|) (u_i its speed bound ``seg.node_speed``, which holds the half kick and the held force's
+    h^2 |f| / m; v_b, w_b the body's speed and spin, ``seg.shape_work`` rows 5, 6; |r_i| its distance from the body's
+    CoM, ``seg.moved_body`` row 1). When D_now less that motion still exceeds both radii by the tie distance, the test
+    at the start and the one at the end of the free motion both answer no (as in :func:`_apart_after_motion`)."""
+    clearance = seg.candidate_clearance[k]
+    if clearance == -math.inf:
+        return False
+    moved = seg.moved_body
+    lever = math.sqrt(max(moved[b, 1, a], moved[b, 1, c]))
+    motion = step * (max(seg.node_speed[a], seg.node_speed[c]) + seg.shape_work[5, s] + seg.shape_work[6, s] * lever)
+    return (clearance - math.sqrt(max(moved[b, 0, a], moved[b, 0, c])) - motion
+            > max(radius[a], radius[c]) + TIE_DISTANCE)
 
 
 @njit(cache=True, inline="always")
