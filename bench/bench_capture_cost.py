@@ -132,6 +132,17 @@ class PhaseClock:
         # the test at the end of the free motion alone
         self.skips = np.zeros((n, 2), np.int64)
         self._skips_seen = np.zeros(2, np.int64)
+        self._skip_window = 0
+        # the kernel's candidate_count, read at each window's change only (read each step, it cost some 3 us a step
+        # of numpy in the glue's column)
+        self._skip_counters = None
+
+    def count_skips(self) -> None:
+        """The skips since the last call, to the window they were counted in (at a window's change and the end)."""
+        if self._skip_counters is not None:
+            self.skips[self._skip_window] += self._skip_counters[2:4] - self._skips_seen
+            self._skips_seen = self._skip_counters[2:4].copy()
+        self._skip_window = self.window
 
     def window_of(self, t: float) -> int:
         return int(min(max(np.searchsorted(self.edges, t, side="right") - 1, 0), len(self.edges) - 2))
@@ -184,9 +195,10 @@ def instrument(clock: PhaseClock) -> None:
         if listed.size:
             clock.builds[clock.window] += listed[1] - clock._builds_seen
             clock._builds_seen = listed[1]
-        if listed.size >= 4:        # the skip counters (helper speed23)
-            clock.skips[clock.window] += listed[2:4] - clock._skips_seen
-            clock._skips_seen = listed[2:4].copy()
+        if listed.size >= 4 and clock._skip_counters is None:        # the skip counters (helper speed23)
+            clock._skip_counters = listed
+        if clock.window != clock._skip_window:
+            clock.count_skips()
         if clock.census_times and t >= clock.census_times[0]:
             clock.census_times.pop(0)
             start = time.process_time()
@@ -218,6 +230,7 @@ def run_digest(folder: Path) -> str:
 
 def print_table(clock: PhaseClock, step: float) -> None:
     """Per window: steps, CPU per simulated second (s/s), us per step of each part, contacts per step."""
+    clock.count_skips()
     print(f"{'window (s)':>14} {'steps':>7} {'CPU/sim-s':>9} {'total':>7} {'kernel':>7} {'post':>6} {'capture':>7} "
           f"{'other':>6} {'contacts':>8} {'builds':>7} {'skip/step':>9} {'end-skip':>8}   (us a step; CPU/sim-s in s "
           f"per simulated s; builds of the thread contact's candidate pairs; per step, pairs skipped whole by their "

@@ -127,9 +127,6 @@ class SegmentBuffers(NamedTuple):
                                      # build (m)
     built_speed: np.ndarray         # (n,) node_speed at the last build (m/s)
     built_surface_speed: np.ndarray  # (ns,) shape_work[1] at the last build (m/s)
-    moved_body: np.ndarray          # (nb, 2, n) each node's squared displacement in each box-carrying body's frame
-                                    # since the last build (m^2, row 0) and its squared distance from the body's CoM
-                                    # (m^2, row 1)
     candidate_clearance: np.ndarray  # (m ns,) per candidate pair, a bound C (m) of its thread's distance to its box
                                      # less its nodes' displacement since the last build (-inf: none; segment_pairs)
     breakpoints: np.ndarray         # (MAX_BREAKPOINTS,) work: a segment's sorted breakpoints
@@ -182,7 +179,7 @@ def segment_buffers(n_threads: int, n_nodes: int, n_shapes: int, n_bodies: int, 
                           candidate_thread=np.zeros(m * ns, np.int64), candidate_shape=np.zeros(m * ns, np.int64),
                           candidate_count=np.zeros(4, np.int64), candidate_scalar=np.array([float(skin), 0.0, 1.0]),
                           built_position_body=np.zeros((nb, 3, n)), built_speed=np.zeros(n),
-                          built_surface_speed=np.zeros(ns), moved_body=np.zeros((nb, 2, n)),
+                          built_surface_speed=np.zeros(ns),
                           candidate_clearance=np.full(m * ns, -np.inf),
                           breakpoints=np.zeros(MAX_BREAKPOINTS), contact_scalar=np.zeros((5, 1)),
                           contact_vector=np.zeros((6, 1, 3)), external_force=np.zeros(3), cycle_out=np.zeros((4, 3)),

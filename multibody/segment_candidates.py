@@ -75,7 +75,6 @@ def _candidates_hold(x, seg, states, shapes, step):
         return False
     limit2 = limit * limit
     body_to_lvlh, com_lvlh, built = states.body_to_lvlh, states.com_lvlh, seg.built_position_body
-    moved_body = seg.moved_body
     for b in range(body_to_lvlh.shape[0]):
         if not _carries_box(b, shapes):
             continue
@@ -84,9 +83,6 @@ def _candidates_hold(x, seg, states, shapes, step):
             p = _to_body(x, i, body_to_lvlh, com_lvlh, b)
             d2 = (p[0] - built[b, 0, i]) ** 2 + (p[1] - built[b, 1, i]) ** 2 + (p[2] - built[b, 2, i]) ** 2
             moved |= d2 > limit2
-            # for the pairs' clearances (multibody.segment_pairs._still_apart)
-            moved_body[b, 0, i] = d2
-            moved_body[b, 1, i] = p[0] * p[0] + p[1] * p[1] + p[2] * p[2]
         if moved:
             return False
     return True
@@ -107,8 +103,6 @@ def _build_candidates(x, threads, radius, seg, states, shapes, step):
         for i in range(x.shape[1]):
             p = _to_body(x, i, body_to_lvlh, com_lvlh, b)
             built[b, 0, i], built[b, 1, i], built[b, 2, i] = p[0], p[1], p[2]
-            seg.moved_body[b, 0, i] = 0.0
-            seg.moved_body[b, 1, i] = p[0] * p[0] + p[1] * p[1] + p[2] * p[2]
     for i in range(node_speed.shape[0]):
         seg.built_speed[i] = node_speed[i]
     for s in range(is_box.shape[0]):

@@ -124,9 +124,12 @@ def _contact_pairs(x, v, net_force_lvlh, net, states, shapes, step, n_substeps, 
     for k in range(seg.candidate_count[0]):
         j, s = seg.candidate_thread[k], seg.candidate_shape[k]
         a, c = threads[j, 0], threads[j, 1]
-        if proofs and _still_apart(seg, k, a, c, shape_body[s], s, radius, step):
-            seg.candidate_count[2] += 1
-            continue
+        if proofs and seg.candidate_clearance[k] > -math.inf:
+            b = shape_body[s]
+            if _still_apart(seg, k, a, c, b, s, _to_body(x, a, body_to_lvlh, com_lvlh, b),
+                            _to_body(x, c, body_to_lvlh, com_lvlh, b), radius, step):
+                seg.candidate_count[2] += 1
+                continue
         length = math.sqrt((x[0, c] - x[0, a]) ** 2 + (x[1, c] - x[1, a]) ** 2 + (x[2, c] - x[2, a]) ** 2)
         motion = step * max(node_speed[a], node_speed[c])
         thread_radius = min(radius[a], radius[c])
@@ -146,8 +149,9 @@ def _contact_pairs(x, v, net_force_lvlh, net, states, shapes, step, n_substeps, 
         touches, separation = _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, radius,
                                                    states, shapes, step, n_substeps, buffers)
         if not touches:
-            moved = math.sqrt(max(seg.moved_body[b, 0, a], seg.moved_body[b, 0, c]))
-            seg.candidate_clearance[k] = max(seg.candidate_clearance[k], separation - moved)
+            if separation > -math.inf:
+                moved = math.sqrt(max(_moved_since_build(seg, b, a, pa), _moved_since_build(seg, b, c, pc)))
+                seg.candidate_clearance[k] = max(seg.candidate_clearance[k], separation - moved)
             continue
         seg.pair_thread[n_pairs] = j
         seg.pair_shape[n_pairs] = s
@@ -206,9 +210,18 @@ def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, rad
 
 
 @njit(cache=True, inline="always")
-def _still_apart(seg, k, a, c, b, s, radius, step):
-    """Whether candidate pair ``k`` (thread (a, c), box ``s`` on body ``b``) is proven apart for this whole step by
-    its clearance C (``seg.candidate_clearance[k]``, m), so that its tests in :func:`_contact_pairs` would all say no.
+def _moved_since_build(seg, b, i, p):
+    """Node ``i``'s squared displacement (m^2) in body ``b``'s frame since the candidate list's build, from its position
+    ``p`` there now (m; ``seg.built_position_body``)."""
+    built = seg.built_position_body
+    return (p[0] - built[b, 0, i]) ** 2 + (p[1] - built[b, 1, i]) ** 2 + (p[2] - built[b, 2, i]) ** 2
+
+
+@njit(cache=True, inline="always")
+def _still_apart(seg, k, a, c, b, s, pa, pc, radius, step):
+    """Whether candidate pair ``k`` (thread (a, c), box ``s`` on body ``b``, its nodes at ``pa``, ``pc`` in the body's
+    frame, m) is proven apart for this whole step by its clearance C (``seg.candidate_clearance[k]``, m), so that its
+    tests in :func:`_contact_pairs` would all say no.
 
     C was set at an earlier step of this build, C = S - max(|p_a - p^0_a|, |p_c - p^0_c|), from the separating-axis
     bound S <= D of the thread's distance to the box then (:func:`_contact_test`) and its nodes' displacements since
@@ -217,19 +230,15 @@ def _still_apart(seg, k, a, c, b, s, radius, step):
 
     .. math:: D_{now} \\ge C - \\max(|p_a - p^0_a|, |p_c - p^0_c|)
 
-    (``seg.moved_body`` row 0), and over the step's free motion each node moves in the body frame by at most
+    (:func:`_moved_since_build`), and over the step's free motion each node moves in the body frame by at most
     h (u_i + v_b + w_b |r_i|) (u_i its speed bound ``seg.node_speed``, which holds the half kick and the held force's
     h^2 |f| / m; v_b, w_b the body's speed and spin, ``seg.shape_work`` rows 5, 6; |r_i| its distance from the body's
-    CoM, ``seg.moved_body`` row 1). When D_now less that motion still exceeds both radii by the tie distance, the test
+    CoM, |p_i|). When D_now less that motion still exceeds both radii by the tie distance, the test
     at the start and the one at the end of the free motion both answer no (as in :func:`_apart_after_motion`)."""
-    clearance = seg.candidate_clearance[k]
-    if clearance == -math.inf:
-        return False
-    moved = seg.moved_body
-    lever = math.sqrt(max(moved[b, 1, a], moved[b, 1, c]))
+    lever = math.sqrt(max(pa[0] * pa[0] + pa[1] * pa[1] + pa[2] * pa[2], pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2]))
     motion = step * (max(seg.node_speed[a], seg.node_speed[c]) + seg.shape_work[5, s] + seg.shape_work[6, s] * lever)
-    return (clearance - math.sqrt(max(moved[b, 0, a], moved[b, 0, c])) - motion
-            > max(radius[a], radius[c]) + TIE_DISTANCE)
+    moved = math.sqrt(max(_moved_since_build(seg, b, a, pa), _moved_since_build(seg, b, c, pc)))
+    return seg.candidate_clearance[k] - moved - motion > max(radius[a], radius[c]) + TIE_DISTANCE
 
 
 @njit(cache=True, inline="always")
