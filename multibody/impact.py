@@ -618,13 +618,15 @@ def with_winch(post_step, *winches):
     return hook
 
 
-def _detach_step_functions(mbs) -> None:
+def detach_step_functions(mbs) -> None:
     """Clear the system's pre- and post-step functions once a run is over.
 
     They are Python objects that hold the system (the kernel's hook, the recorder through the built system), and
     Exudyn holds them from C++: a reference cycle Python's collector cannot see, so every finished simulation stayed
     in memory with its recorded histories (about 1.8 GB a 420 s envisat_small run; a sweep worker paused by Dask's
     memory limit after five such runs and the sweep stalled, 2026-11-28). Cleared, a dropped simulation is freed.
+    Every runner whose step function holds the system (directly or through what it records) calls it when its run
+    ends: the impact, the approach's replay (:mod:`multibody.mu_replay`) and the diagnosis's Exudyn model.
     """
     mbs.SetPreStepUserFunction(0)
     mbs.SetPostStepUserFunction(0)
@@ -694,5 +696,5 @@ class ImpactSimulation:
         finally:
             self.wall_time = time.perf_counter() - start
             recorder.finish(self.wall_time)
-            _detach_step_functions(mbs)
+            detach_step_functions(mbs)
         return recorder

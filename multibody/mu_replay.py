@@ -24,7 +24,8 @@ from scipy.interpolate import CubicSpline
 
 from multibody.assembly import ContactLaw, ImpactAssembly, NetMount, RigidBodySpec, SolverSpec
 from multibody.health import HealthWatch
-from multibody.impact import (INTEGRATORS, build_impact_system, checked_post_step, likely_failure_cause,
+from multibody.impact import (INTEGRATORS, build_impact_system, checked_post_step, detach_step_functions,
+                              likely_failure_cause,
                               simulation_settings, solve_checked)
 from multibody.net import flat_square_net
 
@@ -108,15 +109,17 @@ def _unit_body(name, mass, position_world, velocity_world):
 class _TrackingLoad:
     """Exudyn load user function of one MU: feed-forward plus tracking force (N, world)."""
 
-    def __init__(self, mbs, node, mass, spline, gains, log):
-        self.mbs, self.node, self.mass, self.spline, self.gains, self.log = mbs, node, mass, spline, gains, log
+    def __init__(self, node, mass, spline, gains, log):
+        # no reference to the system: Exudyn holds this function from C++, and one back to the system would be a
+        # cycle the collector cannot see (multibody.impact.detach_step_functions)
+        self.node, self.mass, self.spline, self.gains, self.log = node, mass, spline, gains, log
 
     def __call__(self, mbs, t, load):
         r_ref_world = np.r_[self.spline(t), 0.0]
         v_ref_world = np.r_[self.spline(t, 1), 0.0]
         a_ref_world = np.r_[self.spline(t, 2), 0.0]
-        r_world = np.asarray(self.mbs.GetNodeOutput(self.node, exu.OutputVariableType.Position))
-        v_world = np.asarray(self.mbs.GetNodeOutput(self.node, exu.OutputVariableType.Velocity))
+        r_world = np.asarray(mbs.GetNodeOutput(self.node, exu.OutputVariableType.Position))
+        v_world = np.asarray(mbs.GetNodeOutput(self.node, exu.OutputVariableType.Velocity))
         tracking_world = self.gains[0] * (r_ref_world - r_world) + self.gains[1] * (v_ref_world - v_world)
         self.log[0] = float(np.linalg.norm(tracking_world))
         return list(self.mass * a_ref_world + tracking_world)
@@ -157,14 +160,17 @@ def replay(t_plan, unit_paths, unit_masses, net_spec: dict, debris, keep_out_rad
     for k in range(2):
         marker = mbs.AddMarker(MarkerBodyPosition(bodyNumber=built.body_objects[k], localPosition=[0.0] * 3))
         mbs.AddLoad(LoadForceVector(markerNumber=marker, loadVector=[0.0] * 3, loadVectorUserFunction=_TrackingLoad(
-            mbs, built.body_nodes[k], unit_masses[k], splines[k], gains, logs[k])))
+            built.body_nodes[k], unit_masses[k], splines[k], gains, logs[k])))
     mbs.Assemble()
     samples = _Sampler(mbs, built, net.n_nodes, mouth_nodes, logs, max(1, int(round(1.0 / (output_rate * step)))))
     # thrust-driven tracking: no closed energy balance, so the checks are a finite state and the solver's flag
     watch = HealthWatch(likely_failure_cause(assembly))
     mbs.SetPostStepUserFunction(checked_post_step(watch, samples))
     samples(mbs, 0.0)
-    solve_checked(mbs, simulation_settings(assembly), INTEGRATORS[assembly.solver.integrator][0], watch)
+    try:
+        solve_checked(mbs, simulation_settings(assembly), INTEGRATORS[assembly.solver.integrator][0], watch)
+    finally:
+        detach_step_functions(mbs)     # the sampler holds the built system: freed with it once the replay is over
     samples(mbs, float(t_plan[-1]), force=True)
     return samples.result(debris, keep_out_radius)
 

@@ -26,7 +26,7 @@ from riskassess.diagnosis.plants.scenario import plant_of
 from riskassess.diagnosis.towing_exudyn import simulate_towing_exudyn
 from multibody.assembly import JointSpec, RigidBodySpec
 from multibody.hinge import add_penalty_joint, hinge_frame_lvlh
-from multibody.impact import add_rigid_bodies, explicit_settings
+from multibody.impact import add_rigid_bodies, detach_step_functions, explicit_settings
 from multibody.solver_output import solver_chatter_captured
 
 #: Exudyn RK44 step (s) with a hinge: the penalty hinge is tuned to it (mode at 0.5 / step = 125
@@ -226,8 +226,11 @@ class ExudynScenario:
         recorder.sample(0.0)
         mbs.SetPostStepUserFunction(recorder.post_step)
         n_steps = int(np.ceil(times[-1] / self.step)) + 1
-        with solver_chatter_captured():
-            exu.SolveDynamic(mbs, explicit_settings(self.step, n_steps), solverType=exu.DynamicSolverType.RK44)
+        try:
+            with solver_chatter_captured():
+                exu.SolveDynamic(mbs, explicit_settings(self.step, n_steps), solverType=exu.DynamicSolverType.RK44)
+        finally:
+            detach_step_functions(mbs)     # the recorder holds the system (multibody.impact.detach_step_functions)
         return self._channels(times, recorder.states())
 
     def _channels(self, times, states) -> dict[str, np.ndarray]:
