@@ -9,10 +9,12 @@ VelocityVerlet's terms (module ``multibody.kernel_net``: a force evaluated at ``
 kinetic energy by ``h f . v(n+1)``):
 
 * made = the work the group's forces do on the nodes (``h f . v(n+1)``) + the change of its elastic energy + its
-  dampers' dissipation as the kernel books it (``(T - k s) l'(n+1/2) h``, :func:`multibody.net.kelvin_voigt_dissipated_power`)
-  - the winch's booked work (the loop only): zero for an exact integration;
-* its damper part = the dampers' booking less the work their force does in Verlet's terms (``(T - k s) l'(n+1) h``),
-  helper gain18's split (docs/model.md, "The gain the joints' dampers unmasked"); the spring part is the rest;
+  dampers' dissipation as the kernel books it (``(T - k s) s'(n+1/2) h``, ``s' = l' - l0'``,
+  :func:`multibody.net.kelvin_voigt_dissipated_power`) - the winch's booked work (the loop only; its spring share and
+  its damper share ``-(T - k s) l0' h``, :func:`multibody.net.reel_damper_power`): zero for an exact integration;
+* its damper part = the dampers' booking less the winch's damper share less the work their force does in Verlet's
+  terms (``(T - k s) l'(n+1) h``), helper gain18's split (docs/model.md, "The gain the joints' dampers unmasked");
+  the spring part is the rest;
 * the loop's tension onsets and releases (T > 0 starting or ending) and the loop made within 2 steps of one.
 
 Printed from ``--from`` (default 14.9 s) at ``--times``, as % of the run's first recorded total (the measure of
@@ -36,13 +38,14 @@ from thread_contact_drift import with_overrides  # noqa: E402
 
 from multibody.closing import N_CLOSING  # noqa: E402
 from multibody.impact import ImpactSimulation  # noqa: E402
-from multibody.net import PADDING_REST_LENGTH  # noqa: E402
+from multibody.net import PADDING_REST_LENGTH, reel_damper_power  # noqa: E402
 from riskassess.cases.impact import load_case  # noqa: E402
 from riskassess.models.impact import model_inputs  # noqa: E402
 
 #: Per-step running totals kept by :class:`LoopMeter`, per group (loop, net): work on the nodes, elastic energy
-#: (not running), dampers' booking, dampers' Verlet work; then the winch's work, onsets, releases.
-GROUP_FIELDS = 4
+#: (not running), dampers' booking, dampers' Verlet work, the reel's damper share (0 for a fixed natural length);
+#: then the winch's work, onsets, releases.
+GROUP_FIELDS = 5
 
 
 class LoopMeter(FlowMeter):
@@ -88,15 +91,17 @@ class LoopMeter(FlowMeter):
         d = x[b] - x[a]
         unit = d / np.linalg.norm(d, axis=1)[:, None]
         rest, k, c = self._runs.rest_lengths[padded], self._runs.stiffness[padded], self._runs.damping[padded]
+        rest_rate = self._runs.rest_rates[padded]       # as the step's evaluation read them (the winch sets the next)
         stretch = np.linalg.norm(d, axis=1) - rest
         rate_mid = np.einsum("ti,it->t", unit, velocity_mid[:, b] - velocity_mid[:, a])
         rate_end = np.einsum("ti,it->t", unit, velocity_end[:, b] - velocity_end[:, a])
         pulled = np.where(stretch > 0.0, stretch, 0.0)
-        tension = np.where(stretch > 0.0, np.maximum(k * stretch + c * rate_mid, 0.0), 0.0)
+        tension = np.where(stretch > 0.0, np.maximum(k * stretch + c * (rate_mid - rest_rate), 0.0), 0.0)
         non_elastic = tension - k * pulled
         h = self.step
         return tension, np.array([-h * np.sum(tension * rate_end), np.sum(0.5 * k * pulled ** 2),
-                                  h * np.sum(non_elastic * rate_mid), h * np.sum(non_elastic * rate_end)])
+                                  h * np.sum(non_elastic * (rate_mid - rest_rate)), h * np.sum(non_elastic * rate_end),
+                                  h * np.sum(reel_damper_power(tension, pulled, k, rest_rate))])
 
 
 def print_balance(meter: LoopMeter, series: dict, t_from: float, times: list) -> None:
@@ -111,13 +116,14 @@ def print_balance(meter: LoopMeter, series: dict, t_from: float, times: list) ->
     rows = loop[j] - loop[j[k0]]
     made = {g: rows[:, 1 + o] + rows[:, 2 + o] + rows[:, 3 + o] for g, o in (("loop", 0), ("net", GROUP_FIELDS))}
     made["loop"] = made["loop"] - rows[:, 1 + 2 * GROUP_FIELDS]
-    damper = {g: rows[:, 3 + o] - rows[:, 4 + o] for g, o in (("loop", 0), ("net", GROUP_FIELDS))}
+    damper = {g: rows[:, 3 + o] - rows[:, 5 + o] - rows[:, 4 + o] for g, o in (("loop", 0), ("net", GROUP_FIELDS))}
     d = {key: series[key] - series[key][k0] for key in ("energy_total", "energy_contact_elastic",
                                                           "energy_dissipated_contact")}
     contact = (flows[:, 1] - flows[k0, 1] + flows[:, 3] - flows[k0, 3] + d["energy_contact_elastic"]
                + d["energy_dissipated_contact"])
     print(f"   from {t[k0]:.3f} s (% of the first total {e0:.4f} J): total, contact, loop (spring + damper), net's "
-          "threads (spring + damper), rest; the loop's booked damper dissipation and the winch's work (J)")
+          "threads (spring + damper), rest; the loop's booked damper dissipation, the winch's work and its damper "
+          "share (J)")
     for when in times:
         k = min(int(np.searchsorted(t, when)), len(t) - 1)
         rest = d["energy_total"][k] - contact[k] - made["loop"][k] - made["net"][k]
@@ -125,7 +131,7 @@ def print_balance(meter: LoopMeter, series: dict, t_from: float, times: list) ->
               f"{100 * made['loop'][k] / e0:+8.3f} ({100 * (made['loop'][k] - damper['loop'][k]) / e0:+.3f} "
               f"{100 * damper['loop'][k] / e0:+.3f}) {100 * made['net'][k] / e0:+8.3f} "
               f"({100 * (made['net'][k] - damper['net'][k]) / e0:+.3f} {100 * damper['net'][k] / e0:+.3f}) "
-              f"{100 * rest / e0:+8.3f}   {rows[k, 3]:.3f} {rows[k, 1 + 2 * GROUP_FIELDS]:.3f}")
+              f"{100 * rest / e0:+8.3f}   {rows[k, 3]:.3f} {rows[k, 1 + 2 * GROUP_FIELDS]:.3f} {rows[k, 5]:.3f}")
     print_events(loop[j[k0]:], e0)
 
 

@@ -4,14 +4,21 @@ step by step, in the compiled kernel's thread arrays, and books the work it does
 The loop's threads are the net's last :data:`~multibody.closing.N_CLOSING` threads, so the kernel's tension-only
 thread pass (:func:`multibody.net.add_thread_forces_runs`) gives their forces, their elastic energy (in the
 threads' elastic energy) and their damper's dissipation (in the threads' dissipated energy) like any thread's. Only
-their natural lengths and stiffnesses change: :meth:`ClosingWinch.after_step` runs after each step (from the
-kernel's pre-step hook, with the recorder's sample of that step, :meth:`multibody.kernel_net.KernelNet.set_after_step`)
-and sets them for the next step's force evaluation, at the next step's end time (the time of Verlet's evaluation
-state). The winch's work is the change of the loop's elastic energy across that update (:mod:`multibody.closing`,
-module doc), taken as the mean of the change at the node positions before and after the step that first uses the
-new lengths (the trapezoid rule: the energy balance then closes to second order in the step), summed in
-:attr:`ClosingWinch.work`; the recorder books it (``energy_winch_work``), so the balance stays closed while the
-loop pulls.
+their natural lengths, their stiffnesses and their natural lengths' rates change: :meth:`ClosingWinch.after_step`
+runs after each step (from the kernel's pre-step hook, with the recorder's sample of that step,
+:meth:`multibody.kernel_net.KernelNet.set_after_step`) and sets them for the next step's force evaluation, at the next
+step's end time (the time of Verlet's evaluation state). The rate is the schedule's mean over that step, so the
+threads' dampers read the stretch's rate :math:`\dot l - \dot l_0` (:func:`multibody.net.tension_only_kelvin_voigt`):
+a thread reeled in at constant stretch takes no damper force and dissipates nothing.
+
+The winch holds the whole tension :math:`T` and hauls in at :math:`-\dot l_0`: it puts :math:`-T \dot l_0 +
+\tfrac12 \dot k s^2` into the loop (:func:`multibody.net.reel_damper_power`). Its spring share is the change of the
+loop's elastic energy across each update at fixed positions (:mod:`multibody.closing`, module doc; the stiffness
+EA / l0 changes with l0 and the change is in it), taken as the mean of the change at the node positions before and
+after the step that first uses the new lengths (the trapezoid rule: second order in the step); its damper share,
+:math:`-(T - k s)\,\dot l_0`, is booked at each evaluation over the step, as the kernel books the dampers'
+dissipation. Both are summed in :attr:`ClosingWinch.work`; the recorder books it (``energy_winch_work``), so the
+balance stays closed while the loop pulls (:class:`TrapezoidWork`).
 
 The trigger: a time, or the net's first contact with any body (the kernel's contact count, nodes' and threads')
 plus a delay; a mission fires the closing on a sensed arrival of the net, then waits for the wrap (Boonrath,
@@ -25,7 +32,7 @@ import numpy as np
 
 from multibody.closing import N_CLOSING, closing_stiffness, loop_elastic_energy, reel_fraction, reeled_rest_lengths
 from multibody.kernel import N_CONTACTS, KernelData
-from multibody.net import PADDING_REST_LENGTH
+from multibody.net import PADDING_REST_LENGTH, reel_damper_power
 
 
 class ContactTrigger:
@@ -82,11 +89,18 @@ class ClosingSpec:
 
 
 class TrapezoidWork:
-    """The work a reel does on the net by changing natural lengths, booked by the trapezoid rule: half of each
-    update's elastic-energy change at the positions before the step that uses it (:meth:`book_update`), half at
-    the positions that step ended in (:meth:`book_pending`); second order in the step (either end alone is first
-    order, measured in tests/multibody/test_closing.py). Subclasses give ``_energy_change(rest_from, rest_to)``
-    (J, at the current positions) and start with ``work = 0.0`` and ``_pending = None``."""
+    """The work a reel does on the net by changing natural lengths (:func:`multibody.net.reel_damper_power`).
+
+    The spring's share by the trapezoid rule: half of each update's elastic-energy change at the positions before
+    the step that uses it (:meth:`book_update`), half at the positions that step ended in (:meth:`book_pending`);
+    second order in the step (either end alone is first order, measured in tests/multibody/test_closing.py). The
+    damper's share, :math:`-(T - k s)\,\dot l_0` times the step, at each evaluation (:meth:`book_pending`), as the
+    kernel books the dampers' dissipation :math:`(T - k s)\,\dot s` times the step.
+
+    Subclasses give ``_energy_change(rest_from, rest_to)`` (J, at the current positions) and
+    ``_evaluated_threads()`` (the reeled threads' tension (N), pulling stretch (m), stiffness (N/m) and natural
+    length's rate (m/s) at the last evaluation, arrays or floats), and start with ``work = 0.0``,
+    ``_pending = None``, ``_reeling = False`` (True while a rate is set) and ``step`` (s)."""
 
     def book_update(self, rest_before, rest_after) -> None:
         """Book the first half of the work of the update ``rest_before`` -> ``rest_after`` (m) now."""
@@ -94,10 +108,13 @@ class TrapezoidWork:
         self._pending = (rest_before, rest_after)
 
     def book_pending(self) -> None:
-        """Book the second half of the last update's work, at the positions the step that used it ended in."""
+        """Book the second half of the last update's work, at the positions the step that used it ended in, and the
+        damper's share of that step's evaluation."""
         if self._pending is not None:
             self.work += 0.5 * self._energy_change(*self._pending)
             self._pending = None
+        if self._reeling:
+            self.work += self.step * float(np.sum(reel_damper_power(*self._evaluated_threads())))
 
 
 class ClosingWinch(TrapezoidWork):
@@ -130,7 +147,9 @@ class ClosingWinch(TrapezoidWork):
             raise ValueError(f"{len(real)} real threads in the kernel's runs against {n_threads} in the net")
         self.index = real[n_threads - N_CLOSING:]
         self.threads = np.asarray(kernel.net.threads[n_threads - N_CLOSING:], np.int64)
-        self.rest, self.stiffness = runs.rest_lengths, runs.stiffness   # the kernel's own arrays: written in place
+        # the kernel's own arrays: written in place
+        self.rest, self.stiffness, self.rest_rate = runs.rest_lengths, runs.stiffness, runs.rest_rates
+        self.work_thread = kernel.buffers.work_thread     # the thread pass's last evaluation, per padded thread
         self.spec, self.step = spec, float(step)
         self.scalars = kernel.buffers.scalars
         self.reference_lvlh = kernel.net.reference_lvlh
@@ -140,6 +159,7 @@ class ClosingWinch(TrapezoidWork):
         self.trigger = ContactTrigger(spec.start, spec.delay, self.scalars)
         self.closed = False
         self._pending = None   # (before, after) natural lengths of the last update, half its work still to book
+        self._reeling = False  # the last evaluation had the loop's natural lengths moving (rest_rate set)
         #: the loop's natural lengths (m) when the reel-in starts (the slack taken up) and when it ends; None before
         self.rest_start = self.rest_end = None
 
@@ -192,6 +212,9 @@ class ClosingWinch(TrapezoidWork):
         stiffnesses for the next step's evaluation (at ``t + step``) and book half the work of the change at the
         current positions (:meth:`book_pending` books the other half after the step)."""
         if self.closed or self.trigger.activation(t) is None:
+            if self._reeling:       # the reel-in ended with the last step: the lengths hold from here on
+                self.rest_rate[self.index] = 0.0
+                self._reeling = False
             return
         t_next = t + self.step
         if t_next < self.activated_at:
@@ -203,7 +226,19 @@ class ClosingWinch(TrapezoidWork):
         self.book_update(rest_before, rest)
         self.rest[self.index] = rest
         self.stiffness[self.index] = closing_stiffness(self.spec.axial_rigidity, rest)
+        # the schedule's mean rate over the step (the slack taken up at the activation is no rate: it is no motion
+        # of the reel against tension, and a slack thread holds no force)
+        self.rest_rate[self.index] = (rest - self.natural_lengths(t)) / self.step
+        self._reeling = True
         self.closed = reel_fraction(t_next, self.activated_at, self.spec.duration) >= 1.0
+
+    def _evaluated_threads(self):
+        """The loop's tension (N), pulling stretch (m), stiffness (N/m) and natural length's rate (m/s) at the last
+        evaluation (the thread pass's work rows: the force on node a, T e, and the energy 1/2 k s^2)."""
+        work = self.work_thread[:, self.index]
+        tension = np.sqrt(work[0] ** 2 + work[1] ** 2 + work[2] ** 2)
+        stiffness = self.stiffness[self.index]
+        return tension, np.sqrt(2.0 * work[3] / stiffness), stiffness, self.rest_rate[self.index]
 
     def summary(self) -> dict:
         """JSON-ready: activation and first-contact times (s), the reel-in's end (s), the work booked (J), the loop's

@@ -308,12 +308,18 @@ def tension_only_kelvin_voigt(stretch, rate, stiffness, damping):
     Cuadrat-Grzybowski & Gill 2024 eq. (1); the same law is the main tether and sub-tethers
     of Boonrath, Singh & Botta 2024, eqs. (5a) and (14a).
 
+    The damper reads the rate of the stretch, :math:`\\dot s = \\dot l - \\dot l_0`: for a thread of fixed natural
+    length the length's rate; for one a reel shortens (the closing loop, :mod:`multibody.closing_winch`; the main
+    tether, :mod:`multibody.tether_spool`) the length's rate less the reel's, so that a thread reeled in at constant
+    stretch takes no damper force (until 2026-11-28, helper loop23, the callers passed :math:`\\dot l`: the reel-in
+    itself was damped, and booked as dissipation).
+
     Parameters
     ----------
     stretch : float
-        Length minus natural length, :math:`l - l_0` (m).
+        Length minus natural length, :math:`s = l - l_0` (m).
     rate : float
-        Rate of change of the length, :math:`\\dot l` (m/s).
+        Rate of change of the stretch, :math:`\\dot s = \\dot l - \\dot l_0` (m/s).
     stiffness, damping : float
         :math:`k` (N/m) and :math:`c` (N s/m).
     """
@@ -327,8 +333,14 @@ def kelvin_voigt_dissipated_power(tension, stretch, rate, stiffness):
     """Power (W) a stretched tension-only thread (:func:`tension_only_kelvin_voigt`) takes out of the motion
     and does not store: what the nodes give it less its spring energy's rate.
 
-    .. math:: P = T \\dot l - k (l - l_0) \\dot l =
-              \\begin{cases} c \\dot l^2 & T > 0 \\\\ -k (l - l_0) \\dot l & T = 0 \\end{cases}
+    .. math:: P = T \\dot s - k s \\dot s =
+              \\begin{cases} c \\dot s^2 & T > 0 \\\\ -k s \\dot s & T = 0 \\end{cases}, \\qquad s = l - l_0
+
+    With a fixed natural length :math:`\\dot s = \\dot l`. With a reeled one (:math:`\\dot l_0 \\ne 0`) the power
+    the nodes give the thread is :math:`T \\dot l`, the reel gives it :math:`-T \\dot l_0 + \\tfrac12 \\dot k s^2`
+    (:func:`reel_damper_power` is its damper share; the rest is the change of the spring's energy at fixed
+    positions, which the reels book, :class:`multibody.closing_winch.TrapezoidWork`), and the spring's energy
+    changes by :math:`k s \\dot s + \\tfrac12 \\dot k s^2`: what is left is this :math:`P`.
 
     The second case is a stretched thread shortening faster than :math:`k (l - l_0) / c`: the damper would push,
     the law clips the tension to zero, and the spring energy it gives up is lost (as the contact law books
@@ -341,17 +353,45 @@ def kelvin_voigt_dissipated_power(tension, stretch, rate, stiffness):
     tension : float
         The law's tension (N), >= 0.
     stretch : float
-        :math:`l - l_0` (m), > 0 (a slack thread takes no power).
+        :math:`s = l - l_0` (m), > 0 (a slack thread takes no power).
     rate : float
-        :math:`\\dot l` (m/s).
+        :math:`\\dot s = \\dot l - \\dot l_0` (m/s).
     stiffness : float
         :math:`k` (N/m).
     """
     return (tension - stiffness * stretch) * rate
 
 
+def reel_damper_power(tension, stretch, stiffness, rest_rate):
+    """Power (W) a reel puts into a tension-only thread (:func:`tension_only_kelvin_voigt`) through the damper's
+    share of the tension, while it changes the thread's natural length at ``rest_rate``.
+
+    .. math:: P_\\text{reel} = -T \\dot l_0 + \\tfrac12 \\dot k s^2
+              = \\underbrace{-k s \\dot l_0 + \\tfrac12 \\dot k s^2}_\\text{spring: } \\partial E / \\partial t
+              \\;\\underbrace{-\\,(T - k s)\\,\\dot l_0}_\\text{this function}
+
+    The reel holds the whole tension :math:`T` (spring and damper) and hauls the line in at :math:`-\\dot l_0`; the
+    spring's share is the change of the elastic energy at fixed positions (the reels book it by the trapezoid rule,
+    :class:`multibody.closing_winch.TrapezoidWork`, the stiffness's change with :math:`l_0` included), this is the
+    rest. With :func:`kelvin_voigt_dissipated_power` it closes the balance kinetic + elastic + dissipated - reel work.
+    NumPy arrays or floats, elementwise.
+
+    Parameters
+    ----------
+    tension : float or (m,) float
+        The law's tension (N), >= 0, at the evaluation.
+    stretch : float or (m,) float
+        :math:`s = l - l_0` of a pulling thread (m), 0 for a slack one.
+    stiffness : float or (m,) float
+        :math:`k` (N/m).
+    rest_rate : float or (m,) float
+        :math:`\\dot l_0` (m/s), negative while the reel hauls in.
+    """
+    return -(tension - stiffness * stretch) * rest_rate
+
+
 @njit(cache=True)
-def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
+def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force, rest_rates=None):
     """Add tension-only Kelvin-Voigt thread forces to ``force``; return (elastic J, damping W).
 
     .. math:: T = \\max(0,\\; k (l - l_0) + c \\dot l) \\quad \\text{for } l > l_0
@@ -366,6 +406,10 @@ def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
         Natural length (m), stiffness (N/m) and damping (N s/m) of each thread.
     force : (n, 3) float
         Accumulator (N), frame of ``x``.
+    rest_rates : (m,) float, optional
+        Rate of each natural length (m/s) for threads a reel shortens (the full-net tow's closing loop,
+        :mod:`multibody.net_towing`): the damper reads the stretch's rate l' - l0'
+        (:func:`tension_only_kelvin_voigt`). None: every natural length fixed (the same arithmetic as before).
 
     Returns
     -------
@@ -397,6 +441,8 @@ def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force):
         ey = dy * inverse_length
         ez = dz * inverse_length
         rate = (v[b, 0] - v[a, 0]) * ex + (v[b, 1] - v[a, 1]) * ey + (v[b, 2] - v[a, 2]) * ez
+        if rest_rates is not None:
+            rate -= rest_rates[t]   # the stretch's rate (numba prunes the branch when None is passed)
         elastic += 0.5 * stiffness[t] * stretch * stretch
         tension = tension_only_kelvin_voigt(stretch, rate, stiffness[t], damping[t])
         power += kelvin_voigt_dissipated_power(tension, stretch, rate, stiffness[t])
@@ -433,6 +479,8 @@ class ThreadRuns(NamedTuple):
     rest_lengths: np.ndarray  # (P,) (m)
     stiffness: np.ndarray     # (P,) (N/m)
     damping: np.ndarray       # (P,) (N s/m)
+    rest_rates: np.ndarray    # (P,) (m/s) rate of each natural length: a reel's (the closing loop,
+                              # multibody.closing_winch), 0.0 for every other thread; the damper reads l' - l0'
 
 
 def thread_runs(threads, rest_lengths, stiffness, damping) -> ThreadRuns:
@@ -466,15 +514,17 @@ def thread_runs(threads, rest_lengths, stiffness, damping) -> ThreadRuns:
         k.append(stiffness[t])
         c.append(damping[t])
     return ThreadRuns(np.array(runs, np.int64).reshape(-1, 4), np.array(rest, float), np.array(k, float),
-                      np.array(c, float))
+                      np.array(c, float), np.zeros(len(rest)))
 
 
 @njit(cache=True, inline="always")
-def _run_tensions(x, v, a0, b0, first, count, rest, stiffness, damping, work):
+def _run_tensions(x, v, a0, b0, first, count, rest, stiffness, damping, rest_rates, work):
     """The law of :func:`add_thread_forces` on one run, branch-free so that it vectorizes: per thread the
     force on its node a (N, ``work[0:3]``), its elastic energy (J, ``work[3]``) and dissipated power (W,
-    ``work[4]``), exact zeros for a slack one. Unsigned indices: numba adds no negative-index
-    wrap-around to them, which would keep the loop scalar."""
+    ``work[4]``), exact zeros for a slack one. The damper reads the stretch's rate, the length's rate less
+    ``rest_rates`` (m/s; exact zeros for a thread of fixed natural length, so its arithmetic is the length's rate's
+    to the bit: x - 0.0 == x). Unsigned indices: numba adds no negative-index wrap-around to them, which would keep
+    the loop scalar."""
     a_start, b_start, t_start = uint64(a0), uint64(b0), uint64(first)
     for j_signed in range(count):
         j = uint64(j_signed)
@@ -494,7 +544,7 @@ def _run_tensions(x, v, a0, b0, first, count, rest, stiffness, damping, work):
         ey = dy * inverse_length
         ez = dz * inverse_length
         stretch = length - rest_t
-        rate = (v[0, b] - v[0, a]) * ex + (v[1, b] - v[1, a]) * ey + (v[2, b] - v[2, a]) * ez
+        rate = ((v[0, b] - v[0, a]) * ex + (v[1, b] - v[1, a]) * ey + (v[2, b] - v[2, a]) * ez) - rest_rates[t]
         pulling = taut & (stretch > 0.0)
         tension = max(0.0, stiffness[t] * stretch + damping[t] * rate)  # tension_only_kelvin_voigt
         tension = tension if pulling else 0.0
@@ -548,11 +598,11 @@ def add_thread_forces_runs(x, v, runs, force, work):
         As :func:`add_thread_forces` (J, W).
     """
     run_table = runs.runs
-    rest, stiffness, damping = runs.rest_lengths, runs.stiffness, runs.damping
+    rest, stiffness, damping, rest_rates = runs.rest_lengths, runs.stiffness, runs.damping, runs.rest_rates
     for r in range(run_table.shape[0]):
         first, a0, count, offset = run_table[r, 0], run_table[r, 1], run_table[r, 2], run_table[r, 3]
         b0 = a0 + offset
-        _run_tensions(x, v, a0, b0, first, count, rest, stiffness, damping, work)
+        _run_tensions(x, v, a0, b0, first, count, rest, stiffness, damping, rest_rates, work)
         # A node meets a run at most twice: as end b of an earlier thread than the one it is end a of
         # when the offset is positive. Adding the run's b ends first (a later pass the a ends) keeps
         # each node's sum in the thread list's order, so it equals the sequential loop's to the bit.

@@ -6,13 +6,15 @@ The tether is a tension-only Kelvin-Voigt line (:func:`multibody.net.tension_onl
 model's main tether law, Boonrath et al. eq. (5a); the same pure function, imported) from the anchor to one net
 node:
 
-.. math:: \\mathbf F_\\text{node} = -T\\,\\mathbf u, \\quad T = \\max(0,\\,k (l - l_0) + c\\,\\dot l)\\;(l > l_0),
+.. math:: \\mathbf F_\\text{node} = -T\\,\\mathbf u, \\quad T = \\max(0,\\,k (l - l_0) + c\\,(\\dot l - \\dot l_0))\\;(l > l_0),
           \\quad \\mathbf u = (\\mathbf x_\\text{node} - \\mathbf x_\\text{anchor}) / l,
 
 and the chaser feels :math:`+T\\mathbf u` (what its thrusters must hold). The anchor does not move, so the
 tether's power on the node is :math:`-T\\dot l`; its spring holds :math:`\\tfrac12 k (l - l_0)^2` and its damper
 takes :func:`multibody.net.kelvin_voigt_dissipated_power` out of the motion (booked per step with the Verlet
-evaluation state's rate, as the net's threads are).
+evaluation state's rate, as the net's threads are). The damper reads the stretch's rate: while the spool reels in,
+:math:`\\dot l_0` is its rate (:data:`REST_RATE`), and the reel's work through the damper's share of the tension
+is the spool's to book (:mod:`multibody.tether_spool`).
 
 Pure functions on SI floats and NumPy arrays (the anchor, the tethered node, the spool's schedule) and one
 compiled force pass (:func:`add_tether_force`) that :mod:`multibody.kernel_net` calls inside the net's step; the
@@ -31,9 +33,9 @@ from multibody.net import kelvin_voigt_dissipated_power, tension_only_kelvin_voi
 #: Layout of :attr:`NetTether.state` (one float array, written by the spool and the force pass): natural length
 #: (m), stiffness (N/m), damping (N s/m), on (1.0) or paying out (0.0), then the force pass's outputs at the last
 #: evaluation: tension (N), length (m), elastic energy (J), dissipated energy so far (J), force on the chaser
-#: (3 components, N, LVLH).
-REST, STIFFNESS, DAMPING, ON, TENSION, LENGTH, ELASTIC, DISSIPATED, FORCE_ON_CHASER, STATE_SIZE = (
-    0, 1, 2, 3, 4, 5, 6, 7, 8, 11)
+#: (3 components, N, LVLH); last the natural length's rate (m/s, the spool's while it reels in, else 0).
+REST, STIFFNESS, DAMPING, ON, TENSION, LENGTH, ELASTIC, DISSIPATED, FORCE_ON_CHASER, REST_RATE, STATE_SIZE = (
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 12)
 
 
 class NetTether(NamedTuple):
@@ -115,7 +117,7 @@ def add_tether_force(x_soa, v_soa, tether, force_soa, step):
     if s[ON] == 0.0 or stretch <= 0.0:
         return          # paying out, or slack: no force, no energy
     u0, u1, u2 = d0 / length, d1 / length, d2 / length
-    rate = v_soa[0, i] * u0 + v_soa[1, i] * u1 + v_soa[2, i] * u2
+    rate = (v_soa[0, i] * u0 + v_soa[1, i] * u1 + v_soa[2, i] * u2) - s[REST_RATE]   # the stretch's rate
     k = s[STIFFNESS]
     tension = tension_only_kelvin_voigt(stretch, rate, k, s[DAMPING])
     force_soa[0, i] -= tension * u0

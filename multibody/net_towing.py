@@ -267,7 +267,9 @@ class NetTowState:
         self.tether_on = np.array(model.main_tether, float)
         self.tether_off = np.array([0.0, 0.0, model.main_tether[2]])
         self.reeling = model.closing_duration is not None
-        self.net = NetThreads(top.masses, top.radii, top.threads, self.rest, self.stiffness, top.damping)
+        self.rest_rate = np.zeros(len(self.rest))
+        self.net = NetThreads(top.masses, top.radii, top.threads, self.rest, self.stiffness, top.damping,
+                              self.rest_rate)
         self.debris = DebrisBody(float(model.masses[1]), model.inverse_inertia[1], model.geometry, model.contact_law)
         m = model
         self.kernel = net_tow_kernel(self.x, self.v, self.lag, self.clock, self.net, self.reference, float(m.mu),
@@ -285,7 +287,8 @@ class NetTowState:
         t : float
             Time (s, absolute), at or after ``model.closing_time``.
 
-        Updates ``rest`` and ``stiffness`` of the closing threads in place (the kernel holds views).
+        Updates ``rest``, ``stiffness`` and ``rest_rate`` (m/s: the ramp's, so the loop's dampers act on the
+        stretch's rate, not on the reel-in itself) of the closing threads in place (the kernel holds views).
         """
         m = self.model
         ramp = reel_fraction(t, m.closing_time, m.closing_duration)
@@ -293,6 +296,7 @@ class NetTowState:
         self.rest[-k:] = reeled_rest_lengths(self.rest_open, m.net.closing_rest_closed, ramp)
         self.stiffness[-k:] = m.net.closing_stiffness(self.rest[-k:])
         self.reeling = ramp < 1.0
+        self.rest_rate[-k:] = (m.net.closing_rest_closed - self.rest_open) / m.closing_duration if self.reeling else 0.0
 
     def forces(self, q, v, t, advance):
         """Generalized forces (12,) on chaser and debris (:func:`step_forces`), the closing loop

@@ -61,6 +61,8 @@ class NetThreads(NamedTuple):
     rest: np.ndarray          # (m,) natural lengths (m); the closing loop's change in place while it is reeled in
     stiffness: np.ndarray     # (m,) EA/l0 (N/m), likewise
     damping: np.ndarray       # (m,) (N s/m)
+    rest_rate: np.ndarray     # (m,) rate of each natural length (m/s): the closing loop's while it is reeled in, else
+                              # 0; the dampers read the stretch's rate l' - l0' (multibody.net.tension_only_kelvin_voigt)
 
 
 class DebrisBody(NamedTuple):
@@ -215,12 +217,12 @@ def net_forces(x, v, lag, net, reference, mu, central, end, motion, debris, h, f
     explicit_tether : bool
         Include the main tether's force.
     """
-    node_mass, node_radius, threads, rest, stiffness, damping = net
+    node_mass, node_radius, threads, rest, stiffness, damping, rest_rate = net
     main_tether, a_point, a_velocity, com_c = end
     com_d, rot_d, vel_d, omega_d = motion
     mass_d, inverse_inertia_d, geometry, law = debris
     f[:] = 0.0
-    add_thread_forces(x, v, threads, rest, stiffness, damping, f)
+    add_thread_forces(x, v, threads, rest, stiffness, damping, f, rest_rate)
     n = x.shape[0]
     for i in range(n):
         if mu == 0.0:

@@ -129,13 +129,16 @@ def _drape(x_body, v_body, masses, radii, threads, rest, stiffness, damping, cen
     inverse = np.zeros((3, 3))
     far_body = 1e9 * up_body  # the (force-free) main tether's other end
     n_steps = int((fall + reel + settle) / h)
+    fixed_rest = np.zeros(len(rest))
     for k in range(n_steps):
         t = k * h
         ramp = min(1.0, max(0.0, (t - fall) / reel))
         for c in range(n_closing):
             rest[first + c] = rest_open[c] + ramp * (rest_closed[c] - rest_open[c])
             stiffness[first + c] = ea / rest[first + c]
-        net_forces(x_body, v_body, lag, NetThreads(masses, radii, threads, rest, stiffness, damping), zeros3, 0.0,
+        # the wrap's reel is a pseudo-time procedure (a drape, not a motion), so its dampers keep reading l'
+        net_forces(x_body, v_body, lag, NetThreads(masses, radii, threads, rest, stiffness, damping, fixed_rest),
+                   zeros3, 0.0,
                    central, TetherEnd(tether, far_body, zeros3, zeros3), DebrisMotion(zeros3, rot, zeros3, zeros3),
                    DebrisBody(big, inverse, geometry, law), h, f, acc, work)
         g = gravity if t < fall + reel else 0.0

@@ -10,10 +10,13 @@ rigidity EA gets the stiffness EA / l0 of that length. With a reel-in rate, the 
 
 :meth:`TetherSpool.after_step` runs after each step (from the kernel's pre-step hook, like the closing winch,
 :mod:`multibody.closing_winch`) and sets the natural length for the next step's evaluation, at the next step's end
-time. The reel's work is the change of the tether's elastic energy across each update at fixed positions (the
-closing winch's rule, :mod:`multibody.closing`, module doc), the mean of the change at the node's position before
-and after the step that first uses the new length (the trapezoid rule: second order in the step), summed in
-:attr:`TetherSpool.work`; the recorder books it (``energy_tether_winch_work``) with the tether's elastic energy and
+time, and the natural length's rate (the schedule's mean over that step, :data:`multibody.net_tether.REST_RATE`) that
+the tether's damper subtracts from the length's rate. The reel's work is, as the closing winch's
+(:class:`multibody.closing_winch.TrapezoidWork`), the change of the tether's elastic energy across each update at
+fixed positions (:mod:`multibody.closing`, module doc), the mean of the change at the node's position before and
+after the step that first uses the new length (the trapezoid rule: second order in the step), plus the damper's
+share of the tension against the reel, :math:`-(T - k s)\,\dot l_0` a step (:func:`multibody.net.reel_damper_power`),
+summed in :attr:`TetherSpool.work`; the recorder books it (``energy_tether_winch_work``) with the tether's elastic energy and
 its damper's dissipation (``energy_tether_elastic``, ``energy_dissipated_tether``).
 """
 from __future__ import annotations
@@ -25,9 +28,11 @@ import numpy as np
 from multibody.closing_winch import ContactTrigger, TrapezoidWork
 from multibody.net_tether import (
     DISSIPATED,
+    ELASTIC,
     FORCE_ON_CHASER,
     ON,
     REST,
+    REST_RATE,
     STIFFNESS,
     TENSION,
     NetTether,
@@ -108,6 +113,7 @@ class TetherSpool(TrapezoidWork):
         self.peak_tension, self.peak_tension_at = 0.0, None
         self.peak_chaser_force = 0.0
         self._pending = None   # (before, after) natural lengths of the last reel update, half its work still to book
+        self._reeling = False  # the last evaluation had the natural length moving (REST_RATE set)
 
     def node_lvlh(self) -> np.ndarray:
         """(3,) The tethered node's position (m, LVLH) at the end of the last step."""
@@ -162,11 +168,19 @@ class TetherSpool(TrapezoidWork):
             return
         rest_before = float(self.state[REST])
         rest = reeled_rest_length(self.rest_braked, self.spec.reel_rate, t_next - self.braked_at, self.spec.reel_in)
-        if rest == rest_before:
+        self.state[REST_RATE] = (rest - rest_before) / self.step   # the schedule's mean rate over the step
+        self._reeling = rest != rest_before
+        if not self._reeling:
             return
         self.book_update(rest_before, rest)
         self.state[REST] = rest
         self.state[STIFFNESS] = self.stiffness(rest)
+
+    def _evaluated_threads(self):
+        """The tether's tension (N), pulling stretch (m), stiffness (N/m) and natural length's rate (m/s) at the last
+        evaluation (the force pass's outputs; the stretch from its elastic energy, 1/2 k s^2)."""
+        k = self.state[STIFFNESS]
+        return self.state[TENSION], np.sqrt(2.0 * self.state[ELASTIC] / k), k, self.state[REST_RATE]
 
     @property
     def dissipated(self) -> float:

@@ -8,8 +8,8 @@ import trimesh
 from multibody.assembly import ContactLaw, ImpactAssembly, RigidBodySpec, SolverSpec
 from multibody.impact import ImpactSimulation
 from multibody.net import (NetTopology, add_bending_forces, add_thread_forces, add_thread_forces_runs, bowl_net_positions,
-                          flat_square_net, square_grid_threads, sum_reassociated, thread_node_mass, thread_runs,
-                          thread_tension_strain)
+                          flat_square_net, reel_damper_power, square_grid_threads, sum_reassociated, thread_node_mass,
+                          thread_runs, thread_tension_strain)
 from tests.conftest import PAPER_CONTACT_STIFFNESS
 
 
@@ -33,6 +33,22 @@ def test_thread_is_tension_only_kelvin_voigt():
     f[:] = 0.0
     add_thread_forces(np.array([[0.0, 0, 0], [0.9, 0, 0]]), v, *args, f)
     assert np.all(f == 0.0), "a slack thread pushes nothing"
+
+
+def test_a_reeled_thread_damps_its_stretch_rate_not_the_reel():
+    """A thread whose natural length a reel changes (the full-net tow's closing loop, multibody.net_towing): the damper
+    reads s' = l' - l0'. Nodes at rest, the reel hauling in at l0' = -0.2 m/s: T = k s + c s' = 1000 * 0.1 + 2 * 0.2
+    = 100.4 N, the damper's power c s'^2 = 0.08 W. Nodes parting at the reel's rate (l' = l0'): T = k s exactly, no
+    power: a thread reeled at constant stretch is not damped. Exact arithmetic up to round-off."""
+    threads, rest, k, c = np.array([[0, 1]]), np.array([1.0]), np.array([1000.0]), np.array([2.0])
+    x = np.array([[0.0, 0.0, 0.0], [1.1, 0.0, 0.0]])
+    f = np.zeros((2, 3))
+    _, power = add_thread_forces(x, np.zeros((2, 3)), threads, rest, k, c, f, np.array([-0.2]))
+    assert f[0, 0] == pytest.approx(100.4, rel=1e-12) and power == pytest.approx(2.0 * 0.2 ** 2, rel=1e-12)
+    f[:] = 0.0
+    v = np.array([[0.0, 0.0, 0.0], [-0.2, 0.0, 0.0]])
+    _, power = add_thread_forces(x, v, threads, rest, k, c, f, np.array([-0.2]))
+    assert f[0, 0] == pytest.approx(100.0, rel=1e-12) and power == pytest.approx(0.0, abs=1e-12)
 
 
 def test_a_clipped_thread_books_the_spring_energy_it_gives_up():
@@ -261,6 +277,26 @@ def test_thread_runs_give_the_sequential_loop_to_the_bit():
         assert 0 < elastic and 0 < power
     # the grid's threads are two runs (padded) plus the four tethers
     assert len(thread_runs(net.threads, net.rest_lengths, net.stiffness, net.damping).runs) == 6
+
+
+def test_a_thread_reeled_in_at_constant_stretch_takes_no_damper_force():
+    """A thread whose natural length a reel shortens at l0' (ThreadRuns.rest_rates) and whose length shortens at the
+    same rate keeps its stretch: its damper reads s' = l' - l0' = 0, so the tension is the spring's alone, k s, and it
+    dissipates nothing (analytic; exact here: 0.5 and 0.25 are binary, and the rate's terms are exact). The same
+    thread with l' = 0 (held while the reel hauls in) is stretched at -l0': T = k s - c l0', P = c l0'^2. Ordinary
+    threads get rest rate 0.0."""
+    x_soa = np.array([[0.0, 1.25], [0.0, 0.0], [0.0, 0.0]])    # 1.25 m apart along x
+    runs = thread_runs(np.array([[0, 1]]), np.array([1.0]), np.array([1000.0]), np.array([2.0]))
+    assert np.array_equal(runs.rest_rates, [0.0])
+    runs.rest_rates[0] = -0.5                                   # the reel hauls in at 0.5 m/s
+    for v_b, tension, power in ((-0.5, 1000.0 * 0.25, 0.0), (0.0, 1000.0 * 0.25 + 2.0 * 0.5, 2.0 * 0.5 ** 2)):
+        v_soa = np.array([[0.0, v_b], [0.0, 0.0], [0.0, 0.0]])
+        force, work = np.zeros((3, 2)), np.zeros((5, 1))
+        elastic, dissipated = add_thread_forces_runs(x_soa, v_soa, runs, force, work)
+        assert force[0, 0] == tension and force[0, 1] == -tension
+        assert elastic == 0.5 * 1000.0 * 0.25 ** 2 and dissipated == power
+        # the reel's power through the damper's share: -(T - k s) l0' = c s' (-l0'), 0 at constant stretch
+        assert reel_damper_power(tension, 0.25, 1000.0, -0.5) == (tension - 250.0) * 0.5
 
 
 def test_bowl_net_trails_its_centre_by_the_sag_without_stretching_a_thread():

@@ -50,6 +50,10 @@ def test_closing_loop_is_reeled_in_over_the_closing_duration(capture_case):
         expected = net.closing_rest_open + ramp * (net.closing_rest_closed - net.closing_rest_open)
         np.testing.assert_allclose(state.rest[-12:], expected, rtol=1e-14)
         np.testing.assert_allclose(state.stiffness[-12:], fn.closing_axial_rigidity / expected, rtol=1e-14)
+        # the loop's dampers read the stretch's rate: the natural lengths' rate is the ramp's while it reels, then 0
+        rate = (net.closing_rest_closed - net.closing_rest_open) / fn.closing_duration if ramp < 1.0 else 0.0
+        np.testing.assert_allclose(state.rest_rate[-12:], rate, rtol=1e-14)
+    assert not np.any(state.rest_rate[:-12])
     assert not state.reeling and state.rest[:-12] == pytest.approx(net.topology.rest_lengths[:-12], rel=0)
 
 
