@@ -128,6 +128,21 @@ class PhaseClock:
         self.skin = None         # the thread contact's candidate skin (m) set before the first step; None: default
         self.builds = np.zeros(n, np.int64)   # builds of the candidate pairs (multibody.segment_candidates) per window
         self._builds_seen = 0
+        # pair tests skipped per window (multibody.segment_pairs, helper speed23): a pair's whole step by its clearance,
+        # the test at the end of the free motion alone
+        self.skips = np.zeros((n, 2), np.int64)
+        self._skips_seen = np.zeros(2, np.int64)
+        self._skip_window = 0
+        # the kernel's candidate_count, read at each window's change only (read each step, it cost some 3 us a step
+        # of numpy in the glue's column)
+        self._skip_counters = None
+
+    def count_skips(self) -> None:
+        """The skips since the last call, to the window they were counted in (at a window's change and the end)."""
+        if self._skip_counters is not None:
+            self.skips[self._skip_window] += self._skip_counters[2:4] - self._skips_seen
+            self._skips_seen = self._skip_counters[2:4].copy()
+        self._skip_window = self.window
 
     def window_of(self, t: float) -> int:
         return int(min(max(np.searchsorted(self.edges, t, side="right") - 1, 0), len(self.edges) - 2))
@@ -180,6 +195,10 @@ def instrument(clock: PhaseClock) -> None:
         if listed.size:
             clock.builds[clock.window] += listed[1] - clock._builds_seen
             clock._builds_seen = listed[1]
+        if listed.size >= 4 and clock._skip_counters is None:        # the skip counters (helper speed23)
+            clock._skip_counters = listed
+        if clock.window != clock._skip_window:
+            clock.count_skips()
         if clock.census_times and t >= clock.census_times[0]:
             clock.census_times.pop(0)
             start = time.process_time()
@@ -211,9 +230,11 @@ def run_digest(folder: Path) -> str:
 
 def print_table(clock: PhaseClock, step: float) -> None:
     """Per window: steps, CPU per simulated second (s/s), us per step of each part, contacts per step."""
+    clock.count_skips()
     print(f"{'window (s)':>14} {'steps':>7} {'CPU/sim-s':>9} {'total':>7} {'kernel':>7} {'post':>6} {'capture':>7} "
-          f"{'other':>6} {'contacts':>8} {'builds':>7}   (us a step; CPU/sim-s in s per simulated s; builds of the "
-          f"thread contact's candidate pairs)")
+          f"{'other':>6} {'contacts':>8} {'builds':>7} {'skip/step':>9} {'end-skip':>8}   (us a step; CPU/sim-s in s "
+          f"per simulated s; builds of the thread contact's candidate pairs; per step, pairs skipped whole by their "
+          f"clearance and end-of-motion tests skipped)")
     for k in range(len(clock.steps)):
         n = clock.steps[k]
         if n == 0:
@@ -222,7 +243,8 @@ def print_table(clock: PhaseClock, step: float) -> None:
         other = us["total"] - us["kernel"] - us["post"]
         print(f"{clock.edges[k]:6.2f}-{clock.edges[k + 1]:6.2f} {n:7d} {clock.cpu['total'][k] / (n * step):9.2f} "
               f"{us['total']:7.1f} {us['kernel']:7.1f} {us['post']:6.1f} {us['capture']:7.2f} {other:6.1f} "
-              f"{clock.contacts[k] / n:8.1f} {clock.builds[k]:7d}")
+              f"{clock.contacts[k] / n:8.1f} {clock.builds[k]:7d} {clock.skips[k, 0] / n:9.1f} "
+              f"{clock.skips[k, 1] / n:8.1f}")
     n = clock.steps.sum()
     total = {part: clock.cpu[part].sum() for part in PARTS}
     print(f"whole run: {n} steps, CPU {total['total']:.1f} s ({total['total'] / (n * step):.2f} s per simulated s): "

@@ -111,17 +111,24 @@ class SegmentBuffers(NamedTuple):
     node_force_lvlh: np.ndarray     # (3, n) this pass's forces on the nodes (N), LVLH, coordinate-major
     lag_velocity_lvlh: np.ndarray   # (3, n) the carried impulses' velocity change of each node (m/s), LVLH
     node_speed: np.ndarray          # (n,) bound of each node's speed over the step (m/s)
-    shape_work: np.ndarray          # (5, ns) each shape's bounding-sphere radius (m), surface speed bound (m/s) and
-                                    # bounding-sphere centre (rows 2-4, LVLH, m)
+    shape_work: np.ndarray          # (7, ns) each shape's bounding-sphere radius (m), surface speed bound (m/s),
+                                    # bounding-sphere centre (rows 2-4, LVLH, m), its body's speed (m/s) and spin
+                                    # (rad/s) (rows 5, 6)
     candidate_thread: np.ndarray    # (m ns,) int64 the candidate (thread, box) pairs (multibody.segment_candidates):
                                     # the thread
     candidate_shape: np.ndarray     # (m ns,) int64 ... and the box
-    candidate_count: np.ndarray     # (2,) int64 the pairs listed; the builds so far
-    candidate_scalar: np.ndarray    # (2,) the skin (m); the step of the last build (s), 0 before the first
+    candidate_count: np.ndarray     # (4,) int64 the pairs listed; the builds so far; the pair tests skipped so far, a
+                                    # pair's whole step by its clearance, and the test at the end of the free motion
+                                    # alone (multibody.segment_pairs: counted, their answer known to be no)
+    candidate_scalar: np.ndarray    # (3,) the skin (m); the step of the last build (s), 0 before the first; 1: skip
+                                    # the pair tests whose answer the bounds prove no (the default), 0: test every
+                                    # listed pair at both states (main before helper speed23, for A/B runs)
     built_position_body: np.ndarray  # (nb, 3, n) each node's position in each box-carrying body's frame at the last
                                      # build (m)
     built_speed: np.ndarray         # (n,) node_speed at the last build (m/s)
     built_surface_speed: np.ndarray  # (ns,) shape_work[1] at the last build (m/s)
+    candidate_clearance: np.ndarray  # (m ns,) per candidate pair, a bound C (m) of its thread's distance to its box
+                                     # less its nodes' displacement since the last build (-inf: none; segment_pairs)
     breakpoints: np.ndarray         # (MAX_BREAKPOINTS,) work: a segment's sorted breakpoints
     contact_scalar: np.ndarray      # (5, 1) work: penetration, body mass (sub-step count)
     contact_vector: np.ndarray      # (6, 1, 3) work: relative velocity, normal (sub-step count)
@@ -168,11 +175,12 @@ def segment_buffers(n_threads: int, n_nodes: int, n_shapes: int, n_bodies: int, 
                           lag_body=np.full((2, m), -1, np.int64), end_energy=np.zeros((2, m)), start_energy=np.zeros(m),
                           energy_jump=np.zeros(m), dissipated=np.zeros(m),
                           node_force_lvlh=np.zeros((3, n)), lag_velocity_lvlh=np.zeros((3, n)),
-                          node_speed=np.zeros(n), shape_work=np.zeros((5, ns)),
+                          node_speed=np.zeros(n), shape_work=np.zeros((7, ns)),
                           candidate_thread=np.zeros(m * ns, np.int64), candidate_shape=np.zeros(m * ns, np.int64),
-                          candidate_count=np.zeros(2, np.int64), candidate_scalar=np.array([float(skin), 0.0]),
+                          candidate_count=np.zeros(4, np.int64), candidate_scalar=np.array([float(skin), 0.0, 1.0]),
                           built_position_body=np.zeros((nb, 3, n)), built_speed=np.zeros(n),
                           built_surface_speed=np.zeros(ns),
+                          candidate_clearance=np.full(m * ns, -np.inf),
                           breakpoints=np.zeros(MAX_BREAKPOINTS), contact_scalar=np.zeros((5, 1)),
                           contact_vector=np.zeros((6, 1, 3)), external_force=np.zeros(3), cycle_out=np.zeros((4, 3)),
                           owned_shape=np.full(n, -1, np.int64), node_threads=np.zeros(n, np.int64),

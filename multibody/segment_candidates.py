@@ -18,12 +18,15 @@ of about 1e-14 m for 10-m coordinates). Why it suffices: a pair left out failed 
 both nodes beyond, say, ``hi_k + reach0 + d``; each node has moved by at most the first term along k, and the pair's
 reach has grown by at most the second (its reach is 1.001 (r + h max(u_a, u_c) + h w_s)), so both nodes are still
 beyond ``hi_k + reach`` and the slab test of :mod:`multibody.segment_pairs` skips the pair now too. The listed pairs
-go through the same tests in the same (thread, box) order as the full scan, so the pairs found, and every force, are
-the full scan's to the last bit; a skin of 0 rebuilds at every evaluation (the full scan's slab test).
+go through the same tests in the same (thread, box) order as the full scan (a pair whose clearance proves it apart
+skips them, :func:`multibody.segment_pairs._still_apart`: their answer is known), so the pairs found, and every
+force, are the full scan's to the last bit; a skin of 0 rebuilds at every evaluation (the full scan's slab test).
 
 Frames: LVLH unless named; the shapes in their body frames (origin at the body's CoM). SI units.
 """
 from __future__ import annotations
+
+import math
 
 from numba import njit
 
@@ -124,6 +127,7 @@ def _build_candidates(x, threads, radius, seg, states, shapes, step):
                 continue
             seg.candidate_thread[count] = j
             seg.candidate_shape[count] = s
+            seg.candidate_clearance[count] = -math.inf     # none proven yet (multibody.segment_pairs)
             count += 1
     seg.candidate_count[0] = count
     seg.candidate_count[1] += 1

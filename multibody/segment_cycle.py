@@ -50,7 +50,8 @@ from multibody.jit_cache import NO_REFCOUNTS
 
 from multibody.broad_phase import box_signed_distance
 from multibody.contact import _power, hollar_friction_coefficient_inverse
-from multibody.segment_box import TIE_DISTANCE, segment_box_deepest, segment_box_normal, segment_box_sublevel
+from multibody.segment_box import (TIE_DISTANCE, deepest_between_breakpoints, segment_box_breakpoints,
+                                   segment_box_normal, sublevel_between_breakpoints)
 
 
 class ClusterWork(NamedTuple):
@@ -151,7 +152,9 @@ def thread_contact_geometry(pa, pc, box_min, box_max, s, radius_a, radius_c, wor
     lo = (box_min[s, 0], box_min[s, 1], box_min[s, 2])
     hi = (box_max[s, 0], box_max[s, 1], box_max[s, 2])
     d = (pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2])
-    t_deepest, distance = segment_box_deepest(pa, d, lo, hi, work)
+    # the breakpoints sorted once for the deepest point and the tie interval (work is not written in between)
+    k = segment_box_breakpoints(pa, d, lo, hi, work)
+    t_deepest, distance = deepest_between_breakpoints(pa, d, lo, hi, work, k)
     gap_a, nax, nay, naz = box_signed_distance(pa[0], pa[1], pa[2], box_min, box_max, s)
     gap_c, ncx, ncy, ncz = box_signed_distance(pc[0], pc[1], pc[2], box_min, box_max, s)
     depth_a, depth_c = radius_a - gap_a, radius_c - gap_c
@@ -164,7 +167,7 @@ def thread_contact_geometry(pa, pc, box_min, box_max, s, radius_a, radius_c, wor
     if depth > max(depth_a, depth_c) + TIE_DISTANCE:
         excess = depth - max(0.0, depth_a, depth_c)
         if excess > 0.0:
-            t_low, t_high = segment_box_sublevel(pa, d, lo, hi, distance + TIE_DISTANCE, work)
+            t_low, t_high = sublevel_between_breakpoints(pa, d, lo, hi, distance + TIE_DISTANCE, work, k)
             if t_low <= t_high:
                 split = 0.5 * (t_low + t_high)
     return (excess, depth, split, t_deepest, end, depth_a, depth_c, (nax, nay, naz), (ncx, ncy, ncz))

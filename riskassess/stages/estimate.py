@@ -8,7 +8,7 @@ longer in wall time. They only need to be right within a factor of a few: their 
 
 * impact (``run``, ``assess``, ``perceive``, sweeps): a fixed 2.4 s (building the model, loading the compiled
   kernels, writing the products), then per step 17 us (Exudyn's bodies and joints, the hooks, the recorder) plus
-  0.0273 us per net node (the compiled kernel integrating the net) plus 30 us with the thread contact on
+  0.0273 us per net node (the compiled kernel integrating the net) plus 27 us with the thread contact on
   (``contact.thread_segments``: its pair search, geometry and sub-cycles, a whole capture's mean over flight,
   wrapping and the wrapped net's late contacts). The first two terms fitted by helper speed21 (2026-11-28,
   docs/model.md "Speed", CPU times at load 3-9, nice 10) to the reference case's solve with the 15 x 15 and 35 x 35
@@ -16,7 +16,9 @@ longer in wall time. They only need to be right within a factor of a few: their 
   the fixed part is the pipeline's CPU less the solve's on the 2.0 m/s capture copy to 15 s (2.3-2.5 s). The thread
   contact's term refitted by helper speed22 (2026-11-28) to the 1.0 m/s capture case run to 200 s (the steps' 106.6 s
   CPU, 53.3 us a step, less the first two terms; speed21's 22 us came from runs of 15-135 s, and a capture keeps 3-5
-  thread contacts a step past 200 s against 1-2 before: 50-64 us a step then). Not in the model: the products a run
+  thread contacts a step past 200 s against 1-2 before: 50-64 us a step then), and to 27 us by helper speed23
+  (2026-11-28), who skipped the pair tests whose answer is proven (the same case to 300 s: the steps over 1-300 s
+  149.5 s CPU, 50.0 us a step, against 163.4 s, 54.7 us, on main in the same conditions). Not in the model: the products a run
   writes after its end, which grow with the simulated time (some 0.07-0.09 s CPU per simulated second of a capture at
   1 kHz output, docs/model.md "Speed"), so a long whole run reads some 0.85 of its measured CPU. The earlier model
   (60 us a step plus 0.33 us per node-step, from the 143 and 481 us a step of 2026-11-26) read 2-3x the cost of
@@ -35,12 +37,12 @@ from dataclasses import dataclass
 IMPACT_SETUP_S = 2.4
 IMPACT_US_PER_STEP = 17.0
 IMPACT_US_PER_NODE_STEP = 0.0273
-THREAD_CONTACT_US_PER_STEP = 30.0
+THREAD_CONTACT_US_PER_STEP = 27.0
 TOW_US_PER_STEP = 15.0
 FULL_NET_US_PER_NODE_SUBSTEP = 0.11
 
 #: Work refused without ``--force``: one hour of estimated wall time (a reference impact of 7.5 s is about 6 s; a
-#: 60 s impact of the full net about 33 s; 1000 s of a 15 x 15 capture with the thread contact about 9 min) or
+#: 60 s impact of the full net about 33 s; 1000 s of a 15 x 15 capture with the thread contact about 8.5 min) or
 #: 8 GB of recorded data.
 LIMIT_WALL_S = 3600.0
 LIMIT_MEMORY_BYTES = 8e9

@@ -19,7 +19,9 @@ import pytest
 import trimesh
 
 from multibody.assembly import ContactLaw, ImpactAssembly, RigidBodySpec, SolverSpec
-from multibody.segment_box import MAX_BREAKPOINTS, segment_box_deepest, segment_box_sublevel
+from multibody.broad_phase import box_signed_distance
+from multibody.segment_box import MAX_BREAKPOINTS, TIE_DISTANCE, segment_box_deepest, segment_box_sublevel
+from multibody.segment_cycle import thread_contact_geometry
 from multibody.impact import ImpactSimulation
 from multibody.net import NetTopology
 from multibody.thread_crossing import pass_throughs_shape
@@ -54,6 +56,40 @@ def test_deepest_point_and_pressed_part_are_exact():
         below = t[sampled <= deepest + 0.01]
         assert t_low == pytest.approx(below.min(), abs=5e-5) and t_high == pytest.approx(below.max(), abs=5e-5)
 
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_contact_geometry_sorts_the_breakpoints_once_with_the_same_answer(seed):
+    """thread_contact_geometry finds the deepest point and the tie interval on breakpoints sorted once (helper speed23):
+    its every output is, to the bit, what segment_box_deepest and segment_box_sublevel give called apart (each
+    sorting them), for 3000 threads a seed lying on, across and into a plate and a block, node and bullet radii
+    (equality, no tolerance: the same arithmetic on the same breakpoints); some of them act (the tie interval is
+    used)."""
+    rng = np.random.default_rng(seed)
+    box_min = np.array([[-0.75, -0.078, -5.0], [-1.6875, -1.875, -3.9375]])
+    box_max = np.array([[0.75, 0.078, 5.0], [1.6875, 1.875, 3.9375]])
+    work = np.zeros(MAX_BREAKPOINTS)
+    acted = 0
+    for _ in range(3000):
+        s = int(rng.integers(2))
+        lo, hi = box_min[s], box_max[s]
+        a = rng.uniform(lo - 0.05, hi + 0.05)
+        c = a + rng.normal(size=3) * 0.3
+        radius_a, radius_c = (0.001, 0.001) if rng.random() < 0.5 else (0.01, 0.001)
+        g = thread_contact_geometry(tuple(a), tuple(c), box_min, box_max, s, radius_a, radius_c, work)
+        d = tuple(c - a)
+        t_deepest, distance = segment_box_deepest(tuple(a), d, tuple(lo), tuple(hi), work)
+        depth = min(radius_a, radius_c) - distance
+        depth_a = radius_a - box_signed_distance(a[0], a[1], a[2], box_min, box_max, s)[0]
+        depth_c = radius_c - box_signed_distance(c[0], c[1], c[2], box_min, box_max, s)[0]
+        split = t_deepest
+        if depth > max(depth_a, depth_c) + TIE_DISTANCE and depth - max(0.0, depth_a, depth_c) > 0.0:
+            acted += 1
+            t_low, t_high = segment_box_sublevel(tuple(a), d, tuple(lo), tuple(hi), distance + TIE_DISTANCE, work)
+            if t_low <= t_high:
+                split = 0.5 * (t_low + t_high)
+        assert (g[1], g[2], g[3], g[5], g[6]) == (depth, split, t_deepest, depth_a, depth_c)
+    assert acted > 100
 
 def _thread_net(positions, masses, threads, rest_lengths, stiffness, damping, radius=0.001) -> NetTopology:
     """A net of the given nodes and threads, no bending."""
