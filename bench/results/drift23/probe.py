@@ -1,4 +1,4 @@
-"""drift23 probe: run a case (a sample of a store) to END with overrides; print the energy balance per window and
+"""Energy-balance probe (drift23; made path-independent by loop23): run a case (a sample of a store) to END with overrides; print the energy balance per window and
 the booked terms; save the energy series. python probe.py LABEL END [key=value ...] [--sample N] [--case C] [--store S]"""
 import os, time, json, sqlite3, tomllib, argparse
 from pathlib import Path
@@ -8,7 +8,7 @@ from riskassess.cases.impact import validate_case
 from riskassess.models.impact import model_inputs
 from riskassess.sweep.spec import case_with
 
-WT = "/work/wt-drift23/bench/results/"
+WT = str(Path(__file__).resolve().parents[1]) + "/"
 p = argparse.ArgumentParser()
 p.add_argument("label"); p.add_argument("end", type=float); p.add_argument("sets", nargs="*")
 p.add_argument("--sample", type=int, default=1)
@@ -34,7 +34,8 @@ s = sim.run().series
 print(f"CPU {time.process_time() - start:.1f} s, load {load:.1f} -> {os.getloadavg()[0]:.1f}")
 t, tot = s["time"], s["energy_total"]
 keys = [k for k in s if k.startswith("energy_")]
-np.savez(f"/tmp/drift23/probe_{a.label}.npz", time=t, **{k: s[k] for k in keys})
+os.makedirs("/tmp/probe", exist_ok=True)
+np.savez(f"/tmp/probe/probe_{a.label}.npz", time=t, **{k: s[k] for k in keys})
 e0 = tot[0]
 ws = [float(x) for x in a.windows.split(",")] + [a.end]
 for x, y in zip(ws[:-1], ws[1:]):
