@@ -17,7 +17,7 @@ def main(store: str) -> None:
     for s, st, ds, w, r in rows:
         loc = r["locations"]["solar_array_hinge_panel"]
         cw = r["capture_window"]
-        m = re.search(r"demand rising at [\d.]+ s \(([^)]*)\)", loc.get("indeterminate_reason", ""))
+        m = re.search(r"demand rising at [\d.]+ s \(([^)]*)\)", loc.get("indeterminate_reason") or "")
         print(f"{s:6d}  {st:5s}  {ds or '':13s}  {loc['utilization']:10.3f}  {loc['peaks']['moment']:8.1f}  "
               f"{100 * r['energy_balance_relative_drift']:7.3f}  {cw['net_energy_relative_end_J']:16.3f}  "
               f"{cw['last_rise_s']:11.3f}  {m.group(1) if m else '-':>13s}  {w:6.0f}")
