@@ -25,8 +25,7 @@ from scipy.interpolate import CubicSpline
 from multibody.assembly import ContactLaw, ImpactAssembly, NetMount, RigidBodySpec, SolverSpec
 from multibody.health import HealthWatch
 from multibody.impact import (INTEGRATORS, build_impact_system, checked_post_step, detach_step_functions,
-                              likely_failure_cause,
-                              simulation_settings, solve_checked)
+                              likely_failure_cause, simulation_settings, solve_checked)
 from multibody.net import flat_square_net
 
 #: MU bodies are spheres of this radius for their (unused) inertia (m).

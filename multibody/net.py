@@ -394,7 +394,7 @@ def reel_damper_power(tension, stretch, stiffness, rest_rate):
 def add_thread_forces(x, v, threads, rest_lengths, stiffness, damping, force, rest_rates=None):
     """Add tension-only Kelvin-Voigt thread forces to ``force``; return (elastic J, damping W).
 
-    .. math:: T = \\max(0,\\; k (l - l_0) + c \\dot l) \\quad \\text{for } l > l_0
+    .. math:: T = \\max(0,\\; k (l - l_0) + c (\\dot l - \\dot l_0)) \\quad \\text{for } l > l_0
 
     Parameters
     ----------

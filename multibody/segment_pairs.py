@@ -205,6 +205,7 @@ def _touches_within_step(a, c, s, b, pa, pc, x, v, net_force_lvlh, net_mass, rad
     if seg.candidate_scalar[2] != 0.0 and _apart_after_motion(separation, move_a, move_c, radius[a], radius[c]):
         seg.candidate_count[3] += 1
         return False, separation
+    # not pa + move_a: (pa + h v) + h^2 a / 2 is the sum the pairs were always tested at (bit-identical answers)
     qa = (pa[0] + step * rel_a[0] + h2 * acc_a[0], pa[1] + step * rel_a[1] + h2 * acc_a[1],
           pa[2] + step * rel_a[2] + h2 * acc_a[2])
     qc = (pc[0] + step * rel_c[0] + h2 * acc_c[0], pc[1] + step * rel_c[1] + h2 * acc_c[1],

@@ -229,8 +229,3 @@ def information_weighted_pose(start, poses, informations) -> np.ndarray:
     delta = np.eye(4)
     delta[:3, :3], delta[:3, 3] = Rotation.from_rotvec(twist[:3]).as_matrix(), twist[3:]
     return delta @ start
-
-
-def most_overlapping(cells, candidate_cells: dict, count) -> list:
-    """The ``count`` keys of ``candidate_cells`` (key -> coarse cells) sharing most of ``cells``, largest first."""
-    return sorted(candidate_cells, key=lambda j: -overlap_share(cells, candidate_cells[j]))[:count]

@@ -98,8 +98,8 @@ class ScanPartners:
 
     def most_overlapping(self, keys, count) -> np.ndarray:
         """Rows of the ``count`` partners sharing the largest share of the smaller one's cells with a frame's
-        cells ``keys`` (:func:`cell_keys`), largest first, ties in frame order (the selection of
-        :func:`perception.pose_graph.most_overlapping` with :func:`perception.pose_graph.overlap_share`)."""
+        cells ``keys`` (:func:`cell_keys`), largest first, ties in frame order (the share of
+        :func:`perception.pose_graph.overlap_share`, on integer keys)."""
         if not len(self.keys):
             return np.zeros(0, int)
         position = np.clip(np.searchsorted(self.keys, keys), 0, len(self.keys) - 1)
